@@ -1,0 +1,131 @@
+# pdt — parallel Delaunay triangulation and its step-by-step viewer.
+#
+# Targets
+#   make            build bin/ (release) — pdt, pdtview
+#   make test       install missing Debian packages, build release + sanitizer
+#                   builds, run the whole suite (tests/run.sh)
+#   make demo       install missing packages, build, run the classroom demo
+#   make bench      benchmarks against other tools (prints figures; no asserts)
+#   make table1     the thesis' Table 1 (speedup) reproduced
+#   make deps       only install missing Debian packages
+#   make clean
+#
+# Variables (override on the command line: make CC=clang OPT=-O3)
+#   CC        C compiler                         (default: gcc)
+#   OPT       optimisation flags, release build  (default: -O2 -g)
+#   SAN       sanitizer flags, sanitizer build   (default: ASan + UBSan)
+#   NP        ranks for demo runs                (default: 4)
+#   TRACE=0   compile tracing out entirely (-DPDT_NO_TRACE)
+#
+# Layout: build/rel/... and build/san/... hold objects; bin/ the release
+# programs; bin/san/ the sanitizer programs.  Sources are picked up by
+# wildcard: src/geom (predicates, hull, kernel, checker), src/io (files,
+# generators), src/trace (hook, writer, reader), src/par (parallel driver —
+# the only code that includes mpi.h is src/par/comm_mpi.c), src/cli (the pdt
+# program), src/view (replay model, cairo renderer, SDL2 shell).
+
+CC      ?= gcc
+ifeq ($(origin CC),default)
+CC      := gcc
+endif
+OPT     ?= -O2 -g
+SAN     ?= -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+NP      ?= 4
+TRACE   ?= 1
+
+WARN    := -Wall -Wextra -Wshadow -Wconversion -Wno-sign-conversion -Wstrict-prototypes \
+           -Wmissing-prototypes -Wformat=2 -Wvla
+CSTD    := -std=c17 -D_GNU_SOURCE
+ifeq ($(TRACE),0)
+CSTD    += -DPDT_NO_TRACE
+endif
+INC     := -Iinclude
+
+MPI_CFLAGS  := $(shell pkg-config --cflags ompi-c 2>/dev/null)
+MPI_LIBS    := $(shell pkg-config --libs ompi-c 2>/dev/null)
+VIEW_CFLAGS := $(shell pkg-config --cflags cairo sdl2 2>/dev/null)
+CAIRO_LIBS  := $(shell pkg-config --libs cairo 2>/dev/null)
+SDL_LIBS    := $(shell pkg-config --libs sdl2 2>/dev/null)
+LIBS        := -lm
+
+# Debian packages the build, the tests and the demo need.
+DEB_BUILD := build-essential pkg-config libopenmpi-dev openmpi-bin libsdl2-dev libcairo2-dev
+DEB_TEST  := qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3
+DEB_BENCH := hyperfine libcgal-dev g++ nodejs npm valgrind time
+
+LIB_SRC  := $(wildcard src/geom/*.c src/io/*.c src/trace/*.c)
+PAR_SRC  := $(wildcard src/par/*.c)
+CLI_SRC  := $(wildcard src/cli/*.c)
+VIEWLIB_SRC := $(filter-out src/view/shell.c src/view/pdtview.c,$(wildcard src/view/*.c))
+VIEWAPP_SRC := $(filter src/view/shell.c src/view/pdtview.c,$(wildcard src/view/*.c))
+UNIT_SRC := $(wildcard tests/unit/*.c)
+
+# ---- one build variant: $(call variant,NAME,FLAGS,BINDIR) -------------------
+define variant
+$(1)_OBJ := build/$(1)
+$(1)_LIB := build/$(1)/libpdt.a
+$(1)_VIEWLIB := build/$(1)/libpdtview.a
+
+build/$(1)/%.o: %.c $$(wildcard include/pdt/*.h) | build/$(1)/.dirs
+	@mkdir -p $$(dir $$@)
+	$$(CC) $(CSTD) $(2) $(WARN) $(INC) $$(if $$(findstring src/par/comm_mpi,$$<),$(MPI_CFLAGS)) $$(if $$(findstring /view/,$$<),$(VIEW_CFLAGS)) $$(if $$(findstring tests/unit/view,$$<),$(VIEW_CFLAGS)) -c $$< -o $$@
+
+build/$(1)/.dirs:
+	@mkdir -p build/$(1) $(3)
+	@touch $$@
+
+build/$(1)/libpdt.a: $$(patsubst %.c,build/$(1)/%.o,$(LIB_SRC))
+	@rm -f $$@
+	ar rcs $$@ $$^
+
+build/$(1)/libpdtview.a: $$(patsubst %.c,build/$(1)/%.o,$(VIEWLIB_SRC))
+	@rm -f $$@
+	ar rcs $$@ $$^
+
+$(3)/pdt: $$(patsubst %.c,build/$(1)/%.o,$(CLI_SRC) $(PAR_SRC)) build/$(1)/libpdt.a
+	$$(CC) $(2) -o $$@ $$^ $(MPI_LIBS) $(LIBS)
+
+$(3)/pdtview: $$(patsubst %.c,build/$(1)/%.o,$(VIEWAPP_SRC)) build/$(1)/libpdtview.a build/$(1)/libpdt.a
+	$$(CC) $(2) -o $$@ $$^ $(SDL_LIBS) $(CAIRO_LIBS) $(LIBS)
+
+$(3)/tests/%: build/$(1)/tests/unit/%.o $(if $(VIEWLIB_SRC),build/$(1)/libpdtview.a) build/$(1)/libpdt.a
+	@mkdir -p $$(dir $$@)
+	$$(CC) $(2) -o $$@ $$^ $(CAIRO_LIBS) $(LIBS)
+
+$(1)-all: $(3)/pdt $(if $(VIEWAPP_SRC),$(3)/pdtview) $(patsubst tests/unit/%.c,$(3)/tests/%,$(UNIT_SRC))
+endef
+
+$(eval $(call variant,rel,$(OPT),bin))
+$(eval $(call variant,san,$(SAN),bin/san))
+
+.PHONY: all deps test demo bench table1 clean rel-all san-all check-deps
+.DEFAULT_GOAL := all
+
+all: rel-all
+
+# Install whatever Debian packages are missing (apt-get update once, then
+# install).  Needs root; does nothing when everything is present.
+deps:
+	@scripts/deps.sh $(DEB_BUILD) $(DEB_TEST)
+
+deps-bench:
+	@scripts/deps.sh $(DEB_BUILD) $(DEB_TEST) $(DEB_BENCH)
+
+test: deps
+	$(MAKE) rel-all san-all
+	tests/run.sh
+
+demo: deps
+	$(MAKE) rel-all
+	scripts/demo.sh
+
+bench: deps-bench
+	$(MAKE) rel-all
+	scripts/bench.sh
+
+table1: deps-bench
+	$(MAKE) rel-all
+	scripts/table1.sh
+
+clean:
+	rm -rf build bin

@@ -1,0 +1,49 @@
+/* pdt — the sequential Delaunay kernel (lift-up + lower hull, computed by
+ * Guibas–Stolfi divide and conquer) and the sequential pipeline around it.
+ *
+ * The answer is always T*(P), the canonical Delaunay triangulation of
+ * algorithm.md §2.3 (simulation of simplicity on the lifted heights). */
+#ifndef PDT_DELAUNAY_H
+#define PDT_DELAUNAY_H
+
+#include "pdt/common.h"
+#include "pdt/trace.h"
+
+/* T*(pts) for n DISTINCT points sorted lexicographically (x, then y).
+ * On success *tris is a malloc'd array of *ntri counter-clockwise triangles
+ * (indices into pts; order unspecified; the caller frees).  Fewer than 3
+ * points or all collinear: *ntri = 0 (and *tris may be NULL).
+ * O(n log n) on every input.  Traces TRI_NEW (sub = `run`) at level 1 and
+ * EDGE_ADD / EDGE_DEL at level 2. */
+pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri, int run,
+                        pdt_trace *tr);
+
+/* Rotate every triangle so that it starts at its smallest index (keeping the
+ * counter-clockwise order) and sort the array lexicographically: the
+ * canonical output order, identical for every algorithm and every rank count. */
+void pdt_tri_canonical(pdt_tri *tris, size_t ntri);
+
+/* Figures reported by the pipeline. */
+typedef struct pdt_tri_stats {
+    size_t n_in;        /* points read */
+    size_t n_unique;    /* distinct points */
+    size_t n_dup;       /* duplicates dropped (the smallest input index is kept) */
+    size_t n_tri;       /* triangles */
+    size_t n_hull;      /* hull vertices (collinear boundary points included) */
+    int collinear;      /* 1 if all distinct points are collinear (or n_unique < 3) */
+    double t_sort, t_kernel, t_canon; /* seconds */
+} pdt_tri_stats;
+
+/* The whole sequential pipeline: sort by key, remove duplicates (the
+ * smallest input index is kept), lift-up (traced), kernel, map back to input
+ * indices, canonical order.  *tris (malloc'd, caller frees) holds triangles as
+ * 0-based input indices.  `stats` may be NULL. */
+pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
+                           pdt_tri_stats *stats, pdt_trace *tr);
+
+/* Sort-and-dedupe helper used by the pipeline and the parallel driver:
+ * writes to order[0..*nu) the input indices of the distinct points in
+ * lexicographic order, each the smallest index among its copies. */
+pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size_t *nu);
+
+#endif
