@@ -1,0 +1,17 @@
+#!/bin/bash
+# make bench: run every benchmark section in scripts/bench/*.sh in order.
+# Each section prints its own figures (medians of several runs) and ratios
+# against other tools measured in the same run.  Benchmarks never fail the
+# build on a time; they exit non-zero only if a program itself fails.
+set -u
+cd "$(dirname "$0")/.."
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+mkdir -p build/bench
+rc=0
+for s in scripts/bench/*.sh; do
+    [ -f "$s" ] || continue
+    echo "== $(basename "$s" .sh) =="
+    bash "$s" || rc=1
+    echo
+done
+exit $rc
