@@ -68,7 +68,7 @@ $(1)_VIEWLIB := build/$(1)/libpdtview.a
 
 build/$(1)/%.o: %.c $$(wildcard include/pdt/*.h) | build/$(1)/.dirs
 	@mkdir -p $$(dir $$@)
-	$$(CC) $(CSTD) $(2) $(WARN) $(INC) $$(if $$(findstring src/par/comm_mpi,$$<),$(MPI_CFLAGS)) $$(if $$(findstring /view/,$$<),$(VIEW_CFLAGS)) $$(if $$(findstring tests/unit/view,$$<),$(VIEW_CFLAGS)) -c $$< -o $$@
+	$$(CC) $(CSTD) $(2) $(WARN) $(INC) $$(if $$(findstring src/par/comm_mpi,$$<),$(MPI_CFLAGS)) $$(if $$(findstring /view/,$$<),$(VIEW_CFLAGS)) $$(if $$(findstring tests/unit/test_view,$$<),$(VIEW_CFLAGS)) -c $$< -o $$@
 
 build/$(1)/.dirs:
 	@mkdir -p build/$(1) $(3)

@@ -1,0 +1,207 @@
+/* pdt — the replay model of the viewer: events in, state out (no pixels).
+ *
+ * A replay is built once from the points of a run and its merged event list
+ * (pdt_run_merged(), or an in-memory array in tests).  Building indexes every
+ * object the events talk about — triangles, kernel edges, Graham stacks,
+ * phases, merges, messages — together with its whole history, in one pass.
+ *
+ * A cursor position k (0 <= k <= count) means "events 0 .. k-1 have happened";
+ * the current event is k-1.  A pdt_rstate holds the state at one cursor:
+ *
+ *  - pdt_replay_seek() rebuilds it directly from the histories (each object
+ *    looks up its last change before k: no replay from the start, cost linear
+ *    in the number of objects, independent of k);
+ *  - pdt_replay_step() moves it by one event forwards or backwards in O(1)
+ *    (every event knows the object it changes and that object's previous
+ *    value), so stepping back costs the same as stepping forwards.
+ *
+ * The tests check that both routes give identical states.
+ *
+ * Owns: the replay keeps pointers to `pts` and `recs`; they must outlive it. */
+#ifndef PDT_REPLAY_H
+#define PDT_REPLAY_H
+
+#include "pdt/common.h"
+#include "pdt/trace.h"
+#include "pdt/tracefile.h"
+
+/* Delaunay status of a triangle (the last status event applied to it). */
+typedef enum pdt_tri_status {
+    PDT_TS_NONE = 0,   /* not yet created */
+    PDT_TS_CANDIDATE,  /* TRI_NEW: from a local or border kernel run */
+    PDT_TS_FINAL,      /* TRI_FINAL: certified, part of the output */
+    PDT_TS_DEFERRED,   /* RA_DEFER: its restricted area touches a foreign box */
+    PDT_TS_SHIPPED,    /* SHIP: sent to a merge rank */
+    PDT_TS_DISCARDED,  /* DISCARD: non-Delaunay */
+    PDT_TS_COUNT
+} pdt_tri_status;
+
+/* Point flags in pdt_rstate.pflags. */
+enum {
+    PDT_PF_LIFTED = 1,  /* lifted to the paraboloid by some rank */
+    PDT_PF_SORTED = 2,  /* has a position in Graham's angular order */
+    PDT_PF_DELETED = 4  /* deleted by Graham's sort (tie or copy) */
+};
+
+/* Per-rank slots: the objects of which each rank has exactly one current value. */
+enum {
+    PDT_SLOT_PHASE = 0,  /* innermost open phase interval */
+    PDT_SLOT_MERGE,      /* open merge step (merge rank only) */
+    PDT_SLOT_HULL,       /* last hull reported (HULL event) */
+    PDT_SLOT_STACK0,     /* + pdt_stack_id: top node of that stack */
+    PDT_SLOT_PER_RANK = PDT_SLOT_STACK0 + 5
+};
+
+/* One triangle seen in the events; v[] as first reported (counter-clockwise). */
+typedef struct pdt_rtri {
+    uint32_t v[3];
+    uint32_t maker;     /* rank of the first TRI_NEW (or first event) */
+    uint32_t h0, hn;    /* its history entries: hist[h0 .. h0+hn) */
+} pdt_rtri;
+
+/* One change of a triangle's status. */
+typedef struct pdt_rtri_hist {
+    uint32_t ev;        /* event index */
+    uint32_t rank;      /* rank that reported it */
+    uint8_t status;     /* pdt_tri_status after the event */
+    uint8_t run;        /* TRI_NEW: 0 local kernel, 1 border kernel */
+    int64_t v;          /* RA_DEFER: touched rank; SHIP: destination; DISCARD: witness */
+} pdt_rtri_hist;
+
+/* A kernel edge (level 2) between its EDGE_ADD and EDGE_DEL. */
+typedef struct pdt_redge {
+    uint32_t a, b, rank;
+    uint32_t add_ev, del_ev;  /* del_ev = UINT32_MAX: never deleted */
+} pdt_redge;
+
+/* A stack node: the stacks are persistent (a push makes a node whose parent
+ * is the element below it), so any past stack can be listed from its top. */
+typedef struct pdt_rnode {
+    uint32_t pt;
+    int32_t parent;     /* -1 at the bottom */
+    uint32_t depth;     /* 1 at the bottom */
+} pdt_rnode;
+
+/* A phase of one rank: from its PHASE_BEGIN event to its PHASE_END event. */
+typedef struct pdt_rphase {
+    uint32_t rank;
+    uint32_t phase;     /* pdt_phase */
+    uint32_t sub;       /* merge level or 0 */
+    uint32_t begin_ev, end_ev;  /* end_ev = UINT32_MAX: never ended */
+    int32_t parent;     /* enclosing phase of the same rank, or -1 */
+} pdt_rphase;
+
+/* A merge step, from MERGE_BEGIN to MERGE_END on the merge rank. */
+typedef struct pdt_rmerge {
+    uint32_t rank, level, gl, gr, gend;
+    uint32_t begin_ev, end_ev;
+    uint32_t shipped, border, kept, discarded;  /* from MERGE_END (0 before) */
+} pdt_rmerge;
+
+/* A message: SEND on src and the matching RECV on dst. */
+typedef struct pdt_rmsg {
+    uint32_t src, dst, tag, bytes;
+    uint32_t send_ev, recv_ev;  /* UINT32_MAX when that side is missing */
+} pdt_rmsg;
+
+/* A hull reported by a HULL event: the stack that was just built. */
+typedef struct pdt_rhull {
+    uint32_t rank, ev;
+    int32_t top;        /* top node of the stack (Graham, merge or lower chain) */
+    int32_t top2;       /* upper chain's top for a monotone chain, else -1 */
+    uint32_t count;     /* hull vertices as reported */
+    uint8_t degenerate;
+} pdt_rhull;
+
+typedef struct pdt_replay pdt_replay;
+
+/* The state at one cursor position.  Arrays are sized by the replay and
+ * owned by the state (pdt_rstate_new / pdt_rstate_free). */
+typedef struct pdt_rstate {
+    size_t k;            /* events applied: 0 .. k-1 */
+    uint8_t *pflags;     /* per point: PDT_PF_* */
+    uint32_t *tcur;      /* per triangle: history entry in effect, UINT32_MAX = none */
+    uint8_t *ealive;     /* per kernel edge: 1 while it exists */
+    uint8_t *mflight;    /* per message: 1 sent and not yet received */
+    int32_t *slot;       /* per rank * PDT_SLOT_PER_RANK: current value or -1 */
+} pdt_rstate;
+
+/* Build a replay from `n` points and `m` merged event records of `nranks`
+ * ranks (nranks = 0: take 1 + the largest rank seen).  Events that name
+ * points >= n or ranks >= nranks are counted in pdt_replay_skipped() and
+ * otherwise ignored.  Returns PDT_OK and *out, or an error (out of memory). */
+pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, size_t m,
+                          int nranks, pdt_replay **out, pdt_err *err);
+void pdt_replay_free(pdt_replay *r);
+
+/* Sizes and tables (owned by the replay, valid until pdt_replay_free). */
+size_t pdt_replay_count(const pdt_replay *r);       /* events */
+size_t pdt_replay_skipped(const pdt_replay *r);     /* events ignored as malformed */
+int pdt_replay_nranks(const pdt_replay *r);
+const pdt_point *pdt_replay_points(const pdt_replay *r, size_t *n);
+const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i);  /* NULL if i >= count */
+const pdt_rtri *pdt_replay_tris(const pdt_replay *r, size_t *n);
+const pdt_rtri_hist *pdt_replay_tri_hist(const pdt_replay *r);
+const pdt_redge *pdt_replay_edges(const pdt_replay *r, size_t *n);
+const pdt_rnode *pdt_replay_nodes(const pdt_replay *r, size_t *n);
+const pdt_rphase *pdt_replay_phases(const pdt_replay *r, size_t *n);
+const pdt_rmerge *pdt_replay_merges(const pdt_replay *r, size_t *n);
+const pdt_rmsg *pdt_replay_msgs(const pdt_replay *r, size_t *n);
+const pdt_rhull *pdt_replay_hulls(const pdt_replay *r, size_t *n);
+/* Graham's angular position of point p (first SORT event), or -1. */
+int64_t pdt_replay_sort_pos(const pdt_replay *r, size_t p);
+/* Strip box of a rank: the bounding box of the points it lifted outside merge
+ * steps (or pushed, when it lifted none).  Returns 0 if the rank has no box. */
+int pdt_replay_box(const pdt_replay *r, int rank, pdt_point *lo, pdt_point *hi);
+/* Bounding box of all points; 0 when there are none. */
+int pdt_replay_bbox(const pdt_replay *r, pdt_point *lo, pdt_point *hi);
+/* Index of the point's first lift event, or UINT32_MAX. */
+uint32_t pdt_replay_lift_ev(const pdt_replay *r, size_t p);
+
+/* Allocate a state for `r`, at cursor 0.  NULL when out of memory. */
+pdt_rstate *pdt_rstate_new(const pdt_replay *r);
+void pdt_rstate_free(pdt_rstate *s);
+
+/* Set `s` to the state at cursor k (clamped to count). */
+void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k);
+/* Move `s` by one event: dir > 0 forwards, dir < 0 backwards.  Returns 1 if
+ * it moved, 0 at either end. */
+int pdt_replay_step(const pdt_replay *r, pdt_rstate *s, int dir);
+/* 1 if the two states (of the same replay) are identical. */
+int pdt_rstate_equal(const pdt_replay *r, const pdt_rstate *a, const pdt_rstate *b);
+
+/* Value of a rank's slot in state s (-1 when empty or rank out of range). */
+int32_t pdt_rstate_slot(const pdt_replay *r, const pdt_rstate *s, int rank, int slot);
+/* Status of triangle t in s. */
+pdt_tri_status pdt_rstate_tri_status(const pdt_replay *r, const pdt_rstate *s, size_t t);
+
+/* Searching the event list (for the controls).  Kinds of "selected event": */
+typedef enum pdt_ev_class {
+    PDT_EVC_ANY = 0,
+    PDT_EVC_STACK,     /* push / pop */
+    PDT_EVC_LIFT,      /* lift-up */
+    PDT_EVC_REJECT,    /* ra-defer / discard */
+    PDT_EVC_MERGE,     /* merge-begin / merge-end */
+    PDT_EVC_TRI,       /* any triangle event */
+    PDT_EVC_COUNT
+} pdt_ev_class;
+const char *pdt_ev_class_name(int c);
+/* 1 if event kind `kind` belongs to class c. */
+int pdt_ev_in_class(int kind, int c);
+/* Cursor just after the next (dir > 0) / previous (dir < 0) event of class c
+ * from cursor k, on a rank that `visible(rank)` accepts (NULL: all), or k
+ * when there is none. */
+size_t pdt_replay_find(const pdt_replay *r, size_t k, int dir, int c,
+                       const uint8_t *rank_visible);
+/* Cursor at the next / previous PHASE_BEGIN (any rank), or k. */
+size_t pdt_replay_find_phase(const pdt_replay *r, size_t k, int dir);
+/* Cursor just after the first PHASE_BEGIN of the phase named `name`
+ * ("kernel", "merge", "graham-scan", ...; "merge:2" = merge level 2), or
+ * (size_t)-1 when none. */
+size_t pdt_replay_find_phase_name(const pdt_replay *r, const char *name);
+
+/* The event before cursor k, in words ("rank 2: pop 17 — right turn at
+ * (12,40)").  Writes at most `cap` bytes (always terminated). */
+void pdt_replay_describe(const pdt_replay *r, size_t k, char *buf, size_t cap);
+
+#endif

@@ -1,0 +1,910 @@
+/* pdt — the replay model: index the events once, then answer "state at k". */
+#include "pdt/replay.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- a small growable array ----------------------------------------------- */
+
+static int grow(void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap) return 1;
+    size_t c = *cap ? *cap : 64;
+    while (c < need) c *= 2;
+    void *q = realloc(*p, c * elem);
+    if (!q) return 0;
+    *p = q;
+    *cap = c;
+    return 1;
+}
+
+/* ---- a hash map from a 128-bit key to an int32 ------------------------------ */
+
+typedef struct keymap {
+    uint64_t *hi, *lo;
+    int32_t *val;   /* INT32_MIN = empty slot */
+    size_t cap, used;
+} keymap;
+
+static uint64_t mix(uint64_t hi, uint64_t lo)
+{
+    uint64_t h = hi * 0x9E3779B97F4A7C15ull ^ (lo + 0x632BE59BD9B4E019ull + (hi << 6));
+    h ^= h >> 31;
+    h *= 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 29;
+    return h;
+}
+
+static int km_alloc(keymap *km, size_t cap)
+{
+    km->hi = malloc(cap * sizeof *km->hi);
+    km->lo = malloc(cap * sizeof *km->lo);
+    km->val = malloc(cap * sizeof *km->val);
+    if (!km->hi || !km->lo || !km->val) return 0;
+    for (size_t i = 0; i < cap; i++) km->val[i] = INT32_MIN;
+    km->cap = cap;
+    km->used = 0;
+    return 1;
+}
+
+static void km_free(keymap *km)
+{
+    free(km->hi);
+    free(km->lo);
+    free(km->val);
+    memset(km, 0, sizeof *km);
+}
+
+/* Slot of key (found, or the empty slot where it would go). */
+static size_t km_slot(const keymap *km, uint64_t hi, uint64_t lo)
+{
+    size_t mask = km->cap - 1, i = (size_t)mix(hi, lo) & mask;
+    while (km->val[i] != INT32_MIN && (km->hi[i] != hi || km->lo[i] != lo)) i = (i + 1) & mask;
+    return i;
+}
+
+static int km_get(const keymap *km, uint64_t hi, uint64_t lo, int32_t *v)
+{
+    if (!km->cap) return 0;
+    size_t i = km_slot(km, hi, lo);
+    if (km->val[i] == INT32_MIN) return 0;
+    *v = km->val[i];
+    return 1;
+}
+
+static int km_put(keymap *km, uint64_t hi, uint64_t lo, int32_t v)
+{
+    if (2 * (km->used + 1) > km->cap) {
+        keymap big;
+        if (!km_alloc(&big, km->cap ? 2 * km->cap : 1024)) {
+            km_free(&big);
+            return 0;
+        }
+        for (size_t i = 0; i < km->cap; i++) {
+            if (km->val[i] == INT32_MIN) continue;
+            size_t j = km_slot(&big, km->hi[i], km->lo[i]);
+            big.hi[j] = km->hi[i];
+            big.lo[j] = km->lo[i];
+            big.val[j] = km->val[i];
+            big.used++;
+        }
+        km_free(km);
+        *km = big;
+    }
+    size_t i = km_slot(km, hi, lo);
+    if (km->val[i] == INT32_MIN) km->used++;
+    km->hi[i] = hi;
+    km->lo[i] = lo;
+    km->val[i] = v;
+    return 1;
+}
+
+/* ---- the replay ------------------------------------------------------------ */
+
+typedef struct slot_change {
+    uint32_t ev;
+    int32_t val, prev;
+} slot_change;
+
+struct pdt_replay {
+    const pdt_point *pts;
+    size_t n;
+    const pdt_rec *recs;
+    size_t m, skipped;
+    int nranks;
+    int32_t *ev_obj;   /* per event: object (see build()) or -1 */
+    uint32_t *ev_ent;  /* per event: entry (history / change index, or flag) */
+
+    pdt_rtri *tris;
+    size_t ntri, cap_tri;
+    pdt_rtri_hist *hist;
+    size_t nhist;
+    pdt_redge *edges;
+    size_t nedge, cap_edge;
+    pdt_rnode *nodes;
+    size_t nnode, cap_node;
+    pdt_rphase *phases;
+    size_t nphase, cap_phase;
+    pdt_rmerge *merges;
+    size_t nmerge, cap_merge;
+    pdt_rmsg *msgs;
+    size_t nmsg, cap_msg;
+    pdt_rhull *hulls;
+    size_t nhull, cap_hull;
+
+    slot_change *ch;    /* every slot change, in event order */
+    size_t nch, cap_ch;
+    uint32_t *slot_ch;  /* changes grouped by slot: slot_ch[slot_start[s] .. slot_start[s+1]) */
+    uint32_t *slot_start;
+
+    uint32_t *lift_ev, *sort_ev, *del_ev;  /* per point: first such event or UINT32_MAX */
+    int64_t *sort_pos;
+    pdt_point *box_lo, *box_hi;  /* per rank */
+    uint8_t *has_box;
+};
+
+#define NONE32 UINT32_MAX
+
+static int is_tri_kind(int k)
+{
+    return k == PDT_EV_TRI_NEW || k == PDT_EV_TRI_FINAL || k == PDT_EV_RA_DEFER ||
+           k == PDT_EV_SHIP || k == PDT_EV_DISCARD;
+}
+
+static uint8_t tri_status_of(int k)
+{
+    switch (k) {
+    case PDT_EV_TRI_NEW: return PDT_TS_CANDIDATE;
+    case PDT_EV_TRI_FINAL: return PDT_TS_FINAL;
+    case PDT_EV_RA_DEFER: return PDT_TS_DEFERRED;
+    case PDT_EV_SHIP: return PDT_TS_SHIPPED;
+    default: return PDT_TS_DISCARDED;
+    }
+}
+
+static void sort3(uint32_t v[3], const uint32_t in[3])
+{
+    uint32_t a = in[0], b = in[1], c = in[2], t;
+    if (a > b) { t = a; a = b; b = t; }
+    if (b > c) { t = b; b = c; c = t; }
+    if (a > b) { t = a; a = b; b = t; }
+    v[0] = a;
+    v[1] = b;
+    v[2] = c;
+}
+
+/* Build state while indexing: the current slot values of every rank. */
+typedef struct builder {
+    pdt_replay *r;
+    int32_t *cur;   /* per rank * PDT_SLOT_PER_RANK */
+    int32_t last_stack;  /* per rank: last stack touched, in lastst[] */
+    int32_t *lastst;
+    keymap tri_map, edge_map, msg_map;
+    uint32_t *tri_count;  /* histories per triangle (pass 1) */
+    size_t cap_count;
+} builder;
+
+static int set_slot(builder *b, uint32_t ev, int rank, int slot, int32_t val)
+{
+    pdt_replay *r = b->r;
+    size_t s = (size_t)rank * PDT_SLOT_PER_RANK + (size_t)slot;
+    if (!grow((void **)&r->ch, &r->cap_ch, r->nch + 1, sizeof *r->ch)) return 0;
+    r->ch[r->nch] = (slot_change){ev, val, b->cur[s]};
+    r->ev_obj[ev] = (int32_t)s;
+    r->ev_ent[ev] = (uint32_t)r->nch;
+    r->nch++;
+    b->cur[s] = val;
+    return 1;
+}
+
+/* Ancestor of node t at depth d (or the deepest above it). */
+static int32_t node_at_depth(const pdt_replay *r, int32_t t, uint32_t d)
+{
+    while (t >= 0 && r->nodes[t].depth > d) t = r->nodes[t].parent;
+    return t;
+}
+
+static void box_add(pdt_replay *r, uint32_t rank, pdt_point p)
+{
+    if (!r->has_box[rank]) {
+        r->box_lo[rank] = r->box_hi[rank] = p;
+        r->has_box[rank] = 1;
+        return;
+    }
+    if (p.x < r->box_lo[rank].x) r->box_lo[rank].x = p.x;
+    if (p.y < r->box_lo[rank].y) r->box_lo[rank].y = p.y;
+    if (p.x > r->box_hi[rank].x) r->box_hi[rank].x = p.x;
+    if (p.y > r->box_hi[rank].y) r->box_hi[rank].y = p.y;
+}
+
+/* Pass 1: every object but triangle histories, which need counts first. */
+static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
+{
+    pdt_replay *r = b->r;
+    const pdt_rec *rec = &r->recs[i];
+    const pdt_event *e = &rec->ev;
+    int rank = (int)rec->rank;
+    int32_t *cur = b->cur + (size_t)rank * PDT_SLOT_PER_RANK;
+    switch (e->kind) {
+    case PDT_EV_PHASE_BEGIN: {
+        if (!grow((void **)&r->phases, &r->cap_phase, r->nphase + 1, sizeof *r->phases)) return 0;
+        r->phases[r->nphase] = (pdt_rphase){rec->rank, e->sub, e->a, i, NONE32, cur[PDT_SLOT_PHASE]};
+        r->nphase++;
+        return set_slot(b, i, rank, PDT_SLOT_PHASE, (int32_t)(r->nphase - 1));
+    }
+    case PDT_EV_PHASE_END: {
+        int32_t p = cur[PDT_SLOT_PHASE];
+        while (p >= 0 && r->phases[p].phase != e->sub) p = r->phases[p].parent;
+        if (p < 0) {
+            r->skipped++;
+            return 1;
+        }
+        r->phases[p].end_ev = i;
+        return set_slot(b, i, rank, PDT_SLOT_PHASE, r->phases[p].parent);
+    }
+    case PDT_EV_MERGE_BEGIN: {
+        if (!grow((void **)&r->merges, &r->cap_merge, r->nmerge + 1, sizeof *r->merges)) return 0;
+        r->merges[r->nmerge] =
+            (pdt_rmerge){rec->rank, e->sub, e->a, e->b, e->c, i, NONE32, 0, 0, 0, 0};
+        r->nmerge++;
+        return set_slot(b, i, rank, PDT_SLOT_MERGE, (int32_t)(r->nmerge - 1));
+    }
+    case PDT_EV_MERGE_END: {
+        int32_t g = cur[PDT_SLOT_MERGE];
+        if (g < 0) {
+            r->skipped++;
+            return 1;
+        }
+        pdt_rmerge *mg = &r->merges[g];
+        mg->end_ev = i;
+        mg->shipped = e->a;
+        mg->border = e->b;
+        mg->kept = e->c;
+        mg->discarded = (uint32_t)e->v;
+        return set_slot(b, i, rank, PDT_SLOT_MERGE, -1);
+    }
+    case PDT_EV_PUSH:
+    case PDT_EV_POP: {
+        if (e->sub >= 5 || e->a >= r->n) {
+            r->skipped++;
+            return 1;
+        }
+        int slot = PDT_SLOT_STACK0 + e->sub;
+        int32_t t = cur[slot];
+        b->lastst[rank] = e->sub;
+        if (e->kind == PDT_EV_POP) return set_slot(b, i, rank, slot, node_at_depth(r, t, e->b));
+        uint32_t d = e->b ? e->b : (t >= 0 ? r->nodes[t].depth + 1 : 1);
+        int32_t parent = node_at_depth(r, t, d - 1);
+        if (!grow((void **)&r->nodes, &r->cap_node, r->nnode + 1, sizeof *r->nodes)) return 0;
+        r->nodes[r->nnode] = (pdt_rnode){e->a, parent, d};
+        r->nnode++;
+        if (!lifted_any[rank]) box_add(r, rec->rank, r->pts[e->a]);
+        return set_slot(b, i, rank, slot, (int32_t)(r->nnode - 1));
+    }
+    case PDT_EV_HULL: {
+        if (!grow((void **)&r->hulls, &r->cap_hull, r->nhull + 1, sizeof *r->hulls)) return 0;
+        int st = b->lastst[rank];
+        pdt_rhull h = {rec->rank, i, -1, -1, e->a, (uint8_t)(e->b != 0)};
+        if (st == PDT_STACK_LOWER || st == PDT_STACK_UPPER) {
+            h.top = cur[PDT_SLOT_STACK0 + PDT_STACK_LOWER];
+            h.top2 = cur[PDT_SLOT_STACK0 + PDT_STACK_UPPER];
+        } else if (st == PDT_STACK_MERGE_LOWER || st == PDT_STACK_MERGE_UPPER) {
+            h.top = cur[PDT_SLOT_STACK0 + PDT_STACK_MERGE_LOWER];
+            h.top2 = cur[PDT_SLOT_STACK0 + PDT_STACK_MERGE_UPPER];
+        } else if (st == PDT_STACK_GRAHAM) {
+            h.top = cur[PDT_SLOT_STACK0 + PDT_STACK_GRAHAM];
+        }
+        r->hulls[r->nhull] = h;
+        r->nhull++;
+        return set_slot(b, i, rank, PDT_SLOT_HULL, (int32_t)(r->nhull - 1));
+    }
+    case PDT_EV_LIFT:
+    case PDT_EV_SORT:
+    case PDT_EV_DELETE: {
+        if (e->a >= r->n) {
+            r->skipped++;
+            return 1;
+        }
+        uint32_t *first = e->kind == PDT_EV_LIFT ? r->lift_ev
+                          : e->kind == PDT_EV_SORT ? r->sort_ev : r->del_ev;
+        r->ev_obj[i] = (int32_t)e->a;
+        r->ev_ent[i] = first[e->a] == NONE32;
+        if (first[e->a] == NONE32) {
+            first[e->a] = i;
+            if (e->kind == PDT_EV_SORT) r->sort_pos[e->a] = e->b;
+        }
+        if (e->kind == PDT_EV_LIFT) {
+            int32_t ph = cur[PDT_SLOT_PHASE];
+            int in_merge = cur[PDT_SLOT_MERGE] >= 0;
+            for (; ph >= 0 && !in_merge; ph = r->phases[ph].parent)
+                if (r->phases[ph].phase == PDT_PH_MERGE) in_merge = 1;
+            if (!in_merge) {
+                if (!lifted_any[rank]) r->has_box[rank] = 0;  /* forget pushed points */
+                lifted_any[rank] = 1;
+                box_add(r, rec->rank, r->pts[e->a]);
+            }
+        }
+        return 1;
+    }
+    case PDT_EV_EDGE_ADD:
+    case PDT_EV_EDGE_DEL: {
+        if (e->a >= r->n || e->b >= r->n) {
+            r->skipped++;
+            return 1;
+        }
+        uint32_t lo = e->a < e->b ? e->a : e->b, hi = e->a < e->b ? e->b : e->a;
+        uint64_t k = ((uint64_t)lo << 32) | hi;
+        int32_t id;
+        int have = km_get(&b->edge_map, rec->rank, k, &id) && id >= 0;
+        if (e->kind == PDT_EV_EDGE_ADD) {
+            if (!grow((void **)&r->edges, &r->cap_edge, r->nedge + 1, sizeof *r->edges)) return 0;
+            r->edges[r->nedge] = (pdt_redge){e->a, e->b, rec->rank, i, NONE32};
+            if (!km_put(&b->edge_map, rec->rank, k, (int32_t)r->nedge)) return 0;
+            r->ev_obj[i] = (int32_t)r->nedge;
+            r->nedge++;
+        } else if (have) {
+            r->edges[id].del_ev = i;
+            r->ev_obj[i] = id;
+            if (!km_put(&b->edge_map, rec->rank, k, -1)) return 0;
+        } else {
+            r->skipped++;
+        }
+        return 1;
+    }
+    case PDT_EV_SEND:
+    case PDT_EV_RECV: {
+        if (e->a >= (uint32_t)r->nranks) {
+            r->skipped++;
+            return 1;
+        }
+        int send = e->kind == PDT_EV_SEND;
+        uint32_t src = send ? rec->rank : e->a, dst = send ? e->a : rec->rank;
+        uint64_t hi = ((uint64_t)src << 32) | dst;
+        uint64_t lo = ((uint64_t)e->sub << 56) ^ (uint64_t)e->v;
+        int32_t id;
+        if (!km_get(&b->msg_map, hi, lo, &id) ||
+            (send ? r->msgs[id].send_ev : r->msgs[id].recv_ev) != NONE32) {
+            if (!grow((void **)&r->msgs, &r->cap_msg, r->nmsg + 1, sizeof *r->msgs)) return 0;
+            r->msgs[r->nmsg] = (pdt_rmsg){src, dst, e->sub, e->b, NONE32, NONE32};
+            id = (int32_t)r->nmsg++;
+            if (!km_put(&b->msg_map, hi, lo, id)) return 0;
+        }
+        if (send) r->msgs[id].send_ev = i;
+        else r->msgs[id].recv_ev = i;
+        r->ev_obj[i] = id;
+        return 1;
+    }
+    default:
+        if (!is_tri_kind(e->kind)) return 1;
+        if (e->a >= r->n || e->b >= r->n || e->c >= r->n) {
+            r->skipped++;
+            return 1;
+        }
+        uint32_t in[3] = {e->a, e->b, e->c}, s[3];
+        sort3(s, in);
+        int32_t id;
+        if (!km_get(&b->tri_map, ((uint64_t)s[0] << 32) | s[1], s[2], &id)) {
+            if (!grow((void **)&r->tris, &r->cap_tri, r->ntri + 1, sizeof *r->tris) ||
+                !grow((void **)&b->tri_count, &b->cap_count, r->ntri + 1, sizeof *b->tri_count))
+                return 0;
+            r->tris[r->ntri] = (pdt_rtri){{e->a, e->b, e->c}, rec->rank, 0, 0};
+            b->tri_count[r->ntri] = 0;
+            id = (int32_t)r->ntri++;
+            if (!km_put(&b->tri_map, ((uint64_t)s[0] << 32) | s[1], s[2], id)) return 0;
+        }
+        if (e->kind == PDT_EV_TRI_NEW && b->tri_count[id] == 0) r->tris[id].maker = rec->rank;
+        b->tri_count[id]++;
+        r->ev_obj[i] = id;
+        return 1;
+    }
+}
+
+static pdt_status build(pdt_replay *r, pdt_err *err)
+{
+    builder b;
+    memset(&b, 0, sizeof b);
+    b.r = r;
+    size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
+    b.cur = malloc((nslot ? nslot : 1) * sizeof *b.cur);
+    b.lastst = calloc((size_t)r->nranks + 1, sizeof *b.lastst);
+    uint8_t *lifted_any = calloc((size_t)r->nranks + 1, 1);
+    pdt_status st = PDT_ERR_NOMEM;
+    if (!b.cur || !b.lastst || !lifted_any) goto out;
+    for (size_t s = 0; s < nslot; s++) b.cur[s] = -1;
+    for (int q = 0; q < r->nranks; q++) b.lastst[q] = -1;
+
+    for (size_t i = 0; i < r->m; i++) {
+        r->ev_obj[i] = -1;
+        r->ev_ent[i] = 0;
+        if (r->recs[i].rank >= (uint32_t)r->nranks) {
+            r->skipped++;
+            continue;
+        }
+        if (!index_event(&b, (uint32_t)i, lifted_any)) goto out;
+    }
+    /* Triangle histories: counts -> offsets -> entries in event order. */
+    r->nhist = 0;
+    for (size_t t = 0; t < r->ntri; t++) {
+        r->tris[t].h0 = (uint32_t)r->nhist;
+        r->tris[t].hn = 0;
+        r->nhist += b.tri_count[t];
+    }
+    r->hist = malloc((r->nhist ? r->nhist : 1) * sizeof *r->hist);
+    if (!r->hist) goto out;
+    for (size_t i = 0; i < r->m; i++) {
+        const pdt_event *e = &r->recs[i].ev;
+        if (!is_tri_kind(e->kind) || r->ev_obj[i] < 0) continue;
+        pdt_rtri *t = &r->tris[r->ev_obj[i]];
+        uint32_t h = t->h0 + t->hn++;
+        r->hist[h] = (pdt_rtri_hist){(uint32_t)i, r->recs[i].rank, tri_status_of(e->kind),
+                                     (uint8_t)e->sub, e->v};
+        r->ev_ent[i] = h;
+    }
+    /* Slot changes grouped by slot (counting sort keeps event order). */
+    r->slot_start = calloc(nslot + 1, sizeof *r->slot_start);
+    r->slot_ch = malloc((r->nch ? r->nch : 1) * sizeof *r->slot_ch);
+    if (!r->slot_start || !r->slot_ch) goto out;
+    for (size_t c = 0; c < r->nch; c++) r->slot_start[r->ev_obj[r->ch[c].ev] + 1]++;
+    for (size_t s = 0; s < nslot; s++) r->slot_start[s + 1] += r->slot_start[s];
+    {
+        uint32_t *fill = malloc((nslot ? nslot : 1) * sizeof *fill);
+        if (!fill) goto out;
+        memcpy(fill, r->slot_start, nslot * sizeof *fill);
+        for (size_t c = 0; c < r->nch; c++) r->slot_ch[fill[r->ev_obj[r->ch[c].ev]]++] = (uint32_t)c;
+        free(fill);
+    }
+    st = PDT_OK;
+out:
+    free(b.cur);
+    free(b.lastst);
+    free(lifted_any);
+    free(b.tri_count);
+    km_free(&b.tri_map);
+    km_free(&b.edge_map);
+    km_free(&b.msg_map);
+    if (st != PDT_OK) pdt_err_set(err, st, "%s:%d: out of memory indexing %zu events", __FILE__,
+                                  __LINE__, r->m);
+    return st;
+}
+
+pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, size_t m,
+                          int nranks, pdt_replay **out, pdt_err *err)
+{
+    *out = NULL;
+    if (m >= NONE32 || n >= NONE32)
+        return pdt_err_set(err, PDT_ERR_ARG, "%s:%d: too many events or points (%zu, %zu)",
+                           __FILE__, __LINE__, m, n);
+    if (nranks <= 0) {
+        uint32_t mx = 0;
+        for (size_t i = 0; i < m; i++)
+            if (recs[i].rank > mx) mx = recs[i].rank;
+        nranks = m ? (int)mx + 1 : 1;
+    }
+    pdt_replay *r = calloc(1, sizeof *r);
+    if (!r) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+    r->pts = pts;
+    r->n = n;
+    r->recs = recs;
+    r->m = m;
+    r->nranks = nranks;
+    size_t n1 = n ? n : 1, m1 = m ? m : 1, q1 = (size_t)nranks;
+    r->ev_obj = malloc(m1 * sizeof *r->ev_obj);
+    r->ev_ent = malloc(m1 * sizeof *r->ev_ent);
+    r->lift_ev = malloc(n1 * sizeof *r->lift_ev);
+    r->sort_ev = malloc(n1 * sizeof *r->sort_ev);
+    r->del_ev = malloc(n1 * sizeof *r->del_ev);
+    r->sort_pos = malloc(n1 * sizeof *r->sort_pos);
+    r->box_lo = malloc(q1 * sizeof *r->box_lo);
+    r->box_hi = malloc(q1 * sizeof *r->box_hi);
+    r->has_box = calloc(q1, 1);
+    if (!r->ev_obj || !r->ev_ent || !r->lift_ev || !r->sort_ev || !r->del_ev || !r->sort_pos ||
+        !r->box_lo || !r->box_hi || !r->has_box) {
+        pdt_replay_free(r);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory for %zu events", __FILE__,
+                           __LINE__, m);
+    }
+    for (size_t p = 0; p < n; p++) {
+        r->lift_ev[p] = r->sort_ev[p] = r->del_ev[p] = NONE32;
+        r->sort_pos[p] = -1;
+    }
+    pdt_status st = build(r, err);
+    if (st != PDT_OK) {
+        pdt_replay_free(r);
+        return st;
+    }
+    *out = r;
+    return PDT_OK;
+}
+
+void pdt_replay_free(pdt_replay *r)
+{
+    if (!r) return;
+    free(r->ev_obj);
+    free(r->ev_ent);
+    free(r->tris);
+    free(r->hist);
+    free(r->edges);
+    free(r->nodes);
+    free(r->phases);
+    free(r->merges);
+    free(r->msgs);
+    free(r->hulls);
+    free(r->ch);
+    free(r->slot_ch);
+    free(r->slot_start);
+    free(r->lift_ev);
+    free(r->sort_ev);
+    free(r->del_ev);
+    free(r->sort_pos);
+    free(r->box_lo);
+    free(r->box_hi);
+    free(r->has_box);
+    free(r);
+}
+
+size_t pdt_replay_count(const pdt_replay *r) { return r->m; }
+size_t pdt_replay_skipped(const pdt_replay *r) { return r->skipped; }
+int pdt_replay_nranks(const pdt_replay *r) { return r->nranks; }
+
+const pdt_point *pdt_replay_points(const pdt_replay *r, size_t *n)
+{
+    *n = r->n;
+    return r->pts;
+}
+
+const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i) { return i < r->m ? &r->recs[i] : NULL; }
+
+#define TABLE(fn, type, arr, cnt)                                \
+    const type *fn(const pdt_replay *r, size_t *n)               \
+    {                                                            \
+        *n = r->cnt;                                             \
+        return r->arr;                                           \
+    }
+TABLE(pdt_replay_tris, pdt_rtri, tris, ntri)
+TABLE(pdt_replay_edges, pdt_redge, edges, nedge)
+TABLE(pdt_replay_nodes, pdt_rnode, nodes, nnode)
+TABLE(pdt_replay_phases, pdt_rphase, phases, nphase)
+TABLE(pdt_replay_merges, pdt_rmerge, merges, nmerge)
+TABLE(pdt_replay_msgs, pdt_rmsg, msgs, nmsg)
+TABLE(pdt_replay_hulls, pdt_rhull, hulls, nhull)
+#undef TABLE
+
+const pdt_rtri_hist *pdt_replay_tri_hist(const pdt_replay *r) { return r->hist; }
+
+int64_t pdt_replay_sort_pos(const pdt_replay *r, size_t p) { return p < r->n ? r->sort_pos[p] : -1; }
+
+uint32_t pdt_replay_lift_ev(const pdt_replay *r, size_t p) { return p < r->n ? r->lift_ev[p] : NONE32; }
+
+int pdt_replay_box(const pdt_replay *r, int rank, pdt_point *lo, pdt_point *hi)
+{
+    if (rank < 0 || rank >= r->nranks || !r->has_box[rank]) return 0;
+    *lo = r->box_lo[rank];
+    *hi = r->box_hi[rank];
+    return 1;
+}
+
+int pdt_replay_bbox(const pdt_replay *r, pdt_point *lo, pdt_point *hi)
+{
+    if (!r->n) return 0;
+    *lo = *hi = r->pts[0];
+    for (size_t p = 1; p < r->n; p++) {
+        pdt_point q = r->pts[p];
+        if (q.x < lo->x) lo->x = q.x;
+        if (q.y < lo->y) lo->y = q.y;
+        if (q.x > hi->x) hi->x = q.x;
+        if (q.y > hi->y) hi->y = q.y;
+    }
+    return 1;
+}
+
+/* ---- states ------------------------------------------------------------------ */
+
+pdt_rstate *pdt_rstate_new(const pdt_replay *r)
+{
+    pdt_rstate *s = calloc(1, sizeof *s);
+    if (!s) return NULL;
+    size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
+    s->pflags = calloc(r->n ? r->n : 1, 1);
+    s->tcur = malloc((r->ntri ? r->ntri : 1) * sizeof *s->tcur);
+    s->ealive = calloc(r->nedge ? r->nedge : 1, 1);
+    s->mflight = calloc(r->nmsg ? r->nmsg : 1, 1);
+    s->slot = malloc((nslot ? nslot : 1) * sizeof *s->slot);
+    if (!s->pflags || !s->tcur || !s->ealive || !s->mflight || !s->slot) {
+        pdt_rstate_free(s);
+        return NULL;
+    }
+    pdt_replay_seek(r, s, 0);
+    return s;
+}
+
+void pdt_rstate_free(pdt_rstate *s)
+{
+    if (!s) return;
+    free(s->pflags);
+    free(s->tcur);
+    free(s->ealive);
+    free(s->mflight);
+    free(s->slot);
+    free(s);
+}
+
+static uint8_t point_flags(const pdt_replay *r, size_t p, size_t k)
+{
+    return (uint8_t)((r->lift_ev[p] < k ? PDT_PF_LIFTED : 0) |
+                     (r->sort_ev[p] < k ? PDT_PF_SORTED : 0) |
+                     (r->del_ev[p] < k ? PDT_PF_DELETED : 0));
+}
+
+static uint8_t alive(uint32_t from, uint32_t to, size_t k)
+{
+    return from < k && !(to < k);
+}
+
+void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k)
+{
+    if (k > r->m) k = r->m;
+    s->k = k;
+    for (size_t p = 0; p < r->n; p++) s->pflags[p] = point_flags(r, p, k);
+    for (size_t t = 0; t < r->ntri; t++) {
+        const pdt_rtri *tr = &r->tris[t];
+        uint32_t c = NONE32;
+        for (uint32_t h = tr->h0; h < tr->h0 + tr->hn && r->hist[h].ev < k; h++) c = h;
+        s->tcur[t] = c;
+    }
+    for (size_t e = 0; e < r->nedge; e++) s->ealive[e] = alive(r->edges[e].add_ev, r->edges[e].del_ev, k);
+    for (size_t g = 0; g < r->nmsg; g++) s->mflight[g] = alive(r->msgs[g].send_ev, r->msgs[g].recv_ev, k);
+    size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
+    for (size_t sl = 0; sl < nslot; sl++) {
+        /* last change of this slot with ev < k: binary search */
+        uint32_t lo = r->slot_start[sl], hi = r->slot_start[sl + 1];
+        while (lo < hi) {
+            uint32_t mid = lo + (hi - lo) / 2;
+            if (r->ch[r->slot_ch[mid]].ev < k) lo = mid + 1;
+            else hi = mid;
+        }
+        s->slot[sl] = lo > r->slot_start[sl] ? r->ch[r->slot_ch[lo - 1]].val : -1;
+    }
+}
+
+/* Apply (fwd) or undo (!fwd) event i; s->k is already the new cursor. */
+static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
+{
+    const pdt_event *e = &r->recs[i].ev;
+    int32_t obj = r->ev_obj[i];
+    if (obj < 0) return;
+    uint32_t ent = r->ev_ent[i];
+    switch (e->kind) {
+    case PDT_EV_LIFT:
+    case PDT_EV_SORT:
+    case PDT_EV_DELETE:
+        s->pflags[obj] = point_flags(r, (size_t)obj, s->k);
+        return;
+    case PDT_EV_EDGE_ADD:
+    case PDT_EV_EDGE_DEL:
+        s->ealive[obj] = alive(r->edges[obj].add_ev, r->edges[obj].del_ev, s->k);
+        return;
+    case PDT_EV_SEND:
+    case PDT_EV_RECV:
+        s->mflight[obj] = alive(r->msgs[obj].send_ev, r->msgs[obj].recv_ev, s->k);
+        return;
+    default:
+        if (is_tri_kind(e->kind)) {
+            s->tcur[obj] = fwd ? ent : (ent > r->tris[obj].h0 ? ent - 1 : NONE32);
+            return;
+        }
+        /* a slot change */
+        s->slot[obj] = fwd ? r->ch[ent].val : r->ch[ent].prev;
+        return;
+    }
+}
+
+int pdt_replay_step(const pdt_replay *r, pdt_rstate *s, int dir)
+{
+    if (dir > 0) {
+        if (s->k >= r->m) return 0;
+        s->k++;
+        apply(r, s, s->k - 1, 1);
+        return 1;
+    }
+    if (dir < 0) {
+        if (s->k == 0) return 0;
+        s->k--;
+        apply(r, s, s->k, 0);
+        return 1;
+    }
+    return 0;
+}
+
+int pdt_rstate_equal(const pdt_replay *r, const pdt_rstate *a, const pdt_rstate *b)
+{
+    size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
+    return a->k == b->k && !memcmp(a->pflags, b->pflags, r->n) &&
+           !memcmp(a->tcur, b->tcur, r->ntri * sizeof *a->tcur) &&
+           !memcmp(a->ealive, b->ealive, r->nedge) && !memcmp(a->mflight, b->mflight, r->nmsg) &&
+           !memcmp(a->slot, b->slot, nslot * sizeof *a->slot);
+}
+
+int32_t pdt_rstate_slot(const pdt_replay *r, const pdt_rstate *s, int rank, int slot)
+{
+    if (rank < 0 || rank >= r->nranks || slot < 0 || slot >= PDT_SLOT_PER_RANK) return -1;
+    return s->slot[(size_t)rank * PDT_SLOT_PER_RANK + (size_t)slot];
+}
+
+pdt_tri_status pdt_rstate_tri_status(const pdt_replay *r, const pdt_rstate *s, size_t t)
+{
+    if (t >= r->ntri || s->tcur[t] == NONE32) return PDT_TS_NONE;
+    return (pdt_tri_status)r->hist[s->tcur[t]].status;
+}
+
+/* ---- searching --------------------------------------------------------------- */
+
+static const char *const class_names[PDT_EVC_COUNT] = {"any event", "push/pop", "lift-up",
+                                                       "rejection", "merge", "triangle"};
+
+const char *pdt_ev_class_name(int c) { return c >= 0 && c < PDT_EVC_COUNT ? class_names[c] : NULL; }
+
+int pdt_ev_in_class(int kind, int c)
+{
+    switch (c) {
+    case PDT_EVC_ANY: return 1;
+    case PDT_EVC_STACK: return kind == PDT_EV_PUSH || kind == PDT_EV_POP;
+    case PDT_EVC_LIFT: return kind == PDT_EV_LIFT;
+    case PDT_EVC_REJECT: return kind == PDT_EV_RA_DEFER || kind == PDT_EV_DISCARD;
+    case PDT_EVC_MERGE: return kind == PDT_EV_MERGE_BEGIN || kind == PDT_EV_MERGE_END;
+    case PDT_EVC_TRI: return is_tri_kind(kind);
+    default: return 0;
+    }
+}
+
+size_t pdt_replay_find(const pdt_replay *r, size_t k, int dir, int c, const uint8_t *rank_visible)
+{
+    if (k > r->m) k = r->m;
+    if (dir > 0) {
+        for (size_t i = k; i < r->m; i++)
+            if (pdt_ev_in_class(r->recs[i].ev.kind, c) &&
+                (!rank_visible || rank_visible[r->recs[i].rank]))
+                return i + 1;
+    } else {
+        for (size_t i = k >= 2 ? k - 1 : 0; i-- > 0;)
+            if (pdt_ev_in_class(r->recs[i].ev.kind, c) &&
+                (!rank_visible || rank_visible[r->recs[i].rank]))
+                return i + 1;
+        if (k >= 1) return 0;
+    }
+    return k;
+}
+
+size_t pdt_replay_find_phase(const pdt_replay *r, size_t k, int dir)
+{
+    if (dir > 0) {
+        for (size_t i = k; i < r->m; i++)
+            if (r->recs[i].ev.kind == PDT_EV_PHASE_BEGIN && r->recs[i].ev.sub != PDT_PH_RUN) return i + 1;
+        return r->m;
+    }
+    for (size_t i = k >= 2 ? k - 1 : 0; i-- > 0;)
+        if (r->recs[i].ev.kind == PDT_EV_PHASE_BEGIN && r->recs[i].ev.sub != PDT_PH_RUN) return i + 1;
+    return 0;
+}
+
+size_t pdt_replay_find_phase_name(const pdt_replay *r, const char *name)
+{
+    char base[64];
+    long level = -1;
+    const char *colon = strchr(name, ':');
+    size_t len = colon ? (size_t)(colon - name) : strlen(name);
+    if (len >= sizeof base) return (size_t)-1;
+    memcpy(base, name, len);
+    base[len] = 0;
+    if (colon) level = strtol(colon + 1, NULL, 10);
+    for (size_t i = 0; i < r->m; i++) {
+        const pdt_event *e = &r->recs[i].ev;
+        if (e->kind != PDT_EV_PHASE_BEGIN) continue;
+        const char *nm = pdt_phase_name(e->sub);
+        if (nm && !strcmp(nm, base) && (level < 0 || (long)e->a == level)) return i + 1;
+    }
+    return (size_t)-1;
+}
+
+/* ---- the event line ------------------------------------------------------------ */
+
+static const char *pt_str(const pdt_replay *r, uint32_t p, char *b, size_t cap)
+{
+    if (p < r->n) snprintf(b, cap, "%u (%d,%d)", p, r->pts[p].x, r->pts[p].y);
+    else snprintf(b, cap, "%u", p);
+    return b;
+}
+
+void pdt_replay_describe(const pdt_replay *r, size_t k, char *buf, size_t cap)
+{
+    if (!cap) return;
+    if (k == 0 || k > r->m) {
+        snprintf(buf, cap, "start — %zu events, %d ranks; press Space or → to begin", r->m,
+                 r->nranks);
+        return;
+    }
+    const pdt_rec *rec = &r->recs[k - 1];
+    const pdt_event *e = &rec->ev;
+    char p1[64], p2[64];
+    int n = snprintf(buf, cap, "rank %u: ", rec->rank);
+    if (n < 0 || (size_t)n >= cap) return;
+    char *o = buf + n;
+    size_t c = cap - (size_t)n;
+    const char *stk = pdt_stack_name(e->sub) ? pdt_stack_name(e->sub) : "?";
+    const char *ph = pdt_phase_name(e->sub) ? pdt_phase_name(e->sub) : "?";
+    switch (e->kind) {
+    case PDT_EV_PHASE_BEGIN:
+        if (e->sub == PDT_PH_MERGE) snprintf(o, c, "begin phase merge, level %u", e->a);
+        else snprintf(o, c, "begin phase %s", ph);
+        break;
+    case PDT_EV_PHASE_END: snprintf(o, c, "end of phase %s", ph); break;
+    case PDT_EV_PUSH:
+        snprintf(o, c, "push %s on the %s stack (depth %u)", pt_str(r, e->a, p1, sizeof p1), stk, e->b);
+        break;
+    case PDT_EV_POP:
+        if (e->c != NONE32 && e->c < r->n)
+            snprintf(o, c, "pop %u — %s at (%d,%d) when adding %u", e->a,
+                     e->sub == PDT_STACK_GRAHAM ? "no left turn" : "right turn",
+                     e->a < r->n ? r->pts[e->a].x : 0, e->a < r->n ? r->pts[e->a].y : 0, e->c);
+        else
+            snprintf(o, c, "pop %s from the %s stack", pt_str(r, e->a, p1, sizeof p1), stk);
+        break;
+    case PDT_EV_LIFT:
+        snprintf(o, c, "lift %s to z = %lld", pt_str(r, e->a, p1, sizeof p1), (long long)e->v);
+        break;
+    case PDT_EV_SORT:
+        snprintf(o, c, "%s is number %u in the angular order", pt_str(r, e->a, p1, sizeof p1), e->b);
+        break;
+    case PDT_EV_DELETE:
+        snprintf(o, c, "delete %s — %s %u", pt_str(r, e->a, p1, sizeof p1),
+                 e->sub == PDT_DEL_COINCIDENT ? "a copy of" : "same angle as, and closer than,",
+                 e->b);
+        break;
+    case PDT_EV_TRI_NEW:
+        snprintf(o, c, "candidate triangle %u %u %u from the %s kernel", e->a, e->b, e->c,
+                 e->sub ? "border" : "local");
+        break;
+    case PDT_EV_TRI_FINAL:
+        snprintf(o, c, "triangle %u %u %u is final — its circle misses every foreign box", e->a,
+                 e->b, e->c);
+        break;
+    case PDT_EV_RA_DEFER:
+        snprintf(o, c, "defer %u %u %u — its circle touches the box of rank %lld", e->a, e->b, e->c,
+                 (long long)e->v);
+        break;
+    case PDT_EV_SHIP:
+        snprintf(o, c, "ship %u %u %u to rank %lld", e->a, e->b, e->c, (long long)e->v);
+        break;
+    case PDT_EV_DISCARD:
+        if (e->v >= 0 && (uint64_t)e->v < r->n)
+            snprintf(o, c, "discard %u %u %u — not Delaunay: %s is inside its circle", e->a, e->b,
+                     e->c, pt_str(r, (uint32_t)e->v, p2, sizeof p2));
+        else
+            snprintf(o, c, "discard %u %u %u — not Delaunay", e->a, e->b, e->c);
+        break;
+    case PDT_EV_MERGE_BEGIN:
+        snprintf(o, c, "merge level %u: ranks %u–%u with %u–%u at rank %lld", e->sub, e->a,
+                 e->b ? e->b - 1 : 0, e->b, e->c ? e->c - 1 : 0, (long long)e->v);
+        break;
+    case PDT_EV_MERGE_END:
+        snprintf(o, c, "merge level %u done: %u shipped, border %u, %u kept, %lld discarded",
+                 e->sub, e->a, e->b, e->c, (long long)e->v);
+        break;
+    case PDT_EV_SEND:
+        snprintf(o, c, "send %u bytes to rank %u (tag %u)", e->b, e->a, e->sub);
+        break;
+    case PDT_EV_RECV:
+        snprintf(o, c, "receive %u bytes from rank %u (tag %u)", e->b, e->a, e->sub);
+        break;
+    case PDT_EV_HULL:
+        snprintf(o, c, "hull of %u vertices%s", e->a, e->b ? " (degenerate)" : "");
+        break;
+    case PDT_EV_EDGE_ADD: snprintf(o, c, "kernel adds edge %u–%u", e->a, e->b); break;
+    case PDT_EV_EDGE_DEL: snprintf(o, c, "kernel deletes edge %u–%u", e->a, e->b); break;
+    case PDT_EV_INCIRCLE:
+        snprintf(o, c, "incircle %u %u %u with %lld: %s", e->a, e->b, e->c, (long long)(e->v >> 2),
+                 (e->v & 3) == 2 ? "inside" : (e->v & 3) == 0 ? "outside" : "on the circle");
+        break;
+    default: snprintf(o, c, "event of kind %u", e->kind); break;
+    }
+}

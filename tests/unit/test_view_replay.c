@@ -1,0 +1,254 @@
+/* Replay model: seek equals stepping, stepping back undoes stepping forward,
+ * on synthetic runs with several ranks (and on hand-made event arrays). */
+#include "../harness.h"
+
+#include <string.h>
+
+#include "pdt/replay.h"
+#include "pdt/viewsynth.h"
+
+static pdt_rec rec(int rank, int kind, int sub, uint32_t a, uint32_t b, uint32_t c, int64_t v)
+{
+    pdt_rec r;
+    memset(&r, 0, sizeof r);
+    r.rank = (uint32_t)rank;
+    r.ev.kind = (uint8_t)kind;
+    r.ev.sub = (uint8_t)sub;
+    r.ev.a = a;
+    r.ev.b = b;
+    r.ev.c = c;
+    r.ev.v = v;
+    return r;
+}
+
+/* seek(k) == step 0 -> k for every k; step back from the end == seek too. */
+static int check_routes(const pdt_replay *r, size_t stride)
+{
+    size_t m = pdt_replay_count(r);
+    pdt_rstate *fw = pdt_rstate_new(r), *sk = pdt_rstate_new(r), *bw = pdt_rstate_new(r);
+    int bad = 0;
+    if (!fw || !sk || !bw) return 1;
+    for (size_t k = 0; k <= m; k++) {
+        if (k % stride == 0 || k == m) {
+            pdt_replay_seek(r, sk, k);
+            if (!pdt_rstate_equal(r, fw, sk)) {
+                if (bad++ < 3) printf("#   forward state differs from seek at k=%zu\n", k);
+            }
+        }
+        if (k < m && !pdt_replay_step(r, fw, 1)) bad++;
+    }
+    pdt_replay_seek(r, bw, m);
+    for (size_t k = m + 1; k-- > 0;) {
+        if (k % stride == 0) {
+            pdt_replay_seek(r, sk, k);
+            if (!pdt_rstate_equal(r, bw, sk)) {
+                if (bad++ < 3) printf("#   backward state differs from seek at k=%zu\n", k);
+            }
+        }
+        if (k > 0 && !pdt_replay_step(r, bw, -1)) bad++;
+    }
+    /* a step forward then back is the identity, from scattered positions */
+    for (size_t k = 0; k < m; k += 1 + m / 97) {
+        pdt_replay_seek(r, sk, k);
+        pdt_replay_seek(r, fw, k);
+        pdt_replay_step(r, fw, 1);
+        pdt_replay_step(r, fw, -1);
+        if (!pdt_rstate_equal(r, fw, sk)) bad++;
+    }
+    pdt_rstate_free(fw);
+    pdt_rstate_free(sk);
+    pdt_rstate_free(bw);
+    return bad;
+}
+
+TEST(seek_equals_step_srm_4_ranks)
+{
+    pdt_synth s;
+    pdt_err err = {0};
+    CHECK(pdt_synth_srm(12, 7, 4, 2, &s, &err) == PDT_OK);
+    pdt_replay *r = NULL;
+    CHECK(pdt_replay_new(s.pts, s.n, s.recs, s.m, s.nranks, &r, &err) == PDT_OK);
+    if (!r) return;
+    CHECK(pdt_replay_skipped(r) == 0);
+    CHECK_MSG(check_routes(r, 1) == 0, "m=%zu", s.m);
+    pdt_replay_free(r);
+    pdt_synth_free(&s);
+}
+
+TEST(seek_equals_step_srm_odd_ranks)
+{
+    for (int p = 1; p <= 7; p += 2) {
+        pdt_synth s;
+        pdt_err err = {0};
+        CHECK(pdt_synth_srm(2 * p + 3, 5, p, 2, &s, &err) == PDT_OK);
+        pdt_replay *r = NULL;
+        CHECK(pdt_replay_new(s.pts, s.n, s.recs, s.m, 0, &r, &err) == PDT_OK);
+        if (!r) return;
+        CHECK_MSG(pdt_replay_nranks(r) == p, "nranks %d", pdt_replay_nranks(r));
+        CHECK_MSG(check_routes(r, 3) == 0, "p=%d", p);
+        pdt_replay_free(r);
+        pdt_synth_free(&s);
+    }
+}
+
+TEST(seek_equals_step_graham)
+{
+    pdt_synth s;
+    pdt_err err = {0};
+    CHECK(pdt_synth_graham(60, 7, &s, &err) == PDT_OK);
+    pdt_replay *r = NULL;
+    CHECK(pdt_replay_new(s.pts, s.n, s.recs, s.m, 1, &r, &err) == PDT_OK);
+    if (!r) return;
+    CHECK(check_routes(r, 1) == 0);
+    pdt_replay_free(r);
+    pdt_synth_free(&s);
+}
+
+/* The end state of an SRM run: every triangle final or discarded, nothing in
+ * flight, no open merge. */
+TEST(srm_end_state)
+{
+    pdt_synth s;
+    pdt_err err = {0};
+    CHECK(pdt_synth_srm(16, 6, 4, 1, &s, &err) == PDT_OK);
+    pdt_replay *r = NULL;
+    CHECK(pdt_replay_new(s.pts, s.n, s.recs, s.m, 4, &r, &err) == PDT_OK);
+    if (!r) return;
+    pdt_rstate *st = pdt_rstate_new(r);
+    pdt_replay_seek(r, st, pdt_replay_count(r));
+    size_t nt, nfinal = 0, ndisc = 0, nother = 0;
+    pdt_replay_tris(r, &nt);
+    for (size_t t = 0; t < nt; t++) {
+        pdt_tri_status ts = pdt_rstate_tri_status(r, st, t);
+        if (ts == PDT_TS_FINAL) nfinal++;
+        else if (ts == PDT_TS_DISCARDED) ndisc++;
+        else nother++;
+    }
+    /* a 16 x 6 grid has 2 * 15 * 5 = 150 triangles in any triangulation */
+    CHECK_MSG(nfinal == 150, "final %zu", nfinal);
+    CHECK_MSG(ndisc > 0, "discarded %zu", ndisc);
+    CHECK_MSG(nother == 0, "other %zu", nother);
+    size_t nm;
+    const pdt_rmsg *msg = pdt_replay_msgs(r, &nm);
+    CHECK(nm > 0);
+    for (size_t g = 0; g < nm; g++) {
+        CHECK(st->mflight[g] == 0);
+        CHECK(msg[g].send_ev < msg[g].recv_ev && msg[g].recv_ev != UINT32_MAX);
+    }
+    size_t ng;
+    const pdt_rmerge *mg = pdt_replay_merges(r, &ng);
+    CHECK_MSG(ng == 3, "merges %zu", ng);  /* 4 ranks: two at level 0, one at level 1 */
+    for (size_t i = 0; i < ng; i++) CHECK(mg[i].end_ev != UINT32_MAX && mg[i].discarded > 0);
+    for (int q = 0; q < 4; q++) {
+        CHECK(pdt_rstate_slot(r, st, q, PDT_SLOT_MERGE) == -1);
+        CHECK(pdt_rstate_slot(r, st, q, PDT_SLOT_PHASE) == -1);
+        pdt_point lo, hi;
+        CHECK(pdt_replay_box(r, q, &lo, &hi));
+        CHECK_MSG(lo.x == q * 40 && hi.x == q * 40 + 30, "rank %d box x %d..%d", q, lo.x, hi.x);
+    }
+    pdt_rstate_free(st);
+    pdt_replay_free(r);
+    pdt_synth_free(&s);
+}
+
+/* Hand-made events: stacks, phases, messages and triangle statuses. */
+TEST(hand_made_story)
+{
+    pdt_point pts[5] = {{0, 0}, {10, 0}, {5, 8}, {5, 3}, {0, 10}};
+    pdt_rec ev[] = {
+        rec(0, PDT_EV_PHASE_BEGIN, PDT_PH_HULL, 0, 0, 0, 0),     /* 0 */
+        rec(0, PDT_EV_PUSH, PDT_STACK_LOWER, 0, 1, 0, 0),        /* 1 */
+        rec(0, PDT_EV_PUSH, PDT_STACK_LOWER, 3, 2, 0, 0),        /* 2 */
+        rec(0, PDT_EV_POP, PDT_STACK_LOWER, 3, 1, 1, 0),         /* 3 */
+        rec(0, PDT_EV_PUSH, PDT_STACK_LOWER, 1, 2, 0, 0),        /* 4 */
+        rec(1, PDT_EV_SEND, 1, 0, 64, 0, 0),                     /* 5 */
+        rec(0, PDT_EV_TRI_NEW, 0, 0, 1, 2, 0),                   /* 6 */
+        rec(0, PDT_EV_RECV, 1, 1, 64, 0, 0),                     /* 7 */
+        rec(0, PDT_EV_RA_DEFER, 0, 1, 2, 0, 1),                  /* 8: same triangle, rotated */
+        rec(0, PDT_EV_DISCARD, 0, 2, 0, 1, 3),                   /* 9 */
+        rec(0, PDT_EV_PHASE_END, PDT_PH_HULL, 0, 0, 0, 0),       /* 10 */
+        rec(0, PDT_EV_PUSH, PDT_STACK_LOWER, 4, 1, 0, 0),        /* 11: a new stack */
+    };
+    size_t m = sizeof ev / sizeof *ev;
+    pdt_replay *r = NULL;
+    pdt_err err = {0};
+    CHECK(pdt_replay_new(pts, 5, ev, m, 2, &r, &err) == PDT_OK);
+    if (!r) return;
+    pdt_rstate *s = pdt_rstate_new(r);
+    size_t nt, nn;
+    pdt_replay_tris(r, &nt);
+    const pdt_rnode *nodes = pdt_replay_nodes(r, &nn);
+    CHECK_MSG(nt == 1, "one triangle, %zu", nt);
+    pdt_replay_seek(r, s, 3);
+    int32_t top = pdt_rstate_slot(r, s, 0, PDT_SLOT_STACK0 + PDT_STACK_LOWER);
+    CHECK(top >= 0 && nodes[top].pt == 3 && nodes[top].depth == 2);
+    pdt_replay_seek(r, s, 4);
+    top = pdt_rstate_slot(r, s, 0, PDT_SLOT_STACK0 + PDT_STACK_LOWER);
+    CHECK(top >= 0 && nodes[top].pt == 0 && nodes[top].depth == 1);
+    pdt_replay_seek(r, s, 5);
+    top = pdt_rstate_slot(r, s, 0, PDT_SLOT_STACK0 + PDT_STACK_LOWER);
+    CHECK(top >= 0 && nodes[top].pt == 1 && nodes[nodes[top].parent].pt == 0);
+    CHECK(s->mflight[0] == 0);
+    pdt_replay_step(r, s, 1);
+    CHECK(s->mflight[0] == 1);
+    CHECK(pdt_rstate_tri_status(r, s, 0) == PDT_TS_NONE);
+    pdt_replay_step(r, s, 1);
+    CHECK(pdt_rstate_tri_status(r, s, 0) == PDT_TS_CANDIDATE);
+    pdt_replay_step(r, s, 1);
+    CHECK(s->mflight[0] == 0);
+    pdt_replay_step(r, s, 1);
+    CHECK(pdt_rstate_tri_status(r, s, 0) == PDT_TS_DEFERRED);
+    pdt_replay_step(r, s, 1);
+    CHECK(pdt_rstate_tri_status(r, s, 0) == PDT_TS_DISCARDED);
+    pdt_replay_step(r, s, -1);
+    CHECK(pdt_rstate_tri_status(r, s, 0) == PDT_TS_DEFERRED);
+    CHECK(pdt_rstate_slot(r, s, 0, PDT_SLOT_PHASE) == 0);
+    pdt_replay_seek(r, s, m);
+    CHECK(pdt_rstate_slot(r, s, 0, PDT_SLOT_PHASE) == -1);
+    top = pdt_rstate_slot(r, s, 0, PDT_SLOT_STACK0 + PDT_STACK_LOWER);
+    CHECK(top >= 0 && nodes[top].pt == 4 && nodes[top].parent == -1);
+    CHECK(check_routes(r, 1) == 0);
+    char line[256];
+    pdt_replay_describe(r, 4, line, sizeof line);
+    CHECK_MSG(strstr(line, "rank 0: pop 3") && strstr(line, "right turn at (5,3)"), "%s", line);
+    pdt_replay_describe(r, 10, line, sizeof line);
+    CHECK_MSG(strstr(line, "discard") && strstr(line, "3 (5,3) is inside"), "%s", line);
+    /* searching */
+    CHECK(pdt_replay_find(r, 0, 1, PDT_EVC_STACK, NULL) == 2);
+    CHECK(pdt_replay_find(r, 5, 1, PDT_EVC_REJECT, NULL) == 9);
+    CHECK(pdt_replay_find(r, 9, -1, PDT_EVC_STACK, NULL) == 5);
+    CHECK(pdt_replay_find_phase_name(r, "hull") == 1);
+    CHECK(pdt_replay_find_phase_name(r, "merge") == (size_t)-1);
+    pdt_rstate_free(s);
+    pdt_replay_free(r);
+}
+
+/* Malformed events are skipped, not fatal. */
+TEST(malformed_events_skipped)
+{
+    pdt_point pts[2] = {{0, 0}, {1, 1}};
+    pdt_rec ev[] = {
+        rec(0, PDT_EV_PUSH, PDT_STACK_LOWER, 7, 1, 0, 0),   /* point out of range */
+        rec(0, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0), /* never began */
+        rec(0, PDT_EV_TRI_NEW, 0, 0, 1, 9, 0),
+        rec(0, PDT_EV_LIFT, 0, 1, 0, 0, 2),
+    };
+    pdt_replay *r = NULL;
+    pdt_err err = {0};
+    CHECK(pdt_replay_new(pts, 2, ev, 4, 1, &r, &err) == PDT_OK);
+    if (!r) return;
+    CHECK_MSG(pdt_replay_skipped(r) == 3, "%zu", pdt_replay_skipped(r));
+    CHECK(check_routes(r, 1) == 0);
+    pdt_replay_free(r);
+}
+
+int main(void)
+{
+    RUN(seek_equals_step_srm_4_ranks);
+    RUN(seek_equals_step_srm_odd_ranks);
+    RUN(seek_equals_step_graham);
+    RUN(srm_end_state);
+    RUN(hand_made_story);
+    RUN(malformed_events_skipped);
+    return test_summary();
+}
