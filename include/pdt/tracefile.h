@@ -1,14 +1,47 @@
 /* pdt — run folders: the trace writer and the reader library.
  *
- * A run folder holds a manifest (text), the input points (binary) and one
- * binary trace file per rank.  The format is documented in docs/trace-format.md.
+ * A run folder holds a manifest (text, "manifest"), the input points (binary,
+ * "points.bin") and one binary trace file per rank ("rank-NNNN.trace", four
+ * or more digits).  The format is documented in docs/trace-format.md.
  * Writing never involves MPI: the parallel driver gathers what the manifest
- * needs and calls these functions. */
+ * needs and calls these functions.
+ *
+ * What a driver calls (sequential: nranks = 1, rank = 0, offsets {0}):
+ *
+ *   1. every rank:  pdt_tw_open(dir, rank, level, &w, &err)   (creates dir;
+ *                   rank 0 also removes a stale manifest/points.bin)
+ *   2. measure clock offsets (MPI driver): after a barrier every rank reads
+ *                   pdt_tw_now(w); rank 0 gathers them and sets
+ *                   offset[r] = now[0] - now[r] (or better, a ping-pong
+ *                   estimate); adding offset[r] to rank r's times puts them
+ *                   on rank 0's time line.
+ *   3. rank 0:      fill a pdt_manifest (format_version = PDT_TRACE_FORMAT_MAJOR,
+ *                   program_version = PDT_VERSION, command, command_line,
+ *                   input_name, input_checksum = pdt_points_checksum(pts, n),
+ *                   n, nranks, level, clock_offset_ns, wall_start_ns =
+ *                   pdt_wall_ns()) and call pdt_run_write_meta(dir, &m, pts, n).
+ *                   Doing this before the run means a killed run still
+ *                   leaves a complete folder.  Writing it again later is fine.
+ *   4. pass pdt_tw_hook(w) to the algorithm (set hook->gid if local indices
+ *                   must be translated to global input indices).
+ *   5. every rank:  pdt_tw_close(w, &err) — writes the last block and the end
+ *                   marker; its status reports any write error that happened
+ *                   during the run (the hook cannot return errors; after the
+ *                   first write error the writer stops recording).
+ *
+ * Events carry global input indices (duplicates: the smallest index), so
+ * that every rank's events refer to the same points.bin. */
 #ifndef PDT_TRACEFILE_H
 #define PDT_TRACEFILE_H
 
 #include "pdt/common.h"
 #include "pdt/trace.h"
+
+/* Version of the run-folder format written by this code.  A reader accepts
+ * every minor version of its own major version (unknown manifest keys and
+ * unknown event kinds are skipped); a different major version is refused. */
+#define PDT_TRACE_FORMAT_MAJOR 1
+#define PDT_TRACE_FORMAT_MINOR 0
 
 /* ---- manifest ------------------------------------------------------------ */
 
@@ -24,25 +57,52 @@ typedef struct pdt_manifest {
     char command[16];        /* "triangulate" or "hull" */
     int64_t *clock_offset_ns;/* per rank: add to a rank's times to align (malloc'd) */
     uint64_t wall_start_ns;  /* realtime clock at the start (rank 0) */
+    int format_minor;        /* minor version (reader: as found in the file) */
 } pdt_manifest;
 
+/* Free the malloc'd members (not m itself); m may be NULL. */
 void pdt_manifest_free(pdt_manifest *m);
+
+/* FNV-1a 64 over the points as little-endian int32 pairs (x, y): the
+ * manifest's input_checksum. */
+uint64_t pdt_points_checksum(const pdt_point *pts, size_t n);
+/* CRC-32C (Castagnoli, reflected 0x82F63B78, init and final xor ~0) of n
+ * bytes, continuing from `crc` (start with 0): the checksum of trace blocks
+ * and points.bin.  pdt_crc32c(0, "123456789", 9) == 0xE3069283. */
+uint32_t pdt_crc32c(uint32_t crc, const void *data, size_t n);
+/* Realtime clock in nanoseconds since the epoch (for wall_start_ns). */
+uint64_t pdt_wall_ns(void);
 
 /* ---- writer (one per rank) --------------------------------------------------- */
 
 typedef struct pdt_trace_writer pdt_trace_writer;
 
-/* Create the run folder (rank 0 only: also writes the input points; other
- * ranks call it with pts = NULL after rank 0 did).  Returns a writer for
- * `rank` whose hook (pdt_tw_hook) records events of level <= `level`. */
+/* Create the run folder `dir` if needed (every rank may call this at the same
+ * time) and the file dir/rank-NNNN.trace (truncated if present).  Rank 0 also
+ * removes a stale dir/manifest and dir/points.bin.  Returns in *w a writer for
+ * `rank` whose hook (pdt_tw_hook) records events of level <= `level`
+ * (1 or 2); its clock starts at 0 now.  The caller owns *w (pdt_tw_close). */
 pdt_status pdt_tw_open(const char *dir, int rank, int level, pdt_trace_writer **w,
                        pdt_err *err);
-/* The hook to pass to algorithm code. */
+/* The hook to pass to algorithm code (owned by w; valid until pdt_tw_close).
+ * The sink stamps each event with the writer's clock and appends it to a
+ * buffer; full buffers are encoded and written as one block. */
 pdt_trace *pdt_tw_hook(pdt_trace_writer *w);
-/* Write the last block, close the file and free the writer. */
+/* Current time on the writer's clock (CLOCK_MONOTONIC ns since pdt_tw_open):
+ * the value event times are measured in; for clock-offset measurement. */
+uint64_t pdt_tw_now(const pdt_trace_writer *w);
+/* Events recorded so far (written or buffered). */
+uint64_t pdt_tw_events(const pdt_trace_writer *w);
+/* Write the buffered events, the end marker, close the file and free the
+ * writer (w may be NULL).  Returns the first error of the whole recording
+ * (a failed write during the run is reported here). */
 pdt_status pdt_tw_close(pdt_trace_writer *w, pdt_err *err);
+/* Abandon a writer without the end marker (error paths): closes and frees;
+ * what was written stays readable. */
+void pdt_tw_abort(pdt_trace_writer *w);
 
-/* Rank 0, after the run: write the input points and the manifest (atomic). */
+/* Rank 0: write the input points (points.bin) and the manifest, each
+ * atomically (temporary file + rename).  Creates dir if needed. */
 pdt_status pdt_run_write_meta(const char *dir, const pdt_manifest *m, const pdt_point *pts,
                               size_t n, pdt_err *err);
 
@@ -75,7 +135,58 @@ pdt_status pdt_run_rank_events(pdt_run *run, int rank, const pdt_event **ev, siz
 
 /* All events of all ranks merged in a causally consistent order (a RECV is
  * never before its SEND; each rank's own order is kept; otherwise by aligned
- * time).  Owned by run. */
+ * time, ties by rank).  SEND and RECV are matched by (source, destination,
+ * tag, sequence number); a RECV whose SEND is missing is placed by its time
+ * and noted in the warnings.  Owned by run. */
 pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err *err);
+
+/* Facts about one rank's file, known after pdt_run_open without decoding. */
+typedef struct pdt_rank_info {
+    uint64_t events;     /* intact events */
+    uint64_t bytes;      /* file size */
+    uint64_t blocks;     /* intact blocks */
+    int complete;        /* 1 if the end marker was found (the run closed it) */
+    int present;         /* 0 if the file is missing or unreadable */
+    int level;           /* trace level in the file header */
+} pdt_rank_info;
+
+/* Number of ranks (the manifest's nranks). */
+int pdt_run_nranks(const pdt_run *run);
+/* Fill *info for `rank` (0 <= rank < nranks). */
+void pdt_run_rank_info(const pdt_run *run, int rank, pdt_rank_info *info);
+
+/* A cursor over one rank's events that decodes one block at a time: memory
+ * O(block), seek O(log blocks) (binary search over the block index). */
+typedef struct pdt_cursor pdt_cursor;
+
+/* Open a cursor positioned at event 0 of `rank`.  Caller owns *c. */
+pdt_status pdt_cursor_open(pdt_run *run, int rank, pdt_cursor **c, pdt_err *err);
+/* Position at event k (k == event count positions at the end).  Returns
+ * PDT_ERR_ARG if k is beyond the end. */
+pdt_status pdt_cursor_seek(pdt_cursor *c, uint64_t k, pdt_err *err);
+/* Next event (aligned time) into *ev and its index into *seq (may be NULL).
+ * Returns 1, or 0 at the end. */
+int pdt_cursor_next(pdt_cursor *c, pdt_event *ev, uint64_t *seq);
+void pdt_cursor_close(pdt_cursor *c);
+
+/* One readable line for an event, without rank or time, e.g.
+ * "pop graham pt=17 depth=3 cause=12".  Writes at most cap bytes
+ * (NUL-terminated); returns buf. */
+char *pdt_event_format(const pdt_event *ev, char *buf, size_t cap);
+/* Kind by name ("push", "tri-final", ...); -1 if unknown. */
+int pdt_event_kind_by_name(const char *name);
+
+/* ---- verification (pdt trace check) ------------------------------------------ */
+
+/* Check the invariants a correct run satisfies (docs/trace-format.md,
+ * "Invariants"): intact files; per stack instance every pop removes the top
+ * and depths agree; Graham's final stack is the hull of the points; lift-ups
+ * cover the distinct points once (local) and |B| at each merge, with
+ * z = x*x + y*y; every TRI_FINAL once across ranks and the set equals
+ * T*(points) (recomputed with pdt_triangulate); merge steps begin and end on
+ * one rank and do not overlap within a level; every SEND has its RECV.
+ * Returns PDT_OK and a one-line summary in `summary` (cap bytes), or
+ * PDT_ERR_CHECK with the first violation in err. */
+pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err);
 
 #endif

@@ -1,0 +1,308 @@
+/* pdt — the run folder's manifest (text) and points.bin (binary). */
+#include "tf_internal.h"
+
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+void pdt_manifest_free(pdt_manifest *m)
+{
+    if (!m) return;
+    free(m->command_line);
+    free(m->input_name);
+    free(m->clock_offset_ns);
+    m->command_line = m->input_name = NULL;
+    m->clock_offset_ns = NULL;
+}
+
+/* ---- atomic file writing: dir/name via dir/.name.tmp.PID -------------------- */
+
+typedef struct afile {
+    FILE *fp;
+    char *path, *tmp;
+} afile;
+
+static pdt_status af_open(afile *f, const char *dir, const char *name, pdt_err *err)
+{
+    size_t len = strlen(dir) + strlen(name) + 48;
+    f->fp = NULL;
+    f->path = malloc(len);
+    f->tmp = malloc(len);
+    if (!f->path || !f->tmp) {
+        free(f->path);
+        free(f->tmp);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+    }
+    snprintf(f->path, len, "%s/%s", dir, name);
+    snprintf(f->tmp, len, "%s/.%s.tmp.%ld", dir, name, (long)getpid());
+    f->fp = fopen(f->tmp, "wb");
+    if (!f->fp) {
+        pdt_status st =
+            pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: %s", f->tmp, strerror(errno));
+        free(f->path);
+        free(f->tmp);
+        return st;
+    }
+    return PDT_OK;
+}
+
+static pdt_status af_commit(afile *f, pdt_err *err)
+{
+    pdt_status st = PDT_OK;
+    int bad = ferror(f->fp);
+    if (fclose(f->fp) != 0 || bad)
+        st = pdt_err_set(err, PDT_ERR_IO, "%s: write failed: %s", f->tmp, strerror(errno));
+    else if (rename(f->tmp, f->path) != 0)
+        st = pdt_err_set(err, PDT_ERR_IO, "%s: cannot rename into place: %s", f->path,
+                         strerror(errno));
+    if (st != PDT_OK) remove(f->tmp);
+    free(f->path);
+    free(f->tmp);
+    return st;
+}
+
+/* Write s with backslash, newline, carriage return escaped. */
+static void put_escaped(FILE *fp, const char *s)
+{
+    for (; s && *s; s++) {
+        if (*s == '\\') fputs("\\\\", fp);
+        else if (*s == '\n') fputs("\\n", fp);
+        else if (*s == '\r') fputs("\\r", fp);
+        else fputc(*s, fp);
+    }
+}
+
+pdt_status pdt_run_write_meta(const char *dir, const pdt_manifest *m, const pdt_point *pts,
+                              size_t n, pdt_err *err)
+{
+    if (m->nranks < 1)
+        return pdt_err_set(err, PDT_ERR_ARG, "%s:%d: manifest needs nranks >= 1", __FILE__,
+                           __LINE__);
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST)
+        return pdt_err_set(err, PDT_ERR_IO, "%s: cannot create folder: %s", dir,
+                           strerror(errno));
+    /* points.bin */
+    afile f;
+    pdt_status st = af_open(&f, dir, "points.bin", err);
+    if (st != PDT_OK) return st;
+    uint8_t h[PTS_HEADER_SIZE];
+    memcpy(h, PTS_MAGIC, 8);
+    tf_put64(h + 8, n);
+    uint8_t chunk[8 * 1024];
+    uint32_t crc = 0;
+    for (size_t pass = 0; pass < 2; pass++) {  /* pass 0: checksum, pass 1: write */
+        if (pass == 1) {
+            tf_put32(h + 16, crc);
+            tf_put32(h + 20, pdt_crc32c(0, h, 20));
+            fwrite(h, 1, sizeof h, f.fp);
+        }
+        for (size_t i = 0; i < n;) {
+            size_t k = 0;
+            for (; i < n && k < sizeof chunk; i++, k += 8) {
+                tf_put32(chunk + k, (uint32_t)pts[i].x);
+                tf_put32(chunk + k + 4, (uint32_t)pts[i].y);
+            }
+            if (pass == 0) crc = pdt_crc32c(crc, chunk, k);
+            else fwrite(chunk, 1, k, f.fp);
+        }
+    }
+    st = af_commit(&f, err);
+    if (st != PDT_OK) return st;
+
+    /* manifest */
+    st = af_open(&f, dir, "manifest", err);
+    if (st != PDT_OK) return st;
+    FILE *fp = f.fp;
+    fprintf(fp, "# pdt run folder manifest; format described in docs/trace-format.md\n");
+    fprintf(fp, "format = %d.%d\n", PDT_TRACE_FORMAT_MAJOR, PDT_TRACE_FORMAT_MINOR);
+    fprintf(fp, "program_version = ");
+    put_escaped(fp, m->program_version[0] ? m->program_version : PDT_VERSION);
+    fprintf(fp, "\ncommand = ");
+    put_escaped(fp, m->command);
+    fprintf(fp, "\ncommand_line = ");
+    put_escaped(fp, m->command_line);
+    fprintf(fp, "\ninput_name = ");
+    put_escaped(fp, m->input_name);
+    fprintf(fp, "\ninput_checksum = fnv1a64:%016" PRIx64 "\n", m->input_checksum);
+    fprintf(fp, "n = %" PRIu64 "\n", m->n);
+    fprintf(fp, "ranks = %d\n", m->nranks);
+    fprintf(fp, "level = %d\n", m->level);
+    fprintf(fp, "wall_start_ns = %" PRIu64 "\n", m->wall_start_ns);
+    fprintf(fp, "clock_offset_ns =");
+    for (int r = 0; r < m->nranks; r++)
+        fprintf(fp, " %" PRId64, m->clock_offset_ns ? m->clock_offset_ns[r] : 0);
+    fprintf(fp, "\npoints_file = points.bin\n");
+    return af_commit(&f, err);
+}
+
+/* ---- reading ---------------------------------------------------------------- */
+
+static char *unescape_dup(const char *s)
+{
+    size_t n = strlen(s);
+    char *d = malloc(n + 1), *o = d;
+    if (!d) return NULL;
+    for (; *s; s++) {
+        if (*s == '\\' && s[1]) {
+            s++;
+            *o++ = *s == 'n' ? '\n' : *s == 'r' ? '\r' : *s;
+        } else {
+            *o++ = *s;
+        }
+    }
+    *o = '\0';
+    return d;
+}
+
+static void copy_field(char *dst, size_t cap, const char *src)
+{
+    snprintf(dst, cap, "%s", src);
+}
+
+pdt_status pdt_tf_manifest_parse(const char *path, char *text, pdt_manifest *m, pdt_err *err)
+{
+    memset(m, 0, sizeof *m);
+    m->format_version = -1;
+    m->nranks = -1;
+    char *offsets = NULL;
+    int line = 0, offsets_line = 0;
+    pdt_status st = PDT_OK;
+    for (char *s = text, *next; s && *s; s = next) {
+        line++;
+        next = strchr(s, '\n');
+        if (next) *next++ = '\0';
+        size_t len = strlen(s);
+        if (len && s[len - 1] == '\r') s[--len] = '\0';
+        while (*s == ' ' || *s == '\t') s++;
+        if (*s == '\0' || *s == '#') continue;
+        char *eq = strchr(s, '=');
+        if (!eq) {
+            st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: expected 'key = value'", path, line);
+            break;
+        }
+        char *ke = eq;
+        while (ke > s && (ke[-1] == ' ' || ke[-1] == '\t')) ke--;
+        *ke = '\0';
+        char *v = eq + 1;
+        while (*v == ' ' || *v == '\t') v++;
+        const char *k = s;
+        char *end = NULL;
+        errno = 0;
+        if (!strcmp(k, "format")) {
+            long maj = strtol(v, &end, 10), min = 0;
+            if (end == v || (*end != '.' && *end != '\0')) end = NULL;
+            else if (*end == '.') min = strtol(end + 1, &end, 10);
+            if (!end || *end != '\0' || maj < 0 || maj > 1000000 || min < 0 || min > 1000000) {
+                st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad format version '%s'", path,
+                                 line, v);
+                break;
+            }
+            m->format_version = (int)maj;
+            m->format_minor = (int)min;
+            if (maj != PDT_TRACE_FORMAT_MAJOR) {
+                st = pdt_err_set(err, PDT_ERR_FORMAT,
+                                 "%s:%d: run folder format %ld.%ld; this pdt reads format %d.x",
+                                 path, line, maj, min, PDT_TRACE_FORMAT_MAJOR);
+                break;
+            }
+        } else if (!strcmp(k, "program_version")) {
+            copy_field(m->program_version, sizeof m->program_version, v);
+        } else if (!strcmp(k, "command")) {
+            copy_field(m->command, sizeof m->command, v);
+        } else if (!strcmp(k, "command_line") || !strcmp(k, "input_name")) {
+            char *d = unescape_dup(v);
+            if (!d) {
+                st = pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+                break;
+            }
+            char **slot = !strcmp(k, "command_line") ? &m->command_line : &m->input_name;
+            free(*slot);
+            *slot = d;
+        } else if (!strcmp(k, "input_checksum")) {
+            const char *h = !strncmp(v, "fnv1a64:", 8) ? v + 8 : v;
+            m->input_checksum = strtoull(h, &end, 16);
+            if (end == h || *end) {
+                st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad checksum '%s'", path, line, v);
+                break;
+            }
+        } else if (!strcmp(k, "n") || !strcmp(k, "wall_start_ns")) {
+            uint64_t x = strtoull(v, &end, 10);
+            if (end == v || *end || errno) {
+                st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad number '%s'", path, line, v);
+                break;
+            }
+            if (k[0] == 'n') m->n = x;
+            else m->wall_start_ns = x;
+        } else if (!strcmp(k, "ranks") || !strcmp(k, "level")) {
+            long x = strtol(v, &end, 10);
+            if (end == v || *end || x < 0 || x > (1L << 24)) {
+                st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad %s '%s'", path, line, k, v);
+                break;
+            }
+            if (k[0] == 'r') m->nranks = (int)x;
+            else m->level = (int)x;
+        } else if (!strcmp(k, "clock_offset_ns")) {
+            offsets = v;
+            offsets_line = line;
+        }
+    }
+    if (st == PDT_OK && m->format_version < 0)
+        st = pdt_err_set(err, PDT_ERR_FORMAT, "%s: no 'format' line: not a pdt manifest", path);
+    if (st == PDT_OK && m->nranks < 1)
+        st = pdt_err_set(err, PDT_ERR_FORMAT, "%s: no valid 'ranks' line", path);
+    if (st == PDT_OK) {
+        m->clock_offset_ns = calloc((size_t)m->nranks, sizeof *m->clock_offset_ns);
+        if (!m->clock_offset_ns)
+            st = pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+    }
+    if (st == PDT_OK && offsets) {
+        char *p = offsets;
+        for (int r = 0; r < m->nranks; r++) {
+            char *end;
+            errno = 0;
+            long long x = strtoll(p, &end, 10);
+            if (end == p || errno) {
+                st = pdt_err_set(err, PDT_ERR_FORMAT,
+                                 "%s:%d: clock_offset_ns needs %d numbers, found %d", path,
+                                 offsets_line, m->nranks, r);
+                break;
+            }
+            m->clock_offset_ns[r] = x;
+            p = end;
+        }
+    }
+    if (st != PDT_OK) pdt_manifest_free(m);
+    return st;
+}
+
+pdt_status pdt_tf_points_parse(const char *path, const uint8_t *p, size_t len, pdt_point **pts,
+                               size_t *n, pdt_err *err)
+{
+    *pts = NULL;
+    *n = 0;
+    if (len < PTS_HEADER_SIZE || memcmp(p, PTS_MAGIC, 8) != 0)
+        return pdt_err_set(err, PDT_ERR_FORMAT, "%s: not a pdt points file", path);
+    if (tf_get32(p + 20) != pdt_crc32c(0, p, 20))
+        return pdt_err_set(err, PDT_ERR_CORRUPT, "%s: header checksum mismatch", path);
+    uint64_t cnt = tf_get64(p + 8);
+    if (cnt > (len - PTS_HEADER_SIZE) / 8 || (len - PTS_HEADER_SIZE) != cnt * 8)
+        return pdt_err_set(err, PDT_ERR_CORRUPT,
+                           "%s: holds %zu bytes of points, header says %" PRIu64 " points",
+                           path, len - PTS_HEADER_SIZE, cnt);
+    const uint8_t *d = p + PTS_HEADER_SIZE;
+    if (tf_get32(p + 16) != pdt_crc32c(0, d, (size_t)cnt * 8))
+        return pdt_err_set(err, PDT_ERR_CORRUPT, "%s: checksum mismatch in the point data",
+                           path);
+    pdt_point *a = malloc((cnt ? (size_t)cnt : 1) * sizeof *a);
+    if (!a) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+    for (size_t i = 0; i < cnt; i++) {
+        a[i].x = (int32_t)tf_get32(d + 8 * i);
+        a[i].y = (int32_t)tf_get32(d + 8 * i + 4);
+    }
+    *pts = a;
+    *n = (size_t)cnt;
+    return PDT_OK;
+}

@@ -1,0 +1,127 @@
+/* pdt — events as readable text (pdt trace dump, the viewer's event list). */
+#include <inttypes.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "pdt/tracefile.h"
+
+int pdt_event_kind_by_name(const char *name)
+{
+    for (int k = 0; k < PDT_EV_KIND_COUNT; k++)
+        if (!strcmp(pdt_event_kind_name(k), name)) return k;
+    return -1;
+}
+
+static const char *or_num(const char *name, char *tmp, size_t cap, unsigned v)
+{
+    if (name) return name;
+    snprintf(tmp, cap, "%u", v);
+    return tmp;
+}
+
+static const char *pt_or_dash(char *tmp, size_t cap, uint32_t v)
+{
+    if (v == UINT32_MAX) return "-";
+    snprintf(tmp, cap, "%" PRIu32, v);
+    return tmp;
+}
+
+char *pdt_event_format(const pdt_event *e, char *buf, size_t cap)
+{
+    char t1[24], t2[24];
+    const char *kn = pdt_event_kind_name(e->kind);
+    switch (e->kind) {
+    case PDT_EV_PHASE_BEGIN:
+    case PDT_EV_PHASE_END:
+        if (e->a)
+            snprintf(buf, cap, "%s %s level=%" PRIu32, kn,
+                     or_num(pdt_phase_name(e->sub), t1, sizeof t1, e->sub), e->a);
+        else
+            snprintf(buf, cap, "%s %s", kn, or_num(pdt_phase_name(e->sub), t1, sizeof t1, e->sub));
+        break;
+    case PDT_EV_PUSH:
+        snprintf(buf, cap, "push %s pt=%" PRIu32 " depth=%" PRIu32,
+                 or_num(pdt_stack_name(e->sub), t1, sizeof t1, e->sub), e->a, e->b);
+        break;
+    case PDT_EV_POP:
+        snprintf(buf, cap, "pop %s pt=%" PRIu32 " depth=%" PRIu32 " cause=%s",
+                 or_num(pdt_stack_name(e->sub), t1, sizeof t1, e->sub), e->a, e->b,
+                 pt_or_dash(t2, sizeof t2, e->c));
+        break;
+    case PDT_EV_LIFT:
+        snprintf(buf, cap, "lift pt=%" PRIu32 " z=%" PRIu64, e->a, (uint64_t)e->v);
+        break;
+    case PDT_EV_SORT:
+        snprintf(buf, cap, "sort pt=%" PRIu32 " pos=%" PRIu32, e->a, e->b);
+        break;
+    case PDT_EV_DELETE:
+        snprintf(buf, cap, "delete %s pt=%" PRIu32 " kept=%" PRIu32,
+                 e->sub == PDT_DEL_ANGULAR_TIE ? "angular-tie"
+                 : e->sub == PDT_DEL_COINCIDENT ? "coincident"
+                                                 : or_num(NULL, t1, sizeof t1, e->sub),
+                 e->a, e->b);
+        break;
+    case PDT_EV_TRI_NEW:
+        snprintf(buf, cap, "tri-new %s %" PRIu32 " %" PRIu32 " %" PRIu32,
+                 e->sub == 0 ? "local" : e->sub == 1 ? "border" : or_num(NULL, t1, sizeof t1, e->sub),
+                 e->a, e->b, e->c);
+        break;
+    case PDT_EV_TRI_FINAL:
+        snprintf(buf, cap, "tri-final %" PRIu32 " %" PRIu32 " %" PRIu32, e->a, e->b, e->c);
+        break;
+    case PDT_EV_RA_DEFER:
+        snprintf(buf, cap, "ra-defer %" PRIu32 " %" PRIu32 " %" PRIu32 " rank=%" PRId64, e->a, e->b,
+                 e->c, e->v);
+        break;
+    case PDT_EV_SHIP:
+        snprintf(buf, cap, "ship %" PRIu32 " %" PRIu32 " %" PRIu32 " to=%" PRId64, e->a, e->b, e->c,
+                 e->v);
+        break;
+    case PDT_EV_DISCARD:
+        if (e->v < 0)
+            snprintf(buf, cap, "discard %" PRIu32 " %" PRIu32 " %" PRIu32 " witness=-", e->a, e->b,
+                     e->c);
+        else
+            snprintf(buf, cap, "discard %" PRIu32 " %" PRIu32 " %" PRIu32 " witness=%" PRId64, e->a,
+                     e->b, e->c, e->v);
+        break;
+    case PDT_EV_MERGE_BEGIN:
+        snprintf(buf, cap,
+                 "merge-begin level=%u left=%" PRIu32 " right=%" PRIu32 " end=%" PRIu32
+                 " at=%" PRId64, e->sub, e->a, e->b, e->c, e->v);
+        break;
+    case PDT_EV_MERGE_END:
+        snprintf(buf, cap,
+                 "merge-end level=%u shipped=%" PRIu32 " border=%" PRIu32 " kept=%" PRIu32
+                 " discarded=%" PRId64, e->sub, e->a, e->b, e->c, e->v);
+        break;
+    case PDT_EV_SEND:
+        snprintf(buf, cap, "send tag=%u to=%" PRIu32 " bytes=%" PRIu32 " seq=%" PRId64, e->sub, e->a,
+                 e->b, e->v);
+        break;
+    case PDT_EV_RECV:
+        snprintf(buf, cap, "recv tag=%u from=%" PRIu32 " bytes=%" PRIu32 " seq=%" PRId64, e->sub,
+                 e->a, e->b, e->v);
+        break;
+    case PDT_EV_HULL:
+        snprintf(buf, cap, "hull vertices=%" PRIu32 "%s", e->a, e->b ? " degenerate" : "");
+        break;
+    case PDT_EV_EDGE_ADD:
+    case PDT_EV_EDGE_DEL:
+        snprintf(buf, cap, "%s %" PRIu32 " %" PRIu32, kn, e->a, e->b);
+        break;
+    case PDT_EV_INCIRCLE:
+        snprintf(buf, cap, "incircle %" PRIu32 " %" PRIu32 " %" PRIu32 " pt=%" PRId64 " result=%d",
+                 e->a, e->b, e->c, e->v >> 2, (int)(e->v & 3) - 1);
+        break;
+    default:
+        if (kn)
+            snprintf(buf, cap, "%s sub=%u a=%" PRIu32 " b=%" PRIu32 " c=%" PRIu32 " v=%" PRId64, kn,
+                     e->sub, e->a, e->b, e->c, e->v);
+        else
+            snprintf(buf, cap, "kind-%u sub=%u a=%" PRIu32 " b=%" PRIu32 " c=%" PRIu32
+                               " v=%" PRId64, e->kind, e->sub, e->a, e->b, e->c, e->v);
+        break;
+    }
+    return buf;
+}
