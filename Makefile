@@ -66,7 +66,7 @@ $(1)_OBJ := build/$(1)
 $(1)_LIB := build/$(1)/libpdt.a
 $(1)_VIEWLIB := build/$(1)/libpdtview.a
 
-build/$(1)/%.o: %.c $$(wildcard include/pdt/*.h) | build/$(1)/.dirs
+build/$(1)/%.o: %.c $$(wildcard include/pdt/*.h src/*/*.h) | build/$(1)/.dirs
 	@mkdir -p $$(dir $$@)
 	$$(CC) $(CSTD) $(2) $(WARN) $(INC) $$(if $$(findstring src/par/comm_mpi,$$<),$(MPI_CFLAGS)) $$(if $$(findstring /view/,$$<),$(VIEW_CFLAGS)) $$(if $$(findstring tests/unit/test_view,$$<),$(VIEW_CFLAGS)) -c $$< -o $$@
 

@@ -62,4 +62,9 @@ pdt_status pdt_write_tris(const char *path, pdt_tri_format fmt, const pdt_point 
 /* Read a canonical .tri file (or a Triangle .ele file by extension). */
 pdt_status pdt_read_tris(const char *path, pdt_tri **tris, size_t *ntri, pdt_err *err);
 
+/* As pdt_read_tris, and every index must be < npts: a larger one is a parse
+ * error naming its line ("t.tri:4: point index 12 out of range (10 points)"). */
+pdt_status pdt_read_tris_n(const char *path, size_t npts, pdt_tri **tris, size_t *ntri,
+                           pdt_err *err);
+
 #endif

@@ -1,0 +1,309 @@
+/* pdt — loading a text file and scanning it line by line (see io_internal.h). */
+#include "io_internal.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* ---- loading -------------------------------------------------------------- */
+
+pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
+{
+    t->buf = NULL;
+    t->len = 0;
+    int is_stdin = strcmp(path, "-") == 0;
+    const char *name = is_stdin ? "standard input" : path;
+    int fd = is_stdin ? STDIN_FILENO : open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return pdt_err_set(err, PDT_ERR_IO, "%s: cannot open: %s", name, strerror(errno));
+    struct stat sb;
+    if (fstat(fd, &sb) != 0) {
+        int e = errno;
+        if (!is_stdin) close(fd);
+        return pdt_err_set(err, PDT_ERR_IO, "%s: cannot read: %s", name, strerror(e));
+    }
+    if (S_ISDIR(sb.st_mode)) {
+        if (!is_stdin) close(fd);
+        return pdt_err_set(err, PDT_ERR_IO, "%s: is a directory", name);
+    }
+    /* Regular files: one allocation of the right size; pipes: grow. */
+    size_t cap = S_ISREG(sb.st_mode) && sb.st_size > 0 ? (size_t)sb.st_size + 1 : 65536;
+    char *buf = malloc(cap);
+    if (!buf) {
+        if (!is_stdin) close(fd);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory (%zu bytes)", name, cap);
+    }
+    size_t len = 0;
+    for (;;) {
+        if (cap - len < 2) {
+            size_t ncap = cap * 2;
+            char *nb = ncap > cap ? realloc(buf, ncap) : NULL;
+            if (!nb) {
+                free(buf);
+                if (!is_stdin) close(fd);
+                return pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory", name);
+            }
+            buf = nb;
+            cap = ncap;
+        }
+        ssize_t r = read(fd, buf + len, cap - len - 1);
+        if (r < 0) {
+            if (errno == EINTR) continue;
+            int e = errno;
+            free(buf);
+            if (!is_stdin) close(fd);
+            return pdt_err_set(err, PDT_ERR_IO, "%s: read error: %s", name, strerror(e));
+        }
+        if (r == 0) break;
+        len += (size_t)r;
+    }
+    if (!is_stdin) close(fd);
+    buf[len] = '\0';
+    t->buf = buf;
+    t->len = len;
+    return PDT_OK;
+}
+
+void pdt_io_text_free(pdt_io_text *t)
+{
+    free(t->buf);
+    t->buf = NULL;
+    t->len = 0;
+}
+
+/* ---- the line cursor ------------------------------------------------------ */
+
+static inline int is_blank(char ch)
+{
+    return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\v' || ch == '\f';
+}
+
+void pdt_io_cur_init(pdt_io_cur *c, const pdt_io_text *t, const char *name)
+{
+    c->p = t->buf;
+    c->end = t->buf + t->len;
+    c->name = name;
+    c->line = 1;
+    c->done = 0;
+    /* A UTF-8 byte-order mark at the start is not part of the data. */
+    if (t->len >= 3 && memcmp(t->buf, "\xEF\xBB\xBF", 3) == 0) c->p += 3;
+}
+
+void pdt_io_skip_line(pdt_io_cur *c)
+{
+    const char *nl = memchr(c->p, '\n', (size_t)(c->end - c->p));
+    if (nl) {
+        c->p = nl + 1;
+        c->line++;
+    } else {
+        c->p = c->end;
+    }
+}
+
+int pdt_io_next_line(pdt_io_cur *c)
+{
+    const char *p = c->p, *end = c->end;
+    while (p < end) {
+        while (p < end && is_blank(*p)) p++;
+        if (p == end) break;
+        if (*p == '\n') {
+            p++;
+            c->line++;
+            continue;
+        }
+        if (*p == '#') {
+            c->p = p;
+            pdt_io_skip_line(c);
+            p = c->p;
+            continue;
+        }
+        c->p = p;
+        return 1;
+    }
+    /* At the end: name the last line, not the empty one after its '\n'. */
+    if (!c->done && c->line > 1 && end[-1] == '\n') c->line--;
+    c->done = 1;
+    c->p = end;
+    return 0;
+}
+
+int pdt_io_token(pdt_io_cur *c, const char **tok, size_t *len)
+{
+    const char *p = c->p, *end = c->end;
+    while (p < end && is_blank(*p)) p++;
+    if (p == end || *p == '\n' || *p == '#') {
+        c->p = p;
+        return 0;
+    }
+    const char *s = p;
+    while (p < end && !is_blank(*p) && *p != '\n' && *p != '#') p++;
+    *tok = s;
+    *len = (size_t)(p - s);
+    c->p = p;
+    return 1;
+}
+
+/* ---- numbers ---------------------------------------------------------------- */
+
+int pdt_io_parse_int(const char *tok, size_t len, int64_t *v)
+{
+    size_t i = 0;
+    int neg = 0;
+    if (i < len && (tok[i] == '+' || tok[i] == '-')) neg = tok[i++] == '-';
+    if (i == len) return 1;
+    uint64_t acc = 0;
+    int digits = 0, too_long = 0;
+    for (; i < len; i++) {
+        unsigned d = (unsigned)(unsigned char)tok[i] - '0';
+        if (d > 9) return 1;
+        if (acc == 0 && d == 0) continue; /* leading zeros do not count */
+        if (++digits > 18) too_long = 1;
+        else acc = acc * 10 + d;
+    }
+    if (too_long) {
+        *v = neg ? INT64_MIN : INT64_MAX;
+        return 2;
+    }
+    *v = neg ? -(int64_t)acc : (int64_t)acc;
+    return 0;
+}
+
+int pdt_io_parse_dec(const char *tok, size_t len, pdt_io_dec *d)
+{
+    size_t i = 0;
+    d->m = 0;
+    d->e = 0;
+    d->neg = 0;
+    d->inexact = 0;
+    if (i < len && (tok[i] == '+' || tok[i] == '-')) d->neg = tok[i++] == '-';
+    int sig = 0, seen_digit = 0;
+    int64_t e = 0;
+    for (; i < len && tok[i] >= '0' && tok[i] <= '9'; i++) {
+        seen_digit = 1;
+        unsigned dg = (unsigned)(tok[i] - '0');
+        if (d->m == 0 && dg == 0) continue;
+        if (sig < 19) {
+            d->m = d->m * 10 + dg;
+            sig++;
+        } else {
+            e++; /* a dropped digit before the point scales by 10 */
+            if (dg) d->inexact = 1;
+        }
+    }
+    if (i < len && tok[i] == '.') {
+        for (i++; i < len && tok[i] >= '0' && tok[i] <= '9'; i++) {
+            seen_digit = 1;
+            unsigned dg = (unsigned)(tok[i] - '0');
+            if (d->m == 0 && dg == 0) {
+                e--;
+                continue;
+            }
+            if (sig < 19) {
+                d->m = d->m * 10 + dg;
+                sig++;
+                e--;
+            } else if (dg) {
+                d->inexact = 1;
+            }
+        }
+    }
+    if (!seen_digit) return 1;
+    if (i < len && (tok[i] == 'e' || tok[i] == 'E')) {
+        i++;
+        int eneg = 0;
+        if (i < len && (tok[i] == '+' || tok[i] == '-')) eneg = tok[i++] == '-';
+        if (i == len) return 1;
+        int64_t x = 0;
+        for (; i < len && tok[i] >= '0' && tok[i] <= '9'; i++)
+            if (x < 100000000) x = x * 10 + (tok[i] - '0');
+        e += eneg ? -x : x;
+    }
+    if (i != len) return 1;
+    if (d->m == 0) {
+        d->e = 0;
+        d->neg = 0;
+        return 0;
+    }
+    while (d->m % 10 == 0) {
+        d->m /= 10;
+        e++;
+    }
+    if (e > 1000000000) e = 1000000000;
+    if (e < -1000000000) e = -1000000000;
+    d->e = (int32_t)e;
+    return 0;
+}
+
+int pdt_io_is_decimal(const char *tok, size_t len)
+{
+    pdt_io_dec d;
+    return pdt_io_parse_dec(tok, len, &d) == 0;
+}
+
+int pdt_io_scale_round(const pdt_io_dec *d, const char *tok, size_t len, double scale,
+                       int32_t *v)
+{
+    const __int128 lim = (__int128)1 << 33; /* well past int32: "out of range" */
+    if (d->m == 0) {
+        *v = 0;
+        return 0;
+    }
+    if (!d->inexact && scale >= 1 && scale <= 4294967296.0 && scale == floor(scale)) {
+        /* Exact: m * K * 10^e with m < 10^19 and K <= 2^32, so m*K < 2^96. */
+        __int128 q = (__int128)d->m * (__int128)(uint64_t)scale;
+        if (d->e >= 0) {
+            for (int32_t k = 0; k < d->e && q < lim; k++) q *= 10;
+        } else if (d->e < -38) {
+            q = 0; /* m*K < 2^96 < 10^38 / 2 */
+        } else {
+            __int128 p10 = 1;
+            for (int32_t k = 0; k < -d->e; k++) p10 *= 10;
+            __int128 r = q % p10;
+            q /= p10;
+            if (2 * r >= p10) q++; /* halves away from zero */
+        }
+        if (d->neg) q = -q;
+        if (q > INT32_MAX || q < INT32_MIN) return 1;
+        *v = (int32_t)q;
+        return 0;
+    }
+    /* General case: the token's value in double times the scale. */
+    char small[128];
+    char *s = len < sizeof small ? small : malloc(len + 1);
+    if (!s) return 1;
+    memcpy(s, tok, len);
+    s[len] = '\0';
+    double x = strtod(s, NULL) * scale;
+    if (s != small) free(s);
+    x = round(x);
+    if (!(x >= (double)INT32_MIN && x <= (double)INT32_MAX)) return 1;
+    *v = (int32_t)x;
+    return 0;
+}
+
+const char *pdt_io_show(const char *tok, size_t len, char *buf, size_t cap)
+{
+    static const char hex[] = "0123456789abcdef";
+    size_t o = 0;
+    for (size_t i = 0; i < len; i++) {
+        unsigned char ch = (unsigned char)tok[i];
+        if (o + 8 >= cap || i >= 40) {
+            memcpy(buf + o, "...", 3);
+            o += 3;
+            break;
+        }
+        if (ch >= 0x20 && ch < 0x7f) {
+            buf[o++] = (char)ch;
+        } else {
+            buf[o++] = '\\';
+            buf[o++] = 'x';
+            buf[o++] = hex[ch >> 4];
+            buf[o++] = hex[ch & 15];
+        }
+    }
+    buf[o] = '\0';
+    return buf;
+}

@@ -1,0 +1,447 @@
+/* Unit tests of src/io: point and triangle parsers (every bad input with its
+ * message), --scale rounding and collisions, writers, atomic output. */
+#include <dirent.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "../harness.h"
+#include "pdt/io.h"
+
+static char dir[64];
+
+/* Full path of `name` in the test directory (static buffer, 4 slots). */
+static const char *path(const char *name)
+{
+    static char buf[4][512];
+    static int k;
+    k = (k + 1) % 4;
+    snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name);
+    return buf[k];
+}
+
+static void put(const char *name, const char *text)
+{
+    FILE *f = fopen(path(name), "wb");
+    if (!f) return;
+    fwrite(text, 1, strlen(text), f);
+    fclose(f);
+}
+
+static char *slurp(const char *p)
+{
+    FILE *f = fopen(p, "rb");
+    if (!f) return NULL;
+    char *b = calloc(1, 1 << 16);
+    if (b) fread(b, 1, (1 << 16) - 1, f);
+    fclose(f);
+    return b;
+}
+
+/* Number of entries (other than . and ..) in the test directory. */
+static int entries(void)
+{
+    DIR *d = opendir(dir);
+    int n = 0;
+    struct dirent *e;
+    while (d && (e = readdir(d)))
+        if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) n++;
+    if (d) closedir(d);
+    return n;
+}
+
+static void clean(void)
+{
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    while (d && (e = readdir(d)))
+        if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) unlink(path(e->d_name));
+    if (d) closedir(d);
+}
+
+/* Read `text` saved as `name`; returns the status, fills err. */
+static pdt_status rd(const char *name, const char *text, double scale, pdt_point **p, size_t *n,
+                     size_t *coll, pdt_err *err)
+{
+    put(name, text);
+    pdt_err_clear(err);
+    return pdt_read_points(path(name), scale, p, n, coll, err);
+}
+
+/* Expect reading `text` as `name` to fail with exactly "DIR/name:" + msg. */
+static int bad(const char *name, const char *text, double scale, const char *msg)
+{
+    pdt_point *p = NULL;
+    size_t n = 99;
+    pdt_err err;
+    pdt_status st = rd(name, text, scale, &p, &n, NULL, &err);
+    char want[512];
+    snprintf(want, sizeof want, "%s:%s", path(name), msg);
+    int ok = st == PDT_ERR_PARSE && strcmp(err.msg, want) == 0 && p == NULL && n == 0;
+    if (!ok) printf("#   want [%s]\n#   got  [%s] (status %d)\n", want, err.msg, (int)st);
+    return ok;
+}
+
+TEST(text_basic)
+{
+    pdt_point *p;
+    size_t n;
+    pdt_err err;
+    pdt_status st = rd("a.txt",
+                       "\xEF\xBB\xBF# header comment\n"
+                       "1 2\n"
+                       "\n"
+                       "   -3\t4   \r\n"
+                       "5 6 # trailing comment\n"
+                       "\t\r\n"
+                       "-2147483648 2147483647\n"
+                       "+7 0008", /* no final newline */
+                       0, &p, &n, NULL, &err);
+    CHECK_MSG(st == PDT_OK, "%s", err.msg);
+    CHECK(n == 5);
+    if (st == PDT_OK && n == 5) {
+        CHECK(p[0].x == 1 && p[0].y == 2);
+        CHECK(p[1].x == -3 && p[1].y == 4);
+        CHECK(p[2].x == 5 && p[2].y == 6);
+        CHECK(p[3].x == INT32_MIN && p[3].y == INT32_MAX);
+        CHECK(p[4].x == 7 && p[4].y == 8);
+    }
+    free(p);
+}
+
+TEST(empty_file_is_zero_points)
+{
+    pdt_point *p = (pdt_point *)1;
+    size_t n = 7;
+    pdt_err err;
+    CHECK(rd("e.txt", "", 0, &p, &n, NULL, &err) == PDT_OK && n == 0);
+    free(p);
+    CHECK(rd("e2.txt", "# only a comment\n\n  \n", 0, &p, &n, NULL, &err) == PDT_OK && n == 0);
+    free(p);
+    CHECK(rd("e.node", "", 0, &p, &n, NULL, &err) == PDT_OK && n == 0);
+    free(p);
+}
+
+TEST(text_bad_inputs)
+{
+    CHECK(bad("b.txt", "1 2\n3 4294967296\n", 0, "2: coordinate 4294967296 does not fit in 32 bits"));
+    CHECK(bad("b.txt", "2147483648 0\n", 0, "1: coordinate 2147483648 does not fit in 32 bits"));
+    CHECK(bad("b.txt", "0 -2147483649\n", 0, "1: coordinate -2147483649 does not fit in 32 bits"));
+    CHECK(bad("b.txt", "1 99999999999999999999999\n", 0,
+              "1: coordinate 99999999999999999999999 does not fit in 32 bits"));
+    CHECK(bad("b.txt", "1 2\n\nabc 3\n", 0, "3: 'abc' is not a number"));
+    CHECK(bad("b.txt", "1,2 3\n", 0, "1: '1,2' is not a number"));
+    CHECK(bad("b.txt", "1 2\n- 3\n", 0, "2: '-' is not a number"));
+    CHECK(bad("b.txt", "1 0x10\n", 0, "1: '0x10' is not a number"));
+    CHECK(bad("b.txt", "1 \x01\n", 0, "1: '\\x01' is not a number"));
+    CHECK(bad("b.txt", "1.5 2\n", 0,
+              "1: coordinate 1.5 is not an integer (decimal coordinates need --scale K)"));
+    CHECK(bad("b.txt", "1 2e3\n", 0,
+              "1: coordinate 2e3 is not an integer (decimal coordinates need --scale K)"));
+    CHECK(bad("b.txt", "1 2\n7\n", 0, "2: missing y coordinate"));
+    CHECK(bad("b.txt", "7 # 8\n", 0, "1: missing y coordinate"));
+    CHECK(bad("b.txt", "1 2 3\n", 0,
+              "1: unexpected '3' after the coordinates (one point 'x y' per line)"));
+    CHECK(bad("b.txt", "1 2\r\n3 4 junk\r\n", 0,
+              "2: unexpected 'junk' after the coordinates (one point 'x y' per line)"));
+    CHECK(bad("b.txt", "1 abc\n", 1000, "1: 'abc' is not a number"));
+    CHECK(bad("b.txt", "1 3000000\n", 1000,
+              "1: coordinate 3000000 times scale 1000 does not fit in 32 bits"));
+    CHECK(bad("b.txt", "1 1e999\n", 10, "1: coordinate 1e999 times scale 10 does not fit in 32 bits"));
+}
+
+TEST(file_errors)
+{
+    pdt_point *p;
+    size_t n;
+    pdt_err err;
+    pdt_err_clear(&err);
+    CHECK(pdt_read_points(dir, 0, &p, &n, NULL, &err) == PDT_ERR_IO);
+    char want[256];
+    snprintf(want, sizeof want, "%s: is a directory", dir);
+    CHECK_MSG(strcmp(err.msg, want) == 0, "%s", err.msg);
+    pdt_err_clear(&err);
+    CHECK(pdt_read_points(path("missing.txt"), 0, &p, &n, NULL, &err) == PDT_ERR_IO);
+    snprintf(want, sizeof want, "%s: cannot open: No such file or directory", path("missing.txt"));
+    CHECK_MSG(strcmp(err.msg, want) == 0, "%s", err.msg);
+    pdt_err_clear(&err);
+    CHECK(pdt_read_points(path("x.txt"), -1, &p, &n, NULL, &err) == PDT_ERR_ARG);
+    if (geteuid() != 0) { /* root reads everything */
+        put("noread.txt", "1 2\n");
+        chmod(path("noread.txt"), 0);
+        pdt_err_clear(&err);
+        CHECK(pdt_read_points(path("noread.txt"), 0, &p, &n, NULL, &err) == PDT_ERR_IO);
+        CHECK(strstr(err.msg, "cannot open: Permission denied") != NULL);
+    }
+}
+
+TEST(node_format)
+{
+    pdt_point *p;
+    size_t n;
+    pdt_err err;
+    /* Triangle's own style: 1-based, attributes, markers, comments. */
+    pdt_status st = rd("a.node",
+                       "# made by hand\n"
+                       "3 2 1 1\n"
+                       "1 10 20 0.5 0\n"
+                       "2 -5 7 1e3 1  # comment\n"
+                       "3 0 0 -2 1\n",
+                       0, &p, &n, NULL, &err);
+    CHECK_MSG(st == PDT_OK && n == 3, "%s", err.msg);
+    if (st == PDT_OK && n == 3) CHECK(p[0].x == 10 && p[1].x == -5 && p[1].y == 7 && p[2].y == 0);
+    free(p);
+    /* 0-based, header with only count and dimension. */
+    st = rd("b.node", "2 2\n0 1 1\n1 2 2\n", 0, &p, &n, NULL, &err);
+    CHECK_MSG(st == PDT_OK && n == 2, "%s", err.msg);
+    free(p);
+    CHECK(bad("c.node", "3 3 0 0\n", 0, "1: .node header says dimension 3; only 2 is supported"));
+    CHECK(bad("c.node", "x 2 0 0\n", 0, "1: bad point count in the .node header 'x'"));
+    CHECK(bad("c.node", "-1 2 0 0\n", 0, "1: bad point count in the .node header '-1'"));
+    CHECK(bad("c.node", "2 2 0 2\n", 0, "1: .node header says 2 boundary markers; must be 0 or 1"));
+    CHECK(bad("c.node", "2 2 0 0 9\n", 0,
+              "1: unexpected '9' after the .node header (count, 2, attributes, markers)"));
+    CHECK(bad("c.node", "3 2 0 0\n0 1 1\n1 2 2\n", 0,
+              "3: file ends after 2 of the 3 points the header announces"));
+    CHECK(bad("c.node", "1 2 0 0\n0 1 1\n1 2 2\n", 0,
+              "3: more points than the 1 the header announces"));
+    CHECK(bad("c.node", "2 2 0 0\n0 1 1\n2 2 2\n", 0, "3: point index 2 out of order (expected 1)"));
+    CHECK(bad("c.node", "2 2 0 0\n5 1 1\n", 0, "2: first point index is 5; must be 0 or 1"));
+    CHECK(bad("c.node", "1 2 1 0\n0 1 1\n", 0, "2: missing attribute 1 of 1"));
+    CHECK(bad("c.node", "1 2 1 0\n0 1 1 q\n", 0, "2: attribute 'q' is not a number"));
+    CHECK(bad("c.node", "1 2 0 1\n0 1 1\n", 0, "2: missing boundary marker"));
+    CHECK(bad("c.node", "1 2 0 1\n0 1 1 0.5\n", 0, "2: boundary marker '0.5' is not an integer"));
+    CHECK(bad("c.node", "1 2 0 0\n0 1 1 4\n", 0,
+              "2: unexpected '4' after the point (index x y, attributes, marker)"));
+    CHECK(bad("c.node", "1 2 0 0\n0 1 4294967296\n", 0,
+              "2: coordinate 4294967296 does not fit in 32 bits"));
+}
+
+TEST(scale_rounding)
+{
+    pdt_point *p;
+    size_t n, coll = 99;
+    pdt_err err;
+    pdt_status st = rd("s.txt",
+                       "0.15 0.25\n"      /* 1.5 -> 2, 2.5 -> 3: halves away from zero */
+                       "-0.15 -0.25\n"    /* -2, -3 */
+                       "1e-3 2.5E2\n"     /* 0.01 -> 0, 2500 */
+                       "0.0000000000000000000000001 -0\n" /* 0, 0 */
+                       "214748364.7 -214748364.8\n", /* the int32 extremes */
+                       10, &p, &n, &coll, &err);
+    CHECK_MSG(st == PDT_OK && n == 5, "%s", err.msg);
+    if (st == PDT_OK && n == 5) {
+        CHECK_MSG(p[0].x == 2 && p[0].y == 3, "%d %d", p[0].x, p[0].y);
+        CHECK(p[1].x == -2 && p[1].y == -3);
+        CHECK(p[2].x == 0 && p[2].y == 2500);
+        CHECK(p[3].x == 0 && p[3].y == 0);
+        CHECK(p[4].x == INT32_MAX && p[4].y == INT32_MIN);
+    }
+    CHECK(coll == 0); /* no two rounded points are equal */
+    free(p);
+    /* Non-integer scale goes through double arithmetic. */
+    st = rd("s2.txt", "1.5 2\n", 0.5, &p, &n, &coll, &err);
+    CHECK(st == PDT_OK && n == 1 && p[0].x == 1 && p[0].y == 1);
+    free(p);
+}
+
+TEST(scale_collisions)
+{
+    pdt_point *p;
+    size_t n, coll = 99;
+    pdt_err err;
+    pdt_status st = rd("c.txt",
+                       "1.04 2\n"
+                       "1.0 2\n"   /* collides with 1.04 */
+                       "1 2.00\n"  /* same value as 1.0 2: a duplicate, not a collision */
+                       "0.96 2\n"  /* collides */
+                       "5 5\n"
+                       "5 5\n",    /* exact duplicate: not a collision */
+                       10, &p, &n, &coll, &err);
+    CHECK_MSG(st == PDT_OK && n == 6, "%s", err.msg);
+    CHECK_MSG(coll == 2, "collisions %zu", coll);
+    if (st == PDT_OK)
+        CHECK(p[0].x == 10 && p[1].x == 10 && p[2].x == 10 && p[3].x == 10 && p[0].y == 20);
+    free(p);
+    /* Without scale nothing is counted. */
+    st = rd("c2.txt", "1 2\n1 2\n", 0, &p, &n, &coll, &err);
+    CHECK(st == PDT_OK && coll == 0);
+    free(p);
+}
+
+TEST(points_write_roundtrip)
+{
+    clean();
+    pdt_point pts[3] = { { 0, 0 }, { INT32_MIN, INT32_MAX }, { -7, 12 } };
+    pdt_err err;
+    pdt_err_clear(&err);
+    CHECK(pdt_write_points(path("w.txt"), pts, 3, &err) == PDT_OK);
+    char *t = slurp(path("w.txt"));
+    CHECK(t && strcmp(t, "0 0\n-2147483648 2147483647\n-7 12\n") == 0);
+    free(t);
+    CHECK(pdt_write_points(path("w.node"), pts, 3, &err) == PDT_OK);
+    pdt_point *p;
+    size_t n;
+    CHECK(pdt_read_points(path("w.node"), 0, &p, &n, NULL, &err) == PDT_OK && n == 3);
+    CHECK(n == 3 && memcmp(p, pts, sizeof pts) == 0);
+    free(p);
+    CHECK(entries() == 2); /* no temporaries left */
+}
+
+TEST(tris_write_formats)
+{
+    clean();
+    pdt_point pts[4] = { { 0, 0 }, { 10, 0 }, { 0, 10 }, { 10, 10 } };
+    pdt_tri t[2] = { { { 0, 1, 3 } }, { { 0, 3, 2 } } };
+    pdt_err err;
+    pdt_err_clear(&err);
+    CHECK(pdt_tri_format_of("x.tri") == PDT_FMT_TRI && pdt_tri_format_of(NULL) == PDT_FMT_TRI &&
+          pdt_tri_format_of("x.ele") == PDT_FMT_ELE && pdt_tri_format_of("a/x.off") == PDT_FMT_OFF);
+    CHECK(pdt_write_tris(path("t.tri"), PDT_FMT_TRI, pts, 4, t, 2, &err) == PDT_OK);
+    char *s = slurp(path("t.tri"));
+    CHECK(s && strcmp(s, "0 1 3\n0 3 2\n") == 0);
+    free(s);
+    CHECK(pdt_write_tris(path("t.off"), PDT_FMT_OFF, pts, 4, t, 2, &err) == PDT_OK);
+    s = slurp(path("t.off"));
+    CHECK(s && strcmp(s, "OFF\n4 2 0\n0 0 0\n10 0 0\n0 10 0\n10 10 0\n3 0 1 3\n3 0 3 2\n") == 0);
+    free(s);
+    CHECK(pdt_write_tris(path("t.ele"), PDT_FMT_ELE, pts, 4, t, 2, &err) == PDT_OK);
+    s = slurp(path("t.ele"));
+    CHECK(s && strstr(s, "2 3 0\n0 0 1 3\n1 0 3 2\n") != NULL);
+    free(s);
+    /* Both read back. */
+    pdt_point *p;
+    size_t n;
+    CHECK(pdt_read_points(path("t.node"), 0, &p, &n, NULL, &err) == PDT_OK && n == 4 &&
+          memcmp(p, pts, sizeof pts) == 0);
+    free(p);
+    pdt_tri *r;
+    size_t nr;
+    CHECK(pdt_read_tris(path("t.ele"), &r, &nr, &err) == PDT_OK && nr == 2 &&
+          memcmp(r, t, sizeof t) == 0);
+    free(r);
+    CHECK(pdt_read_tris(path("t.tri"), &r, &nr, &err) == PDT_OK && nr == 2 &&
+          memcmp(r, t, sizeof t) == 0);
+    free(r);
+    CHECK(entries() == 4); /* t.tri t.off t.ele t.node */
+    pdt_err_clear(&err);
+    CHECK(pdt_write_tris("-", PDT_FMT_ELE, pts, 4, t, 2, &err) == PDT_ERR_ARG);
+}
+
+/* Expect reading triangles `text` as `name` (with npts points) to fail with msg. */
+static int badtri(const char *name, const char *text, size_t npts, const char *msg)
+{
+    put(name, text);
+    pdt_tri *t = NULL;
+    size_t n = 5;
+    pdt_err err;
+    pdt_err_clear(&err);
+    pdt_status st = pdt_read_tris_n(path(name), npts, &t, &n, &err);
+    char want[512];
+    snprintf(want, sizeof want, "%s:%s", path(name), msg);
+    int ok = st == PDT_ERR_PARSE && strcmp(err.msg, want) == 0 && !t && n == 0;
+    if (!ok) printf("#   want [%s]\n#   got  [%s]\n", want, err.msg);
+    return ok;
+}
+
+TEST(tris_read_bad_inputs)
+{
+    CHECK(badtri("b.tri", "0 1 2\n0 1\n", 10, "2: missing point index"));
+    CHECK(badtri("b.tri", "0 1 x\n", 10, "1: point index 'x' is not a whole number"));
+    CHECK(badtri("b.tri", "0 1 -2\n", 10, "1: point index -2 is out of range"));
+    CHECK(badtri("b.tri", "0 1 2 3\n", 10,
+                 "1: unexpected '3' after the three point indices (one triangle 'i j k' per line)"));
+    CHECK(badtri("b.tri", "# c\n0 1 2\n0 1 12\n", 10, "3: point index 12 out of range (10 points)"));
+    CHECK(badtri("b.ele", "1 6 0\n", 10, "1: .ele header says 6 points per triangle; only 3 is supported"));
+    CHECK(badtri("b.ele", "2 3 0\n1 1 2 3\n", 10,
+                 "2: file ends after 1 of the 2 triangles the header announces"));
+    CHECK(badtri("b.ele", "1 3 0\n1 0 2 3\n", 10, "2: point index 0 is below the first index 1"));
+    CHECK(badtri("b.ele", "1 3 0\n0 0 1 2\n1 0 1 2\n", 10,
+                 "3: more triangles than the 1 the header announces"));
+    /* 1-based .ele: indices shift down by one. */
+    put("g.ele", "1 3 1\n1 1 2 3 0.5\n");
+    pdt_tri *t;
+    size_t n;
+    pdt_err err;
+    pdt_err_clear(&err);
+    CHECK(pdt_read_tris_n(path("g.ele"), 3, &t, &n, &err) == PDT_OK && n == 1 && t[0].v[0] == 0 &&
+          t[0].v[2] == 2);
+    free(t);
+}
+
+TEST(atomic_write_leaves_nothing)
+{
+    clean();
+    pdt_err err;
+    pdt_outfile o;
+    /* Abort: neither the target nor a temporary remains. */
+    pdt_err_clear(&err);
+    CHECK(pdt_out_open(&o, path("x.tri"), &err) == PDT_OK);
+    fputs("0 1 2\n", o.fp);
+    CHECK(entries() == 1); /* the temporary */
+    pdt_out_abort(&o);
+    CHECK(entries() == 0);
+    /* An existing file is untouched by an aborted write and replaced by a committed one. */
+    put("keep.tri", "old\n");
+    CHECK(pdt_out_open(&o, path("keep.tri"), &err) == PDT_OK);
+    fputs("new\n", o.fp);
+    char *s = slurp(path("keep.tri"));
+    CHECK(s && strcmp(s, "old\n") == 0);
+    free(s);
+    pdt_out_abort(&o);
+    s = slurp(path("keep.tri"));
+    CHECK(s && strcmp(s, "old\n") == 0);
+    free(s);
+    CHECK(pdt_out_open(&o, path("keep.tri"), &err) == PDT_OK);
+    fputs("new\n", o.fp);
+    CHECK(pdt_out_commit(&o, &err) == PDT_OK);
+    s = slurp(path("keep.tri"));
+    CHECK(s && strcmp(s, "new\n") == 0);
+    free(s);
+    CHECK(entries() == 1);
+    /* A target in a missing directory, or a directory: an error, nothing made. */
+    pdt_err_clear(&err);
+    CHECK(pdt_out_open(&o, path("nodir/x.tri"), &err) == PDT_ERR_IO);
+    CHECK_MSG(strstr(err.msg, "nodir/x.tri: cannot create: No such file or directory") != NULL,
+              "%s", err.msg);
+    pdt_err_clear(&err);
+    CHECK(pdt_out_open(&o, dir, &err) == PDT_ERR_IO && strstr(err.msg, "is a directory"));
+    CHECK(entries() == 1);
+    /* A write error (the device is full) at commit: error, nothing left. */
+    if (access("/dev/full", W_OK) == 0) {
+        pdt_err_clear(&err);
+        CHECK(pdt_out_open(&o, "-", &err) == PDT_OK && o.fp == stdout);
+        FILE *full = fopen("/dev/full", "w");
+        if (full) {
+            o.fp = full; /* standard-output mode on a device that fails */
+            fputs("0 1 2\n", full);
+            CHECK(pdt_out_commit(&o, &err) == PDT_ERR_IO);
+            CHECK_MSG(strstr(err.msg, "write error") != NULL, "%s", err.msg);
+            fclose(full);
+        }
+    }
+}
+
+int main(void)
+{
+    snprintf(dir, sizeof dir, "%s/pdt-io.XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
+    if (!mkdtemp(dir)) {
+        perror("mkdtemp");
+        return 1;
+    }
+    RUN(text_basic);
+    RUN(empty_file_is_zero_points);
+    RUN(text_bad_inputs);
+    RUN(file_errors);
+    RUN(node_format);
+    RUN(scale_rounding);
+    RUN(scale_collisions);
+    RUN(points_write_roundtrip);
+    RUN(tris_write_formats);
+    RUN(tris_read_bad_inputs);
+    RUN(atomic_write_leaves_nothing);
+    clean();
+    rmdir(dir);
+    return test_summary();
+}
