@@ -1,0 +1,356 @@
+/* The Delaunay kernel and pipeline: equal to the brute-force lift-up oracle
+ * on thousands of small inputs from every generator family and on hand-made
+ * degenerate sets; traces; sort/dedupe; canonical order. */
+#include "../harness.h"
+#include "pdt/check.h"
+#include "pdt/delaunay.h"
+#include "pdt/gen.h"
+#include "pdt/predicates.h"
+
+#include <string.h>
+
+static pdt_point P(int x, int y)
+{
+    pdt_point p = {x, y};
+    return p;
+}
+
+static uint64_t rs = 0x9E3779B97F4A7C15u;
+static uint64_t xr(void)
+{
+    rs ^= rs << 13;
+    rs ^= rs >> 7;
+    rs ^= rs << 17;
+    return rs;
+}
+
+/* pdt_triangulate == pdt_brute_delaunay; returns 1 if equal.  *nt gets the
+ * triangle count. */
+static int same_as_oracle(const pdt_point *p, size_t n, size_t *nt)
+{
+    pdt_tri *a = NULL, *b = NULL;
+    size_t na = 0, nb = 0;
+    pdt_tri_stats st;
+    if (pdt_triangulate(p, n, &a, &na, &st, NULL) != PDT_OK) return 0;
+    if (pdt_brute_delaunay(p, n, &b, &nb) != PDT_OK) {
+        free(a);
+        return 0;
+    }
+    int ok = na == nb && (na == 0 || memcmp(a, b, na * sizeof *a) == 0);
+    ok = ok && st.n_tri == na && st.n_in == n && st.n_unique + st.n_dup == n;
+    ok = ok && (na == 0) == (st.collinear != 0);
+    if (na) ok = ok && na == 2 * st.n_unique - st.n_hull - 2;
+    if (nt) *nt = na;
+    free(a);
+    free(b);
+    return ok;
+}
+
+TEST(oracle_every_gen_family)
+{
+    const char *const *k = pdt_gen_kinds();
+    int runs = 0, bad = 0;
+    for (; *k; k++) {
+        for (size_t n = 0; n <= 40; n++) {
+            int seeds = n < 12 ? 12 : 5;
+            for (int s = 0; s < seeds; s++) {
+                pdt_point *p;
+                if (pdt_gen(*k, n, (uint64_t)(1000 * n + (size_t)s), &p, NULL) != PDT_OK) {
+                    bad++;
+                    continue;
+                }
+                runs++;
+                if (!same_as_oracle(p, n, NULL)) {
+                    if (bad < 3) printf("#   %s n=%zu seed %d differs\n", *k, n, s);
+                    bad++;
+                }
+                free(p);
+            }
+        }
+    }
+    CHECK_MSG(bad == 0, "%d of %d runs differ", bad, runs);
+    CHECK(runs > 2000);
+}
+
+TEST(oracle_random_small_ranges)
+{
+    /* coordinates from tiny ranges: collinear triples, cocircular
+     * quadruples and duplicates everywhere */
+    int bad = 0;
+    pdt_point p[40];
+    for (int it = 0; it < 3000; it++) {
+        size_t n = (size_t)(xr() % 30);
+        int range = it % 3 == 0 ? 3 : it % 3 == 1 ? 6 : 20;
+        for (size_t i = 0; i < n; i++) p[i] = P((int)(xr() % (uint64_t)range) - range / 2, (int)(xr() % (uint64_t)range));
+        if (!same_as_oracle(p, n, NULL)) bad++;
+    }
+    CHECK_MSG(bad == 0, "%d differ", bad);
+}
+
+TEST(tiny_inputs)
+{
+    pdt_point p[3] = {P(0, 0), P(5, 1), P(2, 7)};
+    size_t nt = 99;
+    for (size_t n = 0; n <= 2; n++) {
+        CHECK(same_as_oracle(p, n, &nt));
+        CHECK(nt == 0);
+    }
+    pdt_tri *t;
+    CHECK(pdt_triangulate(p, 3, &t, &nt, NULL, NULL) == PDT_OK);
+    CHECK(nt == 1 && t[0].v[0] == 0 && t[0].v[1] == 1 && t[0].v[2] == 2);
+    free(t);
+    pdt_point q[3] = {P(0, 0), P(2, 7), P(5, 1)}; /* clockwise input */
+    CHECK(pdt_triangulate(q, 3, &t, &nt, NULL, NULL) == PDT_OK);
+    CHECK(nt == 1 && t[0].v[0] == 0 && t[0].v[1] == 2 && t[0].v[2] == 1);
+    free(t);
+}
+
+TEST(all_collinear)
+{
+    pdt_point p[50];
+    size_t nt = 99;
+    for (int i = 0; i < 50; i++) p[i] = P(7 * ((i * 17) % 50) - 3, 3 * ((i * 17) % 50) + 1);
+    pdt_tri_stats st;
+    pdt_tri *t;
+    CHECK(pdt_triangulate(p, 50, &t, &nt, &st, NULL) == PDT_OK);
+    CHECK(nt == 0 && st.collinear == 1);
+    free(t);
+    CHECK(same_as_oracle(p, 20, &nt) && nt == 0);
+}
+
+TEST(vertical_line)
+{
+    pdt_point p[30];
+    size_t nt = 99;
+    for (int i = 0; i < 30; i++) p[i] = P(4, (i * 7) % 30);
+    CHECK(same_as_oracle(p, 30, &nt) && nt == 0);
+    for (int i = 0; i < 30; i++) p[i] = P((i * 7) % 30, -2); /* horizontal */
+    CHECK(same_as_oracle(p, 30, &nt) && nt == 0);
+}
+
+TEST(line_plus_one_point)
+{
+    pdt_point p[21];
+    size_t nt;
+    for (int i = 0; i < 20; i++) p[i] = P(i, 0);
+    p[20] = P(9, 5);
+    CHECK(same_as_oracle(p, 21, &nt) && nt == 19);
+    p[20] = P(-3, 1); /* off to the side */
+    CHECK(same_as_oracle(p, 21, &nt) && nt == 19);
+    for (int i = 0; i < 20; i++) p[i] = P(0, i); /* vertical line + 1 */
+    p[20] = P(1, 30);
+    CHECK(same_as_oracle(p, 21, &nt) && nt == 19);
+}
+
+TEST(four_cocircular)
+{
+    pdt_point sq[4] = {P(0, 0), P(1, 0), P(0, 1), P(1, 1)};
+    pdt_tri *t;
+    size_t nt;
+    CHECK(pdt_triangulate(sq, 4, &t, &nt, NULL, NULL) == PDT_OK);
+    /* the anti-diagonal (1,0)-(0,1), i.e. indices 1-2, splits the square */
+    CHECK(nt == 2);
+    if (nt == 2) {
+        CHECK(t[0].v[0] == 0 && t[0].v[1] == 1 && t[0].v[2] == 2);
+        CHECK(t[1].v[0] == 1 && t[1].v[1] == 3 && t[1].v[2] == 2);
+    }
+    free(t);
+    pdt_point kite[4] = {P(5, 0), P(0, 5), P(-5, 0), P(0, -5)};
+    CHECK(same_as_oracle(kite, 4, &nt) && nt == 2);
+    pdt_point circ[4] = {P(3, 4), P(-4, 3), P(-3, -4), P(5, 0)};
+    CHECK(same_as_oracle(circ, 4, &nt) && nt == 2);
+}
+
+TEST(grid_cocircular)
+{
+    pdt_point p[100];
+    size_t nt;
+    for (int k = 2; k <= 10; k++) {
+        for (int i = 0; i < k * k; i++) p[i] = P(i % k, i / k);
+        CHECK(same_as_oracle(p, (size_t)(k * k), &nt));
+        CHECK(nt == (size_t)(2 * (k - 1) * (k - 1)));
+    }
+    /* every unit square split by its anti-diagonal */
+    for (int i = 0; i < 25; i++) p[i] = P(i % 5, i / 5);
+    pdt_tri *t;
+    CHECK(pdt_triangulate(p, 25, &t, &nt, NULL, NULL) == PDT_OK);
+    int diag = 0;
+    for (size_t i = 0; i < nt; i++)
+        for (int e = 0; e < 3; e++) {
+            pdt_point a = p[t[i].v[e]], b = p[t[i].v[(e + 1) % 3]];
+            if (a.x != b.x && a.y != b.y) {
+                diag++;
+                CHECK((b.x - a.x) * (b.y - a.y) < 0); /* anti-diagonal */
+            }
+        }
+    CHECK(diag == 2 * 16);
+    free(t);
+}
+
+TEST(lattice_circle_65)
+{
+    pdt_point c[36];
+    int m = 0;
+    for (int x = -65; x <= 65; x++)
+        for (int y = -65; y <= 65; y++)
+            if (x * x + y * y == 65 * 65) c[m++] = P(x, y);
+    size_t nt;
+    CHECK(m == 36);
+    CHECK(same_as_oracle(c, 36, &nt) && nt == 34);
+    /* replace one circle point by the centre: it is strictly inside every
+     * circle through three circle points, so it is joined to all 35 */
+    c[0] = P(0, 0);
+    CHECK(same_as_oracle(c, 36, &nt) && nt == 35);
+}
+
+TEST(duplicate_points)
+{
+    pdt_point p[12] = {P(0, 0), P(4, 0), P(0, 4), P(4, 0), P(1, 1), P(0, 0),
+                       P(4, 4), P(1, 1), P(4, 4), P(0, 4), P(2, 3), P(2, 3)};
+    pdt_tri *t;
+    size_t nt;
+    pdt_tri_stats st;
+    CHECK(pdt_triangulate(p, 12, &t, &nt, &st, NULL) == PDT_OK);
+    CHECK(st.n_unique == 6 && st.n_dup == 6);
+    for (size_t i = 0; i < nt; i++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t v = t[i].v[k];
+            CHECK(v == 0 || v == 1 || v == 2 || v == 4 || v == 6 || v == 10);
+        }
+    free(t);
+    CHECK(same_as_oracle(p, 12, &nt));
+    pdt_point same[5] = {P(3, 3), P(3, 3), P(3, 3), P(3, 3), P(3, 3)};
+    CHECK(same_as_oracle(same, 5, &nt) && nt == 0);
+}
+
+TEST(int32_extreme_coordinates)
+{
+    pdt_point p[] = {P(INT32_MIN, INT32_MIN), P(INT32_MAX, INT32_MIN), P(INT32_MAX, INT32_MAX),
+                     P(INT32_MIN, INT32_MAX), P(0, 0), P(INT32_MIN + 1, INT32_MAX - 1),
+                     P(1, -1), P(INT32_MAX, 0), P(-5, INT32_MAX)};
+    size_t nt;
+    CHECK(same_as_oracle(p, sizeof p / sizeof *p, &nt) && nt > 0);
+}
+
+TEST(sort_unique_keeps_smallest_index)
+{
+    pdt_point p[8] = {P(3, 1), P(-2, 5), P(3, 1), P(-2, -5), P(0, 0), P(-2, 5), P(3, 0), P(0, 0)};
+    uint32_t o[8];
+    size_t nu;
+    CHECK(pdt_sort_unique(p, 8, o, &nu) == PDT_OK);
+    static const uint32_t want[] = {3, 1, 4, 6, 0};
+    CHECK(nu == 5);
+    for (size_t i = 0; i < 5 && i < nu; i++) CHECK_MSG(o[i] == want[i], "o[%zu] = %u", i, o[i]);
+    /* a large random case: strictly increasing keys, each the first index */
+    size_t n = 200000;
+    pdt_point *q = malloc(n * sizeof *q);
+    uint32_t *u = malloc(n * sizeof *u);
+    for (size_t i = 0; i < n; i++) q[i] = P((int)(xr() % 300) - 150, (int)(int32_t)(uint32_t)xr() % 1000);
+    CHECK(pdt_sort_unique(q, n, u, &nu) == PDT_OK);
+    int bad = 0;
+    for (size_t i = 1; i < nu; i++) bad += pdt_key(q[u[i - 1]]) >= pdt_key(q[u[i]]);
+    for (size_t i = 0; i < n; i++) /* every point has a representative <= i */
+        if (i % 1000 == 0) {
+            size_t lo = 0, hi = nu;
+            while (lo < hi) {
+                size_t mid = (lo + hi) / 2;
+                if (pdt_key(q[u[mid]]) < pdt_key(q[i])) lo = mid + 1; else hi = mid;
+            }
+            bad += lo == nu || pdt_key(q[u[lo]]) != pdt_key(q[i]) || u[lo] > i;
+        }
+    CHECK_MSG(bad == 0, "%d bad", bad);
+    free(q);
+    free(u);
+}
+
+TEST(canonical_order)
+{
+    pdt_tri t[4] = {{{5, 2, 9}}, {{1, 7, 3}}, {{4, 0, 6}}, {{2, 9, 5}}};
+    pdt_tri_canonical(t, 4);
+    CHECK(t[0].v[0] == 0 && t[0].v[1] == 6 && t[0].v[2] == 4);
+    CHECK(t[1].v[0] == 1 && t[1].v[1] == 7 && t[1].v[2] == 3);
+    CHECK(t[2].v[0] == 2 && t[2].v[1] == 9 && t[2].v[2] == 5);
+    CHECK(t[3].v[0] == 2 && t[3].v[1] == 9 && t[3].v[2] == 5);
+}
+
+TEST(trace_events)
+{
+    pdt_point *p;
+    size_t n = 300, nt;
+    CHECK(pdt_gen("uniform", n, 7, &p, NULL) == PDT_OK);
+    p[5] = p[17]; /* one duplicate */
+    pdt_trace tr;
+    pdt_trace_buf buf;
+    pdt_trace_buf_init(&tr, &buf, 2, 0);
+    pdt_tri *t;
+    pdt_tri_stats st;
+    CHECK(pdt_triangulate(p, n, &t, &nt, &st, &tr) == PDT_OK);
+    size_t lift = 0, tri = 0, add = 0, del = 0, bad = 0;
+    for (size_t i = 0; i < buf.n; i++) {
+        const pdt_event *e = &buf.ev[i];
+        if (e->kind == PDT_EV_LIFT) {
+            lift++;
+            bad += e->a >= n || e->a == 17 ||
+                   (uint64_t)e->v != (uint64_t)((int64_t)p[e->a].x * p[e->a].x + (int64_t)p[e->a].y * p[e->a].y);
+        }
+        if (e->kind == PDT_EV_TRI_NEW) {
+            tri++;
+            bad += e->sub != 0 || pdt_orient(p[e->a], p[e->b], p[e->c]) <= 0;
+        }
+        add += e->kind == PDT_EV_EDGE_ADD;
+        del += e->kind == PDT_EV_EDGE_DEL;
+    }
+    CHECK(lift == n - 1 && tri == nt && bad == 0);
+    /* edges alive at the end: 3n - 3 - h */
+    CHECK_MSG(add - del == 3 * st.n_unique - 3 - st.n_hull, "add %zu del %zu", add, del);
+    CHECK(buf.ev[0].kind == PDT_EV_PHASE_BEGIN && buf.ev[buf.n - 1].kind == PDT_EV_PHASE_END);
+    free(t);
+    pdt_trace_buf_free(&buf);
+    /* level 1: no edge events */
+    pdt_trace_buf_init(&tr, &buf, 1, 0);
+    CHECK(pdt_triangulate(p, n, &t, &nt, &st, &tr) == PDT_OK);
+    for (size_t i = 0; i < buf.n; i++) CHECK(buf.ev[i].kind != PDT_EV_EDGE_ADD);
+    free(t);
+    pdt_trace_buf_free(&buf);
+    free(p);
+}
+
+TEST(symmetric_parabola_and_circle_large)
+{
+    /* O(n log n) on the classic quadratic cases: just run them (a quadratic
+     * kernel would take minutes here) and count */
+    pdt_point *p;
+    pdt_tri *t;
+    size_t nt;
+    pdt_tri_stats st;
+    CHECK(pdt_gen("parabola", 80000, 1, &p, NULL) == PDT_OK);
+    CHECK(pdt_triangulate(p, 80000, &t, &nt, &st, NULL) == PDT_OK);
+    CHECK(nt == 80000 - 2 && st.n_hull == 80000);
+    free(t);
+    free(p);
+    CHECK(pdt_gen("circle", 4860, 1, &p, NULL) == PDT_OK);
+    CHECK(pdt_triangulate(p, 4860, &t, &nt, &st, NULL) == PDT_OK);
+    CHECK(nt == 4860 - 2);
+    free(t);
+    free(p);
+}
+
+int main(void)
+{
+    RUN(oracle_every_gen_family);
+    RUN(oracle_random_small_ranges);
+    RUN(tiny_inputs);
+    RUN(all_collinear);
+    RUN(vertical_line);
+    RUN(line_plus_one_point);
+    RUN(four_cocircular);
+    RUN(grid_cocircular);
+    RUN(lattice_circle_65);
+    RUN(duplicate_points);
+    RUN(int32_extreme_coordinates);
+    RUN(sort_unique_keeps_smallest_index);
+    RUN(canonical_order);
+    RUN(trace_events);
+    RUN(symmetric_parabola_and_circle_large);
+    return test_summary();
+}
