@@ -1,0 +1,93 @@
+/* pdt — Phase 0 of SRM: sorting keys, splitters, duplicates (algorithm.md §3.2).
+ *
+ * The collective part (scatter, sample exchange, all-to-all) is in driver.c;
+ * here are the local building blocks. */
+#include "srm.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* Stable LSD radix sort on the 64-bit key, 16 bits per pass; passes in which
+ * every record has the same digit are skipped (small coordinates leave the
+ * high digits constant). */
+void srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n)
+{
+    if (n < 2) return;
+    enum { BITS = 16, B = 1 << BITS, PASSES = 64 / BITS };
+    size_t *hist = calloc((size_t)PASSES * B, sizeof *hist);
+    if (!hist) { /* fall back to insertion-free merge sort: rare path */
+        /* Stable bottom-up merge sort using tmp. */
+        srm_rec *src = r, *dst = tmp;
+        for (size_t w = 1; w < n; w *= 2) {
+            for (size_t lo = 0; lo < n; lo += 2 * w) {
+                size_t mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
+                size_t i = lo, j = mid, k = lo;
+                while (i < mid && j < hi) dst[k++] = src[j].key < src[i].key ? src[j++] : src[i++];
+                while (i < mid) dst[k++] = src[i++];
+                while (j < hi) dst[k++] = src[j++];
+            }
+            srm_rec *t = src;
+            src = dst;
+            dst = t;
+        }
+        if (src != r) memcpy(r, src, n * sizeof *r);
+        return;
+    }
+    for (size_t i = 0; i < n; i++)
+        for (int p = 0; p < PASSES; p++) hist[(size_t)p * B + ((r[i].key >> (p * BITS)) & (B - 1))]++;
+    srm_rec *src = r, *dst = tmp;
+    for (int p = 0; p < PASSES; p++) {
+        size_t *h = hist + (size_t)p * B;
+        unsigned d0 = (unsigned)((r[0].key >> (p * BITS)) & (B - 1));
+        if (h[d0] == n) continue; /* all records share this digit */
+        size_t sum = 0;
+        for (size_t d = 0; d < B; d++) {
+            size_t c = h[d];
+            h[d] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++) dst[h[(src[i].key >> (p * BITS)) & (B - 1)]++] = src[i];
+        srm_rec *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != r) memcpy(r, src, n * sizeof *r);
+    free(hist);
+}
+
+size_t srm_dedupe(srm_rec *r, size_t n)
+{
+    if (n == 0) return 0;
+    size_t k = 1;
+    for (size_t i = 1; i < n; i++)
+        if (r[i].key != r[k - 1].key) r[k++] = r[i];
+    return k;
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+void srm_pick_splitters(uint64_t *samples, size_t ns, int p, uint64_t *split)
+{
+    qsort(samples, ns, sizeof *samples, cmp_u64);
+    for (int i = 1; i < p; i++) {
+        /* The i-th p-quantile of the samples; with no samples every record
+         * goes to rank 0 (UINT64_MAX splitters). */
+        split[i - 1] = ns ? samples[(size_t)i * ns / (size_t)p] : UINT64_MAX;
+    }
+}
+
+int srm_dest_rank(const uint64_t *split, int p, uint64_t key)
+{
+    /* number of splitters <= key (upper bound): equal keys, same rank */
+    int lo = 0, hi = p - 1;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (split[mid] <= key) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}

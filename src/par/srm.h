@@ -1,0 +1,159 @@
+/* pdt — private interface of the SRM parallel triangulation (src/par).
+ *
+ * Everything here is free of MPI: the driver (driver.c) moves the byte
+ * buffers these functions produce and consume with the pdt_comm wrappers,
+ * and a unit test can move them in-process to simulate any number of ranks.
+ *
+ * Vocabulary (algorithm.md §3): a strip is the lexicographic block of points
+ * owned by one rank; a level-l group is the rank block [j 2^l, (j+1) 2^l);
+ * the merge rank of a pair (G_L, G_R) is the first rank of G_R; the holder of
+ * a group keeps its hull; a pending triangle waits at one rank until the
+ * merge at its "send level". */
+#ifndef PDT_SRM_H
+#define PDT_SRM_H
+
+#include "pdt/common.h"
+#include "pdt/par.h"
+#include "pdt/trace.h"
+
+/* A point with its identity: global input index of its representative. */
+typedef struct srm_pt {
+    int32_t x, y;
+    uint32_t gid;
+} srm_pt;
+
+/* Strip descriptor of one rank (allgathered after the partition). */
+typedef struct srm_strip {
+    uint64_t count;              /* distinct points (0 = empty strip: no box) */
+    uint64_t first_key, last_key;
+    int32_t xmin, xmax, ymin, ymax;
+} srm_strip;
+
+/* A pending triangle (counter-clockwise) and the merge level it waits for. */
+typedef struct srm_tri {
+    srm_pt p[3];
+    int level;
+} srm_tri;
+
+/* ---- partition.c ------------------------------------------------------- */
+
+/* A record of the partition: key and input index. */
+typedef struct srm_rec {
+    uint64_t key;
+    uint32_t idx;
+    uint32_t pad;
+} srm_rec;
+
+/* Stable LSD radix sort of r[0..n) by key (tmp: n scratch records). */
+void srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n);
+
+/* Remove records with equal keys keeping the first; returns the new count. */
+size_t srm_dedupe(srm_rec *r, size_t n);
+
+/* p-1 splitter keys from the pooled samples (sorted in place); rank of a
+ * key = number of splitters <= key. */
+void srm_pick_splitters(uint64_t *samples, size_t ns, int p, uint64_t *split);
+int srm_dest_rank(const uint64_t *split, int p, uint64_t key);
+
+/* Point of a key (inverse of pdt_key). */
+static inline pdt_point srm_key_point(uint64_t key)
+{
+    pdt_point p;
+    p.x = (int32_t)((uint32_t)(key >> 32) ^ 0x80000000u);
+    p.y = (int32_t)((uint32_t)key ^ 0x80000000u);
+    return p;
+}
+
+static inline uint64_t srm_key(srm_pt p)
+{
+    pdt_point q = {p.x, p.y};
+    return pdt_key(q);
+}
+
+/* ---- touch.c: the restricted-area tests (§3.4) ------------------------- */
+
+/* Sound over-approximation of the closed circumdisk of the CCW triangle
+ * (a, b, c): on return the disk is certainly inside the axis box
+ * [*x0, *x1] x [*y0, *y1] and "might touch" a box exactly when
+ * srm_disk_touch says so.  Deterministic: the answer depends only on the
+ * three points as a set. */
+typedef struct srm_disk {
+    double ox, oy;   /* centre, relative to (ax, ay) */
+    double r;        /* radius, already enlarged by the error bound */
+    int64_t ax, ay;  /* origin: the lexicographically smallest vertex */
+    int all;         /* 1: could not bound (degenerate): touches everything */
+} srm_disk;
+
+void srm_disk_of(srm_disk *d, srm_pt a, srm_pt b, srm_pt c);
+/* 0 only if the closed disk certainly misses the closed box. */
+int srm_disk_touch(const srm_disk *d, const srm_strip *box);
+/* x-range of the (enlarged) disk. */
+void srm_disk_xrange(const srm_disk *d, double *lo, double *hi);
+
+/* Exact: 1 if the closed half-plane right of u->v (the restricted area of
+ * the hull edge u->v) meets the closed box. */
+int srm_edge_touch(srm_pt u, srm_pt v, const srm_strip *box);
+
+/* ---- srm.c: the per-rank state machine --------------------------------- */
+
+typedef struct srm_counts {
+    uint64_t local_tris, final_at_once, deferred, shipped, merges, border_max, kept, discarded,
+        final_merge;
+    double critical_path; /* compute seconds along the longest dependent chain */
+} srm_counts;
+
+typedef struct srm_rank {
+    int rank, p, levels;          /* levels = ceil(log2 p) */
+    const srm_strip *strip;       /* p descriptors (not owned) */
+    int *nonempty;                /* ranks with points, in order (x-sorted boxes) */
+    int nne;
+    /* output: final triangles as global indices, CCW */
+    pdt_tri *fin;
+    size_t nfin, capfin;
+    /* pending triangles held here */
+    srm_tri *pend;
+    size_t npend, cappend;
+    /* hull of the group this rank holds (valid if holds_hull) */
+    srm_pt *hull;
+    size_t nhull;
+    int hull_degenerate, holds_hull;
+    srm_counts cnt;
+    pdt_trace *tr;
+    double (*clock)(void *);      /* seconds, for the counts */
+    void *clock_user;
+} srm_rank;
+
+/* Set up (strip: p descriptors, kept by pointer).  Frees with srm_free. */
+pdt_status srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pdt_trace *tr,
+                    pdt_err *err);
+void srm_free(srm_rank *s);
+
+/* Phases 1 and 2 on the local strip: pts[0..m) distinct and lex-sorted,
+ * gid[i] the global index of pts[i].  Lift-up (traced), kernel (run 0),
+ * strip hull (traced pushes and pops), classification. */
+pdt_status srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid, size_t m,
+                     pdt_err *err);
+
+/* Merge schedule.  The pair merged at `level` that contains rank r:
+ * G_L = [gl, gr), G_R = [gr, ge); returns 0 if r's group has no partner at
+ * this level (nothing happens), else 1.  Merge rank = gr. */
+int srm_pair(int r, int p, int level, int *gl, int *gr, int *ge);
+/* The rank holding the hull of the level-`level` group that contains r. */
+int srm_holder(int r, int p, int level);
+
+/* Message from this rank to the merge rank of `level`: its pending
+ * triangles waiting for that level (removed here), and its hull if it holds
+ * the hull of G_L or G_R.  *buf malloc'd.  cp = sender's critical path. */
+pdt_status srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err);
+
+/* At the merge rank: merge the messages of every rank of the pair
+ * (msg[i] from rank gl + i, i = 0 .. ge-gl-1, including this rank's own).
+ * Shipped sets, border set, lift-up, kernel (run 1), selection, discards,
+ * hull merge, reclassification. `cp_in` = max critical path of the senders. */
+pdt_status srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len,
+                     pdt_err *err);
+
+/* ceil(log2 p): the number of merge levels. */
+int srm_ceil_log2(int p);
+
+#endif

@@ -1,0 +1,169 @@
+/* Unit tests of the MPI-free building blocks of the parallel triangulation:
+ * the restricted-area tests against exact arithmetic, the partition helpers
+ * (radix sort, duplicates, splitters) and the merge schedule.
+ *
+ * src/par is linked only into the pdt program, so the sources under test are
+ * compiled into this test directly. */
+#include "../harness.h"
+
+#include <string.h>
+
+#include "../../src/par/partition.c"
+#include "../../src/par/schedule.c"
+#include "../../src/par/touch.c"
+
+static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
+static uint64_t rnd(void)
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return rng_state;
+}
+static int32_t rndi(int32_t lo, int32_t hi) { return lo + (int32_t)(rnd() % (uint64_t)(hi - lo + 1)); }
+
+/* ---- restricted areas ------------------------------------------------------- */
+
+/* Exact: does the closed circumdisk of (a, b, c) meet the closed box?
+ * Small coordinates only (|.| < 2^20) so that everything fits in int128. */
+static int exact_touch(srm_pt a, srm_pt b, srm_pt c, const srm_strip *bx)
+{
+    __int128 bxx = b.x - a.x, byy = b.y - a.y, cxx = c.x - a.x, cyy = c.y - a.y;
+    __int128 D = 2 * (bxx * cyy - byy * cxx);
+    __int128 b2 = bxx * bxx + byy * byy, c2 = cxx * cxx + cyy * cyy;
+    __int128 nx = cyy * b2 - byy * c2, ny = bxx * c2 - cxx * b2;
+    if (D < 0) {
+        D = -D;
+        nx = -nx;
+        ny = -ny;
+    }
+    /* centre = a + (nx, ny) / D; closest box point, coordinates relative to a */
+    __int128 lo[2] = {bx->xmin - a.x, bx->ymin - a.y}, hi[2] = {bx->xmax - a.x, bx->ymax - a.y};
+    __int128 nn[2] = {nx, ny}, cc[2];
+    for (int k = 0; k < 2; k++) cc[k] = nn[k] < lo[k] * D ? lo[k] : nn[k] > hi[k] * D ? hi[k] : 0;
+    /* inside the box in that coordinate: distance 0 there */
+    __int128 dist = 0; /* D^2 * dist^2 */
+    for (int k = 0; k < 2; k++) {
+        __int128 diff = nn[k] < lo[k] * D || nn[k] > hi[k] * D ? cc[k] * D - nn[k] : 0;
+        dist += diff * diff;
+    }
+    __int128 rho = nx * nx + ny * ny; /* D^2 * rho^2 */
+    return dist <= rho;
+}
+
+TEST(touch_is_sound)
+{
+    int wrong = 0, tight = 0, checked = 0;
+    for (int it = 0; it < 200000; it++) {
+        int32_t R = it % 3 == 0 ? 20 : it % 3 == 1 ? 1000 : 1 << 19;
+        srm_pt p[3];
+        for (int k = 0; k < 3; k++) p[k] = (srm_pt){rndi(-R, R), rndi(-R, R), (uint32_t)k};
+        __int128 o = (__int128)(p[1].x - p[0].x) * (p[2].y - p[0].y) -
+                     (__int128)(p[1].y - p[0].y) * (p[2].x - p[0].x);
+        if (o == 0) continue;
+        if (o < 0) {
+            srm_pt t = p[1];
+            p[1] = p[2];
+            p[2] = t;
+        }
+        srm_strip bx = {1, 0, 0, rndi(-2 * R, 2 * R), 0, rndi(-2 * R, 2 * R), 0};
+        bx.xmax = bx.xmin + rndi(0, R);
+        bx.ymax = bx.ymin + rndi(0, R);
+        srm_disk d;
+        srm_disk_of(&d, p[0], p[1], p[2]);
+        int ex = exact_touch(p[0], p[1], p[2], &bx);
+        int ap = srm_disk_touch(&d, &bx);
+        checked++;
+        if (ex && !ap) wrong++;
+        if (ex == ap) tight++;
+    }
+    CHECK_MSG(wrong == 0, "%d of %d unsound answers", wrong, checked);
+    CHECK_MSG(tight > checked * 99 / 100, "only %d of %d exact", tight, checked);
+}
+
+TEST(touch_cocircular_corner)
+{
+    /* (3,4), (-4,3), (5,0) lie on x^2 + y^2 = 25; boxes touching the circle
+     * at exactly one point must count as touching (closed disk) */
+    srm_pt a = {5, 0, 0}, b = {3, 4, 1}, c = {-4, 3, 2};
+    srm_disk d;
+    srm_disk_of(&d, a, b, c);
+    srm_strip at = {1, 0, 0, 0, 3, -8, -5}; /* corner... top edge y = -5 at x = 0 */
+    srm_strip off = {1, 0, 0, 0, 3, -8, -6};
+    srm_strip corner = {1, 0, 0, 4, 9, -9, -3}; /* corner (4,-3) is on the circle */
+    CHECK(srm_disk_touch(&d, &at));
+    CHECK(srm_disk_touch(&d, &corner));
+    CHECK(!srm_disk_touch(&d, &off));
+    /* empty strips are never touched */
+    srm_strip empty = {0, 0, 0, 0, 3, -8, -5};
+    CHECK(!srm_disk_touch(&d, &empty));
+    /* the hull-edge test: closed half-plane right of u->v */
+    srm_pt u = {0, 0, 0}, v = {10, 0, 1};
+    srm_strip below = {1, 0, 0, 2, 3, -5, -1}, on = {1, 0, 0, 2, 3, 0, 4}, above = {1, 0, 0, 2, 3, 1, 4};
+    CHECK(srm_edge_touch(u, v, &below));
+    CHECK(srm_edge_touch(u, v, &on));
+    CHECK(!srm_edge_touch(u, v, &above));
+}
+
+/* ---- partition helpers and schedule ------------------------------------------ */
+
+TEST(radix_sort_stable_dedupe)
+{
+    size_t n = 50000;
+    srm_rec *r = malloc(n * sizeof *r), *t = malloc(n * sizeof *t);
+    for (size_t i = 0; i < n; i++) {
+        pdt_point p = {rndi(-30, 30), rndi(-3, 3)};
+        if (i % 7 == 0) p.x = (int32_t)(rnd() >> 33) * (rnd() & 1 ? 1 : -1);
+        r[i] = (srm_rec){pdt_key(p), (uint32_t)i, 0};
+    }
+    srm_radix_sort(r, t, n);
+    int bad = 0;
+    for (size_t i = 1; i < n; i++) {
+        pdt_point a = srm_key_point(r[i - 1].key), b = srm_key_point(r[i].key);
+        int c = pdt_lex_cmp(a, b);
+        if (c > 0 || (c == 0 && r[i - 1].idx >= r[i].idx)) bad++;
+    }
+    CHECK_MSG(bad == 0, "%d out of order", bad);
+    size_t m = srm_dedupe(r, n);
+    for (size_t i = 1; i < m; i++) CHECK(r[i - 1].key < r[i].key);
+    free(r);
+    free(t);
+}
+
+TEST(splitters_equal_keys_one_rank)
+{
+    uint64_t samples[12] = {5, 5, 5, 5, 5, 5, 7, 7, 9, 9, 9, 1};
+    uint64_t split[3];
+    srm_pick_splitters(samples, 12, 4, split);
+    int d5 = srm_dest_rank(split, 4, 5);
+    CHECK(srm_dest_rank(split, 4, 5) == d5);
+    CHECK(srm_dest_rank(split, 4, 1) <= d5);
+    CHECK(srm_dest_rank(split, 4, 9) >= srm_dest_rank(split, 4, 7));
+    CHECK(srm_dest_rank(split, 1, 5) == 0);
+}
+
+TEST(schedule)
+{
+    int gl, gr, ge;
+    CHECK(srm_pair(1, 5, 0, &gl, &gr, &ge) && gl == 0 && gr == 1 && ge == 2);
+    CHECK(!srm_pair(4, 5, 0, &gl, &gr, &ge));
+    CHECK(!srm_pair(4, 5, 1, &gl, &gr, &ge));
+    CHECK(srm_pair(4, 5, 2, &gl, &gr, &ge) && gl == 0 && gr == 4 && ge == 5);
+    CHECK(srm_pair(6, 7, 1, &gl, &gr, &ge) && gl == 4 && gr == 6 && ge == 7);
+    CHECK(srm_holder(3, 8, 2) == 2);
+    CHECK(srm_holder(0, 8, 3) == 4);
+    CHECK(srm_holder(4, 5, 2) == 4);
+    CHECK(srm_holder(0, 5, 3) == 4);
+    CHECK(srm_holder(5, 6, 2) == 5 && srm_holder(0, 6, 3) == 4);
+    CHECK(srm_ceil_log2(1) == 0 && srm_ceil_log2(2) == 1 && srm_ceil_log2(5) == 3);
+}
+
+int main(void)
+{
+    RUN(touch_is_sound);
+    RUN(touch_cocircular_corner);
+    RUN(radix_sort_stable_dedupe);
+    RUN(splitters_equal_keys_one_rank);
+    RUN(schedule);
+    return test_summary();
+}
