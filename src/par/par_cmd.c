@@ -1,0 +1,198 @@
+/* pdt — `pdt triangulate` on an MPI job: read (rank 0), compute (all ranks),
+ * write (rank 0, atomically), report.
+ *
+ * This is the command layer of the parallel driver (it prints messages and
+ * decides exit codes); the algorithm is in driver.c and srm.c.  A run that
+ * fails on any rank aborts the whole job before rank 0 has opened the output,
+ * so a failed run never leaves an output file. */
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "pdt/io.h"
+#include "pdt/par.h"
+#include "pdt/tracefile.h"
+
+enum { TAG_CLOCK = 9, CLOCK_ROUNDS = 8 };
+
+static int64_t mono_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+/* Clock offsets by ping-pong with rank 0 (the round with the smallest round
+ * trip wins): offset[q] is what to add to rank q's clock to get rank 0's.
+ * off (size p) matters at rank 0 only. */
+static pdt_status clock_offsets(pdt_comm *c, int64_t *off, pdt_err *err)
+{
+    int r = pdt_comm_rank(c), p = pdt_comm_size(c);
+    pdt_status st = PDT_OK;
+    if (r == 0) {
+        off[0] = 0;
+        for (int q = 1; q < p && st == PDT_OK; q++) {
+            int64_t best = INT64_MAX;
+            for (int k = 0; k < CLOCK_ROUNDS && st == PDT_OK; k++) {
+                int64_t t0 = mono_ns(), tq;
+                void *buf = NULL;
+                size_t len = 0;
+                st = pdt_comm_send(c, q, TAG_CLOCK, &t0, sizeof t0, err);
+                if (st == PDT_OK) st = pdt_comm_recv(c, q, TAG_CLOCK, &buf, &len, err);
+                int64_t t1 = mono_ns();
+                if (st == PDT_OK && len == sizeof tq) {
+                    memcpy(&tq, buf, sizeof tq);
+                    if (t1 - t0 < best) {
+                        best = t1 - t0;
+                        off[q] = t0 + (t1 - t0) / 2 - tq;
+                    }
+                }
+                free(buf);
+            }
+        }
+    } else {
+        for (int k = 0; k < CLOCK_ROUNDS && st == PDT_OK; k++) {
+            void *buf = NULL;
+            size_t len = 0;
+            st = pdt_comm_recv(c, 0, TAG_CLOCK, &buf, &len, err);
+            free(buf);
+            int64_t t = mono_ns();
+            if (st == PDT_OK) st = pdt_comm_send(c, 0, TAG_CLOCK, &t, sizeof t, err);
+        }
+    }
+    return st;
+}
+
+static uint64_t fnv1a(const void *data, size_t n)
+{
+    const unsigned char *b = data;
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ull;
+    return h;
+}
+
+/* Stop the whole job after an error on this rank. */
+static void die(pdt_comm *c, const pdt_err *err)
+{
+    fprintf(stderr, "pdt: %s\n", err->msg[0] ? err->msg : pdt_status_str(err->code));
+    fflush(stderr);
+    pdt_comm_abort(c, 1);
+}
+
+int pdt_par_cmd_triangulate(int *argc, char ***argv, const pdt_par_job *job)
+{
+    pdt_err err;
+    pdt_err_clear(&err);
+    pdt_comm *c = NULL;
+    if (pdt_comm_init(argc, argv, 1, &c, &err) != PDT_OK) {
+        fprintf(stderr, "pdt: %s\n", err.msg);
+        return 1;
+    }
+    int r = pdt_comm_rank(c), p = pdt_comm_size(c);
+    double t0 = pdt_comm_wtime(c);
+
+    /* read at rank 0; every rank learns whether that worked */
+    pdt_point *pts = NULL;
+    size_t n = 0, collisions = 0;
+    int32_t rc = 0;
+    if (r == 0 && pdt_read_points(job->input, job->scale, &pts, &n, &collisions, &err) != PDT_OK)
+        rc = err.code == PDT_ERR_NOMEM ? 1 : 2;
+    if (pdt_comm_bcast(c, &rc, sizeof rc, 0, &err) != PDT_OK) die(c, &err);
+    if (rc) {
+        if (r == 0) fprintf(stderr, "pdt: %s\n", err.msg);
+        free(pts);
+        pdt_comm_finalize(c, NULL);
+        return rc;
+    }
+    double t_read = pdt_comm_wtime(c) - t0;
+    if (r == 0 && job->scale > 0 && collisions)
+        fprintf(stderr, "pdt: %zu points collide after scaling by %g\n", collisions, job->scale);
+
+    /* trace writers: rank 0 creates the folder first */
+    pdt_trace_writer *w = NULL;
+    pdt_trace *tr = NULL;
+    int64_t *off = NULL;
+    if (job->trace_dir) {
+        int32_t ok = 1;
+        if (r == 0) ok = pdt_tw_open(job->trace_dir, 0, job->trace_level, &w, &err) == PDT_OK;
+        if (pdt_comm_bcast(c, &ok, sizeof ok, 0, &err) != PDT_OK) die(c, &err);
+        if (!ok) {
+            if (r == 0) die(c, &err);
+            pdt_comm_abort(c, 1);
+        }
+        if (r != 0 && pdt_tw_open(job->trace_dir, r, job->trace_level, &w, &err) != PDT_OK)
+            die(c, &err);
+        off = calloc((size_t)p, sizeof *off);
+        if (!off) {
+            pdt_err_set(&err, PDT_ERR_NOMEM, "rank %d: out of memory", r);
+            die(c, &err);
+        }
+        if (clock_offsets(c, off, &err) != PDT_OK) die(c, &err);
+        tr = pdt_tw_hook(w);
+        tr->rank = r;
+        tr->gid = NULL;
+    }
+
+    pdt_tri *tris = NULL;
+    size_t ntri = 0;
+    pdt_par_stats stats;
+    if (pdt_par_triangulate(c, pts, n, &tris, &ntri, job->stats ? &stats : NULL, tr, &err) !=
+        PDT_OK)
+        die(c, &err);
+
+    if (w && pdt_tw_close(w, &err) != PDT_OK) die(c, &err);
+    if (job->trace_dir) {
+        /* every rank file is complete before the manifest appears */
+        if (pdt_comm_barrier(c, &err) != PDT_OK) die(c, &err);
+        if (r == 0) {
+            pdt_manifest m;
+            memset(&m, 0, sizeof m);
+            m.format_version = 1;
+            snprintf(m.program_version, sizeof m.program_version, "%s", PDT_VERSION);
+            m.command_line = (char *)(job->command_line ? job->command_line : "pdt triangulate");
+            m.input_name = (char *)job->input;
+            m.input_checksum = fnv1a(pts, n * sizeof *pts);
+            m.n = n;
+            m.nranks = p;
+            m.level = job->trace_level;
+            snprintf(m.command, sizeof m.command, "triangulate");
+            m.clock_offset_ns = off;
+            struct timespec ts;
+            clock_gettime(CLOCK_REALTIME, &ts);
+            m.wall_start_ns = (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+            if (pdt_run_write_meta(job->trace_dir, &m, pts, n, &err) != PDT_OK) {
+                fprintf(stderr, "pdt: %s\n", err.msg);
+                rc = 1;
+            }
+        }
+    }
+    free(off);
+
+    if (r == 0 && rc == 0) {
+        double tw = pdt_comm_wtime(c);
+        if (pdt_write_tris(job->output, pdt_tri_format_of(job->output), pts, n, tris, ntri,
+                           &err) != PDT_OK) {
+            fprintf(stderr, "pdt: %s\n", err.msg);
+            rc = 1;
+        }
+        if (rc == 0 && ntri == 0 && job->stats == 0)
+            fprintf(stderr, "pdt: no triangles: %s\n",
+                    n < 3 ? "fewer than 3 points" : "fewer than 3 distinct points or all collinear");
+        if (job->stats) {
+            if (rc == 0 && ntri == 0)
+                fprintf(stderr, "pdt: no triangles: %s\n",
+                        stats.n_unique < 3 ? "fewer than 3 distinct points"
+                                           : "all points are collinear");
+            fprintf(stderr, "{\"command\": \"triangulate\", \"read_s\": %.6f, \"write_s\": %.6f, "
+                            "\"parallel\": ",
+                    t_read, pdt_comm_wtime(c) - tw);
+            pdt_par_stats_json(&stats, stderr);
+            fprintf(stderr, "}\n");
+            pdt_par_stats_free(&stats);
+        }
+    }
+    free(tris);
+    free(pts);
+    pdt_comm_finalize(c, NULL);
+    return rc;
+}

@@ -1,0 +1,638 @@
+/* pdt — SRM per rank: local phase, classification, merge steps
+ * (algorithm.md §3.3–3.8).  No MPI here: messages are byte buffers that the
+ * driver moves.
+ *
+ * Correctness rests on the Merge Lemma (§3.8): at the merge of G_L and G_R the
+ * border set B must contain every vertex of every shipped triangle AND the
+ * endpoints of every hull edge of G_L whose restricted area (the closed
+ * half-plane outside the edge) meets a box of G_R (all of G_L if its hull is
+ * degenerate), and symmetrically.  Then T*(G) = (unshipped triangles) ∪
+ * {t in T*(B) : t has vertices in both groups, or t was shipped}. */
+#include "srm.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "pdt/delaunay.h"
+#include "pdt/hull.h"
+#include "pdt/predicates.h"
+
+#define MSG_MAGIC 0x4d525350u /* "PSRM" */
+
+/* Message header (native byte order: a homogeneous cluster is assumed). */
+typedef struct msg_head {
+    uint32_t magic, level, npts, ntri, nhull, flags;
+    double cp;
+} msg_head;
+enum { MSG_HAS_HULL = 1, MSG_HULL_DEGENERATE = 2 };
+
+/* ---- small helpers ------------------------------------------------------- */
+
+static int msb(unsigned v)
+{
+    return 31 - __builtin_clz(v);
+}
+
+static double now(const srm_rank *s)
+{
+    return s->clock ? s->clock(s->clock_user) : 0.0;
+}
+
+static pdt_status nomem(pdt_err *err, int rank, const char *what)
+{
+    return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", rank, what);
+}
+
+static pdt_status grow(void **p, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap) return PDT_OK;
+    size_t c = *cap ? *cap : 64;
+    while (c < need) c *= 2;
+    void *q = realloc(*p, c * size);
+    if (!q) return PDT_ERR_NOMEM;
+    *p = q;
+    *cap = c;
+    return PDT_OK;
+}
+
+static pdt_status add_final(srm_rank *s, srm_pt a, srm_pt b, srm_pt c)
+{
+    if (grow((void **)&s->fin, &s->capfin, s->nfin + 1, sizeof *s->fin)) return PDT_ERR_NOMEM;
+    s->fin[s->nfin++] = (pdt_tri){{a.gid, b.gid, c.gid}};
+    PDT_TRACE(s->tr, 1, PDT_EV_TRI_FINAL, 0, a.gid, b.gid, c.gid, 0);
+    return PDT_OK;
+}
+
+static pdt_status add_pending(srm_rank *s, srm_pt a, srm_pt b, srm_pt c, int level)
+{
+    if (grow((void **)&s->pend, &s->cappend, s->npend + 1, sizeof *s->pend))
+        return PDT_ERR_NOMEM;
+    srm_tri *t = &s->pend[s->npend++];
+    t->p[0] = a;
+    t->p[1] = b;
+    t->p[2] = c;
+    t->level = level;
+    return PDT_OK;
+}
+
+/* The classification of a triangle held at rank h whose group has level
+ * `from`: -1 if its restricted area misses every box outside that group
+ * (final), else the first merge level whose partner group holds a box it
+ * touches (*who = that rank). */
+static int send_level(const srm_rank *s, int h, int from, srm_pt a, srm_pt b, srm_pt c, int *who)
+{
+    srm_disk d;
+    srm_disk_of(&d, a, b, c);
+    double lo, hi;
+    srm_disk_xrange(&d, &lo, &hi);
+    /* boxes of non-empty strips are ordered in x: binary search the first
+     * whose xmax reaches lo, walk while xmin <= hi */
+    int l = 0, r = s->nne;
+    while (l < r) {
+        int mid = (l + r) / 2;
+        if ((double)s->strip[s->nonempty[mid]].xmax < lo) l = mid + 1;
+        else r = mid;
+    }
+    int best = -1;
+    *who = -1;
+    for (int i = l; i < s->nne; i++) {
+        int q = s->nonempty[i];
+        const srm_strip *bx = &s->strip[q];
+        if ((double)bx->xmin > hi) break;
+        if (q == h) continue;
+        int lev = msb((unsigned)(q ^ h));
+        if (lev < from) continue;                  /* inside the group already */
+        if (best >= 0 && lev >= best) continue;    /* cannot improve */
+        if (srm_disk_touch(&d, bx)) {
+            best = lev;
+            *who = q;
+        }
+    }
+    return best;
+}
+
+/* ---- set-up ---------------------------------------------------------------- */
+
+pdt_status srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pdt_trace *tr,
+                    pdt_err *err)
+{
+    memset(s, 0, sizeof *s);
+    s->rank = rank;
+    s->p = p;
+    s->levels = srm_ceil_log2(p);
+    s->strip = strip;
+    s->tr = tr;
+    s->nonempty = malloc((size_t)p * sizeof *s->nonempty);
+    if (!s->nonempty) return nomem(err, rank, "init");
+    for (int q = 0; q < p; q++)
+        if (strip[q].count) s->nonempty[s->nne++] = q;
+    return PDT_OK;
+}
+
+void srm_free(srm_rank *s)
+{
+    free(s->nonempty);
+    free(s->fin);
+    free(s->pend);
+    free(s->hull);
+    memset(s, 0, sizeof *s);
+}
+
+/* ---- Phases 1 and 2 ----------------------------------------------------------- */
+
+pdt_status srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid, size_t m,
+                     pdt_err *err)
+{
+    pdt_trace *tr = s->tr;
+    double t0 = now(s);
+    /* lift-up */
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_LIFT, 0, 0, 0, 0);
+    if (PDT_TRACING(tr, 1))
+        for (size_t i = 0; i < m; i++) {
+            uint64_t z = (uint64_t)((int64_t)pts[i].x * pts[i].x) +
+                         (uint64_t)((int64_t)pts[i].y * pts[i].y);
+            PDT_TRACE(tr, 1, PDT_EV_LIFT, 0, gid[i], 0, 0, (int64_t)z);
+        }
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_LIFT, 0, 0, 0, 0);
+
+    /* local kernel */
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_KERNEL, 0, 0, 0, 0);
+    pdt_tri *tris = NULL;
+    size_t ntri = 0;
+    const uint32_t *saved = tr ? tr->gid : NULL;
+    if (tr) tr->gid = gid;
+    pdt_status st = pdt_delaunay(pts, m, &tris, &ntri, 0, tr);
+    if (tr) tr->gid = saved;
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
+    if (st != PDT_OK) {
+        free(tris);
+        return pdt_err_set(err, st, "rank %d: local kernel failed (%s)", s->rank,
+                           pdt_status_str(st));
+    }
+    s->cnt.local_tris = ntri;
+
+    /* strip hull: monotone chain (Graham's scan with the origin at infinity) */
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_HULL, 0, 0, 0, 0);
+    uint32_t *h = malloc((m + 1) * sizeof *h);
+    s->hull = malloc((m + 1) * sizeof *s->hull);
+    if (!h || !s->hull) {
+        free(h);
+        free(tris);
+        return nomem(err, s->rank, "hull");
+    }
+    size_t nh = 0;
+    int deg = 0;
+    if (tr) tr->gid = gid;
+    st = pdt_hull_chain(pts, m, h, &nh, &deg, PDT_STACK_LOWER, PDT_STACK_UPPER, tr);
+    if (tr) tr->gid = saved;
+    if (st != PDT_OK) {
+        free(h);
+        free(tris);
+        return pdt_err_set(err, st, "rank %d: strip hull failed", s->rank);
+    }
+    for (size_t i = 0; i < nh; i++) s->hull[i] = (srm_pt){pts[h[i]].x, pts[h[i]].y, gid[h[i]]};
+    s->nhull = nh;
+    s->hull_degenerate = deg;
+    s->holds_hull = 1;
+    free(h);
+    PDT_TRACE(tr, 1, PDT_EV_HULL, 0, nh, deg, 0, 0);
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_HULL, 0, 0, 0, 0);
+
+    /* classification: final at once, or deferred until a merge level */
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_CLASSIFY, 0, 0, 0, 0);
+    for (size_t i = 0; i < ntri; i++) {
+        srm_pt v[3];
+        for (int k = 0; k < 3; k++) {
+            uint32_t j = tris[i].v[k];
+            v[k] = (srm_pt){pts[j].x, pts[j].y, gid[j]};
+        }
+        int who;
+        int lev = send_level(s, s->rank, 0, v[0], v[1], v[2], &who);
+        if (lev < 0) {
+            st = add_final(s, v[0], v[1], v[2]);
+            s->cnt.final_at_once++;
+        } else {
+            st = add_pending(s, v[0], v[1], v[2], lev);
+            s->cnt.deferred++;
+            PDT_TRACE(tr, 1, PDT_EV_RA_DEFER, 0, v[0].gid, v[1].gid, v[2].gid, who);
+        }
+        if (st != PDT_OK) {
+            free(tris);
+            return nomem(err, s->rank, "classify");
+        }
+    }
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_CLASSIFY, 0, 0, 0, 0);
+    free(tris);
+    s->cnt.critical_path += now(s) - t0;
+    return PDT_OK;
+}
+
+/* ---- messages ------------------------------------------------------------------ */
+
+static int cmp_gid(const void *a, const void *b)
+{
+    uint32_t x = ((const srm_pt *)a)->gid, y = ((const srm_pt *)b)->gid;
+    return x < y ? -1 : x > y;
+}
+
+static uint32_t find_gid(const srm_pt *p, size_t n, uint32_t gid)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (p[mid].gid < gid) lo = mid + 1;
+        else hi = mid;
+    }
+    return (uint32_t)lo;
+}
+
+pdt_status srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err)
+{
+    *buf = NULL;
+    *len = 0;
+    int send_hull = s->holds_hull && srm_holder(s->rank, s->p, level) == s->rank;
+    size_t nt = 0;
+    for (size_t i = 0; i < s->npend; i++) nt += s->pend[i].level == level;
+    size_t nh = send_hull ? s->nhull : 0;
+    /* point table: distinct vertices of the shipped triangles and the hull */
+    srm_pt *tab = malloc((3 * nt + nh + 1) * sizeof *tab);
+    if (!tab) return nomem(err, s->rank, "pack");
+    size_t np = 0;
+    for (size_t i = 0; i < s->npend; i++)
+        if (s->pend[i].level == level)
+            for (int k = 0; k < 3; k++) tab[np++] = s->pend[i].p[k];
+    for (size_t i = 0; i < nh; i++) tab[np++] = s->hull[i];
+    qsort(tab, np, sizeof *tab, cmp_gid);
+    size_t u = 0;
+    for (size_t i = 0; i < np; i++)
+        if (u == 0 || tab[i].gid != tab[u - 1].gid) tab[u++] = tab[i];
+    np = u;
+
+    size_t bytes = sizeof(msg_head) + np * sizeof(srm_pt) + (3 * nt + nh) * sizeof(uint32_t);
+    unsigned char *b = malloc(bytes);
+    if (!b) {
+        free(tab);
+        return nomem(err, s->rank, "pack");
+    }
+    msg_head hd = {MSG_MAGIC, (uint32_t)level, (uint32_t)np, (uint32_t)nt, (uint32_t)nh,
+                   (send_hull ? MSG_HAS_HULL : 0u) |
+                       (send_hull && s->hull_degenerate ? MSG_HULL_DEGENERATE : 0u),
+                   s->cnt.critical_path};
+    memcpy(b, &hd, sizeof hd);
+    memcpy(b + sizeof hd, tab, np * sizeof(srm_pt));
+    uint32_t *pos = (uint32_t *)(void *)(b + sizeof hd + np * sizeof(srm_pt));
+    size_t k = 0, keep = 0;
+    for (size_t i = 0; i < s->npend; i++) {
+        srm_tri *t = &s->pend[i];
+        if (t->level != level) {
+            s->pend[keep++] = *t;
+            continue;
+        }
+        for (int j = 0; j < 3; j++) pos[k++] = find_gid(tab, np, t->p[j].gid);
+        PDT_TRACE(s->tr, 1, PDT_EV_SHIP, 0, t->p[0].gid, t->p[1].gid, t->p[2].gid,
+                  (int64_t)((s->rank >> (level + 1) << (level + 1)) + (1 << level)));
+    }
+    s->npend = keep;
+    s->cnt.shipped += nt;
+    for (size_t i = 0; i < nh; i++) pos[k++] = find_gid(tab, np, s->hull[i].gid);
+    if (send_hull) {
+        s->holds_hull = 0;
+        s->nhull = 0;
+    }
+    free(tab);
+    *buf = b;
+    *len = bytes;
+    return PDT_OK;
+}
+
+/* A decoded message (pointers into the buffer). */
+typedef struct msg_view {
+    msg_head h;
+    const srm_pt *pts;
+    const uint32_t *tri; /* 3 * ntri positions */
+    const uint32_t *hull;
+} msg_view;
+
+static pdt_status decode(const void *buf, size_t len, int level, int from, msg_view *v,
+                         pdt_err *err)
+{
+    if (len < sizeof(msg_head))
+        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: too short", from);
+    memcpy(&v->h, buf, sizeof v->h);
+    const msg_head *h = &v->h;
+    if (h->magic != MSG_MAGIC || h->level != (uint32_t)level)
+        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: bad header", from);
+    size_t need = sizeof(msg_head) + (size_t)h->npts * sizeof(srm_pt) +
+                  (3 * (size_t)h->ntri + h->nhull) * sizeof(uint32_t);
+    if (need != len)
+        return pdt_err_set(err, PDT_ERR_CORRUPT,
+                           "merge message from rank %d: %zu bytes, expected %zu", from, len, need);
+    const unsigned char *b = buf;
+    v->pts = (const srm_pt *)(const void *)(b + sizeof(msg_head));
+    v->tri = (const uint32_t *)(const void *)(b + sizeof(msg_head) + h->npts * sizeof(srm_pt));
+    v->hull = v->tri + 3 * (size_t)h->ntri;
+    for (size_t i = 0; i < 3 * (size_t)h->ntri + h->nhull; i++)
+        if (v->tri[i] >= h->npts)
+            return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: bad index",
+                               from);
+    return PDT_OK;
+}
+
+/* ---- the merge step ------------------------------------------------------------ */
+
+typedef struct gtri {
+    uint32_t v[3];
+} gtri;
+
+/* rotate so that the smallest gid comes first (keeps the orientation) */
+static gtri canon3(uint32_t a, uint32_t b, uint32_t c)
+{
+    gtri t;
+    if (a < b && a < c) t = (gtri){{a, b, c}};
+    else if (b < c) t = (gtri){{b, c, a}};
+    else t = (gtri){{c, a, b}};
+    return t;
+}
+
+static int cmp_gtri(const void *x, const void *y)
+{
+    const gtri *a = x, *b = y;
+    for (int k = 0; k < 3; k++)
+        if (a->v[k] != b->v[k]) return a->v[k] < b->v[k] ? -1 : 1;
+    return 0;
+}
+
+static int has_gtri(const gtri *set, size_t n, gtri t)
+{
+    return bsearch(&t, set, n, sizeof t, cmp_gtri) != NULL;
+}
+
+static int cmp_key(const void *a, const void *b)
+{
+    uint64_t x = srm_key(*(const srm_pt *)a), y = srm_key(*(const srm_pt *)b);
+    return x < y ? -1 : x > y;
+}
+
+/* Collect the facing hull vertices of one side into B: endpoints of every
+ * hull edge whose outer half-plane meets a box of the other side (all points
+ * if the hull is degenerate). */
+static size_t facing(const srm_rank *s, const msg_view *hv, int q0, int q1, srm_pt *out)
+{
+    size_t n = 0, k = hv->h.nhull;
+    const uint32_t *h = hv->hull;
+    if (hv->h.flags & MSG_HULL_DEGENERATE) {
+        for (size_t i = 0; i < k; i++) out[n++] = hv->pts[h[i]];
+        return n;
+    }
+    for (size_t i = 0; i < k; i++) {
+        srm_pt u = hv->pts[h[i]], w = hv->pts[h[(i + 1) % k]];
+        for (int q = q0; q < q1; q++)
+            if (s->strip[q].count && srm_edge_touch(u, w, &s->strip[q])) {
+                out[n++] = u;
+                out[n++] = w;
+                break;
+            }
+    }
+    return n;
+}
+
+pdt_status srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len, pdt_err *err)
+{
+    pdt_trace *tr = s->tr;
+    int gl, gr, ge;
+    srm_pair(s->rank, s->p, level, &gl, &gr, &ge);
+    int nm = ge - gl;
+    double t0 = now(s);
+    pdt_status st = PDT_OK;
+    msg_view *mv = calloc((size_t)nm, sizeof *mv);
+    gtri *shipped = NULL, *tb = NULL;
+    srm_pt *B = NULL, *hp = NULL;
+    pdt_point *bp = NULL;
+    uint32_t *bg = NULL, *hidx = NULL;
+    pdt_tri *tris = NULL;
+    size_t ntri = 0;
+    if (!mv) return nomem(err, s->rank, "merge");
+    PDT_TRACE(tr, 1, PDT_EV_MERGE_BEGIN, level, gl, gr, ge, s->rank);
+
+    double cp_in = s->cnt.critical_path;
+    size_t nship = 0, nshipL = 0, nbmax = 0;
+    int hl = -1, hr = -1;
+    for (int i = 0; i < nm; i++) {
+        st = decode(msg[i], len[i], level, gl + i, &mv[i], err);
+        if (st != PDT_OK) goto done;
+        if (mv[i].h.cp > cp_in) cp_in = mv[i].h.cp;
+        nship += mv[i].h.ntri;
+        if (gl + i < gr) nshipL += mv[i].h.ntri;
+        nbmax += 3 * (size_t)mv[i].h.ntri + 2 * (size_t)mv[i].h.nhull;
+        if (mv[i].h.flags & MSG_HAS_HULL) {
+            int *side = gl + i < gr ? &hl : &hr;
+            if (*side >= 0) {
+                st = pdt_err_set(err, PDT_ERR_CORRUPT, "merge at level %d: two hulls", level);
+                goto done;
+            }
+            *side = i;
+        }
+    }
+
+    /* shipped set R_L ∪ R_R, canonical, sorted */
+    shipped = malloc((nship + 1) * sizeof *shipped);
+    B = malloc((nbmax + 1) * sizeof *B);
+    if (!shipped || !B) {
+        st = nomem(err, s->rank, "merge");
+        goto done;
+    }
+    size_t ns = 0, nb = 0;
+    for (int i = 0; i < nm; i++) {
+        const msg_view *v = &mv[i];
+        for (size_t t = 0; t < v->h.ntri; t++) {
+            srm_pt a = v->pts[v->tri[3 * t]], b = v->pts[v->tri[3 * t + 1]],
+                   c = v->pts[v->tri[3 * t + 2]];
+            shipped[ns++] = canon3(a.gid, b.gid, c.gid);
+            B[nb++] = a;
+            B[nb++] = b;
+            B[nb++] = c;
+        }
+    }
+    qsort(shipped, ns, sizeof *shipped, cmp_gtri);
+    /* facing hull vertices (the hull-vertex rule of the Merge Lemma) */
+    if (hl >= 0) nb += facing(s, &mv[hl], gr, ge, B + nb);
+    if (hr >= 0) nb += facing(s, &mv[hr], gl, gr, B + nb);
+    qsort(B, nb, sizeof *B, cmp_key);
+    {
+        size_t u = 0;
+        for (size_t i = 0; i < nb; i++)
+            if (u == 0 || B[i].gid != B[u - 1].gid) B[u++] = B[i];
+        nb = u;
+    }
+    if (nb > s->cnt.border_max) s->cnt.border_max = nb;
+
+    /* lift-up of B and T*(B) */
+    bp = malloc((nb + 1) * sizeof *bp);
+    bg = malloc((nb + 1) * sizeof *bg);
+    if (!bp || !bg) {
+        st = nomem(err, s->rank, "merge");
+        goto done;
+    }
+    for (size_t i = 0; i < nb; i++) {
+        bp[i] = (pdt_point){B[i].x, B[i].y};
+        bg[i] = B[i].gid;
+        if (PDT_TRACING(tr, 1)) {
+            uint64_t z = (uint64_t)((int64_t)B[i].x * B[i].x) + (uint64_t)((int64_t)B[i].y * B[i].y);
+            PDT_TRACE(tr, 1, PDT_EV_LIFT, 0, B[i].gid, 0, 0, (int64_t)z);
+        }
+    }
+    {
+        const uint32_t *saved = tr ? tr->gid : NULL;
+        if (tr) tr->gid = bg;
+        st = pdt_delaunay(bp, nb, &tris, &ntri, 1, tr);
+        if (tr) tr->gid = saved;
+        if (st != PDT_OK) {
+            pdt_err_set(err, st, "rank %d: border kernel failed", s->rank);
+            goto done;
+        }
+    }
+
+    /* selection: keep multi-group triangles and shipped ones */
+    uint64_t first_r = UINT64_MAX;
+    int have_r = 0;
+    for (int q = gr; q < ge; q++)
+        if (s->strip[q].count) {
+            first_r = s->strip[q].first_key;
+            have_r = 1;
+            break;
+        }
+    tb = malloc((ntri + 1) * sizeof *tb);
+    if (!tb) {
+        st = nomem(err, s->rank, "merge");
+        goto done;
+    }
+    size_t kept = 0, ntb = 0;
+    for (size_t i = 0; i < ntri; i++) {
+        const uint32_t *v = tris[i].v;
+        gtri g = canon3(bg[v[0]], bg[v[1]], bg[v[2]]);
+        tb[ntb++] = g;
+        int nl = 0;
+        for (int k = 0; k < 3; k++) nl += !have_r || srm_key(B[v[k]]) < first_r;
+        int multi = nl > 0 && nl < 3;
+        if (!multi && !has_gtri(shipped, ns, g)) continue;
+        kept++;
+        /* reclassify against the boxes outside the merged group */
+        int who;
+        int lev = level + 1 < s->levels
+                      ? send_level(s, s->rank, level + 1, B[v[0]], B[v[1]], B[v[2]], &who)
+                      : -1;
+        if (lev < 0) {
+            st = add_final(s, B[v[0]], B[v[1]], B[v[2]]);
+            s->cnt.final_merge++;
+        } else {
+            st = add_pending(s, B[v[0]], B[v[1]], B[v[2]], lev);
+            PDT_TRACE(tr, 1, PDT_EV_RA_DEFER, 0, B[v[0]].gid, B[v[1]].gid, B[v[2]].gid, who);
+        }
+        if (st != PDT_OK) {
+            st = nomem(err, s->rank, "merge");
+            goto done;
+        }
+    }
+    s->cnt.kept += kept;
+
+    /* discards: shipped triangles that T*(B) does not contain */
+    qsort(tb, ntb, sizeof *tb, cmp_gtri);
+    size_t ndisc = 0;
+    srm_pt *byg = NULL;
+    if (PDT_TRACING(tr, 1)) {
+        byg = malloc((nb + 1) * sizeof *byg);
+        if (byg) {
+            memcpy(byg, B, nb * sizeof *B);
+            qsort(byg, nb, sizeof *byg, cmp_gid);
+        }
+    }
+    for (size_t i = 0; i < ns; i++) {
+        if (has_gtri(tb, ntb, shipped[i])) continue;
+        ndisc++;
+        if (!PDT_TRACING(tr, 1)) continue;
+        /* witness: a point of B strictly inside the circle (tie rule); a
+         * non-border point may be the real cause, then there is none */
+        int64_t wit = -1;
+        if (byg) {
+            pdt_point t3[3];
+            for (int k = 0; k < 3; k++) {
+                srm_pt q = byg[find_gid(byg, nb, shipped[i].v[k])];
+                t3[k] = (pdt_point){q.x, q.y};
+            }
+            for (size_t j = 0; j < nb && wit < 0; j++) {
+                uint32_t g = byg[j].gid;
+                if (g == shipped[i].v[0] || g == shipped[i].v[1] || g == shipped[i].v[2]) continue;
+                if (pdt_incircle_sos(t3[0], t3[1], t3[2], (pdt_point){byg[j].x, byg[j].y}) > 0)
+                    wit = g;
+            }
+        }
+        PDT_TRACE(tr, 1, PDT_EV_DISCARD, 0, shipped[i].v[0], shipped[i].v[1], shipped[i].v[2],
+                  wit);
+    }
+    free(byg);
+    s->cnt.discarded += ndisc;
+
+    /* hull merge: monotone chain over both hulls (lex-sorted union) */
+    {
+        size_t n1 = hl >= 0 ? mv[hl].h.nhull : 0, n2 = hr >= 0 ? mv[hr].h.nhull : 0;
+        size_t nh = n1 + n2;
+        hp = malloc((nh + 1) * sizeof *hp);
+        hidx = malloc((nh + 2) * sizeof *hidx);
+        pdt_point *pp = malloc((nh + 1) * sizeof *pp);
+        uint32_t *pg = malloc((nh + 1) * sizeof *pg);
+        srm_pt *nhull = malloc((nh + 1) * sizeof *nhull);
+        if (!hp || !hidx || !pp || !pg || !nhull) {
+            free(pp);
+            free(pg);
+            free(nhull);
+            st = nomem(err, s->rank, "hull merge");
+            goto done;
+        }
+        size_t k = 0;
+        for (size_t i = 0; i < n1; i++) hp[k++] = mv[hl].pts[mv[hl].hull[i]];
+        for (size_t i = 0; i < n2; i++) hp[k++] = mv[hr].pts[mv[hr].hull[i]];
+        qsort(hp, nh, sizeof *hp, cmp_key);
+        for (size_t i = 0; i < nh; i++) {
+            pp[i] = (pdt_point){hp[i].x, hp[i].y};
+            pg[i] = hp[i].gid;
+        }
+        size_t nout = 0;
+        int deg = 0;
+        const uint32_t *saved = tr ? tr->gid : NULL;
+        if (tr) tr->gid = pg;
+        st = pdt_hull_chain(pp, nh, hidx, &nout, &deg, PDT_STACK_MERGE_LOWER,
+                            PDT_STACK_MERGE_UPPER, tr);
+        if (tr) tr->gid = saved;
+        if (st == PDT_OK) {
+            for (size_t i = 0; i < nout; i++) nhull[i] = hp[hidx[i]];
+            free(s->hull);
+            s->hull = nhull;
+            s->nhull = nout;
+            s->hull_degenerate = deg;
+            s->holds_hull = 1;
+            PDT_TRACE(tr, 1, PDT_EV_HULL, 0, nout, deg, 0, 0);
+        } else {
+            free(nhull);
+            pdt_err_set(err, st, "rank %d: hull merge failed", s->rank);
+        }
+        free(pp);
+        free(pg);
+        if (st != PDT_OK) goto done;
+    }
+    s->cnt.merges++;
+    PDT_TRACE(tr, 1, PDT_EV_MERGE_END, level, ns, nb, kept, (int64_t)ndisc);
+    (void)nshipL;
+    s->cnt.critical_path = cp_in + (now(s) - t0);
+
+done:
+    free(mv);
+    free(shipped);
+    free(tb);
+    free(B);
+    free(hp);
+    free(bp);
+    free(bg);
+    free(hidx);
+    free(tris);
+    return st;
+}

@@ -1,0 +1,233 @@
+/* Whole runs of the SRM parallel triangulation without MPI: p simulated
+ * ranks (their messages moved in-process) on adversarial families with
+ * random strip cuts (empty, 1- and 2-point strips included), compared with
+ * one kernel run on all points.  Also: dropping the hull-vertex rule of the
+ * Merge Lemma must break it (the test can fail).
+ *
+ * src/par is linked only into the pdt program, so the MPI-free SRM sources
+ * are compiled into this test directly. */
+#include "../harness.h"
+
+#include <string.h>
+
+#include "../../src/par/partition.c"
+#include "../../src/par/schedule.c"
+#include "../../src/par/srm.c"
+#include "../../src/par/touch.c"
+#include "pdt/delaunay.h"
+
+static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
+static uint64_t rnd(void)
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return rng_state;
+}
+static int32_t rndi(int32_t lo, int32_t hi) { return lo + (int32_t)(rnd() % (uint64_t)(hi - lo + 1)); }
+
+/* ---- whole runs, simulated ----------------------------------------------------- */
+
+enum { FAMILIES = 14 };
+static const char *const fam_name[FAMILIES] = {
+    "uniform", "grid", "lattice-circle", "rounded-circle", "parabola", "parabola-sym",
+    "column", "row", "diagonal", "line+1", "two-lines", "duplicates", "clusters", "tiny"};
+
+static pdt_point *family(int f, size_t n, size_t *outn)
+{
+    pdt_point *p = malloc((n + 64) * sizeof *p);
+    size_t k = 0;
+    switch (f) {
+    case 0: for (; k < n; k++) p[k] = (pdt_point){rndi(0, 1000), rndi(0, 1000)}; break;
+    case 1: for (; k < n; k++) p[k] = (pdt_point){(int32_t)(k % 8), (int32_t)(k / 8)}; break;
+    case 2: /* all lattice points on x^2 + y^2 = 65^2 (36 of them) */
+        for (int x = -65; x <= 65; x++)
+            for (int y = -65; y <= 65; y++)
+                if (x * x + y * y == 65 * 65) p[k++] = (pdt_point){x, y};
+        break;
+    case 3:
+        for (; k < n; k++) {
+            double a = 6.283185307179586 * (double)k / (double)n;
+            p[k] = (pdt_point){(int32_t)lround(1000 * cos(a)), (int32_t)lround(1000 * sin(a))};
+        }
+        break;
+    case 4: for (; k < n; k++) p[k] = (pdt_point){(int32_t)k, (int32_t)(k * k)}; break;
+    case 5:
+        for (; k < n; k++) {
+            int32_t x = (int32_t)k - (int32_t)n / 2;
+            p[k] = (pdt_point){x, x * x};
+        }
+        break;
+    case 6: for (; k < n; k++) p[k] = (pdt_point){7, (int32_t)(rnd() % 1000)}; break;
+    case 7: for (; k < n; k++) p[k] = (pdt_point){(int32_t)(rnd() % 1000), -3}; break;
+    case 8: for (; k < n; k++) p[k] = (pdt_point){(int32_t)k, 2 * (int32_t)k}; break;
+    case 9:
+        for (; k + 1 < n; k++) p[k] = (pdt_point){(int32_t)k, 0};
+        p[k++] = (pdt_point){(int32_t)n / 2, 5};
+        break;
+    case 10: for (; k < n; k++) p[k] = (pdt_point){(int32_t)(k / 2), k % 2 ? 10 : 0}; break;
+    case 11: for (; k < n; k++) p[k] = (pdt_point){rndi(0, 4), rndi(0, 4)}; break;
+    case 12:
+        for (; k < n; k++) {
+            int cl = (int)(k % 3);
+            p[k] = (pdt_point){cl * 5000 + rndi(0, 40), cl * 700 + rndi(0, 40)};
+        }
+        break;
+    default: /* 0..3 points */
+        for (; k < n % 4; k++) p[k] = (pdt_point){(int32_t)k * 3, (int32_t)(k * k)};
+        break;
+    }
+    *outn = k;
+    return p;
+}
+
+static int cmp_tri(const void *x, const void *y)
+{
+    const pdt_tri *a = x, *b = y;
+    for (int k = 0; k < 3; k++)
+        if (a->v[k] != b->v[k]) return a->v[k] < b->v[k] ? -1 : 1;
+    return 0;
+}
+
+/* One simulated run: the sorted distinct records cut into p blocks at the
+ * given positions.  Returns the canonical triangles (malloc'd). */
+static pdt_status simulate(const srm_rec *u, int p, const size_t *cut, pdt_tri **out,
+                           size_t *nout, uint64_t *bmax)
+{
+    srm_strip *strip = calloc((size_t)p, sizeof *strip);
+    srm_rank *rk = calloc((size_t)p, sizeof *rk);
+    pdt_err err;
+    pdt_err_clear(&err);
+    pdt_status st = PDT_OK;
+    for (int r = 0; r < p; r++) {
+        size_t lo = cut[r], hi = cut[r + 1];
+        srm_strip *s = &strip[r];
+        s->count = hi - lo;
+        for (size_t i = lo; i < hi; i++) {
+            pdt_point q = srm_key_point(u[i].key);
+            if (i == lo || q.y < s->ymin) s->ymin = q.y;
+            if (i == lo || q.y > s->ymax) s->ymax = q.y;
+        }
+        if (hi > lo) {
+            s->first_key = u[lo].key;
+            s->last_key = u[hi - 1].key;
+            s->xmin = srm_key_point(u[lo].key).x;
+            s->xmax = srm_key_point(u[hi - 1].key).x;
+        }
+    }
+    for (int r = 0; r < p && st == PDT_OK; r++) {
+        size_t lo = cut[r], hi = cut[r + 1];
+        pdt_point *pts = malloc((hi - lo + 1) * sizeof *pts);
+        uint32_t *gid = malloc((hi - lo + 1) * sizeof *gid);
+        for (size_t i = lo; i < hi; i++) {
+            pts[i - lo] = srm_key_point(u[i].key);
+            gid[i - lo] = u[i].idx;
+        }
+        st = srm_init(&rk[r], r, p, strip, NULL, &err);
+        if (st == PDT_OK) st = srm_local(&rk[r], pts, gid, hi - lo, &err);
+        free(pts);
+        free(gid);
+    }
+    int L = srm_ceil_log2(p);
+    for (int level = 0; level < L && st == PDT_OK; level++)
+        for (int r = 0; r < p && st == PDT_OK; r++) {
+            int gl, gr, ge;
+            if (!srm_pair(r, p, level, &gl, &gr, &ge) || r != gr) continue;
+            void *msg[64];
+            size_t len[64];
+            for (int q = gl; q < ge; q++) srm_pack(&rk[q], level, &msg[q - gl], &len[q - gl], &err);
+            st = srm_merge(&rk[r], level, msg, len, &err);
+            for (int q = gl; q < ge; q++) free(msg[q - gl]);
+        }
+    size_t total = 0;
+    *bmax = 0;
+    for (int r = 0; r < p; r++) {
+        total += rk[r].nfin;
+        if (rk[r].npend) st = PDT_ERR_CHECK;
+        if (rk[r].cnt.border_max > *bmax) *bmax = rk[r].cnt.border_max;
+    }
+    pdt_tri *t = malloc((total + 1) * sizeof *t);
+    size_t k = 0;
+    for (int r = 0; r < p; r++) {
+        if (rk[r].nfin) memcpy(t + k, rk[r].fin, rk[r].nfin * sizeof *t);
+        k += rk[r].nfin;
+        srm_free(&rk[r]);
+    }
+    pdt_tri_canonical(t, total);
+    *out = t;
+    *nout = total;
+    free(strip);
+    free(rk);
+    if (st != PDT_OK && err.code) printf("#   %s\n", err.msg);
+    return st;
+}
+
+TEST(srm_equals_sequential)
+{
+    static const int ps[] = {1, 2, 3, 4, 5, 7, 8, 11};
+    static const size_t ns[] = {0, 1, 2, 3, 5, 17, 40, 90};
+    int runs = 0, bad = 0;
+    for (int f = 0; f < FAMILIES; f++)
+        for (size_t ni = 0; ni < sizeof ns / sizeof *ns; ni++) {
+            size_t n;
+            pdt_point *pts = family(f, ns[ni], &n);
+            srm_rec *u = malloc((n + 1) * sizeof *u), *tmp = malloc((n + 1) * sizeof *tmp);
+            for (size_t i = 0; i < n; i++) u[i] = (srm_rec){pdt_key(pts[i]), (uint32_t)i, 0};
+            srm_radix_sort(u, tmp, n);
+            size_t m = srm_dedupe(u, n);
+            /* reference: one kernel run on everything */
+            pdt_point *up = malloc((m + 1) * sizeof *up);
+            for (size_t i = 0; i < m; i++) up[i] = srm_key_point(u[i].key);
+            pdt_tri *ref = NULL;
+            size_t nref = 0;
+            pdt_delaunay(up, m, &ref, &nref, 0, NULL);
+            for (size_t i = 0; i < nref; i++)
+                for (int k = 0; k < 3; k++) ref[i].v[k] = u[ref[i].v[k]].idx;
+            pdt_tri_canonical(ref, nref);
+            for (size_t pi = 0; pi < sizeof ps / sizeof *ps; pi++)
+                for (int rep = 0; rep < 3; rep++) {
+                    int p = ps[pi];
+                    size_t cut[65];
+                    cut[0] = 0;
+                    cut[p] = m;
+                    for (int r = 1; r < p; r++) cut[r] = m ? (size_t)(rnd() % (m + 1)) : 0;
+                    if (rep == 0) /* balanced */
+                        for (int r = 1; r < p; r++) cut[r] = m * (size_t)r / (size_t)p;
+                    for (int a = 1; a < p; a++) /* sort the cuts */
+                        for (int b = a + 1; b < p; b++)
+                            if (cut[b] < cut[a]) {
+                                size_t t = cut[a];
+                                cut[a] = cut[b];
+                                cut[b] = t;
+                            }
+                    pdt_tri *got = NULL;
+                    size_t ngot = 0;
+                    uint64_t bmax;
+                    pdt_status st = simulate(u, p, cut, &got, &ngot, &bmax);
+                    runs++;
+                    int same = st == PDT_OK && ngot == nref &&
+                               (nref == 0 || memcmp(got, ref, nref * sizeof *ref) == 0);
+                    if (!same) {
+                        bad++;
+                        if (bad <= 5)
+                            printf("#   %s n=%zu p=%d rep=%d: %zu triangles, expected %zu\n",
+                                   fam_name[f], n, p, rep, ngot, nref);
+                    }
+                    free(got);
+                }
+            free(ref);
+            free(up);
+            free(u);
+            free(tmp);
+            free(pts);
+        }
+    CHECK_MSG(bad == 0, "%d of %d simulated runs differ from the sequential kernel", bad, runs);
+    printf("# %d simulated runs\n", runs);
+}
+
+int main(void)
+{
+    RUN(srm_equals_sequential);
+    (void)cmp_tri;
+    return test_summary();
+}
