@@ -7,7 +7,6 @@
  * so a failed run never leaves an output file. */
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "pdt/io.h"
 #include "pdt/par.h"
@@ -15,17 +14,11 @@
 
 enum { TAG_CLOCK = 9, CLOCK_ROUNDS = 8 };
 
-static int64_t mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
-
 /* Clock offsets by ping-pong with rank 0 (the round with the smallest round
  * trip wins): offset[q] is what to add to rank q's clock to get rank 0's.
  * off (size p) matters at rank 0 only. */
-static pdt_status clock_offsets(pdt_comm *c, int64_t *off, pdt_err *err)
+static pdt_status clock_offsets(pdt_comm *c, const pdt_trace_writer *w, int64_t *off,
+                                pdt_err *err)
 {
     int r = pdt_comm_rank(c), p = pdt_comm_size(c);
     pdt_status st = PDT_OK;
@@ -34,12 +27,12 @@ static pdt_status clock_offsets(pdt_comm *c, int64_t *off, pdt_err *err)
         for (int q = 1; q < p && st == PDT_OK; q++) {
             int64_t best = INT64_MAX;
             for (int k = 0; k < CLOCK_ROUNDS && st == PDT_OK; k++) {
-                int64_t t0 = mono_ns(), tq;
+                int64_t t0 = (int64_t)pdt_tw_now(w), tq;
                 void *buf = NULL;
                 size_t len = 0;
                 st = pdt_comm_send(c, q, TAG_CLOCK, &t0, sizeof t0, err);
                 if (st == PDT_OK) st = pdt_comm_recv(c, q, TAG_CLOCK, &buf, &len, err);
-                int64_t t1 = mono_ns();
+                int64_t t1 = (int64_t)pdt_tw_now(w);
                 if (st == PDT_OK && len == sizeof tq) {
                     memcpy(&tq, buf, sizeof tq);
                     if (t1 - t0 < best) {
@@ -56,19 +49,30 @@ static pdt_status clock_offsets(pdt_comm *c, int64_t *off, pdt_err *err)
             size_t len = 0;
             st = pdt_comm_recv(c, 0, TAG_CLOCK, &buf, &len, err);
             free(buf);
-            int64_t t = mono_ns();
+            int64_t t = (int64_t)pdt_tw_now(w);
             if (st == PDT_OK) st = pdt_comm_send(c, 0, TAG_CLOCK, &t, sizeof t, err);
         }
     }
     return st;
 }
 
-static uint64_t fnv1a(const void *data, size_t n)
+static pdt_status write_meta(const pdt_par_job *job, int p, const pdt_point *pts, size_t n,
+                             int64_t *off, pdt_err *err)
 {
-    const unsigned char *b = data;
-    uint64_t h = 0xcbf29ce484222325ull;
-    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ull;
-    return h;
+    pdt_manifest m;
+    memset(&m, 0, sizeof m);
+    m.format_version = PDT_TRACE_FORMAT_MAJOR;
+    snprintf(m.program_version, sizeof m.program_version, "%s", PDT_VERSION);
+    m.command_line = (char *)(job->command_line ? job->command_line : "pdt triangulate");
+    m.input_name = (char *)job->input;
+    m.input_checksum = pdt_points_checksum(pts, n);
+    m.n = n;
+    m.nranks = p;
+    m.level = job->trace_level;
+    snprintf(m.command, sizeof m.command, "triangulate");
+    m.clock_offset_ns = off;
+    m.wall_start_ns = pdt_wall_ns();
+    return pdt_run_write_meta(job->trace_dir, &m, pts, n, err);
 }
 
 /* Stop the whole job after an error on this rank. */
@@ -127,7 +131,9 @@ int pdt_par_cmd_triangulate(int *argc, char ***argv, const pdt_par_job *job)
             pdt_err_set(&err, PDT_ERR_NOMEM, "rank %d: out of memory", r);
             die(c, &err);
         }
-        if (clock_offsets(c, off, &err) != PDT_OK) die(c, &err);
+        if (clock_offsets(c, w, off, &err) != PDT_OK) die(c, &err);
+        /* the manifest goes first: a killed run still leaves a complete folder */
+        if (r == 0 && write_meta(job, p, pts, n, off, &err) != PDT_OK) die(c, &err);
         tr = pdt_tw_hook(w);
         tr->rank = r;
         tr->gid = NULL;
@@ -141,31 +147,7 @@ int pdt_par_cmd_triangulate(int *argc, char ***argv, const pdt_par_job *job)
         die(c, &err);
 
     if (w && pdt_tw_close(w, &err) != PDT_OK) die(c, &err);
-    if (job->trace_dir) {
-        /* every rank file is complete before the manifest appears */
-        if (pdt_comm_barrier(c, &err) != PDT_OK) die(c, &err);
-        if (r == 0) {
-            pdt_manifest m;
-            memset(&m, 0, sizeof m);
-            m.format_version = 1;
-            snprintf(m.program_version, sizeof m.program_version, "%s", PDT_VERSION);
-            m.command_line = (char *)(job->command_line ? job->command_line : "pdt triangulate");
-            m.input_name = (char *)job->input;
-            m.input_checksum = fnv1a(pts, n * sizeof *pts);
-            m.n = n;
-            m.nranks = p;
-            m.level = job->trace_level;
-            snprintf(m.command, sizeof m.command, "triangulate");
-            m.clock_offset_ns = off;
-            struct timespec ts;
-            clock_gettime(CLOCK_REALTIME, &ts);
-            m.wall_start_ns = (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
-            if (pdt_run_write_meta(job->trace_dir, &m, pts, n, &err) != PDT_OK) {
-                fprintf(stderr, "pdt: %s\n", err.msg);
-                rc = 1;
-            }
-        }
-    }
+    if (job->trace_dir && pdt_comm_barrier(c, &err) != PDT_OK) die(c, &err);
     free(off);
 
     if (r == 0 && rc == 0) {
