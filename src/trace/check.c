@@ -1,0 +1,515 @@
+/* pdt — pdt trace check: the invariants a correct run's trace satisfies.
+ *
+ * One streaming pass per rank (cursor: memory O(block) plus what is being
+ * checked), then the cross-rank checks.  The first violation found is
+ * reported as "rank R event #K (the event as text): what is wrong". */
+#include <inttypes.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pdt/delaunay.h"
+#include "pdt/hull.h"
+#include "pdt/predicates.h"
+#include "pdt/tracefile.h"
+
+typedef struct u32vec {
+    uint32_t *v;
+    size_t n, cap;
+} u32vec;
+
+static int u32_push(u32vec *s, uint32_t x)
+{
+    if (s->n == s->cap) {
+        size_t cap = s->cap ? 2 * s->cap : 16;
+        uint32_t *v = realloc(s->v, cap * sizeof *v);
+        if (!v) return -1;
+        s->v = v;
+        s->cap = cap;
+    }
+    s->v[s->n++] = x;
+    return 0;
+}
+
+typedef struct fin {   /* a TRI_FINAL, rotated to start at its smallest index */
+    pdt_tri t;
+    uint32_t rank;
+    uint64_t seq;
+} fin;
+
+typedef struct msg {   /* a SEND or RECV */
+    uint32_t src, dst, tag, bytes, rank;
+    int64_t seq_no;
+    uint64_t seq;      /* event index */
+    pdt_event ev;
+} msg;
+
+typedef struct merge {
+    uint32_t level, gl, gr, end, rank;
+    uint64_t seq, lifts, discards;
+    int closed;
+} merge;
+
+typedef struct chk {
+    pdt_run *run;
+    pdt_err *err;
+    const pdt_point *pts;
+    size_t npts;
+    int is_tri, is_hull;
+    uint8_t *mark;          /* per point: see M_* */
+    fin *fin;
+    size_t nfin, capfin;
+    msg *msg;
+    size_t nmsg, capmsg;
+    merge *mg;
+    size_t nmg, capmg;
+    u32vec graham_final;    /* last finished Graham stack of rank 0 */
+    uint64_t events, pushes, pops, instances, lifts_local, lifts_merge, sorts;
+} chk;
+
+enum { M_SORTED = 1, M_DELETED = 2, M_PUSHED = 4, M_LIFTED = 8, M_REP = 16 };
+
+static pdt_status nomem(chk *c)
+{
+    return pdt_err_set(c->err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+}
+
+static pdt_status viol(chk *c, uint32_t rank, uint64_t seq, const pdt_event *e, const char *fmt,
+                       ...) __attribute__((format(printf, 5, 6)));
+static pdt_status viol(chk *c, uint32_t rank, uint64_t seq, const pdt_event *e, const char *fmt,
+                       ...)
+{
+    char what[600], text[160];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    if (e)
+        return pdt_err_set(c->err, PDT_ERR_CHECK, "rank %" PRIu32 " event #%" PRIu64 " (%s): %s",
+                           rank, seq, pdt_event_format(e, text, sizeof text), what);
+    return pdt_err_set(c->err, PDT_ERR_CHECK, "%s", what);
+}
+
+static int grow(void **p, size_t *cap, size_t n, size_t size)
+{
+    if (n < *cap) return 0;
+    size_t nc = *cap ? 2 * *cap : 64;
+    void *q = realloc(*p, nc * size);
+    if (!q) return -1;
+    *p = q;
+    *cap = nc;
+    return 0;
+}
+
+/* A point argument must name a point of the run. */
+static pdt_status need_pt(chk *c, uint32_t rank, uint64_t seq, const pdt_event *e, uint32_t p)
+{
+    if (p < c->npts) return PDT_OK;
+    return viol(c, rank, seq, e, "point %" PRIu32 " does not exist (the run has %zu points)", p,
+                c->npts);
+}
+
+typedef struct rank_state {
+    u32vec stack[256];      /* by stack id */
+    u32vec phases;          /* open phases: (phase << 32 would not fit) ids */
+    u32vec phase_seq_lo;    /* low 32 bits of the event index of each open phase */
+    long open_merge;        /* index into c->mg, or -1 */
+} rank_state;
+
+static void rank_state_free(rank_state *s)
+{
+    for (int i = 0; i < 256; i++) free(s->stack[i].v);
+    free(s->phases.v);
+    free(s->phase_seq_lo.v);
+}
+
+/* Graham's stack of rank 0 finished: remember its content. */
+static pdt_status graham_done(chk *c, const u32vec *s)
+{
+    c->graham_final.n = 0;
+    for (size_t i = 0; i < s->n; i++)
+        if (u32_push(&c->graham_final, s->v[i])) return nomem(c);
+    return PDT_OK;
+}
+
+static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, const pdt_event *e)
+{
+    pdt_status st = PDT_OK;
+    switch (e->kind) {
+    case PDT_EV_PHASE_BEGIN:
+        if (u32_push(&rs->phases, e->sub) || u32_push(&rs->phase_seq_lo, (uint32_t)seq))
+            return nomem(c);
+        break;
+    case PDT_EV_PHASE_END:
+        if (rs->phases.n == 0 || rs->phases.v[rs->phases.n - 1] != e->sub) {
+            const char *open = rs->phases.n ? pdt_phase_name((int)rs->phases.v[rs->phases.n - 1])
+                                            : NULL;
+            return viol(c, r, seq, e, "ends a phase that is not the innermost open one (%s)",
+                        rs->phases.n ? (open ? open : "?") : "none open");
+        }
+        rs->phases.n--;
+        rs->phase_seq_lo.n--;
+        break;
+    case PDT_EV_PUSH: {
+        u32vec *s = &rs->stack[e->sub];
+        if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
+        if (e->b == 1) {  /* a new stack instance begins */
+            if (r == 0 && e->sub == PDT_STACK_GRAHAM && s->n && (st = graham_done(c, s)))
+                return st;
+            s->n = 0;
+            c->instances++;
+        } else if (e->b != s->n + 1) {
+            return viol(c, r, seq, e, "depth after push should be %zu", s->n + 1);
+        }
+        if (u32_push(s, e->a)) return nomem(c);
+        c->pushes++;
+        if (e->sub == PDT_STACK_GRAHAM) c->mark[e->a] |= M_PUSHED;
+        break;
+    }
+    case PDT_EV_POP: {
+        u32vec *s = &rs->stack[e->sub];
+        if (s->n == 0) return viol(c, r, seq, e, "pop from an empty stack");
+        if (s->v[s->n - 1] != e->a)
+            return viol(c, r, seq, e, "the top of the %s stack is pt %" PRIu32 ", not pt %" PRIu32,
+                        pdt_stack_name(e->sub) ? pdt_stack_name(e->sub) : "?",
+                        s->v[s->n - 1], e->a);
+        if (e->b != s->n - 1)
+            return viol(c, r, seq, e, "depth after pop should be %zu", s->n - 1);
+        s->n--;
+        c->pops++;
+        break;
+    }
+    case PDT_EV_LIFT: {
+        if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
+        pdt_point p = c->pts[e->a];
+        uint64_t z = (uint64_t)((int64_t)p.x * p.x) + (uint64_t)((int64_t)p.y * p.y);
+        if ((uint64_t)e->v != z)
+            return viol(c, r, seq, e, "z should be x*x + y*y = %" PRIu64, z);
+        if (rs->open_merge >= 0) {
+            c->mg[rs->open_merge].lifts++;
+            c->lifts_merge++;
+            break;
+        }
+        c->lifts_local++;
+        if (!(c->mark[e->a] & M_REP))
+            return viol(c, r, seq, e, "pt %" PRIu32 " is a duplicate of an earlier input point "
+                                      "and should not be lifted", e->a);
+        if (c->mark[e->a] & M_LIFTED)
+            return viol(c, r, seq, e, "pt %" PRIu32 " was already lifted (local lift-ups must "
+                                      "cover each distinct point once)", e->a);
+        c->mark[e->a] |= M_LIFTED;
+        break;
+    }
+    case PDT_EV_SORT:
+        if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
+        c->mark[e->a] |= M_SORTED;
+        c->sorts++;
+        break;
+    case PDT_EV_DELETE:
+        if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
+        if ((st = need_pt(c, r, seq, e, e->b)) != PDT_OK) return st;
+        c->mark[e->a] |= M_DELETED;
+        break;
+    case PDT_EV_TRI_FINAL: {
+        uint32_t v[3] = {e->a, e->b, e->c};
+        for (int i = 0; i < 3; i++)
+            if ((st = need_pt(c, r, seq, e, v[i])) != PDT_OK) return st;
+        if (pdt_orient(c->pts[v[0]], c->pts[v[1]], c->pts[v[2]]) <= 0)
+            return viol(c, r, seq, e, "the triangle is not counter-clockwise");
+        int k = v[0] < v[1] ? (v[0] < v[2] ? 0 : 2) : (v[1] < v[2] ? 1 : 2);
+        if (grow((void **)&c->fin, &c->capfin, c->nfin, sizeof *c->fin)) return nomem(c);
+        fin *f = &c->fin[c->nfin++];
+        for (int i = 0; i < 3; i++) f->t.v[i] = v[(k + i) % 3];
+        f->rank = r;
+        f->seq = seq;
+        break;
+    }
+    case PDT_EV_DISCARD:
+        if (rs->open_merge >= 0) c->mg[rs->open_merge].discards++;
+        break;
+    case PDT_EV_MERGE_BEGIN:
+        if (rs->open_merge >= 0)
+            return viol(c, r, seq, e, "the merge begun at event #%" PRIu64 " has not ended",
+                        c->mg[rs->open_merge].seq);
+        if (!(e->a < e->b && e->b < e->c && e->c <= (uint32_t)pdt_run_nranks(c->run)))
+            return viol(c, r, seq, e, "groups must be ranks [left, right) and [right, end) "
+                                      "with left < right < end <= %d", pdt_run_nranks(c->run));
+        if (e->v != (int64_t)r || e->b != r)
+            return viol(c, r, seq, e, "the merge rank must be the first rank of the right "
+                                      "group (%" PRIu32 ") and the rank recording it", e->b);
+        if (grow((void **)&c->mg, &c->capmg, c->nmg, sizeof *c->mg)) return nomem(c);
+        c->mg[c->nmg] = (merge){e->sub, e->a, e->b, e->c, r, seq, 0, 0, 0};
+        rs->open_merge = (long)c->nmg++;
+        break;
+    case PDT_EV_MERGE_END: {
+        if (rs->open_merge < 0) return viol(c, r, seq, e, "no merge step is open");
+        merge *m = &c->mg[rs->open_merge];
+        if (e->sub != m->level)
+            return viol(c, r, seq, e, "the open merge (event #%" PRIu64 ") is at level %" PRIu32,
+                        m->seq, m->level);
+        if (m->lifts != e->b)
+            return viol(c, r, seq, e, "the merge lifted %" PRIu64 " points, its border set has %"
+                                      PRIu32, m->lifts, e->b);
+        if (m->discards != (uint64_t)e->v)
+            return viol(c, r, seq, e, "%" PRIu64 " discard events were recorded in this merge",
+                        m->discards);
+        m->closed = 1;
+        rs->open_merge = -1;
+        break;
+    }
+    case PDT_EV_SEND:
+    case PDT_EV_RECV: {
+        if (grow((void **)&c->msg, &c->capmsg, c->nmsg, sizeof *c->msg)) return nomem(c);
+        msg *m = &c->msg[c->nmsg++];
+        int send = e->kind == PDT_EV_SEND;
+        m->src = send ? r : e->a;
+        m->dst = send ? e->a : r;
+        m->tag = e->sub;
+        m->seq_no = e->v;
+        m->bytes = e->b;
+        m->rank = r;
+        m->seq = seq;
+        m->ev = *e;
+        break;
+    }
+    default:
+        break;
+    }
+    return PDT_OK;
+}
+
+static pdt_status check_rank(chk *c, uint32_t r)
+{
+    rank_state *rs = calloc(1, sizeof *rs);
+    pdt_cursor *cur = NULL;
+    if (!rs) return nomem(c);
+    rs->open_merge = -1;
+    pdt_status st = pdt_cursor_open(c->run, (int)r, &cur, c->err);
+    pdt_event e;
+    uint64_t seq;
+    while (st == PDT_OK && pdt_cursor_next(cur, &e, &seq)) {
+        c->events++;
+        st = check_event(c, rs, r, seq, &e);
+    }
+    if (st == PDT_OK && rs->phases.n) {
+        uint32_t ph = rs->phases.v[rs->phases.n - 1];
+        st = viol(c, r, 0, NULL, "rank %" PRIu32 ": phase %s begun at event #%" PRIu32
+                                 " never ends", r,
+                  pdt_phase_name((int)ph) ? pdt_phase_name((int)ph) : "?",
+                  rs->phase_seq_lo.v[rs->phases.n - 1]);
+    }
+    if (st == PDT_OK && rs->open_merge >= 0)
+        st = viol(c, r, 0, NULL, "rank %" PRIu32 ": the merge step begun at event #%" PRIu64
+                                 " never ends", r, c->mg[rs->open_merge].seq);
+    if (st == PDT_OK && r == 0 && rs->stack[PDT_STACK_GRAHAM].n)
+        st = graham_done(c, &rs->stack[PDT_STACK_GRAHAM]);
+    pdt_cursor_close(cur);
+    rank_state_free(rs);
+    free(rs);
+    return st;
+}
+
+static int cmp_tri(const void *a, const void *b)
+{
+    const uint32_t *x = a, *y = b;
+    for (int i = 0; i < 3; i++)
+        if (x[i] != y[i]) return x[i] < y[i] ? -1 : 1;
+    return 0;
+}
+
+static int cmp_fin(const void *a, const void *b)
+{
+    int k = cmp_tri(&((const fin *)a)->t, &((const fin *)b)->t);
+    if (k) return k;
+    const fin *x = a, *y = b;
+    if (x->rank != y->rank) return x->rank < y->rank ? -1 : 1;
+    return x->seq < y->seq ? -1 : x->seq > y->seq;
+}
+
+static pdt_status check_finals(chk *c)
+{
+    if (c->nfin) qsort(c->fin, c->nfin, sizeof *c->fin, cmp_fin);
+    for (size_t i = 1; i < c->nfin; i++)
+        if (!cmp_tri(&c->fin[i].t, &c->fin[i - 1].t)) {
+            const fin *f = &c->fin[i], *g = &c->fin[i - 1];
+            return viol(c, 0, 0, NULL, "triangle %" PRIu32 " %" PRIu32 " %" PRIu32
+                                       " made final twice: rank %" PRIu32 " event #%" PRIu64
+                                       " and rank %" PRIu32 " event #%" PRIu64,
+                        f->t.v[0], f->t.v[1], f->t.v[2], g->rank, g->seq, f->rank, f->seq);
+        }
+    pdt_tri *ref = NULL;
+    size_t nref = 0;
+    pdt_status st = pdt_triangulate(c->pts, c->npts, &ref, &nref, NULL, NULL);
+    if (st != PDT_OK) {
+        free(ref);
+        return pdt_err_set(c->err, st, "recomputing T* of the run's points failed: %s",
+                           pdt_status_str(st));
+    }
+    size_t i = 0, j = 0;
+    while (st == PDT_OK && (i < c->nfin || j < nref)) {
+        int k = i == c->nfin ? 1 : j == nref ? -1 : cmp_tri(&c->fin[i].t, &ref[j]);
+        if (k < 0) {
+            const fin *f = &c->fin[i];
+            st = viol(c, 0, 0, NULL, "rank %" PRIu32 " event #%" PRIu64 ": final triangle %"
+                                     PRIu32 " %" PRIu32 " %" PRIu32 " is not in T* of the "
+                                     "run's points", f->rank, f->seq, f->t.v[0], f->t.v[1],
+                      f->t.v[2]);
+        } else if (k > 0) {
+            st = viol(c, 0, 0, NULL, "triangle %" PRIu32 " %" PRIu32 " %" PRIu32 " of T* was "
+                                     "never made final (%zu final triangles recorded, T* has %zu)",
+                      ref[j].v[0], ref[j].v[1], ref[j].v[2], c->nfin, nref);
+        } else {
+            i++;
+            j++;
+        }
+    }
+    free(ref);
+    return st;
+}
+
+static int cmp_msg(const void *a, const void *b)
+{
+    const msg *x = a, *y = b;
+    if (x->src != y->src) return x->src < y->src ? -1 : 1;
+    if (x->dst != y->dst) return x->dst < y->dst ? -1 : 1;
+    if (x->tag != y->tag) return x->tag < y->tag ? -1 : 1;
+    if (x->seq_no != y->seq_no) return x->seq_no < y->seq_no ? -1 : 1;
+    /* the SEND before the RECV of the same message */
+    return (x->ev.kind == PDT_EV_RECV) - (y->ev.kind == PDT_EV_RECV);
+}
+
+static pdt_status check_messages(chk *c)
+{
+    if (c->nmsg) qsort(c->msg, c->nmsg, sizeof *c->msg, cmp_msg);
+    for (size_t i = 0; i < c->nmsg;) {
+        const msg *m = &c->msg[i];
+        const msg *n = i + 1 < c->nmsg ? &c->msg[i + 1] : NULL;
+        if (n && !(m->ev.kind == PDT_EV_SEND && n->ev.kind == PDT_EV_RECV && n->src == m->src &&
+                   n->dst == m->dst && n->tag == m->tag && n->seq_no == m->seq_no))
+            n = NULL;
+        if (!n) {
+            if (m->ev.kind == PDT_EV_SEND)
+                return viol(c, m->rank, m->seq, &m->ev, "no matching recv on rank %" PRIu32,
+                            m->dst);
+            return viol(c, m->rank, m->seq, &m->ev, "no matching send on rank %" PRIu32, m->src);
+        }
+        if (n->bytes != m->bytes)
+            return viol(c, n->rank, n->seq, &n->ev, "the send (rank %" PRIu32 " event #%" PRIu64
+                                                    ") has %" PRIu32 " bytes",
+                        m->rank, m->seq, m->bytes);
+        i += 2;
+    }
+    return PDT_OK;
+}
+
+static int cmp_merge(const void *a, const void *b)
+{
+    const merge *x = a, *y = b;
+    if (x->level != y->level) return x->level < y->level ? -1 : 1;
+    return x->gl < y->gl ? -1 : x->gl > y->gl;
+}
+
+static pdt_status check_merges(chk *c)
+{
+    if (c->nmg) qsort(c->mg, c->nmg, sizeof *c->mg, cmp_merge);
+    for (size_t i = 1; i < c->nmg; i++) {
+        const merge *a = &c->mg[i - 1], *b = &c->mg[i];
+        if (a->level == b->level && b->gl < a->end)
+            return viol(c, 0, 0, NULL, "merge steps at level %" PRIu32 " overlap: ranks [%" PRIu32
+                                       ", %" PRIu32 ") (rank %" PRIu32 " event #%" PRIu64
+                                       ") and [%" PRIu32 ", %" PRIu32 ") (rank %" PRIu32
+                                       " event #%" PRIu64 ")",
+                        a->level, a->gl, a->end, a->rank, a->seq, b->gl, b->end, b->rank, b->seq);
+    }
+    int p = pdt_run_nranks(c->run);
+    if (c->is_tri && p > 1) {
+        const merge *top = c->nmg ? &c->mg[c->nmg - 1] : NULL;
+        if (!top || top->gl != 0 || top->end != (uint32_t)p)
+            return viol(c, 0, 0, NULL, "no merge step joins all %d ranks (the last merge %s)", p,
+                        top ? "covers fewer ranks" : "is missing");
+    }
+    return PDT_OK;
+}
+
+pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
+{
+    if (cap) summary[0] = '\0';
+    const char *w = pdt_run_warnings(run);
+    if (*w) {
+        const char *nl = strchr(w, '\n');
+        return pdt_err_set(err, PDT_ERR_CHECK, "damaged run folder: %.*s",
+                           (int)(nl ? nl - w : (long)strlen(w)), w);
+    }
+    chk c;
+    memset(&c, 0, sizeof c);
+    c.run = run;
+    c.err = err;
+    c.pts = pdt_run_points(run, &c.npts);
+    const pdt_manifest *m = pdt_run_manifest(run);
+    c.is_tri = !strcmp(m->command, "triangulate");
+    c.is_hull = !strcmp(m->command, "hull");
+    c.mark = calloc(c.npts ? c.npts : 1, 1);
+    uint32_t *order = malloc((c.npts ? c.npts : 1) * sizeof *order);
+    size_t nu = 0;
+    pdt_status st = PDT_OK;
+    if (!c.mark || !order) st = nomem(&c);
+    else if ((st = pdt_sort_unique(c.pts, c.npts, order, &nu)) != PDT_OK)
+        pdt_err_set(err, st, "sorting the run's points failed: %s", pdt_status_str(st));
+    for (size_t i = 0; st == PDT_OK && i < nu; i++) c.mark[order[i]] |= M_REP;
+    free(order);
+
+    for (int r = 0; st == PDT_OK && r < pdt_run_nranks(run); r++) st = check_rank(&c, (uint32_t)r);
+
+    if (st == PDT_OK && c.is_tri) {
+        if (c.lifts_local == 0 && nu > 0)
+            st = viol(&c, 0, 0, NULL, "no lift-up events (the run has %zu distinct points)", nu);
+        for (size_t i = 0; st == PDT_OK && i < c.npts; i++)
+            if ((c.mark[i] & M_REP) && !(c.mark[i] & M_LIFTED))
+                st = viol(&c, 0, 0, NULL, "pt %zu was never lifted (%" PRIu64 " local lift-ups "
+                                          "for %zu distinct points)", i, c.lifts_local, nu);
+    }
+    if (st == PDT_OK && c.is_tri) st = check_finals(&c);
+    if (st == PDT_OK && c.is_hull) {
+        /* every point sorted; each deleted or pushed; the final stack is the hull */
+        for (size_t i = 0; st == PDT_OK && i < c.npts; i++) {
+            if (!(c.mark[i] & M_SORTED))
+                st = viol(&c, 0, 0, NULL, "pt %zu never appears in the angular order", i);
+            else if (!(c.mark[i] & (M_DELETED | M_PUSHED)))
+                st = viol(&c, 0, 0, NULL, "pt %zu was neither deleted nor pushed", i);
+            else if ((c.mark[i] & M_DELETED) && (c.mark[i] & M_PUSHED))
+                st = viol(&c, 0, 0, NULL, "pt %zu was deleted and also pushed", i);
+        }
+        uint32_t *hull = malloc((c.npts ? c.npts : 1) * sizeof *hull);
+        size_t nh = 0;
+        if (st == PDT_OK && !hull) st = nomem(&c);
+        if (st == PDT_OK && (st = pdt_hull_graham(c.pts, c.npts, hull, &nh, NULL)) != PDT_OK)
+            pdt_err_set(err, st, "recomputing the hull failed: %s", pdt_status_str(st));
+        if (st == PDT_OK &&
+            (nh != c.graham_final.n ||
+             (nh && memcmp(hull, c.graham_final.v, nh * sizeof *hull) != 0))) {
+            size_t k = 0;
+            while (k < nh && k < c.graham_final.n && hull[k] == c.graham_final.v[k]) k++;
+            st = viol(&c, 0, 0, NULL, "the final Graham stack (%zu points) is not the hull of the "
+                                      "run's points (%zu points); first difference at position %zu",
+                      c.graham_final.n, nh, k);
+        }
+        free(hull);
+    }
+    if (st == PDT_OK) st = check_merges(&c);
+    if (st == PDT_OK) st = check_messages(&c);
+    if (st == PDT_OK && cap)
+        snprintf(summary, cap,
+                 "%d rank%s, %" PRIu64 " events: %" PRIu64 " stack instances (%" PRIu64
+                 " pushes, %" PRIu64 " pops), %" PRIu64 " local + %" PRIu64
+                 " merge lift-ups, %zu final triangles%s, %zu merge steps, %zu messages",
+                 pdt_run_nranks(run), pdt_run_nranks(run) == 1 ? "" : "s", c.events, c.instances,
+                 c.pushes, c.pops, c.lifts_local, c.lifts_merge, c.nfin,
+                 c.is_tri ? " = T*" : "", c.nmg, c.nmsg / 2);
+    free(c.mark);
+    free(c.fin);
+    free(c.msg);
+    free(c.mg);
+    free(c.graham_final.v);
+    return st;
+}

@@ -1,0 +1,332 @@
+/* pdt_run_check: passes on real traces of every generator family, fails
+ * naming the problem on traces altered on purpose (an event removed, a block
+ * truncated, a checksum flipped, a triangle made final twice, a lift with the
+ * wrong height, a message without its receive). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "../../src/trace/tf_internal.h"
+#include "../harness.h"
+#include "pdt/delaunay.h"
+#include "pdt/gen.h"
+#include "pdt/hull.h"
+#include "pdt/tracefile.h"
+
+static char tmpdir[256];
+
+static void meta(const char *dir, const char *command, const pdt_point *pts, size_t n, int nranks)
+{
+    int64_t *off = calloc((size_t)nranks, sizeof *off);
+    pdt_manifest m;
+    memset(&m, 0, sizeof m);
+    m.format_version = PDT_TRACE_FORMAT_MAJOR;
+    snprintf(m.command, sizeof m.command, "%s", command);
+    m.n = n;
+    m.nranks = nranks;
+    m.level = 1;
+    m.clock_offset_ns = off;
+    m.input_checksum = pdt_points_checksum(pts, n);
+    pdt_err err = {0};
+    CHECK_MSG(pdt_run_write_meta(dir, &m, pts, n, &err) == PDT_OK, "%s", err.msg);
+    free(off);
+}
+
+/* A traced sequential triangulation, as `pdt triangulate --trace` records it. */
+static void record_tri(const char *dir, const pdt_point *pts, size_t n, int level)
+{
+    pdt_trace_writer *w;
+    pdt_err err = {0};
+    CHECK(pdt_tw_open(dir, 0, level, &w, &err) == PDT_OK);
+    meta(dir, "triangulate", pts, n, 1);
+    pdt_trace *tr = pdt_tw_hook(w);
+    pdt_tri *t;
+    size_t nt;
+    CHECK(pdt_triangulate(pts, n, &t, &nt, NULL, tr) == PDT_OK);
+    for (size_t i = 0; i < nt; i++)
+        PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, t[i].v[0], t[i].v[1], t[i].v[2], 0);
+    free(t);
+    CHECK(pdt_tw_close(w, &err) == PDT_OK);
+}
+
+static void record_hull(const char *dir, const pdt_point *pts, size_t n)
+{
+    pdt_trace_writer *w;
+    pdt_err err = {0};
+    CHECK(pdt_tw_open(dir, 0, 1, &w, &err) == PDT_OK);
+    meta(dir, "hull", pts, n, 1);
+    uint32_t *out = malloc((n ? n : 1) * sizeof *out);
+    size_t nout;
+    CHECK(pdt_hull_graham(pts, n, out, &nout, pdt_tw_hook(w)) == PDT_OK);
+    free(out);
+    CHECK(pdt_tw_close(w, &err) == PDT_OK);
+}
+
+/* Run the check; returns its status, the message in msg. */
+static pdt_status check_dir(const char *dir, char *msg, size_t cap)
+{
+    pdt_run *run;
+    pdt_err err = {0};
+    if (pdt_run_open(dir, &run, &err) != PDT_OK) {
+        snprintf(msg, cap, "open: %s", err.msg);
+        return err.code;
+    }
+    char summary[512];
+    pdt_status st = pdt_run_check(run, summary, sizeof summary, &err);
+    snprintf(msg, cap, "%s", st == PDT_OK ? summary : err.msg);
+    pdt_run_close(run);
+    return st;
+}
+
+/* Copy run `from` to `to`, dropping event `drop` of rank 0 (or none if
+ * drop == UINT64_MAX) and applying `edit` to event `at` (if not NULL). */
+static void copy_run(const char *from, const char *to, uint64_t drop, uint64_t at,
+                     void (*edit)(pdt_event *))
+{
+    pdt_run *run;
+    pdt_err err = {0};
+    CHECK(pdt_run_open(from, &run, &err) == PDT_OK);
+    if (!run) return;
+    pdt_trace_writer *w;
+    CHECK(pdt_tw_open(to, 0, 2, &w, &err) == PDT_OK);
+    size_t np;
+    const pdt_point *pts = pdt_run_points(run, &np);
+    meta(to, pdt_run_manifest(run)->command, pts, np, 1);
+    const pdt_event *ev;
+    size_t n;
+    CHECK(pdt_run_rank_events(run, 0, &ev, &n, &err) == PDT_OK);
+    pdt_trace *tr = pdt_tw_hook(w);
+    for (size_t i = 0; i < n; i++) {
+        if (i == drop) continue;
+        pdt_event e = ev[i];
+        if (i == at && edit) edit(&e);
+        tr->sink(tr, &e);
+    }
+    CHECK(pdt_tw_close(w, &err) == PDT_OK);
+    pdt_run_close(run);
+}
+
+/* Index of the k-th (0-based) event of `kind` in rank 0 of dir. */
+static uint64_t find_kind(const char *dir, int kind, int k)
+{
+    pdt_run *run;
+    pdt_err err = {0};
+    uint64_t found = UINT64_MAX;
+    if (pdt_run_open(dir, &run, &err) != PDT_OK) return found;
+    const pdt_event *ev;
+    size_t n;
+    pdt_run_rank_events(run, 0, &ev, &n, &err);
+    for (size_t i = 0; i < n && found == UINT64_MAX; i++)
+        if (ev[i].kind == kind && k-- == 0) found = i;
+    pdt_run_close(run);
+    return found;
+}
+
+static char *sub(const char *name)
+{
+    static char buf[4][400];
+    static int k;
+    k = (k + 1) % 4;
+    snprintf(buf[k], sizeof buf[k], "%s/%s", tmpdir, name);
+    return buf[k];
+}
+
+TEST(every_family_passes)
+{
+    const char *const *kinds = pdt_gen_kinds();
+    for (int i = 0; kinds[i]; i++) {
+        pdt_point *pts;
+        size_t n = 300;
+        pdt_err err = {0};
+        CHECK(pdt_gen(kinds[i], n, 7, &pts, &err) == PDT_OK);
+        char name[64], msg[1100];
+        snprintf(name, sizeof name, "fam-%s", kinds[i]);
+        record_tri(sub(name), pts, n, i % 2 ? 2 : 1);
+        pdt_status st = check_dir(sub(name), msg, sizeof msg);
+        CHECK_MSG(st == PDT_OK, "triangulate %s: %s", kinds[i], msg);
+        snprintf(name, sizeof name, "hull-%s", kinds[i]);
+        record_hull(sub(name), pts, n);
+        st = check_dir(sub(name), msg, sizeof msg);
+        CHECK_MSG(st == PDT_OK, "hull %s: %s", kinds[i], msg);
+        free(pts);
+    }
+    /* tiny and empty inputs */
+    pdt_point few[3] = {{0, 0}, {1, 0}, {0, 1}};
+    char msg[1100];
+    for (size_t n = 0; n <= 3; n++) {
+        record_tri(sub("tiny"), few, n, 1);
+        CHECK_MSG(check_dir(sub("tiny"), msg, sizeof msg) == PDT_OK, "n=%zu: %s", n, msg);
+        record_hull(sub("tinyh"), few, n);
+        CHECK_MSG(check_dir(sub("tinyh"), msg, sizeof msg) == PDT_OK, "hull n=%zu: %s", n, msg);
+    }
+}
+
+static pdt_point *uniform(size_t n)
+{
+    pdt_point *pts;
+    pdt_err err = {0};
+    if (pdt_gen("uniform", n, 3, &pts, &err) != PDT_OK) return NULL;
+    return pts;
+}
+
+static void expect_fail(const char *dir, const char *want)
+{
+    char msg[1100];
+    pdt_status st = check_dir(dir, msg, sizeof msg);
+    CHECK_MSG(st == PDT_ERR_CHECK, "%s: status %d: %s", dir, st, msg);
+    CHECK_MSG(strstr(msg, want) != NULL, "%s: message '%s' lacks '%s'", dir, msg, want);
+}
+
+TEST(removed_events_are_named)
+{
+    pdt_point *pts = uniform(500);
+    record_tri(sub("base"), pts, 500, 1);
+    record_hull(sub("baseh"), pts, 500);
+    char msg[1100];
+    CHECK(check_dir(sub("base"), msg, sizeof msg) == PDT_OK);
+
+    /* a copy with nothing removed still passes (the copy itself is sound) */
+    copy_run(sub("base"), sub("same"), UINT64_MAX, UINT64_MAX, NULL);
+    CHECK_MSG(check_dir(sub("same"), msg, sizeof msg) == PDT_OK, "%s", msg);
+
+    uint64_t k = find_kind(sub("base"), PDT_EV_TRI_FINAL, 10);
+    copy_run(sub("base"), sub("nofinal"), k, UINT64_MAX, NULL);
+    expect_fail(sub("nofinal"), "was never made final");
+
+    k = find_kind(sub("base"), PDT_EV_LIFT, 17);
+    copy_run(sub("base"), sub("nolift"), k, UINT64_MAX, NULL);
+    expect_fail(sub("nolift"), "was never lifted");
+
+    k = find_kind(sub("base"), PDT_EV_PHASE_END, 1);
+    copy_run(sub("base"), sub("nophaseend"), k, UINT64_MAX, NULL);
+    expect_fail(sub("nophaseend"), "phase lift begun at event #2 never ends");
+
+    k = find_kind(sub("baseh"), PDT_EV_POP, 3);
+    copy_run(sub("baseh"), sub("nopop"), k, UINT64_MAX, NULL);
+    expect_fail(sub("nopop"), "rank 0 event #");
+
+    k = find_kind(sub("baseh"), PDT_EV_PUSH, 5);
+    copy_run(sub("baseh"), sub("nopush"), k, UINT64_MAX, NULL);
+    expect_fail(sub("nopush"), "depth after push should be");
+
+    k = find_kind(sub("baseh"), PDT_EV_DELETE, 0);
+    if (k != UINT64_MAX) {
+        copy_run(sub("baseh"), sub("nodelete"), k, UINT64_MAX, NULL);
+        expect_fail(sub("nodelete"), "neither deleted nor pushed");
+    }
+    free(pts);
+}
+
+static void bad_z(pdt_event *e) { e->v += 1; }
+static void cw(pdt_event *e)
+{
+    uint32_t t = e->b;
+    e->b = e->c;
+    e->c = t;
+}
+
+TEST(edited_events_are_named)
+{
+    pdt_point *pts = uniform(200);
+    record_tri(sub("base2"), pts, 200, 1);
+    uint64_t k = find_kind(sub("base2"), PDT_EV_LIFT, 3);
+    copy_run(sub("base2"), sub("badz"), UINT64_MAX, k, bad_z);
+    expect_fail(sub("badz"), "z should be x*x + y*y");
+    k = find_kind(sub("base2"), PDT_EV_TRI_FINAL, 4);
+    copy_run(sub("base2"), sub("cw"), UINT64_MAX, k, cw);
+    expect_fail(sub("cw"), "not counter-clockwise");
+    free(pts);
+}
+
+/* Bytes of a run's rank-0 file altered in place. */
+static void alter(const char *dir, long truncate_to, long flip_at)
+{
+    char path[500];
+    snprintf(path, sizeof path, "%s/rank-0000.trace", dir);
+    if (truncate_to >= 0) CHECK(truncate(path, truncate_to) == 0);
+    if (flip_at >= 0) {
+        FILE *f = fopen(path, "r+b");
+        CHECK(f != NULL);
+        if (!f) return;
+        fseek(f, flip_at, SEEK_SET);
+        int c = fgetc(f);
+        fseek(f, flip_at, SEEK_SET);
+        fputc(c ^ 1, f);
+        fclose(f);
+    }
+}
+
+TEST(damaged_files_fail)
+{
+    pdt_point *pts = uniform(3000);  /* several blocks */
+    record_tri(sub("dmg1"), pts, 3000, 1);
+    alter(sub("dmg1"), 70000, -1);
+    expect_fail(sub("dmg1"), "damaged run folder: rank-0000.trace: block 1 at byte");
+    record_tri(sub("dmg2"), pts, 3000, 1);
+    alter(sub("dmg2"), -1, 5000);
+    expect_fail(sub("dmg2"), "rank-0000.trace: block 0 at byte 32: checksum mismatch");
+    /* points.bin altered */
+    record_tri(sub("dmg3"), pts, 3000, 1);
+    char path[500];
+    snprintf(path, sizeof path, "%s/points.bin", sub("dmg3"));
+    FILE *f = fopen(path, "r+b");
+    if (f) {
+        fseek(f, 100, SEEK_SET);
+        fputc(0x55, f);
+        fclose(f);
+    }
+    expect_fail(sub("dmg3"), "points.bin: checksum mismatch");
+    free(pts);
+}
+
+/* Synthetic two-rank runs: messages and merge steps. */
+static void two_ranks(const char *dir, int with_recv, int with_merge_end)
+{
+    static const pdt_point pts[3] = {{0, 0}, {4, 0}, {0, 4}};
+    pdt_trace_writer *w0, *w1;
+    pdt_err err = {0};
+    CHECK(pdt_tw_open(dir, 0, 1, &w0, &err) == PDT_OK);
+    CHECK(pdt_tw_open(dir, 1, 1, &w1, &err) == PDT_OK);
+    pdt_trace *t0 = pdt_tw_hook(w0), *t1 = pdt_tw_hook(w1);
+    PDT_TRACE(t0, 1, PDT_EV_LIFT, 0, 0, 0, 0, 0);
+    PDT_TRACE(t0, 1, PDT_EV_LIFT, 0, 1, 0, 0, 16);
+    PDT_TRACE(t1, 1, PDT_EV_LIFT, 0, 2, 0, 0, 16);
+    PDT_TRACE(t0, 1, PDT_EV_SEND, 5, 1, 24, 0, 0);
+    if (with_recv) PDT_TRACE(t1, 1, PDT_EV_RECV, 5, 0, 24, 0, 0);
+    PDT_TRACE(t1, 1, PDT_EV_MERGE_BEGIN, 0, 0, 1, 2, 1);
+    for (uint32_t i = 0; i < 3; i++) PDT_TRACE(t1, 1, PDT_EV_LIFT, 0, i, 0, 0, i ? 16 : 0);
+    PDT_TRACE(t1, 1, PDT_EV_TRI_FINAL, 0, 0, 1, 2, 0);
+    if (with_merge_end) PDT_TRACE(t1, 1, PDT_EV_MERGE_END, 0, 0, 3, 1, 0);
+    CHECK(pdt_tw_close(w0, &err) == PDT_OK);
+    CHECK(pdt_tw_close(w1, &err) == PDT_OK);
+    meta(dir, "triangulate", pts, 3, 2);
+}
+
+TEST(messages_and_merges)
+{
+    char msg[1100];
+    two_ranks(sub("msg-ok"), 1, 1);
+    CHECK_MSG(check_dir(sub("msg-ok"), msg, sizeof msg) == PDT_OK, "%s", msg);
+    CHECK_MSG(strstr(msg, "1 merge steps, 1 messages") != NULL, "%s", msg);
+    two_ranks(sub("msg-norecv"), 0, 1);
+    expect_fail(sub("msg-norecv"), "(send tag=5 to=1 bytes=24 seq=0): no matching recv on rank 1");
+    two_ranks(sub("msg-noend"), 1, 0);
+    expect_fail(sub("msg-noend"), "never ends");
+}
+
+int main(void)
+{
+    snprintf(tmpdir, sizeof tmpdir, "%s/pdt-ttc.XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
+    if (!mkdtemp(tmpdir)) return 1;
+    RUN(every_family_passes);
+    RUN(removed_events_are_named);
+    RUN(edited_events_are_named);
+    RUN(damaged_files_fail);
+    RUN(messages_and_merges);
+    char cmd[300];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    if (system(cmd) != 0) return 1;
+    return test_summary();
+}
