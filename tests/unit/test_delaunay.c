@@ -24,7 +24,7 @@ static uint64_t xr(void)
     return rs;
 }
 
-/* pdt_triangulate == pdt_brute_delaunay; returns 1 if equal.  *nt gets the
+/* pdt_triangulate == pdt_brute_delaunay, and the checker accepts it; returns 1 if so.  *nt gets the
  * triangle count. */
 static int same_as_oracle(const pdt_point *p, size_t n, size_t *nt)
 {
@@ -40,6 +40,11 @@ static int same_as_oracle(const pdt_point *p, size_t n, size_t *nt)
     ok = ok && st.n_tri == na && st.n_in == n && st.n_unique + st.n_dup == n;
     ok = ok && (na == 0) == (st.collinear != 0);
     if (na) ok = ok && na == 2 * st.n_unique - st.n_hull - 2;
+    pdt_err err = {0};
+    if (pdt_check_delaunay(p, n, a, na, &err) != PDT_OK) {
+        printf("#   checker: %s\n", err.msg);
+        ok = 0;
+    }
     if (nt) *nt = na;
     free(a);
     free(b);

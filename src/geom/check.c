@@ -1,0 +1,341 @@
+/* pdt — the independent checker.
+ *
+ * Shares no code path with the kernel: its own exact arithmetic (two's
+ * complement 192-bit integers on 32-bit limbs, evaluated by plain schoolbook
+ * multiplication — a different scheme from predicates.c's 64-bit limbs and
+ * floating-point filter), its own sort, its own hull.
+ *
+ * Why these checks prove tris == T*(P):
+ *  1. every triangle is strictly counter-clockwise and uses representatives;
+ *  2. every undirected edge is used once or twice, twice only with opposite
+ *     directions; the edges used once (boundary) form exactly the convex hull
+ *     cycle of the distinct points, collinear boundary points included,
+ *     traversed once counter-clockwise;
+ *     => the chains of the triangle boundaries sum to the hull boundary, so a
+ *     generic point is covered by (winding number) = 1 triangle inside the
+ *     hull and 0 outside: the triangles tile the hull without overlap;
+ *  3. every distinct point is a vertex (so no point hides inside a triangle);
+ *  4. every interior edge is locally Delaunay under the tie rule (the
+ *     opposite point is outside by incircle with simulation of simplicity):
+ *     the perturbed lifted surface is locally convex over a convex domain,
+ *     hence it is the lower hull of the perturbed lift, i.e. T*(P).
+ *  The Euler count 2n - h - 2 (thesis D5) is checked as well. */
+#include "pdt/check.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- own exact arithmetic ---- */
+
+#define LIMBS 6 /* 192 bits, two's complement, w[0] least significant */
+
+typedef struct wide {
+    uint32_t w[LIMBS];
+} wide;
+
+static wide w_from(int64_t v)
+{
+    wide r;
+    uint64_t u = (uint64_t)v;
+    r.w[0] = (uint32_t)u;
+    r.w[1] = (uint32_t)(u >> 32);
+    for (int i = 2; i < LIMBS; i++) r.w[i] = v < 0 ? 0xffffffffu : 0u;
+    return r;
+}
+
+static wide w_add(wide a, wide b)
+{
+    uint64_t c = 0;
+    for (int i = 0; i < LIMBS; i++) {
+        c += (uint64_t)a.w[i] + b.w[i];
+        a.w[i] = (uint32_t)c;
+        c >>= 32;
+    }
+    return a;
+}
+
+static wide w_sub(wide a, wide b)
+{
+    for (int i = 0; i < LIMBS; i++) b.w[i] = ~b.w[i];
+    return w_add(a, w_add(b, w_from(1)));
+}
+
+/* a * b mod 2^192 (exact whenever the true product fits) */
+static wide w_mul(wide a, wide b)
+{
+    uint32_t r[LIMBS] = {0};
+    for (int i = 0; i < LIMBS; i++) {
+        uint64_t c = 0;
+        for (int j = 0; i + j < LIMBS; j++) {
+            c += (uint64_t)a.w[i] * b.w[j] + r[i + j];
+            r[i + j] = (uint32_t)c;
+            c >>= 32;
+        }
+    }
+    wide o;
+    memcpy(o.w, r, sizeof r);
+    return o;
+}
+
+static int w_sign(wide a)
+{
+    if (a.w[LIMBS - 1] & 0x80000000u) return -1;
+    for (int i = 0; i < LIMBS; i++)
+        if (a.w[i]) return 1;
+    return 0;
+}
+
+/* sign of (b - a) x (c - a) */
+static int ck_orient(pdt_point a, pdt_point b, pdt_point c)
+{
+    wide bx = w_from((int64_t)b.x - a.x), by = w_from((int64_t)b.y - a.y);
+    wide cx = w_from((int64_t)c.x - a.x), cy = w_from((int64_t)c.y - a.y);
+    return w_sign(w_sub(w_mul(bx, cy), w_mul(by, cx)));
+}
+
+/* sign of the lifted determinant: > 0 iff d inside the circle of CCW a,b,c */
+static int ck_incircle(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
+{
+    wide ax = w_from((int64_t)a.x - d.x), ay = w_from((int64_t)a.y - d.y);
+    wide bx = w_from((int64_t)b.x - d.x), by = w_from((int64_t)b.y - d.y);
+    wide cx = w_from((int64_t)c.x - d.x), cy = w_from((int64_t)c.y - d.y);
+    wide al = w_add(w_mul(ax, ax), w_mul(ay, ay));
+    wide bl = w_add(w_mul(bx, bx), w_mul(by, by));
+    wide cl = w_add(w_mul(cx, cx), w_mul(cy, cy));
+    wide t1 = w_mul(al, w_sub(w_mul(bx, cy), w_mul(cx, by)));
+    wide t2 = w_mul(bl, w_sub(w_mul(cx, ay), w_mul(ax, cy)));
+    wide t3 = w_mul(cl, w_sub(w_mul(ax, by), w_mul(bx, ay)));
+    return w_sign(w_add(w_add(t1, t2), t3));
+}
+
+/* the tie rule: on 0, the cofactor of the lexicographically smallest point */
+static int ck_incircle_sos(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
+{
+    int s = ck_incircle(a, b, c, d);
+    if (s) return s;
+    pdt_point q[4] = {a, b, c, d};
+    int used[4] = {0, 0, 0, 0};
+    for (int round = 0; round < 4; round++) {
+        int m = -1;
+        for (int i = 0; i < 4; i++)
+            if (!used[i] && (m < 0 || pdt_lex_cmp(q[i], q[m]) < 0)) m = i;
+        used[m] = 1;
+        int cof = m == 0 ? ck_orient(b, c, d)
+                : m == 1 ? -ck_orient(a, c, d)
+                : m == 2 ? ck_orient(a, b, d)
+                         : -ck_orient(a, b, c);
+        if (cof) return cof;
+    }
+    return 0;
+}
+
+/* ---- helpers ---- */
+
+typedef struct pidx {
+    pdt_point p;
+    uint32_t i;
+} pidx;
+
+static int pidx_cmp(const void *x, const void *y)
+{
+    const pidx *a = x, *b = y;
+    int c = pdt_lex_cmp(a->p, b->p);
+    if (c) return c;
+    return (a->i > b->i) - (a->i < b->i);
+}
+
+typedef struct dedge {
+    uint32_t lo, hi; /* endpoints, lo < hi */
+    uint32_t tri;    /* triangle */
+    uint8_t fwd;     /* 1 if the triangle runs lo -> hi */
+    uint8_t k;       /* position of the edge in the triangle */
+} dedge;
+
+static int dedge_cmp(const void *x, const void *y)
+{
+    const dedge *a = x, *b = y;
+    if (a->lo != b->lo) return a->lo < b->lo ? -1 : 1;
+    if (a->hi != b->hi) return a->hi < b->hi ? -1 : 1;
+    return (a->fwd > b->fwd) - (a->fwd < b->fwd);
+}
+
+#define FAIL(...) (st = pdt_err_set(err, PDT_ERR_CHECK, __VA_ARGS__))
+
+pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tris, size_t ntri,
+                              pdt_err *err)
+{
+    pdt_status st = PDT_OK;
+    if (n > UINT32_MAX || ntri > (size_t)UINT32_MAX / 3)
+        return pdt_err_set(err, PDT_ERR_ARG, "check.c:%d: input too large", __LINE__);
+    pidx *s = malloc((n ? n : 1) * sizeof *s);
+    uint32_t *rep = malloc((n ? n : 1) * sizeof *rep);
+    uint32_t *hull = malloc((2 * n + 2) * sizeof *hull); /* the chains may overshoot */
+    uint32_t *nxt = malloc((n ? n : 1) * sizeof *nxt);
+    uint8_t *usedv = calloc(n ? n : 1, 1);
+    dedge *ed = malloc((ntri ? 3 * ntri : 1) * sizeof *ed);
+    if (!s || !rep || !hull || !nxt || !usedv || !ed) {
+        st = pdt_err_set(err, PDT_ERR_NOMEM, "check.c:%d: out of memory", __LINE__);
+        goto done;
+    }
+
+    /* representatives: the smallest index of each location */
+    for (size_t i = 0; i < n; i++) {
+        s[i].p = pts[i];
+        s[i].i = (uint32_t)i;
+    }
+    qsort(s, n, sizeof *s, pidx_cmp);
+    size_t m = 0; /* distinct points, in s[0..m) after compaction */
+    for (size_t i = 0; i < n; i++) {
+        if (i > 0 && pdt_lex_cmp(s[i].p, s[m - 1].p) == 0) {
+            rep[s[i].i] = s[m - 1].i;
+            continue;
+        }
+        rep[s[i].i] = s[i].i;
+        s[m++] = s[i];
+    }
+
+    /* own monotone chain over the distinct points, collinear points kept */
+    size_t h = 0;
+    int collinear = 1;
+    for (size_t i = 2; i < m && collinear; i++)
+        collinear = ck_orient(s[0].p, s[1].p, s[i].p) == 0;
+    if (!collinear) {
+        for (size_t i = 0; i < m; i++) {
+            while (h >= 2 && ck_orient(pts[hull[h - 2]], pts[hull[h - 1]], s[i].p) < 0) h--;
+            hull[h++] = s[i].i;
+        }
+        size_t low = h;
+        for (size_t i = m - 1; i-- > 0;) {
+            while (h > low && ck_orient(pts[hull[h - 2]], pts[hull[h - 1]], s[i].p) < 0) h--;
+            hull[h++] = s[i].i;
+        }
+        h--; /* the start point came back */
+    }
+
+    if (collinear) {
+        if (ntri)
+            FAIL("check.c:%d: %zu triangles for %s input (expected none)", __LINE__, ntri,
+                 m < 3 ? "fewer than 3 distinct points" : "all-collinear");
+        goto done;
+    }
+    if (ntri == 0) {
+        FAIL("check.c:%d: no triangles, but the %zu distinct points are not collinear",
+             __LINE__, m);
+        goto done;
+    }
+
+    /* 1: triangles: valid representatives, counter-clockwise */
+    for (size_t t = 0; t < ntri && st == PDT_OK; t++) {
+        const uint32_t *v = tris[t].v;
+        for (int k = 0; k < 3 && st == PDT_OK; k++) {
+            if (v[k] >= n)
+                FAIL("check.c:%d: triangle %zu (%u %u %u): index %u out of range (n = %zu)",
+                     __LINE__, t, v[0], v[1], v[2], v[k], n);
+            else if (rep[v[k]] != v[k])
+                FAIL("check.c:%d: triangle %zu (%u %u %u) uses %u, a duplicate of point %u "
+                     "(the smallest index must represent it)", __LINE__, t, v[0], v[1], v[2],
+                     v[k], rep[v[k]]);
+        }
+        if (st != PDT_OK) break;
+        if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2])
+            FAIL("check.c:%d: triangle %zu (%u %u %u) repeats a vertex", __LINE__, t, v[0], v[1],
+                 v[2]);
+        else if (ck_orient(pts[v[0]], pts[v[1]], pts[v[2]]) <= 0)
+            FAIL("check.c:%d: triangle %zu (%u %u %u) is not counter-clockwise", __LINE__, t,
+                 v[0], v[1], v[2]);
+        for (int k = 0; k < 3; k++) {
+            uint32_t a = v[k], b = v[(k + 1) % 3];
+            dedge *e = &ed[3 * t + (size_t)k];
+            e->lo = a < b ? a : b;
+            e->hi = a < b ? b : a;
+            e->fwd = a < b;
+            e->tri = (uint32_t)t;
+            e->k = (uint8_t)k;
+            usedv[a] = 1;
+        }
+    }
+    if (st != PDT_OK) goto done;
+
+    /* 3: every distinct point used */
+    for (size_t i = 0; i < m && st == PDT_OK; i++)
+        if (!usedv[s[i].i])
+            FAIL("check.c:%d: point %u (%d, %d) is in no triangle", __LINE__, s[i].i, s[i].p.x,
+                 s[i].p.y);
+    if (st != PDT_OK) goto done;
+
+    /* 2: edge multiplicities; collect the boundary */
+    size_t ne = 3 * ntri, nb = 0;
+    qsort(ed, ne, sizeof *ed, dedge_cmp);
+    for (size_t i = 0; i < n; i++) nxt[i] = UINT32_MAX;
+    for (size_t i = 0; i < ne && st == PDT_OK;) {
+        size_t j = i + 1;
+        while (j < ne && ed[j].lo == ed[i].lo && ed[j].hi == ed[i].hi) j++;
+        if (j - i > 2 || (j - i == 2 && ed[i].fwd == ed[i + 1].fwd)) {
+            const pdt_tri *a = &tris[ed[i].tri], *b = &tris[ed[i + 1].tri];
+            FAIL("check.c:%d: edge %u-%u is used by %zu triangles (%u %u %u), (%u %u %u)%s",
+                 __LINE__, ed[i].lo, ed[i].hi, j - i, a->v[0], a->v[1], a->v[2], b->v[0],
+                 b->v[1], b->v[2], j - i == 2 ? " on the same side" : ", ...");
+        } else if (j - i == 1) { /* boundary edge, directed as in its triangle */
+            uint32_t from = ed[i].fwd ? ed[i].lo : ed[i].hi, to = ed[i].fwd ? ed[i].hi : ed[i].lo;
+            if (nxt[from] != UINT32_MAX)
+                FAIL("check.c:%d: boundary vertex %u has two outgoing boundary edges (to %u "
+                     "and %u)", __LINE__, from, nxt[from], to);
+            nxt[from] = to;
+            nb++;
+        }
+        i = j;
+    }
+    if (st != PDT_OK) goto done;
+
+    /* the boundary is exactly the hull cycle */
+    if (nb != h) {
+        FAIL("check.c:%d: %zu boundary edges, but the convex hull has %zu vertices "
+             "(collinear boundary points included)", __LINE__, nb, h);
+        goto done;
+    }
+    for (size_t k = 0; k < h; k++) {
+        uint32_t a = hull[k], b = hull[(k + 1) % h];
+        if (nxt[a] != b) {
+            if (nxt[a] == UINT32_MAX)
+                FAIL("check.c:%d: hull edge %u-%u is not a boundary edge (hull vertex %u has "
+                     "no outgoing boundary edge)", __LINE__, a, b, a);
+            else
+                FAIL("check.c:%d: boundary edge %u-%u is not the hull edge %u-%u", __LINE__, a,
+                     nxt[a], a, b);
+            goto done;
+        }
+    }
+
+    /* Euler (thesis D5) */
+    if (ntri != 2 * m - h - 2) {
+        FAIL("check.c:%d: %zu triangles, Euler count 2n - h - 2 = %zu (n = %zu, h = %zu)",
+             __LINE__, ntri, 2 * m - h - 2, m, h);
+        goto done;
+    }
+
+    /* 4: every interior edge locally Delaunay under the tie rule */
+    for (size_t i = 0; i + 1 < ne && st == PDT_OK; i++) {
+        if (ed[i].lo != ed[i + 1].lo || ed[i].hi != ed[i + 1].hi) continue;
+        const pdt_tri *t1 = &tris[ed[i].tri], *t2 = &tris[ed[i + 1].tri];
+        uint32_t a = t1->v[ed[i].k], b = t1->v[(ed[i].k + 1) % 3], c = t1->v[(ed[i].k + 2) % 3];
+        uint32_t d = t2->v[(ed[i + 1].k + 2) % 3];
+        int r = ck_incircle_sos(pts[a], pts[b], pts[c], pts[d]);
+        if (r >= 0)
+            FAIL("check.c:%d: edge %u-%u is not locally Delaunay: point %u is %s the circle of "
+                 "triangle (%u %u %u)%s", __LINE__, ed[i].lo, ed[i].hi, d,
+                 ck_incircle(pts[a], pts[b], pts[c], pts[d]) > 0 ? "inside" : "on",
+                 a, b, c,
+                 ck_incircle(pts[a], pts[b], pts[c], pts[d]) > 0 ? ""
+                                                                 : " and the tie rule says inside");
+        i++;
+    }
+
+done:
+    free(s);
+    free(rep);
+    free(hull);
+    free(nxt);
+    free(usedv);
+    free(ed);
+    return st;
+}
