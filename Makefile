@@ -7,6 +7,12 @@
 #   make demo       install missing packages, build, run the classroom demo
 #   make bench      benchmarks against other tools (prints figures; no asserts)
 #   make table1     the thesis' Table 1 (speedup) reproduced
+#   make fuzz       build the libFuzzer targets (clang, bin/fuzz/) and run each
+#                   for FUZZ_SECONDS; new crashes are kept in
+#                   tests/fuzz/crashes/TARGET/ (make test replays them, and the
+#                   seed corpus tests/fuzz/corpus/, without libFuzzer); the
+#                   grown corpus stays in build/fuzz/corpus/ (tests/fuzz/run.sh)
+#   make fuzz-seeds rewrite the binary trace seeds of tests/fuzz/corpus/
 #   make deps       only install missing Debian packages
 #   make clean
 #
@@ -16,6 +22,9 @@
 #   SAN       sanitizer flags, sanitizer build   (default: ASan + UBSan)
 #   NP        ranks for demo runs                (default: 4)
 #   TRACE=0   compile tracing out entirely (-DPDT_NO_TRACE)
+#   FUZZ_SECONDS  time per fuzz target        (default: 60)
+#   FUZZ_TARGETS  which fuzz targets to run   (default: all of them)
+#   FUZZ_JOBS     targets fuzzed at once      (default: 1)
 #
 # Layout: build/rel/... and build/san/... hold objects; bin/ the release
 # programs; bin/san/ the sanitizer programs.  Sources are picked up by
@@ -52,6 +61,7 @@ LIBS        := -lm
 DEB_BUILD := build-essential pkg-config libopenmpi-dev openmpi-bin libsdl2-dev libcairo2-dev
 DEB_TEST  := qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3
 DEB_BENCH := hyperfine libcgal-dev g++ nodejs npm valgrind time
+DEB_FUZZ  := clang libclang-rt-dev
 
 LIB_SRC  := $(wildcard src/geom/*.c src/io/*.c src/trace/*.c)
 PAR_SRC  := $(wildcard src/par/*.c)
@@ -98,7 +108,7 @@ endef
 $(eval $(call variant,rel,$(OPT),bin))
 $(eval $(call variant,san,$(SAN),bin/san))
 
-.PHONY: all deps test demo bench table1 clean rel-all san-all check-deps
+.PHONY: all deps test demo bench table1 clean rel-all san-all check-deps fuzz fuzz-build fuzz-seeds
 .DEFAULT_GOAL := all
 
 all: rel-all
@@ -126,6 +136,44 @@ bench: deps-bench
 table1: deps-bench
 	$(MAKE) rel-all
 	scripts/table1.sh
+
+# ---- fuzzing (clang + libFuzzer; see tests/fuzz/fuzz_common.h) ----------------
+FUZZ_CC      ?= clang
+FUZZ_SECONDS ?= 60
+FUZZ_JOBS    ?= 1
+FUZZ_TARGETS ?= points_text points_node tris manifest trace_rank trace_run
+FUZZ_FLAGS   := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined \
+                -fno-sanitize-recover=undefined
+
+build/fuzz/%.o: %.c $(wildcard include/pdt/*.h src/*/*.h)
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(CSTD) $(FUZZ_FLAGS) -fsanitize=fuzzer-no-link $(INC) -c $< -o $@
+
+build/fuzz/libpdt.a: $(patsubst %.c,build/fuzz/%.o,$(LIB_SRC))
+	@rm -f $@
+	ar rcs $@ $^
+
+bin/fuzz/fuzz_%: tests/fuzz/fuzz_main.c $(wildcard tests/fuzz/*.c tests/fuzz/*.h) build/fuzz/libpdt.a
+	@mkdir -p bin/fuzz
+	$(FUZZ_CC) $(CSTD) $(FUZZ_FLAGS) -fsanitize=fuzzer $(INC) -DFUZZ_FN=fuzz_$* \
+	    tests/fuzz/fuzz_main.c build/fuzz/libpdt.a $(LIBS) -o $@
+
+fuzz-build: $(patsubst %,bin/fuzz/fuzz_%,$(FUZZ_TARGETS))
+
+deps-fuzz:
+	@scripts/deps.sh $(DEB_BUILD) $(DEB_FUZZ)
+
+fuzz: deps-fuzz
+	$(MAKE) fuzz-build
+	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_JOBS=$(FUZZ_JOBS) tests/fuzz/run.sh $(FUZZ_TARGETS)
+
+build/fuzz-seeds/make_seeds: tests/fuzz/make_seeds.c build/rel/libpdt.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CSTD) $(OPT) $(WARN) $(INC) $< build/rel/libpdt.a $(LIBS) -o $@
+
+fuzz-seeds: build/fuzz-seeds/make_seeds
+	rm -rf build/fuzz-seeds/tmp && mkdir -p build/fuzz-seeds/tmp
+	build/fuzz-seeds/make_seeds build/fuzz-seeds/tmp tests/fuzz/corpus
 
 clean:
 	rm -rf build bin
