@@ -80,6 +80,7 @@ typedef struct pdt_rnode {
     uint32_t pt;
     int32_t parent;     /* -1 at the bottom */
     uint32_t depth;     /* 1 at the bottom */
+    uint32_t hull_ev;   /* first HULL event that reported this stack, or UINT32_MAX */
 } pdt_rnode;
 
 /* A phase of one rank: from its PHASE_BEGIN event to its PHASE_END event. */
@@ -137,6 +138,7 @@ void pdt_replay_free(pdt_replay *r);
 /* Sizes and tables (owned by the replay, valid until pdt_replay_free). */
 size_t pdt_replay_count(const pdt_replay *r);       /* events */
 size_t pdt_replay_skipped(const pdt_replay *r);     /* events ignored as malformed */
+size_t pdt_replay_kind_count(const pdt_replay *r, int kind); /* events of a pdt_event_kind */
 int pdt_replay_nranks(const pdt_replay *r);
 const pdt_point *pdt_replay_points(const pdt_replay *r, size_t *n);
 const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i);  /* NULL if i >= count */

@@ -142,6 +142,7 @@ struct pdt_replay {
     int64_t *sort_pos;
     pdt_point *box_lo, *box_hi;  /* per rank */
     uint8_t *has_box;
+    size_t kind_count[PDT_EV_KIND_COUNT];
 };
 
 #define NONE32 UINT32_MAX
@@ -277,7 +278,7 @@ static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
         uint32_t d = e->b ? e->b : (t >= 0 ? r->nodes[t].depth + 1 : 1);
         int32_t parent = node_at_depth(r, t, d - 1);
         if (!grow((void **)&r->nodes, &r->cap_node, r->nnode + 1, sizeof *r->nodes)) return 0;
-        r->nodes[r->nnode] = (pdt_rnode){e->a, parent, d};
+        r->nodes[r->nnode] = (pdt_rnode){e->a, parent, d, NONE32};
         r->nnode++;
         if (!lifted_any[rank]) box_add(r, rec->rank, r->pts[e->a]);
         return set_slot(b, i, rank, slot, (int32_t)(r->nnode - 1));
@@ -295,6 +296,8 @@ static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
         } else if (st == PDT_STACK_GRAHAM) {
             h.top = cur[PDT_SLOT_STACK0 + PDT_STACK_GRAHAM];
         }
+        if (h.top >= 0 && r->nodes[h.top].hull_ev == NONE32) r->nodes[h.top].hull_ev = i;
+        if (h.top2 >= 0 && r->nodes[h.top2].hull_ev == NONE32) r->nodes[h.top2].hull_ev = i;
         r->hulls[r->nhull] = h;
         r->nhull++;
         return set_slot(b, i, rank, PDT_SLOT_HULL, (int32_t)(r->nhull - 1));
@@ -421,6 +424,7 @@ static pdt_status build(pdt_replay *r, pdt_err *err)
             r->skipped++;
             continue;
         }
+        if (r->recs[i].ev.kind < PDT_EV_KIND_COUNT) r->kind_count[r->recs[i].ev.kind]++;
         if (!index_event(&b, (uint32_t)i, lifted_any)) goto out;
     }
     /* Triangle histories: counts -> offsets -> entries in event order. */
@@ -545,6 +549,11 @@ void pdt_replay_free(pdt_replay *r)
 
 size_t pdt_replay_count(const pdt_replay *r) { return r->m; }
 size_t pdt_replay_skipped(const pdt_replay *r) { return r->skipped; }
+
+size_t pdt_replay_kind_count(const pdt_replay *r, int kind)
+{
+    return kind >= 0 && kind < PDT_EV_KIND_COUNT ? r->kind_count[kind] : 0;
+}
 int pdt_replay_nranks(const pdt_replay *r) { return r->nranks; }
 
 const pdt_point *pdt_replay_points(const pdt_replay *r, size_t *n)
@@ -815,6 +824,14 @@ static const char *pt_str(const pdt_replay *r, uint32_t p, char *b, size_t cap)
     return b;
 }
 
+/* A point on Graham's stack: "p7 (point 12)" once sorted, else "12". */
+static const char *gpt(const pdt_replay *r, uint32_t p, char *b, size_t cap)
+{
+    if (p < r->n && r->sort_pos[p] >= 0) snprintf(b, cap, "p%lld (point %u)", (long long)r->sort_pos[p], p);
+    else snprintf(b, cap, "%u", p);
+    return b;
+}
+
 void pdt_replay_describe(const pdt_replay *r, size_t k, char *buf, size_t cap)
 {
     if (!cap) return;
@@ -839,10 +856,16 @@ void pdt_replay_describe(const pdt_replay *r, size_t k, char *buf, size_t cap)
         break;
     case PDT_EV_PHASE_END: snprintf(o, c, "end of phase %s", ph); break;
     case PDT_EV_PUSH:
-        snprintf(o, c, "push %s on the %s stack (depth %u)", pt_str(r, e->a, p1, sizeof p1), stk, e->b);
+        if (e->sub == PDT_STACK_GRAHAM)
+            snprintf(o, c, "push %s on the Graham stack (depth %u)", gpt(r, e->a, p1, sizeof p1), e->b);
+        else
+            snprintf(o, c, "push %s on the %s stack (depth %u)", pt_str(r, e->a, p1, sizeof p1), stk, e->b);
         break;
     case PDT_EV_POP:
-        if (e->c != NONE32 && e->c < r->n)
+        if (e->sub == PDT_STACK_GRAHAM && e->c < r->n && e->a < r->n)
+            snprintf(o, c, "pop %s — no left turn at (%d,%d) towards %s", gpt(r, e->a, p1, sizeof p1),
+                     r->pts[e->a].x, r->pts[e->a].y, gpt(r, e->c, p2, sizeof p2));
+        else if (e->c != NONE32 && e->c < r->n)
             snprintf(o, c, "pop %u — %s at (%d,%d) when adding %u", e->a,
                      e->sub == PDT_STACK_GRAHAM ? "no left turn" : "right turn",
                      e->a < r->n ? r->pts[e->a].x : 0, e->a < r->n ? r->pts[e->a].y : 0, e->c);

@@ -1,0 +1,81 @@
+/* pdt — the viewer's cairo renderer: draws one replay state on any cairo
+ * surface (the window's texture, PNG, SVG, PDF).  Knows nothing of windows or
+ * input; the SDL2 shell and the headless mode both call pdt_render().
+ *
+ * The picture: the geometry (strip boxes, triangles styled by Delaunay
+ * status and coloured by the rank that made them, kernel edges, hulls,
+ * stacks, Graham's angular numbers, the current triangle's circumdisk and the
+ * boxes it touches, merge sets), an event line at the top, a legend, a
+ * pseudo-code panel, a stack panel and a lifted view on the right, and a
+ * timeline at the bottom. */
+#ifndef PDT_RENDER_H
+#define PDT_RENDER_H
+
+#include <cairo.h>
+
+#include "pdt/replay.h"
+
+/* What the viewer shows and how (owned by the caller). */
+typedef struct pdt_view {
+    double zoom;          /* 1 = fit the points in the geometry area */
+    double cx, cy;        /* world point at the centre of the geometry area */
+    int centred;          /* 0: centre on the points' bounding box */
+    const uint8_t *hidden;/* per rank: 1 = hidden (NULL: all shown) */
+    double yaw, pitch;    /* lifted view rotation (radians) */
+    int help;             /* draw the help overlay */
+    int fade;             /* discarded triangles fade out over this many events */
+    int ev_class;         /* pdt_ev_class selected for Shift+arrows */
+    int64_t sel_point;    /* point whose details are shown, or -1 */
+    int64_t sel_tri;      /* triangle whose details are shown, or -1 */
+    const char *status;   /* short text for the status corner ("playing 8 ev/s"), or NULL */
+} pdt_view;
+
+/* Rectangles of the panels for a w x h picture (pixels). */
+typedef struct pdt_rect {
+    double x, y, w, h;
+} pdt_rect;
+
+typedef struct pdt_layout {
+    double font;          /* base font size in pixels */
+    pdt_rect top, geo, legend, code, stack, lifted, timeline;
+} pdt_layout;
+
+/* Defaults: fit, all ranks, yaw 30°, pitch 25°, fade 400 events. */
+void pdt_view_defaults(pdt_view *v);
+
+void pdt_render_layout(double w, double h, int nranks, pdt_layout *L);
+
+/* Draw state s of replay r on cr, in the rectangle (0,0)-(w,h).  Leaves the
+ * cairo state as it found it.  Returns PDT_OK, or an error if cairo reports
+ * one (err describes it). */
+pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, const pdt_rstate *s,
+                      const pdt_view *v, pdt_err *err);
+
+/* Draw into a file: the format comes from the extension (.png, .svg, .pdf). */
+pdt_status pdt_render_file(const char *path, int w, int h, const pdt_replay *r,
+                           const pdt_rstate *s, const pdt_view *v, pdt_err *err);
+
+/* The colour of a rank (Okabe–Ito for 0..7; beyond, the same hues darker or
+ * lighter), components in [0,1]. */
+void pdt_rank_rgb(int rank, double rgb[3]);
+
+/* Screen <-> world for the geometry area of a w x h picture. */
+void pdt_view_to_world(const pdt_replay *r, const pdt_view *v, double w, double h, double sx,
+                       double sy, double *wx, double *wy);
+void pdt_view_to_screen(const pdt_replay *r, const pdt_view *v, double w, double h, double wx,
+                        double wy, double *sx, double *sy);
+/* Zoom by factor f keeping the world point under (sx,sy) fixed. */
+void pdt_view_zoom_at(const pdt_replay *r, pdt_view *v, double w, double h, double sx, double sy,
+                      double f);
+
+/* What is under screen point (sx,sy): the nearest point within `radius`
+ * pixels (*point, else -1), otherwise a triangle drawn in state s that
+ * contains it (*tri, else -1). */
+void pdt_render_pick(const pdt_replay *r, const pdt_rstate *s, const pdt_view *v, double w,
+                     double h, double sx, double sy, double radius, int64_t *point, int64_t *tri);
+
+/* Cursor for a click at x in the timeline rectangle, or (size_t)-1 when x,y is
+ * not in it. */
+size_t pdt_render_timeline_at(const pdt_replay *r, double w, double h, double sx, double sy);
+
+#endif

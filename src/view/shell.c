@@ -1,0 +1,450 @@
+/* pdt — the viewer's SDL2 shell: the window, the keys and mouse, the clock.
+ *
+ * One loop() per frame: handle the pending events (real ones, or the next
+ * token of a --script), advance playback, draw one frame with the cairo
+ * renderer into an image surface that wraps the streaming texture, present.
+ * One quit path (shell_quit).  The frame is drawn at the drawable size, so
+ * it is sharp on high-DPI screens; mouse positions are scaled to match. */
+#include "shell.h"
+
+#include <SDL.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct shell {
+    const pdt_replay *r;
+    pdt_rstate *s;
+    pdt_view *v;
+    const pdt_shell_opts *o;
+    SDL_Window *win;
+    SDL_Renderer *ren;
+    SDL_Texture *tex;
+    int tw, th;             /* texture size = drawable size */
+    double sx, sy;          /* drawable / window scale */
+    uint8_t *hidden;        /* writable copy of the view's hidden ranks */
+    int nranks;
+    int playing, quit, dirty, shots;
+    double speed, acc;      /* events per second; fraction carried over */
+    uint64_t last;          /* performance counter at the last frame */
+    /* mouse */
+    int down, dragged, drag_lifted;
+    double mx0, my0, mx, my;
+    /* script */
+    const char *script;
+    int wait_frames;
+    char status[160];
+} shell;
+
+static void set_status(shell *sh)
+{
+    snprintf(sh->status, sizeof sh->status, "%s · %.0f ev/s · Shift+←/→: %s · h: help",
+             sh->playing ? "playing" : "paused", sh->speed, pdt_ev_class_name(sh->v->ev_class));
+    sh->v->status = sh->status;
+}
+
+static void seek(shell *sh, size_t k)
+{
+    size_t m = pdt_replay_count(sh->r);
+    if (k > m) k = m;
+    /* a few steps are cheaper than a seek; either gives the same state */
+    if (k > sh->s->k && k - sh->s->k <= 64) {
+        while (sh->s->k < k) pdt_replay_step(sh->r, sh->s, 1);
+    } else if (k < sh->s->k && sh->s->k - k <= 64) {
+        while (sh->s->k > k) pdt_replay_step(sh->r, sh->s, -1);
+    } else {
+        pdt_replay_seek(sh->r, sh->s, k);
+    }
+    sh->dirty = 1;
+}
+
+static int screenshot(shell *sh, const char *path)
+{
+    char name[64];
+    if (!path) {
+        snprintf(name, sizeof name, "pdtview-%03d.png", sh->shots++);
+        path = name;
+    }
+    pdt_err err = {0};
+    if (pdt_render_file(path, sh->tw, sh->th, sh->r, sh->s, sh->v, &err) != PDT_OK) {
+        fprintf(stderr, "pdtview: %s\n", err.msg);
+        return 0;
+    }
+    fprintf(stderr, "pdtview: screenshot %s (%dx%d, event %zu)\n", path, sh->tw, sh->th, sh->s->k);
+    return 1;
+}
+
+static void key(shell *sh, SDL_Keycode k, Uint16 mod)
+{
+    int shift = (mod & KMOD_SHIFT) != 0;
+    size_t m = pdt_replay_count(sh->r), cur = sh->s->k;
+    uint8_t *vis = NULL;
+    sh->dirty = 1;
+    switch (k) {
+    case SDLK_ESCAPE:
+    case SDLK_q: sh->quit = 1; break;
+    case SDLK_SPACE:
+        sh->playing = !sh->playing;
+        sh->acc = 0;
+        break;
+    case SDLK_RIGHT:
+    case SDLK_LEFT: {
+        int dir = k == SDLK_RIGHT ? 1 : -1;
+        sh->playing = 0;
+        if (!shift) {
+            pdt_replay_step(sh->r, sh->s, dir);
+            break;
+        }
+        vis = malloc((size_t)sh->nranks);
+        if (vis)
+            for (int q = 0; q < sh->nranks; q++) vis[q] = !sh->hidden[q];
+        seek(sh, pdt_replay_find(sh->r, cur, dir, sh->v->ev_class, vis));
+        free(vis);
+        break;
+    }
+    case SDLK_k:
+        sh->v->ev_class = sh->v->ev_class % (PDT_EVC_COUNT - 1) + 1;
+        break;
+    case SDLK_PAGEDOWN: seek(sh, pdt_replay_find_phase(sh->r, cur, 1)); break;
+    case SDLK_PAGEUP: seek(sh, pdt_replay_find_phase(sh->r, cur, -1)); break;
+    case SDLK_HOME: seek(sh, 0); break;
+    case SDLK_END: seek(sh, m); break;
+    case SDLK_PLUS:
+    case SDLK_EQUALS:
+    case SDLK_KP_PLUS: sh->speed = fmin(sh->speed * 2, 1e7); break;
+    case SDLK_MINUS:
+    case SDLK_KP_MINUS: sh->speed = fmax(sh->speed / 2, 0.25); break;
+    case SDLK_0:
+        memset(sh->hidden, 0, (size_t)sh->nranks);
+        break;
+    case SDLK_f:
+        sh->v->zoom = 1;
+        sh->v->centred = 0;
+        break;
+    case SDLK_h:
+    case SDLK_QUESTION: sh->v->help = !sh->v->help; break;
+    case SDLK_SLASH:
+        if (shift) sh->v->help = !sh->v->help;
+        break;
+    case SDLK_s: screenshot(sh, sh->o->screenshot); break;
+    default:
+        if (k >= SDLK_1 && k <= SDLK_9) {
+            int q = (int)(k - SDLK_1);
+            if (q < sh->nranks) sh->hidden[q] = !sh->hidden[q];
+        } else {
+            sh->dirty = 0;
+        }
+    }
+}
+
+static void click(shell *sh, double x, double y)
+{
+    size_t k = pdt_render_timeline_at(sh->r, sh->tw, sh->th, x, y);
+    if (k != (size_t)-1) {
+        sh->playing = 0;
+        seek(sh, k);
+        return;
+    }
+    pdt_layout L;
+    pdt_render_layout(sh->tw, sh->th, sh->nranks, &L);
+    if (x < L.geo.x || x > L.geo.x + L.geo.w || y < L.geo.y || y > L.geo.y + L.geo.h) return;
+    pdt_render_pick(sh->r, sh->s, sh->v, sh->tw, sh->th, x, y, 0.8 * L.font, &sh->v->sel_point,
+                    &sh->v->sel_tri);
+    sh->dirty = 1;
+}
+
+static int in_rect(pdt_rect R, double x, double y)
+{
+    return x >= R.x && x <= R.x + R.w && y >= R.y && y <= R.y + R.h;
+}
+
+static void mouse(shell *sh, const SDL_Event *e)
+{
+    pdt_layout L;
+    pdt_render_layout(sh->tw, sh->th, sh->nranks, &L);
+    switch (e->type) {
+    case SDL_MOUSEBUTTONDOWN:
+        if (e->button.button != SDL_BUTTON_LEFT) return;
+        sh->down = 1;
+        sh->dragged = 0;
+        sh->mx0 = sh->mx = e->button.x * sh->sx;
+        sh->my0 = sh->my = e->button.y * sh->sy;
+        sh->drag_lifted = in_rect(L.lifted, sh->mx, sh->my);
+        return;
+    case SDL_MOUSEMOTION: {
+        double x = e->motion.x * sh->sx, y = e->motion.y * sh->sy;
+        if (sh->down) {
+            if (fabs(x - sh->mx0) + fabs(y - sh->my0) > 4) sh->dragged = 1;
+            if (sh->dragged) {
+                if (sh->drag_lifted) {
+                    sh->v->yaw += (x - sh->mx) * 0.01;
+                    sh->v->pitch = fmin(1.5, fmax(0.05, sh->v->pitch + (y - sh->my) * 0.01));
+                } else {
+                    double ax, ay, bx, by;
+                    pdt_view_to_world(sh->r, sh->v, sh->tw, sh->th, sh->mx, sh->my, &ax, &ay);
+                    pdt_view_to_world(sh->r, sh->v, sh->tw, sh->th, x, y, &bx, &by);
+                    double cx, cy;
+                    pdt_view_to_world(sh->r, sh->v, sh->tw, sh->th, L.geo.x + L.geo.w / 2,
+                                      L.geo.y + L.geo.h / 2, &cx, &cy);
+                    sh->v->cx = cx - (bx - ax);
+                    sh->v->cy = cy - (by - ay);
+                    sh->v->centred = 1;
+                }
+                sh->dirty = 1;
+            }
+        }
+        sh->mx = x;
+        sh->my = y;
+        return;
+    }
+    case SDL_MOUSEBUTTONUP:
+        if (e->button.button != SDL_BUTTON_LEFT || !sh->down) return;
+        sh->down = 0;
+        if (!sh->dragged) click(sh, e->button.x * sh->sx, e->button.y * sh->sy);
+        return;
+    case SDL_MOUSEWHEEL: {
+        int mx, my;
+        SDL_GetMouseState(&mx, &my);
+        double x = mx * sh->sx, y = my * sh->sy;
+        if (!in_rect(L.geo, x, y)) return;
+        pdt_view_zoom_at(sh->r, sh->v, sh->tw, sh->th, x, y, pow(1.2, e->wheel.y));
+        sh->dirty = 1;
+        return;
+    }
+    default: return;
+    }
+}
+
+/* Feed the next script token as SDL events.  Tokens (space separated):
+ * key names (space right left S-right S-left pgdn pgup home end plus minus
+ * 0-9 h k f s q), wait:N (frames), click:X,Y and wheel:X,Y,N (window
+ * coordinates), drag:X0,Y0,X1,Y1. */
+static void script_step(shell *sh)
+{
+    if (!sh->script) return;
+    if (sh->wait_frames > 0) {
+        sh->wait_frames--;
+        return;
+    }
+    while (*sh->script == ' ') sh->script++;
+    if (!*sh->script) {
+        sh->script = NULL;
+        return;
+    }
+    char tok[64];
+    size_t n = strcspn(sh->script, " ");
+    if (n >= sizeof tok) n = sizeof tok - 1;
+    memcpy(tok, sh->script, n);
+    tok[n] = 0;
+    sh->script += strcspn(sh->script, " ");
+    static const struct { const char *name; SDL_Keycode k; Uint16 mod; } keys[] = {
+        {"space", SDLK_SPACE, 0},   {"right", SDLK_RIGHT, 0},  {"left", SDLK_LEFT, 0},
+        {"S-right", SDLK_RIGHT, KMOD_LSHIFT}, {"S-left", SDLK_LEFT, KMOD_LSHIFT},
+        {"pgdn", SDLK_PAGEDOWN, 0}, {"pgup", SDLK_PAGEUP, 0},  {"home", SDLK_HOME, 0},
+        {"end", SDLK_END, 0},       {"plus", SDLK_PLUS, 0},    {"minus", SDLK_MINUS, 0},
+        {"h", SDLK_h, 0},           {"k", SDLK_k, 0},          {"f", SDLK_f, 0},
+        {"s", SDLK_s, 0},           {"q", SDLK_q, 0},          {"esc", SDLK_ESCAPE, 0},
+    };
+    SDL_Event e;
+    memset(&e, 0, sizeof e);
+    for (size_t i = 0; i < sizeof keys / sizeof *keys; i++)
+        if (!strcmp(tok, keys[i].name)) {
+            e.type = SDL_KEYDOWN;
+            e.key.keysym.sym = keys[i].k;
+            e.key.keysym.mod = keys[i].mod;
+            SDL_PushEvent(&e);
+            return;
+        }
+    if (tok[0] >= '0' && tok[0] <= '9' && !tok[1]) {
+        e.type = SDL_KEYDOWN;
+        e.key.keysym.sym = SDLK_0 + (tok[0] - '0');
+        SDL_PushEvent(&e);
+        return;
+    }
+    int a, b, c, d;
+    if (sscanf(tok, "wait:%d", &a) == 1) {
+        sh->wait_frames = a;
+    } else if (sscanf(tok, "click:%d,%d", &a, &b) == 2) {
+        e.type = SDL_MOUSEBUTTONDOWN;
+        e.button.button = SDL_BUTTON_LEFT;
+        e.button.x = a;
+        e.button.y = b;
+        SDL_PushEvent(&e);
+        e.type = SDL_MOUSEBUTTONUP;
+        SDL_PushEvent(&e);
+    } else if (sscanf(tok, "drag:%d,%d,%d,%d", &a, &b, &c, &d) == 4) {
+        e.type = SDL_MOUSEBUTTONDOWN;
+        e.button.button = SDL_BUTTON_LEFT;
+        e.button.x = a;
+        e.button.y = b;
+        SDL_PushEvent(&e);
+        SDL_Event mv;
+        memset(&mv, 0, sizeof mv);
+        mv.type = SDL_MOUSEMOTION;
+        mv.motion.x = c;
+        mv.motion.y = d;
+        SDL_PushEvent(&mv);
+        e.type = SDL_MOUSEBUTTONUP;
+        e.button.x = c;
+        e.button.y = d;
+        SDL_PushEvent(&e);
+    } else if (sscanf(tok, "wheel:%d,%d,%d", &a, &b, &c) == 3) {
+        SDL_WarpMouseInWindow(sh->win, a, b);
+        e.type = SDL_MOUSEWHEEL;
+        e.wheel.y = c;
+        SDL_PushEvent(&e);
+    } else {
+        fprintf(stderr, "pdtview: script: unknown token \"%s\"\n", tok);
+    }
+}
+
+static int make_texture(shell *sh)
+{
+    int w, h, ww, wh;
+    if (SDL_GetRendererOutputSize(sh->ren, &w, &h) != 0) return 0;
+    SDL_GetWindowSize(sh->win, &ww, &wh);
+    sh->sx = ww > 0 ? (double)w / ww : 1;
+    sh->sy = wh > 0 ? (double)h / wh : 1;
+    if (sh->tex && w == sh->tw && h == sh->th) return 1;
+    if (sh->tex) SDL_DestroyTexture(sh->tex);
+    sh->tex = SDL_CreateTexture(sh->ren, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, w, h);
+    sh->tw = w;
+    sh->th = h;
+    sh->dirty = 1;
+    return sh->tex != NULL;
+}
+
+static int draw(shell *sh)
+{
+    void *pix;
+    int pitch;
+    if (SDL_LockTexture(sh->tex, NULL, &pix, &pitch) != 0) return 0;
+    cairo_surface_t *sf = cairo_image_surface_create_for_data(pix, CAIRO_FORMAT_RGB24, sh->tw,
+                                                              sh->th, pitch);
+    cairo_t *cr = cairo_create(sf);
+    pdt_err err = {0};
+    set_status(sh);
+    pdt_status st = pdt_render(cr, sh->tw, sh->th, sh->r, sh->s, sh->v, &err);
+    cairo_destroy(cr);
+    cairo_surface_flush(sf);
+    cairo_surface_destroy(sf);
+    SDL_UnlockTexture(sh->tex);
+    if (st != PDT_OK) fprintf(stderr, "pdtview: %s\n", err.msg);
+    return 1;
+}
+
+/* One frame: events, playback, draw, present. */
+static void loop(shell *sh)
+{
+    SDL_Event e;
+    script_step(sh);
+    int got = sh->playing || sh->dirty || sh->script ? SDL_PollEvent(&e)
+                                                    : SDL_WaitEventTimeout(&e, 100);
+    while (got) {
+        switch (e.type) {
+        case SDL_QUIT: sh->quit = 1; break;
+        case SDL_KEYDOWN: key(sh, e.key.keysym.sym, e.key.keysym.mod); break;
+        case SDL_TEXTINPUT:
+            if (!strcmp(e.text.text, "?")) {
+                sh->v->help = !sh->v->help;
+                sh->dirty = 1;
+            } else if (!strcmp(e.text.text, "+")) {
+                /* '+' typed with Shift on layouts where it is not SDLK_PLUS:
+                 * handled as SDLK_EQUALS already */
+            }
+            break;
+        case SDL_WINDOWEVENT:
+            if (e.window.event == SDL_WINDOWEVENT_SIZE_CHANGED ||
+                e.window.event == SDL_WINDOWEVENT_EXPOSED)
+                sh->dirty = 1;
+            break;
+        case SDL_MOUSEBUTTONDOWN:
+        case SDL_MOUSEBUTTONUP:
+        case SDL_MOUSEMOTION:
+        case SDL_MOUSEWHEEL: mouse(sh, &e); break;
+        default: break;
+        }
+        got = SDL_PollEvent(&e);
+    }
+    uint64_t now = SDL_GetPerformanceCounter();
+    double dt = (double)(now - sh->last) / (double)SDL_GetPerformanceFrequency();
+    sh->last = now;
+    if (sh->playing) {
+        sh->acc += fmin(dt, 0.25) * sh->speed;
+        size_t adv = (size_t)sh->acc;
+        sh->acc -= (double)adv;
+        if (adv) seek(sh, sh->s->k + adv);
+        if (sh->s->k >= pdt_replay_count(sh->r)) sh->playing = 0;
+        sh->dirty = 1;
+    }
+    if (!make_texture(sh)) {
+        fprintf(stderr, "pdtview: texture: %s\n", SDL_GetError());
+        sh->quit = 1;
+        return;
+    }
+    if (sh->dirty) {
+        if (!draw(sh)) {
+            fprintf(stderr, "pdtview: draw: %s\n", SDL_GetError());
+            sh->quit = 1;
+            return;
+        }
+        sh->dirty = 0;
+    }
+    SDL_RenderClear(sh->ren);
+    SDL_RenderCopy(sh->ren, sh->tex, NULL, NULL);
+    SDL_RenderPresent(sh->ren);
+}
+
+/* The one teardown path. */
+static int shell_quit(shell *sh, int rc)
+{
+    if (rc == 0 && sh->o->screenshot && sh->tex) screenshot(sh, sh->o->screenshot);
+    if (sh->tex) SDL_DestroyTexture(sh->tex);
+    if (sh->ren) SDL_DestroyRenderer(sh->ren);
+    if (sh->win) SDL_DestroyWindow(sh->win);
+    free(sh->hidden);
+    SDL_Quit();
+    return rc;
+}
+
+int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_shell_opts *o)
+{
+    shell sh;
+    memset(&sh, 0, sizeof sh);
+    sh.r = r;
+    sh.s = s;
+    sh.v = v;
+    sh.o = o;
+    sh.nranks = pdt_replay_nranks(r);
+    sh.speed = o->speed > 0 ? o->speed : 20;
+    sh.script = o->script;
+    sh.hidden = calloc((size_t)sh.nranks + 1, 1);
+    if (!sh.hidden) return 1;
+    if (v->hidden) memcpy(sh.hidden, v->hidden, (size_t)sh.nranks);
+    v->hidden = sh.hidden;
+    SDL_SetHint(SDL_HINT_VIDEO_X11_NET_WM_BYPASS_COMPOSITOR, "0");
+    if (SDL_Init(SDL_INIT_VIDEO) != 0) {
+        fprintf(stderr, "pdtview: SDL_Init: %s\n", SDL_GetError());
+        return shell_quit(&sh, 1);
+    }
+    char title[512];
+    snprintf(title, sizeof title, "pdtview — %s", o->title ? o->title : "");
+    sh.win = SDL_CreateWindow(title, SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, o->w, o->h,
+                              SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI);
+    if (!sh.win) {
+        fprintf(stderr, "pdtview: window: %s\n", SDL_GetError());
+        return shell_quit(&sh, 1);
+    }
+    sh.ren = SDL_CreateRenderer(sh.win, -1, SDL_RENDERER_PRESENTVSYNC);
+    if (!sh.ren) sh.ren = SDL_CreateRenderer(sh.win, -1, 0);
+    if (!sh.ren) {
+        fprintf(stderr, "pdtview: renderer: %s\n", SDL_GetError());
+        return shell_quit(&sh, 1);
+    }
+    SDL_StartTextInput();
+    sh.last = SDL_GetPerformanceCounter();
+    sh.dirty = 1;
+    while (!sh.quit) loop(&sh);
+    return shell_quit(&sh, 0);
+}

@@ -1,0 +1,42 @@
+#!/bin/bash
+# pdtview --headless: PNG/SVG/PDF pictures that other tools can read, frames,
+# phases, errors.  (The pixel-level checks are in tests/unit/test_view_render.c.)
+# san: yes
+. "$(dirname "$0")/lib.sh"
+V=$BIN/pdtview
+RUN=synth:srm:12:6:4
+
+if "$V" --headless "$RUN" --end -o "$TMP/end.png" --size 800x500 --quiet &&
+   [ "$(python3 -c 'import struct,sys; d=open(sys.argv[1],"rb").read(24); print(*struct.unpack(">II", d[16:24]))' "$TMP/end.png")" = "800 500" ]; then
+    ok png_size
+else fail png_size "no 800x500 PNG"; fi
+
+if "$V" --headless "$RUN" --phase merge -o "$TMP/m.svg" --quiet && xmllint --noout "$TMP/m.svg" 2>"$TMP/xl.err" &&
+   grep -q '<svg' "$TMP/m.svg"; then ok svg_valid; else fail svg_valid "$(head -3 "$TMP/xl.err")"; fi
+
+if command -v rsvg-convert >/dev/null && rsvg-convert -o "$TMP/m_svg.png" "$TMP/m.svg" 2>/dev/null && [ -s "$TMP/m_svg.png" ]; then
+    ok svg_renders
+else fail svg_renders "rsvg-convert could not render the SVG"; fi
+
+if "$V" --headless "$RUN" --at 500 -o "$TMP/a.pdf" --quiet && pdftoppm -r 30 -png "$TMP/a.pdf" "$TMP/pdfpage" &&
+   ls "$TMP"/pdfpage*.png >/dev/null 2>&1; then ok pdf_renders; else fail pdf_renders; fi
+
+# frames: 0, K, 2K, ..., m
+m=$("$V" --headless "$RUN" --end -o "$TMP/x.png" | sed -n 's/.*event \([0-9]*\) of.*/\1/p')
+"$V" --headless "$RUN" --frames "$TMP/frames" --every 400 --size 320x200 --quiet
+want=$(( (m + 399) / 400 + 1 ))
+got=$(ls "$TMP/frames" | grep -c '^frame-.*\.png$')
+if [ "$got" -eq "$want" ]; then ok frames_count; else fail frames_count "want $want frames, got $got (m=$m)"; fi
+
+# the picture changes along the run
+if ! cmp -s "$TMP/frames/frame-000000.png" "$TMP/frames/frame-000002.png"; then ok frames_differ; else fail frames_differ; fi
+
+# errors: unknown phase, cursor out of range, bad extension, missing run
+if ! "$V" --headless "$RUN" --phase nosuch -o "$TMP/n.png" 2>"$TMP/e1" && grep -q 'no phase named' "$TMP/e1"; then
+    ok error_phase; else fail error_phase; fi
+if ! "$V" --headless "$RUN" --at 99999999 -o "$TMP/n.png" 2>"$TMP/e2" && grep -q 'has [0-9]* events' "$TMP/e2"; then
+    ok error_at; else fail error_at; fi
+if ! "$V" --headless "$RUN" --end -o "$TMP/n.bmp" 2>"$TMP/e3" && grep -q 'unknown picture format' "$TMP/e3"; then
+    ok error_format; else fail error_format; fi
+if ! "$V" --headless "$TMP/no-such-run" --end -o "$TMP/n.png" 2>"$TMP/e4"; then ok error_run; else fail error_run; fi
+summary

@@ -1,0 +1,328 @@
+/* Headless renders: colours of edges by rank, discarded triangles marked,
+ * panels present, every file format written. */
+#include "../harness.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "pdt/render.h"
+#include "pdt/replay.h"
+#include "pdt/viewsynth.h"
+
+#define W 1200
+#define H 800
+
+typedef struct fixture {
+    pdt_synth syn;
+    pdt_replay *r;
+    pdt_rstate *s;
+    pdt_view v;
+    cairo_surface_t *sf;
+} fixture;
+
+static int setup(fixture *f, int cols, int rows, int ranks)
+{
+    pdt_err err = {0};
+    memset(f, 0, sizeof *f);
+    if (pdt_synth_srm(cols, rows, ranks, 2, &f->syn, &err) != PDT_OK) return 0;
+    if (pdt_replay_new(f->syn.pts, f->syn.n, f->syn.recs, f->syn.m, ranks, &f->r, &err) != PDT_OK) return 0;
+    f->s = pdt_rstate_new(f->r);
+    pdt_view_defaults(&f->v);
+    f->sf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
+    return f->s != NULL;
+}
+
+static void teardown(fixture *f)
+{
+    cairo_surface_destroy(f->sf);
+    pdt_rstate_free(f->s);
+    pdt_replay_free(f->r);
+    pdt_synth_free(&f->syn);
+}
+
+static int draw(fixture *f, size_t k)
+{
+    pdt_replay_seek(f->r, f->s, k);
+    cairo_t *cr = cairo_create(f->sf);
+    pdt_err err = {0};
+    pdt_status st = pdt_render(cr, W, H, f->r, f->s, &f->v, &err);
+    cairo_destroy(cr);
+    cairo_surface_flush(f->sf);
+    return st == PDT_OK;
+}
+
+static void pixel(cairo_surface_t *sf, int x, int y, double c[3])
+{
+    const unsigned char *d = cairo_image_surface_get_data(sf);
+    int stride = cairo_image_surface_get_stride(sf);
+    uint32_t p = *(const uint32_t *)(d + (size_t)y * (size_t)stride + (size_t)x * 4);
+    c[0] = ((p >> 16) & 255) / 255.0;
+    c[1] = ((p >> 8) & 255) / 255.0;
+    c[2] = (p & 255) / 255.0;
+}
+
+static double cdist(const double a[3], const double b[3])
+{
+    return fabs(a[0] - b[0]) + fabs(a[1] - b[1]) + fabs(a[2] - b[2]);
+}
+
+/* Smallest colour distance to `want` in the 3x3 pixels around (x,y). */
+static double near_colour(cairo_surface_t *sf, double x, double y, const double want[3])
+{
+    double best = 9;
+    for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+            double c[3];
+            int px = (int)lround(x) + dx, py = (int)lround(y) + dy;
+            if (px < 0 || py < 0 || px >= W || py >= H) continue;
+            pixel(sf, px, py, c);
+            double d = cdist(c, want);
+            if (d < best) best = d;
+        }
+    return best;
+}
+
+/* Pixels in a rectangle that are neither white nor the panel background. */
+static size_t ink(cairo_surface_t *sf, pdt_rect R)
+{
+    size_t n = 0;
+    for (int y = (int)R.y + 4; y < (int)(R.y + R.h) - 4; y++)
+        for (int x = (int)R.x + 4; x < (int)(R.x + R.w) - 4; x++) {
+            double c[3];
+            pixel(sf, x, y, c);
+            if (c[0] + c[1] + c[2] < 2.7) n++;
+        }
+    return n;
+}
+
+/* Midpoint on screen of the diagonal of a final triangle made by `rank`
+ * (the diagonal belongs to two triangles of the same cell and rank). */
+static int final_diagonal(fixture *f, int rank, double *x, double *y)
+{
+    size_t nt;
+    const pdt_rtri *T = pdt_replay_tris(f->r, &nt);
+    const pdt_point *P = f->syn.pts;
+    for (size_t t = 0; t < nt; t++) {
+        if (T[t].maker != (uint32_t)rank || pdt_rstate_tri_status(f->r, f->s, t) != PDT_TS_FINAL)
+            continue;
+        /* T1 = (p00, p10, p11): diagonal p00-p11 */
+        pdt_point a = P[T[t].v[0]], c = P[T[t].v[2]];
+        if (!(c.x > a.x && c.y > a.y)) continue;
+        pdt_view_to_screen(f->r, &f->v, W, H, (a.x + c.x) / 2.0, (a.y + c.y) / 2.0, x, y);
+        return 1;
+    }
+    return 0;
+}
+
+TEST(final_edge_has_rank_colour)
+{
+    fixture f;
+    CHECK(setup(&f, 16, 6, 4));
+    if (!f.s) return;
+    f.v.fade = 1;
+    CHECK(draw(&f, pdt_replay_count(f.r)));
+    for (int q = 0; q < 4; q++) {
+        double x, y, want[3], other[3];
+        CHECK(final_diagonal(&f, q, &x, &y));
+        pdt_rank_rgb(q, want);
+        pdt_rank_rgb((q + 1) % 4, other);
+        double d = near_colour(f.sf, x, y, want);
+        CHECK_MSG(d < 0.12, "rank %d: colour distance %.3f at (%.0f,%.0f)", q, d, x, y);
+        CHECK_MSG(near_colour(f.sf, x, y, other) > 0.3, "rank %d edge looks like rank %d", q, (q + 1) % 4);
+    }
+    teardown(&f);
+}
+
+TEST(discarded_drawn_differently)
+{
+    fixture f;
+    CHECK(setup(&f, 16, 6, 4));
+    if (!f.s) return;
+    /* the cursor just after the first discard: a red cross at its centroid */
+    size_t m = pdt_replay_count(f.r), k = 0;
+    for (size_t i = 0; i < m && !k; i++)
+        if (pdt_replay_rec(f.r, i)->ev.kind == PDT_EV_DISCARD) k = i + 1;
+    CHECK(k > 0);
+    CHECK(draw(&f, k + 3));
+    const pdt_event *e = &pdt_replay_rec(f.r, k - 1)->ev;
+    const pdt_point *P = f.syn.pts;
+    double cx = (P[e->a].x + P[e->b].x + P[e->c].x) / 3.0, cy = (P[e->a].y + P[e->b].y + P[e->c].y) / 3.0;
+    double x, y, red[3] = {0.85, 0, 0};
+    pdt_view_to_screen(f.r, &f.v, W, H, cx, cy, &x, &y);
+    CHECK_MSG(near_colour(f.sf, x, y, red) < 0.35, "no red mark on the discarded triangle at (%.0f,%.0f)", x, y);
+    /* a final triangle's centroid has no red mark */
+    CHECK(draw(&f, m));
+    size_t nt;
+    const pdt_rtri *T = pdt_replay_tris(f.r, &nt);
+    int checked = 0;
+    for (size_t t = 0; t < nt && checked < 20; t++) {
+        if (pdt_rstate_tri_status(f.r, f.s, t) != PDT_TS_FINAL) continue;
+        double fx = (P[T[t].v[0]].x + P[T[t].v[1]].x + P[T[t].v[2]].x) / 3.0;
+        double fy = (P[T[t].v[0]].y + P[T[t].v[1]].y + P[T[t].v[2]].y) / 3.0;
+        pdt_view_to_screen(f.r, &f.v, W, H, fx, fy, &x, &y);
+        CHECK(near_colour(f.sf, x, y, red) > 0.5);
+        checked++;
+    }
+    /* and the discarded one is gone (faded) at the end, the final one drawn */
+    pdt_view_to_screen(f.r, &f.v, W, H, cx, cy, &x, &y);
+    CHECK(near_colour(f.sf, x, y, red) > 0.5);
+    teardown(&f);
+}
+
+TEST(panels_present)
+{
+    fixture f;
+    CHECK(setup(&f, 12, 5, 3));
+    if (!f.s) return;
+    /* a triangle event: the code panel has a highlighted line, the lifted
+     * view a plane */
+    size_t m = pdt_replay_count(f.r), k = 0;
+    for (size_t i = 0; i < m && !k; i++)
+        if (pdt_replay_rec(f.r, i)->ev.kind == PDT_EV_RA_DEFER) k = i + 1;
+    CHECK(draw(&f, k));
+    pdt_layout L;
+    pdt_render_layout(W, H, 3, &L);
+    CHECK_MSG(ink(f.sf, L.legend) > 2000, "legend %zu", ink(f.sf, L.legend));
+    CHECK_MSG(ink(f.sf, L.code) > 2000, "code %zu", ink(f.sf, L.code));
+    CHECK_MSG(ink(f.sf, L.stack) > 300, "stack %zu", ink(f.sf, L.stack));
+    CHECK_MSG(ink(f.sf, L.lifted) > 2000, "lifted %zu", ink(f.sf, L.lifted));
+    CHECK_MSG(ink(f.sf, L.timeline) > 5000, "timeline %zu", ink(f.sf, L.timeline));
+    CHECK_MSG(ink(f.sf, L.top) > 500, "event line %zu", ink(f.sf, L.top));
+    /* the highlighted code line: yellow pixels in the code panel */
+    size_t yellow = 0;
+    for (int y = (int)L.code.y; y < (int)(L.code.y + L.code.h); y++)
+        for (int x = (int)L.code.x; x < (int)(L.code.x + L.code.w); x++) {
+            double c[3];
+            pixel(f.sf, x, y, c);
+            if (c[0] > 0.9 && c[1] > 0.8 && c[2] < 0.45) yellow++;
+        }
+    CHECK_MSG(yellow > 500, "highlight %zu", yellow);
+    /* the help overlay darkens the picture */
+    f.v.help = 1;
+    CHECK(draw(&f, k));
+    double c[3];
+    pixel(f.sf, 3, (int)(L.geo.y + 5), c);
+    CHECK_MSG(c[0] < 0.8, "help overlay missing (%.2f)", c[0]);
+    teardown(&f);
+}
+
+TEST(hidden_rank_not_drawn)
+{
+    fixture f;
+    CHECK(setup(&f, 16, 6, 4));
+    if (!f.s) return;
+    uint8_t hidden[4] = {0, 0, 1, 0};
+    f.v.hidden = hidden;
+    f.v.fade = 1;
+    CHECK(draw(&f, pdt_replay_count(f.r)));
+    double x, y, want[3];
+    CHECK(final_diagonal(&f, 2, &x, &y));
+    pdt_rank_rgb(2, want);
+    CHECK(near_colour(f.sf, x, y, want) > 0.3);
+    CHECK(final_diagonal(&f, 1, &x, &y));
+    pdt_rank_rgb(1, want);
+    CHECK(near_colour(f.sf, x, y, want) < 0.12);
+    teardown(&f);
+}
+
+static int file_starts(const char *path, const char *magic)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp) return 0;
+    char b[16] = {0};
+    size_t n = fread(b, 1, strlen(magic), fp);
+    fclose(fp);
+    return n == strlen(magic) && !memcmp(b, magic, n);
+}
+
+TEST(files_png_svg_pdf)
+{
+    fixture f;
+    CHECK(setup(&f, 8, 4, 2));
+    if (!f.s) return;
+    pdt_replay_seek(f.r, f.s, pdt_replay_count(f.r) / 2);
+    pdt_err err = {0};
+    char dir[] = "/tmp/pdt-view-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char p[3][64];
+    const char *ext[3] = {"png", "svg", "pdf"}, *magic[3] = {"\x89PNG", "<?xml", "%PDF"};
+    for (int i = 0; i < 3; i++) {
+        snprintf(p[i], sizeof p[i], "%s/a.%s", dir, ext[i]);
+        CHECK_MSG(pdt_render_file(p[i], 640, 400, f.r, f.s, &f.v, &err) == PDT_OK, "%s", err.msg);
+        CHECK_MSG(file_starts(p[i], magic[i]), "%s", p[i]);
+        remove(p[i]);
+    }
+    snprintf(p[0], sizeof p[0], "%s/a.bmp", dir);
+    CHECK(pdt_render_file(p[0], 640, 400, f.r, f.s, &f.v, &err) == PDT_ERR_ARG);
+    remove(dir);
+    teardown(&f);
+}
+
+TEST(graham_and_every_cursor)
+{
+    pdt_synth s;
+    pdt_err err = {0};
+    CHECK(pdt_synth_graham(50, 3, &s, &err) == PDT_OK);
+    pdt_replay *r = NULL;
+    CHECK(pdt_replay_new(s.pts, s.n, s.recs, s.m, 1, &r, &err) == PDT_OK);
+    if (!r) return;
+    pdt_rstate *st = pdt_rstate_new(r);
+    pdt_view v;
+    pdt_view_defaults(&v);
+    cairo_surface_t *sf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, 400, 300);
+    int bad = 0;
+    for (size_t k = 0; k <= pdt_replay_count(r); k++) { /* small pictures too */
+        pdt_replay_seek(r, st, k);
+        cairo_t *cr = cairo_create(sf);
+        bad += pdt_render(cr, 400, 300, r, st, &v, &err) != PDT_OK;
+        cairo_destroy(cr);
+    }
+    CHECK(bad == 0);
+    cairo_surface_destroy(sf);
+    pdt_rstate_free(st);
+    pdt_replay_free(r);
+    pdt_synth_free(&s);
+}
+
+TEST(pick_and_zoom)
+{
+    fixture f;
+    CHECK(setup(&f, 8, 4, 2));
+    if (!f.s) return;
+    pdt_replay_seek(f.r, f.s, pdt_replay_count(f.r));
+    double x, y;
+    pdt_view_to_screen(f.r, &f.v, W, H, f.syn.pts[5].x, f.syn.pts[5].y, &x, &y);
+    int64_t p, t;
+    pdt_render_pick(f.r, f.s, &f.v, W, H, x + 2, y - 1, 10, &p, &t);
+    CHECK_MSG(p == 5, "picked %lld", (long long)p);
+    /* zoom at a point keeps that point under the cursor */
+    pdt_view_zoom_at(f.r, &f.v, W, H, x, y, 3.0);
+    double x2, y2;
+    pdt_view_to_screen(f.r, &f.v, W, H, f.syn.pts[5].x, f.syn.pts[5].y, &x2, &y2);
+    CHECK_MSG(fabs(x2 - x) < 0.01 && fabs(y2 - y) < 0.01, "moved to %.2f,%.2f from %.2f,%.2f", x2, y2, x, y);
+    /* a click in the middle of a cell picks a triangle */
+    pdt_view_to_screen(f.r, &f.v, W, H, 12, 10, &x, &y);
+    pdt_render_pick(f.r, f.s, &f.v, W, H, x, y, 2, &p, &t);
+    CHECK(p == -1 && t >= 0);
+    /* the timeline maps clicks to cursors */
+    pdt_layout L;
+    pdt_render_layout(W, H, 2, &L);
+    size_t k0 = pdt_render_timeline_at(f.r, W, H, L.timeline.x + 1, L.timeline.y + 10);
+    size_t k1 = pdt_render_timeline_at(f.r, W, H, L.timeline.x + L.timeline.w - 1, L.timeline.y + 10);
+    CHECK(k0 == 0 && k1 == pdt_replay_count(f.r));
+    CHECK(pdt_render_timeline_at(f.r, W, H, 5, 5) == (size_t)-1);
+    teardown(&f);
+}
+
+int main(void)
+{
+    RUN(final_edge_has_rank_colour);
+    RUN(discarded_drawn_differently);
+    RUN(panels_present);
+    RUN(hidden_rank_not_drawn);
+    RUN(files_png_svg_pdf);
+    RUN(graham_and_every_cursor);
+    RUN(pick_and_zoom);
+    return test_summary();
+}
