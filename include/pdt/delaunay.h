@@ -14,7 +14,9 @@
  * (indices into pts; order unspecified; the caller frees).  Fewer than 3
  * points or all collinear: *ntri = 0 (and *tris may be NULL).
  * O(n log n) on every input.  Traces TRI_NEW (sub = `run`) at level 1 and
- * EDGE_ADD / EDGE_DEL at level 2. */
+ * EDGE_ADD / EDGE_DEL at level 2.  Returns PDT_ERR_ARG (and nothing else
+ * happens) if the points are not distinct and sorted, PDT_ERR_NOMEM when an
+ * allocation fails. */
 pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri, int run,
                         pdt_trace *tr);
 

@@ -159,6 +159,45 @@ static int dedge_cmp(const void *x, const void *y)
     return (a->fwd > b->fwd) - (a->fwd < b->fwd);
 }
 
+/* Sort by (lo, hi, fwd): a counting sort on lo, then each bucket on its own
+ * (insertion sort when short, qsort when long: O(n log n) in all cases). */
+static int sort_edges(dedge *ed, size_t ne, size_t n)
+{
+    size_t *start = calloc(n + 1, sizeof *start);
+    dedge *tmp = malloc((ne ? ne : 1) * sizeof *tmp);
+    if (!start || !tmp) {
+        free(start);
+        free(tmp);
+        return 0;
+    }
+    for (size_t i = 0; i < ne; i++) start[ed[i].lo + 1]++;
+    for (size_t v = 0; v < n; v++) start[v + 1] += start[v];
+    for (size_t i = 0; i < ne; i++) tmp[start[ed[i].lo]++] = ed[i];
+    /* start[v] is now the end of bucket v */
+    size_t b = 0;
+    for (size_t v = 0; v < n; v++) {
+        size_t e = start[v];
+        if (e - b > 32) {
+            qsort(tmp + b, e - b, sizeof *tmp, dedge_cmp);
+        } else {
+            for (size_t i = b + 1; i < e; i++) {
+                dedge x = tmp[i];
+                size_t j = i;
+                while (j > b && dedge_cmp(&tmp[j - 1], &x) > 0) {
+                    tmp[j] = tmp[j - 1];
+                    j--;
+                }
+                tmp[j] = x;
+            }
+        }
+        b = e;
+    }
+    memcpy(ed, tmp, ne * sizeof *ed);
+    free(tmp);
+    free(start);
+    return 1;
+}
+
 #define FAIL(...) (st = pdt_err_set(err, PDT_ERR_CHECK, __VA_ARGS__))
 
 pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tris, size_t ntri,
@@ -265,7 +304,10 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
 
     /* 2: edge multiplicities; collect the boundary */
     size_t ne = 3 * ntri, nb = 0;
-    qsort(ed, ne, sizeof *ed, dedge_cmp);
+    if (!sort_edges(ed, ne, n)) {
+        st = pdt_err_set(err, PDT_ERR_NOMEM, "check.c:%d: out of memory", __LINE__);
+        goto done;
+    }
     for (size_t i = 0; i < n; i++) nxt[i] = UINT32_MAX;
     for (size_t i = 0; i < ne && st == PDT_OK;) {
         size_t j = i + 1;

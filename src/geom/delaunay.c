@@ -247,6 +247,8 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
     *ntri = 0;
     if (n < 2) return PDT_OK;
     if (n > (size_t)(UINT32_MAX / 8)) return PDT_ERR_ARG;
+    for (size_t i = 1; i < n; i++) /* the precondition: distinct and sorted */
+        if (pdt_key(pts[i - 1]) >= pdt_key(pts[i])) return PDT_ERR_ARG;
     dt d;
     memset(&d, 0, sizeof d);
     d.p = pts;

@@ -106,6 +106,7 @@ TEST(tiny_inputs)
     free(t);
     pdt_point q[3] = {P(0, 0), P(2, 7), P(5, 1)}; /* clockwise input */
     CHECK(pdt_triangulate(q, 3, &t, &nt, NULL, NULL) == PDT_OK);
+    pdt_tri_canonical(t, nt); /* the kernel's rotation is unspecified */
     CHECK(nt == 1 && t[0].v[0] == 0 && t[0].v[1] == 2 && t[0].v[2] == 1);
     free(t);
 }
@@ -268,6 +269,21 @@ TEST(sort_unique_keeps_smallest_index)
     free(u);
 }
 
+TEST(kernel_rejects_unsorted_or_duplicate_points)
+{
+    pdt_point dup[3] = {P(0, 0), P(0, 0), P(1, 5)};
+    pdt_point uns[3] = {P(0, 0), P(2, 0), P(1, 5)};
+    pdt_point ok[3] = {P(0, 0), P(1, 5), P(2, 0)};
+    pdt_tri *t;
+    size_t nt;
+    CHECK(pdt_delaunay(dup, 3, &t, &nt, 0, NULL) == PDT_ERR_ARG && nt == 0);
+    CHECK(pdt_delaunay(uns, 3, &t, &nt, 0, NULL) == PDT_ERR_ARG && nt == 0);
+    CHECK(pdt_delaunay(ok, 3, &t, &nt, 0, NULL) == PDT_OK && nt == 1);
+    pdt_tri_canonical(t, nt); /* the kernel's rotation is unspecified */
+    CHECK(nt == 1 && t[0].v[0] == 0 && t[0].v[1] == 2 && t[0].v[2] == 1);
+    free(t);
+}
+
 TEST(canonical_order)
 {
     pdt_tri t[4] = {{{5, 2, 9}}, {{1, 7, 3}}, {{4, 0, 6}}, {{2, 9, 5}}};
@@ -354,6 +370,7 @@ int main(void)
     RUN(duplicate_points);
     RUN(int32_extreme_coordinates);
     RUN(sort_unique_keeps_smallest_index);
+    RUN(kernel_rejects_unsorted_or_duplicate_points);
     RUN(canonical_order);
     RUN(trace_events);
     RUN(symmetric_parabola_and_circle_large);
