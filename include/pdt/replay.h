@@ -90,6 +90,8 @@ typedef struct pdt_rphase {
     uint32_t sub;       /* merge level or 0 */
     uint32_t begin_ev, end_ev;  /* end_ev = UINT32_MAX: never ended */
     int32_t parent;     /* enclosing phase of the same rank, or -1 */
+    uint8_t first;      /* 1 if no other rank was already in the same phase
+                         * (same id and level) when it began: PgUp/PgDn stops */
 } pdt_rphase;
 
 /* A merge step, from MERGE_BEGIN to MERGE_END on the merge rank. */
@@ -195,7 +197,8 @@ int pdt_ev_in_class(int kind, int c);
  * when there is none. */
 size_t pdt_replay_find(const pdt_replay *r, size_t k, int dir, int c,
                        const uint8_t *rank_visible);
-/* Cursor at the next / previous PHASE_BEGIN (any rank), or k. */
+/* Cursor just after the next / previous PHASE_BEGIN that starts a phase no
+ * rank was in yet (pdt_rphase.first; "run" excluded), or the end / 0. */
 size_t pdt_replay_find_phase(const pdt_replay *r, size_t k, int dir);
 /* Cursor just after the first PHASE_BEGIN of the phase named `name`
  * ("kernel", "merge", "graham-scan", ...; "merge:2" = merge level 2), or

@@ -78,8 +78,8 @@ void pdt_view_defaults(pdt_view *v)
 
 void pdt_render_layout(double w, double h, int nranks, pdt_layout *L)
 {
-    double f = h / 52;
-    if (f > w / 80) f = w / 80;
+    double f = h / 46;
+    if (f > w / 72) f = w / 72;
     if (f < 10) f = 10;
     L->font = f;
     double top = 2.0 * f;
@@ -541,7 +541,8 @@ static void draw_hulls_and_stacks(ctx *c, uint32_t *buf, size_t cap)
                 cairo_close_path(cr);
                 rgb(cr, INK, 1);
                 cairo_fill(cr);
-                text_at(cr, SANS, 1, 0.7 * c->L.font, x + 0.7 * a, y - 1.0 * a, "top");
+                double tw = text_wb(cr, SANS, 1, 0.7 * c->L.font, "top");
+                text_at(cr, SANS, 1, 0.7 * c->L.font, x - 0.8 * a - tw, y - 1.0 * a, "top");
             }
         }
     }
@@ -953,7 +954,7 @@ static void draw_legend(ctx *c)
     cairo_set_source_rgb(cr, 0.8, 0.45, 0.0);
     cairo_stroke(cr);
     rgb(cr, INK, 1);
-    text_at(cr, SANS, 0, fs, lx + 0.95 * f, ly, "circumdisk = restricted area");
+    text_at(cr, SANS, 0, fs, lx + 0.95 * f, ly, "circumdisk (RA)");
     cairo_restore(cr);
 }
 
@@ -1419,8 +1420,12 @@ static void draw_help(ctx *c, double w, double h)
     };
     int nk = (int)(sizeof keys / sizeof *keys);
     cairo_t *cr = c->cr;
-    double f = c->L.font * 1.05;
-    double bw = fmin(w * 0.8, 36 * f), bh = (nk + 2.6) * 1.45 * f;
+    double f = c->L.font * 1.05, kw = 0, dw = 0;
+    for (int i = 0; i < nk; i++) {
+        kw = fmax(kw, text_wb(cr, MONO, 1, 0.9 * f, keys[i][0]));
+        dw = fmax(dw, text_w(cr, SANS, 0.9 * f, keys[i][1]));
+    }
+    double bw = fmin(w * 0.96, kw + dw + 3.5 * f), bh = (nk + 2.6) * 1.45 * f;
     double bx = (w - bw) / 2, by = (h - bh) / 2;
     cairo_rectangle(cr, 0, 0, w, h);
     cairo_set_source_rgba(cr, 0, 0, 0, 0.35);
@@ -1438,7 +1443,7 @@ static void draw_help(ctx *c, double w, double h)
     for (int i = 0; i < nk; i++) {
         double y = by + (i + 2.4) * 1.45 * f + 0.4 * f;
         text_at(cr, MONO, 1, 0.9 * f, bx + f, y, keys[i][0]);
-        text_at(cr, SANS, 0, 0.9 * f, bx + 10 * f, y, keys[i][1]);
+        text_at(cr, SANS, 0, 0.9 * f, bx + kw + 2.5 * f, y, keys[i][1]);
     }
 }
 

@@ -230,7 +230,7 @@ static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
     switch (e->kind) {
     case PDT_EV_PHASE_BEGIN: {
         if (!grow((void **)&r->phases, &r->cap_phase, r->nphase + 1, sizeof *r->phases)) return 0;
-        r->phases[r->nphase] = (pdt_rphase){rec->rank, e->sub, e->a, i, NONE32, cur[PDT_SLOT_PHASE]};
+        r->phases[r->nphase] = (pdt_rphase){rec->rank, e->sub, e->a, i, NONE32, cur[PDT_SLOT_PHASE], 0};
         r->nphase++;
         return set_slot(b, i, rank, PDT_SLOT_PHASE, (int32_t)(r->nphase - 1));
     }
@@ -426,6 +426,25 @@ static pdt_status build(pdt_replay *r, pdt_err *err)
         }
         if (r->recs[i].ev.kind < PDT_EV_KIND_COUNT) r->kind_count[r->recs[i].ev.kind]++;
         if (!index_event(&b, (uint32_t)i, lifted_any)) goto out;
+    }
+    /* Phases that open a cluster of overlapping same phases (any rank). */
+    {
+        keymap last_end;
+        memset(&last_end, 0, sizeof last_end);
+        for (size_t p = 0; p < r->nphase; p++) {
+            pdt_rphase *ph = &r->phases[p];
+            int32_t end;
+            int have = km_get(&last_end, ph->phase, ph->sub, &end);
+            uint32_t e = ph->end_ev == NONE32 ? (uint32_t)INT32_MAX : ph->end_ev;
+            ph->first = !have || (uint32_t)end < ph->begin_ev;
+            if (!have || (uint32_t)end < e) {
+                if (!km_put(&last_end, ph->phase, ph->sub, (int32_t)(e > INT32_MAX ? INT32_MAX : e))) {
+                    km_free(&last_end);
+                    goto out;
+                }
+            }
+        }
+        km_free(&last_end);
     }
     /* Triangle histories: counts -> offsets -> entries in event order. */
     r->nhist = 0;
@@ -787,12 +806,14 @@ size_t pdt_replay_find(const pdt_replay *r, size_t k, int dir, int c, const uint
 size_t pdt_replay_find_phase(const pdt_replay *r, size_t k, int dir)
 {
     if (dir > 0) {
-        for (size_t i = k; i < r->m; i++)
-            if (r->recs[i].ev.kind == PDT_EV_PHASE_BEGIN && r->recs[i].ev.sub != PDT_PH_RUN) return i + 1;
+        for (size_t p = 0; p < r->nphase; p++)
+            if (r->phases[p].first && r->phases[p].phase != PDT_PH_RUN && r->phases[p].begin_ev >= k)
+                return (size_t)r->phases[p].begin_ev + 1;
         return r->m;
     }
-    for (size_t i = k >= 2 ? k - 1 : 0; i-- > 0;)
-        if (r->recs[i].ev.kind == PDT_EV_PHASE_BEGIN && r->recs[i].ev.sub != PDT_PH_RUN) return i + 1;
+    for (size_t p = r->nphase; p-- > 0;)
+        if (r->phases[p].first && r->phases[p].phase != PDT_PH_RUN && (size_t)r->phases[p].begin_ev + 1 < k)
+            return (size_t)r->phases[p].begin_ev + 1;
     return 0;
 }
 

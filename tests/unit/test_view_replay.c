@@ -146,6 +146,21 @@ TEST(srm_end_state)
         CHECK(pdt_replay_box(r, q, &lo, &hi));
         CHECK_MSG(lo.x == q * 40 && hi.x == q * 40 + 30, "rank %d box x %d..%d", q, lo.x, hi.x);
     }
+    /* PgDn: lift, kernel, hull, classify, merge 0, merge 1, output, end */
+    static const int want[] = {PDT_PH_LIFT, PDT_PH_KERNEL, PDT_PH_HULL, PDT_PH_CLASSIFY,
+                               PDT_PH_MERGE, PDT_PH_MERGE, PDT_PH_OUTPUT};
+    size_t k = 0;
+    for (int i = 0; i < 7; i++) {
+        size_t k2 = pdt_replay_find_phase(r, k, 1);
+        CHECK(k2 > k);
+        const pdt_rec *e = pdt_replay_rec(r, k2 - 1);
+        CHECK_MSG(e->ev.kind == PDT_EV_PHASE_BEGIN && e->ev.sub == want[i], "step %d: kind %d phase %d", i,
+                  e->ev.kind, e->ev.sub);
+        if (i == 5) CHECK(e->ev.a == 1);
+        CHECK(pdt_replay_find_phase(r, k2, -1) == (i ? k : 0));
+        k = k2;
+    }
+    CHECK(pdt_replay_find_phase(r, k, 1) == pdt_replay_count(r));
     pdt_rstate_free(st);
     pdt_replay_free(r);
     pdt_synth_free(&s);
