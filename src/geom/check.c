@@ -88,14 +88,44 @@ static int w_sign(wide a)
 /* sign of (b - a) x (c - a) */
 static int ck_orient(pdt_point a, pdt_point b, pdt_point c)
 {
+    { /* screen: exact differences, two rounded products and one rounded
+       * difference: |error| <= gamma_3 (|m1| + |m2|); we ask for 2^-50 */
+        double m1 = (double)((int64_t)b.x - a.x) * (double)((int64_t)c.y - a.y);
+        double m2 = (double)((int64_t)b.y - a.y) * (double)((int64_t)c.x - a.x);
+        double det = m1 - m2, bound = (__builtin_fabs(m1) + __builtin_fabs(m2)) * 0x1p-50;
+        if (det > bound) return 1;
+        if (det < -bound) return -1;
+    }
     wide bx = w_from((int64_t)b.x - a.x), by = w_from((int64_t)b.y - a.y);
     wide cx = w_from((int64_t)c.x - a.x), cy = w_from((int64_t)c.y - a.y);
     return w_sign(w_sub(w_mul(bx, cy), w_mul(by, cx)));
 }
 
-/* sign of the lifted determinant: > 0 iff d inside the circle of CCW a,b,c */
+/* sign of the lifted determinant: > 0 iff d inside the circle of CCW a,b,c.
+ * A coarse floating-point screen first, with our own (loose) bound: the six
+ * differences are exact doubles (< 2^33); each of the three terms
+ * lift * minor is a sum/product chain of depth 5 and the final sum adds 2
+ * more roundings, so |error| <= gamma_7 * P with P the permanent
+ * (sum of |lift| * (|xy| + |zw|)) and gamma_7 = 7u / (1 - 7u), u = 2^-53;
+ * computing P itself in floating point loses at most another gamma_5.  We
+ * accept the sign only if |det| > 2^-48 * P (= 32u * P, over 4x the
+ * need); otherwise the exact 192-bit evaluation decides. */
 static int ck_incircle(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
 {
+    {
+        double ax = (double)((int64_t)a.x - d.x), ay = (double)((int64_t)a.y - d.y);
+        double bx = (double)((int64_t)b.x - d.x), by = (double)((int64_t)b.y - d.y);
+        double cx = (double)((int64_t)c.x - d.x), cy = (double)((int64_t)c.y - d.y);
+        double al = ax * ax + ay * ay, bl = bx * bx + by * by, cl = cx * cx + cy * cy;
+        double m1 = bx * cy, m2 = cx * by, m3 = cx * ay, m4 = ax * cy, m5 = ax * by, m6 = bx * ay;
+        double det = al * (m1 - m2) + bl * (m3 - m4) + cl * (m5 - m6);
+        double perm = al * (__builtin_fabs(m1) + __builtin_fabs(m2)) +
+                      bl * (__builtin_fabs(m3) + __builtin_fabs(m4)) +
+                      cl * (__builtin_fabs(m5) + __builtin_fabs(m6));
+        double bound = perm * 0x1p-48;
+        if (det > bound) return 1;
+        if (det < -bound) return -1;
+    }
     wide ax = w_from((int64_t)a.x - d.x), ay = w_from((int64_t)a.y - d.y);
     wide bx = w_from((int64_t)b.x - d.x), by = w_from((int64_t)b.y - d.y);
     wide cx = w_from((int64_t)c.x - d.x), cy = w_from((int64_t)c.y - d.y);
