@@ -1,0 +1,110 @@
+/* pdt hull — the convex hull by Graham's scan, Version B (thesis Chapter 2). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "pdt/hull.h"
+#include "pdt/io.h"
+#include "run_opts.h"
+
+static const char help[] =
+    "usage: pdt hull INPUT [-o OUT] [--scale K] [--stats] [--trace DIR] [--trace-level N]\n"
+    "\n"
+    "Convex hull of the points in INPUT by Graham's scan, Version B (the thesis'\n"
+    "Chapter 2): the rightmost lowest point is the origin, the others are sorted\n"
+    "by angle, only the farther of collinear points and one copy of coincident\n"
+    "points are kept, and a point is pushed only on a strict left turn.\n"
+    "\n"
+    "Output: the indices (0-based, into INPUT) of the extreme points, one per\n"
+    "line, counter-clockwise, starting at the origin.  Points in the middle of\n"
+    "a hull edge are not extreme and are not listed.\n"
+    "\n"
+    "INPUT, -o, --scale, --stats, --trace, --trace-level: as for pdt triangulate.\n"
+    "Exit status: 0 success, 2 usage or input error.\n";
+
+static int parse_options(int argc, char **argv, pdt_run_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->command = "hull";
+    o->trace_level = 1;
+    o->argc = argc;
+    o->argv = argv;
+    const pdt_cli_opt opts[] = {
+        { "--output", "-o", PDT_OPT_STR, &o->output },
+        { "--scale", NULL, PDT_OPT_POSNUM, &o->scale },
+        { "--stats", NULL, PDT_OPT_FLAG, &o->stats },
+        { "--trace", NULL, PDT_OPT_STR, &o->trace_dir },
+        { "--trace-level", NULL, PDT_OPT_LEVEL, &o->trace_level },
+        { NULL, NULL, PDT_OPT_FLAG, NULL },
+    };
+    const char *pos[1];
+    int npos;
+    int rc = pdt_cli_parse("hull", help, argc, argv, opts, pos, 1, &npos);
+    if (rc == 1) return PDT_EXIT_OK;
+    if (rc) return PDT_EXIT_USAGE;
+    if (npos != 1) return pdt_cli_usage("hull", "needs one INPUT file");
+    o->input = pos[0];
+    return -1;
+}
+
+/* Graham's scan on pts[0..n), traced when o asks for it. */
+static pdt_status compute(const pdt_run_opts *o, const pdt_point *pts, size_t n, uint32_t *out,
+                          size_t *nout, pdt_err *err)
+{
+    pdt_cli_trace *t;
+    pdt_status st = pdt_cli_trace_open(o, pts, n, &t, err);
+    if (st != PDT_OK) return st;
+    st = pdt_hull_graham(pts, n, out, nout, pdt_cli_trace_hook(t));
+    if (st != PDT_OK) pdt_err_set(err, st, "hull failed: %s", pdt_status_str(st));
+    pdt_status cst = pdt_cli_trace_close(t, err);
+    return st != PDT_OK ? st : cst;
+}
+
+/* One index per line, atomically. */
+static pdt_status write_hull(const char *path, const uint32_t *h, size_t nh, pdt_err *err)
+{
+    pdt_outfile f;
+    pdt_status st = pdt_out_open(&f, path, err);
+    if (st != PDT_OK) return st;
+    for (size_t i = 0; i < nh; i++) fprintf(f.fp, "%u\n", (unsigned)h[i]);
+    return pdt_out_commit(&f, err);
+}
+
+int pdt_cmd_hull(int argc, char **argv)
+{
+    pdt_run_opts o;
+    int rc = parse_options(argc, argv, &o);
+    if (rc >= 0) return rc;
+
+    double t0 = pdt_cli_now(), t1 = t0, t2 = t0, t3 = t0;
+    pdt_err err = { PDT_OK, "" };
+    pdt_point *pts = NULL;
+    uint32_t *hull = NULL;
+    size_t n = 0, nh = 0, coll = 0;
+    pdt_status st = pdt_read_points(o.input, o.scale, &pts, &n, &coll, &err);
+    t1 = pdt_cli_now();
+    if (st == PDT_OK) {
+        hull = malloc((n ? n : 1) * sizeof *hull);
+        if (!hull) st = pdt_err_set(&err, PDT_ERR_NOMEM, "out of memory");
+    }
+    if (st == PDT_OK) st = compute(&o, pts, n, hull, &nh, &err);
+    t2 = pdt_cli_now();
+    if (st == PDT_OK) st = write_hull(o.output, hull, nh, &err);
+    t3 = pdt_cli_now();
+
+    if (st == PDT_OK) {
+        if (coll)
+            fprintf(stderr, "pdt: warning: %zu point%s became equal to a different point after "
+                    "rounding with --scale %g\n", coll, coll == 1 ? "" : "s", o.scale);
+        if (o.stats)
+            fprintf(stderr, "{\"command\": \"hull\", \"n\": %zu, \"collisions\": %zu, "
+                    "\"hull\": %zu, \"seconds\": {\"read\": %.6f, \"hull\": %.6f, "
+                    "\"write\": %.6f, \"total\": %.6f}, \"peak_rss_kib\": %ld}\n",
+                    n, coll, nh, t1 - t0, t2 - t1, t3 - t2, t3 - t0, pdt_cli_peak_kib());
+    }
+    rc = st == PDT_OK ? PDT_EXIT_OK : pdt_cli_fail(&err);
+    free(pts);
+    free(hull);
+    return rc;
+}
