@@ -16,10 +16,12 @@
 typedef struct pdt_outfile {
     FILE *fp;        /* write here */
     char *path;      /* final name (NULL for standard output) */
-    char *tmp;       /* temporary name */
+    char *tmp;       /* temporary name (NULL: writing directly) */
 } pdt_outfile;
 
-/* Open `path` for atomic writing ("-" or NULL = standard output). */
+/* Open `path` for atomic writing ("-" or NULL = standard output).  A path
+ * that names an existing device or pipe (/dev/null, a fifo) is written
+ * directly, never replaced. */
 pdt_status pdt_out_open(pdt_outfile *o, const char *path, pdt_err *err);
 /* Flush, close and rename into place.  On any write error the temporary is
  * removed and an error returned. */

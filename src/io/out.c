@@ -18,8 +18,23 @@ pdt_status pdt_out_open(pdt_outfile *o, const char *path, pdt_err *err)
         return PDT_OK;
     }
     struct stat sb;
-    if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
+    int exists = stat(path, &sb) == 0;
+    if (exists && S_ISDIR(sb.st_mode))
         return pdt_err_set(err, PDT_ERR_IO, "%s: is a directory", path);
+    if (exists && !S_ISREG(sb.st_mode)) {
+        /* A device or a pipe (/dev/null, /dev/stdout, a fifo): write to it
+         * directly; it cannot be replaced atomically, and must not be. */
+        o->path = strdup(path);
+        if (!o->path) return pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory", path);
+        o->fp = fopen(path, "w");
+        if (!o->fp) {
+            int e = errno;
+            free(o->path);
+            o->path = NULL;
+            return pdt_err_set(err, PDT_ERR_IO, "%s: cannot open: %s", path, strerror(e));
+        }
+        return PDT_OK; /* tmp == NULL marks the direct mode */
+    }
     /* The temporary lives in the target's directory so that rename() is
      * atomic: "DIR/.BASE.tmpXXXXXX". */
     const char *slash = strrchr(path, '/');
@@ -81,13 +96,13 @@ pdt_status pdt_out_commit(pdt_outfile *o, pdt_err *err)
         e = errno;
     }
     o->fp = NULL;
-    if (!bad && rename(o->tmp, o->path) != 0) {
+    if (!bad && o->tmp && rename(o->tmp, o->path) != 0) {
         bad = 1;
         e = errno;
     }
     pdt_status st = PDT_OK;
     if (bad) {
-        unlink(o->tmp);
+        if (o->tmp) unlink(o->tmp);
         st = pdt_err_set(err, PDT_ERR_IO, "%s: write error: %s", o->path, strerror(e));
     }
     free(o->path);
@@ -100,7 +115,7 @@ void pdt_out_abort(pdt_outfile *o)
 {
     if (o->path) {
         if (o->fp) fclose(o->fp);
-        unlink(o->tmp);
+        if (o->tmp) unlink(o->tmp);
     } else if (o->fp) {
         fflush(o->fp);
     }

@@ -408,19 +408,26 @@ TEST(atomic_write_leaves_nothing)
     pdt_err_clear(&err);
     CHECK(pdt_out_open(&o, dir, &err) == PDT_ERR_IO && strstr(err.msg, "is a directory"));
     CHECK(entries() == 1);
-    /* A write error (the device is full) at commit: error, nothing left. */
+    /* A write error (the device is full) at commit: an error. */
     if (access("/dev/full", W_OK) == 0) {
         pdt_err_clear(&err);
-        CHECK(pdt_out_open(&o, "-", &err) == PDT_OK && o.fp == stdout);
-        FILE *full = fopen("/dev/full", "w");
-        if (full) {
-            o.fp = full; /* standard-output mode on a device that fails */
-            fputs("0 1 2\n", full);
+        CHECK(pdt_out_open(&o, "/dev/full", &err) == PDT_OK);
+        if (o.fp) {
+            fputs("0 1 2\n", o.fp);
             CHECK(pdt_out_commit(&o, &err) == PDT_ERR_IO);
-            CHECK_MSG(strstr(err.msg, "write error") != NULL, "%s", err.msg);
-            fclose(full);
+            CHECK_MSG(strstr(err.msg, "/dev/full: write error") != NULL, "%s", err.msg);
         }
     }
+}
+
+TEST(devices_are_written_not_replaced)
+{
+    pdt_err err;
+    pdt_point pts[1] = { { 1, 2 } };
+    pdt_err_clear(&err);
+    CHECK(pdt_write_points("/dev/null", pts, 1, &err) == PDT_OK);
+    struct stat sb;
+    CHECK(stat("/dev/null", &sb) == 0 && S_ISCHR(sb.st_mode));
 }
 
 int main(void)
@@ -441,6 +448,7 @@ int main(void)
     RUN(tris_write_formats);
     RUN(tris_read_bad_inputs);
     RUN(atomic_write_leaves_nothing);
+    RUN(devices_are_written_not_replaced);
     clean();
     rmdir(dir);
     return test_summary();
