@@ -97,6 +97,7 @@ typedef struct pdt_par_rank_stats {
     uint64_t merge_bytes_sent, merge_bytes_recv; /* merge-step traffic only */
     double t_partition, t_local, t_classify, t_merge, t_gather; /* seconds */
     double critical_path;   /* seconds: longest chain of dependent compute ending here */
+    int64_t peak_rss_kib;   /* peak resident memory of this rank's process */
 } pdt_par_rank_stats;
 
 typedef struct pdt_par_stats {

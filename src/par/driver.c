@@ -11,6 +11,7 @@
  *   Phase 4  final triangles gathered at rank 0 and put in canonical order. */
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -209,6 +210,74 @@ done:
     return st;
 }
 
+static int tri_less(const pdt_tri *a, const pdt_tri *b)
+{
+    for (int k = 0; k < 3; k++)
+        if (a->v[k] != b->v[k]) return a->v[k] < b->v[k];
+    return 0;
+}
+
+/* Merge p sorted blocks (count[q] bytes each, contiguous) of *all into one
+ * sorted array with a binary heap of block cursors: O(T log p). */
+static pdt_status merge_blocks(pdt_tri **all, const size_t *count, int p, size_t total,
+                               pdt_err *err)
+{
+    size_t *pos = malloc((size_t)p * sizeof *pos), *end = malloc((size_t)p * sizeof *end);
+    int *heap = malloc((size_t)p * sizeof *heap);
+    pdt_tri *out = malloc((total + 1) * sizeof *out);
+    if (!pos || !end || !heap || !out) {
+        free(pos);
+        free(end);
+        free(heap);
+        free(out);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "rank 0: out of memory merging %zu triangles",
+                           total);
+    }
+    const pdt_tri *a = *all;
+    size_t off = 0;
+    int h = 0;
+    for (int q = 0; q < p; q++) {
+        pos[q] = off;
+        off += count[q] / sizeof(pdt_tri);
+        end[q] = off;
+        if (pos[q] < end[q]) heap[h++] = q;
+    }
+#define HLESS(i, j) tri_less(&a[pos[heap[i]]], &a[pos[heap[j]]])
+    for (int i = h / 2 - 1; i >= 0; i--) /* heapify */
+        for (int k = i;;) {
+            int m = k, l = 2 * k + 1, r = l + 1;
+            if (l < h && HLESS(l, m)) m = l;
+            if (r < h && HLESS(r, m)) m = r;
+            if (m == k) break;
+            int t = heap[k];
+            heap[k] = heap[m];
+            heap[m] = t;
+            k = m;
+        }
+    for (size_t o = 0; o < total; o++) {
+        int q = heap[0];
+        out[o] = a[pos[q]++];
+        if (pos[q] == end[q]) heap[0] = heap[--h];
+        for (int k = 0;;) {
+            int m = k, l = 2 * k + 1, r = l + 1;
+            if (l < h && HLESS(l, m)) m = l;
+            if (r < h && HLESS(r, m)) m = r;
+            if (m == k) break;
+            int t = heap[k];
+            heap[k] = heap[m];
+            heap[m] = t;
+            k = m;
+        }
+    }
+#undef HLESS
+    free(pos);
+    free(end);
+    free(heap);
+    free(*all);
+    *all = out;
+    return PDT_OK;
+}
+
 /* ---- the whole run ------------------------------------------------------------ */
 
 pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, pdt_tri **tris,
@@ -353,8 +422,10 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, p
     double t_merge = pdt_comm_wtime(c);
     me.st.t_merge = t_merge - t_local;
 
-    /* Phase 4: gather at rank 0 */
+    /* Phase 4: every rank puts its triangles in canonical order, rank 0
+     * gathers the sorted blocks and merges them */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_OUTPUT, 0, 0, 0, 0);
+    pdt_tri_canonical(s.fin, s.nfin);
     uint64_t nf = s.nfin, *nfs = malloc((size_t)p * sizeof *nfs);
     counts = malloc((size_t)p * sizeof *counts);
     if (!nfs || !counts) {
@@ -383,7 +454,8 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, p
     if (r == 0) {
         for (int q = 1; q < p; q++)
             if (counts[q]) note_recv(&d, TAG_GATHER, q, counts[q]);
-        pdt_tri_canonical(all, total);
+        st = merge_blocks(&all, counts, p, total, err);
+        if (st != PDT_OK) goto done;
     } else if (s.nfin) {
         note_send(&d, TAG_GATHER, 0, s.nfin * sizeof(pdt_tri));
     }
@@ -407,6 +479,10 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, p
     me.st.merge_bytes_recv = d.merge_recv;
     me.st.t_gather = t_end - t_merge;
     me.st.critical_path = s.cnt.critical_path;
+    {
+        struct rusage ru;
+        me.st.peak_rss_kib = getrusage(RUSAGE_SELF, &ru) == 0 ? (int64_t)ru.ru_maxrss : -1;
+    }
     me.holds_final_hull = s.holds_hull && srm_holder(r, p, s.levels) == r;
     me.hull = s.nhull;
     me.hull_degenerate = s.hull_degenerate;
@@ -495,7 +571,8 @@ void pdt_par_stats_json(const pdt_par_stats *s, FILE *f)
                 "\"final_by_merge\": %llu, \"emitted\": %llu, \"bytes_sent\": %llu, "
                 "\"bytes_received\": %llu, \"merge_bytes_sent\": %llu, "
                 "\"merge_bytes_received\": %llu, \"partition_s\": %.6f, \"local_s\": %.6f, "
-                "\"merge_s\": %.6f, \"gather_s\": %.6f, \"critical_path_s\": %.6f}",
+                "\"merge_s\": %.6f, \"gather_s\": %.6f, \"critical_path_s\": %.6f, "
+                "\"peak_rss_kib\": %lld}",
                 q ? "," : "", q, (unsigned long long)r->points,
                 (unsigned long long)r->local_tris, (unsigned long long)r->final_at_once,
                 (unsigned long long)r->deferred, (unsigned long long)r->shipped,
@@ -504,7 +581,8 @@ void pdt_par_stats_json(const pdt_par_stats *s, FILE *f)
                 (unsigned long long)r->final_merge, (unsigned long long)r->emitted,
                 (unsigned long long)r->bytes_sent, (unsigned long long)r->bytes_recv,
                 (unsigned long long)r->merge_bytes_sent, (unsigned long long)r->merge_bytes_recv,
-                r->t_partition, r->t_local, r->t_merge, r->t_gather, r->critical_path);
+                r->t_partition, r->t_local, r->t_merge, r->t_gather, r->critical_path,
+                (long long)r->peak_rss_kib);
     }
     fprintf(f, "]}");
 }

@@ -7,6 +7,8 @@
  * so a failed run never leaves an output file. */
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 
 #include "pdt/io.h"
 #include "pdt/par.h"
@@ -75,6 +77,70 @@ static pdt_status write_meta(const pdt_par_job *job, int p, const pdt_point *pts
     return pdt_run_write_meta(job->trace_dir, &m, pts, n, err);
 }
 
+/* 1 if paths a and b name the same existing file. */
+static int same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
+           sa.st_ino == sb.st_ino;
+}
+
+/* The output (or the .node written beside an .ele) must not replace the
+ * input: 1 and a message if it would. */
+static int output_clash(const pdt_par_job *job, pdt_err *err)
+{
+    if (!job->output || !strcmp(job->input, "-")) return 0;
+    if (pdt_tri_format_of(job->output) == PDT_FMT_ELE) {
+        size_t len = strlen(job->output);
+        char *node = malloc(len + 2);
+        if (!node) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory") != PDT_OK;
+        memcpy(node, job->output, len - 4);
+        memcpy(node + len - 4, ".node", 6);
+        int clash = same_file(node, job->input);
+        if (clash)
+            pdt_err_set(err, PDT_ERR_ARG, "%s: writing %s would replace the input %s; choose "
+                        "another -o name", job->output, node, job->input);
+        free(node);
+        return clash;
+    }
+    if (!same_file(job->output, job->input)) return 0;
+    pdt_err_set(err, PDT_ERR_ARG, "%s: output would replace the input; choose another -o name",
+                job->output);
+    return 1;
+}
+
+/* Messages about the input and, with --stats, the JSON figures (rank 0). */
+static void report(const pdt_par_job *job, const pdt_par_stats *s, size_t collisions,
+                   double t_read, double t_write, double t_total)
+{
+    if (collisions)
+        fprintf(stderr, "pdt: warning: %zu point%s became equal to a different point after "
+                "rounding with --scale %g\n", collisions, collisions == 1 ? "" : "s", job->scale);
+    if (s->n_dup)
+        fprintf(stderr, "pdt: %llu duplicate point%s dropped (each copy is represented by its "
+                "first occurrence)\n", (unsigned long long)s->n_dup, s->n_dup == 1 ? "" : "s");
+    if (s->n_unique < 3)
+        fprintf(stderr, "pdt: 0 triangles: only %llu distinct point%s (a triangle needs 3)\n",
+                (unsigned long long)s->n_unique, s->n_unique == 1 ? "" : "s");
+    else if (s->n_tri == 0)
+        fprintf(stderr, "pdt: 0 triangles: all %llu distinct points are collinear\n",
+                (unsigned long long)s->n_unique);
+    if (!job->stats) return;
+    struct rusage ru;
+    long rss = getrusage(RUSAGE_SELF, &ru) == 0 ? ru.ru_maxrss : -1;
+    fprintf(stderr,
+            "{\"command\": \"triangulate\", \"n\": %llu, \"unique\": %llu, \"duplicates\": %llu, "
+            "\"collisions\": %zu, \"triangles\": %llu, \"hull\": %llu, \"collinear\": %s, "
+            "\"seconds\": {\"read\": %.6f, \"parallel\": %.6f, \"write\": %.6f, "
+            "\"total\": %.6f}, \"peak_rss_kib\": %ld,\n\"parallel\": ",
+            (unsigned long long)s->n_in, (unsigned long long)s->n_unique,
+            (unsigned long long)s->n_dup, collisions, (unsigned long long)s->n_tri,
+            (unsigned long long)s->hull, s->collinear ? "true" : "false", t_read, s->t_total,
+            t_write, t_total, rss);
+    pdt_par_stats_json(s, stderr);
+    fprintf(stderr, "}\n");
+}
+
 /* Stop the whole job after an error on this rank. */
 static void die(pdt_comm *c, const pdt_err *err)
 {
@@ -99,7 +165,9 @@ int pdt_par_cmd_triangulate(int *argc, char ***argv, const pdt_par_job *job)
     pdt_point *pts = NULL;
     size_t n = 0, collisions = 0;
     int32_t rc = 0;
-    if (r == 0 && pdt_read_points(job->input, job->scale, &pts, &n, &collisions, &err) != PDT_OK)
+    if (r == 0 && output_clash(job, &err)) rc = 2;
+    if (r == 0 && rc == 0 &&
+        pdt_read_points(job->input, job->scale, &pts, &n, &collisions, &err) != PDT_OK)
         rc = err.code == PDT_ERR_NOMEM ? 1 : 2;
     if (pdt_comm_bcast(c, &rc, sizeof rc, 0, &err) != PDT_OK) die(c, &err);
     if (rc) {
@@ -109,8 +177,6 @@ int pdt_par_cmd_triangulate(int *argc, char ***argv, const pdt_par_job *job)
         return rc;
     }
     double t_read = pdt_comm_wtime(c) - t0;
-    if (r == 0 && job->scale > 0 && collisions)
-        fprintf(stderr, "pdt: %zu points collide after scaling by %g\n", collisions, job->scale);
 
     /* trace writers: rank 0 creates the folder first */
     pdt_trace_writer *w = NULL;
@@ -142,7 +208,7 @@ int pdt_par_cmd_triangulate(int *argc, char ***argv, const pdt_par_job *job)
     pdt_tri *tris = NULL;
     size_t ntri = 0;
     pdt_par_stats stats;
-    if (pdt_par_triangulate(c, pts, n, &tris, &ntri, job->stats ? &stats : NULL, tr, &err) !=
+    if (pdt_par_triangulate(c, pts, n, &tris, &ntri, &stats, tr, &err) !=
         PDT_OK)
         die(c, &err);
 
@@ -157,21 +223,9 @@ int pdt_par_cmd_triangulate(int *argc, char ***argv, const pdt_par_job *job)
             fprintf(stderr, "pdt: %s\n", err.msg);
             rc = 1;
         }
-        if (rc == 0 && ntri == 0 && job->stats == 0)
-            fprintf(stderr, "pdt: no triangles: %s\n",
-                    n < 3 ? "fewer than 3 points" : "fewer than 3 distinct points or all collinear");
-        if (job->stats) {
-            if (rc == 0 && ntri == 0)
-                fprintf(stderr, "pdt: no triangles: %s\n",
-                        stats.n_unique < 3 ? "fewer than 3 distinct points"
-                                           : "all points are collinear");
-            fprintf(stderr, "{\"command\": \"triangulate\", \"read_s\": %.6f, \"write_s\": %.6f, "
-                            "\"parallel\": ",
-                    t_read, pdt_comm_wtime(c) - tw);
-            pdt_par_stats_json(&stats, stderr);
-            fprintf(stderr, "}\n");
-            pdt_par_stats_free(&stats);
-        }
+        double t_write = pdt_comm_wtime(c) - tw;
+        if (rc == 0) report(job, &stats, collisions, t_read, t_write, pdt_comm_wtime(c) - t0);
+        pdt_par_stats_free(&stats);
     }
     free(tris);
     free(pts);
