@@ -141,7 +141,8 @@ typedef struct pdt_par_job {
     int stats;             /* --stats: print JSON to stderr at rank 0 */
     const char *trace_dir; /* --trace DIR, or NULL */
     int trace_level;       /* 1 or 2 */
-    const char *command_line; /* for the trace manifest (may be NULL) */
+    int argc;              /* the command's arguments, for the trace manifest */
+    char **argv;           /* (argv may be NULL) */
 } pdt_par_job;
 
 /* Run `pdt triangulate` on every rank of an MPI job (initialises and

@@ -65,7 +65,16 @@ static pdt_status write_meta(const pdt_par_job *job, int p, const pdt_point *pts
     memset(&m, 0, sizeof m);
     m.format_version = PDT_TRACE_FORMAT_MAJOR;
     snprintf(m.program_version, sizeof m.program_version, "%s", PDT_VERSION);
-    m.command_line = (char *)(job->command_line ? job->command_line : "pdt triangulate");
+    size_t len = 4;
+    for (int i = 0; i < job->argc && job->argv; i++) len += strlen(job->argv[i]) + 1;
+    char *line = malloc(len + 1);
+    if (!line) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    strcpy(line, "pdt");
+    for (int i = 0; i < job->argc && job->argv; i++) {
+        strcat(line, " ");
+        strcat(line, job->argv[i]);
+    }
+    m.command_line = line;
     m.input_name = (char *)job->input;
     m.input_checksum = pdt_points_checksum(pts, n);
     m.n = n;
@@ -74,7 +83,9 @@ static pdt_status write_meta(const pdt_par_job *job, int p, const pdt_point *pts
     snprintf(m.command, sizeof m.command, "triangulate");
     m.clock_offset_ns = off;
     m.wall_start_ns = pdt_wall_ns();
-    return pdt_run_write_meta(job->trace_dir, &m, pts, n, err);
+    pdt_status st = pdt_run_write_meta(job->trace_dir, &m, pts, n, err);
+    free(line);
+    return st;
 }
 
 /* 1 if paths a and b name the same existing file. */
