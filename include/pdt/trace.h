@@ -141,8 +141,15 @@ static inline void pdt_trace_emit(pdt_trace *tr, int kind, int sub, uint32_t a, 
 }
 
 #ifdef PDT_NO_TRACE
-#define PDT_TRACING(tr, lvl) 0
-#define PDT_TRACE(tr, lvl, kind, sub, a, b, c, v) do { } while (0)
+/* Compiled out: the arguments stay "used" (no unused-variable warnings in a
+ * TRACE=0 build) but sit in dead code, so no instruction is generated. */
+#define PDT_TRACING(tr, lvl) (0 && (tr) != NULL && (lvl))
+#define PDT_TRACE(tr, lvl, kind, sub, a, b, c, v)                                          \
+    do {                                                                                   \
+        if (0)                                                                             \
+            pdt_trace_emit((tr), (kind), (sub), (uint32_t)(a), (uint32_t)(b), (uint32_t)(c), \
+                           (int64_t)(v));                                                  \
+    } while (0)
 #else
 /* True when an event of level `lvl` would be recorded. */
 #define PDT_TRACING(tr, lvl) __builtin_expect((tr) != NULL && (tr)->level >= (lvl), 0)

@@ -238,7 +238,7 @@ pdt_status pdt_tf_manifest_parse(const char *path, char *text, pdt_manifest *m, 
             else m->wall_start_ns = x;
         } else if (!strcmp(k, "ranks") || !strcmp(k, "level")) {
             long x = strtol(v, &end, 10);
-            if (end == v || *end || x < 0 || x > (1L << 24)) {
+            if (end == v || *end || x < 0 || x > (1L << 20)) {
                 st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad %s '%s'", path, line, k, v);
                 break;
             }
