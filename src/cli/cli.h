@@ -26,6 +26,7 @@ int pdt_cmd_triangulate(int argc, char **argv);
 int pdt_cmd_hull(int argc, char **argv);
 int pdt_cmd_check(int argc, char **argv);
 int pdt_cmd_gen(int argc, char **argv);
+int pdt_cmd_trace(int argc, char **argv);
 
 /* ---- option parsing --------------------------------------------------------- */
 

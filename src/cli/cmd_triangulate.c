@@ -80,6 +80,7 @@ pdt_status pdt_tri_job_compute(const pdt_run_opts *o, pdt_tri_job *j, pdt_err *e
     st = pdt_triangulate(j->pts, j->n, &j->tris, &j->ntri, &j->st,
                          pdt_cli_trace_hook(j->trace));
     if (st != PDT_OK) pdt_err_set(err, st, "triangulation failed: %s", pdt_status_str(st));
+    else pdt_cli_trace_finals(j->trace, j->tris, j->ntri);
     pdt_status cst = pdt_cli_trace_close(j->trace, err);
     j->trace = NULL;
     return st != PDT_OK ? st : cst;

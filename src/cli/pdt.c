@@ -10,6 +10,7 @@ static const pdt_cli_cmd commands[] = {
     { "hull", pdt_cmd_hull, "convex hull by Graham's scan (Version B)" },
     { "check", pdt_cmd_check, "verify that a triangle file is the Delaunay triangulation T*" },
     { "gen", pdt_cmd_gen, "generate a point set (uniform, grid, circle, ...)" },
+    { "trace", pdt_cmd_trace, "look into a traced run folder: info, dump, check, export" },
 };
 
 static void usage(FILE *f)

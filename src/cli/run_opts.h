@@ -36,6 +36,8 @@ pdt_status pdt_cli_trace_open(const pdt_run_opts *o, const pdt_point *pts, size_
                               pdt_cli_trace **t, pdt_err *err);
 /* The hook to pass to the algorithm (NULL when t is NULL). */
 pdt_trace *pdt_cli_trace_hook(pdt_cli_trace *t);
+/* Record the output triangles as final (TRI_FINAL); nothing if t is NULL. */
+void pdt_cli_trace_finals(pdt_cli_trace *t, const pdt_tri *tris, size_t ntri);
 /* Finish the run folder and free t (t may be NULL). */
 pdt_status pdt_cli_trace_close(pdt_cli_trace *t, pdt_err *err);
 

@@ -1,0 +1,460 @@
+/* pdt trace — look into a run folder: info, dump, check, export --chrome. */
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "cli.h"
+#include "pdt/io.h"
+#include "pdt/tracefile.h"
+
+static const char help_main[] =
+    "usage: pdt trace info DIR\n"
+    "       pdt trace dump DIR [--rank R] [--kind K] [--from N] [--count M]\n"
+    "       pdt trace check DIR\n"
+    "       pdt trace export --chrome DIR -o run.json [--events]\n"
+    "\n"
+    "DIR is a run folder written by `pdt triangulate --trace DIR` or `pdt hull --trace DIR`\n"
+    "(format: docs/trace-format.md).\n"
+    "  info    ranks, events per kind per rank, phases with durations, bytes\n"
+    "  dump    one line per event: rank, index in the rank, aligned time, event\n"
+    "  check   verify the invariants of a correct run; exit 1 naming the first violation\n"
+    "  export  Chrome trace-event JSON (chrome://tracing, ui.perfetto.dev): one row per\n"
+    "          rank, phases and merge steps as slices, messages as flow arrows\n";
+
+static const char help_dump[] =
+    "usage: pdt trace dump DIR [--rank R] [--kind K] [--from N] [--count M]\n"
+    "One line per event: `r2 #17 t=1.234567ms pop graham pt=17 depth=3 cause=12`\n"
+    "(#17 = index of the event in its rank's file, t = time aligned across ranks).\n"
+    "--rank R   only rank R, in its recording order (default: all ranks merged in a\n"
+    "           causally consistent order)\n"
+    "--kind K   only events of kind K (push, pop, lift, sort, delete, tri-new, tri-final,\n"
+    "           ra-defer, ship, discard, merge-begin, merge-end, send, recv, hull,\n"
+    "           phase-begin, phase-end, edge-add, edge-del, incircle)\n"
+    "--from N   start at event N (of rank R, or of the merged order)\n"
+    "--count M  print at most M lines\n";
+
+static int open_run(const char *dir, pdt_run **run)
+{
+    pdt_err err = {0};
+    if (pdt_run_open(dir, run, &err) != PDT_OK) return pdt_cli_fail(&err);
+    return PDT_EXIT_OK;
+}
+
+static void print_warnings(const pdt_run *run, FILE *f)
+{
+    const char *w = pdt_run_warnings(run);
+    while (*w) {
+        const char *nl = strchr(w, '\n');
+        int len = (int)(nl ? nl - w : (long)strlen(w));
+        fprintf(f, "warning: %.*s\n", len, w);
+        w += len + (nl ? 1 : 0);
+    }
+}
+
+/* ---- info ------------------------------------------------------------------ */
+
+typedef struct phase_rec {
+    pdt_event begin;
+    uint64_t t, end;  /* end = UINT64_MAX while open */
+    size_t depth;
+} phase_rec;
+
+static int cmd_info(const char *dir)
+{
+    pdt_run *run;
+    int rc = open_run(dir, &run);
+    if (rc) return rc;
+    const pdt_manifest *m = pdt_run_manifest(run);
+    int p = pdt_run_nranks(run);
+    printf("run folder   %s (format %d.%d)\n", dir, m->format_version, m->format_minor);
+    printf("command      %s  (pdt %s)\n", m->command[0] ? m->command : "?",
+           m->program_version[0] ? m->program_version : "?");
+    if (m->command_line) printf("command line %s\n", m->command_line);
+    printf("input        %s  n=%" PRIu64 "  checksum fnv1a64:%016" PRIx64 "\n",
+           m->input_name ? m->input_name : "?", m->n, m->input_checksum);
+    if (m->wall_start_ns) {
+        time_t s = (time_t)(m->wall_start_ns / 1000000000u);
+        struct tm tm;
+        char when[64];
+        gmtime_r(&s, &tm);
+        strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S UTC", &tm);
+        printf("started      %s\n", when);
+    }
+    printf("ranks        %d   trace level %d\n\n", p, m->level);
+
+    uint64_t (*cnt)[PDT_EV_KIND_COUNT + 1] = calloc((size_t)p, sizeof *cnt);
+    if (!cnt) {
+        fprintf(stderr, "pdt: out of memory\n");
+        pdt_run_close(run);
+        return PDT_EXIT_USAGE;
+    }
+    printf("rank      events   blocks        bytes  bytes/event  complete\n");
+    uint64_t tev = 0, tbytes = 0;
+    for (int r = 0; r < p; r++) {
+        pdt_rank_info in;
+        pdt_run_rank_info(run, r, &in);
+        tev += in.events;
+        tbytes += in.bytes;
+        printf("%4d %11" PRIu64 " %8" PRIu64 " %12" PRIu64 " %12.2f  %s\n", r, in.events,
+               in.blocks, in.bytes, in.events ? (double)in.bytes / (double)in.events : 0.0,
+               !in.present ? "missing" : in.complete ? "yes" : "NO");
+    }
+    if (p > 1)
+        printf(" all %11" PRIu64 " %8s %12" PRIu64 " %12.2f\n", tev, "", tbytes,
+               tev ? (double)tbytes / (double)tev : 0.0);
+
+    /* one pass per rank: counts and phases (listed in the order they begin) */
+    printf("\nphases (rank, phase, start on the aligned clock, duration; nested ones "
+           "indented):\n");
+    uint64_t t0 = UINT64_MAX;  /* the earliest aligned time of any rank */
+    for (int r = 0; r < p; r++) {
+        pdt_cursor *c;
+        pdt_event e;
+        if (pdt_cursor_open(run, r, &c, NULL) != PDT_OK) continue;
+        if (pdt_cursor_next(c, &e, NULL) && e.t < t0) t0 = e.t;
+        pdt_cursor_close(c);
+    }
+    for (int r = 0; r < p; r++) {
+        pdt_cursor *c;
+        pdt_err err = {0};
+        if (pdt_cursor_open(run, r, &c, &err) != PDT_OK) continue;
+        phase_rec *ph = NULL;
+        size_t nph = 0, cap = 0, *open = NULL, depth = 0, capo = 0;
+        pdt_event e;
+        int nomem = 0;
+        while (!nomem && pdt_cursor_next(c, &e, NULL)) {
+            cnt[r][e.kind < PDT_EV_KIND_COUNT ? e.kind : PDT_EV_KIND_COUNT]++;
+            if (e.kind == PDT_EV_PHASE_BEGIN || e.kind == PDT_EV_MERGE_BEGIN) {
+                if (nph == cap) {
+                    cap = cap ? 2 * cap : 64;
+                    phase_rec *q = realloc(ph, cap * sizeof *q);
+                    if (!q) { nomem = 1; break; }
+                    ph = q;
+                }
+                if (depth == capo) {
+                    capo = capo ? 2 * capo : 16;
+                    size_t *q = realloc(open, capo * sizeof *q);
+                    if (!q) { nomem = 1; break; }
+                    open = q;
+                }
+                ph[nph] = (phase_rec){e, e.t, UINT64_MAX, depth};
+                open[depth++] = nph++;
+            } else if ((e.kind == PDT_EV_PHASE_END || e.kind == PDT_EV_MERGE_END) && depth > 0) {
+                ph[open[--depth]].end = e.t;
+            }
+        }
+        for (size_t i = 0; i < nph; i++) {
+            const pdt_event *b = &ph[i].begin;
+            const char *pn = pdt_phase_name(b->sub);
+            char name[80];
+            if (b->kind == PDT_EV_MERGE_BEGIN)
+                snprintf(name, sizeof name, "merge step level %u: [%u,%u)+[%u,%u)", b->sub, b->a,
+                         b->b, b->b, b->c);
+            else if (b->a)
+                snprintf(name, sizeof name, "%s %u", pn ? pn : "?", b->a);
+            else
+                snprintf(name, sizeof name, "%s", pn ? pn : "?");
+            printf("  r%-3d %*s%-*s start %12.6f ms  ", r, (int)(2 * ph[i].depth), "",
+                   (int)(34 - 2 * (ph[i].depth < 8 ? ph[i].depth : 8)), name,
+                   (double)(ph[i].t - t0) / 1e6);
+            if (ph[i].end == UINT64_MAX) printf("never ends\n");
+            else printf("duration %12.6f ms\n", (double)(ph[i].end - ph[i].t) / 1e6);
+        }
+        if (nomem) printf("  r%-3d (out of memory: phase list cut short)\n", r);
+        free(ph);
+        free(open);
+        pdt_cursor_close(c);
+    }
+
+    printf("\nevents per kind:\n%-12s", "kind");
+    for (int r = 0; r < p && r < 16; r++) printf(" %10s%d", "r", r);
+    if (p > 1) printf(" %11s", "all");
+    printf("\n");
+    for (int k = 0; k <= PDT_EV_KIND_COUNT; k++) {
+        uint64_t tot = 0;
+        for (int r = 0; r < p; r++) tot += cnt[r][k];
+        if (!tot) continue;
+        printf("%-12s", k < PDT_EV_KIND_COUNT ? pdt_event_kind_name(k) : "(unknown)");
+        for (int r = 0; r < p && r < 16; r++) printf(" %11" PRIu64, cnt[r][k]);
+        if (p > 1) printf(" %11" PRIu64, tot);
+        printf("\n");
+    }
+    if (p > 16) printf("(per-rank columns shown for ranks 0..15)\n");
+    free(cnt);
+    print_warnings(run, stdout);
+    pdt_run_close(run);
+    return PDT_EXIT_OK;
+}
+
+/* ---- dump ------------------------------------------------------------------ */
+
+static void dump_line(uint32_t rank, uint64_t seq, const pdt_event *e)
+{
+    char text[200];
+    printf("r%" PRIu32 " #%" PRIu64 " t=%.6fms %s\n", rank, seq, (double)e->t / 1e6,
+           pdt_event_format(e, text, sizeof text));
+}
+
+static int cmd_dump(int argc, char **argv)
+{
+    const char *pos[1];
+    int npos = 0;
+    uint64_t rank = UINT64_MAX, from = 0, count = UINT64_MAX;
+    const char *kind = NULL;
+    const pdt_cli_opt opts[] = {
+        {"--rank", NULL, PDT_OPT_U64, &rank},
+        {"--kind", NULL, PDT_OPT_STR, &kind},
+        {"--from", NULL, PDT_OPT_U64, &from},
+        {"--count", NULL, PDT_OPT_U64, &count},
+        {NULL, NULL, PDT_OPT_FLAG, NULL},
+    };
+    int rc = pdt_cli_parse("trace dump", help_dump, argc, argv, opts, pos, 1, &npos);
+    if (rc == 1) return PDT_EXIT_OK;
+    if (rc) return PDT_EXIT_USAGE;
+    if (npos != 1) return pdt_cli_usage("trace dump", "needs one run folder DIR");
+    int k = -1;
+    if (kind && (k = pdt_event_kind_by_name(kind)) < 0)
+        return pdt_cli_usage("trace dump", "unknown event kind '%s'", kind);
+    pdt_run *run;
+    if ((rc = open_run(pos[0], &run))) return rc;
+    print_warnings(run, stderr);
+    pdt_err err = {0};
+    if (rank != UINT64_MAX) {
+        if (rank >= (uint64_t)pdt_run_nranks(run)) {
+            pdt_run_close(run);
+            return pdt_cli_usage("trace dump", "--rank %" PRIu64 ": the run has ranks 0..%d", rank,
+                                 pdt_run_nranks(run) - 1);
+        }
+        pdt_cursor *c;
+        if (pdt_cursor_open(run, (int)rank, &c, &err) != PDT_OK ||
+            pdt_cursor_seek(c, from, &err) != PDT_OK) {
+            pdt_run_close(run);
+            return pdt_cli_fail(&err);
+        }
+        pdt_event e;
+        uint64_t seq;
+        while (count > 0 && pdt_cursor_next(c, &e, &seq)) {
+            if (k >= 0 && e.kind != k) continue;
+            dump_line((uint32_t)rank, seq, &e);
+            count--;
+        }
+        pdt_cursor_close(c);
+    } else {
+        const pdt_rec *rec;
+        size_t n;
+        if (pdt_run_merged(run, &rec, &n, &err) != PDT_OK) {
+            pdt_run_close(run);
+            return pdt_cli_fail(&err);
+        }
+        for (size_t i = from; i < n && count > 0; i++) {
+            if (k >= 0 && rec[i].ev.kind != k) continue;
+            dump_line(rec[i].rank, rec[i].seq, &rec[i].ev);
+            count--;
+        }
+    }
+    pdt_run_close(run);
+    return fflush(stdout) == 0 && !ferror(stdout) ? PDT_EXIT_OK : PDT_EXIT_USAGE;
+}
+
+/* ---- check ------------------------------------------------------------------ */
+
+static int cmd_check(const char *dir)
+{
+    pdt_run *run;
+    pdt_err err = {0};
+    if (pdt_run_open(dir, &run, &err) != PDT_OK) {
+        fprintf(stderr, "pdt trace check: %s\n", err.msg);
+        return PDT_EXIT_CHECK;
+    }
+    char summary[512];
+    pdt_status st = pdt_run_check(run, summary, sizeof summary, &err);
+    pdt_run_close(run);
+    if (st != PDT_OK) {
+        fprintf(stderr, "pdt trace check: %s: %s\n", dir, err.msg);
+        return st == PDT_ERR_CHECK ? PDT_EXIT_CHECK : PDT_EXIT_USAGE;
+    }
+    printf("ok: %s\n", summary);
+    return PDT_EXIT_OK;
+}
+
+/* ---- export --chrome ----------------------------------------------------------- */
+
+static void json_str(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; s && *s; s++) {
+        unsigned char ch = (unsigned char)*s;
+        if (ch == '"' || ch == '\\') fprintf(f, "\\%c", ch);
+        else if (ch < 0x20) fprintf(f, "\\u%04x", ch);
+        else fputc(ch, f);
+    }
+    fputc('"', f);
+}
+
+static void us(FILE *f, uint64_t t)
+{
+    fprintf(f, "%" PRIu64 ".%03u", t / 1000, (unsigned)(t % 1000));
+}
+
+static void chrome_ev(FILE *f, int *first, const char *ph, const char *name, const char *cat,
+                      int rank, uint64_t t)
+{
+    fprintf(f, "%s\n{\"ph\":\"%s\",\"name\":", *first ? "" : ",", ph);
+    json_str(f, name);
+    fprintf(f, ",\"cat\":\"%s\",\"pid\":0,\"tid\":%d,\"ts\":", cat, rank);
+    us(f, t);
+    *first = 0;
+}
+
+static int export_chrome(pdt_run *run, FILE *f, int all_events)
+{
+    const pdt_manifest *m = pdt_run_manifest(run);
+    int p = pdt_run_nranks(run), first = 1;
+    fprintf(f, "{\"displayTimeUnit\":\"ns\",\"otherData\":{\"command\":");
+    json_str(f, m->command);
+    fprintf(f, ",\"command_line\":");
+    json_str(f, m->command_line ? m->command_line : "");
+    fprintf(f, ",\"n\":%" PRIu64 ",\"ranks\":%d},\n\"traceEvents\":[", m->n, p);
+    fprintf(f, "\n{\"ph\":\"M\",\"name\":\"process_name\",\"pid\":0,\"args\":{\"name\":\"pdt %s\"}}",
+            m->command);
+    first = 0;
+    for (int r = 0; r < p; r++) {
+        fprintf(f, ",\n{\"ph\":\"M\",\"name\":\"thread_name\",\"pid\":0,\"tid\":%d,"
+                   "\"args\":{\"name\":\"rank %d\"}}", r, r);
+        fprintf(f, ",\n{\"ph\":\"M\",\"name\":\"thread_sort_index\",\"pid\":0,\"tid\":%d,"
+                   "\"args\":{\"sort_index\":%d}}", r, r);
+    }
+    for (int r = 0; r < p; r++) {
+        pdt_cursor *c;
+        pdt_err err = {0};
+        if (pdt_cursor_open(run, r, &c, &err) != PDT_OK) return pdt_cli_fail(&err);
+        pdt_event e;
+        uint64_t seq, depth = 0, last_t = 0;
+        char name[200];
+        while (pdt_cursor_next(c, &e, &seq)) {
+            last_t = e.t;
+            switch (e.kind) {
+            case PDT_EV_PHASE_BEGIN:
+            case PDT_EV_PHASE_END: {
+                const char *pn = pdt_phase_name(e.sub);
+                if (e.a) snprintf(name, sizeof name, "%s %u", pn ? pn : "?", e.a);
+                else snprintf(name, sizeof name, "%s", pn ? pn : "?");
+                int b = e.kind == PDT_EV_PHASE_BEGIN;
+                if (!b && depth == 0) break;  /* unbalanced (damaged) */
+                depth += b ? 1 : (uint64_t)-1;
+                chrome_ev(f, &first, b ? "B" : "E", name, "phase", r, e.t);
+                fprintf(f, "}");
+                break;
+            }
+            case PDT_EV_MERGE_BEGIN:
+                snprintf(name, sizeof name, "merge level %u", e.sub);
+                depth++;
+                chrome_ev(f, &first, "B", name, "merge", r, e.t);
+                fprintf(f, ",\"args\":{\"left\":%u,\"right\":%u,\"end\":%u}}", e.a, e.b, e.c);
+                break;
+            case PDT_EV_MERGE_END:
+                if (depth == 0) break;
+                depth--;
+                snprintf(name, sizeof name, "merge level %u", e.sub);
+                chrome_ev(f, &first, "E", name, "merge", r, e.t);
+                fprintf(f, ",\"args\":{\"shipped\":%u,\"border\":%u,\"kept\":%u,"
+                           "\"discarded\":%" PRId64 "}}", e.a, e.b, e.c, e.v);
+                break;
+            case PDT_EV_SEND:
+            case PDT_EV_RECV: {
+                int send = e.kind == PDT_EV_SEND;
+                unsigned src = send ? (unsigned)r : e.a, dst = send ? e.a : (unsigned)r;
+                snprintf(name, sizeof name, "%s %s %u (%u bytes)", send ? "send" : "recv",
+                         send ? "to" : "from", e.a, e.b);
+                chrome_ev(f, &first, "X", name, "message", r, e.t);
+                fprintf(f, ",\"dur\":0.001,\"args\":{\"tag\":%u,\"seq\":%" PRId64 "}}", e.sub,
+                        e.v);
+                chrome_ev(f, &first, send ? "s" : "f", "message", "message", r, e.t);
+                fprintf(f, ",\"id\":\"%u-%u-%u-%" PRId64 "\"%s}", src, dst, e.sub, e.v,
+                        send ? "" : ",\"bp\":\"e\"");
+                break;
+            }
+            default:
+                if (all_events) {
+                    pdt_event_format(&e, name, sizeof name);
+                    chrome_ev(f, &first, "i", name, "event", r, e.t);
+                    fprintf(f, ",\"s\":\"t\",\"args\":{\"seq\":%" PRIu64 "}}", seq);
+                }
+                break;
+            }
+        }
+        while (depth > 0) {  /* close what a damaged trace left open */
+            chrome_ev(f, &first, "E", "(unfinished)", "phase", r, last_t);
+            fprintf(f, "}");
+            depth--;
+        }
+        pdt_cursor_close(c);
+    }
+    fprintf(f, "\n]}\n");
+    return PDT_EXIT_OK;
+}
+
+static int cmd_export(int argc, char **argv)
+{
+    static const char help[] =
+        "usage: pdt trace export --chrome DIR -o run.json [--events]\n"
+        "Write the run as Chrome trace-event JSON (open in ui.perfetto.dev or\n"
+        "chrome://tracing): one row per rank, phases and merge steps as slices,\n"
+        "messages as flow arrows.  --events adds every other event as an instant.\n";
+    const char *pos[1], *out = NULL;
+    int npos = 0, chrome = 0, events = 0;
+    const pdt_cli_opt opts[] = {
+        {"--chrome", NULL, PDT_OPT_FLAG, &chrome},
+        {"--output", "-o", PDT_OPT_STR, &out},
+        {"--events", NULL, PDT_OPT_FLAG, &events},
+        {NULL, NULL, PDT_OPT_FLAG, NULL},
+    };
+    int rc = pdt_cli_parse("trace export", help, argc, argv, opts, pos, 1, &npos);
+    if (rc == 1) return PDT_EXIT_OK;
+    if (rc) return PDT_EXIT_USAGE;
+    if (!chrome) return pdt_cli_usage("trace export", "only --chrome is available");
+    if (npos != 1) return pdt_cli_usage("trace export", "needs one run folder DIR");
+    pdt_run *run;
+    if ((rc = open_run(pos[0], &run))) return rc;
+    print_warnings(run, stderr);
+    pdt_outfile o;
+    pdt_err err = {0};
+    if (pdt_out_open(&o, out, &err) != PDT_OK) {
+        pdt_run_close(run);
+        return pdt_cli_fail(&err);
+    }
+    rc = export_chrome(run, o.fp, events);
+    pdt_run_close(run);
+    if (rc) {
+        pdt_out_abort(&o);
+        return rc;
+    }
+    if (pdt_out_commit(&o, &err) != PDT_OK) return pdt_cli_fail(&err);
+    return PDT_EXIT_OK;
+}
+
+int pdt_cmd_trace(int argc, char **argv)
+{
+    if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+        fputs(help_main, argc < 2 ? stderr : stdout);
+        return argc < 2 ? PDT_EXIT_USAGE : PDT_EXIT_OK;
+    }
+    const char *sub = argv[1];
+    if (!strcmp(sub, "dump")) return cmd_dump(argc - 1, argv + 1);
+    if (!strcmp(sub, "export")) return cmd_export(argc - 1, argv + 1);
+    if (!strcmp(sub, "info") || !strcmp(sub, "check")) {
+        const char *pos[1];
+        int npos = 0;
+        const pdt_cli_opt opts[] = {{NULL, NULL, PDT_OPT_FLAG, NULL}};
+        char cmd[32];
+        snprintf(cmd, sizeof cmd, "trace %s", sub);
+        int rc = pdt_cli_parse(cmd, help_main, argc - 1, argv + 1, opts, pos, 1, &npos);
+        if (rc == 1) return PDT_EXIT_OK;
+        if (rc) return PDT_EXIT_USAGE;
+        if (npos != 1) return pdt_cli_usage(cmd, "needs one run folder DIR");
+        return !strcmp(sub, "info") ? cmd_info(pos[0]) : cmd_check(pos[0]);
+    }
+    return pdt_cli_usage("trace", "unknown subcommand '%s' (info, dump, check, export)", sub);
+}
