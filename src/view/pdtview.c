@@ -3,6 +3,8 @@
  *   pdtview RUN                                   the window
  *   pdtview --headless RUN (--at N | --phase NAME | --end) -o FILE.png|.svg|.pdf [--size WxH]
  *   pdtview --headless RUN --frames DIR --every K [--size WxH]
+ *   pdtview --bench RUN [--size WxH]        open / seek / draw figures
+ *   pdtview --write-run DIR RUN             copy a (synthetic) run to a run folder
  *
  * RUN is a run folder (pdt triangulate/hull --trace DIR), or a synthetic run
  * "synth:srm:COLS:ROWS:RANKS" / "synth:graham:N" (for tests and demos). */
@@ -13,6 +15,8 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include <cairo.h>
+
 #include "pdt/render.h"
 #include "pdt/replay.h"
 #include "pdt/tracefile.h"
@@ -20,8 +24,8 @@
 #include "shell.h"
 
 typedef struct opts {
-    const char *run, *out, *frames, *phase, *script, *screenshot, *hide;
-    int headless, end, every, w, h, have_at, quiet;
+    const char *run, *out, *frames, *phase, *script, *screenshot, *hide, *write_run;
+    int headless, end, every, w, h, have_at, quiet, bench;
     size_t at;
     double speed;
 } opts;
@@ -34,6 +38,8 @@ static void usage(FILE *f)
             "       pdtview --headless RUN (--at N | --phase NAME | --end) -o FILE.png|.svg|.pdf\n"
             "               [--size WxH]\n"
             "       pdtview --headless RUN --frames DIR --every K [--size WxH]\n"
+            "       pdtview --bench RUN [--size WxH]\n"
+            "       pdtview --write-run DIR RUN\n"
             "RUN: a run folder, or synth:srm:COLS:ROWS:RANKS, synth:graham:N\n"
             "The cursor N counts events applied (0 = start, --end = all).\n"
             "Keys in the window: h or ? (help).  See docs/viewer.md.\n");
@@ -69,6 +75,8 @@ static int parse_args(int argc, char **argv, opts *o)
         i++;                                                          \
     } while (0)
         if (!strcmp(a, "--headless")) o->headless = 1;
+        else if (!strcmp(a, "--bench")) o->bench = 1;
+        else if (!strcmp(a, "--write-run")) { NEED(); o->write_run = val; }
         else if (!strcmp(a, "--end")) o->end = 1;
         else if (!strcmp(a, "--quiet")) o->quiet = 1;
         else if (!strcmp(a, "--at")) {
@@ -120,7 +128,7 @@ static int parse_args(int argc, char **argv, opts *o)
         fprintf(stderr, "pdtview: no run folder given\n");
         return 0;
     }
-    if (o->headless && !o->out && !o->frames) {
+    if (o->headless && !o->out && !o->frames && !o->bench) {
         fprintf(stderr, "pdtview: --headless needs -o FILE or --frames DIR\n");
         return 0;
     }
@@ -203,6 +211,126 @@ static int headless(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const opts 
     return 0;
 }
 
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double median(double *v, size_t n)
+{
+    qsort(v, n, sizeof *v, cmp_d);
+    return n ? v[n / 2] : 0;
+}
+
+/* Figures for scripts/bench/40-view.sh: seek, step back, frames per second. */
+static int bench(const pdt_replay *r, pdt_rstate *s, const pdt_view *v, const opts *o)
+{
+    size_t m = pdt_replay_count(r), nt, ne;
+    pdt_replay_tris(r, &nt);
+    pdt_replay_edges(r, &ne);
+    enum { NSEEK = 101 };
+    double t[NSEEK];
+    uint64_t x = 88172645463325252ull;
+    for (int i = 0; i < NSEEK; i++) {
+        x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+        size_t k = m ? (size_t)(x % (m + 1)) : 0;
+        double t0 = now_s();
+        pdt_replay_seek(r, s, k);
+        t[i] = now_s() - t0;
+    }
+    printf("seek (random cursor, median of %d): %.2f ms\n", NSEEK, 1e3 * median(t, NSEEK));
+    for (int i = 0; i < NSEEK; i++) {
+        double t0 = now_s();
+        for (int j = 0; j < 1000; j++) pdt_replay_step(r, s, -1);
+        t[i] = (now_s() - t0) / 1000;
+    }
+    printf("step back (median): %.3f us\n", 1e6 * median(t, NSEEK));
+    pdt_replay_seek(r, s, m);
+    size_t drawn = 0;
+    for (size_t i = 0; i < nt; i++)
+        if (pdt_rstate_tri_status(r, s, i) != PDT_TS_NONE && pdt_rstate_tri_status(r, s, i) != PDT_TS_DISCARDED)
+            drawn++;
+    cairo_surface_t *sf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, o->w, o->h);
+    int frames = 0;
+    double t0 = now_s(), el = 0;
+    pdt_err err = {0};
+    while (frames < 3 || (el < 3.0 && frames < 200)) {
+        cairo_t *cr = cairo_create(sf);
+        if (pdt_render(cr, o->w, o->h, r, s, v, &err) != PDT_OK) {
+            fprintf(stderr, "pdtview: %s\n", err.msg);
+            cairo_destroy(cr);
+            cairo_surface_destroy(sf);
+            return 1;
+        }
+        cairo_destroy(cr);
+        frames++;
+        el = now_s() - t0;
+    }
+    cairo_surface_destroy(sf);
+    printf("draw %zu triangles (%zu edges) at %dx%d: %.1f frames/s (%d frames)\n", drawn, 3 * drawn,
+           o->w, o->h, frames / el, frames);
+    return 0;
+}
+
+/* Write the loaded events to a run folder through the trace writer, in
+ * their merged order (so the reader's causal merge finds the same order). */
+static int write_run(const char *dir, const loaded *L, pdt_err *err)
+{
+    int p = L->nranks;
+    pdt_trace_writer **w = calloc((size_t)p, sizeof *w);
+    int64_t *off = calloc((size_t)p, sizeof *off);
+    pdt_status st = PDT_OK;
+    if (!w || !off) st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    for (int q = 0; q < p && st == PDT_OK; q++) st = pdt_tw_open(dir, q, 2, &w[q], err);
+    /* every writer's clock starts at its open: align them on rank 0's */
+    if (st == PDT_OK) {
+        uint64_t t0 = pdt_tw_now(w[0]);
+        for (int q = 0; q < p; q++) off[q] = (int64_t)(t0 - pdt_tw_now(w[q]));
+    }
+    for (size_t i = 0; i < L->m && st == PDT_OK; i++) {
+        pdt_trace *tr = pdt_tw_hook(w[L->recs[i].rank]);
+        tr->sink(tr, &L->recs[i].ev);
+    }
+    for (int q = 0; q < p && w; q++) {
+        pdt_status s2 = pdt_tw_close(w[q], err);
+        if (st == PDT_OK) st = s2;
+    }
+    if (st == PDT_OK) {
+        pdt_manifest mf;
+        memset(&mf, 0, sizeof mf);
+        mf.format_version = PDT_TRACE_FORMAT_MAJOR;
+        snprintf(mf.program_version, sizeof mf.program_version, "%s", PDT_VERSION);
+        mf.command_line = (char *)"pdtview --write-run";
+        mf.input_name = (char *)"synthetic";
+        mf.input_checksum = pdt_points_checksum(L->pts, L->n);
+        mf.n = L->n;
+        mf.nranks = p;
+        mf.level = 2;
+        snprintf(mf.command, sizeof mf.command, "triangulate");
+        mf.clock_offset_ns = off;
+        mf.wall_start_ns = pdt_wall_ns();
+        st = pdt_run_write_meta(dir, &mf, L->pts, L->n, err);
+    }
+    free(w);
+    free(off);
+    return st == PDT_OK ? 0 : 1;
+}
+
 int main(int argc, char **argv)
 {
     opts o;
@@ -216,8 +344,19 @@ int main(int argc, char **argv)
     pdt_rstate *s = NULL;
     uint8_t *hidden = NULL;
     int rc = 1;
+    double t0 = now_s(), c0 = cpu_s();
     if (load(o.run, &L, &err) != PDT_OK) goto out;
+    double t1 = now_s(), c1 = cpu_s();
+    if (o.write_run) {
+        rc = write_run(o.write_run, &L, &err);
+        if (!rc && !o.quiet) printf("pdtview: wrote %zu events of %d ranks to %s\n", L.m, L.nranks, o.write_run);
+        goto out;
+    }
     if (pdt_replay_new(L.pts, L.n, L.recs, L.m, L.nranks, &r, &err) != PDT_OK) goto out;
+    if (o.bench)
+        printf("open %zu events, %zu points, %d ranks: %.3f s (read %.3f s + index %.3f s; "
+               "cpu %.3f s + %.3f s)\n", L.m, L.n, L.nranks, now_s() - t0, t1 - t0, now_s() - t1,
+               c1 - c0, cpu_s() - c1);
     if (pdt_replay_skipped(r) && !o.quiet)
         fprintf(stderr, "pdtview: %zu malformed events ignored\n", pdt_replay_skipped(r));
     s = pdt_rstate_new(r);
@@ -254,7 +393,9 @@ int main(int argc, char **argv)
     pdt_view v;
     pdt_view_defaults(&v);
     v.hidden = hidden;
-    if (o.headless) {
+    if (o.bench) {
+        rc = bench(r, s, &v, &o);
+    } else if (o.headless) {
         rc = headless(r, s, &v, &o, &err);
     } else {
         pdt_shell_opts so = {o.w, o.h, o.run, o.script, o.screenshot, o.speed};

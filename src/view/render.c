@@ -106,6 +106,15 @@ void pdt_render_layout(double w, double h, int nranks, pdt_layout *L)
     L->code = (pdt_rect){x, y + leg, side, code};
     L->stack = (pdt_rect){x, y + leg + code, side, stk};
     L->lifted = (pdt_rect){x, y + leg + code + stk, side, rest - stk};
+    /* whole pixels: clipping to them stays a fast box clip */
+    pdt_rect *all[] = {&L->top, &L->geo, &L->legend, &L->code, &L->stack, &L->lifted, &L->timeline};
+    for (size_t i = 0; i < sizeof all / sizeof *all; i++) {
+        double x1 = round(all[i]->x + all[i]->w), y1 = round(all[i]->y + all[i]->h);
+        all[i]->x = round(all[i]->x);
+        all[i]->y = round(all[i]->y);
+        all[i]->w = x1 - all[i]->x;
+        all[i]->h = y1 - all[i]->y;
+    }
 }
 
 typedef struct xform {
@@ -248,6 +257,7 @@ typedef struct ctx {
     double lw;      /* base line width */
     const pdt_rec *cur;  /* the current event or NULL */
     int all_lifted;      /* the run has no lift events: show every point lifted */
+    double spacing;      /* typical distance between points, pixels */
 } ctx;
 
 static int shown(const ctx *c, uint32_t rank)
@@ -384,6 +394,13 @@ static void draw_triangles(ctx *c)
     }
     free(fill);
     cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+    double gx0 = c->L.geo.x, gx1 = c->L.geo.x + c->L.geo.w, gy0 = c->L.geo.y, gy1 = c->L.geo.y + c->L.geo.h;
+    /* dense pictures: thin lines without antialiasing (a mesh of 10^5 edges
+     * looks the same and draws several times faster) */
+    int dense = start[nb] > 10000;
+    cairo_save(cr);
+    cairo_set_line_cap(cr, dense ? CAIRO_LINE_CAP_BUTT : CAIRO_LINE_CAP_ROUND);
+    if (dense) cairo_set_antialias(cr, CAIRO_ANTIALIAS_NONE);
     /* discarded first (underneath), fading; then candidate, shipped, deferred, final */
     static const int order_st[] = {PDT_TS_DISCARDED, PDT_TS_CANDIDATE, PDT_TS_SHIPPED,
                                    PDT_TS_DEFERRED, PDT_TS_FINAL};
@@ -415,12 +432,31 @@ static void draw_triangles(ctx *c)
                 }
                 continue;
             }
-            status_style(cr, st, c->lw);
-            for (size_t i = start[b]; i < start[b + 1]; i++) tri_path(c, T[order[i]].v);
+            status_style(cr, st, dense ? 0.8 : c->lw);
             set_rank(cr, q, st == PDT_TS_CANDIDATE ? 0.75 : 1);
+            /* separate segments (no joins), stroked in chunks: much faster
+             * than one long path of closed triangles */
+            size_t seg = 0;
+            for (size_t i = start[b]; i < start[b + 1]; i++) {
+                const uint32_t *v = T[order[i]].v;
+                double x[3], y[3];
+                for (int j = 0; j < 3; j++) wpt(c, v[j], &x[j], &y[j]);
+                if ((x[0] < gx0 && x[1] < gx0 && x[2] < gx0) || (x[0] > gx1 && x[1] > gx1 && x[2] > gx1) ||
+                    (y[0] < gy0 && y[1] < gy0 && y[2] < gy0) || (y[0] > gy1 && y[1] > gy1 && y[2] > gy1))
+                    continue;
+                for (int j = 0; j < 3; j++) {
+                    cairo_move_to(cr, x[j], y[j]);
+                    cairo_line_to(cr, x[(j + 1) % 3], y[(j + 1) % 3]);
+                }
+                if ((seg += 3) >= 3000) {
+                    cairo_stroke(cr);
+                    seg = 0;
+                }
+            }
             cairo_stroke(cr);
         }
     }
+    cairo_restore(cr);
     cairo_set_dash(cr, NULL, 0, 0);
     free(start);
     free(order);
@@ -432,9 +468,19 @@ static void draw_kernel_edges(ctx *c)
     const pdt_redge *E = pdt_replay_edges(c->r, &ne);
     if (!ne) return;
     cairo_t *cr = c->cr;
+    size_t np;
+    const pdt_rphase *Ph = pdt_replay_phases(c->r, &np);
+    cairo_save(cr);
     cairo_set_line_width(cr, 0.5 * c->lw);
+    if (ne > 20000) cairo_set_antialias(cr, CAIRO_ANTIALIAS_NONE);
     for (int q = 0; q < c->nranks; q++) {
         if (!shown(c, (uint32_t)q)) continue;
+        /* the kernel's edges show its progress; once its phase is over the
+         * triangles tell the story */
+        int in_kernel = 0;
+        for (int32_t p = pdt_rstate_slot(c->r, c->s, q, PDT_SLOT_PHASE); p >= 0; p = Ph[p].parent)
+            if (Ph[p].phase == PDT_PH_KERNEL || Ph[p].phase == PDT_PH_MERGE) in_kernel = 1;
+        if (!in_kernel) continue;
         int any = 0;
         for (size_t e = 0; e < ne; e++) {
             if (!c->s->ealive[e] || E[e].rank != (uint32_t)q) continue;
@@ -450,6 +496,7 @@ static void draw_kernel_edges(ctx *c)
             cairo_stroke(cr);
         }
     }
+    cairo_restore(cr);
 }
 
 /* List a stack from its top node: writes points bottom..top into out, returns count. */
@@ -562,6 +609,7 @@ static void draw_points(ctx *c)
         nvis++;
     }
     if (nvis > 4000) rad = fmin(rad, 1.5);
+    if (nvis > 4000 && c->spacing < 5) return; /* the points would only hide the edges */
     /* not yet lifted: hollow grey; lifted: filled dark */
     for (int pass = 0; pass < 2; pass++) {
         for (size_t p = 0; p < c->n; p++) {
@@ -569,7 +617,8 @@ static void draw_points(ctx *c)
             if (lifted != pass) continue;
             double x, y;
             wpt(c, (uint32_t)p, &x, &y);
-            if (nvis > 4000) cairo_rectangle(cr, x - rad, y - rad, 2 * rad, 2 * rad);
+            if (nvis > 4000) /* pixel-aligned squares: cairo fills them as boxes, fast */
+                cairo_rectangle(cr, floor(x) - 1, floor(y) - 1, 2, 2);
             else {
                 cairo_new_sub_path(cr);
                 cairo_arc(cr, x, y, rad, 0, 2 * M_PI);
@@ -803,6 +852,7 @@ static void draw_geometry(ctx *c)
     cairo_t *cr = c->cr;
     cairo_save(cr);
     clip_rect(cr, c->L.geo);
+
     size_t cap = c->n + 1;
     uint32_t *buf = malloc(2 * cap * sizeof *buf);
     int cur_tri = 0;
@@ -1252,23 +1302,26 @@ static void draw_lifted(ctx *c)
     size_t step = c->n > 6000 ? c->n / 6000 : 1;
     double rad = c->n > 1000 ? 1.4 : 2.6;
     size_t nbelow = 0;
-    for (size_t p = 0; p < c->n; p += step) {
-        double u = (c->P[p].x - J.cx) / J.sc, w = (c->P[p].y - J.cy) / J.sc, z = u * u + w * w;
-        int lifted = c->all_lifted || (c->s->pflags[p] & PDT_PF_LIFTED) != 0;
-        double sx, sy;
-        lift_xy(&J, u, w, lifted ? z : 0, &sx, &sy);
-        int below = have_plane && lifted && z < pa * u + pb * w + pc - 1e-12 && p != tv[0] &&
-                    p != tv[1] && p != tv[2];
-        cairo_new_sub_path(cr);
-        cairo_arc(cr, sx, sy, below ? rad * 1.8 : rad, 0, 2 * M_PI);
-        if (below) {
-            rgb(cr, RED, 1);
-            nbelow++;
-        } else if (lifted) {
-            rgb(cr, INK, 0.85);
-        } else {
-            cairo_set_source_rgba(cr, 0.6, 0.6, 0.6, 0.5);
+    for (int cls = 0; cls < 3; cls++) { /* 0 floor, 1 lifted, 2 below the plane: one fill each */
+        for (size_t p = 0; p < c->n; p += step) {
+            double u = (c->P[p].x - J.cx) / J.sc, w = (c->P[p].y - J.cy) / J.sc, z = u * u + w * w;
+            int lifted = c->all_lifted || (c->s->pflags[p] & PDT_PF_LIFTED) != 0;
+            int below = have_plane && lifted && z < pa * u + pb * w + pc - 1e-12 && p != tv[0] &&
+                        p != tv[1] && p != tv[2];
+            if ((below ? 2 : lifted ? 1 : 0) != cls) continue;
+            double sx, sy;
+            lift_xy(&J, u, w, lifted ? z : 0, &sx, &sy);
+            double rr = below ? rad * 1.8 : rad;
+            if (step > 1 || c->n > 2000) cairo_rectangle(cr, floor(sx) - 1, floor(sy) - 1, 2, 2);
+            else {
+                cairo_new_sub_path(cr);
+                cairo_arc(cr, sx, sy, rr, 0, 2 * M_PI);
+            }
+            nbelow += below;
         }
+        if (cls == 2) rgb(cr, RED, 1);
+        else if (cls == 1) rgb(cr, INK, 0.85);
+        else cairo_set_source_rgba(cr, 0.6, 0.6, 0.6, 0.5);
         cairo_fill(cr);
     }
     if (have_plane) {
@@ -1472,6 +1525,7 @@ pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, cons
     if (pdt_replay_bbox(r, &lo, &hi))
         spacing = c.X.s * sqrt(fmax(1.0, ((double)hi.x - lo.x) * ((double)hi.y - lo.y)) / (double)(c.n ? c.n : 1));
     c.lw = fmax(0.5, fmin(0.16 * c.L.font, spacing / 9));
+    c.spacing = spacing;
 
     cairo_save(cr);
     cairo_rectangle(cr, 0, 0, w, h);

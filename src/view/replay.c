@@ -21,9 +21,14 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
 
 /* ---- a hash map from a 128-bit key to an int32 ------------------------------ */
 
+typedef struct km_slot_t {
+    uint64_t hi, lo;
+    int32_t val;  /* INT32_MIN = empty slot */
+    int32_t pad;
+} km_slot_t;
+
 typedef struct keymap {
-    uint64_t *hi, *lo;
-    int32_t *val;   /* INT32_MIN = empty slot */
+    km_slot_t *e;
     size_t cap, used;
 } keymap;
 
@@ -36,13 +41,14 @@ static uint64_t mix(uint64_t hi, uint64_t lo)
     return h;
 }
 
-static int km_alloc(keymap *km, size_t cap)
+/* Room for at least `n` keys at load <= 1/2. */
+static int km_alloc(keymap *km, size_t n)
 {
-    km->hi = malloc(cap * sizeof *km->hi);
-    km->lo = malloc(cap * sizeof *km->lo);
-    km->val = malloc(cap * sizeof *km->val);
-    if (!km->hi || !km->lo || !km->val) return 0;
-    for (size_t i = 0; i < cap; i++) km->val[i] = INT32_MIN;
+    size_t cap = 1024;
+    while (cap < 2 * n) cap *= 2;
+    km->e = malloc(cap * sizeof *km->e);
+    if (!km->e) return 0;
+    for (size_t i = 0; i < cap; i++) km->e[i].val = INT32_MIN;
     km->cap = cap;
     km->used = 0;
     return 1;
@@ -50,9 +56,7 @@ static int km_alloc(keymap *km, size_t cap)
 
 static void km_free(keymap *km)
 {
-    free(km->hi);
-    free(km->lo);
-    free(km->val);
+    free(km->e);
     memset(km, 0, sizeof *km);
 }
 
@@ -60,7 +64,7 @@ static void km_free(keymap *km)
 static size_t km_slot(const keymap *km, uint64_t hi, uint64_t lo)
 {
     size_t mask = km->cap - 1, i = (size_t)mix(hi, lo) & mask;
-    while (km->val[i] != INT32_MIN && (km->hi[i] != hi || km->lo[i] != lo)) i = (i + 1) & mask;
+    while (km->e[i].val != INT32_MIN && (km->e[i].hi != hi || km->e[i].lo != lo)) i = (i + 1) & mask;
     return i;
 }
 
@@ -68,8 +72,8 @@ static int km_get(const keymap *km, uint64_t hi, uint64_t lo, int32_t *v)
 {
     if (!km->cap) return 0;
     size_t i = km_slot(km, hi, lo);
-    if (km->val[i] == INT32_MIN) return 0;
-    *v = km->val[i];
+    if (km->e[i].val == INT32_MIN) return 0;
+    *v = km->e[i].val;
     return 1;
 }
 
@@ -77,26 +81,18 @@ static int km_put(keymap *km, uint64_t hi, uint64_t lo, int32_t v)
 {
     if (2 * (km->used + 1) > km->cap) {
         keymap big;
-        if (!km_alloc(&big, km->cap ? 2 * km->cap : 1024)) {
-            km_free(&big);
-            return 0;
-        }
+        if (!km_alloc(&big, km->cap ? km->cap : 512)) return 0;
         for (size_t i = 0; i < km->cap; i++) {
-            if (km->val[i] == INT32_MIN) continue;
-            size_t j = km_slot(&big, km->hi[i], km->lo[i]);
-            big.hi[j] = km->hi[i];
-            big.lo[j] = km->lo[i];
-            big.val[j] = km->val[i];
+            if (km->e[i].val == INT32_MIN) continue;
+            big.e[km_slot(&big, km->e[i].hi, km->e[i].lo)] = km->e[i];
             big.used++;
         }
         km_free(km);
         *km = big;
     }
     size_t i = km_slot(km, hi, lo);
-    if (km->val[i] == INT32_MIN) km->used++;
-    km->hi[i] = hi;
-    km->lo[i] = lo;
-    km->val[i] = v;
+    if (km->e[i].val == INT32_MIN) km->used++;
+    km->e[i] = (km_slot_t){hi, lo, v, 0};
     return 1;
 }
 
@@ -416,6 +412,22 @@ static pdt_status build(pdt_replay *r, pdt_err *err)
     if (!b.cur || !b.lastst || !lifted_any) goto out;
     for (size_t s = 0; s < nslot; s++) b.cur[s] = -1;
     for (int q = 0; q < r->nranks; q++) b.lastst[q] = -1;
+    /* size the tables once: counts of the events that create objects */
+    {
+        size_t cnt[PDT_EV_KIND_COUNT] = {0};
+        for (size_t i = 0; i < r->m; i++)
+            if (r->recs[i].ev.kind < PDT_EV_KIND_COUNT) cnt[r->recs[i].ev.kind]++;
+        size_t ntri_ev = cnt[PDT_EV_TRI_NEW] + cnt[PDT_EV_TRI_FINAL] + cnt[PDT_EV_RA_DEFER] +
+                         cnt[PDT_EV_SHIP] + cnt[PDT_EV_DISCARD];
+        size_t guess_tri = cnt[PDT_EV_TRI_NEW] ? cnt[PDT_EV_TRI_NEW] : ntri_ev;
+        if (!km_alloc(&b.tri_map, guess_tri) || !km_alloc(&b.edge_map, cnt[PDT_EV_EDGE_ADD]) ||
+            !km_alloc(&b.msg_map, cnt[PDT_EV_SEND]) ||
+            !grow((void **)&r->tris, &r->cap_tri, guess_tri, sizeof *r->tris) ||
+            !grow((void **)&b.tri_count, &b.cap_count, guess_tri, sizeof *b.tri_count) ||
+            !grow((void **)&r->edges, &r->cap_edge, cnt[PDT_EV_EDGE_ADD], sizeof *r->edges) ||
+            !grow((void **)&r->nodes, &r->cap_node, cnt[PDT_EV_PUSH], sizeof *r->nodes))
+            goto out;
+    }
 
     for (size_t i = 0; i < r->m; i++) {
         r->ev_obj[i] = -1;

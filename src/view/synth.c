@@ -186,13 +186,14 @@ pdt_status pdt_synth_srm(int cols, int rows, int nranks, int level, pdt_synth *o
     box *bx = malloc((size_t)nranks * sizeof *bx);
     tlist *pend = calloc((size_t)nranks, sizeof *pend);
     uint32_t **hull = calloc((size_t)nranks, sizeof *hull);  /* hull held by a rank */
+    int *holder = malloc((size_t)nranks * sizeof *holder);   /* per group start: hull holder */
     size_t *nhull = calloc((size_t)nranks, sizeof *nhull);
     uint32_t *ids = malloc(n * sizeof *ids), *stack = malloc((n + 1) * sizeof *stack);
     uint32_t *hbuf = malloc(2 * (n + 1) * sizeof *hbuf);
     uint8_t *inB = calloc(n, 1);
     gen g;
     gen_init(&g, nranks, level);
-    if (!pts || !first || !bx || !pend || !hull || !nhull || !ids || !stack || !hbuf || !inB)
+    if (!pts || !first || !bx || !pend || !hull || !nhull || !ids || !stack || !hbuf || !inB || !holder)
         g.failed = 1;
     if (g.failed) goto done;
     g.pts = pts;
@@ -200,6 +201,7 @@ pdt_status pdt_synth_srm(int cols, int rows, int nranks, int level, pdt_synth *o
         for (size_t j = 0; j < R; j++) pts[c * R + j] = (pdt_point){(int32_t)c * 10, (int32_t)j * 30};
 #define P(c, j) ((uint32_t)((size_t)(c) * R + (size_t)(j)))
     for (int r = 0; r <= nranks; r++) first[r] = (int)((long)r * cols / nranks);
+    for (int r = 0; r < nranks; r++) holder[r] = r;
     for (int r = 0; r < nranks; r++)
         bx[r] = (box){first[r] * 10.0, 0, (first[r + 1] - 1) * 10.0, (rows - 1) * 30.0};
 
@@ -293,11 +295,14 @@ pdt_status pdt_synth_srm(int cols, int rows, int nranks, int level, pdt_synth *o
                     recv_msg(&g, q, m, 1, (uint32_t)(ns * 12 + 16), st, sq);
                 }
             }
-            if (gl != m) {  /* the hull of G_L travels to m */
+            int hl = holder[gl], hr = holder[gr];
+            for (int side = 0; side < 2; side++) {  /* the group hulls travel to m */
+                int hq = side ? hr : hl;
+                if (hq == m) continue;
                 uint64_t st;
                 uint32_t sq;
-                send_msg(&g, gl, m, 2, (uint32_t)(nhull[gl] * 16), &st, &sq);
-                recv_msg(&g, gl, m, 2, (uint32_t)(nhull[gl] * 16), st, sq);
+                send_msg(&g, hq, m, 2, (uint32_t)(nhull[hq] * 16), &st, &sq);
+                recv_msg(&g, hq, m, 2, (uint32_t)(nhull[hq] * 16), st, sq);
             }
             EV(&g, m, PDT_EV_MERGE_BEGIN, lv, (uint32_t)gl, (uint32_t)gr, (uint32_t)ge, m);
             /* border set: shipped vertices and the two seam columns */
@@ -348,8 +353,9 @@ pdt_status pdt_synth_srm(int cols, int rows, int nranks, int level, pdt_synth *o
             }
             /* hull merge over both hulls' vertices (lex order) */
             size_t nh = 0;
-            for (size_t a = 0; a < nhull[gl]; a++) ids[nh++] = hull[gl][a];
-            for (size_t a = 0; a < nhull[m]; a++) ids[nh++] = hull[m][a];
+            for (size_t a = 0; a < nhull[hl]; a++) ids[nh++] = hull[hl][a];
+            for (size_t a = 0; a < nhull[hr]; a++) ids[nh++] = hull[hr][a];
+            holder[gl] = m;
             qsort(ids, nh, sizeof *ids, cmp_u32);
             size_t h = chain(&g, m, ids, nh, PDT_STACK_MERGE_LOWER, PDT_STACK_MERGE_UPPER, stack, hbuf);
             uint32_t *nhl = realloc(hull[m], (h + 1) * sizeof *nhl);
@@ -400,6 +406,7 @@ done:
     free(hull);
     free(nhull);
     free(first);
+    free(holder);
     free(bx);
     free(ids);
     free(stack);

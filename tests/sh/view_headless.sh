@@ -31,6 +31,15 @@ if [ "$got" -eq "$want" ]; then ok frames_count; else fail frames_count "want $w
 # the picture changes along the run
 if ! cmp -s "$TMP/frames/frame-000000.png" "$TMP/frames/frame-000002.png"; then ok frames_differ; else fail frames_differ; fi
 
+# a run folder written by the trace writer reads back with the same events
+if "$V" --write-run "$TMP/run" "$RUN" --quiet && [ -f "$TMP/run/manifest" ] &&
+   a=$("$V" --headless "$TMP/run" --end -o "$TMP/run.png" --size 640x400) &&
+   b=$("$V" --headless "$RUN" --end -o "$TMP/syn.png" --size 640x400) &&
+   [ "${a##*(}" = "${b##*(}" ] && [ -s "$TMP/run.png" ]; then ok run_folder_roundtrip
+else fail run_folder_roundtrip "$a / $b"; fi
+if "$V" --headless "$TMP/run" --phase merge:1 -o "$TMP/run_m1.png" --size 640x400 --quiet; then ok run_folder_phase
+else fail run_folder_phase; fi
+
 # errors: unknown phase, cursor out of range, bad extension, missing run
 if ! "$V" --headless "$RUN" --phase nosuch -o "$TMP/n.png" 2>"$TMP/e1" && grep -q 'no phase named' "$TMP/e1"; then
     ok error_phase; else fail error_phase; fi
