@@ -162,6 +162,31 @@ out=$("$PDT" trace check "$TMP/nolift" 2>&1); rc=$?
 [[ $rc -eq 1 && "$out" == *"was never lifted"* ]] &&
     ok check_fails_removed_lift || fail check_fails_removed_lift "rc=$rc $out"
 
+# ---- a run killed with SIGKILL leaves a readable trace ------------------------------------
+"$PDT" gen uniform 400000 -o "$TMP/big.txt"
+"$PDT" triangulate "$TMP/big.txt" -o "$TMP/big.tri" --trace "$TMP/killed" 2>/dev/null &
+pid=$!
+for ((i = 0; i < 400; i++)); do  # until a few blocks are on disk (or the run ended)
+    sz=$(stat -c %s "$TMP/killed/rank-0000.trace" 2>/dev/null || echo 0)
+    [ "$sz" -ge 150000 ] && break
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.02
+done
+if kill -9 "$pid" 2>/dev/null; then
+    wait "$pid" 2>/dev/null
+    info=$("$PDT" trace info "$TMP/killed")
+    ev=$(echo "$info" | awk '$1 == "0" && NF >= 5 {print $2; exit}')
+    if [[ "$info" == *"warning: rank-0000.trace: "*"run killed?"* || "$info" == *"warning: rank-0000.trace: block"* ]] &&
+        [ "${ev:-0}" -gt 4000 ]; then ok killed_run_readable; else fail killed_run_readable "$info"; fi
+    out=$("$PDT" trace check "$TMP/killed" 2>&1); rc=$?
+    [[ $rc -eq 1 && "$out" == *"damaged run folder"* ]] && ok killed_run_fails_check ||
+        fail killed_run_fails_check "rc=$rc $out"
+else
+    wait "$pid"
+    echo "ok - killed_run_readable # skip: the run finished before it could be killed"
+fi
+rm -f "$TMP/big.txt" "$TMP/big.tri"
+
 # ---- the documented Python reader agrees with pdt trace dump ------------------------
 awk '/^```python/ {f = 1; next} /^```/ {f = 0} f' "$ROOT/docs/trace-format.md" >"$TMP/reader.py"
 python3 "$TMP/reader.py" "$TMP/grid2/rank-0000.trace" | awk '{print $1}' >"$TMP/py.kinds"
