@@ -598,7 +598,7 @@ static void draw_hulls_and_stacks(ctx *c, uint32_t *buf, size_t cap)
 static void draw_points(ctx *c)
 {
     cairo_t *cr = c->cr;
-    double rad = fmax(1.2, fmin(0.28 * c->L.font, 0.18 * c->X.s * 10));
+    double rad = fmax(1.5, fmin(0.28 * c->L.font, c->spacing / 5));
     size_t nvis = 0;
     for (size_t p = 0; p < c->n; p++) {
         double x, y;
@@ -692,7 +692,7 @@ static void draw_merge(ctx *c)
                 hi.y = h.y > hi.y ? h.y : hi.y;
             }
             if (!have) continue;
-            double pad = 1.1 * c->L.font;
+            double pad = 1.6 * c->L.font;
             double x0 = c->X.ox + c->X.s * lo.x - pad, x1 = c->X.ox + c->X.s * hi.x + pad;
             double y0 = c->X.oy - c->X.s * hi.y - pad, y1 = c->X.oy - c->X.s * lo.y + pad;
             cairo_rectangle(c->cr, x0, y0, x1 - x0, y1 - y0);
@@ -705,8 +705,7 @@ static void draw_merge(ctx *c)
             char lab[64];
             snprintf(lab, sizeof lab, "%s", side ? "G_R" : "G_L");
             double tw = text_wb(c->cr, SANS, 1, 0.8 * c->L.font, lab);
-            text_at(c->cr, SANS, 1, 0.8 * c->L.font, side ? x1 - tw - 0.2 * c->L.font : x0 + 0.2 * c->L.font,
-                    y1 - 0.25 * c->L.font, lab);
+            text_at(c->cr, SANS, 1, 0.8 * c->L.font, side ? x1 - tw : x0, y0 - 0.3 * c->L.font, lab);
         }
         /* the border set B: points the merge rank lifted since the merge began */
         size_t from = mg->begin_ev, to = c->s->k;
