@@ -93,7 +93,7 @@ static int i192_sign(i192 a)
 }
 
 /* Exact incircle0 for arbitrary int32 input (stage 3). */
-static int incircle_exact192(int64_t adx, int64_t ady, int64_t bdx, int64_t bdy, int64_t cdx,
+static __attribute__((noinline)) int incircle_exact192(int64_t adx, int64_t ady, int64_t bdx, int64_t bdy, int64_t cdx,
                              int64_t cdy)
 {
     i128 al = (i128)adx * adx + (i128)ady * ady; /* < 2^65 */
@@ -107,7 +107,7 @@ static int incircle_exact192(int64_t adx, int64_t ady, int64_t bdx, int64_t bdy,
 }
 
 /* Exact incircle0 when every difference is < 2^30 in magnitude (stage 2). */
-static int incircle_exact128(int64_t adx, int64_t ady, int64_t bdx, int64_t bdy, int64_t cdx,
+static __attribute__((noinline)) int incircle_exact128(int64_t adx, int64_t ady, int64_t bdx, int64_t bdy, int64_t cdx,
                              int64_t cdy)
 {
     int64_t al = adx * adx + ady * ady; /* < 2^61 */
@@ -125,7 +125,8 @@ static inline int small30(int64_t v)
     return v > -(INT64_C(1) << 30) && v < (INT64_C(1) << 30);
 }
 
-int pdt_incircle0(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
+static inline __attribute__((always_inline)) int incircle(pdt_point a, pdt_point b, pdt_point c,
+                                                         pdt_point d)
 {
     int64_t adx = (int64_t)a.x - d.x, ady = (int64_t)a.y - d.y;
     int64_t bdx = (int64_t)b.x - d.x, bdy = (int64_t)b.y - d.y;
@@ -158,10 +159,15 @@ int pdt_incircle0(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
     return incircle_exact192(adx, ady, bdx, bdy, cdx, cdy);
 }
 
-int pdt_incircle_sos(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
+int pdt_incircle0(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
 {
-    int s = pdt_incircle0(a, b, c, d);
-    if (s != 0) return s;
+    return incircle(a, b, c, d);
+}
+
+/* The tie-breaking part, kept out of line: it runs only on exact zeros. */
+static __attribute__((noinline)) int incircle_ties(pdt_point a, pdt_point b, pdt_point c,
+                                                   pdt_point d)
+{
     /* H(eps) = incircle0 + d_a orient(b,c,d) - d_b orient(a,c,d) + d_c orient(a,b,d)
      *          - d_d orient(a,b,c), the lexicographically smallest point having
      * the largest perturbation: take the first non-zero cofactor in lex order. */
@@ -186,6 +192,12 @@ int pdt_incircle_sos(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
         if (cof != 0) return cof;
     }
     return 0;
+}
+
+int pdt_incircle_sos(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
+{
+    int s = incircle(a, b, c, d);
+    return s != 0 ? s : incircle_ties(a, b, c, d);
 }
 
 pdt_lifted pdt_lift(pdt_point p)
