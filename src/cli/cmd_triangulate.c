@@ -9,6 +9,7 @@
 #include "cli.h"
 #include "pdt/delaunay.h"
 #include "pdt/io.h"
+#include "pdt/par.h"
 #include "run_opts.h"
 
 static const char help[] =
@@ -164,6 +165,11 @@ int pdt_cmd_triangulate(int argc, char **argv)
     pdt_run_opts o;
     int rc = parse_options(argc, argv, &o);
     if (rc >= 0) return rc;
+    if (pdt_comm_launched()) { /* under mpirun / srun: the parallel driver (src/par) */
+        pdt_par_job pj = {o.input, o.output, o.scale, o.stats, o.trace_dir, o.trace_level,
+                          o.argc, o.argv};
+        return pdt_par_cmd_triangulate(NULL, NULL, &pj);
+    }
 
     pdt_tri_job job = { .t_start = pdt_cli_now() };
     pdt_err err = { PDT_OK, "" };

@@ -1,0 +1,84 @@
+#!/bin/bash
+# pdt triangulate under mpirun when things go wrong: a rank killed with
+# SIGKILL in the middle of the run, bad input, an output that would replace
+# the input.  Each time: non-zero exit, a message, no output file.
+# Also the quiet cases: empty and collinear input give 0 triangles and say so.
+# san: yes
+source "$(dirname "$0")/lib.sh"
+cd "$TMP"
+export OMPI_MCA_rmaps_base_oversubscribe=1
+# Open MPI's own allocations in MPI_Init/Finalize are suppressed in
+# tests/lsan.supp; those suppressions need full stacks and named plugins.
+export ASAN_OPTIONS="${ASAN_OPTIONS:-}:fast_unwind_on_malloc=0"
+export OMPI_MCA_mca_base_component_disable_dlclose=1 PMIX_MCA_mca_base_component_disable_dlclose=1
+if ! command -v mpirun > /dev/null; then fail mpirun_available "mpirun not found"; summary; exit; fi
+
+"$PDT" gen uniform 3000 --seed 3 -o u.txt
+
+# --- a rank dies: rank 1 sleeps before its merge step (test-only variable),
+# we kill exactly that process
+PDT_TEST_SLEEP_BEFORE_MERGE=1:60 timeout 120 mpirun -np 2 "$PDT" triangulate u.txt -o killed.tri \
+    > kill.out 2> kill.err &
+MPID=$!   # timeout, whose child is mpirun, whose children are the ranks
+victim=
+for _ in $(seq 1 100); do
+    for c in $(for m in $(pgrep -P "$MPID"); do pgrep -P "$m"; done 2> /dev/null); do
+        if tr '\0' '\n' < "/proc/$c/environ" 2> /dev/null | grep -qx 'OMPI_COMM_WORLD_RANK=1'; then
+            victim=$c
+        fi
+    done
+    [ -n "$victim" ] && break
+    sleep 0.1
+done
+if [ -z "$victim" ]; then
+    fail rank_killed_mid_run "could not find rank 1 of mpirun $MPID"
+    kill "$MPID" 2> /dev/null
+else
+    sleep 1   # let it reach the sleep before its merge
+    t0=$SECONDS
+    kill -KILL "$victim"
+    wait "$MPID"; rc=$?
+    left=$(ls -A | grep -c killed)
+    if [ $rc -ne 0 ] && [ $rc -ne 124 ] && [ "$left" -eq 0 ] && [ $((SECONDS - t0)) -lt 30 ]; then
+        ok rank_killed_mid_run
+    else
+        fail rank_killed_mid_run "rc=$rc files=$(ls -A | grep killed) after $((SECONDS - t0)) s"
+    fi
+fi
+wait 2> /dev/null
+
+# --- bad input: file:line message, exit 2, no output
+printf '0 0\n1 1\n2 x\n' > bad.txt
+mpirun -np 3 "$PDT" triangulate bad.txt -o bad.tri > /dev/null 2> bad.err; rc=$?
+if [ $rc -eq 2 ] && grep -q 'bad.txt:3' bad.err && [ ! -e bad.tri ]; then ok bad_input_exit_2
+else fail bad_input_exit_2 "rc=$rc $(cat bad.err)"; fi
+
+mpirun -np 2 "$PDT" triangulate missing.txt -o m.tri > /dev/null 2> m.err; rc=$?
+if [ $rc -eq 2 ] && grep -q 'missing.txt' m.err && [ ! -e m.tri ]; then ok missing_input_exit_2
+else fail missing_input_exit_2 "rc=$rc $(cat m.err)"; fi
+
+cp u.txt same.txt
+mpirun -np 2 "$PDT" triangulate same.txt -o same.txt > /dev/null 2> s.err; rc=$?
+if [ $rc -eq 2 ] && cmp -s u.txt same.txt && grep -q 'replace the input' s.err; then
+    ok output_would_replace_input
+else fail output_would_replace_input "rc=$rc $(cat s.err)"; fi
+
+# --- no triangles: exit 0, empty output, the reason on stderr
+: > empty.txt
+mpirun -np 3 "$PDT" triangulate empty.txt -o empty.tri > /dev/null 2> e.err; rc=$?
+if [ $rc -eq 0 ] && [ -e empty.tri ] && [ ! -s empty.tri ] && grep -q '0 triangles' e.err; then
+    ok empty_input_zero_triangles
+else fail empty_input_zero_triangles "rc=$rc $(cat e.err)"; fi
+seq 0 499 | awk '{print 3 * $1, 2 * $1 + 1}' > col.txt   # one line
+mpirun -np 4 "$PDT" triangulate col.txt -o col.tri --stats > /dev/null 2> c.err; rc=$?
+if [ $rc -eq 0 ] && [ ! -s col.tri ] && grep -q 'collinear' c.err && grep -q '"collinear": true' c.err; then
+    ok collinear_input_zero_triangles
+else fail collinear_input_zero_triangles "rc=$rc $(head -3 c.err)"; fi
+
+# --- a small run with --stats under the sanitizer build too
+"$PDT" gen clusters 1500 --seed 5 -o cl.txt
+"$PDT" triangulate cl.txt -o cl.ref
+mpirun -np 3 "$PDT" triangulate cl.txt -o cl.tri --stats > /dev/null 2> cl.err; rc=$?
+if [ $rc -eq 0 ] && cmp -s cl.ref cl.tri && grep -q '"per_rank"' cl.err; then ok stats_run_3_ranks
+else fail stats_run_3_ranks "rc=$rc $(head -5 cl.err)"; fi
+summary
