@@ -5,6 +5,9 @@
 missing=""
 for p in "$@"; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+        # A program of that name already on PATH counts as present (npm comes
+        # inside NodeSource's nodejs, which conflicts with Debian's npm).
+        case "$p" in npm|node|hyperfine) command -v "$p" >/dev/null 2>&1 && continue ;; esac
         missing="$missing $p"
     fi
 done
