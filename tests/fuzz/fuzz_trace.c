@@ -17,7 +17,8 @@
  *   - per rank: the decoded events, the cursor's walk and the rank info agree
  *     on the count; a cursor seek to k then next gives event k;
  *   - the merged order holds every event of every rank exactly once, each
- *     rank's events in their own order. */
+ *     rank's events in their own order;
+ *   - pdt_run_check gives a verdict (a failure carries a message). */
 #include "fuzz_common.h"
 #include "pdt/tracefile.h"
 
@@ -148,6 +149,11 @@ static void fz_exercise(pdt_run *run)
         next[rec[i].rank]++;
     }
     free(next);
+    /* the invariant checker: any verdict, but a message when it fails */
+    char summary[256];
+    pdt_err cerr = {0};
+    pdt_status cst = pdt_run_check(run, summary, sizeof summary, &cerr);
+    FZ_ASSERT(cst == PDT_OK || (cerr.code == cst && cerr.msg[0]));
     /* a second call returns the same array */
     const pdt_rec *rec2;
     size_t nrec2;
