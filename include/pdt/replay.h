@@ -66,6 +66,10 @@ typedef struct pdt_rtri_hist {
     uint8_t status;     /* pdt_tri_status after the event */
     uint8_t run;        /* TRI_NEW: 0 local kernel, 1 border kernel */
     int64_t v;          /* RA_DEFER: touched rank; SHIP: destination; DISCARD: witness */
+    uint32_t until;     /* TRI_NEW of a border kernel: the MERGE_END of its merge step.
+                         * A candidate still in this state after that event was
+                         * neither kept nor shipped: the merge dropped it without
+                         * an event (pdt_rstate_tri_visible).  Else UINT32_MAX. */
 } pdt_rtri_hist;
 
 /* A kernel edge (level 2) between its EDGE_ADD and EDGE_DEL. */
@@ -178,6 +182,14 @@ int pdt_rstate_equal(const pdt_replay *r, const pdt_rstate *a, const pdt_rstate 
 int32_t pdt_rstate_slot(const pdt_replay *r, const pdt_rstate *s, int rank, int slot);
 /* Status of triangle t in s. */
 pdt_tri_status pdt_rstate_tri_status(const pdt_replay *r, const pdt_rstate *s, size_t t);
+/* The history entry that decides how triangle t looks in s: its current
+ * entry, except that a border-kernel candidate dropped silently by its merge
+ * (pdt_rtri_hist.until passed) gives way to the entry before it (a final
+ * triangle recomputed by a border kernel stays final).  UINT32_MAX when the
+ * triangle does not exist (yet, or any more). */
+uint32_t pdt_rstate_tri_entry(const pdt_replay *r, const pdt_rstate *s, size_t t);
+/* pdt_rstate_tri_entry() != UINT32_MAX; discarded triangles count as visible. */
+int pdt_rstate_tri_visible(const pdt_replay *r, const pdt_rstate *s, size_t t);
 
 /* Searching the event list (for the controls).  Kinds of "selected event": */
 typedef enum pdt_ev_class {

@@ -25,7 +25,7 @@
 
 typedef struct opts {
     const char *run, *out, *frames, *phase, *script, *screenshot, *hide, *write_run;
-    int headless, end, every, w, h, have_at, quiet, bench;
+    int headless, end, every, w, h, have_at, quiet, bench, counts, check;
     size_t at;
     double speed;
 } opts;
@@ -39,6 +39,8 @@ static void usage(FILE *f)
             "               [--size WxH]\n"
             "       pdtview --headless RUN --frames DIR --every K [--size WxH]\n"
             "       pdtview --bench RUN [--size WxH]\n"
+            "       pdtview RUN [--at N|--phase NAME|--end] --counts   (triangles by status)\n"
+            "       pdtview RUN --check     (seek equals stepping, both ways, at every cursor)\n"
             "       pdtview --write-run DIR RUN\n"
             "RUN: a run folder, or synth:srm:COLS:ROWS:RANKS, synth:graham:N\n"
             "The cursor N counts events applied (0 = start, --end = all).\n"
@@ -76,6 +78,8 @@ static int parse_args(int argc, char **argv, opts *o)
     } while (0)
         if (!strcmp(a, "--headless")) o->headless = 1;
         else if (!strcmp(a, "--bench")) o->bench = 1;
+        else if (!strcmp(a, "--counts")) o->counts = 1;
+        else if (!strcmp(a, "--check")) o->check = 1;
         else if (!strcmp(a, "--write-run")) { NEED(); o->write_run = val; }
         else if (!strcmp(a, "--end")) o->end = 1;
         else if (!strcmp(a, "--quiet")) o->quiet = 1;
@@ -128,7 +132,7 @@ static int parse_args(int argc, char **argv, opts *o)
         fprintf(stderr, "pdtview: no run folder given\n");
         return 0;
     }
-    if (o->headless && !o->out && !o->frames && !o->bench) {
+    if (o->headless && !o->out && !o->frames && !o->bench && !o->counts) {
         fprintf(stderr, "pdtview: --headless needs -o FILE or --frames DIR\n");
         return 0;
     }
@@ -287,6 +291,55 @@ static int bench(const pdt_replay *r, pdt_rstate *s, const pdt_view *v, const op
     return 0;
 }
 
+/* Triangles by status at the cursor ("dropped": border-kernel candidates
+ * that their merge neither kept nor shipped). */
+static void counts(const pdt_replay *r, const pdt_rstate *s)
+{
+    size_t nt, c[PDT_TS_COUNT] = {0}, dropped = 0;
+    pdt_replay_tris(r, &nt);
+    const pdt_rtri_hist *H = pdt_replay_tri_hist(r);
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t h = pdt_rstate_tri_entry(r, s, t);
+        if (h != UINT32_MAX) c[H[h].status]++;
+        else if (pdt_rstate_tri_status(r, s, t) != PDT_TS_NONE) dropped++;
+    }
+    printf("cursor %zu of %zu: candidate %zu final %zu deferred %zu shipped %zu discarded %zu dropped %zu\n",
+           s->k, pdt_replay_count(r), c[PDT_TS_CANDIDATE], c[PDT_TS_FINAL], c[PDT_TS_DEFERRED],
+           c[PDT_TS_SHIPPED], c[PDT_TS_DISCARDED], dropped);
+}
+
+/* Seek(k) == stepping forwards from 0 == stepping backwards from the end. */
+static int check(const pdt_replay *r)
+{
+    size_t m = pdt_replay_count(r), bad = 0, stride = m > 20000 ? m / 20000 : 1;
+    pdt_rstate *a = pdt_rstate_new(r), *b = pdt_rstate_new(r);
+    if (!a || !b) {
+        pdt_rstate_free(a);
+        pdt_rstate_free(b);
+        fprintf(stderr, "pdtview: out of memory\n");
+        return 1;
+    }
+    for (size_t k = 0; k <= m; k++) {
+        if (k % stride == 0 || k == m) {
+            pdt_replay_seek(r, b, k);
+            bad += !pdt_rstate_equal(r, a, b);
+        }
+        pdt_replay_step(r, a, 1);
+    }
+    for (size_t k = m + 1; k-- > 0;) {
+        if (k % stride == 0) {
+            pdt_replay_seek(r, b, k);
+            bad += !pdt_rstate_equal(r, a, b);
+        }
+        pdt_replay_step(r, a, -1);
+    }
+    printf("check: %zu events, %zu cursors compared both ways, %zu differ\n", m,
+           2 * (m / stride + 1), bad);
+    pdt_rstate_free(a);
+    pdt_rstate_free(b);
+    return bad != 0;
+}
+
 /* Write the loaded events to a run folder through the trace writer, in
  * their merged order (so the reader's causal merge finds the same order). */
 static int write_run(const char *dir, const loaded *L, pdt_err *err)
@@ -375,7 +428,7 @@ int main(int argc, char **argv)
         }
     }
     /* where to start */
-    size_t k = o.headless ? pdt_replay_count(r) : 0;
+    size_t k = o.headless || o.counts ? pdt_replay_count(r) : 0;
     if (o.have_at) k = o.at;
     if (o.end) k = pdt_replay_count(r);
     if (o.phase) {
@@ -393,7 +446,12 @@ int main(int argc, char **argv)
     pdt_view v;
     pdt_view_defaults(&v);
     v.hidden = hidden;
-    if (o.bench) {
+    if (o.check) {
+        rc = check(r);
+    } else if (o.counts) {
+        counts(r, s);
+        rc = 0;
+    } else if (o.bench) {
         rc = bench(r, s, &v, &o);
     } else if (o.headless) {
         rc = headless(r, s, &v, &o, &err);

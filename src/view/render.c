@@ -375,7 +375,7 @@ static void draw_triangles(ctx *c)
         return;
     }
     for (size_t t = 0; t < nt; t++) {
-        uint32_t h = c->s->tcur[t];
+        uint32_t h = pdt_rstate_tri_entry(c->r, c->s, t);
         if (h == NONE32 || !shown(c, T[t].maker)) continue;
         start[(size_t)H[h].status * (size_t)c->nranks + T[t].maker + 1]++;
     }
@@ -388,7 +388,7 @@ static void draw_triangles(ctx *c)
     }
     memcpy(fill, start, (nb + 1) * sizeof *fill);
     for (size_t t = 0; t < nt; t++) {
-        uint32_t h = c->s->tcur[t];
+        uint32_t h = pdt_rstate_tri_entry(c->r, c->s, t);
         if (h == NONE32 || !shown(c, T[t].maker)) continue;
         order[fill[(size_t)H[h].status * (size_t)c->nranks + T[t].maker]++] = (uint32_t)t;
     }
@@ -412,7 +412,7 @@ static void draw_triangles(ctx *c)
             if (st == PDT_TS_DISCARDED) {
                 for (size_t i = start[b]; i < start[b + 1]; i++) {
                     uint32_t t = order[i];
-                    double age = (double)c->s->k - H[c->s->tcur[t]].ev;
+                    double age = (double)c->s->k - H[pdt_rstate_tri_entry(c->r, c->s, t)].ev;
                     double a = c->v->fade > 0 ? 1 - age / c->v->fade : 1;
                     if (a <= 0.02) continue;
                     status_style(cr, st, c->lw);
@@ -824,7 +824,9 @@ static void draw_selection(ctx *c)
             cairo_stroke(cr);
             snprintf(lines[nl++], sizeof lines[0], "triangle %u %u %u", t->v[0], t->v[1], t->v[2]);
             snprintf(lines[nl++], sizeof lines[0], "made by rank %u, now %s", t->maker,
-                     sn[pdt_rstate_tri_status(c->r, c->s, (size_t)c->v->sel_tri)]);
+                     pdt_rstate_tri_visible(c->r, c->s, (size_t)c->v->sel_tri)
+                         ? sn[pdt_replay_tri_hist(c->r)[pdt_rstate_tri_entry(c->r, c->s, (size_t)c->v->sel_tri)].status]
+                         : "dropped by its merge");
             double ox, oy, rr;
             if (circum(c->P, t->v, &ox, &oy, &rr))
                 snprintf(lines[nl++], sizeof lines[0], "circle centre (%.1f, %.1f) radius %.1f", ox,
@@ -1613,8 +1615,10 @@ void pdt_render_pick(const pdt_replay *r, const pdt_rstate *s, const pdt_view *v
     const pdt_rtri *T = pdt_replay_tris(r, &nt);
     int nr = pdt_replay_nranks(r);
     for (size_t t = 0; t < nt; t++) {
-        pdt_tri_status st = pdt_rstate_tri_status(r, s, t);
-        if (st == PDT_TS_NONE || st == PDT_TS_DISCARDED) continue;
+        uint32_t he = pdt_rstate_tri_entry(r, s, t);
+        if (he == UINT32_MAX) continue;
+        pdt_tri_status st = (pdt_tri_status)pdt_replay_tri_hist(r)[he].status;
+        if (st == PDT_TS_DISCARDED) continue;
         if (v->hidden && T[t].maker < (uint32_t)nr && v->hidden[T[t].maker]) continue;
         int pos = 0, neg = 0;
         for (int j = 0; j < 3; j++) {

@@ -473,7 +473,12 @@ static pdt_status build(pdt_replay *r, pdt_err *err)
         pdt_rtri *t = &r->tris[r->ev_obj[i]];
         uint32_t h = t->h0 + t->hn++;
         r->hist[h] = (pdt_rtri_hist){(uint32_t)i, r->recs[i].rank, tri_status_of(e->kind),
-                                     (uint8_t)e->sub, e->v};
+                                     (uint8_t)e->sub, e->v, NONE32};
+        if (e->kind == PDT_EV_TRI_NEW && e->sub == 1) /* border kernel: which merge step? */
+            for (size_t g = 0; g < r->nmerge; g++)
+                if (r->merges[g].rank == r->recs[i].rank && r->merges[g].begin_ev < i &&
+                    r->merges[g].end_ev != NONE32 && i < r->merges[g].end_ev)
+                    r->hist[h].until = r->merges[g].end_ev;
         r->ev_ent[i] = h;
     }
     /* Slot changes grouped by slot (counting sort keeps event order). */
@@ -775,6 +780,22 @@ pdt_tri_status pdt_rstate_tri_status(const pdt_replay *r, const pdt_rstate *s, s
 {
     if (t >= r->ntri || s->tcur[t] == NONE32) return PDT_TS_NONE;
     return (pdt_tri_status)r->hist[s->tcur[t]].status;
+}
+
+uint32_t pdt_rstate_tri_entry(const pdt_replay *r, const pdt_rstate *s, size_t t)
+{
+    if (t >= r->ntri || s->tcur[t] == NONE32) return NONE32;
+    uint32_t h = s->tcur[t];
+    while (r->hist[h].status == PDT_TS_CANDIDATE && r->hist[h].until < s->k) {
+        if (h == r->tris[t].h0) return NONE32;
+        h--;
+    }
+    return h;
+}
+
+int pdt_rstate_tri_visible(const pdt_replay *r, const pdt_rstate *s, size_t t)
+{
+    return pdt_rstate_tri_entry(r, s, t) != NONE32;
 }
 
 /* ---- searching --------------------------------------------------------------- */
