@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 
 /* ---- a small growable array ----------------------------------------------- */
 
@@ -41,12 +42,19 @@ static uint64_t mix(uint64_t hi, uint64_t lo)
     return h;
 }
 
-/* Room for at least `n` keys at load <= 1/2. */
+/* Room for at least `n` keys at load <= 1/2.  Big tables ask for huge pages:
+ * lookups are random, and TLB misses otherwise dominate. */
 static int km_alloc(keymap *km, size_t n)
 {
     size_t cap = 1024;
     while (cap < 2 * n) cap *= 2;
-    km->e = malloc(cap * sizeof *km->e);
+    size_t bytes = cap * sizeof *km->e;
+    if (bytes >= ((size_t)4 << 20)) {
+        km->e = aligned_alloc((size_t)2 << 20, bytes);
+        if (km->e) madvise(km->e, bytes, MADV_HUGEPAGE);
+    } else {
+        km->e = malloc(bytes);
+    }
     if (!km->e) return 0;
     for (size_t i = 0; i < cap; i++) km->e[i].val = INT32_MIN;
     km->cap = cap;
