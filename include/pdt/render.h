@@ -27,6 +27,7 @@ typedef struct pdt_view {
     int ev_class;         /* pdt_ev_class selected for Shift+arrows */
     int64_t sel_point;    /* point whose details are shown, or -1 */
     int64_t sel_tri;      /* triangle whose details are shown, or -1 */
+    int sel_edge;         /* 0..2: the edge v[e]-v[e+1] of sel_tri is selected, or -1 */
     const char *status;   /* short text for the status corner ("playing 8 ev/s"), or NULL */
 } pdt_view;
 
@@ -69,10 +70,12 @@ void pdt_view_zoom_at(const pdt_replay *r, pdt_view *v, double w, double h, doub
                       double f);
 
 /* What is under screen point (sx,sy): the nearest point within `radius`
- * pixels (*point, else -1), otherwise a triangle drawn in state s that
- * contains it (*tri, else -1). */
+ * pixels (*point, else -1); otherwise the nearest edge within radius/2 of a
+ * triangle drawn in state s (*tri and *edge = 0..2, the edge v[e]-v[e+1]);
+ * otherwise a drawn triangle that contains it (*tri, *edge = -1); else all -1. */
 void pdt_render_pick(const pdt_replay *r, const pdt_rstate *s, const pdt_view *v, double w,
-                     double h, double sx, double sy, double radius, int64_t *point, int64_t *tri);
+                     double h, double sx, double sy, double radius, int64_t *point, int64_t *tri,
+                     int *edge);
 
 /* Cursor for a click at x in the timeline rectangle, or (size_t)-1 when x,y is
  * not in it. */

@@ -74,6 +74,7 @@ void pdt_view_defaults(pdt_view *v)
     v->fade = 400;
     v->ev_class = PDT_EVC_STACK;
     v->sel_point = v->sel_tri = -1;
+    v->sel_edge = -1;
 }
 
 void pdt_render_layout(double w, double h, int nranks, pdt_layout *L)
@@ -792,7 +793,7 @@ static void draw_current(ctx *c, uint32_t *buf, size_t cap)
 static void draw_selection(ctx *c)
 {
     cairo_t *cr = c->cr;
-    char lines[4][160];
+    char lines[5][160];
     int nl = 0;
     if (c->v->sel_point >= 0 && (size_t)c->v->sel_point < c->n) {
         size_t p = (size_t)c->v->sel_point;
@@ -822,11 +823,26 @@ static void draw_selection(ctx *c)
             const pdt_rtri *t = &T[c->v->sel_tri];
             static const char *const sn[] = {"not created", "candidate", "final", "deferred",
                                              "shipped", "discarded"};
+            int e = c->v->sel_edge;
+            if (e >= 0 && e < 3) {
+                uint32_t a = t->v[e], b = t->v[(e + 1) % 3];
+                double x, y;
+                wpt(c, a, &x, &y);
+                cairo_move_to(cr, x, y);
+                wpt(c, b, &x, &y);
+                cairo_line_to(cr, x, y);
+                cairo_set_source_rgba(cr, 0.0, 0.3, 0.9, 0.9);
+                cairo_set_line_width(cr, 5);
+                cairo_stroke(cr);
+                double dx = (double)c->P[b].x - c->P[a].x, dy = (double)c->P[b].y - c->P[a].y;
+                snprintf(lines[nl++], sizeof lines[0], "edge %u–%u, length %.1f", a, b, sqrt(dx * dx + dy * dy));
+            }
             tri_path(c, t->v);
             cairo_set_source_rgba(cr, 0.0, 0.3, 0.9, 0.9);
             cairo_set_line_width(cr, 3);
             cairo_stroke(cr);
-            snprintf(lines[nl++], sizeof lines[0], "triangle %u %u %u", t->v[0], t->v[1], t->v[2]);
+            snprintf(lines[nl++], sizeof lines[0], "%s %u %u %u", e >= 0 ? "of triangle" : "triangle",
+                     t->v[0], t->v[1], t->v[2]);
             snprintf(lines[nl++], sizeof lines[0], "made by rank %u, now %s", t->maker,
                      pdt_rstate_tri_visible(c->r, c->s, (size_t)c->v->sel_tri)
                          ? sn[pdt_replay_tri_hist(c->r)[pdt_rstate_tri_entry(c->r, c->s, (size_t)c->v->sel_tri)].status]
@@ -1470,7 +1486,7 @@ static void draw_help(ctx *c, double w, double h)
         {"0", "show all ranks"},
         {"wheel", "zoom at the cursor"},
         {"drag", "pan (in the lifted view: rotate)"},
-        {"click", "details of a point or triangle; timeline: seek"},
+        {"click", "details of a point, edge or triangle; timeline: seek"},
         {"f", "fit the points in the window"},
         {"h  ?", "this help"},
         {"s", "screenshot (PNG)"},
@@ -1599,9 +1615,11 @@ pdt_status pdt_render_file(const char *path, int w, int h, const pdt_replay *r,
 /* ---- picking ----------------------------------------------------------------------------------- */
 
 void pdt_render_pick(const pdt_replay *r, const pdt_rstate *s, const pdt_view *v, double w,
-                     double h, double sx, double sy, double radius, int64_t *point, int64_t *tri)
+                     double h, double sx, double sy, double radius, int64_t *point, int64_t *tri,
+                     int *edge)
 {
     *point = *tri = -1;
+    *edge = -1;
     size_t n;
     const pdt_point *P = pdt_replay_points(r, &n);
     xform X = geo_xform(r, v, w, h);
@@ -1617,12 +1635,13 @@ void pdt_render_pick(const pdt_replay *r, const pdt_rstate *s, const pdt_view *v
     double wx = (sx - X.ox) / X.s, wy = (X.oy - sy) / X.s;
     size_t nt;
     const pdt_rtri *T = pdt_replay_tris(r, &nt);
+    const pdt_rtri_hist *H = pdt_replay_tri_hist(r);
     int nr = pdt_replay_nranks(r);
+    double best_e = radius * radius / 4;
+    int64_t inside = -1;
     for (size_t t = 0; t < nt; t++) {
         uint32_t he = pdt_rstate_tri_entry(r, s, t);
-        if (he == UINT32_MAX) continue;
-        pdt_tri_status st = (pdt_tri_status)pdt_replay_tri_hist(r)[he].status;
-        if (st == PDT_TS_DISCARDED) continue;
+        if (he == UINT32_MAX || H[he].status == PDT_TS_DISCARDED) continue;
         if (v->hidden && T[t].maker < (uint32_t)nr && v->hidden[T[t].maker]) continue;
         int pos = 0, neg = 0;
         for (int j = 0; j < 3; j++) {
@@ -1630,10 +1649,20 @@ void pdt_render_pick(const pdt_replay *r, const pdt_rstate *s, const pdt_view *v
             double o = ((double)b.x - a.x) * (wy - a.y) - ((double)b.y - a.y) * (wx - a.x);
             pos |= o > 0;
             neg |= o < 0;
+            /* distance on screen from the click to the segment a-b */
+            double ax = X.ox + X.s * a.x, ay = X.oy - X.s * a.y, bx = X.ox + X.s * b.x,
+                   by = X.oy - X.s * b.y;
+            double ex = bx - ax, ey = by - ay, l2 = ex * ex + ey * ey;
+            double u = l2 > 0 ? ((sx - ax) * ex + (sy - ay) * ey) / l2 : 0;
+            u = u < 0 ? 0 : u > 1 ? 1 : u;
+            double qx = ax + u * ex - sx, qy = ay + u * ey - sy;
+            if (qx * qx + qy * qy < best_e) {
+                best_e = qx * qx + qy * qy;
+                *tri = (int64_t)t;
+                *edge = j;
+            }
         }
-        if (!(pos && neg)) {
-            *tri = (int64_t)t;
-            if (st == PDT_TS_FINAL) return;
-        }
+        if (!(pos && neg) && (inside < 0 || H[he].status == PDT_TS_FINAL)) inside = (int64_t)t;
     }
+    if (*edge < 0) *tri = inside;
 }

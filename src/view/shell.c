@@ -150,7 +150,7 @@ static void click(shell *sh, double x, double y)
     pdt_render_layout(sh->tw, sh->th, sh->nranks, &L);
     if (x < L.geo.x || x > L.geo.x + L.geo.w || y < L.geo.y || y > L.geo.y + L.geo.h) return;
     pdt_render_pick(sh->r, sh->s, sh->v, sh->tw, sh->th, x, y, 0.8 * L.font, &sh->v->sel_point,
-                    &sh->v->sel_tri);
+                    &sh->v->sel_tri, &sh->v->sel_edge);
     sh->dirty = 1;
 }
 

@@ -294,7 +294,8 @@ TEST(pick_and_zoom)
     double x, y;
     pdt_view_to_screen(f.r, &f.v, W, H, f.syn.pts[5].x, f.syn.pts[5].y, &x, &y);
     int64_t p, t;
-    pdt_render_pick(f.r, f.s, &f.v, W, H, x + 2, y - 1, 10, &p, &t);
+    int e;
+    pdt_render_pick(f.r, f.s, &f.v, W, H, x + 2, y - 1, 10, &p, &t, &e);
     CHECK_MSG(p == 5, "picked %lld", (long long)p);
     /* zoom at a point keeps that point under the cursor */
     pdt_view_zoom_at(f.r, &f.v, W, H, x, y, 3.0);
@@ -303,8 +304,18 @@ TEST(pick_and_zoom)
     CHECK_MSG(fabs(x2 - x) < 0.01 && fabs(y2 - y) < 0.01, "moved to %.2f,%.2f from %.2f,%.2f", x2, y2, x, y);
     /* a click in the middle of a cell picks a triangle */
     pdt_view_to_screen(f.r, &f.v, W, H, 12, 10, &x, &y);
-    pdt_render_pick(f.r, f.s, &f.v, W, H, x, y, 2, &p, &t);
-    CHECK(p == -1 && t >= 0);
+    pdt_render_pick(f.r, f.s, &f.v, W, H, x, y, 2, &p, &t, &e);
+    CHECK(p == -1 && t >= 0 && e == -1);
+    /* a click on the middle of the edge (0,0)-(10,0) picks that edge */
+    pdt_view_to_screen(f.r, &f.v, W, H, 5, 0, &x, &y);
+    pdt_render_pick(f.r, f.s, &f.v, W, H, x, y + 1, 10, &p, &t, &e);
+    size_t nt;
+    const pdt_rtri *T = pdt_replay_tris(f.r, &nt);
+    CHECK_MSG(p == -1 && t >= 0 && e >= 0, "p %lld t %lld e %d", (long long)p, (long long)t, e);
+    if (t >= 0 && e >= 0) {
+        pdt_point a = f.syn.pts[T[t].v[e]], b = f.syn.pts[T[t].v[(e + 1) % 3]];
+        CHECK(a.y == 0 && b.y == 0 && a.x + b.x == 10);
+    }
     /* the timeline maps clicks to cursors */
     pdt_layout L;
     pdt_render_layout(W, H, 2, &L);
