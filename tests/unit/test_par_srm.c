@@ -15,6 +15,7 @@
 #include "../../src/par/srm.c"
 #include "../../src/par/touch.c"
 #include "pdt/delaunay.h"
+#include "pdt/gen.h"
 
 static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
 static uint64_t rnd(void)
@@ -225,9 +226,72 @@ TEST(srm_equals_sequential)
     printf("# %d simulated runs\n", runs);
 }
 
+/* The project's generators at larger sizes, against the sequential
+ * pipeline, with random cuts (empty strips included). */
+TEST(srm_gen_families)
+{
+    static const int ps[] = {2, 3, 5, 8, 13};
+    static const size_t ns[] = {600, 3000};
+    int runs = 0, bad = 0;
+    for (const char *const *k = pdt_gen_kinds(); *k; k++)
+        for (size_t ni = 0; ni < sizeof ns / sizeof *ns; ni++) {
+            pdt_point *pts = NULL;
+            pdt_err err;
+            pdt_err_clear(&err);
+            size_t n = ns[ni];
+            if (pdt_gen(*k, n, 11, &pts, &err) != PDT_OK) {
+                CHECK_MSG(0, "gen %s: %s", *k, err.msg);
+                continue;
+            }
+            pdt_tri *ref = NULL;
+            size_t nref = 0;
+            CHECK(pdt_triangulate(pts, n, &ref, &nref, NULL, NULL) == PDT_OK);
+            srm_rec *u = malloc((n + 1) * sizeof *u), *tmp = malloc((n + 1) * sizeof *tmp);
+            for (size_t i = 0; i < n; i++) u[i] = (srm_rec){pdt_key(pts[i]), (uint32_t)i, 0};
+            srm_radix_sort(u, tmp, n);
+            size_t m = srm_dedupe(u, n);
+            for (size_t pi = 0; pi < sizeof ps / sizeof *ps; pi++)
+                for (int rep = 0; rep < 2; rep++) {
+                    int p = ps[pi];
+                    size_t cut[65];
+                    cut[0] = 0;
+                    cut[p] = m;
+                    for (int r = 1; r < p; r++)
+                        cut[r] = rep == 0 ? m * (size_t)r / (size_t)p : (size_t)(rnd() % (m + 1));
+                    for (int a = 1; a < p; a++)
+                        for (int b = a + 1; b < p; b++)
+                            if (cut[b] < cut[a]) {
+                                size_t t = cut[a];
+                                cut[a] = cut[b];
+                                cut[b] = t;
+                            }
+                    pdt_tri *got = NULL;
+                    size_t ngot = 0;
+                    uint64_t bmax;
+                    pdt_status st = simulate(u, p, cut, &got, &ngot, &bmax);
+                    runs++;
+                    if (!(st == PDT_OK && ngot == nref &&
+                          (nref == 0 || memcmp(got, ref, nref * sizeof *ref) == 0))) {
+                        bad++;
+                        if (bad <= 5)
+                            printf("#   %s n=%zu p=%d rep=%d: %zu triangles, expected %zu\n", *k,
+                                   n, p, rep, ngot, nref);
+                    }
+                    free(got);
+                }
+            free(u);
+            free(tmp);
+            free(ref);
+            free(pts);
+        }
+    CHECK_MSG(bad == 0, "%d of %d simulated runs differ from pdt_triangulate", bad, runs);
+    printf("# %d simulated runs on the generators\n", runs);
+}
+
 int main(void)
 {
     RUN(srm_equals_sequential);
+    RUN(srm_gen_families);
     (void)cmp_tri;
     return test_summary();
 }
