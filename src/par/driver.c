@@ -132,9 +132,8 @@ static pdt_status partition(drv *d, const pdt_point *pts, uint64_t n, srm_rec **
     for (size_t i = 0; i < mine_n; i++) rec[i] = (srm_rec){pdt_key(mine[i]), (uint32_t)(lo + i), 0};
     free(mine);
     mine = NULL;
-    srm_radix_sort(rec, tmp, mine_n);
-
-    /* regular samples, allgathered: [count, S keys] per rank */
+    /* samples at a regular stride of the input order (no sort needed here),
+     * allgathered: [count, S keys] per rank */
     size_t S = (size_t)64 * (size_t)p;
     samp = calloc(S + 1, sizeof *samp);
     all = malloc((size_t)p * (S + 1) * sizeof *all);
@@ -154,9 +153,26 @@ static pdt_status partition(drv *d, const pdt_point *pts, uint64_t n, srm_rec **
     }
     srm_pick_splitters(all, ns, p, split);
 
-    /* records are sorted by key, so each destination gets one block */
+    /* destination of each record; a stable counting pass groups them by
+     * destination (input order, hence index order, kept within a group) */
     for (int q = 0; q < p; q++) cnt[q] = 0;
-    for (size_t i = 0; i < mine_n; i++) cnt[srm_dest_rank(split, p, rec[i].key)]++;
+    if (p > 1) {
+        for (size_t i = 0; i < mine_n; i++) {
+            rec[i].pad = (uint32_t)srm_dest_rank(split, p, rec[i].key);
+            cnt[rec[i].pad]++;
+        }
+        size_t off = 0;
+        for (int q = 0; q < p; q++) {
+            rcnt[q] = off; /* scratch: start of group q */
+            off += cnt[q];
+        }
+        for (size_t i = 0; i < mine_n; i++) tmp[rcnt[rec[i].pad]++] = rec[i];
+        srm_rec *t = rec;
+        rec = tmp;
+        tmp = t;
+    } else {
+        cnt[0] = mine_n;
+    }
     sc = malloc((size_t)p * sizeof *sc);
     rc = malloc((size_t)p * sizeof *rc);
     if (!sc || !rc) goto nomem;
@@ -184,9 +200,9 @@ static pdt_status partition(drv *d, const pdt_point *pts, uint64_t n, srm_rec **
     free(tmp);
     tmp = malloc((total + 1) * sizeof *tmp);
     if (!tmp) goto nomem;
-    /* blocks arrive in rank order and rank q's indices are all below rank
-     * q+1's, so a stable sort by key orders equal keys by index: the first
-     * copy is the smallest index */
+    /* blocks arrive in rank order, each in index order, and rank q's indices
+     * are all below rank q+1's, so a stable sort by key orders equal keys by
+     * index: the first copy is the smallest index */
     srm_radix_sort(got, tmp, total);
     *nrecv = total;
     *m = srm_dedupe(got, total);

@@ -63,6 +63,17 @@ if [ $rc -eq 2 ] && cmp -s u.txt same.txt && grep -q 'replace the input' s.err; 
     ok output_would_replace_input
 else fail output_would_replace_input "rc=$rc $(cat s.err)"; fi
 
+# --- rank 0 cannot write: non-zero exit, message, nothing left behind
+mpirun -np 2 "$PDT" triangulate u.txt -o nodir/out.tri > /dev/null 2> w.err; rc=$?
+if [ $rc -ne 0 ] && grep -q 'nodir/out.tri' w.err && [ ! -e nodir ]; then ok write_error_nonzero_exit
+else fail write_error_nonzero_exit "rc=$rc $(head -3 w.err)"; fi
+
+# --- standard input is read by rank 0
+"$PDT" triangulate u.txt -o u.ref
+mpirun -np 3 "$PDT" triangulate - -o u.stdin.tri < u.txt > /dev/null 2> in.err; rc=$?
+if [ $rc -eq 0 ] && cmp -s u.ref u.stdin.tri; then ok stdin_input
+else fail stdin_input "rc=$rc $(head -3 in.err)"; fi
+
 # --- no triangles: exit 0, empty output, the reason on stderr
 : > empty.txt
 mpirun -np 3 "$PDT" triangulate empty.txt -o empty.tri > /dev/null 2> e.err; rc=$?
