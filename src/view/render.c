@@ -331,7 +331,9 @@ static void cross(cairo_t *cr, double x, double y, double a)
 
 /* ---- the geometry --------------------------------------------------------------------- */
 
-static void draw_boxes(ctx *c, int cur_tri_ok, double ox, double oy, double rr)
+/* The strip boxes (labels = 0) or their labels (labels = 1, drawn last, on a
+ * white ground so that edges and hulls do not hide them). */
+static void draw_boxes(ctx *c, int cur_tri_ok, double ox, double oy, double rr, int labels)
 {
     cairo_t *cr = c->cr;
     int cur_rank = c->cur ? (int)c->cur->rank : -1;
@@ -342,24 +344,33 @@ static void draw_boxes(ctx *c, int cur_tri_ok, double ox, double oy, double rr)
         double y0 = c->X.oy - c->X.s * hi.y, y1 = c->X.oy - c->X.s * lo.y;
         double pad = 0.4 * c->L.font;
         int touched = cur_tri_ok && q != cur_rank && disk_touches_box(ox, oy, rr, lo, hi);
-        cairo_rectangle(cr, x0 - pad, y0 - pad, x1 - x0 + 2 * pad, y1 - y0 + 2 * pad);
-        { /* opaque tint (rank colour over white): much cheaper than alpha on big areas */
+        if (!labels) {
+            cairo_rectangle(cr, x0 - pad, y0 - pad, x1 - x0 + 2 * pad, y1 - y0 + 2 * pad);
+            /* opaque tint (rank colour over white): much cheaper than alpha on big areas */
             double col[3], a = touched ? 0.16 : 0.05;
             pdt_rank_rgb(q, col);
             cairo_set_source_rgb(cr, 1 - a + a * col[0], 1 - a + a * col[1], 1 - a + a * col[2]);
+            cairo_fill_preserve(cr);
+            set_rank(cr, q, touched ? 0.95 : 0.5);
+            double d[2] = {4, 3};
+            cairo_set_dash(cr, touched ? NULL : d, touched ? 0 : 2, 0);
+            cairo_set_line_width(cr, touched ? 2.5 * c->lw : 1);
+            cairo_stroke(cr);
+            cairo_set_dash(cr, NULL, 0, 0);
+            continue;
         }
-        cairo_fill_preserve(cr);
-        set_rank(cr, q, touched ? 0.95 : 0.5);
-        double d[2] = {4, 3};
-        cairo_set_dash(cr, touched ? NULL : d, touched ? 0 : 2, 0);
-        cairo_set_line_width(cr, touched ? 2.5 * c->lw : 1);
-        cairo_stroke(cr);
-        cairo_set_dash(cr, NULL, 0, 0);
         char lab[32];
+        double fs = 0.8 * c->L.font;
         snprintf(lab, sizeof lab, touched ? "rank %d (touched)" : "rank %d", q);
-        set_rank(cr, q, 1);
+        if (text_wb(cr, SANS, touched, fs, lab) > x1 - x0 + 2 * pad + 0.3 * c->L.font)
+            snprintf(lab, sizeof lab, touched ? "r%d!" : "r%d", q); /* narrow strips */
+        double tw = text_wb(cr, SANS, touched, fs, lab);
         double ly = q % 2 ? y1 + pad + 0.95 * c->L.font : y0 - pad - 0.25 * c->L.font;
-        text_at(cr, SANS, touched, 0.8 * c->L.font, x0 - pad, ly, lab);
+        cairo_rectangle(cr, x0 - pad - 0.1 * fs, ly - 0.85 * fs, tw + 0.2 * fs, 1.1 * fs);
+        cairo_set_source_rgba(cr, 1, 1, 1, 0.8);
+        cairo_fill(cr);
+        set_rank(cr, q, 1);
+        text_at(cr, SANS, touched, fs, x0 - pad, ly, lab);
     }
 }
 
@@ -883,13 +894,14 @@ static void draw_geometry(ctx *c)
         uint32_t v[3] = {c->cur->ev.a, c->cur->ev.b, c->cur->ev.c};
         cur_tri = circum(c->P, v, &ox, &oy, &rr);
     }
-    draw_boxes(c, cur_tri, ox, oy, rr);
+    draw_boxes(c, cur_tri, ox, oy, rr, 0);
     draw_kernel_edges(c);
     draw_triangles(c);
     if (buf) draw_hulls_and_stacks(c, buf, 2 * cap);
     draw_merge(c);
     draw_points(c);
     if (buf) draw_current(c, buf, 2 * cap);
+    draw_boxes(c, cur_tri, ox, oy, rr, 1);
     draw_selection(c);
     free(buf);
     cairo_restore(cr);
