@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include "cli.h"
@@ -25,6 +26,14 @@ int pdt_cli_fail(const pdt_err *err)
 {
     fprintf(stderr, "pdt: %s\n", err->msg[0] ? err->msg : pdt_status_str(err->code));
     return err->code == PDT_ERR_CHECK ? PDT_EXIT_CHECK : PDT_EXIT_USAGE;
+}
+
+int pdt_cli_same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    if (!a || !b || strcmp(a, "-") == 0 || strcmp(b, "-") == 0) return 0;
+    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
+           sa.st_ino == sb.st_ino;
 }
 
 double pdt_cli_now(void)

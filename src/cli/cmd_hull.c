@@ -90,6 +90,9 @@ int pdt_cmd_hull(int argc, char **argv)
     }
     if (st == PDT_OK) st = compute(&o, pts, n, hull, &nh, &err);
     t2 = pdt_cli_now();
+    if (st == PDT_OK && pdt_cli_same_file(o.output, o.input))
+        st = pdt_err_set(&err, PDT_ERR_ARG, "%s: output would replace the input; choose another "
+                         "-o name", o.output);
     if (st == PDT_OK) st = write_hull(o.output, hull, nh, &err);
     t3 = pdt_cli_now();
 

@@ -87,14 +87,6 @@ pdt_status pdt_tri_job_compute(const pdt_run_opts *o, pdt_tri_job *j, pdt_err *e
     return st != PDT_OK ? st : cst;
 }
 
-/* 1 if paths a and b name the same existing file. */
-static int same_file(const char *a, const char *b)
-{
-    struct stat sa, sb;
-    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
-           sa.st_ino == sb.st_ino;
-}
-
 pdt_status pdt_tri_job_write(const pdt_run_opts *o, pdt_tri_job *j, pdt_err *err)
 {
     double t0 = pdt_cli_now();
@@ -106,14 +98,14 @@ pdt_status pdt_tri_job_write(const pdt_run_opts *o, pdt_tri_job *j, pdt_err *err
         if (!node) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
         memcpy(node, o->output, len - 4);
         memcpy(node + len - 4, ".node", 6);
-        int clash = strcmp(o->input, "-") != 0 && same_file(node, o->input);
+        int clash = strcmp(o->input, "-") != 0 && pdt_cli_same_file(node, o->input);
         pdt_status st = clash ? pdt_err_set(err, PDT_ERR_ARG, "%s: writing %s would replace "
                                             "the input %s; choose another -o name",
                                             o->output, node, o->input)
                               : PDT_OK;
         free(node);
         if (st != PDT_OK) return st;
-    } else if (o->output && strcmp(o->input, "-") != 0 && same_file(o->output, o->input)) {
+    } else if (o->output && strcmp(o->input, "-") != 0 && pdt_cli_same_file(o->output, o->input)) {
         return pdt_err_set(err, PDT_ERR_ARG, "%s: output would replace the input; choose "
                            "another -o name", o->output);
     }

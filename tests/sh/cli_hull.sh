@@ -28,6 +28,10 @@ printf '0 0\n4 zero\n' > bad.txt
 "$PDT" hull bad.txt -o bad.hull 2> bad.err; rc=$?
 [ $rc -eq 2 ] && grep -q "bad.txt:2: 'zero' is not a number" bad.err && [ ! -e bad.hull ] \
     && ok bad_input || fail bad_input "rc=$rc $(cat bad.err)"
+cp tri.txt self.txt
+"$PDT" hull self.txt -o self.txt 2> self.err; rc=$?
+[ $rc -eq 2 ] && cmp -s self.txt tri.txt && grep -q 'would replace the input' self.err \
+    && ok output_would_replace_input || fail output_would_replace_input "rc=$rc"
 "$PDT" hull --help | grep -q '^usage: pdt hull INPUT' && ok help || fail help
 "$PDT" hull 2> /dev/null; [ $? -eq 2 ] && ok usage_no_input || fail usage_no_input
 summary
