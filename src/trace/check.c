@@ -65,7 +65,7 @@ typedef struct chk {
     merge *mg;
     size_t nmg, capmg;
     u32vec graham_final;    /* last finished Graham stack of rank 0 */
-    uint64_t events, pushes, pops, instances, lifts_local, lifts_merge, sorts;
+    uint64_t events, pushes, pops, instances, lifts_local, lifts_merge, sorts, hulls;
 } chk;
 
 enum { M_SORTED = 1, M_DELETED = 2, M_PUSHED = 4, M_LIFTED = 8, M_REP = 16 };
@@ -115,6 +115,7 @@ typedef struct rank_state {
     u32vec phases;          /* open phases: (phase << 32 would not fit) ids */
     u32vec phase_seq_lo;    /* low 32 bits of the event index of each open phase */
     long open_merge;        /* index into c->mg, or -1 */
+    int last_stack;         /* stack id of the latest push or pop, or -1 */
 } rank_state;
 
 static void rank_state_free(rank_state *s)
@@ -164,6 +165,7 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
         }
         if (u32_push(s, e->a)) return nomem(c);
         c->pushes++;
+        rs->last_stack = e->sub;
         if (e->sub == PDT_STACK_GRAHAM) c->mark[e->a] |= M_PUSHED;
         break;
     }
@@ -178,6 +180,7 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
             return viol(c, r, seq, e, "depth after pop should be %zu", s->n - 1);
         s->n--;
         c->pops++;
+        rs->last_stack = e->sub;
         break;
     }
     case PDT_EV_LIFT: {
@@ -223,6 +226,23 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
         for (int i = 0; i < 3; i++) f->t.v[i] = v[(k + i) % 3];
         f->rank = r;
         f->seq = seq;
+        break;
+    }
+    case PDT_EV_HULL: {
+        /* after a monotone chain (lower stack, then upper stack): the hull is
+         * the lower chain plus the upper chain without its two ends */
+        int up = rs->last_stack;
+        rs->last_stack = -1;
+        if (e->b || (up != PDT_STACK_UPPER && up != PDT_STACK_MERGE_UPPER)) break;
+        const u32vec *lo = &rs->stack[up - 1], *hi = &rs->stack[up];
+        if (lo->n < 2 || hi->n < 2 || lo->v[0] != hi->v[hi->n - 1] ||
+            lo->v[lo->n - 1] != hi->v[0])
+            return viol(c, r, seq, e, "the %s and %s stacks do not form a closed chain",
+                        pdt_stack_name(up - 1), pdt_stack_name(up));
+        if (e->a != lo->n + hi->n - 2)
+            return viol(c, r, seq, e, "the %s and %s stacks hold %zu hull vertices",
+                        pdt_stack_name(up - 1), pdt_stack_name(up), lo->n + hi->n - 2);
+        c->hulls++;
         break;
     }
     case PDT_EV_DISCARD:
@@ -285,6 +305,7 @@ static pdt_status check_rank(chk *c, uint32_t r)
     pdt_cursor *cur = NULL;
     if (!rs) return nomem(c);
     rs->open_merge = -1;
+    rs->last_stack = -1;
     pdt_status st = pdt_cursor_open(c->run, (int)r, &cur, c->err);
     pdt_event e;
     uint64_t seq;
@@ -501,10 +522,10 @@ pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
     if (st == PDT_OK && cap)
         snprintf(summary, cap,
                  "%d rank%s, %" PRIu64 " events: %" PRIu64 " stack instances (%" PRIu64
-                 " pushes, %" PRIu64 " pops), %" PRIu64 " local + %" PRIu64
+                 " pushes, %" PRIu64 " pops, %" PRIu64 " chain hulls), %" PRIu64 " local + %" PRIu64
                  " merge lift-ups, %zu final triangles%s, %zu merge steps, %zu messages",
                  pdt_run_nranks(run), pdt_run_nranks(run) == 1 ? "" : "s", c.events, c.instances,
-                 c.pushes, c.pops, c.lifts_local, c.lifts_merge, c.nfin,
+                 c.pushes, c.pops, c.hulls, c.lifts_local, c.lifts_merge, c.nfin,
                  c.is_tri ? " = T*" : "", c.nmg, c.nmsg / 2);
     free(c.mark);
     free(c.fin);

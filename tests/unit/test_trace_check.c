@@ -316,6 +316,36 @@ TEST(messages_and_merges)
     expect_fail(sub("msg-noend"), "never ends");
 }
 
+/* A monotone chain (lower stack 0 1 2, upper stack 2 ... 0) followed by its
+ * HULL event: the count must be lower + upper - 2. */
+static void chain_run(const char *dir, uint32_t hull_count)
+{
+    static const pdt_point pts[4] = {{0, 0}, {2, -1}, {4, 0}, {2, 3}};
+    pdt_trace_writer *w;
+    pdt_err err = {0};
+    CHECK(pdt_tw_open(dir, 0, 1, &w, &err) == PDT_OK);
+    pdt_trace *t = pdt_tw_hook(w);
+    PDT_TRACE(t, 1, PDT_EV_PUSH, PDT_STACK_LOWER, 0, 1, 0, 0);
+    PDT_TRACE(t, 1, PDT_EV_PUSH, PDT_STACK_LOWER, 1, 2, 0, 0);
+    PDT_TRACE(t, 1, PDT_EV_PUSH, PDT_STACK_LOWER, 2, 3, 0, 0);
+    PDT_TRACE(t, 1, PDT_EV_PUSH, PDT_STACK_UPPER, 2, 1, 0, 0);
+    PDT_TRACE(t, 1, PDT_EV_PUSH, PDT_STACK_UPPER, 3, 2, 0, 0);
+    PDT_TRACE(t, 1, PDT_EV_PUSH, PDT_STACK_UPPER, 0, 3, 0, 0);
+    PDT_TRACE(t, 1, PDT_EV_HULL, 0, hull_count, 0, 0, 0);
+    CHECK(pdt_tw_close(w, &err) == PDT_OK);
+    meta(dir, "chain-test", pts, 4, 1);
+}
+
+TEST(chain_hull_counts)
+{
+    char msg[1100];
+    chain_run(sub("chain-ok"), 4);
+    CHECK_MSG(check_dir(sub("chain-ok"), msg, sizeof msg) == PDT_OK, "%s", msg);
+    CHECK_MSG(strstr(msg, "1 chain hulls") != NULL, "%s", msg);
+    chain_run(sub("chain-bad"), 5);
+    expect_fail(sub("chain-bad"), "(hull vertices=5): the lower and upper stacks hold 4 hull vertices");
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "%s/pdt-ttc.XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -325,6 +355,7 @@ int main(void)
     RUN(edited_events_are_named);
     RUN(damaged_files_fail);
     RUN(messages_and_merges);
+    RUN(chain_hull_counts);
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
     if (system(cmd) != 0) return 1;
