@@ -72,11 +72,10 @@ static inline uint64_t srm_key(srm_pt p)
 
 /* ---- touch.c: the restricted-area tests (§3.4) ------------------------- */
 
-/* Sound over-approximation of the closed circumdisk of the CCW triangle
- * (a, b, c): on return the disk is certainly inside the axis box
- * [*x0, *x1] x [*y0, *y1] and "might touch" a box exactly when
- * srm_disk_touch says so.  Deterministic: the answer depends only on the
- * three points as a set. */
+/* The closed circumdisk of a triangle, as touch.c computes it: centre and a
+ * radius enlarged by a bound on every rounding error, so that "misses" is
+ * only ever said of a box the exact disk misses (sound).  Deterministic: the
+ * result depends only on the three points as a set. */
 typedef struct srm_disk {
     double ox, oy;   /* centre, relative to (ax, ay) */
     double r;        /* radius, already enlarged by the error bound */
@@ -84,10 +83,12 @@ typedef struct srm_disk {
     int all;         /* 1: could not bound (degenerate): touches everything */
 } srm_disk;
 
+/* The disk of the triangle (a, b, c) (any orientation, not collinear). */
 void srm_disk_of(srm_disk *d, srm_pt a, srm_pt b, srm_pt c);
-/* 0 only if the closed disk certainly misses the closed box. */
+/* 0 only if the closed disk certainly misses the closed box; an empty
+ * strip (count 0) has no box and is never touched. */
 int srm_disk_touch(const srm_disk *d, const srm_strip *box);
-/* x-range of the (enlarged) disk. */
+/* An x-range certainly containing the disk (for a search by x). */
 void srm_disk_xrange(const srm_disk *d, double *lo, double *hi);
 
 /* Exact: 1 if the closed half-plane right of u->v (the restricted area of
@@ -142,14 +143,16 @@ int srm_pair(int r, int p, int level, int *gl, int *gr, int *ge);
 int srm_holder(int r, int p, int level);
 
 /* Message from this rank to the merge rank of `level`: its pending
- * triangles waiting for that level (removed here), and its hull if it holds
- * the hull of G_L or G_R.  *buf malloc'd.  cp = sender's critical path. */
+ * triangles waiting for that level (removed here), its hull if it holds the
+ * hull of G_L or G_R, and its critical path so far.  *buf malloc'd (caller
+ * frees).  Every rank of the pair sends one, possibly empty. */
 pdt_status srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err);
 
 /* At the merge rank: merge the messages of every rank of the pair
  * (msg[i] from rank gl + i, i = 0 .. ge-gl-1, including this rank's own).
  * Shipped sets, border set, lift-up, kernel (run 1), selection, discards,
- * hull merge, reclassification. `cp_in` = max critical path of the senders. */
+ * hull merge, reclassification.  The critical path continues from the
+ * longest one among the senders (carried in the messages). */
 pdt_status srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len,
                      pdt_err *err);
 
