@@ -19,11 +19,46 @@
 
 #define MSG_MAGIC 0x4d525350u /* "PSRM" */
 
-/* Message header (native byte order: a homogeneous cluster is assumed). */
+/* Message: this header (native byte order: a homogeneous cluster is
+ * assumed) and `payload` bytes of LEB128 varints: the point table in
+ * increasing gid order (gid delta, zigzag x, zigzag y), then the triangles and
+ * the hull as positions in that table.  About 8 bytes per point and 5 per
+ * triangle for coordinates below 2^20, instead of 12 and 12. */
 typedef struct msg_head {
-    uint32_t magic, level, npts, ntri, nhull, flags;
+    uint32_t magic, level, npts, ntri, nhull, flags, payload, reserved;
     double cp;
 } msg_head;
+
+static size_t put_varint(unsigned char *b, uint64_t v)
+{
+    size_t n = 0;
+    while (v >= 0x80) {
+        b[n++] = (unsigned char)(v | 0x80);
+        v >>= 7;
+    }
+    b[n++] = (unsigned char)v;
+    return n;
+}
+
+static uint64_t zigzag(int64_t v)
+{
+    return ((uint64_t)v << 1) ^ (uint64_t)(v >> 63);
+}
+
+/* Read one varint at *p (< end); 0 on a truncated or over-long one. */
+static int get_varint(const unsigned char **p, const unsigned char *end, uint64_t *v)
+{
+    uint64_t r = 0;
+    for (int shift = 0; shift < 64 && *p < end; shift += 7) {
+        unsigned char c = *(*p)++;
+        r |= (uint64_t)(c & 0x7f) << shift;
+        if (!(c & 0x80)) {
+            *v = r;
+            return 1;
+        }
+    }
+    return 0;
+}
 enum { MSG_HAS_HULL = 1, MSG_HULL_DEGENERATE = 2 };
 
 /* ---- small helpers ------------------------------------------------------- */
@@ -268,50 +303,70 @@ pdt_status srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *er
         if (u == 0 || tab[i].gid != tab[u - 1].gid) tab[u++] = tab[i];
     np = u;
 
-    size_t bytes = sizeof(msg_head) + np * sizeof(srm_pt) + (3 * nt + nh) * sizeof(uint32_t);
+    size_t bytes = sizeof(msg_head) + np * 15 + (3 * nt + nh) * 5;
     unsigned char *b = malloc(bytes);
     if (!b) {
         free(tab);
         return nomem(err, s->rank, "pack");
     }
-    msg_head hd = {MSG_MAGIC, (uint32_t)level, (uint32_t)np, (uint32_t)nt, (uint32_t)nh,
-                   (send_hull ? MSG_HAS_HULL : 0u) |
-                       (send_hull && s->hull_degenerate ? MSG_HULL_DEGENERATE : 0u),
-                   s->cnt.critical_path};
-    memcpy(b, &hd, sizeof hd);
-    memcpy(b + sizeof hd, tab, np * sizeof(srm_pt));
-    uint32_t *pos = (uint32_t *)(void *)(b + sizeof hd + np * sizeof(srm_pt));
-    size_t k = 0, keep = 0;
+    unsigned char *w = b + sizeof(msg_head);
+    uint32_t prev = 0;
+    for (size_t i = 0; i < np; i++) {
+        w += put_varint(w, tab[i].gid - prev);
+        prev = tab[i].gid;
+        w += put_varint(w, zigzag(tab[i].x));
+        w += put_varint(w, zigzag(tab[i].y));
+    }
+    size_t keep = 0;
     for (size_t i = 0; i < s->npend; i++) {
         srm_tri *t = &s->pend[i];
         if (t->level != level) {
             s->pend[keep++] = *t;
             continue;
         }
-        for (int j = 0; j < 3; j++) pos[k++] = find_gid(tab, np, t->p[j].gid);
+        for (int j = 0; j < 3; j++) w += put_varint(w, find_gid(tab, np, t->p[j].gid));
         PDT_TRACE(s->tr, 1, PDT_EV_SHIP, 0, t->p[0].gid, t->p[1].gid, t->p[2].gid,
                   (int64_t)((s->rank >> (level + 1) << (level + 1)) + (1 << level)));
     }
     s->npend = keep;
     s->cnt.shipped += nt;
-    for (size_t i = 0; i < nh; i++) pos[k++] = find_gid(tab, np, s->hull[i].gid);
+    for (size_t i = 0; i < nh; i++) w += put_varint(w, find_gid(tab, np, s->hull[i].gid));
+    msg_head hd = {MSG_MAGIC,
+                   (uint32_t)level,
+                   (uint32_t)np,
+                   (uint32_t)nt,
+                   (uint32_t)nh,
+                   (send_hull ? MSG_HAS_HULL : 0u) |
+                       (send_hull && s->hull_degenerate ? MSG_HULL_DEGENERATE : 0u),
+                   (uint32_t)(w - b - sizeof(msg_head)),
+                   0,
+                   s->cnt.critical_path};
+    memcpy(b, &hd, sizeof hd);
     if (send_hull) {
         s->holds_hull = 0;
         s->nhull = 0;
     }
     free(tab);
     *buf = b;
-    *len = bytes;
+    *len = (size_t)(w - b);
     return PDT_OK;
 }
 
-/* A decoded message (pointers into the buffer). */
+/* A decoded message (arrays owned: msg_view_free). */
 typedef struct msg_view {
     msg_head h;
-    const srm_pt *pts;
-    const uint32_t *tri; /* 3 * ntri positions */
-    const uint32_t *hull;
+    srm_pt *pts;
+    uint32_t *tri;  /* 3 * ntri positions, then nhull positions */
+    uint32_t *hull;
 } msg_view;
+
+static void msg_view_free(msg_view *v)
+{
+    free(v->pts);
+    free(v->tri);
+    v->pts = NULL;
+    v->tri = v->hull = NULL;
+}
 
 static pdt_status decode(const void *buf, size_t len, int level, int from, msg_view *v,
                          pdt_err *err)
@@ -320,22 +375,40 @@ static pdt_status decode(const void *buf, size_t len, int level, int from, msg_v
         return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: too short", from);
     memcpy(&v->h, buf, sizeof v->h);
     const msg_head *h = &v->h;
-    if (h->magic != MSG_MAGIC || h->level != (uint32_t)level)
+    if (h->magic != MSG_MAGIC || h->level != (uint32_t)level ||
+        (size_t)h->payload != len - sizeof(msg_head))
         return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: bad header", from);
-    size_t need = sizeof(msg_head) + (size_t)h->npts * sizeof(srm_pt) +
-                  (3 * (size_t)h->ntri + h->nhull) * sizeof(uint32_t);
-    if (need != len)
-        return pdt_err_set(err, PDT_ERR_CORRUPT,
-                           "merge message from rank %d: %zu bytes, expected %zu", from, len, need);
-    const unsigned char *b = buf;
-    v->pts = (const srm_pt *)(const void *)(b + sizeof(msg_head));
-    v->tri = (const uint32_t *)(const void *)(b + sizeof(msg_head) + h->npts * sizeof(srm_pt));
+    size_t ni = 3 * (size_t)h->ntri + h->nhull;
+    if (h->npts > h->payload || ni > h->payload)
+        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: bad counts", from);
+    v->pts = malloc(((size_t)h->npts + 1) * sizeof *v->pts);
+    v->tri = malloc((ni + 1) * sizeof *v->tri);
+    if (!v->pts || !v->tri) {
+        msg_view_free(v);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "merge message from rank %d: out of memory",
+                           from);
+    }
     v->hull = v->tri + 3 * (size_t)h->ntri;
-    for (size_t i = 0; i < 3 * (size_t)h->ntri + h->nhull; i++)
-        if (v->tri[i] >= h->npts)
-            return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: bad index",
-                               from);
+    const unsigned char *p = (const unsigned char *)buf + sizeof(msg_head), *end = p + h->payload;
+    uint64_t gid = 0, a, x, y;
+    for (size_t i = 0; i < h->npts; i++) {
+        if (!get_varint(&p, end, &a) || !get_varint(&p, end, &x) || !get_varint(&p, end, &y))
+            goto bad;
+        gid += a;
+        int64_t sx = (int64_t)(x >> 1) ^ -(int64_t)(x & 1), sy = (int64_t)(y >> 1) ^ -(int64_t)(y & 1);
+        if (gid > UINT32_MAX || sx < INT32_MIN || sx > INT32_MAX || sy < INT32_MIN || sy > INT32_MAX)
+            goto bad;
+        v->pts[i] = (srm_pt){(int32_t)sx, (int32_t)sy, (uint32_t)gid};
+    }
+    for (size_t i = 0; i < ni; i++) {
+        if (!get_varint(&p, end, &a) || a >= h->npts) goto bad;
+        v->tri[i] = (uint32_t)a;
+    }
+    if (p != end) goto bad;
     return PDT_OK;
+bad:
+    msg_view_free(v);
+    return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: damaged payload", from);
 }
 
 /* ---- the merge step ------------------------------------------------------------ */
@@ -625,6 +698,7 @@ pdt_status srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len
     s->cnt.critical_path = cp_in + (now(s) - t0);
 
 done:
+    for (int i = 0; i < nm; i++) msg_view_free(&mv[i]);
     free(mv);
     free(shipped);
     free(tb);
