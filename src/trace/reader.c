@@ -650,9 +650,13 @@ typedef struct merge_ctx {
     uint8_t *blocked;    /* ranks whose head is a RECV waiting for its SEND */
     size_t nblocked;
     msg_set *sent;       /* sends not yet received */
+    msg_set *unsent;     /* sends not yet placed (all SENDs of the run at the start) */
 } merge_ctx;
 
-/* Put rank r's head event into the heap, or mark it blocked. */
+/* Put rank r's head event into the heap, or mark it blocked.  A RECV waits
+ * only for a SEND that is still to come: one whose SEND is in no file (a
+ * lost or damaged rank file) is placed by its time at once, so it cannot
+ * hold up, or be forced ahead of, messages that are all there. */
 static void schedule(merge_ctx *mc, uint32_t r)
 {
     if (mc->pos[r] >= mc->run->rk[r].nev) return;
@@ -660,7 +664,8 @@ static void schedule(merge_ctx *mc, uint32_t r)
     if (e->kind == PDT_EV_RECV) {
         msg_key key = ev_key(e, r);
         msg_slot *s = msg_find(mc->sent, &key, 0);
-        if (!s || s->count == 0) {
+        msg_slot *u = msg_find(mc->unsent, &key, 0);
+        if ((!s || s->count == 0) && u && u->count > 0) {
             mc->blocked[r] = 1;
             mc->nblocked++;
             return;
@@ -691,13 +696,25 @@ pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err
     size_t *pos = calloc(R, sizeof *pos);
     heap h = {malloc(R * sizeof(uint32_t)), 0};
     uint8_t *blocked = calloc(R, 1);
-    msg_set sent = {0};
+    msg_set sent = {0}, unsent = {0};
     pdt_status st = PDT_OK;
     if (!out || !pos || !h.r || !blocked) {
         st = pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
         goto done;
     }
-    merge_ctx mc = {run, pos, &h, blocked, 0, &sent};
+    for (uint32_t r = 0; r < R; r++)
+        for (size_t i = 0; i < run->rk[r].nev; i++) {
+            const pdt_event *e = &run->rk[r].ev[i];
+            if (e->kind != PDT_EV_SEND) continue;
+            msg_key key = ev_key(e, r);
+            msg_slot *u = msg_find(&unsent, &key, 1);
+            if (!u) {
+                st = pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+                goto done;
+            }
+            u->count++;
+        }
+    merge_ctx mc = {run, pos, &h, blocked, 0, &sent, &unsent};
     size_t k = 0;
     for (uint32_t r = 0; r < R; r++) schedule(&mc, r);
     while (k < total) {
@@ -710,9 +727,6 @@ pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err
                 if (blocked[q] && (r == UINT32_MAX || head_less(run, pos, q, r))) r = q;
             blocked[r] = 0;
             mc.nblocked--;
-            const pdt_event *e = &run->rk[r].ev[pos[r]];
-            warnf(run, "rank %u event #%zu: recv from rank %u (tag %u, seq %" PRId64
-                       ") has no matching send", r, pos[r], e->a, e->sub, e->v);
         }
         const pdt_event *e = &run->rk[r].ev[pos[r]];
         out[k].ev = *e;
@@ -728,6 +742,8 @@ pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err
                 goto done;
             }
             s->count++;
+            msg_slot *u = msg_find(&unsent, &key, 0);
+            if (u && u->count) u->count--;
             if (mc.nblocked) {  /* wake the receiver waiting for this message */
                 uint32_t d = key.dst;
                 if (d < R && blocked[d]) {
@@ -743,6 +759,9 @@ pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err
         } else if (e->kind == PDT_EV_RECV) {
             msg_slot *s = msg_find(&sent, &key, 0);
             if (s && s->count) s->count--;
+            else  /* its SEND is in no file, or a cycle forced it */
+                warnf(run, "rank %u event #%zu: recv from rank %u (tag %u, seq %" PRId64
+                           ") has no matching send", r, pos[r] - 1, e->a, e->sub, e->v);
         }
         schedule(&mc, r);
     }
@@ -758,5 +777,6 @@ done:
     free(h.r);
     free(blocked);
     free(sent.s);
+    free(unsent.s);
     return st;
 }

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "../harness.h"
@@ -406,6 +407,54 @@ TEST(damage_manifest_version)
     CHECK_MSG(strstr(o.err, "rank-0000.trace") && strstr(o.err, "trace format 2.0"), "%s", o.err);
 }
 
+/* Regression: with a rank file lost, the causal merge blamed (and moved
+ * ahead of its SEND) a RECV whose SEND was present.  Rank 1's file is
+ * missing; rank 0 receives from rank 1 (that SEND is lost) and then sends to
+ * rank 2, whose RECV has the earliest time of all.  The merge must place
+ * rank 0's orphaned RECV, then its SEND, then rank 2's RECV, and warn only
+ * about rank 0's RECV. */
+TEST(damage_merge_missing_sender_rank)
+{
+    char d[300];
+    snprintf(d, sizeof d, "%s/lostsender", tmpdir);
+    pdt_trace_writer *w0, *w2;
+    pdt_err err = {0};
+    CHECK(pdt_tw_open(d, 0, 1, &w0, &err) == PDT_OK);
+    CHECK(pdt_tw_open(d, 2, 1, &w2, &err) == PDT_OK);
+    if (err.code) return;
+    PDT_TRACE(pdt_tw_hook(w2), 1, PDT_EV_RECV, 7, 0, 16, 0, 0);  /* earliest time */
+    struct timespec ts = {0, 2000000};
+    nanosleep(&ts, NULL);
+    PDT_TRACE(pdt_tw_hook(w0), 1, PDT_EV_RECV, 7, 1, 16, 0, 0);  /* from the lost rank */
+    PDT_TRACE(pdt_tw_hook(w0), 1, PDT_EV_SEND, 7, 2, 16, 0, 0);
+    CHECK(pdt_tw_close(w0, &err) == PDT_OK && pdt_tw_close(w2, &err) == PDT_OK);
+    int64_t off[3] = {0, 0, 0};
+    pdt_manifest m = {0};
+    m.format_version = PDT_TRACE_FORMAT_MAJOR;
+    m.nranks = 3;
+    m.level = 1;
+    m.clock_offset_ns = off;
+    CHECK(pdt_run_write_meta(d, &m, NULL, 0, &err) == PDT_OK);
+    pdt_run *run = NULL;
+    CHECK(pdt_run_open(d, &run, &err) == PDT_OK);
+    if (!run) return;
+    const pdt_rec *rec;
+    size_t n = 0;
+    CHECK(pdt_run_merged(run, &rec, &n, &err) == PDT_OK);
+    CHECK(n == 3);
+    if (n == 3) {
+        CHECK_MSG(rec[0].rank == 0 && rec[0].ev.kind == PDT_EV_RECV, "first: rank %u kind %u",
+                  rec[0].rank, rec[0].ev.kind);
+        CHECK(rec[1].rank == 0 && rec[1].ev.kind == PDT_EV_SEND);
+        CHECK_MSG(rec[2].rank == 2 && rec[2].ev.kind == PDT_EV_RECV, "last: rank %u", rec[2].rank);
+    }
+    const char *wn = pdt_run_warnings(run);
+    CHECK_MSG(strstr(wn, "rank-0001.trace: missing"), "%s", wn);
+    CHECK_MSG(strstr(wn, "rank 0 event #0: recv from rank 1"), "%s", wn);
+    CHECK_MSG(!strstr(wn, "rank 2 event"), "%s", wn);
+    pdt_run_close(run);
+}
+
 static void on_alarm(int sig)
 {
     (void)sig;
@@ -434,6 +483,7 @@ int main(void)
     RUN(damage_bitflip_every_byte);
     RUN(damage_missing_rank_file);
     RUN(damage_manifest_version);
+    RUN(damage_merge_missing_sender_rank);
     free(orig);
     rm_rf(tmpdir);
     return test_summary();
