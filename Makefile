@@ -31,7 +31,10 @@
 # wildcard: src/geom (predicates, hull, kernel, checker), src/io (files,
 # generators), src/trace (hook, writer, reader), src/par (parallel driver —
 # the only code that includes mpi.h is src/par/comm_mpi.c), src/cli (the pdt
-# program), src/view (replay model, cairo renderer, SDL2 shell).
+# program), src/view (replay model, cairo renderer, SDL2 shell: every file
+# but shell.c and pdtview.c goes into libpdtview.a, which needs cairo only;
+# bin/pdtview adds SDL2).  Unit tests named tests/unit/test_view*.c are
+# compiled with the cairo/SDL flags and linked with libpdtview.a.
 
 CC      ?= gcc
 ifeq ($(origin CC),default)

@@ -183,8 +183,7 @@ static void sort3(uint32_t v[3], const uint32_t in[3])
 typedef struct builder {
     pdt_replay *r;
     int32_t *cur;   /* per rank * PDT_SLOT_PER_RANK */
-    int32_t last_stack;  /* per rank: last stack touched, in lastst[] */
-    int32_t *lastst;
+    int32_t *lastst;     /* per rank: the stack touched last (HULL reports it) */
     keymap tri_map, edge_map, msg_map;
     uint32_t *tri_count;  /* histories per triangle (pass 1) */
     size_t cap_count;
