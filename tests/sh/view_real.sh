@@ -43,6 +43,12 @@ if command -v mpirun >/dev/null; then
        pdftoppm -r 20 -png "$TMP/p4.pdf" "$TMP/p4page" && [ "$(final_of "$TMP/p4")" = "$(wc -l < "$TMP/u4.tri")" ]; then
         ok mpi4_merge_levels
     else fail mpi4_merge_levels; fi
+    # a damaged run (one rank file cut short): warned about, still replayed
+    cp -r "$TMP/p4" "$TMP/dmg" && truncate -s 3000 "$TMP/dmg/rank-0002.trace"
+    if "$V" --headless "$TMP/dmg" --end --size 640x400 -o "$TMP/dmg.png" 2>"$TMP/dmg.err" >/dev/null &&
+       grep -q 'rank-0002.trace' "$TMP/dmg.err" && "$V" "$TMP/dmg" --check 2>/dev/null | grep -q ' 0 differ'; then
+        ok damaged_run
+    else fail damaged_run "$(head -3 "$TMP/dmg.err")"; fi
 else
     fail mpi "mpirun not installed"
 fi
