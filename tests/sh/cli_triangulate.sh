@@ -99,6 +99,9 @@ mkdir -p bad_count && printf '4 2 0 0\n1 0 0\n2 1 0\n3 0 1\n' > bad_count/in.nod
 "$PDT" triangulate nosuch.txt -o n.tri 2> ns.err; rc=$?
 [ $rc -eq 2 ] && grep -q 'nosuch.txt: cannot open: No such file or directory' ns.err && [ ! -e n.tri ] \
     && ok input_missing || fail input_missing
+"$PDT" triangulate /proc/self/mem -o m.tri 2> mem.err; rc=$?
+[ $rc -eq 2 ] && grep -q '/proc/self/mem: read error' mem.err && [ ! -e m.tri ] \
+    && ok input_unreadable || fail input_unreadable "rc=$rc $(cat mem.err)"
 "$PDT" triangulate sq.txt -o nodir/x.tri 2> nd.err; rc=$?
 [ $rc -eq 2 ] && grep -q 'nodir/x.tri: cannot create' nd.err && ok output_dir_missing || fail output_dir_missing
 cp sq.txt self.tri

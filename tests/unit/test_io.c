@@ -167,6 +167,13 @@ TEST(file_errors)
     CHECK_MSG(strcmp(err.msg, want) == 0, "%s", err.msg);
     pdt_err_clear(&err);
     CHECK(pdt_read_points(path("x.txt"), -1, &p, &n, NULL, &err) == PDT_ERR_ARG);
+    /* A file that opens but cannot be read: offset 0 of /proc/self/mem. */
+    if (access("/proc/self/mem", R_OK) == 0) {
+        pdt_err_clear(&err);
+        CHECK(pdt_read_points("/proc/self/mem", 0, &p, &n, NULL, &err) == PDT_ERR_IO);
+        CHECK_MSG(strcmp(err.msg, "/proc/self/mem: read error: Input/output error") == 0, "%s",
+                  err.msg);
+    }
     if (geteuid() != 0) { /* root reads everything */
         put("noread.txt", "1 2\n");
         chmod(path("noread.txt"), 0);
