@@ -5,6 +5,8 @@
 #   make test       install missing Debian packages, build release + sanitizer
 #                   builds, run the whole suite (tests/run.sh)
 #   make demo       install missing packages, build, run the classroom demo
+#   make lesson L=NN  record lesson NN (lessons/NN-*) and open the viewer on it
+#                   (no display: render its key frames into build/lessons/NN)
 #   make bench      benchmarks against other tools (prints figures; no asserts)
 #   make table1     the thesis' Table 1 (speedup) reproduced
 #   make fuzz       build the libFuzzer targets (clang, bin/fuzz/) and run each
@@ -111,7 +113,7 @@ endef
 $(eval $(call variant,rel,$(OPT),bin))
 $(eval $(call variant,san,$(SAN),bin/san))
 
-.PHONY: all deps test demo bench table1 clean rel-all san-all check-deps fuzz fuzz-build fuzz-seeds
+.PHONY: all deps test demo lesson bench table1 clean rel-all san-all check-deps fuzz fuzz-build fuzz-seeds
 .DEFAULT_GOAL := all
 
 all: rel-all
@@ -131,6 +133,11 @@ test: deps
 demo: deps
 	$(MAKE) rel-all
 	scripts/demo.sh
+
+lesson: deps
+	@test -n "$(L)" || { echo "usage: make lesson L=NN   (lessons: $(notdir $(wildcard lessons/[0-9]*)))"; exit 2; }
+	$(MAKE) rel-all
+	scripts/lesson.sh $(L)
 
 bench: deps-bench
 	$(MAKE) rel-all

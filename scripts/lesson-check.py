@@ -1,0 +1,249 @@
+#!/usr/bin/env python3
+"""pdt — verify a lesson's `checks` file against its recorded run(s).
+
+    scripts/lesson-check.py LESSON_DIR RUNS_DIR
+
+LESSON_DIR is lessons/NN-name (holds `checks`, the points and lesson.conf);
+RUNS_DIR is where scripts/lesson.sh recorded it (build/lessons/NN): one folder
+per run holding dump.txt (`pdt trace dump` of the trace) and output.txt (what
+the program printed).
+
+Every line of `checks` states one fact the lesson text relies on.  Lines:
+
+    # comment
+    run NAME                    following lines are about run NAME (default: the first run)
+    event N KIND [F=V ...]      event N (as `pdt trace dump` and the viewer number it)
+                                is of kind KIND and has these fields
+    first KIND [F=V ...] = N    the first event of KIND with these fields is event N
+    count KIND [F=V ...] = M    there are exactly M such events (KIND `*` = any kind)
+    output-lines = M            the program printed M lines (triangles or hull vertices)
+    output-has A B C            one printed line is `A B C` (for triangles the order
+                                of the three indices as printed: canonical)
+    output = A B C ...          hull: the printed vertices, in order
+    area2 A B C = V             Area2 of input points A, B, C (0-based) is V
+    lift A = Z                  x*x + y*y of input point A is Z
+    incircle A B C D = S        sign (+, -, 0) of the in-circle test: + when D is inside
+                                the circle through A, B, C (counter-clockwise), i.e. D's
+                                lift is below the plane of the lifted A, B, C (the
+                                thesis' H has the opposite sign: H > 0 means outside)
+    output-same RUN             this run printed exactly what run RUN printed
+
+Fields F=V are compared with the fields of the dump line (same names as
+`pdt trace dump` prints, e.g. rank=2 pt=5).  Exit 0 when every line holds;
+otherwise print every failing line with what was found, exit 1.
+"""
+import os
+import re
+import sys
+
+
+def read_points(path):
+    pts = []
+    with open(path) as f:
+        for line in f:
+            line = line.split('#', 1)[0].strip()
+            if not line:
+                continue
+            x, y = line.split()[:2]
+            pts.append((int(x), int(y)))
+    return pts
+
+
+def read_conf(path):
+    """Global keys and the run names in order (mirrors scripts/lesson.sh)."""
+    glob, runs, cur = {}, [], None
+    sections = {}
+    with open(path) as f:
+        for line in f:
+            line = line.split('#', 1)[0].strip()
+            if not line:
+                continue
+            m = re.match(r'^\[([A-Za-z0-9_-]+)\]$', line)
+            if m:
+                cur = m.group(1)
+                runs.append(cur)
+                sections[cur] = {}
+                continue
+            k, v = [s.strip() for s in line.split('=', 1)]
+            (sections[cur] if cur else glob)[k] = v
+    if not runs:
+        runs = ['run']
+        sections['run'] = {}
+    return glob, runs, sections
+
+
+# ---- the dump --------------------------------------------------------------
+# One event per line.  parse_dump_line() returns (index, kind, fields) or None
+# for lines that are not events (headers).  Kept in one place so that a change
+# of the dump's layout is one edit.
+EVENT_RE = re.compile(r'^\s*#?(\d+)\s+(.*)$')
+
+
+def parse_dump_line(line):
+    m = EVENT_RE.match(line)
+    if not m:
+        return None
+    idx = int(m.group(1))
+    kind = None
+    fields = {}
+    for tok in m.group(2).split():
+        if '=' in tok:
+            k, v = tok.split('=', 1)
+            fields[k] = v.rstrip(',;')
+        elif kind is None and re.match(r'^[a-z_-]+$', tok):
+            kind = tok
+    if kind is None:
+        return None
+    return idx, kind, fields
+
+
+def read_dump(path):
+    events = {}
+    order = []
+    with open(path) as f:
+        for line in f:
+            e = parse_dump_line(line)
+            if e is None:
+                continue
+            events[e[0]] = (e[1], e[2], line.rstrip('\n'))
+            order.append(e[0])
+    return events, order
+
+
+def match(kind, fields, want_kind, want):
+    if want_kind != '*' and kind != want_kind:
+        return False
+    for k, v in want.items():
+        if fields.get(k) != v:
+            return False
+    return True
+
+
+def parse_fields(toks):
+    want = {}
+    for t in toks:
+        if '=' not in t:
+            raise ValueError('expected FIELD=VALUE, got %r' % t)
+        k, v = t.split('=', 1)
+        want[k] = v
+    return want
+
+
+def area2(a, b, c):
+    return (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
+
+
+def incircle(a, b, c, d):
+    """> 0 when d is inside the circle through a, b, c (counter-clockwise)."""
+    m = [(p[0] - d[0], p[1] - d[1]) for p in (a, b, c)]
+    m = [(x, y, x * x + y * y) for x, y in m]
+    return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+
+def main():
+    if len(sys.argv) != 3:
+        print(__doc__.strip().split('\n\n')[1], file=sys.stderr)
+        return 2
+    ldir, rdir = sys.argv[1], sys.argv[2]
+    glob, runs, sections = read_conf(os.path.join(ldir, 'lesson.conf'))
+    cache = {}
+
+    def run_data(run):
+        if run not in cache:
+            d = os.path.join(rdir, run)
+            events, order = read_dump(os.path.join(d, 'dump.txt'))
+            out = []
+            op = os.path.join(d, 'output.txt')
+            if os.path.exists(op):
+                with open(op) as f:
+                    out = [l.split() for l in f if l.strip() and not l.startswith('#')]
+            pfile = sections[run].get('points', glob.get('points', 'points.txt'))
+            pts = read_points(os.path.join(ldir, pfile)) if os.path.exists(
+                os.path.join(ldir, pfile)) else []
+            cache[run] = (events, order, out, pts)
+        return cache[run]
+
+    run = runs[0]
+    bad = 0
+    nchecks = 0
+    with open(os.path.join(ldir, 'checks')) as f:
+        lines = list(f)
+    for lineno, raw in enumerate(lines, 1):
+        line = raw.split('#', 1)[0].strip()
+        if not line:
+            continue
+        toks = line.split()
+        where = '%s/checks:%d: %s' % (ldir, lineno, line)
+        try:
+            if toks[0] == 'run':
+                if toks[1] not in runs:
+                    raise ValueError('no run %r in lesson.conf' % toks[1])
+                run = toks[1]
+                continue
+            nchecks += 1
+            events, order, out, pts = run_data(run)
+            ltoks, rhs = toks, None
+            if ' = ' in line:
+                lhs, rhs = line.rsplit(' = ', 1)
+                ltoks = lhs.split()
+            if toks[0] == 'event':
+                n = int(toks[1])
+                want = parse_fields(toks[3:])
+                if n not in events:
+                    raise AssertionError('no event %d in the dump' % n)
+                kind, fields, text = events[n]
+                if not match(kind, fields, toks[2], want):
+                    raise AssertionError('event %d is: %s' % (n, text.strip()))
+            elif toks[0] == 'first':
+                want = parse_fields(ltoks[2:])
+                hits = [i for i in order if match(events[i][0], events[i][1], ltoks[1], want)]
+                got = hits[0] if hits else None
+                if got != int(rhs):
+                    raise AssertionError('first such event is %s' % (
+                        events[got][2].strip() if got is not None else 'none'))
+            elif toks[0] == 'count':
+                want = parse_fields(ltoks[2:])
+                got = sum(1 for i in order if match(events[i][0], events[i][1], ltoks[1], want))
+                if got != int(rhs):
+                    raise AssertionError('counted %d' % got)
+            elif toks[0] == 'output-lines':
+                if len(out) != int(rhs):
+                    raise AssertionError('the program printed %d lines' % len(out))
+            elif toks[0] == 'output-has':
+                if toks[1:] not in out:
+                    raise AssertionError('no such line in the output')
+            elif toks[0] == 'output':
+                got = [l[0] for l in out]
+                if got != rhs.split():
+                    raise AssertionError('the output is %s' % ' '.join(got))
+            elif toks[0] == 'area2':
+                a, b, c = (pts[int(t)] for t in ltoks[1:4])
+                if area2(a, b, c) != int(rhs):
+                    raise AssertionError('Area2 = %d' % area2(a, b, c))
+            elif toks[0] == 'incircle':
+                a, b, c, d = (pts[int(t)] for t in ltoks[1:5])
+                got = incircle(a, b, c, d)
+                sign = '+' if got > 0 else '-' if got < 0 else '0'
+                if sign != rhs:
+                    raise AssertionError('incircle = %d' % got)
+            elif toks[0] == 'output-same':
+                other = run_data(toks[1])[2]
+                if other != out:
+                    raise AssertionError('the outputs of %s and %s differ' % (run, toks[1]))
+            elif toks[0] == 'lift':
+                x, y = pts[int(ltoks[1])]
+                if x * x + y * y != int(rhs):
+                    raise AssertionError('z = %d' % (x * x + y * y))
+            else:
+                raise ValueError('unknown check %r' % toks[0])
+        except (AssertionError, ValueError, IndexError, KeyError, OSError) as e:
+            bad += 1
+            print('FAIL %s\n     %s' % (where, e))
+    print('%s: %d checks, %d failed' % (os.path.basename(os.path.normpath(ldir)), nchecks, bad))
+    return 1 if bad else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

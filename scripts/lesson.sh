@@ -1,0 +1,207 @@
+#!/bin/bash
+# pdt — run one lesson: record its run(s), then open the viewer at the right place.
+#
+#   scripts/lesson.sh [options] LESSON        (LESSON = lessons/NN-name, NN-name or NN)
+#   make lesson L=NN
+#
+# What it does, for every run the lesson's lesson.conf describes:
+#   1. records the run with `pdt COMMAND POINTS --trace DIR` (under `mpirun -np R`
+#      when the lesson uses R > 1 ranks) into build/lessons/NN/RUN/trace, or uses
+#      the recorded run the lesson names (`recorded = ...`);
+#   2. checks the recording with `pdt trace check` and writes `pdt trace dump`
+#      into build/lessons/NN/RUN/dump.txt;
+#   3. with a display ($DISPLAY or $WAYLAND_DISPLAY set): opens `pdtview` on the
+#      run at the lesson's start point; without one (or with --headless): renders
+#      the start frame and the key frames into build/lessons/NN/RUN/frames/.
+#
+# Options
+#   --headless     never open a window, render frames (default without a display)
+#   --record-only  record and check, render nothing, open nothing
+#   --out DIR      where to put the runs (default: build/lessons/NN)
+#   --quiet        print only where things are
+#
+# lesson.conf: `key = value` lines, `#` comments; optional `[NAME]` sections, one
+# per run (keys before the first section apply to every run).  Keys:
+#   title      one line
+#   command    hull | triangulate
+#   points     the input file, relative to the lesson folder
+#   ranks      number of MPI ranks (default 1: no mpirun)
+#   level      trace level, 1 or 2 (default 1)
+#   start      where the viewer starts: `event N`, `phase NAME` or `end`
+#   frames     key frames rendered headless, separated by `;` (same forms as start)
+#   view       extra pdtview options (panels), passed as they are
+#   recorded   a run folder recorded ahead (relative to the lesson folder): not re-recorded
+#
+# Exit status: 0 when every run was recorded, checked and shown/rendered; 1 otherwise.
+set -u
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+BIN=${BIN:-$ROOT/bin}
+PDT=${PDT:-$BIN/pdt}
+PDTVIEW=${PDTVIEW:-$BIN/pdtview}
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+
+headless=0; record_only=0; out=""; quiet=0; lesson=""
+while [ $# -gt 0 ]; do
+    case $1 in
+        --headless) headless=1 ;;
+        --record-only) record_only=1 ;;
+        --out) out=$2; shift ;;
+        --quiet) quiet=1 ;;
+        -h|--help) sed -n '2,/^set -u/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
+        -*) echo "lesson: unknown option $1 (see --help)" >&2; exit 2 ;;
+        *) lesson=$1 ;;
+    esac
+    shift
+done
+[ -n "$lesson" ] || { echo "usage: scripts/lesson.sh [--headless] LESSON   (e.g. lessons/02-graham or 02)" >&2; exit 2; }
+
+# ---- find the lesson folder ------------------------------------------------
+if [ ! -d "$lesson" ]; then
+    for cand in "$ROOT/lessons/$lesson" "$ROOT"/lessons/"$lesson"-* "$ROOT"/lessons/0"$lesson"-*; do
+        if [ -d "$cand" ]; then lesson=$cand; break; fi
+    done
+fi
+[ -f "$lesson/lesson.conf" ] || { echo "lesson: no lesson.conf in '$lesson'" >&2; exit 2; }
+LDIR=$(cd "$lesson" && pwd)
+LNAME=$(basename "$LDIR")
+NN=${LNAME%%-*}
+[ -n "$out" ] || out=$ROOT/build/lessons/$NN
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+
+say() { [ "$quiet" = 1 ] || echo "$@"; }
+
+# ---- read lesson.conf --------------------------------------------------------
+declare -A CONF
+RUNS=()
+section=""
+while IFS= read -r line || [ -n "$line" ]; do
+    line=${line%%#*}
+    line=$(echo "$line" | sed 's/^[[:space:]]*//; s/[[:space:]]*$//')
+    [ -z "$line" ] && continue
+    if [[ $line =~ ^\[([A-Za-z0-9_-]+)\]$ ]]; then
+        section=${BASH_REMATCH[1]}; RUNS+=("$section"); continue
+    fi
+    if [[ $line =~ ^([a-z]+)[[:space:]]*=[[:space:]]*(.*)$ ]]; then
+        CONF["$section.${BASH_REMATCH[1]}"]=${BASH_REMATCH[2]}
+    else
+        echo "lesson: $LDIR/lesson.conf: cannot read line: $line" >&2; exit 2
+    fi
+done <"$LDIR/lesson.conf"
+[ ${#RUNS[@]} -gt 0 ] || RUNS=(run)
+
+# conf RUN KEY DEFAULT: the run's value, else the global one, else DEFAULT
+conf() {
+    if [ -n "${CONF[$1.$2]+x}" ]; then echo "${CONF[$1.$2]}"
+    elif [ -n "${CONF[.$2]+x}" ]; then echo "${CONF[.$2]}"
+    else echo "$3"; fi
+}
+
+# viewer position "event N" | "phase NAME" | "end" -> pdtview options
+pos_args() {
+    local w1 w2
+    read -r w1 w2 <<<"$1"
+    case $w1 in
+        event) echo "--at $w2" ;;
+        phase) echo "--phase $w2" ;;
+        end) echo "--end" ;;
+        *) echo "lesson: bad viewer position '$1' (event N | phase NAME | end)" >&2; return 1 ;;
+    esac
+}
+# file-name form of a position: "event 12" -> event-12
+pos_name() { echo "$1" | tr ' ' '-' | tr -cd 'A-Za-z0-9_-'; }
+
+have_display=0
+if [ -n "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then have_display=1; fi
+[ "$headless" = 1 ] && have_display=0
+
+title=$(conf "" title "$LNAME")
+say "Lesson $NN: $title"
+say "  text: $LDIR/README.md"
+status=0
+VIEW_QUEUE=()
+
+for run in "${RUNS[@]}"; do
+    rdir=$out/$run
+    command=$(conf "$run" command triangulate)
+    points=$(conf "$run" points points.txt)
+    ranks=$(conf "$run" ranks 1)
+    level=$(conf "$run" level 1)
+    start=$(conf "$run" start end)
+    frames=$(conf "$run" frames "")
+    view=$(conf "$run" view "")
+    recorded=$(conf "$run" recorded "")
+    mkdir -p "$rdir"
+    rm -rf "$rdir/frames" "$rdir/dump.txt" "$rdir/output.txt" "$rdir/log.txt"
+
+    # 1. record (or use the recorded run)
+    if [ -n "$recorded" ]; then
+        trace=$LDIR/$recorded
+        say "  [$run] using the run recorded ahead: $trace"
+    else
+        trace=$rdir/trace
+        rm -rf "$trace"
+        cmd=("$PDT" "$command" "$LDIR/$points" --trace "$trace" --trace-level "$level")
+        if [ "$ranks" -gt 1 ]; then
+            cmd=(mpirun -np "$ranks" --oversubscribe "${cmd[@]}")
+        fi
+        say "  [$run] recording: $command of $points on $ranks rank(s), trace level $level"
+        if ! "${cmd[@]}" >"$rdir/output.txt" 2>"$rdir/log.txt"; then
+            echo "lesson: [$run] the run failed: ${cmd[*]}" >&2
+            sed 's/^/    /' "$rdir/log.txt" >&2
+            status=1; continue
+        fi
+    fi
+
+    # 2. check and dump
+    if ! "$PDT" trace check "$trace" >"$rdir/check.txt" 2>&1; then
+        echo "lesson: [$run] pdt trace check failed on $trace:" >&2
+        sed 's/^/    /' "$rdir/check.txt" >&2
+        status=1; continue
+    fi
+    "$PDT" trace dump "$trace" >"$rdir/dump.txt" 2>>"$rdir/log.txt" || { echo "lesson: [$run] pdt trace dump failed" >&2; status=1; continue; }
+    say "  [$run] trace: $trace ($(wc -l <"$rdir/dump.txt") events, pdt trace check passed)"
+    [ "$record_only" = 1 ] && continue
+
+    # 3. view or render
+    startargs=$(pos_args "$start") || { status=1; continue; }
+    if [ "$have_display" = 1 ]; then
+        VIEW_QUEUE+=("$trace|$startargs $view|$run")
+        continue
+    fi
+    if [ ! -x "$PDTVIEW" ]; then
+        echo "lesson: [$run] $PDTVIEW is not built: no frames rendered (the trace is recorded and checked)" >&2
+        status=1; continue
+    fi
+    mkdir -p "$rdir/frames"
+    k=0
+    IFS=';' read -r -a keys <<<"start;$frames"
+    for key in "${keys[@]}"; do
+        key=$(echo "$key" | sed 's/^[[:space:]]*//; s/[[:space:]]*$//')
+        [ -z "$key" ] && continue
+        if [ "$key" = start ]; then pos=$start; else pos=$key; fi
+        args=$(pos_args "$pos") || { status=1; continue; }
+        png=$(printf '%s/frames/%02d-%s.png' "$rdir" "$k" "$(pos_name "$pos")")
+        # shellcheck disable=SC2086
+        if ! "$PDTVIEW" --headless "$trace" $args $view -o "$png" >>"$rdir/log.txt" 2>&1; then
+            echo "lesson: [$run] rendering '$pos' failed (see $rdir/log.txt)" >&2
+            status=1
+        fi
+        k=$((k + 1))
+    done
+    say "  [$run] no display: $k frame(s) rendered into $rdir/frames/"
+done
+
+# with a display: open the viewer on each run in turn
+if [ ${#VIEW_QUEUE[@]} -gt 0 ]; then
+    if [ ! -x "$PDTVIEW" ]; then
+        echo "lesson: $PDTVIEW is not built (make)" >&2; exit 1
+    fi
+    for item in "${VIEW_QUEUE[@]}"; do
+        IFS='|' read -r trace args run <<<"$item"
+        say "  [$run] opening the viewer (h shows every key; q closes it)"
+        # shellcheck disable=SC2086
+        "$PDTVIEW" "$trace" $args || status=1
+    done
+fi
+exit $status
