@@ -12,8 +12,13 @@ Every line of `checks` states one fact the lesson text relies on.  Lines:
 
     # comment
     run NAME                    following lines are about run NAME (default: the first run)
-    event N KIND [F=V ...]      event N (as `pdt trace dump` and the viewer number it)
-                                is of kind KIND and has these fields
+    event N KIND [W ...] [F=V ...]
+                                event N, as `pdt trace dump` numbers it, is of kind KIND,
+                                has these words right after the kind (e.g. `graham`,
+                                a triangle's three points) and these fields
+    at K KIND [W ...] [F=V ...] the event the viewer describes when its counter reads
+                                "K / total" (K events applied: the K-th event), the same
+                                test
     first KIND [F=V ...] = N    the first event of KIND with these fields is event N
     count KIND [F=V ...] = M    there are exactly M such events (KIND `*` = any kind)
     output-lines = M            the program printed M lines (triangles or hull vertices)
@@ -72,6 +77,10 @@ def read_conf(path):
     return glob, runs, sections
 
 
+# The number `pdt trace dump` gives the first event of a run (the viewer's
+# counter K shows event K - 1 + DUMP_FIRST).
+DUMP_FIRST = 0
+
 # ---- the dump --------------------------------------------------------------
 # One event per line.  parse_dump_line() returns (index, kind, fields) or None
 # for lines that are not events (headers).  Kept in one place so that a change
@@ -79,22 +88,40 @@ def read_conf(path):
 EVENT_RE = re.compile(r'^\s*#?(\d+)\s+(.*)$')
 
 
+KINDS = {'phase-begin', 'phase-end', 'push', 'pop', 'lift', 'sort', 'delete', 'tri-new',
+         'tri-final', 'ra-defer', 'ship', 'discard', 'merge-begin', 'merge-end', 'send',
+         'recv', 'hull', 'edge-add', 'edge-del', 'incircle'}
+
+
+def split_event(toks):
+    """Words of an event after its kind -> {'_words': [...], field: value}."""
+    fields = {'_words': []}
+    for tok in toks:
+        if '=' in tok:
+            k, v = tok.split('=', 1)
+            fields[k] = v
+        else:
+            fields['_words'].append(tok)
+    return fields
+
+
 def parse_dump_line(line):
+    """(index, rank, kind, fields) of one dump line, or None."""
     m = EVENT_RE.match(line)
     if not m:
         return None
-    idx = int(m.group(1))
-    kind = None
-    fields = {}
-    for tok in m.group(2).split():
-        if '=' in tok:
-            k, v = tok.split('=', 1)
-            fields[k] = v.rstrip(',;')
-        elif kind is None and re.match(r'^[a-z_-]+$', tok):
-            kind = tok
-    if kind is None:
-        return None
-    return idx, kind, fields
+    toks = m.group(2).split()
+    for i, tok in enumerate(toks):
+        if tok in KINDS:
+            fields = split_event(toks[i + 1:])
+            rank = None
+            for pre in toks[:i]:
+                r = re.match(r'^(?:r|rank=?)(\d+)$', pre)
+                if r:
+                    rank = r.group(1)
+            fields['@rank'] = rank
+            return int(m.group(1)), tok, fields
+    return None
 
 
 def read_dump(path):
@@ -111,22 +138,23 @@ def read_dump(path):
 
 
 def match(kind, fields, want_kind, want):
+    """Does an event (kind, fields) have kind want_kind ('*': any), start its
+    words with want['_words'] and carry every other field of want?"""
     if want_kind != '*' and kind != want_kind:
         return False
+    words = want.get('_words', [])
+    if fields['_words'][:len(words)] != words:
+        return False
     for k, v in want.items():
-        if fields.get(k) != v:
+        if k != '_words' and fields.get(k) != v:
             return False
     return True
 
 
 def parse_fields(toks):
-    want = {}
-    for t in toks:
-        if '=' not in t:
-            raise ValueError('expected FIELD=VALUE, got %r' % t)
-        k, v = t.split('=', 1)
-        want[k] = v
-    return want
+    """Words and F=V fields of a check line after its kind; `rank=R` of the
+    recording rank is written @rank=R."""
+    return split_event(toks)
 
 
 def area2(a, b, c):
@@ -188,8 +216,10 @@ def main():
             if ' = ' in line:
                 lhs, rhs = line.rsplit(' = ', 1)
                 ltoks = lhs.split()
-            if toks[0] == 'event':
+            if toks[0] in ('event', 'at'):
                 n = int(toks[1])
+                if toks[0] == 'at':
+                    n = n - 1 + DUMP_FIRST
                 want = parse_fields(toks[3:])
                 if n not in events:
                     raise AssertionError('no event %d in the dump' % n)

@@ -27,7 +27,8 @@
 #   points     the input file, relative to the lesson folder
 #   ranks      number of MPI ranks (default 1: no mpirun)
 #   level      trace level, 1 or 2 (default 1)
-#   start      where the viewer starts: `event N`, `phase NAME` or `end`
+#   start      where the viewer starts: `at N` (the viewer's counter: N events
+#              applied), `phase NAME` (just after the phase begins) or `end`
 #   frames     key frames rendered headless, separated by `;` (same forms as start)
 #   view       extra pdtview options (panels), passed as they are
 #   recorded   a run folder recorded ahead (relative to the lesson folder): not re-recorded
@@ -97,18 +98,18 @@ conf() {
     else echo "$3"; fi
 }
 
-# viewer position "event N" | "phase NAME" | "end" -> pdtview options
+# viewer position "at N" | "phase NAME" | "end" -> pdtview options
 pos_args() {
     local w1 w2
     read -r w1 w2 <<<"$1"
     case $w1 in
-        event) echo "--at $w2" ;;
+        at) echo "--at $w2" ;;
         phase) echo "--phase $w2" ;;
         end) echo "--end" ;;
-        *) echo "lesson: bad viewer position '$1' (event N | phase NAME | end)" >&2; return 1 ;;
+        *) echo "lesson: bad viewer position '$1' (at N | phase NAME | end)" >&2; return 1 ;;
     esac
 }
-# file-name form of a position: "event 12" -> event-12
+# file-name form of a position: "at 12" -> at-12
 pos_name() { echo "$1" | tr ' ' '-' | tr -cd 'A-Za-z0-9_-'; }
 
 have_display=0
