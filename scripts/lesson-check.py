@@ -2,6 +2,9 @@
 """pdt — verify a lesson's `checks` file against its recorded run(s).
 
     scripts/lesson-check.py LESSON_DIR RUNS_DIR
+    scripts/lesson-check.py --find DUMP first|last KIND [W ...] [F=V ...]
+        (prints the viewer cursor K that shows that event; scripts/lesson.sh
+        uses it for the positions `first ...` / `last ...` of lesson.conf)
 
 LESSON_DIR is lessons/NN-name (holds `checks`, the points and lesson.conf);
 RUNS_DIR is where scripts/lesson.sh recorded it (build/lessons/NN): one folder
@@ -27,14 +30,22 @@ Every line of `checks` states one fact the lesson text relies on.  Lines:
     output = A B C ...          hull: the printed vertices, in order
     area2 A B C = V             Area2 of input points A, B, C (0-based) is V
     lift A = Z                  x*x + y*y of input point A is Z
-    incircle A B C D = S        sign (+, -, 0) of the in-circle test: + when D is inside
+    hull-size = H               the input points have H hull corners
+    squares = anti|main         every unit square of the input (four corners among the
+                                points) is cut by its anti-diagonal (x+1,y)-(x,y+1),
+                                or by its main diagonal, in the printed triangles
+    degree A = D                input point A is a corner of D printed triangles
+    incircle A B C D = S        sign (+, -, 0; or the exact value) of the in-circle test: + when D is inside
                                 the circle through A, B, C (counter-clockwise), i.e. D's
                                 lift is below the plane of the lifted A, B, C (the
                                 thesis' H has the opposite sign: H > 0 means outside)
     output-same RUN             this run printed exactly what run RUN printed
 
 Fields F=V are compared with the fields of the dump line (same names as
-`pdt trace dump` prints, e.g. rank=2 pt=5).  Exit 0 when every line holds;
+`pdt trace dump` prints, e.g. pt=5 cause=3); words W with the words that
+follow the kind (`pop graham ...`: graham; `ra-defer 5 8 2 rank=1`: 5 8 2).
+Pseudo-fields: @rank=R (the rank that recorded the event), @phase=NAME and
+@level=L (the innermost phase open on that rank when it happened).  Exit 0 when every line holds;
 otherwise print every failing line with what was found, exit 1.
 """
 import os
@@ -125,16 +136,41 @@ def parse_dump_line(line):
 
 
 def read_dump(path):
+    """Events of a dump: {index: (kind, fields, text)} and the indices in
+    order.  Adds the pseudo-fields @rank (the recording rank), @phase and
+    @level (the innermost phase open on that rank, and its merge level)."""
     events = {}
     order = []
+    open_phases = {}
     with open(path) as f:
         for line in f:
             e = parse_dump_line(line)
             if e is None:
                 continue
-            events[e[0]] = (e[1], e[2], line.rstrip('\n'))
-            order.append(e[0])
+            idx, kind, fields = e
+            stack = open_phases.setdefault(fields['@rank'], [])
+            if kind == 'phase-begin':
+                stack.append((fields['_words'][0] if fields['_words'] else '?',
+                              fields.get('level', '0')))
+            top = stack[-1] if stack else ('-', '0')
+            fields['@phase'], fields['@level'] = top
+            if kind == 'phase-end' and stack:
+                stack.pop()
+            events[idx] = (kind, fields, line.rstrip('\n'))
+            order.append(idx)
     return events, order
+
+
+def find(dump, which, spec):
+    """Viewer cursor that shows the first/last event matching spec (KIND
+    [words] [F=V]): its dump index + 1 - DUMP_FIRST; None if there is none."""
+    events, order = read_dump(dump)
+    want = parse_fields(spec[1:])
+    hits = [i for i in order if match(events[i][0], events[i][1], spec[0], want)]
+    if not hits:
+        return None
+    i = hits[0] if which == 'first' else hits[-1]
+    return i + 1 - DUMP_FIRST
 
 
 def match(kind, fields, want_kind, want):
@@ -161,6 +197,47 @@ def area2(a, b, c):
     return (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
 
 
+def square_diagonals(pts, out):
+    """How the output cuts the unit squares whose four corners are input
+    points: 'anti' (every square by (x+1,y)-(x,y+1)), 'main' (every one by
+    (x,y)-(x+1,y+1)), 'mixed', or 'none' (no such square)."""
+    idx = {}
+    for i, p in enumerate(pts):
+        idx.setdefault(p, i)
+    edges = set()
+    for t in out:
+        v = [int(a) for a in t[:3]]
+        for k in range(3):
+            edges.add(frozenset((v[k], v[(k + 1) % 3])))
+    kinds = set()
+    for (x, y), i in idx.items():
+        c = [(x + 1, y), (x, y + 1), (x + 1, y + 1)]
+        if not all(q in idx for q in c):
+            continue
+        anti = frozenset((idx[(x + 1, y)], idx[(x, y + 1)])) in edges
+        main = frozenset((i, idx[(x + 1, y + 1)])) in edges
+        kinds.add('anti' if anti and not main else 'main' if main and not anti else '?')
+    if not kinds:
+        return 'none'
+    return kinds.pop() if len(kinds) == 1 else 'mixed'
+
+
+def hull_size(pts):
+    """Number of corners of the convex hull (collinear boundary points not
+    counted), by the monotone chain."""
+    q = sorted(set(pts))
+    if len(q) < 3:
+        return len(q)
+    def chain(seq):
+        h = []
+        for p in seq:
+            while len(h) >= 2 and area2(h[-2], h[-1], p) <= 0:
+                h.pop()
+            h.append(p)
+        return h[:-1]
+    return len(chain(q) + chain(q[::-1]))
+
+
 def incircle(a, b, c, d):
     """> 0 when d is inside the circle through a, b, c (counter-clockwise)."""
     m = [(p[0] - d[0], p[1] - d[1]) for p in (a, b, c)]
@@ -171,6 +248,14 @@ def incircle(a, b, c, d):
 
 
 def main():
+    if len(sys.argv) >= 5 and sys.argv[1] == '--find':
+        k = find(sys.argv[2], sys.argv[3], sys.argv[4:])
+        if k is None:
+            print('lesson-check: no event %s in %s' % (' '.join(sys.argv[4:]), sys.argv[2]),
+                  file=sys.stderr)
+            return 1
+        print(k)
+        return 0
     if len(sys.argv) != 3:
         print(__doc__.strip().split('\n\n')[1], file=sys.stderr)
         return 2
@@ -256,12 +341,23 @@ def main():
                 a, b, c, d = (pts[int(t)] for t in ltoks[1:5])
                 got = incircle(a, b, c, d)
                 sign = '+' if got > 0 else '-' if got < 0 else '0'
-                if sign != rhs:
+                if rhs not in (sign, str(got)):
                     raise AssertionError('incircle = %d' % got)
             elif toks[0] == 'output-same':
                 other = run_data(toks[1])[2]
                 if other != out:
                     raise AssertionError('the outputs of %s and %s differ' % (run, toks[1]))
+            elif toks[0] == 'squares':
+                got = square_diagonals(pts, out)
+                if got != rhs:
+                    raise AssertionError('the unit squares are cut by: %s' % got)
+            elif toks[0] == 'degree':
+                d = sum(1 for t in out if ltoks[1] in t[:3])
+                if d != int(rhs):
+                    raise AssertionError('point %s is a corner of %d triangles' % (ltoks[1], d))
+            elif toks[0] == 'hull-size':
+                if hull_size(pts) != int(rhs):
+                    raise AssertionError('the points have %d hull corners' % hull_size(pts))
             elif toks[0] == 'lift':
                 x, y = pts[int(ltoks[1])]
                 if x * x + y * y != int(rhs):

@@ -28,7 +28,9 @@
 #   ranks      number of MPI ranks (default 1: no mpirun)
 #   level      trace level, 1 or 2 (default 1)
 #   start      where the viewer starts: `at N` (the viewer's counter: N events
-#              applied), `phase NAME` (just after the phase begins) or `end`
+#              applied), `phase NAME` (just after the phase first begins), `end`,
+#              or `first KIND ...` / `last KIND ...` (the first/last event of
+#              that kind, words and fields: see scripts/lesson-check.py)
 #   frames     key frames rendered headless, separated by `;` (same forms as start)
 #   view       extra pdtview options (panels), passed as they are
 #   recorded   a run folder recorded ahead (relative to the lesson folder): not re-recorded
@@ -98,15 +100,23 @@ conf() {
     else echo "$3"; fi
 }
 
-# viewer position "at N" | "phase NAME" | "end" -> pdtview options
+# pos_args POSITION DUMP: viewer position -> pdtview options.  Positions:
+#   at N | phase NAME | end | first KIND [W..] [F=V..] | last KIND [W..] [F=V..]
+# (first/last: the cursor that shows the first/last event of the run that
+# matches, found in the dump: stable across runs of several ranks, whose
+# merged event numbers vary with timing)
 pos_args() {
-    local w1 w2
+    local w1 w2 k
     read -r w1 w2 <<<"$1"
     case $w1 in
         at) echo "--at $w2" ;;
         phase) echo "--phase $w2" ;;
         end) echo "--end" ;;
-        *) echo "lesson: bad viewer position '$1' (at N | phase NAME | end)" >&2; return 1 ;;
+        first|last)
+            # shellcheck disable=SC2086
+            k=$(python3 "$ROOT/scripts/lesson-check.py" --find "$2" $1) || return 1
+            echo "--at $k" ;;
+        *) echo "lesson: bad viewer position '$1' (at N | phase NAME | end | first/last KIND ...)" >&2; return 1 ;;
     esac
 }
 # file-name form of a position: "at 12" -> at-12
@@ -165,7 +175,7 @@ for run in "${RUNS[@]}"; do
     [ "$record_only" = 1 ] && continue
 
     # 3. view or render
-    startargs=$(pos_args "$start") || { status=1; continue; }
+    startargs=$(pos_args "$start" "$rdir/dump.txt") || { status=1; continue; }
     if [ "$have_display" = 1 ]; then
         VIEW_QUEUE+=("$trace|$startargs $view|$run")
         continue
@@ -181,7 +191,7 @@ for run in "${RUNS[@]}"; do
         key=$(echo "$key" | sed 's/^[[:space:]]*//; s/[[:space:]]*$//')
         [ -z "$key" ] && continue
         if [ "$key" = start ]; then pos=$start; else pos=$key; fi
-        args=$(pos_args "$pos") || { status=1; continue; }
+        args=$(pos_args "$pos" "$rdir/dump.txt") || { status=1; continue; }
         png=$(printf '%s/frames/%02d-%s.png' "$rdir" "$k" "$(pos_name "$pos")")
         # shellcheck disable=SC2086
         if ! "$PDTVIEW" --headless "$trace" $args $view -o "$png" >>"$rdir/log.txt" 2>&1; then
