@@ -31,6 +31,8 @@ Every line of `checks` states one fact the lesson text relies on.  Lines:
     area2 A B C = V             Area2 of input points A, B, C (0-based) is V
     lift A = Z                  x*x + y*y of input point A is Z
     hull-size = H               the input points have H hull corners
+    xrange KIND [W..] [F=V..] = A B
+                                the points (pt=) of the matching events have x from A to B
     squares = anti|main         every unit square of the input (four corners among the
                                 points) is cut by its anti-diagonal (x+1,y)-(x,y+1),
                                 or by its main diagonal, in the printed triangles
@@ -347,6 +349,13 @@ def main():
                 other = run_data(toks[1])[2]
                 if other != out:
                     raise AssertionError('the outputs of %s and %s differ' % (run, toks[1]))
+            elif toks[0] == 'xrange':
+                want = parse_fields(ltoks[2:])
+                xs = [pts[int(events[i][1]['pt'])][0] for i in order
+                      if match(events[i][0], events[i][1], ltoks[1], want)]
+                got = '%d %d' % (min(xs), max(xs)) if xs else 'none'
+                if got != rhs:
+                    raise AssertionError('x runs from %s' % got.replace(' ', ' to '))
             elif toks[0] == 'squares':
                 got = square_diagonals(pts, out)
                 if got != rhs:
