@@ -24,6 +24,8 @@ Every line of `checks` states one fact the lesson text relies on.  Lines:
                                 test
     first KIND [F=V ...] = N    the first event of KIND with these fields is event N
     count KIND [F=V ...] = M    there are exactly M such events (KIND `*` = any kind)
+    max KIND FIELD [W..] [F=V..] = V
+                                the largest FIELD of the matching events is V
     output-lines = M            the program printed M lines (triangles or hull vertices)
     output-has A B C            one printed line is `A B C` (for triangles the order
                                 of the three indices as printed: canonical)
@@ -325,6 +327,14 @@ def main():
                 got = sum(1 for i in order if match(events[i][0], events[i][1], ltoks[1], want))
                 if got != int(rhs):
                     raise AssertionError('counted %d' % got)
+            elif toks[0] == 'max':
+                want = parse_fields(ltoks[3:])
+                vals = [int(events[i][1][ltoks[2]]) for i in order
+                        if match(events[i][0], events[i][1], ltoks[1], want)
+                        and ltoks[2] in events[i][1]]
+                got = max(vals) if vals else None
+                if got is None or got != int(rhs):
+                    raise AssertionError('the largest %s is %s' % (ltoks[2], got))
             elif toks[0] == 'output-lines':
                 if len(out) != int(rhs):
                     raise AssertionError('the program printed %d lines' % len(out))
