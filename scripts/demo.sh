@@ -38,16 +38,33 @@ run=$OUT/run
 rm -rf "$OUT"
 mkdir -p "$OUT"
 
-echo "pdt demo: the Delaunay triangulation of $n points, computed by $NP processes."
-echo
-echo "1. The points are in $points."
-echo "   $NP MPI processes (ranks) share the work: each takes a vertical strip of the"
-echo "   points, lifts them onto the paraboloid z = x² + y² and triangulates its strip;"
-echo "   then neighbouring strips are merged, two at a time.  Every step is recorded."
 if ! mpirun -np "$NP" --oversubscribe "$BIN/pdt" triangulate "$points" -o "$OUT/triangles.tri" \
         --trace "$run" >"$OUT/log.txt" 2>&1; then
     cat "$OUT/log.txt" >&2
     die "the run failed (the messages above say why)"
+fi
+note=""
+if [ "$(sed -n 's/^ranks = //p' "$run/manifest" 2>/dev/null)" != "$NP" ]; then
+    # A pdt built without the parallel driver runs NP separate copies under
+    # mpirun: say so and record one process instead.
+    note="(This build of pdt does not run the parallel algorithm under mpirun, so the demo
+   recorded a run with one process instead.)"
+    NP=1
+    rm -rf "$run"
+    "$BIN/pdt" triangulate "$points" -o "$OUT/triangles.tri" --trace "$run" >"$OUT/log.txt" 2>&1 ||
+        { cat "$OUT/log.txt" >&2; die "the run failed (the messages above say why)"; }
+fi
+echo "pdt demo: the Delaunay triangulation of $n points, computed by $NP process$([ "$NP" -gt 1 ] && echo es)."
+echo
+echo "1. The points are in $points."
+if [ "$NP" -gt 1 ]; then
+    echo "   $NP MPI processes (ranks) shared the work: each took a vertical strip of the"
+    echo "   points, lifted them onto the paraboloid z = x² + y² and triangulated its strip;"
+    echo "   then neighbouring strips were merged, two at a time.  Every step was recorded."
+else
+    echo "   The points were lifted onto the paraboloid z = x² + y², and the lower side of"
+    echo "   their convex hull in space gave the triangles.  Every step was recorded."
+    echo "   $note"
 fi
 ntri=$(grep -c . "$OUT/triangles.tri")
 echo "   Done: $ntri triangles, written to $OUT/triangles.tri;"
@@ -85,21 +102,40 @@ fi
 # No display: draw the key moments instead.
 frames=$OUT/frames
 mkdir -p "$frames"
+"$BIN/pdt" trace dump "$run" >"$OUT/dump.txt" 2>>"$OUT/log.txt"
 echo "3. There is no display here, so the key moments are drawn as pictures instead:"
-# picture name | pdtview position | what it shows
-shots=(
-    "01-start|--at 0|the points, before anything happened"
-    "02-strips|--phase partition|the points shared out into $NP vertical strips, one colour per process"
-    "03-local|--phase classify|each strip triangulated on its own; the restricted areas decide which triangles are final"
-    "04-merge|--phase merge|a merge step: the triangles near a seam are shipped and re-triangulated"
-    "05-end|--end|the finished Delaunay triangulation"
-)
+# picture name | position (as in lesson.conf: at N, end, first/last KIND ...) | what it shows
+if [ "$NP" -gt 1 ]; then
+    shots=(
+        "01-points|at 1|the points, before anything happened"
+        "02-strips|last phase-end partition|the points shared out into $NP vertical strips, one colour per process"
+        "03-local|last phase-end kernel|each strip triangulated on its own"
+        "04-restricted|last phase-end classify|restricted areas: solid triangles are final, dashed ones wait for a merge"
+        "05-merge|first merge-end|the first merge step: triangles near a seam re-done, non-Delaunay ones crossed out"
+        "06-end|end|the finished Delaunay triangulation"
+    )
+else
+    shots=(
+        "01-points|at 1|the points, before anything happened"
+        "02-lifted|last phase-end lift|every point lifted onto the paraboloid (right: the lifted view)"
+        "03-kernel|last phase-end kernel|the triangles found by divide and conquer"
+        "04-end|end|the finished Delaunay triangulation"
+    )
+fi
 fail=0
 for s in "${shots[@]}"; do
     IFS='|' read -r name pos what <<<"$s"
+    read -r w1 rest <<<"$pos"
+    case $w1 in
+        at) args="--at $rest" ;;
+        end) args="--end" ;;
+        *) k=$(python3 -B "$ROOT/scripts/lesson-check.py" --find "$OUT/dump.txt" $pos) || k=""
+           args=${k:+--at $k} ;;
+    esac
     # shellcheck disable=SC2086
-    if "$BIN/pdtview" --headless "$run" $pos -o "$frames/$name.png" >>"$OUT/log.txt" 2>&1; then
-        printf '   %-34s %s\n' "$frames/$name.png" "$what"
+    if [ -n "$args" ] && "$BIN/pdtview" --headless "$run" $args -o "$frames/$name.png" >>"$OUT/log.txt" 2>&1; then
+        echo "   $frames/$name.png"
+        echo "       $what"
     else
         echo "   could not draw $name (see $OUT/log.txt)" >&2
         fail=1

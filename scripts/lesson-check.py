@@ -15,14 +15,13 @@ Every line of `checks` states one fact the lesson text relies on.  Lines:
 
     # comment
     run NAME                    following lines are about run NAME (default: the first run)
-    event N KIND [W ...] [F=V ...]
-                                event N, as `pdt trace dump` numbers it, is of kind KIND,
-                                has these words right after the kind (e.g. `graham`,
-                                a triangle's three points) and these fields
-    at K KIND [W ...] [F=V ...] the event the viewer describes when its counter reads
-                                "K / total" (K events applied: the K-th event), the same
-                                test
-    first KIND [F=V ...] = N    the first event of KIND with these fields is event N
+    at K KIND [W ...] [F=V ...] the K-th event of the run (the K-th line of `pdt trace
+                                dump`; the one the viewer describes when its counter
+                                reads "K / total") is of kind KIND, has these words right
+                                after the kind (e.g. `graham`, a triangle's three
+                                points) and these fields
+    first KIND [W..] [F=V..] = K
+                                the first matching event is the K-th (counter K)
     count KIND [F=V ...] = M    there are exactly M such events (KIND `*` = any kind)
     max KIND FIELD [W..] [F=V..] = V
                                 the largest FIELD of the matching events is V
@@ -48,7 +47,8 @@ Every line of `checks` states one fact the lesson text relies on.  Lines:
 Fields F=V are compared with the fields of the dump line (same names as
 `pdt trace dump` prints, e.g. pt=5 cause=3); words W with the words that
 follow the kind (`pop graham ...`: graham; `ra-defer 5 8 2 rank=1`: 5 8 2).
-Pseudo-fields: @rank=R (the rank that recorded the event), @phase=NAME and
+Pseudo-fields: @rank=R (the rank that recorded the event), @seq=N (its index
+in that rank's file), @phase=NAME and
 @level=L (the innermost phase open on that rank when it happened).  Exit 0 when every line holds;
 otherwise print every failing line with what was found, exit 1.
 """
@@ -92,15 +92,14 @@ def read_conf(path):
     return glob, runs, sections
 
 
-# The number `pdt trace dump` gives the first event of a run (the viewer's
-# counter K shows event K - 1 + DUMP_FIRST).
+# `pdt trace dump` prints one line per event, all ranks merged in the order
+# the viewer replays them: "r2 #17 t=0.25ms pop graham pt=4 depth=3 cause=5"
+# (rank, index of the event in its rank's file, aligned time, the event).
+# Events are numbered here by their line, from 0: the viewer's counter K
+# ("K / total": K events applied) shows event K - 1.
 DUMP_FIRST = 0
 
-# ---- the dump --------------------------------------------------------------
-# One event per line.  parse_dump_line() returns (index, kind, fields) or None
-# for lines that are not events (headers).  Kept in one place so that a change
-# of the dump's layout is one edit.
-EVENT_RE = re.compile(r'^\s*#?(\d+)\s+(.*)$')
+EVENT_RE = re.compile(r'^r(\d+)\s+#(\d+)\s+t=\S+\s+(.*)$')
 
 
 KINDS = {'phase-begin', 'phase-end', 'push', 'pop', 'lift', 'sort', 'delete', 'tri-new',
@@ -121,22 +120,17 @@ def split_event(toks):
 
 
 def parse_dump_line(line):
-    """(index, rank, kind, fields) of one dump line, or None."""
-    m = EVENT_RE.match(line)
+    """(rank, kind, fields) of one dump line, or None for other lines."""
+    m = EVENT_RE.match(line.strip())
     if not m:
         return None
-    toks = m.group(2).split()
-    for i, tok in enumerate(toks):
-        if tok in KINDS:
-            fields = split_event(toks[i + 1:])
-            rank = None
-            for pre in toks[:i]:
-                r = re.match(r'^(?:r|rank=?)(\d+)$', pre)
-                if r:
-                    rank = r.group(1)
-            fields['@rank'] = rank
-            return int(m.group(1)), tok, fields
-    return None
+    toks = m.group(3).split()
+    if not toks or toks[0] not in KINDS:
+        return None
+    fields = split_event(toks[1:])
+    fields['@rank'] = m.group(1)
+    fields['@seq'] = m.group(2)
+    return m.group(1), toks[0], fields
 
 
 def read_dump(path):
@@ -151,7 +145,8 @@ def read_dump(path):
             e = parse_dump_line(line)
             if e is None:
                 continue
-            idx, kind, fields = e
+            _, kind, fields = e
+            idx = len(order)
             stack = open_phases.setdefault(fields['@rank'], [])
             if kind == 'phase-begin':
                 stack.append((fields['_words'][0] if fields['_words'] else '?',
@@ -305,23 +300,20 @@ def main():
             if ' = ' in line:
                 lhs, rhs = line.rsplit(' = ', 1)
                 ltoks = lhs.split()
-            if toks[0] in ('event', 'at'):
-                n = int(toks[1])
-                if toks[0] == 'at':
-                    n = n - 1 + DUMP_FIRST
+            if toks[0] == 'at':
+                n = int(toks[1]) - 1 + DUMP_FIRST
                 want = parse_fields(toks[3:])
                 if n not in events:
-                    raise AssertionError('no event %d in the dump' % n)
+                    raise AssertionError('the run has only %d events' % len(order))
                 kind, fields, text = events[n]
                 if not match(kind, fields, toks[2], want):
-                    raise AssertionError('event %d is: %s' % (n, text.strip()))
+                    raise AssertionError('event %d is: %s' % (n + 1 - DUMP_FIRST, text.strip()))
             elif toks[0] == 'first':
                 want = parse_fields(ltoks[2:])
                 hits = [i for i in order if match(events[i][0], events[i][1], ltoks[1], want)]
-                got = hits[0] if hits else None
+                got = hits[0] + 1 - DUMP_FIRST if hits else None
                 if got != int(rhs):
-                    raise AssertionError('first such event is %s' % (
-                        events[got][2].strip() if got is not None else 'none'))
+                    raise AssertionError('the first such event is the %s-th' % got)
             elif toks[0] == 'count':
                 want = parse_fields(ltoks[2:])
                 got = sum(1 for i in order if match(events[i][0], events[i][1], ltoks[1], want))

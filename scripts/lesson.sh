@@ -114,7 +114,7 @@ pos_args() {
         end) echo "--end" ;;
         first|last)
             # shellcheck disable=SC2086
-            k=$(python3 "$ROOT/scripts/lesson-check.py" --find "$2" $1) || return 1
+            k=$(python3 -B "$ROOT/scripts/lesson-check.py" --find "$2" $1) || return 1
             echo "--at $k" ;;
         *) echo "lesson: bad viewer position '$1' (at N | phase NAME | end | first/last KIND ...)" >&2; return 1 ;;
     esac
@@ -160,6 +160,12 @@ for run in "${RUNS[@]}"; do
         if ! "${cmd[@]}" >"$rdir/output.txt" 2>"$rdir/log.txt"; then
             echo "lesson: [$run] the run failed: ${cmd[*]}" >&2
             sed 's/^/    /' "$rdir/log.txt" >&2
+            status=1; continue
+        fi
+        got=$(sed -n 's/^ranks = //p' "$trace/manifest" 2>/dev/null)
+        if [ "$got" != "$ranks" ]; then
+            echo "lesson: [$run] mpirun started $ranks processes but the recorded run has '${got:-?}' rank(s):" >&2
+            echo "    this pdt does not run the parallel algorithm under mpirun" >&2
             status=1; continue
         fi
     fi
