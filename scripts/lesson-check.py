@@ -23,6 +23,8 @@ Every line of `checks` states one fact the lesson text relies on.  Lines:
     first KIND [W..] [F=V..] = K
                                 the first matching event is the K-th (counter K)
     count KIND [F=V ...] = M    there are exactly M such events (KIND `*` = any kind)
+    sum KIND FIELD [W..] [F=V..] = V   (or > V)
+                                the FIELD values of the matching events add up to V
     max KIND FIELD [W..] [F=V..] = V
                                 the largest FIELD of the matching events is V
     output-lines = M            the program printed M lines (triangles or hull vertices)
@@ -108,7 +110,9 @@ KINDS = {'phase-begin', 'phase-end', 'push', 'pop', 'lift', 'sort', 'delete', 't
 
 
 def split_event(toks):
-    """Words of an event after its kind -> {'_words': [...], field: value}."""
+    """Words of an event after its kind -> {'_words': [...], field: value}.
+    Three point numbers in a row (a triangle) are rotated to start at the
+    smallest, so that `9 30 28` matches however the triangle is reported."""
     fields = {'_words': []}
     for tok in toks:
         if '=' in tok:
@@ -116,6 +120,13 @@ def split_event(toks):
             fields[k] = v
         else:
             fields['_words'].append(tok)
+    w = fields['_words']
+    for i in range(len(w) - 2):
+        if all(t.isdigit() for t in w[i:i + 3]) and (i + 3 == len(w) or not w[i + 3].isdigit()):
+            tri = w[i:i + 3]
+            k = tri.index(min(tri, key=int))
+            w[i:i + 3] = tri[k:] + tri[:k]
+            break
     return fields
 
 
@@ -297,7 +308,7 @@ def main():
             nchecks += 1
             events, order, out, pts = run_data(run)
             ltoks, rhs = toks, None
-            if ' = ' in line:
+            if ' = ' in line and toks[0] != 'sum':
                 lhs, rhs = line.rsplit(' = ', 1)
                 ltoks = lhs.split()
             if toks[0] == 'at':
@@ -319,6 +330,14 @@ def main():
                 got = sum(1 for i in order if match(events[i][0], events[i][1], ltoks[1], want))
                 if got != int(rhs):
                     raise AssertionError('counted %d' % got)
+            elif toks[0] == 'sum':
+                lhs2, op, val = line.rpartition(' > ') if ' > ' in line else line.rpartition(' = ')
+                lt = lhs2.split()
+                want = parse_fields(lt[3:])
+                got = sum(int(events[i][1].get(lt[2], 0)) for i in order
+                          if match(events[i][0], events[i][1], lt[1], want))
+                if (op == ' > ' and not got > int(val)) or (op == ' = ' and got != int(val)):
+                    raise AssertionError('the sum is %d' % got)
             elif toks[0] == 'max':
                 want = parse_fields(ltoks[3:])
                 vals = [int(events[i][1][ltoks[2]]) for i in order
