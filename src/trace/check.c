@@ -66,6 +66,7 @@ typedef struct chk {
     size_t nmg, capmg;
     u32vec graham_final;    /* last finished Graham stack of rank 0 */
     uint64_t events, pushes, pops, instances, lifts_local, lifts_merge, sorts, hulls;
+    uint64_t edge_scopes;   /* kernel runs whose level-2 edges were replayed */
 } chk;
 
 enum { M_SORTED = 1, M_DELETED = 2, M_PUSHED = 4, M_LIFTED = 8, M_REP = 16 };
@@ -110,12 +111,82 @@ static pdt_status need_pt(chk *c, uint32_t rank, uint64_t seq, const pdt_event *
                 c->npts);
 }
 
+/* A set of undirected edges (key: smaller point << 32 | larger point; 0 is
+ * never a key because the two points differ).  Linear probing with
+ * backward-shift deletion. */
+typedef struct edge_set {
+    uint64_t *k;
+    size_t cap, n;
+} edge_set;
+
+static uint64_t edge_key(uint32_t a, uint32_t b)
+{
+    return a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a;
+}
+
+static size_t edge_slot(const edge_set *e, uint64_t key)
+{
+    uint64_t h = key * 0x9e3779b97f4a7c15u;
+    size_t i = (size_t)(h >> 20) & (e->cap - 1);
+    while (e->k[i] && e->k[i] != key) i = (i + 1) & (e->cap - 1);
+    return i;
+}
+
+static int edge_has(const edge_set *e, uint64_t key)
+{
+    return e->cap && e->k[edge_slot(e, key)] == key;
+}
+
+/* 0 ok, -1 no memory. */
+static int edge_add(edge_set *e, uint64_t key)
+{
+    if (2 * (e->n + 1) > e->cap) {
+        edge_set g = {calloc(e->cap ? 2 * e->cap : 1024, sizeof *g.k), e->cap ? 2 * e->cap : 1024, 0};
+        if (!g.k) return -1;
+        for (size_t i = 0; i < e->cap; i++)
+            if (e->k[i]) g.k[edge_slot(&g, e->k[i])] = e->k[i];
+        g.n = e->n;
+        free(e->k);
+        *e = g;
+    }
+    size_t i = edge_slot(e, key);
+    if (!e->k[i]) {
+        e->k[i] = key;
+        e->n++;
+    }
+    return 0;
+}
+
+static void edge_del(edge_set *e, uint64_t key)
+{
+    size_t i = edge_slot(e, key), j = i;
+    if (!e->k[i]) return;
+    e->k[i] = 0;
+    e->n--;
+    for (;;) {  /* move later entries of the cluster back into the hole */
+        j = (j + 1) & (e->cap - 1);
+        if (!e->k[j]) break;
+        size_t home = (size_t)((e->k[j] * 0x9e3779b97f4a7c15u) >> 20) & (e->cap - 1);
+        if ((j > i && (home <= i || home > j)) || (j < i && home <= i && home > j)) {
+            e->k[i] = e->k[j];
+            e->k[j] = 0;
+            i = j;
+        }
+    }
+}
+
 typedef struct rank_state {
     u32vec stack[256];      /* by stack id */
     u32vec phases;          /* open phases: (phase << 32 would not fit) ids */
     u32vec phase_seq_lo;    /* low 32 bits of the event index of each open phase */
     long open_merge;        /* index into c->mg, or -1 */
     int last_stack;         /* stack id of the latest push or pop, or -1 */
+    /* level 2: the kernel's edges in the current kernel scope (a kernel
+     * phase or a merge step) and the triangles it reported */
+    edge_set edges;
+    u32vec scope_tris;      /* 3 points per TRI_NEW */
+    uint64_t edge_events;   /* in the current scope */
+    uint64_t scope_seq;     /* event that opened the scope */
 } rank_state;
 
 static void rank_state_free(rank_state *s)
@@ -123,6 +194,8 @@ static void rank_state_free(rank_state *s)
     for (int i = 0; i < 256; i++) free(s->stack[i].v);
     free(s->phases.v);
     free(s->phase_seq_lo.v);
+    free(s->edges.k);
+    free(s->scope_tris.v);
 }
 
 /* Graham's stack of rank 0 finished: remember its content. */
@@ -134,11 +207,51 @@ static pdt_status graham_done(chk *c, const u32vec *s)
     return PDT_OK;
 }
 
+static void scope_open(rank_state *rs, uint64_t seq)
+{
+    if (rs->edges.k) memset(rs->edges.k, 0, rs->edges.cap * sizeof *rs->edges.k);
+    rs->edges.n = 0;
+    rs->scope_tris.n = 0;
+    rs->edge_events = 0;
+    rs->scope_seq = seq;
+}
+
+/* End of a kernel scope: with level-2 edge events, the edges alive are
+ * exactly the edges of the triangles the kernel reported. */
+static pdt_status scope_close(chk *c, rank_state *rs, uint32_t r, uint64_t seq,
+                              const pdt_event *e)
+{
+    size_t nt = rs->scope_tris.n / 3;
+    if (!rs->edge_events || nt == 0) return PDT_OK;
+    edge_set tri = {0};
+    pdt_status st = PDT_OK;
+    for (size_t i = 0; i < nt && st == PDT_OK; i++) {
+        const uint32_t *v = rs->scope_tris.v + 3 * i;
+        for (int k = 0; k < 3 && st == PDT_OK; k++) {
+            uint64_t key = edge_key(v[k], v[(k + 1) % 3]);
+            if (!edge_has(&rs->edges, key))
+                st = viol(c, r, seq, e, "edge %" PRIu32 " %" PRIu32 " of triangle %" PRIu32
+                                        " %" PRIu32 " %" PRIu32 " was never added or was deleted",
+                          v[k], v[(k + 1) % 3], v[0], v[1], v[2]);
+            else if (edge_add(&tri, key))
+                st = nomem(c);
+        }
+    }
+    if (st == PDT_OK && tri.n != rs->edges.n)
+        st = viol(c, r, seq, e, "%zu edges alive at the end of the kernel run (begun at event #%"
+                                PRIu64 "), but its %zu triangles have %zu edges",
+                  rs->edges.n, rs->scope_seq, nt, tri.n);
+    free(tri.k);
+    if (st == PDT_OK) c->edge_scopes++;
+    return st;
+}
+
 static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, const pdt_event *e)
 {
     pdt_status st = PDT_OK;
     switch (e->kind) {
     case PDT_EV_PHASE_BEGIN:
+        if (e->sub == PDT_PH_KERNEL) scope_open(rs, seq);
         if (u32_push(&rs->phases, e->sub) || u32_push(&rs->phase_seq_lo, (uint32_t)seq))
             return nomem(c);
         break;
@@ -151,6 +264,29 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
         }
         rs->phases.n--;
         rs->phase_seq_lo.n--;
+        if (e->sub == PDT_PH_KERNEL) return scope_close(c, rs, r, seq, e);
+        break;
+    case PDT_EV_EDGE_ADD:
+    case PDT_EV_EDGE_DEL: {
+        if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
+        if ((st = need_pt(c, r, seq, e, e->b)) != PDT_OK) return st;
+        if (e->a == e->b) return viol(c, r, seq, e, "an edge from a point to itself");
+        uint64_t key = edge_key(e->a, e->b);
+        int alive = edge_has(&rs->edges, key);
+        rs->edge_events++;
+        if (e->kind == PDT_EV_EDGE_ADD) {
+            if (alive) return viol(c, r, seq, e, "the edge already exists");
+            if (edge_add(&rs->edges, key)) return nomem(c);
+        } else {
+            if (!alive) return viol(c, r, seq, e, "the edge does not exist");
+            edge_del(&rs->edges, key);
+        }
+        break;
+    }
+    case PDT_EV_TRI_NEW:
+        if (u32_push(&rs->scope_tris, e->a) || u32_push(&rs->scope_tris, e->b) ||
+            u32_push(&rs->scope_tris, e->c))
+            return nomem(c);
         break;
     case PDT_EV_PUSH: {
         u32vec *s = &rs->stack[e->sub];
@@ -261,6 +397,7 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
         if (grow((void **)&c->mg, &c->capmg, c->nmg, sizeof *c->mg)) return nomem(c);
         c->mg[c->nmg] = (merge){e->sub, e->a, e->b, e->c, r, seq, 0, 0, 0};
         rs->open_merge = (long)c->nmg++;
+        scope_open(rs, seq);
         break;
     case PDT_EV_MERGE_END: {
         if (rs->open_merge < 0) return viol(c, r, seq, e, "no merge step is open");
@@ -276,7 +413,7 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
                         m->discards);
         m->closed = 1;
         rs->open_merge = -1;
-        break;
+        return scope_close(c, rs, r, seq, e);
     }
     case PDT_EV_SEND:
     case PDT_EV_RECV: {
@@ -523,10 +660,11 @@ pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
         snprintf(summary, cap,
                  "%d rank%s, %" PRIu64 " events: %" PRIu64 " stack instances (%" PRIu64
                  " pushes, %" PRIu64 " pops, %" PRIu64 " chain hulls), %" PRIu64 " local + %" PRIu64
-                 " merge lift-ups, %zu final triangles%s, %zu merge steps, %zu messages",
+                 " merge lift-ups, %zu final triangles%s, %zu merge steps, %zu messages, "
+                 "%" PRIu64 " kernel runs with edges replayed",
                  pdt_run_nranks(run), pdt_run_nranks(run) == 1 ? "" : "s", c.events, c.instances,
                  c.pushes, c.pops, c.hulls, c.lifts_local, c.lifts_merge, c.nfin,
-                 c.is_tri ? " = T*" : "", c.nmg, c.nmsg / 2);
+                 c.is_tri ? " = T*" : "", c.nmg, c.nmsg / 2, c.edge_scopes);
     free(c.mark);
     free(c.fin);
     free(c.msg);

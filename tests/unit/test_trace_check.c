@@ -211,6 +211,17 @@ TEST(removed_events_are_named)
     copy_run(sub("baseh"), sub("nopush"), k, UINT64_MAX, NULL);
     expect_fail(sub("nopush"), "depth after push should be");
 
+    /* level 2: the kernel's edges replay to exactly the triangles' edges */
+    record_tri(sub("base-l2"), pts, 500, 2);
+    CHECK_MSG(check_dir(sub("base-l2"), msg, sizeof msg) == PDT_OK, "%s", msg);
+    CHECK_MSG(strstr(msg, "1 kernel runs with edges replayed") != NULL, "%s", msg);
+    k = find_kind(sub("base-l2"), PDT_EV_EDGE_DEL, 20);
+    copy_run(sub("base-l2"), sub("noedgedel"), k, UINT64_MAX, NULL);
+    expect_fail(sub("noedgedel"), "rank 0 event #");
+    k = find_kind(sub("base-l2"), PDT_EV_EDGE_ADD, 30);
+    copy_run(sub("base-l2"), sub("noedgeadd"), k, UINT64_MAX, NULL);
+    expect_fail(sub("noedgeadd"), "rank 0 event #");
+
     k = find_kind(sub("baseh"), PDT_EV_DELETE, 0);
     if (k != UINT64_MAX) {
         copy_run(sub("baseh"), sub("nodelete"), k, UINT64_MAX, NULL);
