@@ -97,6 +97,7 @@ typedef struct pdt_par_rank_stats {
     uint64_t merge_bytes_sent, merge_bytes_recv; /* merge-step traffic only */
     double t_partition, t_local, t_classify, t_merge, t_gather; /* seconds */
     double critical_path;   /* seconds: longest chain of dependent compute ending here */
+    double critical_cpu;    /* the same chain in CPU seconds */
     int64_t peak_rss_kib;   /* peak resident memory of this rank's process */
 } pdt_par_rank_stats;
 
@@ -109,6 +110,7 @@ typedef struct pdt_par_stats {
     uint64_t bytes_total;     /* sum of bytes sent by all ranks */
     uint64_t merge_bytes;     /* sum of merge-step bytes sent */
     double critical_path;     /* seconds, max over ranks */
+    double critical_cpu;      /* CPU seconds, max over ranks */
     double t_total;           /* seconds, driver wall time at rank 0 */
     pdt_par_rank_stats *rank; /* nranks entries (malloc'd; pdt_par_stats_free) */
 } pdt_par_stats;

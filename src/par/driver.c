@@ -495,6 +495,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, p
     me.st.merge_bytes_recv = d.merge_recv;
     me.st.t_gather = t_end - t_merge;
     me.st.critical_path = s.cnt.critical_path;
+    me.st.critical_cpu = s.cnt.critical_cpu;
     {
         struct rusage ru;
         me.st.peak_rss_kib = getrusage(RUSAGE_SELF, &ru) == 0 ? (int64_t)ru.ru_maxrss : -1;
@@ -528,6 +529,8 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, p
                 stats->merge_bytes += rp->st.merge_bytes_sent;
                 if (rp->st.critical_path > stats->critical_path)
                     stats->critical_path = rp->st.critical_path;
+                if (rp->st.critical_cpu > stats->critical_cpu)
+                    stats->critical_cpu = rp->st.critical_cpu;
                 if (rp->st.border_max > stats->border_max) stats->border_max = rp->st.border_max;
                 if (rp->holds_final_hull) {
                     stats->hull = rp->hull;
@@ -568,7 +571,8 @@ void pdt_par_stats_json(const pdt_par_stats *s, FILE *f)
             "\"largest_border_set\": %llu, \"largest_border_set_rel_n\": %.6f, "
             "\"sequential_merge\": %s, "
             "\"bytes_total\": %llu, \"merge_bytes\": %llu, \"merge_bytes_rel_input\": %.6f, "
-            "\"critical_path_s\": %.6f, \"time_s\": %.6f,\n \"per_rank\": [",
+            "\"critical_path_s\": %.6f, \"critical_path_cpu_s\": %.6f, \"time_s\": %.6f,\n"
+            " \"per_rank\": [",
             s->nranks, (unsigned long long)s->n_in, (unsigned long long)s->n_unique,
             (unsigned long long)s->n_dup, (unsigned long long)s->n_tri,
             (unsigned long long)s->hull, s->collinear ? "true" : "false",
@@ -577,6 +581,7 @@ void pdt_par_stats_json(const pdt_par_stats *s, FILE *f)
             s->n_unique >= 64 && 2 * s->border_max > s->n_unique ? "true" : "false",
             (unsigned long long)s->bytes_total, (unsigned long long)s->merge_bytes,
             s->n_in ? (double)s->merge_bytes / (8.0 * (double)s->n_in) : 0.0, s->critical_path,
+            s->critical_cpu,
             s->t_total);
     for (int q = 0; q < s->nranks; q++) {
         const pdt_par_rank_stats *r = &s->rank[q];

@@ -12,6 +12,7 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "pdt/delaunay.h"
 #include "pdt/hull.h"
@@ -26,7 +27,7 @@
  * triangle for coordinates below 2^20, instead of 12 and 12. */
 typedef struct msg_head {
     uint32_t magic, level, npts, ntri, nhull, flags, payload, reserved;
-    double cp;
+    double cp, cp_cpu;
 } msg_head;
 
 static size_t put_varint(unsigned char *b, uint64_t v)
@@ -71,6 +72,15 @@ static int msb(unsigned v)
 static double now(const srm_rank *s)
 {
     return s->clock ? s->clock(s->clock_user) : 0.0;
+}
+
+/* CPU seconds of this thread (srm_local and srm_merge never wait for
+ * messages, so this is their compute time whatever the machine's load). */
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 static pdt_status nomem(pdt_err *err, int rank, const char *what)
@@ -179,7 +189,7 @@ pdt_status srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid, siz
                      pdt_err *err)
 {
     pdt_trace *tr = s->tr;
-    double t0 = now(s);
+    double t0 = now(s), c0 = cpu_now();
     /* lift-up */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_LIFT, 0, 0, 0, 0);
     if (PDT_TRACING(tr, 1))
@@ -259,6 +269,7 @@ pdt_status srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid, siz
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_CLASSIFY, 0, 0, 0, 0);
     free(tris);
     s->cnt.critical_path += now(s) - t0;
+    s->cnt.critical_cpu += cpu_now() - c0;
     return PDT_OK;
 }
 
@@ -340,7 +351,8 @@ pdt_status srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *er
                        (send_hull && s->hull_degenerate ? MSG_HULL_DEGENERATE : 0u),
                    (uint32_t)(w - b - sizeof(msg_head)),
                    0,
-                   s->cnt.critical_path};
+                   s->cnt.critical_path,
+                   s->cnt.critical_cpu};
     memcpy(b, &hd, sizeof hd);
     if (send_hull) {
         s->holds_hull = 0;
@@ -487,13 +499,14 @@ pdt_status srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len
     if (!mv) return nomem(err, s->rank, "merge");
     PDT_TRACE(tr, 1, PDT_EV_MERGE_BEGIN, level, gl, gr, ge, s->rank);
 
-    double cp_in = s->cnt.critical_path;
+    double cp_in = s->cnt.critical_path, cpu_in = s->cnt.critical_cpu, c0 = cpu_now();
     size_t nship = 0, nshipL = 0, nbmax = 0;
     int hl = -1, hr = -1;
     for (int i = 0; i < nm; i++) {
         st = decode(msg[i], len[i], level, gl + i, &mv[i], err);
         if (st != PDT_OK) goto done;
         if (mv[i].h.cp > cp_in) cp_in = mv[i].h.cp;
+        if (mv[i].h.cp_cpu > cpu_in) cpu_in = mv[i].h.cp_cpu;
         nship += mv[i].h.ntri;
         if (gl + i < gr) nshipL += mv[i].h.ntri;
         nbmax += 3 * (size_t)mv[i].h.ntri + 2 * (size_t)mv[i].h.nhull;
@@ -696,6 +709,7 @@ pdt_status srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len
     PDT_TRACE(tr, 1, PDT_EV_MERGE_END, level, ns, nb, kept, (int64_t)ndisc);
     (void)nshipL;
     s->cnt.critical_path = cp_in + (now(s) - t0);
+    s->cnt.critical_cpu = cpu_in + (cpu_now() - c0);
 
 done:
     for (int i = 0; i < nm; i++) msg_view_free(&mv[i]);

@@ -101,6 +101,7 @@ typedef struct srm_counts {
     uint64_t local_tris, final_at_once, deferred, shipped, merges, border_max, kept, discarded,
         final_merge;
     double critical_path; /* compute seconds along the longest dependent chain */
+    double critical_cpu;  /* the same chain in CPU seconds (insensitive to load) */
 } srm_counts;
 
 typedef struct srm_rank {
