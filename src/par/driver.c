@@ -470,7 +470,9 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, p
     if (r == 0) {
         for (int q = 1; q < p; q++)
             if (counts[q]) note_recv(&d, TAG_GATHER, q, counts[q]);
-        st = merge_blocks(&all, counts, p, total, err);
+        int blocks = 0;
+        for (int q = 0; q < p; q++) blocks += counts[q] != 0;
+        if (blocks > 1) st = merge_blocks(&all, counts, p, total, err);
         if (st != PDT_OK) goto done;
     } else if (s.nfin) {
         note_send(&d, TAG_GATHER, 0, s.nfin * sizeof(pdt_tri));

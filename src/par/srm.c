@@ -243,8 +243,10 @@ pdt_status srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid, siz
     PDT_TRACE(tr, 1, PDT_EV_HULL, 0, nh, deg, 0, 0);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_HULL, 0, 0, 0, 0);
 
-    /* classification: final at once, or deferred until a merge level */
+    /* classification: final at once, or deferred until a merge level (with
+     * no other strip at all, everything is final without a test) */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_CLASSIFY, 0, 0, 0, 0);
+    int alone = s->nne == 0 || (s->nne == 1 && s->nonempty[0] == s->rank);
     for (size_t i = 0; i < ntri; i++) {
         srm_pt v[3];
         for (int k = 0; k < 3; k++) {
@@ -252,7 +254,7 @@ pdt_status srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid, siz
             v[k] = (srm_pt){pts[j].x, pts[j].y, gid[j]};
         }
         int who;
-        int lev = send_level(s, s->rank, 0, v[0], v[1], v[2], &who);
+        int lev = alone ? -1 : send_level(s, s->rank, 0, v[0], v[1], v[2], &who);
         if (lev < 0) {
             st = add_final(s, v[0], v[1], v[2]);
             s->cnt.final_at_once++;

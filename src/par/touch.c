@@ -12,7 +12,8 @@
  * c' = c - a are exact int64 (|.| < 2^32), and the circumcentre is
  * u = (Nx / D, Ny / D) with D = 2 (b'x c'y - b'y c'x),
  * Nx = c'y |b'|^2 - b'y |c'|^2, Ny = b'x |c'|^2 - c'x |b'|^2.  All three are
- * EXACT in __int128 (|N| < 2^99).  Converting them to double and dividing
+ * EXACT in __int128 (|N| < 2^99), and already in int64 when every difference
+ * is below 2^20 (|N| < 2^62; the common, faster case).  Converting them to double and dividing
  * gives each coordinate of u with relative error <= 3 eps (eps = 2^-53), so the
  * computed centre is within 5 eps |u| of the true one and the computed
  * radius |u| within 6 eps |u| of rho.  Distances to a box are then computed
@@ -45,19 +46,33 @@ void srm_disk_of(srm_disk *d, srm_pt a, srm_pt b, srm_pt c)
     d->all = 0;
     int64_t bx = (int64_t)b.x - a.x, by = (int64_t)b.y - a.y;
     int64_t cx = (int64_t)c.x - a.x, cy = (int64_t)c.y - a.y;
-    __int128 D = 2 * ((__int128)bx * cy - (__int128)by * cx);
-    if (D == 0) {
-        d->all = 1;
-        d->ox = d->oy = d->r = 0;
-        return;
+    const int64_t small = (int64_t)1 << 20;
+    if (bx > -small && bx < small && by > -small && by < small && cx > -small && cx < small &&
+        cy > -small && cy < small) {
+        /* the same exact values in int64: |D| < 2^42, |b|^2 < 2^41, |N| < 2^62 */
+        int64_t D = 2 * (bx * cy - by * cx);
+        if (D == 0) {
+            d->all = 1;
+            d->ox = d->oy = d->r = 0;
+            return;
+        }
+        int64_t b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+        d->ox = (double)(cy * b2 - by * c2) / (double)D;
+        d->oy = (double)(bx * c2 - cx * b2) / (double)D;
+    } else {
+        __int128 D = 2 * ((__int128)bx * cy - (__int128)by * cx);
+        if (D == 0) {
+            d->all = 1;
+            d->ox = d->oy = d->r = 0;
+            return;
+        }
+        __int128 b2 = (__int128)bx * bx + (__int128)by * by;
+        __int128 c2 = (__int128)cx * cx + (__int128)cy * cy;
+        __int128 nx = (__int128)cy * b2 - (__int128)by * c2;
+        __int128 ny = (__int128)bx * c2 - (__int128)cx * b2;
+        d->ox = (double)nx / (double)D;
+        d->oy = (double)ny / (double)D;
     }
-    __int128 b2 = (__int128)bx * bx + (__int128)by * by;
-    __int128 c2 = (__int128)cx * cx + (__int128)cy * cy;
-    __int128 nx = (__int128)cy * b2 - (__int128)by * c2;
-    __int128 ny = (__int128)bx * c2 - (__int128)cx * b2;
-    double dd = (double)D;
-    d->ox = (double)nx / dd;
-    d->oy = (double)ny / dd;
     double rho = sqrt(d->ox * d->ox + d->oy * d->oy);
     double scale = rho + fabs(d->ox) + fabs(d->oy);
     d->r = rho + MARGIN * scale;
