@@ -176,11 +176,11 @@ static pdt_status read_node(reader *r)
                                    "markers; must be 0 or 1", c->name, c->line, (long long)nmark);
         }
     }
-    if ((st = end_of_line(r, "the .node header (count, 2, attributes, markers)")) != PDT_OK)
-        return st;
-    if (count >= UINT32_MAX)
+    if (count >= UINT32_MAX)  /* before end_of_line, which moves to the next line */
         return pdt_err_set(err, PDT_ERR_PARSE, "%s:%zu: too many points (at most %u)", c->name,
                            c->line, (unsigned)(UINT32_MAX - 1));
+    if ((st = end_of_line(r, "the .node header (count, 2, attributes, markers)")) != PDT_OK)
+        return st;
 
     int64_t base = 0;
     for (int64_t i = 0; i < count; i++) {
