@@ -108,9 +108,9 @@ echo "3. There is no display here, so the key moments are drawn as pictures inst
 if [ "$NP" -gt 1 ]; then
     shots=(
         "01-points|at 1|the points, before anything happened"
-        "02-strips|last phase-end partition|the points shared out into $NP vertical strips, one colour per process"
-        "03-local|last phase-end kernel|each strip triangulated on its own"
-        "04-restricted|last phase-end classify|restricted areas: solid triangles are final, dashed ones wait for a merge"
+        "02-strips|last phase-end partition|the last process has received its strip (one colour per process); the others, served earlier, are already further on — each runs at its own pace"
+        "03-local|last phase-end kernel|the last process has triangulated its strip"
+        "04-restricted|last phase-end classify|the last process has tested its triangles' restricted areas: solid ones are final, dashed ones wait for a merge"
         "05-merge|first merge-end|the first merge step: triangles near a seam re-done, non-Delaunay ones crossed out"
         "06-end|end|the finished Delaunay triangulation"
     )
@@ -135,7 +135,7 @@ for s in "${shots[@]}"; do
     # shellcheck disable=SC2086
     if [ -n "$args" ] && "$BIN/pdtview" --headless "$run" $args -o "$frames/$name.png" >>"$OUT/log.txt" 2>&1; then
         echo "   $frames/$name.png"
-        echo "       $what"
+        echo "$what" | fold -s -w 70 | sed 's/^/       /'
     else
         echo "   could not draw $name (see $OUT/log.txt)" >&2
         fail=1

@@ -30,4 +30,26 @@ if [ -x "$BIN/pdtview" ]; then
 else
     ok "demo: frames # SKIP pdtview is not built"
 fi
+# with a display the demo opens the viewer on the recorded run (Xvfb; a
+# wrapper quits the viewer at once)
+if [ -x "$BIN/pdtview" ] && command -v Xvfb >/dev/null; then
+    dpy=:$((50 + RANDOM % 200))
+    Xvfb "$dpy" -screen 0 1280x800x24 >/dev/null 2>&1 &
+    xpid=$!
+    sleep 1
+    mkdir -p "$TMP/bin"
+    ln -s "$BIN/pdt" "$TMP/bin/pdt"
+    printf '#!/bin/bash\necho "$*" >"%s/pv.log"\nexec "%s" "$@" --script "q"\n' "$TMP" "$BIN/pdtview" \
+        >"$TMP/bin/pdtview"
+    chmod +x "$TMP/bin/pdtview"
+    if DISPLAY=$dpy BIN=$TMP/bin OUT=$TMP/demo-win timeout 60 bash "$ROOT/scripts/demo.sh" \
+            >"$TMP/demo-win.log" 2>&1 && grep -q "$TMP/demo-win/run" "$TMP/pv.log"; then
+        ok "demo with a display opens pdtview on the recorded run"
+    else
+        fail "demo with a display" "$(tail -3 "$TMP/demo-win.log")"
+    fi
+    kill "$xpid" 2>/dev/null; wait "$xpid" 2>/dev/null
+else
+    ok "demo with a display # SKIP no pdtview or no Xvfb"
+fi
 summary

@@ -81,4 +81,25 @@ assert flows == int(sys.argv[2]), (flows, sys.argv[2])
 EOF_PY
 then ok "09-replay: Chrome export has 8 rows and one flow arrow per message"
 else fail "09-replay: Chrome export" "$(tail -3 "$TMP/export.log")"; fi
+# with a display, lesson.sh opens the viewer at the lesson's start (Xvfb; the
+# viewer is driven by a wrapper that quits at once and saves a screenshot)
+if [ "$have_view" = 1 ] && command -v Xvfb >/dev/null; then
+    dpy=:$((50 + RANDOM % 200))
+    Xvfb "$dpy" -screen 0 1280x800x24 >/dev/null 2>&1 &
+    xpid=$!
+    sleep 1
+    printf '#!/bin/bash\necho "$*" >>"%s/pv.log"\nexec "%s" "$@" --script "s q" --screenshot "%s/pv.png"\n' \
+        "$TMP" "$BIN/pdtview" "$TMP" >"$TMP/pv.sh"
+    chmod +x "$TMP/pv.sh"
+    if DISPLAY=$dpy PDTVIEW=$TMP/pv.sh timeout 60 bash "$ROOT/scripts/lesson.sh" --out "$TMP/win" \
+            "$ROOT/lessons/01-orientation" >"$TMP/win.log" 2>&1 &&
+       grep -q -- "--phase graham-scan" "$TMP/pv.log" && [ -s "$TMP/pv.png" ]; then
+        ok "lesson.sh with a display opens pdtview at the lesson's start"
+    else
+        fail "lesson.sh with a display" "$(tail -3 "$TMP/win.log")"
+    fi
+    kill "$xpid" 2>/dev/null; wait "$xpid" 2>/dev/null
+else
+    ok "lesson.sh with a display # SKIP no pdtview or no Xvfb"
+fi
 summary
