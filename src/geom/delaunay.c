@@ -527,10 +527,17 @@ void pdt_tri_canonical(pdt_tri *tris, size_t ntri)
     for (size_t i = 0; i < ntri; i++) cnt[tris[i].v[0] + 1]++;
     for (size_t b = 1; b < nb; b++) cnt[b] += cnt[b - 1];
     for (size_t i = 0; i < ntri; i++) tmp[cnt[tris[i].v[0]]++] = tris[i];
-    /* cnt[v] is now the end of bucket v; insertion sort within buckets */
+    /* cnt[v] is now the end of bucket v; sort within buckets (insertion sort
+     * for short ones, qsort for long ones: a vertex of huge degree must not
+     * make this quadratic) */
     size_t start = 0;
     for (size_t b = 0; b + 1 < nb; b++) {
         size_t end = cnt[b];
+        if (end - start > 32) {
+            qsort(tmp + start, end - start, sizeof *tmp, tri_qcmp);
+            start = end;
+            continue;
+        }
         for (size_t i = start + 1; i < end; i++) {
             pdt_tri v = tmp[i];
             size_t j = i;

@@ -8,6 +8,7 @@
 #include "pdt/predicates.h"
 
 #include <string.h>
+#include <time.h>
 
 static pdt_point P(int x, int y)
 {
@@ -356,6 +357,35 @@ TEST(symmetric_parabola_and_circle_large)
     free(p);
 }
 
+static double cpu_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+TEST(high_degree_vertex)
+{
+    /* a line of n points and one apex joined to all of them: the apex (index
+     * 0, so every triangle starts with it in canonical order) once made the
+     * canonical sort quadratic (minutes for 10^6); now linearithmic */
+    size_t n = 300000, nt;
+    pdt_point *p = malloc(n * sizeof *p);
+    for (size_t i = 0; i < n; i++) p[i] = P((int)i, 0);
+    p[0] = P(1000, 7);
+    pdt_tri *t;
+    double c0 = cpu_seconds();
+    CHECK(pdt_triangulate(p, n, &t, &nt, NULL, NULL) == PDT_OK);
+    double c1 = cpu_seconds();
+    CHECK(nt == n - 2);
+    int bad = 0;
+    for (size_t i = 0; i < nt; i++) bad += t[i].v[0] != 0 || (i && t[i - 1].v[1] >= t[i].v[1]);
+    CHECK_MSG(bad == 0, "%d triangles out of canonical order", bad);
+    CHECK_MSG(c1 - c0 < 5.0, "%.2f s of CPU time for %zu points", c1 - c0, n);
+    free(t);
+    free(p);
+}
+
 int main(void)
 {
     RUN(oracle_every_gen_family);
@@ -374,5 +404,6 @@ int main(void)
     RUN(canonical_order);
     RUN(trace_events);
     RUN(symmetric_parabola_and_circle_large);
+    RUN(high_degree_vertex);
     return test_summary();
 }
