@@ -67,6 +67,8 @@ typedef struct chk {
     u32vec graham_final;    /* last finished Graham stack of rank 0 */
     uint64_t events, pushes, pops, instances, lifts_local, lifts_merge, sorts, hulls;
     uint64_t edge_scopes;   /* kernel runs whose level-2 edges were replayed */
+    /* the strip of each rank: lexicographic keys of its local lift-ups */
+    uint64_t *kmin, *kmax, *nlocal;
 } chk;
 
 enum { M_SORTED = 1, M_DELETED = 2, M_PUSHED = 4, M_LIFTED = 8, M_REP = 16 };
@@ -331,6 +333,10 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
             break;
         }
         c->lifts_local++;
+        uint64_t key = pdt_key(p);
+        if (!c->nlocal[r] || key < c->kmin[r]) c->kmin[r] = key;
+        if (!c->nlocal[r] || key > c->kmax[r]) c->kmax[r] = key;
+        c->nlocal[r]++;
         if (!(c->mark[e->a] & M_REP))
             return viol(c, r, seq, e, "pt %" PRIu32 " is a duplicate of an earlier input point "
                                       "and should not be lifted", e->a);
@@ -608,10 +614,14 @@ pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
     c.is_tri = !strcmp(m->command, "triangulate");
     c.is_hull = !strcmp(m->command, "hull");
     c.mark = calloc(c.npts ? c.npts : 1, 1);
+    size_t nr = (size_t)pdt_run_nranks(run);
+    c.kmin = calloc(nr, sizeof *c.kmin);
+    c.kmax = calloc(nr, sizeof *c.kmax);
+    c.nlocal = calloc(nr, sizeof *c.nlocal);
     uint32_t *order = malloc((c.npts ? c.npts : 1) * sizeof *order);
     size_t nu = 0;
     pdt_status st = PDT_OK;
-    if (!c.mark || !order) st = nomem(&c);
+    if (!c.mark || !order || !c.kmin || !c.kmax || !c.nlocal) st = nomem(&c);
     else if ((st = pdt_sort_unique(c.pts, c.npts, order, &nu)) != PDT_OK)
         pdt_err_set(err, st, "sorting the run's points failed: %s", pdt_status_str(st));
     for (size_t i = 0; st == PDT_OK && i < nu; i++) c.mark[order[i]] |= M_REP;
@@ -626,6 +636,15 @@ pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
             if ((c.mark[i] & M_REP) && !(c.mark[i] & M_LIFTED))
                 st = viol(&c, 0, 0, NULL, "pt %zu was never lifted (%" PRIu64 " local lift-ups "
                                           "for %zu distinct points)", i, c.lifts_local, nu);
+    }
+    /* strips: the ranks' local points are consecutive lexicographic blocks */
+    for (size_t r = 0, prev = SIZE_MAX; st == PDT_OK && c.is_tri && r < nr; r++) {
+        if (!c.nlocal[r]) continue;
+        if (prev != SIZE_MAX && c.kmin[r] <= c.kmax[prev])
+            st = viol(&c, 0, 0, NULL, "the local lift-ups of rank %zu (%" PRIu64 " points) are not "
+                                      "a lexicographic block after those of rank %zu: the strips "
+                                      "overlap", r, c.nlocal[r], prev);
+        prev = r;
     }
     if (st == PDT_OK && c.is_tri) st = check_finals(&c);
     if (st == PDT_OK && c.is_hull) {
@@ -666,6 +685,9 @@ pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
                  c.pushes, c.pops, c.hulls, c.lifts_local, c.lifts_merge, c.nfin,
                  c.is_tri ? " = T*" : "", c.nmg, c.nmsg / 2, c.edge_scopes);
     free(c.mark);
+    free(c.kmin);
+    free(c.kmax);
+    free(c.nlocal);
     free(c.fin);
     free(c.msg);
     free(c.mg);

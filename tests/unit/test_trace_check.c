@@ -293,9 +293,11 @@ TEST(damaged_files_fail)
 }
 
 /* Synthetic two-rank runs: messages and merge steps. */
-static void two_ranks(const char *dir, int with_recv, int with_merge_end)
+static void two_ranks(const char *dir, int with_recv, int with_merge_end, int swap)
 {
-    static const pdt_point pts[3] = {{0, 0}, {4, 0}, {0, 4}};
+    /* lexicographic order, or (swap) points 1 and 2 exchanged */
+    static const pdt_point lex[3] = {{0, 0}, {0, 4}, {4, 0}}, sw[3] = {{0, 0}, {4, 0}, {0, 4}};
+    const pdt_point *pts = swap ? sw : lex;
     pdt_trace_writer *w0, *w1;
     pdt_err err = {0};
     CHECK(pdt_tw_open(dir, 0, 1, &w0, &err) == PDT_OK);
@@ -308,7 +310,7 @@ static void two_ranks(const char *dir, int with_recv, int with_merge_end)
     if (with_recv) PDT_TRACE(t1, 1, PDT_EV_RECV, 5, 0, 24, 0, 0);
     PDT_TRACE(t1, 1, PDT_EV_MERGE_BEGIN, 0, 0, 1, 2, 1);
     for (uint32_t i = 0; i < 3; i++) PDT_TRACE(t1, 1, PDT_EV_LIFT, 0, i, 0, 0, i ? 16 : 0);
-    PDT_TRACE(t1, 1, PDT_EV_TRI_FINAL, 0, 0, 1, 2, 0);
+    PDT_TRACE(t1, 1, PDT_EV_TRI_FINAL, 0, 0, swap ? 1 : 2, swap ? 2 : 1, 0);
     if (with_merge_end) PDT_TRACE(t1, 1, PDT_EV_MERGE_END, 0, 0, 3, 1, 0);
     CHECK(pdt_tw_close(w0, &err) == PDT_OK);
     CHECK(pdt_tw_close(w1, &err) == PDT_OK);
@@ -318,13 +320,17 @@ static void two_ranks(const char *dir, int with_recv, int with_merge_end)
 TEST(messages_and_merges)
 {
     char msg[1100];
-    two_ranks(sub("msg-ok"), 1, 1);
+    two_ranks(sub("msg-ok"), 1, 1, 0);
     CHECK_MSG(check_dir(sub("msg-ok"), msg, sizeof msg) == PDT_OK, "%s", msg);
     CHECK_MSG(strstr(msg, "1 merge steps, 1 messages") != NULL, "%s", msg);
-    two_ranks(sub("msg-norecv"), 0, 1);
+    two_ranks(sub("msg-norecv"), 0, 1, 0);
     expect_fail(sub("msg-norecv"), "(send tag=5 to=1 bytes=24 seq=0): no matching recv on rank 1");
-    two_ranks(sub("msg-noend"), 1, 0);
+    two_ranks(sub("msg-noend"), 1, 0, 0);
     expect_fail(sub("msg-noend"), "never ends");
+    /* strips must be consecutive lexicographic blocks: swap two points */
+    two_ranks(sub("strips"), 1, 1, 1);
+    expect_fail(sub("strips"), "the local lift-ups of rank 1 (1 points) are not a lexicographic "
+                               "block after those of rank 0");
 }
 
 /* A monotone chain (lower stack 0 1 2, upper stack 2 ... 0) followed by its
