@@ -110,7 +110,8 @@ pdt_status pdt_run_write_meta(const char *dir, const pdt_manifest *m, const pdt_
 
 typedef struct pdt_run pdt_run;
 
-/* One event with the rank that recorded it. */
+/* One event with the rank that recorded it.  Reader times are aligned:
+ * t + clock_offset_ns[rank] - min(0, smallest offset) (never negative). */
 typedef struct pdt_rec {
     pdt_event ev;   /* ev.t aligned with the manifest's clock offsets */
     uint32_t rank;
@@ -120,7 +121,10 @@ typedef struct pdt_rec {
 /* Open a run folder: the manifest, the points, every rank file (memory-mapped).
  * Damaged files are read up to their last intact block; what was lost is
  * described by pdt_run_warnings() instead of failing the whole open.  Fails
- * only when nothing usable is there (no manifest, wrong major version, ...). */
+ * only when nothing usable is there (neither manifest nor rank-0000.trace,
+ * another major version, out of memory); without a manifest the rank files
+ * found are read with a warning.  The caller owns *run (pdt_run_close).
+ * A pdt_run is not thread-safe (decoding is lazy); a writer is not either. */
 pdt_status pdt_run_open(const char *dir, pdt_run **run, pdt_err *err);
 void pdt_run_close(pdt_run *run);
 
@@ -129,7 +133,9 @@ const pdt_point *pdt_run_points(const pdt_run *run, size_t *n);
 /* Text describing damage found while opening ("" if none). */
 const char *pdt_run_warnings(const pdt_run *run);
 
-/* All events of one rank, decoded, in recording order (owned by run). */
+/* All events of one rank, decoded (aligned times), in recording order; owned
+ * by run, valid until pdt_run_close.  Memory: 40 bytes per event (use a
+ * cursor for very large ranks). */
 pdt_status pdt_run_rank_events(pdt_run *run, int rank, const pdt_event **ev, size_t *n,
                                pdt_err *err);
 
