@@ -33,10 +33,11 @@ fi
 # with a display the demo opens the viewer on the recorded run (Xvfb; a
 # wrapper quits the viewer at once)
 if [ -x "$BIN/pdtview" ] && command -v Xvfb >/dev/null; then
-    dpy=:$((50 + RANDOM % 200))
-    Xvfb "$dpy" -screen 0 1280x800x24 >/dev/null 2>&1 &
+    # -displayfd: Xvfb picks a free display and writes its number when ready
+    Xvfb -displayfd 3 -screen 0 1280x800x24 3>"$TMP/xvfb.num" >/dev/null 2>&1 &
     xpid=$!
-    sleep 1
+    for _ in $(seq 100); do [ -s "$TMP/xvfb.num" ] && break; sleep 0.1; done
+    dpy=:$(head -1 "$TMP/xvfb.num")
     mkdir -p "$TMP/bin"
     ln -s "$BIN/pdt" "$TMP/bin/pdt"
     printf '#!/bin/bash\necho "$*" >"%s/pv.log"\nexec "%s" "$@" --script "q"\n' "$TMP" "$BIN/pdtview" \

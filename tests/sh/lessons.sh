@@ -84,10 +84,11 @@ else fail "09-replay: Chrome export" "$(tail -3 "$TMP/export.log")"; fi
 # with a display, lesson.sh opens the viewer at the lesson's start (Xvfb; the
 # viewer is driven by a wrapper that quits at once and saves a screenshot)
 if [ "$have_view" = 1 ] && command -v Xvfb >/dev/null; then
-    dpy=:$((50 + RANDOM % 200))
-    Xvfb "$dpy" -screen 0 1280x800x24 >/dev/null 2>&1 &
+    # -displayfd: Xvfb picks a free display and writes its number when ready
+    Xvfb -displayfd 3 -screen 0 1280x800x24 3>"$TMP/xvfb.num" >/dev/null 2>&1 &
     xpid=$!
-    sleep 1
+    for _ in $(seq 100); do [ -s "$TMP/xvfb.num" ] && break; sleep 0.1; done
+    dpy=:$(head -1 "$TMP/xvfb.num")
     printf '#!/bin/bash\necho "$*" >>"%s/pv.log"\nexec "%s" "$@" --script "s q" --screenshot "%s/pv.png"\n' \
         "$TMP" "$BIN/pdtview" "$TMP" >"$TMP/pv.sh"
     chmod +x "$TMP/pv.sh"
