@@ -92,4 +92,13 @@ else fail collinear_input_zero_triangles "rc=$rc $(head -3 c.err)"; fi
 mpirun -np 3 "$PDT" triangulate cl.txt -o cl.tri --stats > /dev/null 2> cl.err; rc=$?
 if [ $rc -eq 0 ] && cmp -s cl.ref cl.tri && grep -q '"per_rank"' cl.err; then ok stats_run_3_ranks
 else fail stats_run_3_ranks "rc=$rc $(head -5 cl.err)"; fi
+# --- the partition balances by count even when every point has the same x
+seq 0 7999 | awk '{ print 5, ($1 * 7919) % 100003 }' > col8k.txt   # one vertical line, shuffled
+mpirun -np 4 "$PDT" triangulate col8k.txt -o col8k.tri --stats > /dev/null 2> col8k.err; rc=$?
+pts=$(grep -o '"points": [0-9]*' col8k.err | awk '{print $2}' | tr '\n' ' ')
+uniq=$(grep -o '"unique": [0-9]*' col8k.err | head -1 | awk '{print $2}')
+if [ $rc -eq 0 ] && [ -n "$uniq" ] && echo "$pts" | awk -v u="$uniq" '
+    { for (i = 1; i <= NF; i++) if ($i < 0.8 * u / NF || $i > 1.2 * u / NF) bad = 1; n = NF }
+    END { exit !(n == 4 && !bad) }'; then ok column_strips_balanced
+else fail column_strips_balanced "rc=$rc points per rank: $pts of $uniq"; fi
 summary
