@@ -4,10 +4,10 @@
  *   Phase 0  rank 0 scatters index blocks; sample sort by key (equal keys to
  *            one rank); duplicates removed (smallest index kept); strip
  *            descriptors allgathered.
- *   Phase 1-2 srm_local: lift-up, kernel, strip hull, classification.
+ *   Phase 1-2 pdt_srm_local: lift-up, kernel, strip hull, classification.
  *   Phase 3  for each level: every rank of a pair sends one message (its
  *            pending triangles for that level, and the hull if it holds one)
- *            to the merge rank, which runs srm_merge.
+ *            to the merge rank, which runs pdt_srm_merge.
  *   Phase 4  final triangles gathered at rank 0 and put in canonical order. */
 #include <stdlib.h>
 #include <string.h>
@@ -151,14 +151,14 @@ static pdt_status partition(drv *d, const pdt_point *pts, uint64_t n, srm_rec **
         size_t cnt_q = b[0] < S ? (size_t)b[0] : S;
         for (size_t i = 0; i < cnt_q; i++) all[ns++] = b[1 + i];
     }
-    srm_pick_splitters(all, ns, p, split);
+    pdt_srm_pick_splitters(all, ns, p, split);
 
     /* destination of each record; a stable counting pass groups them by
      * destination (input order, hence index order, kept within a group) */
     for (int q = 0; q < p; q++) cnt[q] = 0;
     if (p > 1) {
         for (size_t i = 0; i < mine_n; i++) {
-            rec[i].pad = (uint32_t)srm_dest_rank(split, p, rec[i].key);
+            rec[i].pad = (uint32_t)pdt_srm_dest_rank(split, p, rec[i].key);
             cnt[rec[i].pad]++;
         }
         size_t off = 0;
@@ -203,9 +203,9 @@ static pdt_status partition(drv *d, const pdt_point *pts, uint64_t n, srm_rec **
     /* blocks arrive in rank order, each in index order, and rank q's indices
      * are all below rank q+1's, so a stable sort by key orders equal keys by
      * index: the first copy is the smallest index */
-    srm_radix_sort(got, tmp, total);
+    pdt_srm_radix_sort(got, tmp, total);
     *nrecv = total;
-    *m = srm_dedupe(got, total);
+    *m = pdt_srm_dedupe(got, total);
     *out = got;
     got = NULL;
     goto done;
@@ -375,12 +375,12 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, p
     me.st.t_partition = t_part - t_start;
 
     /* Phases 1 and 2 */
-    st = srm_init(&s, r, p, strip, tr, err);
+    st = pdt_srm_init(&s, r, p, strip, tr, err);
     if (st != PDT_OK) goto done;
     s_init = 1;
     s.clock = wclock;
     s.clock_user = c;
-    st = srm_local(&s, lp, lg, m, err);
+    st = pdt_srm_local(&s, lp, lg, m, err);
     if (st != PDT_OK) goto done;
     free(lp);
     free(lg);
@@ -392,11 +392,11 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, p
     /* Phase 3: the merge tree */
     for (int level = 0; level < s.levels; level++) {
         int gl, gr, ge;
-        if (!srm_pair(r, p, level, &gl, &gr, &ge)) continue;
+        if (!pdt_srm_pair(r, p, level, &gl, &gr, &ge)) continue;
         PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_MERGE, level, 0, 0, 0);
         void *buf = NULL;
         size_t len = 0;
-        st = srm_pack(&s, level, &buf, &len, err);
+        st = pdt_srm_pack(&s, level, &buf, &len, err);
         if (st != PDT_OK) goto done;
         if (r != gr) {
             st = pdt_comm_send(c, gr, TAG_MERGE + level, buf, len, err);
@@ -422,7 +422,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, p
                 st = pdt_comm_recv(c, q, TAG_MERGE + level, &msg[q - gl], &lens[q - gl], err);
                 if (st == PDT_OK) note_recv(&d, TAG_MERGE + level, q, lens[q - gl]);
             }
-            if (st == PDT_OK) st = srm_merge(&s, level, msg, lens, err);
+            if (st == PDT_OK) st = pdt_srm_merge(&s, level, msg, lens, err);
             for (int i = 0; i < nm; i++) free(msg[i]);
             free(msg);
             free(lens);
@@ -502,7 +502,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, p
         struct rusage ru;
         me.st.peak_rss_kib = getrusage(RUSAGE_SELF, &ru) == 0 ? (int64_t)ru.ru_maxrss : -1;
     }
-    me.holds_final_hull = s.holds_hull && srm_holder(r, p, s.levels) == r;
+    me.holds_final_hull = s.holds_hull && pdt_srm_holder(r, p, s.levels) == r;
     me.hull = s.nhull;
     me.hull_degenerate = s.hull_degenerate;
     reps = r == 0 ? malloc((size_t)p * sizeof *reps) : NULL;
@@ -550,7 +550,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, p
 
 done:
     if (tr) tr->gid = saved_gid;
-    if (s_init) srm_free(&s);
+    if (s_init) pdt_srm_free(&s);
     free(rec);
     free(lp);
     free(lg);

@@ -10,7 +10,7 @@
 /* Stable LSD radix sort on the 64-bit key, 16 bits per pass; passes in which
  * every record has the same digit are skipped (small coordinates leave the
  * high digits constant). */
-void srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n)
+void pdt_srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n)
 {
     if (n < 2) return;
     enum { BITS = 16, B = 1 << BITS, PASSES = 64 / BITS };
@@ -55,7 +55,7 @@ void srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n)
     free(hist);
 }
 
-size_t srm_dedupe(srm_rec *r, size_t n)
+size_t pdt_srm_dedupe(srm_rec *r, size_t n)
 {
     if (n == 0) return 0;
     size_t k = 1;
@@ -70,7 +70,7 @@ static int cmp_u64(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-void srm_pick_splitters(uint64_t *samples, size_t ns, int p, uint64_t *split)
+void pdt_srm_pick_splitters(uint64_t *samples, size_t ns, int p, uint64_t *split)
 {
     qsort(samples, ns, sizeof *samples, cmp_u64);
     for (int i = 1; i < p; i++) {
@@ -80,7 +80,7 @@ void srm_pick_splitters(uint64_t *samples, size_t ns, int p, uint64_t *split)
     }
 }
 
-int srm_dest_rank(const uint64_t *split, int p, uint64_t key)
+int pdt_srm_dest_rank(const uint64_t *split, int p, uint64_t key)
 {
     /* number of splitters <= key (upper bound): equal keys, same rank */
     int lo = 0, hi = p - 1;

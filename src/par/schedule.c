@@ -7,14 +7,14 @@
  * unchanged. */
 #include "srm.h"
 
-int srm_ceil_log2(int p)
+int pdt_srm_ceil_log2(int p)
 {
     int l = 0;
     while ((1 << l) < p) l++;
     return l;
 }
 
-int srm_pair(int r, int p, int level, int *gl, int *gr, int *ge)
+int pdt_srm_pair(int r, int p, int level, int *gl, int *gr, int *ge)
 {
     int base = (r >> (level + 1)) << (level + 1);
     *gl = base;
@@ -23,12 +23,12 @@ int srm_pair(int r, int p, int level, int *gl, int *gr, int *ge)
     return *gr < p;
 }
 
-int srm_holder(int r, int p, int level)
+int pdt_srm_holder(int r, int p, int level)
 {
     if (level == 0) return r;
     int base = (r >> level) << level;
     int right = base + (1 << (level - 1));
     if (right < p) return right;
-    return srm_holder(base, p, level - 1);
+    return pdt_srm_holder(base, p, level - 1);
 }
 

@@ -74,7 +74,7 @@ static double now(const srm_rank *s)
     return s->clock ? s->clock(s->clock_user) : 0.0;
 }
 
-/* CPU seconds of this thread (srm_local and srm_merge never wait for
+/* CPU seconds of this thread (pdt_srm_local and pdt_srm_merge never wait for
  * messages, so this is their compute time whatever the machine's load). */
 static double cpu_now(void)
 {
@@ -127,9 +127,9 @@ static pdt_status add_pending(srm_rank *s, srm_pt a, srm_pt b, srm_pt c, int lev
 static int send_level(const srm_rank *s, int h, int from, srm_pt a, srm_pt b, srm_pt c, int *who)
 {
     srm_disk d;
-    srm_disk_of(&d, a, b, c);
+    pdt_srm_disk_of(&d, a, b, c);
     double lo, hi;
-    srm_disk_xrange(&d, &lo, &hi);
+    pdt_srm_disk_xrange(&d, &lo, &hi);
     /* boxes of non-empty strips are ordered in x: binary search the first
      * whose xmax reaches lo, walk while xmin <= hi */
     int l = 0, r = s->nne;
@@ -148,7 +148,7 @@ static int send_level(const srm_rank *s, int h, int from, srm_pt a, srm_pt b, sr
         int lev = msb((unsigned)(q ^ h));
         if (lev < from) continue;                  /* inside the group already */
         if (best >= 0 && lev >= best) continue;    /* cannot improve */
-        if (srm_disk_touch(&d, bx)) {
+        if (pdt_srm_disk_touch(&d, bx)) {
             best = lev;
             *who = q;
         }
@@ -158,13 +158,13 @@ static int send_level(const srm_rank *s, int h, int from, srm_pt a, srm_pt b, sr
 
 /* ---- set-up ---------------------------------------------------------------- */
 
-pdt_status srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pdt_trace *tr,
+pdt_status pdt_srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pdt_trace *tr,
                     pdt_err *err)
 {
     memset(s, 0, sizeof *s);
     s->rank = rank;
     s->p = p;
-    s->levels = srm_ceil_log2(p);
+    s->levels = pdt_srm_ceil_log2(p);
     s->strip = strip;
     s->tr = tr;
     s->nonempty = malloc((size_t)p * sizeof *s->nonempty);
@@ -174,7 +174,7 @@ pdt_status srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pdt_tr
     return PDT_OK;
 }
 
-void srm_free(srm_rank *s)
+void pdt_srm_free(srm_rank *s)
 {
     free(s->nonempty);
     free(s->fin);
@@ -185,7 +185,7 @@ void srm_free(srm_rank *s)
 
 /* ---- Phases 1 and 2 ----------------------------------------------------------- */
 
-pdt_status srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid, size_t m,
+pdt_status pdt_srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid, size_t m,
                      pdt_err *err)
 {
     pdt_trace *tr = s->tr;
@@ -294,11 +294,11 @@ static uint32_t find_gid(const srm_pt *p, size_t n, uint32_t gid)
     return (uint32_t)lo;
 }
 
-pdt_status srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err)
+pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err)
 {
     *buf = NULL;
     *len = 0;
-    int send_hull = s->holds_hull && srm_holder(s->rank, s->p, level) == s->rank;
+    int send_hull = s->holds_hull && pdt_srm_holder(s->rank, s->p, level) == s->rank;
     size_t nt = 0;
     for (size_t i = 0; i < s->npend; i++) nt += s->pend[i].level == level;
     size_t nh = send_hull ? s->nhull : 0;
@@ -474,7 +474,7 @@ static size_t facing(const srm_rank *s, const msg_view *hv, int q0, int q1, srm_
     for (size_t i = 0; i < k; i++) {
         srm_pt u = hv->pts[h[i]], w = hv->pts[h[(i + 1) % k]];
         for (int q = q0; q < q1; q++)
-            if (s->strip[q].count && srm_edge_touch(u, w, &s->strip[q])) {
+            if (s->strip[q].count && pdt_srm_edge_touch(u, w, &s->strip[q])) {
                 out[n++] = u;
                 out[n++] = w;
                 break;
@@ -483,11 +483,11 @@ static size_t facing(const srm_rank *s, const msg_view *hv, int q0, int q1, srm_
     return n;
 }
 
-pdt_status srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len, pdt_err *err)
+pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len, pdt_err *err)
 {
     pdt_trace *tr = s->tr;
     int gl, gr, ge;
-    srm_pair(s->rank, s->p, level, &gl, &gr, &ge);
+    pdt_srm_pair(s->rank, s->p, level, &gl, &gr, &ge);
     int nm = ge - gl;
     double t0 = now(s);
     pdt_status st = PDT_OK;

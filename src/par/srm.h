@@ -45,15 +45,15 @@ typedef struct srm_rec {
 } srm_rec;
 
 /* Stable LSD radix sort of r[0..n) by key (tmp: n scratch records). */
-void srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n);
+void pdt_srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n);
 
 /* Remove records with equal keys keeping the first; returns the new count. */
-size_t srm_dedupe(srm_rec *r, size_t n);
+size_t pdt_srm_dedupe(srm_rec *r, size_t n);
 
 /* p-1 splitter keys from the pooled samples (sorted in place); rank of a
  * key = number of splitters <= key. */
-void srm_pick_splitters(uint64_t *samples, size_t ns, int p, uint64_t *split);
-int srm_dest_rank(const uint64_t *split, int p, uint64_t key);
+void pdt_srm_pick_splitters(uint64_t *samples, size_t ns, int p, uint64_t *split);
+int pdt_srm_dest_rank(const uint64_t *split, int p, uint64_t key);
 
 /* Point of a key (inverse of pdt_key). */
 static inline pdt_point srm_key_point(uint64_t key)
@@ -84,16 +84,16 @@ typedef struct srm_disk {
 } srm_disk;
 
 /* The disk of the triangle (a, b, c) (any orientation, not collinear). */
-void srm_disk_of(srm_disk *d, srm_pt a, srm_pt b, srm_pt c);
+void pdt_srm_disk_of(srm_disk *d, srm_pt a, srm_pt b, srm_pt c);
 /* 0 only if the closed disk certainly misses the closed box; an empty
  * strip (count 0) has no box and is never touched. */
-int srm_disk_touch(const srm_disk *d, const srm_strip *box);
+int pdt_srm_disk_touch(const srm_disk *d, const srm_strip *box);
 /* An x-range certainly containing the disk (for a search by x). */
-void srm_disk_xrange(const srm_disk *d, double *lo, double *hi);
+void pdt_srm_disk_xrange(const srm_disk *d, double *lo, double *hi);
 
 /* Exact: 1 if the closed half-plane right of u->v (the restricted area of
  * the hull edge u->v) meets the closed box. */
-int srm_edge_touch(srm_pt u, srm_pt v, const srm_strip *box);
+int pdt_srm_edge_touch(srm_pt u, srm_pt v, const srm_strip *box);
 
 /* ---- srm.c: the per-rank state machine --------------------------------- */
 
@@ -125,39 +125,39 @@ typedef struct srm_rank {
     void *clock_user;
 } srm_rank;
 
-/* Set up (strip: p descriptors, kept by pointer).  Frees with srm_free. */
-pdt_status srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pdt_trace *tr,
+/* Set up (strip: p descriptors, kept by pointer).  Frees with pdt_srm_free. */
+pdt_status pdt_srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pdt_trace *tr,
                     pdt_err *err);
-void srm_free(srm_rank *s);
+void pdt_srm_free(srm_rank *s);
 
 /* Phases 1 and 2 on the local strip: pts[0..m) distinct and lex-sorted,
  * gid[i] the global index of pts[i].  Lift-up (traced), kernel (run 0),
  * strip hull (traced pushes and pops), classification. */
-pdt_status srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid, size_t m,
+pdt_status pdt_srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid, size_t m,
                      pdt_err *err);
 
 /* Merge schedule.  The pair merged at `level` that contains rank r:
  * G_L = [gl, gr), G_R = [gr, ge); returns 0 if r's group has no partner at
  * this level (nothing happens), else 1.  Merge rank = gr. */
-int srm_pair(int r, int p, int level, int *gl, int *gr, int *ge);
+int pdt_srm_pair(int r, int p, int level, int *gl, int *gr, int *ge);
 /* The rank holding the hull of the level-`level` group that contains r. */
-int srm_holder(int r, int p, int level);
+int pdt_srm_holder(int r, int p, int level);
 
 /* Message from this rank to the merge rank of `level`: its pending
  * triangles waiting for that level (removed here), its hull if it holds the
  * hull of G_L or G_R, and its critical path so far.  *buf malloc'd (caller
  * frees).  Every rank of the pair sends one, possibly empty. */
-pdt_status srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err);
+pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err);
 
 /* At the merge rank: merge the messages of every rank of the pair
  * (msg[i] from rank gl + i, i = 0 .. ge-gl-1, including this rank's own).
  * Shipped sets, border set, lift-up, kernel (run 1), selection, discards,
  * hull merge, reclassification.  The critical path continues from the
  * longest one among the senders (carried in the messages). */
-pdt_status srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len,
+pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len,
                      pdt_err *err);
 
 /* ceil(log2 p): the number of merge levels. */
-int srm_ceil_log2(int p);
+int pdt_srm_ceil_log2(int p);
 
 #endif

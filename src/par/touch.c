@@ -32,7 +32,7 @@ static int lex_less(srm_pt a, srm_pt b)
     return a.x != b.x ? a.x < b.x : a.y < b.y;
 }
 
-void srm_disk_of(srm_disk *d, srm_pt a, srm_pt b, srm_pt c)
+void pdt_srm_disk_of(srm_disk *d, srm_pt a, srm_pt b, srm_pt c)
 {
     /* origin = lexicographically smallest vertex, so the answer does not
      * depend on the rotation the triangle is stored in */
@@ -79,7 +79,7 @@ void srm_disk_of(srm_disk *d, srm_pt a, srm_pt b, srm_pt c)
     if (!isfinite(d->r)) d->all = 1;
 }
 
-void srm_disk_xrange(const srm_disk *d, double *lo, double *hi)
+void pdt_srm_disk_xrange(const srm_disk *d, double *lo, double *hi)
 {
     if (d->all) {
         *lo = -INFINITY;
@@ -92,7 +92,7 @@ void srm_disk_xrange(const srm_disk *d, double *lo, double *hi)
     *hi = cx + m;
 }
 
-int srm_disk_touch(const srm_disk *d, const srm_strip *box)
+int pdt_srm_disk_touch(const srm_disk *d, const srm_strip *box)
 {
     if (box->count == 0) return 0; /* an empty strip has no box */
     if (d->all) return 1;
@@ -111,7 +111,7 @@ static __int128 orient128(int64_t ax, int64_t ay, int64_t bx, int64_t by, int64_
     return (__int128)(bx - ax) * (cy - ay) - (__int128)(by - ay) * (cx - ax);
 }
 
-int srm_edge_touch(srm_pt u, srm_pt v, const srm_strip *box)
+int pdt_srm_edge_touch(srm_pt u, srm_pt v, const srm_strip *box)
 {
     if (box->count == 0) return 0;
     const int32_t xs[2] = {box->xmin, box->xmax}, ys[2] = {box->ymin, box->ymax};

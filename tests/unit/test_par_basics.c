@@ -70,9 +70,9 @@ TEST(touch_is_sound)
         bx.xmax = bx.xmin + rndi(0, R);
         bx.ymax = bx.ymin + rndi(0, R);
         srm_disk d;
-        srm_disk_of(&d, p[0], p[1], p[2]);
+        pdt_srm_disk_of(&d, p[0], p[1], p[2]);
         int ex = exact_touch(p[0], p[1], p[2], &bx);
-        int ap = srm_disk_touch(&d, &bx);
+        int ap = pdt_srm_disk_touch(&d, &bx);
         checked++;
         if (ex && !ap) wrong++;
         if (ex == ap) tight++;
@@ -87,22 +87,22 @@ TEST(touch_cocircular_corner)
      * at exactly one point must count as touching (closed disk) */
     srm_pt a = {5, 0, 0}, b = {3, 4, 1}, c = {-4, 3, 2};
     srm_disk d;
-    srm_disk_of(&d, a, b, c);
+    pdt_srm_disk_of(&d, a, b, c);
     srm_strip at = {1, 0, 0, 0, 3, -8, -5}; /* corner... top edge y = -5 at x = 0 */
     srm_strip off = {1, 0, 0, 0, 3, -8, -6};
     srm_strip corner = {1, 0, 0, 4, 9, -9, -3}; /* corner (4,-3) is on the circle */
-    CHECK(srm_disk_touch(&d, &at));
-    CHECK(srm_disk_touch(&d, &corner));
-    CHECK(!srm_disk_touch(&d, &off));
+    CHECK(pdt_srm_disk_touch(&d, &at));
+    CHECK(pdt_srm_disk_touch(&d, &corner));
+    CHECK(!pdt_srm_disk_touch(&d, &off));
     /* empty strips are never touched */
     srm_strip empty = {0, 0, 0, 0, 3, -8, -5};
-    CHECK(!srm_disk_touch(&d, &empty));
+    CHECK(!pdt_srm_disk_touch(&d, &empty));
     /* the hull-edge test: closed half-plane right of u->v */
     srm_pt u = {0, 0, 0}, v = {10, 0, 1};
     srm_strip below = {1, 0, 0, 2, 3, -5, -1}, on = {1, 0, 0, 2, 3, 0, 4}, above = {1, 0, 0, 2, 3, 1, 4};
-    CHECK(srm_edge_touch(u, v, &below));
-    CHECK(srm_edge_touch(u, v, &on));
-    CHECK(!srm_edge_touch(u, v, &above));
+    CHECK(pdt_srm_edge_touch(u, v, &below));
+    CHECK(pdt_srm_edge_touch(u, v, &on));
+    CHECK(!pdt_srm_edge_touch(u, v, &above));
 }
 
 /* ---- partition helpers and schedule ------------------------------------------ */
@@ -116,7 +116,7 @@ TEST(radix_sort_stable_dedupe)
         if (i % 7 == 0) p.x = (int32_t)(rnd() >> 33) * (rnd() & 1 ? 1 : -1);
         r[i] = (srm_rec){pdt_key(p), (uint32_t)i, 0};
     }
-    srm_radix_sort(r, t, n);
+    pdt_srm_radix_sort(r, t, n);
     int bad = 0;
     for (size_t i = 1; i < n; i++) {
         pdt_point a = srm_key_point(r[i - 1].key), b = srm_key_point(r[i].key);
@@ -124,7 +124,7 @@ TEST(radix_sort_stable_dedupe)
         if (c > 0 || (c == 0 && r[i - 1].idx >= r[i].idx)) bad++;
     }
     CHECK_MSG(bad == 0, "%d out of order", bad);
-    size_t m = srm_dedupe(r, n);
+    size_t m = pdt_srm_dedupe(r, n);
     for (size_t i = 1; i < m; i++) CHECK(r[i - 1].key < r[i].key);
     free(r);
     free(t);
@@ -134,28 +134,28 @@ TEST(splitters_equal_keys_one_rank)
 {
     uint64_t samples[12] = {5, 5, 5, 5, 5, 5, 7, 7, 9, 9, 9, 1};
     uint64_t split[3];
-    srm_pick_splitters(samples, 12, 4, split);
-    int d5 = srm_dest_rank(split, 4, 5);
-    CHECK(srm_dest_rank(split, 4, 5) == d5);
-    CHECK(srm_dest_rank(split, 4, 1) <= d5);
-    CHECK(srm_dest_rank(split, 4, 9) >= srm_dest_rank(split, 4, 7));
-    CHECK(srm_dest_rank(split, 1, 5) == 0);
+    pdt_srm_pick_splitters(samples, 12, 4, split);
+    int d5 = pdt_srm_dest_rank(split, 4, 5);
+    CHECK(pdt_srm_dest_rank(split, 4, 5) == d5);
+    CHECK(pdt_srm_dest_rank(split, 4, 1) <= d5);
+    CHECK(pdt_srm_dest_rank(split, 4, 9) >= pdt_srm_dest_rank(split, 4, 7));
+    CHECK(pdt_srm_dest_rank(split, 1, 5) == 0);
 }
 
 TEST(schedule)
 {
     int gl, gr, ge;
-    CHECK(srm_pair(1, 5, 0, &gl, &gr, &ge) && gl == 0 && gr == 1 && ge == 2);
-    CHECK(!srm_pair(4, 5, 0, &gl, &gr, &ge));
-    CHECK(!srm_pair(4, 5, 1, &gl, &gr, &ge));
-    CHECK(srm_pair(4, 5, 2, &gl, &gr, &ge) && gl == 0 && gr == 4 && ge == 5);
-    CHECK(srm_pair(6, 7, 1, &gl, &gr, &ge) && gl == 4 && gr == 6 && ge == 7);
-    CHECK(srm_holder(3, 8, 2) == 2);
-    CHECK(srm_holder(0, 8, 3) == 4);
-    CHECK(srm_holder(4, 5, 2) == 4);
-    CHECK(srm_holder(0, 5, 3) == 4);
-    CHECK(srm_holder(5, 6, 2) == 5 && srm_holder(0, 6, 3) == 4);
-    CHECK(srm_ceil_log2(1) == 0 && srm_ceil_log2(2) == 1 && srm_ceil_log2(5) == 3);
+    CHECK(pdt_srm_pair(1, 5, 0, &gl, &gr, &ge) && gl == 0 && gr == 1 && ge == 2);
+    CHECK(!pdt_srm_pair(4, 5, 0, &gl, &gr, &ge));
+    CHECK(!pdt_srm_pair(4, 5, 1, &gl, &gr, &ge));
+    CHECK(pdt_srm_pair(4, 5, 2, &gl, &gr, &ge) && gl == 0 && gr == 4 && ge == 5);
+    CHECK(pdt_srm_pair(6, 7, 1, &gl, &gr, &ge) && gl == 4 && gr == 6 && ge == 7);
+    CHECK(pdt_srm_holder(3, 8, 2) == 2);
+    CHECK(pdt_srm_holder(0, 8, 3) == 4);
+    CHECK(pdt_srm_holder(4, 5, 2) == 4);
+    CHECK(pdt_srm_holder(0, 5, 3) == 4);
+    CHECK(pdt_srm_holder(5, 6, 2) == 5 && pdt_srm_holder(0, 6, 3) == 4);
+    CHECK(pdt_srm_ceil_log2(1) == 0 && pdt_srm_ceil_log2(2) == 1 && pdt_srm_ceil_log2(5) == 3);
 }
 
 int main(void)

@@ -124,20 +124,20 @@ static pdt_status simulate(const srm_rec *u, int p, const size_t *cut, pdt_tri *
             pts[i - lo] = srm_key_point(u[i].key);
             gid[i - lo] = u[i].idx;
         }
-        st = srm_init(&rk[r], r, p, strip, NULL, &err);
-        if (st == PDT_OK) st = srm_local(&rk[r], pts, gid, hi - lo, &err);
+        st = pdt_srm_init(&rk[r], r, p, strip, NULL, &err);
+        if (st == PDT_OK) st = pdt_srm_local(&rk[r], pts, gid, hi - lo, &err);
         free(pts);
         free(gid);
     }
-    int L = srm_ceil_log2(p);
+    int L = pdt_srm_ceil_log2(p);
     for (int level = 0; level < L && st == PDT_OK; level++)
         for (int r = 0; r < p && st == PDT_OK; r++) {
             int gl, gr, ge;
-            if (!srm_pair(r, p, level, &gl, &gr, &ge) || r != gr) continue;
+            if (!pdt_srm_pair(r, p, level, &gl, &gr, &ge) || r != gr) continue;
             void *msg[64];
             size_t len[64];
-            for (int q = gl; q < ge; q++) srm_pack(&rk[q], level, &msg[q - gl], &len[q - gl], &err);
-            st = srm_merge(&rk[r], level, msg, len, &err);
+            for (int q = gl; q < ge; q++) pdt_srm_pack(&rk[q], level, &msg[q - gl], &len[q - gl], &err);
+            st = pdt_srm_merge(&rk[r], level, msg, len, &err);
             for (int q = gl; q < ge; q++) free(msg[q - gl]);
         }
     size_t total = 0;
@@ -152,7 +152,7 @@ static pdt_status simulate(const srm_rec *u, int p, const size_t *cut, pdt_tri *
     for (int r = 0; r < p; r++) {
         if (rk[r].nfin) memcpy(t + k, rk[r].fin, rk[r].nfin * sizeof *t);
         k += rk[r].nfin;
-        srm_free(&rk[r]);
+        pdt_srm_free(&rk[r]);
     }
     pdt_tri_canonical(t, total);
     *out = t;
@@ -174,8 +174,8 @@ TEST(srm_equals_sequential)
             pdt_point *pts = family(f, ns[ni], &n);
             srm_rec *u = malloc((n + 1) * sizeof *u), *tmp = malloc((n + 1) * sizeof *tmp);
             for (size_t i = 0; i < n; i++) u[i] = (srm_rec){pdt_key(pts[i]), (uint32_t)i, 0};
-            srm_radix_sort(u, tmp, n);
-            size_t m = srm_dedupe(u, n);
+            pdt_srm_radix_sort(u, tmp, n);
+            size_t m = pdt_srm_dedupe(u, n);
             /* reference: one kernel run on everything */
             pdt_point *up = malloc((m + 1) * sizeof *up);
             for (size_t i = 0; i < m; i++) up[i] = srm_key_point(u[i].key);
@@ -248,8 +248,8 @@ TEST(srm_gen_families)
             CHECK(pdt_triangulate(pts, n, &ref, &nref, NULL, NULL) == PDT_OK);
             srm_rec *u = malloc((n + 1) * sizeof *u), *tmp = malloc((n + 1) * sizeof *tmp);
             for (size_t i = 0; i < n; i++) u[i] = (srm_rec){pdt_key(pts[i]), (uint32_t)i, 0};
-            srm_radix_sort(u, tmp, n);
-            size_t m = srm_dedupe(u, n);
+            pdt_srm_radix_sort(u, tmp, n);
+            size_t m = pdt_srm_dedupe(u, n);
             for (size_t pi = 0; pi < sizeof ps / sizeof *ps; pi++)
                 for (int rep = 0; rep < 2; rep++) {
                     int p = ps[pi];
