@@ -86,7 +86,10 @@ pdt_status pdt_tw_open(const char *dir, int rank, int level, pdt_trace_writer **
                        pdt_err *err);
 /* The hook to pass to algorithm code (owned by w; valid until pdt_tw_close).
  * The sink stamps each event with the writer's clock and appends it to a
- * buffer; full buffers are encoded and written as one block. */
+ * buffer; full buffers are encoded and written as one block.  The clock is
+ * read for phase, merge, message and hull events and at least every 16
+ * events; events in between reuse the latest reading (docs/trace-format.md,
+ * "Time"). */
 pdt_trace *pdt_tw_hook(pdt_trace_writer *w);
 /* Current time on the writer's clock (CLOCK_MONOTONIC ns since pdt_tw_open):
  * the value event times are measured in; for clock-offset measurement. */

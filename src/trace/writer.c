@@ -19,6 +19,7 @@ struct pdt_trace_writer {
     int fd;
     char *path;
     uint64_t origin_ns;  /* CLOCK_MONOTONIC at open */
+    uint64_t last_t;     /* latest clock reading (ns since origin) */
     pdt_event *buf;      /* TF_BLOCK_EVENTS */
     size_t nbuf;
     uint8_t *enc;        /* block header + encoded payload */
@@ -73,13 +74,24 @@ static void tw_flush(pdt_trace_writer *w)
     w->nbuf = 0;
 }
 
+/* Kinds whose time is always read from the clock (boundaries and messages);
+ * the others (pushes, pops, lift-ups, triangles, edges ...) come in dense
+ * bursts and reuse the latest reading unless TF_CLOCK_EVERY events passed. */
+#define TF_CLOCK_KINDS                                                                     \
+    ((1u << PDT_EV_PHASE_BEGIN) | (1u << PDT_EV_PHASE_END) | (1u << PDT_EV_MERGE_BEGIN) |   \
+     (1u << PDT_EV_MERGE_END) | (1u << PDT_EV_SEND) | (1u << PDT_EV_RECV) |                \
+     (1u << PDT_EV_HULL))
+#define TF_CLOCK_EVERY 16u
+
 static void tw_sink(pdt_trace *tr, const pdt_event *ev)
 {
     pdt_trace_writer *w = tr->user;
-    pdt_event *d = &w->buf[w->nbuf++];
+    pdt_event *d = &w->buf[w->nbuf];
     *d = *ev;
-    d->t = mono_ns() - w->origin_ns;
-    if (w->nbuf == TF_BLOCK_EVENTS) tw_flush(w);
+    if ((ev->kind < 32 && (TF_CLOCK_KINDS >> ev->kind) & 1u) || w->nbuf % TF_CLOCK_EVERY == 0)
+        w->last_t = mono_ns() - w->origin_ns;
+    d->t = w->last_t;
+    if (++w->nbuf == TF_BLOCK_EVENTS) tw_flush(w);
 }
 
 static char *path_join(const char *dir, const char *name)
