@@ -48,6 +48,9 @@ double pdt_comm_wtime(const pdt_comm *c);
 /* Collectives.  Byte counts; every count must be <= INT_MAX (else
  * PDT_ERR_MPI "message too large").  Receive buffers are the caller's. */
 pdt_status pdt_comm_barrier(pdt_comm *c, pdt_err *err);
+/* A barrier during which waiting ranks sleep (0.1 ms polls) instead of
+ * spinning: call it before a collective that some ranks reach much later. */
+pdt_status pdt_comm_quiet_barrier(pdt_comm *c, pdt_err *err);
 pdt_status pdt_comm_bcast(pdt_comm *c, void *buf, size_t bytes, int root, pdt_err *err);
 /* Every rank sends `bytes` bytes; recv gets size * bytes, rank order. */
 pdt_status pdt_comm_allgather(pdt_comm *c, const void *send, size_t bytes, void *recv,
@@ -70,8 +73,9 @@ pdt_status pdt_comm_gatherv(pdt_comm *c, const void *send, size_t bytes, void *r
 /* Element-wise maximum / sum of n doubles over all ranks, result everywhere. */
 pdt_status pdt_comm_allmax(pdt_comm *c, double *v, int n, pdt_err *err);
 
-/* Point to point, blocking.  recv: probes the size, *buf is malloc'd
- * (caller frees; may be non-NULL even for 0 bytes). */
+/* Point to point, blocking.  recv: waits (sleeping between polls) for the
+ * message, *buf is malloc'd (caller frees; may be non-NULL even for 0
+ * bytes). */
 pdt_status pdt_comm_send(pdt_comm *c, int peer, int tag, const void *buf, size_t bytes,
                          pdt_err *err);
 pdt_status pdt_comm_recv(pdt_comm *c, int peer, int tag, void **buf, size_t *bytes,

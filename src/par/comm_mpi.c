@@ -154,6 +154,28 @@ pdt_status pdt_comm_barrier(pdt_comm *c, pdt_err *err)
     return mpi_check(MPI_Barrier(c->comm), "MPI_Barrier", c, err);
 }
 
+/* Waiting ranks sleep between polls instead of spinning in MPI's progress
+ * loop, so that they leave the cores to the ranks still computing (matters
+ * when ranks outnumber cores or the machine is busy). */
+static void nap(void)
+{
+    struct timespec ts = {0, 100000}; /* 0.1 ms */
+    nanosleep(&ts, NULL);
+}
+
+pdt_status pdt_comm_quiet_barrier(pdt_comm *c, pdt_err *err)
+{
+    if (!c->mpi) return PDT_OK;
+    MPI_Request rq;
+    pdt_status s = mpi_check(MPI_Ibarrier(c->comm, &rq), "MPI_Ibarrier", c, err);
+    int done = 0;
+    while (s == PDT_OK && !done) {
+        s = mpi_check(MPI_Test(&rq, &done, MPI_STATUS_IGNORE), "MPI_Test", c, err);
+        if (s == PDT_OK && !done) nap();
+    }
+    return s;
+}
+
 pdt_status pdt_comm_bcast(pdt_comm *c, void *buf, size_t bytes, int root, pdt_err *err)
 {
     if (!c->mpi) return PDT_OK;
@@ -278,7 +300,12 @@ pdt_status pdt_comm_recv(pdt_comm *c, int peer, int tag, void **buf, size_t *byt
     if (!c->mpi || peer == c->rank)
         return pdt_err_set(err, PDT_ERR_MPI, "rank %d: receive from itself", c->rank);
     MPI_Status st;
-    pdt_status s = mpi_check(MPI_Probe(peer, tag, c->comm, &st), "MPI_Probe", c, err);
+    int flag = 0;
+    pdt_status s = PDT_OK;
+    while (s == PDT_OK && !flag) {
+        s = mpi_check(MPI_Iprobe(peer, tag, c->comm, &flag, &st), "MPI_Iprobe", c, err);
+        if (s == PDT_OK && !flag) nap();
+    }
     int nb = 0;
     if (s == PDT_OK) s = mpi_check(MPI_Get_count(&st, MPI_BYTE, &nb), "MPI_Get_count", c, err);
     if (s != PDT_OK) return s;

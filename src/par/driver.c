@@ -442,6 +442,8 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, p
      * gathers the sorted blocks and merges them */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_OUTPUT, 0, 0, 0, 0);
     pdt_tri_canonical(s.fin, s.nfin);
+    st = pdt_comm_quiet_barrier(c, err); /* ranks done early sleep until the last merge ends */
+    if (st != PDT_OK) goto done;
     uint64_t nf = s.nfin, *nfs = malloc((size_t)p * sizeof *nfs);
     counts = malloc((size_t)p * sizeof *counts);
     if (!nfs || !counts) {

@@ -180,6 +180,8 @@ int pdt_par_cmd_triangulate(int *argc, char ***argv, const pdt_par_job *job)
     if (r == 0 && rc == 0 &&
         pdt_read_points(job->input, job->scale, &pts, &n, &collisions, &err) != PDT_OK)
         rc = err.code == PDT_ERR_NOMEM ? 1 : 2;
+    /* the others sleep while rank 0 reads */
+    if (pdt_comm_quiet_barrier(c, &err) != PDT_OK) die(c, &err);
     if (pdt_comm_bcast(c, &rc, sizeof rc, 0, &err) != PDT_OK) die(c, &err);
     if (rc) {
         if (r == 0) fprintf(stderr, "pdt: %s\n", err.msg);
