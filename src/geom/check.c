@@ -22,6 +22,8 @@
  *  The Euler count 2n - h - 2 (thesis D5) is checked as well. */
 #include "pdt/check.h"
 
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -228,7 +230,18 @@ static int sort_edges(dedge *ed, size_t ne, size_t n)
     return 1;
 }
 
-#define FAIL(...) (st = pdt_err_set(err, PDT_ERR_CHECK, __VA_ARGS__))
+
+/* Record a violation (PDT_ERR_CHECK) with a printf-style message. */
+static pdt_status fail(pdt_err *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static pdt_status fail(pdt_err *err, const char *fmt, ...)
+{
+    char msg[sizeof err->msg];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return pdt_err_set(err, PDT_ERR_CHECK, "%s", msg);
+}
 
 pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tris, size_t ntri,
                               pdt_err *err)
@@ -283,12 +296,12 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
 
     if (collinear) {
         if (ntri)
-            FAIL("check.c:%d: %zu triangles for %s input (expected none)", __LINE__, ntri,
+            st = fail(err, "check.c:%d: %zu triangles for %s input (expected none)", __LINE__, ntri,
                  m < 3 ? "fewer than 3 distinct points" : "all-collinear");
         goto done;
     }
     if (ntri == 0) {
-        FAIL("check.c:%d: no triangles, but the %zu distinct points are not collinear",
+        st = fail(err, "check.c:%d: no triangles, but the %zu distinct points are not collinear",
              __LINE__, m);
         goto done;
     }
@@ -298,20 +311,22 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
         const uint32_t *v = tris[t].v;
         for (int k = 0; k < 3 && st == PDT_OK; k++) {
             if (v[k] >= n)
-                FAIL("check.c:%d: triangle %zu (%u %u %u): index %u out of range (n = %zu)",
-                     __LINE__, t, v[0], v[1], v[2], v[k], n);
+                st = fail(err,
+                          "check.c:%d: triangle %zu (%u %u %u): index %u out of range (n = %zu)",
+                          __LINE__, t, v[0], v[1], v[2], v[k], n);
             else if (rep[v[k]] != v[k])
-                FAIL("check.c:%d: triangle %zu (%u %u %u) uses %u, a duplicate of point %u "
-                     "(the smallest index must represent it)", __LINE__, t, v[0], v[1], v[2],
-                     v[k], rep[v[k]]);
+                st = fail(err,
+                          "check.c:%d: triangle %zu (%u %u %u) uses %u, a duplicate of point %u "
+                          "(the smallest index must represent it)",
+                          __LINE__, t, v[0], v[1], v[2], v[k], rep[v[k]]);
         }
         if (st != PDT_OK) break;
         if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2])
-            FAIL("check.c:%d: triangle %zu (%u %u %u) repeats a vertex", __LINE__, t, v[0], v[1],
-                 v[2]);
+            st = fail(err, "check.c:%d: triangle %zu (%u %u %u) repeats a vertex", __LINE__, t,
+                      v[0], v[1], v[2]);
         else if (ck_orient(pts[v[0]], pts[v[1]], pts[v[2]]) <= 0)
-            FAIL("check.c:%d: triangle %zu (%u %u %u) is not counter-clockwise", __LINE__, t,
-                 v[0], v[1], v[2]);
+            st = fail(err, "check.c:%d: triangle %zu (%u %u %u) is not counter-clockwise", __LINE__,
+                      t, v[0], v[1], v[2]);
         for (int k = 0; k < 3; k++) {
             uint32_t a = v[k], b = v[(k + 1) % 3];
             dedge *e = &ed[3 * t + (size_t)k];
@@ -328,8 +343,8 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
     /* 3: every distinct point used */
     for (size_t i = 0; i < m && st == PDT_OK; i++)
         if (!usedv[s[i].i])
-            FAIL("check.c:%d: point %u (%d, %d) is in no triangle", __LINE__, s[i].i, s[i].p.x,
-                 s[i].p.y);
+            st = fail(err, "check.c:%d: point %u (%d, %d) is in no triangle", __LINE__, s[i].i,
+                      s[i].p.x, s[i].p.y);
     if (st != PDT_OK) goto done;
 
     /* 2: edge multiplicities; collect the boundary */
@@ -338,20 +353,25 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
         st = pdt_err_set(err, PDT_ERR_NOMEM, "check.c:%d: out of memory", __LINE__);
         goto done;
     }
-    for (size_t i = 0; i < n; i++) nxt[i] = UINT32_MAX;
+    for (size_t i = 0; i < n; i++)
+        nxt[i] = UINT32_MAX;
     for (size_t i = 0; i < ne && st == PDT_OK;) {
         size_t j = i + 1;
-        while (j < ne && ed[j].lo == ed[i].lo && ed[j].hi == ed[i].hi) j++;
+        while (j < ne && ed[j].lo == ed[i].lo && ed[j].hi == ed[i].hi)
+            j++;
         if (j - i > 2 || (j - i == 2 && ed[i].fwd == ed[i + 1].fwd)) {
             const pdt_tri *a = &tris[ed[i].tri], *b = &tris[ed[i + 1].tri];
-            FAIL("check.c:%d: edge %u-%u is used by %zu triangles (%u %u %u), (%u %u %u)%s",
-                 __LINE__, ed[i].lo, ed[i].hi, j - i, a->v[0], a->v[1], a->v[2], b->v[0],
-                 b->v[1], b->v[2], j - i == 2 ? " on the same side" : ", ...");
+            st = fail(err,
+                      "check.c:%d: edge %u-%u is used by %zu triangles (%u %u %u), (%u %u %u)%s",
+                      __LINE__, ed[i].lo, ed[i].hi, j - i, a->v[0], a->v[1], a->v[2], b->v[0],
+                      b->v[1], b->v[2], j - i == 2 ? " on the same side" : ", ...");
         } else if (j - i == 1) { /* boundary edge, directed as in its triangle */
             uint32_t from = ed[i].fwd ? ed[i].lo : ed[i].hi, to = ed[i].fwd ? ed[i].hi : ed[i].lo;
             if (nxt[from] != UINT32_MAX)
-                FAIL("check.c:%d: boundary vertex %u has two outgoing boundary edges (to %u "
-                     "and %u)", __LINE__, from, nxt[from], to);
+                st = fail(err,
+                          "check.c:%d: boundary vertex %u has two outgoing boundary edges (to %u "
+                          "and %u)",
+                          __LINE__, from, nxt[from], to);
             nxt[from] = to;
             nb++;
         }
@@ -361,27 +381,31 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
 
     /* the boundary is exactly the hull cycle */
     if (nb != h) {
-        FAIL("check.c:%d: %zu boundary edges, but the convex hull has %zu vertices "
-             "(collinear boundary points included)", __LINE__, nb, h);
+        st = fail(err,
+                  "check.c:%d: %zu boundary edges, but the convex hull has %zu vertices "
+                  "(collinear boundary points included)",
+                  __LINE__, nb, h);
         goto done;
     }
     for (size_t k = 0; k < h; k++) {
         uint32_t a = hull[k], b = hull[(k + 1) % h];
         if (nxt[a] != b) {
             if (nxt[a] == UINT32_MAX)
-                FAIL("check.c:%d: hull edge %u-%u is not a boundary edge (hull vertex %u has "
-                     "no outgoing boundary edge)", __LINE__, a, b, a);
+                st = fail(err,
+                          "check.c:%d: hull edge %u-%u is not a boundary edge (hull vertex %u has "
+                          "no outgoing boundary edge)",
+                          __LINE__, a, b, a);
             else
-                FAIL("check.c:%d: boundary edge %u-%u is not the hull edge %u-%u", __LINE__, a,
-                     nxt[a], a, b);
+                st = fail(err, "check.c:%d: boundary edge %u-%u is not the hull edge %u-%u",
+                          __LINE__, a, nxt[a], a, b);
             goto done;
         }
     }
 
     /* Euler (thesis D5) */
     if (ntri != 2 * m - h - 2) {
-        FAIL("check.c:%d: %zu triangles, Euler count 2n - h - 2 = %zu (n = %zu, h = %zu)",
-             __LINE__, ntri, 2 * m - h - 2, m, h);
+        st = fail(err, "check.c:%d: %zu triangles, Euler count 2n - h - 2 = %zu (n = %zu, h = %zu)",
+                  __LINE__, ntri, 2 * m - h - 2, m, h);
         goto done;
     }
 
@@ -393,12 +417,14 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
         uint32_t d = t2->v[(ed[i + 1].k + 2) % 3];
         int r = ck_incircle_sos(pts[a], pts[b], pts[c], pts[d]);
         if (r >= 0)
-            FAIL("check.c:%d: edge %u-%u is not locally Delaunay: point %u is %s the circle of "
-                 "triangle (%u %u %u)%s", __LINE__, ed[i].lo, ed[i].hi, d,
-                 ck_incircle(pts[a], pts[b], pts[c], pts[d]) > 0 ? "inside" : "on",
-                 a, b, c,
-                 ck_incircle(pts[a], pts[b], pts[c], pts[d]) > 0 ? ""
-                                                                 : " and the tie rule says inside");
+            st = fail(
+                err,
+                "check.c:%d: edge %u-%u is not locally Delaunay: point %u is %s the circle of "
+                "triangle (%u %u %u)%s",
+                __LINE__, ed[i].lo, ed[i].hi, d,
+                ck_incircle(pts[a], pts[b], pts[c], pts[d]) > 0 ? "inside" : "on", a, b, c,
+                ck_incircle(pts[a], pts[b], pts[c], pts[d]) > 0 ? ""
+                                                                : " and the tie rule says inside");
         i++;
     }
 

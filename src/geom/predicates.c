@@ -93,8 +93,8 @@ static int i192_sign(i192 a)
 }
 
 /* Exact incircle0 for arbitrary int32 input (stage 3). */
-static __attribute__((noinline)) int incircle_exact192(int64_t adx, int64_t ady, int64_t bdx, int64_t bdy, int64_t cdx,
-                             int64_t cdy)
+static __attribute__((noinline)) int incircle_exact192(int64_t adx, int64_t ady, int64_t bdx,
+                                                       int64_t bdy, int64_t cdx, int64_t cdy)
 {
     i128 al = (i128)adx * adx + (i128)ady * ady; /* < 2^65 */
     i128 bl = (i128)bdx * bdx + (i128)bdy * bdy;
@@ -107,8 +107,8 @@ static __attribute__((noinline)) int incircle_exact192(int64_t adx, int64_t ady,
 }
 
 /* Exact incircle0 when every difference is < 2^30 in magnitude (stage 2). */
-static __attribute__((noinline)) int incircle_exact128(int64_t adx, int64_t ady, int64_t bdx, int64_t bdy, int64_t cdx,
-                             int64_t cdy)
+static __attribute__((noinline)) int incircle_exact128(int64_t adx, int64_t ady, int64_t bdx,
+                                                       int64_t bdy, int64_t cdx, int64_t cdy)
 {
     int64_t al = adx * adx + ady * ady; /* < 2^61 */
     int64_t bl = bdx * bdx + bdy * bdy;
