@@ -31,7 +31,7 @@ else fail lift_ups_at_merge_ranks "$(cat check.out)"; fi
 
 nd=$("$PDT" trace dump run4 --kind ra-defer | wc -l)
 nx=$("$PDT" trace dump run4 --kind discard | wc -l)
-nw=$("$PDT" trace dump run4 --kind discard | grep -vc 'witness=-1')
+nw=$("$PDT" trace dump run4 --kind discard | grep -c 'witness=[0-9]')
 if [ "$nd" -gt 0 ] && [ "$nx" -gt 0 ] && [ "$nw" -gt 0 ]; then ok deferrals_and_discards
 else fail deferrals_and_discards "ra-defer=$nd discard=$nx with witness=$nw"; fi
 
