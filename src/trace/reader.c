@@ -20,6 +20,7 @@ typedef struct tf_block {
 
 typedef struct tf_rank {
     int present, complete, level;
+    int absent;       /* the file does not exist (reported in ranges by pdt_run_open) */
     uint8_t *map;
     size_t size;
     tf_block *blk;
@@ -120,9 +121,12 @@ static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
     if (!path) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
     int e = map_file(path, &rk->map, &rk->size);
     free(path);
+    if (e == ENOENT) {
+        rk->absent = 1;
+        return PDT_OK;
+    }
     if (e) {
-        warnf(run, "%s: %s: no events for rank %d", name,
-              e == ENOENT ? "missing" : strerror(e), r);
+        warnf(run, "%s: %s: no events for rank %d", name, strerror(e), r);
         return PDT_OK;
     }
     const uint8_t *p = rk->map;
@@ -340,9 +344,30 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
     int64_t minoff = 0;
     for (int r = 0; r < run->nranks; r++)
         if (run->m.clock_offset_ns[r] < minoff) minoff = run->m.clock_offset_ns[r];
-    for (int r = 0; r < run->nranks && st == PDT_OK; r++) {
-        run->rk[r].shift = run->m.clock_offset_ns[r] - minoff;
-        st = scan_rank(run, r, err);
+    /* Missing rank files are reported as ranges: a damaged manifest may
+     * announce up to 2^20 ranks, and one line per absent file would bury the
+     * other warnings. */
+    int absent_from = -1;
+    for (int r = 0; r <= run->nranks && st == PDT_OK; r++) {
+        if (r < run->nranks) {
+            run->rk[r].shift = run->m.clock_offset_ns[r] - minoff;
+            st = scan_rank(run, r, err);
+            if (run->rk[r].absent) {
+                if (absent_from < 0) absent_from = r;
+                continue;
+            }
+        }
+        if (absent_from >= 0) {
+            char a[32], b[32];
+            rank_name(a, sizeof a, absent_from);
+            rank_name(b, sizeof b, r - 1);
+            if (absent_from == r - 1)
+                warnf(run, "%s: missing: no events for rank %d", a, absent_from);
+            else
+                warnf(run, "%s to %s: missing (%d files): no events for ranks %d to %d", a, b,
+                      r - absent_from, absent_from, r - 1);
+            absent_from = -1;
+        }
     }
     if (st != PDT_OK) {
         pdt_run_close(run);

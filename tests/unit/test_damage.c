@@ -316,7 +316,15 @@ TEST(damage_missing_rank_file)
     open_run(dir2, &o, 1);
     CHECK_MSG(o.st == PDT_OK, "%s", o.err);
     CHECK(o.events == 0 && !o.present);
-    CHECK(strstr(o.warn, "rank-0000.trace: missing") && strstr(o.warn, "rank-0001.trace: missing"));
+    CHECK_MSG(strstr(o.warn, "rank-0000.trace to rank-0001.trace: missing (2 files)"), "%s",
+              o.warn);
+    /* a damaged manifest announcing a million ranks: one line, not a million */
+    snprintf(p, sizeof p, "%s/manifest", dir2);
+    CHECK(put_file(p, "format = 1.0\nranks = 1000000\n", 28) == 0);
+    open_run(dir2, &o, 0);
+    CHECK_MSG(o.st == PDT_OK, "%s", o.err);
+    CHECK_MSG(strstr(o.warn, "rank-0000.trace to rank-999999.trace: missing (1000000 files)") &&
+                  strlen(o.warn) < 200, "%.300s", o.warn);
     /* no manifest: the rank files alone still open, with a notice */
     char dir3[300];
     snprintf(dir3, sizeof dir3, "%s/nomanifest", tmpdir);
