@@ -742,9 +742,15 @@ pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err
     merge_ctx mc = {run, pos, &h, blocked, 0, &sent, &unsent};
     size_t k = 0;
     for (uint32_t r = 0; r < R; r++) schedule(&mc, r);
+    /* `next`: a rank known to go next without asking the heap (see the end
+     * of the loop), or UINT32_MAX. */
+    uint32_t next = UINT32_MAX;
     while (k < total) {
         uint32_t r;
-        if (h.n > 0) {
+        if (next != UINT32_MAX) {
+            r = next;
+            next = UINT32_MAX;
+        } else if (h.n > 0) {
             r = heap_pop(&h, run, pos);
         } else {  /* every remaining head is a RECV whose SEND is missing: force one */
             r = UINT32_MAX;
@@ -788,7 +794,14 @@ pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err
                 warnf(run, "rank %u event #%zu: recv from rank %u (tag %u, seq %" PRId64
                            ") has no matching send", r, pos[r] - 1, e->a, e->sub, e->v);
         }
-        schedule(&mc, r);
+        /* Fast path: if r's next event is no RECV and comes before every
+         * head in the heap, pushing r and popping the heap would give r
+         * again (the order (t, rank) is total), so skip both. */
+        if (pos[r] < run->rk[r].nev && run->rk[r].ev[pos[r]].kind != PDT_EV_RECV &&
+            (h.n == 0 || head_less(run, pos, r, h.r[0])))
+            next = r;
+        else
+            schedule(&mc, r);
     }
     run->merged = out;
     run->nmerged = total;
