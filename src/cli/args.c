@@ -10,6 +10,7 @@
 #include <time.h>
 
 #include "cli.h"
+#include "run_opts.h"
 
 int pdt_cli_usage(const char *cmd, const char *fmt, ...)
 {
@@ -143,4 +144,30 @@ int pdt_cli_parse(const char *cmd, const char *help, int argc, char **argv,
         if (store(cmd, o, val) != 0) return 2;
     }
     return 0;
+}
+
+int pdt_cli_parse_run_opts(const char *cmd, const char *help, int argc, char **argv,
+                           pdt_run_opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->command = cmd;
+    o->trace_level = 1;
+    o->argc = argc;
+    o->argv = argv;
+    const pdt_cli_opt opts[] = {
+        { "--output", "-o", PDT_OPT_STR, &o->output },
+        { "--scale", NULL, PDT_OPT_POSNUM, &o->scale },
+        { "--stats", NULL, PDT_OPT_FLAG, &o->stats },
+        { "--trace", NULL, PDT_OPT_STR, &o->trace_dir },
+        { "--trace-level", NULL, PDT_OPT_LEVEL, &o->trace_level },
+        { NULL, NULL, PDT_OPT_FLAG, NULL },
+    };
+    const char *pos[1];
+    int npos;
+    int rc = pdt_cli_parse(cmd, help, argc, argv, opts, pos, 1, &npos);
+    if (rc == 1) return PDT_EXIT_OK;
+    if (rc) return PDT_EXIT_USAGE;
+    if (npos != 1) return pdt_cli_usage(cmd, "needs one INPUT file");
+    o->input = pos[0];
+    return -1;
 }

@@ -23,31 +23,6 @@ static const char help[] =
     "INPUT, -o, --scale, --stats, --trace, --trace-level: as for pdt triangulate.\n"
     "Exit status: 0 success, 2 usage or input error.\n";
 
-static int parse_options(int argc, char **argv, pdt_run_opts *o)
-{
-    memset(o, 0, sizeof *o);
-    o->command = "hull";
-    o->trace_level = 1;
-    o->argc = argc;
-    o->argv = argv;
-    const pdt_cli_opt opts[] = {
-        { "--output", "-o", PDT_OPT_STR, &o->output },
-        { "--scale", NULL, PDT_OPT_POSNUM, &o->scale },
-        { "--stats", NULL, PDT_OPT_FLAG, &o->stats },
-        { "--trace", NULL, PDT_OPT_STR, &o->trace_dir },
-        { "--trace-level", NULL, PDT_OPT_LEVEL, &o->trace_level },
-        { NULL, NULL, PDT_OPT_FLAG, NULL },
-    };
-    const char *pos[1];
-    int npos;
-    int rc = pdt_cli_parse("hull", help, argc, argv, opts, pos, 1, &npos);
-    if (rc == 1) return PDT_EXIT_OK;
-    if (rc) return PDT_EXIT_USAGE;
-    if (npos != 1) return pdt_cli_usage("hull", "needs one INPUT file");
-    o->input = pos[0];
-    return -1;
-}
-
 /* Graham's scan on pts[0..n), traced when o asks for it. */
 static pdt_status compute(const pdt_run_opts *o, const pdt_point *pts, size_t n, uint32_t *out,
                           size_t *nout, pdt_err *err)
@@ -74,7 +49,7 @@ static pdt_status write_hull(const char *path, const uint32_t *h, size_t nh, pdt
 int pdt_cmd_hull(int argc, char **argv)
 {
     pdt_run_opts o;
-    int rc = parse_options(argc, argv, &o);
+    int rc = pdt_cli_parse_run_opts("hull", help, argc, argv, &o);
     if (rc >= 0) return rc;
 
     double t0 = pdt_cli_now(), t1 = t0, t2 = t0, t3 = t0;

@@ -40,32 +40,6 @@ static const char help[] =
     "\n"
     "Exit status: 0 success, 2 usage or input error.\n";
 
-/* Parse the command line into o.  Returns -1 to go on, else an exit status. */
-static int parse_options(int argc, char **argv, pdt_run_opts *o)
-{
-    memset(o, 0, sizeof *o);
-    o->command = "triangulate";
-    o->trace_level = 1;
-    o->argc = argc;
-    o->argv = argv;
-    const pdt_cli_opt opts[] = {
-        { "--output", "-o", PDT_OPT_STR, &o->output },
-        { "--scale", NULL, PDT_OPT_POSNUM, &o->scale },
-        { "--stats", NULL, PDT_OPT_FLAG, &o->stats },
-        { "--trace", NULL, PDT_OPT_STR, &o->trace_dir },
-        { "--trace-level", NULL, PDT_OPT_LEVEL, &o->trace_level },
-        { NULL, NULL, PDT_OPT_FLAG, NULL },
-    };
-    const char *pos[1];
-    int npos;
-    int rc = pdt_cli_parse("triangulate", help, argc, argv, opts, pos, 1, &npos);
-    if (rc == 1) return PDT_EXIT_OK;
-    if (rc) return PDT_EXIT_USAGE;
-    if (npos != 1) return pdt_cli_usage("triangulate", "needs one INPUT file");
-    o->input = pos[0];
-    return -1;
-}
-
 pdt_status pdt_tri_job_read(const pdt_run_opts *o, pdt_tri_job *j, pdt_err *err)
 {
     double t0 = pdt_cli_now();
@@ -155,7 +129,7 @@ void pdt_tri_job_free(pdt_tri_job *j)
 int pdt_cmd_triangulate(int argc, char **argv)
 {
     pdt_run_opts o;
-    int rc = parse_options(argc, argv, &o);
+    int rc = pdt_cli_parse_run_opts("triangulate", help, argc, argv, &o);
     if (rc >= 0) return rc;
     if (pdt_comm_launched()) { /* under mpirun / srun: the parallel driver (src/par) */
         pdt_par_job pj = {o.input, o.output, o.scale, o.stats, o.trace_dir, o.trace_level,

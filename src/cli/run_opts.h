@@ -26,6 +26,13 @@ typedef struct pdt_run_opts {
     char **argv;
 } pdt_run_opts;
 
+/* Parse the options shared by `pdt triangulate` and `pdt hull` (INPUT, -o,
+ * --scale, --stats, --trace, --trace-level) for command `cmd` into o.
+ * Returns -1 to go on, else the exit status to return (help printed, or a
+ * usage error already reported). */
+int pdt_cli_parse_run_opts(const char *cmd, const char *help, int argc, char **argv,
+                           pdt_run_opts *o);
+
 /* Tracing of one run (the run folder of docs/trace-format.md).  Opened
  * before the computation when o->trace_dir is set, closed after it. */
 typedef struct pdt_cli_trace pdt_cli_trace;
