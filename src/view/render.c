@@ -543,6 +543,24 @@ static int hull_live(const ctx *c, int q, int32_t h)
     return 1;
 }
 
+/* Has rank q's last Graham scan (begun before the cursor) ended?  Graham's
+ * Version B reports no HULL event: once the scan is over, its stack is the
+ * hull and is drawn closed. */
+static int graham_scan_ended(const ctx *c, int q)
+{
+    size_t np;
+    const pdt_rphase *Ph = pdt_replay_phases(c->r, &np);
+    int ended = 0;
+    uint32_t last = 0;
+    for (size_t i = 0; i < np; i++) {
+        if (Ph[i].rank != (uint32_t)q || Ph[i].phase != PDT_PH_GRAHAM_SCAN) continue;
+        if (Ph[i].begin_ev >= c->s->k || (ended && Ph[i].begin_ev < last)) continue;
+        last = Ph[i].begin_ev;
+        ended = Ph[i].end_ev != UINT32_MAX && Ph[i].end_ev < c->s->k;
+    }
+    return ended;
+}
+
 /* Is a stack (its top node) still being built: not yet reported as a hull? */
 static int stack_open(const ctx *c, int32_t top)
 {
@@ -586,11 +604,21 @@ static void draw_hulls_and_stacks(ctx *c, uint32_t *buf, size_t cap)
             int32_t top = pdt_rstate_slot(c->r, c->s, q, PDT_SLOT_STACK0 + st);
             if (top < 0 || !stack_open(c, top)) continue;
             size_t k = stack_list(c->r, top, buf, cap);
+            int closed = st == PDT_STACK_GRAHAM && k >= 3 && graham_scan_ended(c, q);
             double x, y;
             for (size_t i = 0; i < k; i++) {
                 wpt(c, buf[i], &x, &y);
                 if (i) cairo_line_to(cr, x, y);
                 else cairo_move_to(cr, x, y);
+            }
+            if (closed) { /* the scan is over: the stack is the hull, drawn like one */
+                cairo_close_path(cr);
+                double col[3];
+                pdt_rank_rgb(q, col);
+                cairo_set_line_width(cr, 3.2 * c->lw);
+                cairo_set_source_rgba(cr, 0.6 * col[0], 0.6 * col[1], 0.6 * col[2], 0.9);
+                cairo_stroke(cr);
+                continue;
             }
             set_rank(cr, q, 0.9);
             cairo_set_line_width(cr, 2.6 * c->lw);

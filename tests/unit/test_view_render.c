@@ -285,6 +285,63 @@ TEST(graham_and_every_cursor)
     pdt_synth_free(&s);
 }
 
+/* Graham's scan as `pdt hull --trace` records it: no HULL event.  Once the
+ * scan phase has ended, the stack is the hull and is drawn closed: the edge
+ * from the top back to p0 carries the hull colour. */
+TEST(graham_hull_closed_at_end)
+{
+    pdt_synth s;
+    pdt_err err = {0};
+    CHECK(pdt_synth_graham(40, 5, &s, &err) == PDT_OK);
+    size_t m = 0;
+    for (size_t i = 0; i < s.m; i++) /* drop the HULL events */
+        if (s.recs[i].ev.kind != PDT_EV_HULL) s.recs[m++] = s.recs[i];
+    CHECK(m < s.m);
+    pdt_replay *r = NULL;
+    CHECK(pdt_replay_new(s.pts, s.n, s.recs, m, 1, &r, &err) == PDT_OK);
+    if (!r) return;
+    pdt_rstate *st = pdt_rstate_new(r);
+    pdt_view v;
+    pdt_view_defaults(&v);
+    cairo_surface_t *sf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
+    pdt_replay_seek(r, st, m);
+    int32_t top = pdt_rstate_slot(r, st, 0, PDT_SLOT_STACK0 + PDT_STACK_GRAHAM);
+    CHECK(top >= 0);
+    size_t nn;
+    const pdt_rnode *N = pdt_replay_nodes(r, &nn);
+    int32_t bot = top;
+    while (bot >= 0 && N[bot].parent >= 0) bot = N[bot].parent;
+    CHECK(top >= 0 && N[top].depth >= 3);
+    cairo_t *cr = cairo_create(sf);
+    CHECK(pdt_render(cr, W, H, r, st, &v, &err) == PDT_OK);
+    cairo_destroy(cr);
+    cairo_surface_flush(sf);
+    if (top >= 0) {
+        double ax, ay, bx, by, col[3], want[3];
+        pdt_view_to_screen(r, &v, W, H, s.pts[N[top].pt].x, s.pts[N[top].pt].y, &ax, &ay);
+        pdt_view_to_screen(r, &v, W, H, s.pts[N[bot].pt].x, s.pts[N[bot].pt].y, &bx, &by);
+        pdt_rank_rgb(0, col);
+        for (int j = 0; j < 3; j++) want[j] = 0.6 * col[j] * 0.9 + 0.1; /* 0.9 over white */
+        double d = 9;
+        for (int t = 1; t < 4; t++) { /* a few points along the closing edge */
+            double x = ax + (bx - ax) * t / 4, y = ay + (by - ay) * t / 4;
+            double e = 9;
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    double c[3];
+                    pixel(sf, (int)lround(x) + dx, (int)lround(y) + dy, c);
+                    if (cdist(c, want) < e) e = cdist(c, want);
+                }
+            if (t == 1 || e > d) d = e; /* the worst of the three samples */
+        }
+        CHECK(d < 0.35);
+    }
+    cairo_surface_destroy(sf);
+    pdt_rstate_free(st);
+    pdt_replay_free(r);
+    pdt_synth_free(&s);
+}
+
 TEST(pick_and_zoom)
 {
     fixture f;
@@ -334,6 +391,7 @@ int main(void)
     RUN(hidden_rank_not_drawn);
     RUN(files_png_svg_pdf);
     RUN(graham_and_every_cursor);
+    RUN(graham_hull_closed_at_end);
     RUN(pick_and_zoom);
     return test_summary();
 }
