@@ -32,7 +32,7 @@
 #              or `first KIND ...` / `last KIND ...` (the first/last event of
 #              that kind, words and fields: see scripts/lesson-check.py)
 #   frames     key frames rendered headless, separated by `;` (same forms as start)
-#   view       extra pdtview options (panels), passed as they are
+#   view       extra pdtview options, passed as they are (e.g. --panels code,stack)
 #   recorded   a run folder recorded ahead (relative to the lesson folder): not re-recorded
 #
 # Exit status: 0 when every run was recorded, checked and shown/rendered; 1 otherwise.

@@ -29,7 +29,22 @@ typedef struct pdt_view {
     int64_t sel_tri;      /* triangle whose details are shown, or -1 */
     int sel_edge;         /* 0..2: the edge v[e]-v[e+1] of sel_tri is selected, or -1 */
     const char *status;   /* short text for the status corner ("playing 8 ev/s"), or NULL */
+    unsigned panels;      /* PDT_PANEL_* bits: the optional panels shown (legend always) */
 } pdt_view;
+
+/* The optional panels (pdt_view.panels).  A hidden panel gets no room: the
+ * geometry and the other panels grow instead. */
+enum {
+    PDT_PANEL_CODE = 1,     /* pseudo-code */
+    PDT_PANEL_STACK = 2,    /* stacks being built */
+    PDT_PANEL_LIFTED = 4,   /* lifted view */
+    PDT_PANEL_TIMELINE = 8, /* timeline */
+    PDT_PANEL_ALL = 15
+};
+
+/* Parse a comma-separated list of panel names ("code,stack,lifted,timeline",
+ * or "all" / "none") into PDT_PANEL_* bits.  Returns -1 on an unknown name. */
+int pdt_panels_parse(const char *list, unsigned *panels);
 
 /* Rectangles of the panels for a w x h picture (pixels). */
 typedef struct pdt_rect {
@@ -44,7 +59,11 @@ typedef struct pdt_layout {
 /* Defaults: fit, all ranks, yaw 30°, pitch 25°, fade 400 events. */
 void pdt_view_defaults(pdt_view *v);
 
+/* Layout with every panel shown. */
 void pdt_render_layout(double w, double h, int nranks, pdt_layout *L);
+/* Layout with the panels of `panels` (PDT_PANEL_* bits); hidden ones have
+ * zero width and height. */
+void pdt_render_layout_panels(double w, double h, int nranks, unsigned panels, pdt_layout *L);
 
 /* Draw state s of replay r on cr, in the rectangle (0,0)-(w,h).  Leaves the
  * cairo state as it found it.  Returns PDT_OK, or an error if cairo reports
@@ -79,6 +98,7 @@ void pdt_render_pick(const pdt_replay *r, const pdt_rstate *s, const pdt_view *v
 
 /* Cursor for a click at x in the timeline rectangle, or (size_t)-1 when x,y is
  * not in it. */
-size_t pdt_render_timeline_at(const pdt_replay *r, double w, double h, double sx, double sy);
+size_t pdt_render_timeline_at(const pdt_replay *r, const pdt_view *v, double w, double h, double sx,
+                              double sy);
 
 #endif

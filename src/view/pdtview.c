@@ -28,12 +28,14 @@ typedef struct opts {
     int headless, end, every, w, h, have_at, quiet, bench, counts, check;
     size_t at;
     double speed;
+    unsigned panels; /* PDT_PANEL_* bits (--panels) */
 } opts;
 
 static void usage(FILE *f)
 {
     fprintf(f,
             "usage: pdtview RUN [--size WxH] [--at N|--phase NAME|--end] [--hide R,R..]\n"
+            "               [--panels code,stack,lifted,timeline|all|none]\n"
             "               [--script KEYS] [--screenshot FILE.png] [--speed EV_PER_S]\n"
             "       pdtview --headless RUN (--at N | --phase NAME | --end) -o FILE.png|.svg|.pdf\n"
             "               [--size WxH]\n"
@@ -65,6 +67,7 @@ static int parse_args(int argc, char **argv, opts *o)
     o->w = 1600;
     o->h = 1000;
     o->speed = 20;
+    o->panels = PDT_PANEL_ALL;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
@@ -111,6 +114,14 @@ static int parse_args(int argc, char **argv, opts *o)
         } else if (!strcmp(a, "--script")) { NEED(); o->script = val; }
         else if (!strcmp(a, "--screenshot")) { NEED(); o->screenshot = val; }
         else if (!strcmp(a, "--hide")) { NEED(); o->hide = val; }
+        else if (!strcmp(a, "--panels")) {
+            NEED();
+            if (pdt_panels_parse(val, &o->panels) != 0) {
+                fprintf(stderr, "pdtview: --panels %s: want a list of code, stack, lifted, "
+                                "timeline (or all, none)\n", val);
+                return 0;
+            }
+        }
         else if (!strcmp(a, "--speed")) {
             NEED();
             o->speed = atof(val);
@@ -450,6 +461,7 @@ int main(int argc, char **argv)
     pdt_view v;
     pdt_view_defaults(&v);
     v.hidden = hidden;
+    v.panels = o.panels;
     if (o.check) {
         rc = check(r);
     } else if (o.counts) {

@@ -75,9 +75,36 @@ void pdt_view_defaults(pdt_view *v)
     v->ev_class = PDT_EVC_STACK;
     v->sel_point = v->sel_tri = -1;
     v->sel_edge = -1;
+    v->panels = PDT_PANEL_ALL;
+}
+
+int pdt_panels_parse(const char *list, unsigned *panels)
+{
+    static const struct { const char *name; unsigned bit; } names[] = {
+        {"code", PDT_PANEL_CODE}, {"stack", PDT_PANEL_STACK}, {"lifted", PDT_PANEL_LIFTED},
+        {"timeline", PDT_PANEL_TIMELINE}, {"all", PDT_PANEL_ALL}, {"none", 0}};
+    unsigned bits = 0;
+    const char *p = list;
+    while (*p) {
+        size_t len = strcspn(p, ",");
+        size_t i;
+        for (i = 0; i < sizeof names / sizeof *names; i++)
+            if (strlen(names[i].name) == len && !strncmp(p, names[i].name, len)) break;
+        if (i == sizeof names / sizeof *names) return -1;
+        bits |= names[i].bit;
+        p += len;
+        if (*p == ',') p++;
+    }
+    *panels = bits;
+    return 0;
 }
 
 void pdt_render_layout(double w, double h, int nranks, pdt_layout *L)
+{
+    pdt_render_layout_panels(w, h, nranks, PDT_PANEL_ALL, L);
+}
+
+void pdt_render_layout_panels(double w, double h, int nranks, unsigned panels, pdt_layout *L)
 {
     double f = h / 46;
     if (f > w / 72) f = w / 72;
@@ -87,26 +114,31 @@ void pdt_render_layout(double w, double h, int nranks, pdt_layout *L)
     int rows = nranks < 1 ? 1 : nranks > 16 ? 16 : nranks;
     double tl = (rows + 1.6) * f * 1.15;
     if (tl > 0.28 * h) tl = 0.28 * h;
+    if (!(panels & PDT_PANEL_TIMELINE)) tl = 0;
     double side = 0.34 * w;
     if (side < 22 * f) side = 22 * f;
     if (side > 0.5 * w) side = 0.5 * w;
     L->top = (pdt_rect){0, 0, w, top};
-    L->timeline = (pdt_rect){0, h - tl, w, tl};
+    L->timeline = (pdt_rect){0, h - tl, tl > 0 ? w : 0, tl};
     double mid = h - tl - top;
     L->geo = (pdt_rect){0, top, w - side, mid};
     double x = w - side, y = top;
-    double leg = 7.6 * f, code = 12.2 * f * 0.9;
+    int has_code = (panels & PDT_PANEL_CODE) != 0, has_stack = (panels & PDT_PANEL_STACK) != 0,
+        has_lifted = (panels & PDT_PANEL_LIFTED) != 0;
+    double leg = 7.6 * f, code = has_code ? 12.2 * f * 0.9 : 0;
     double rest = mid - leg - code;
-    if (rest < 10 * f) { /* small pictures: shrink the code panel first */
+    if (has_code && rest < 10 * f) { /* small pictures: shrink the code panel first */
         code = mid - leg - 10 * f;
         if (code < 4 * f) code = 4 * f;
         rest = mid - leg - code;
     }
-    double stk = rest * 0.38;
+    double stk = has_stack ? (has_lifted ? rest * 0.38 : rest) : 0;
+    double lifted = has_lifted ? rest - stk : 0;
+    if (!has_stack && !has_lifted && has_code) code += rest; /* the code panel takes the column */
     L->legend = (pdt_rect){x, y, side, leg};
-    L->code = (pdt_rect){x, y + leg, side, code};
-    L->stack = (pdt_rect){x, y + leg + code, side, stk};
-    L->lifted = (pdt_rect){x, y + leg + code + stk, side, rest - stk};
+    L->code = (pdt_rect){x, y + leg, has_code ? side : 0, code};
+    L->stack = (pdt_rect){x, y + leg + code, has_stack ? side : 0, stk};
+    L->lifted = (pdt_rect){x, y + leg + code + stk, has_lifted ? side : 0, lifted};
     /* whole pixels: clipping to them stays a fast box clip */
     pdt_rect *all[] = {&L->top, &L->geo, &L->legend, &L->code, &L->stack, &L->lifted, &L->timeline};
     for (size_t i = 0; i < sizeof all / sizeof *all; i++) {
@@ -125,7 +157,7 @@ typedef struct xform {
 static xform geo_xform(const pdt_replay *r, const pdt_view *v, double w, double h)
 {
     pdt_layout L;
-    pdt_render_layout(w, h, pdt_replay_nranks(r), &L);
+    pdt_render_layout_panels(w, h, pdt_replay_nranks(r), v->panels, &L);
     pdt_point lo = {0, 0}, hi = {1, 1};
     pdt_replay_bbox(r, &lo, &hi);
     double bw = (double)hi.x - lo.x, bh = (double)hi.y - lo.y;
@@ -160,7 +192,7 @@ void pdt_view_zoom_at(const pdt_replay *r, pdt_view *v, double w, double h, doub
     double wx, wy, cx, cy;
     pdt_view_to_world(r, v, w, h, sx, sy, &wx, &wy);
     pdt_layout L;
-    pdt_render_layout(w, h, pdt_replay_nranks(r), &L);
+    pdt_render_layout_panels(w, h, pdt_replay_nranks(r), v->panels, &L);
     pdt_view_to_world(r, v, w, h, L.geo.x + L.geo.w / 2, L.geo.y + L.geo.h / 2, &cx, &cy);
     v->zoom *= f;
     if (v->zoom < 0.05) v->zoom = 0.05;
@@ -1497,11 +1529,13 @@ static void draw_timeline(ctx *c)
     cairo_restore(cr);
 }
 
-size_t pdt_render_timeline_at(const pdt_replay *r, double w, double h, double sx, double sy)
+size_t pdt_render_timeline_at(const pdt_replay *r, const pdt_view *v, double w, double h, double sx,
+                              double sy)
 {
     pdt_layout L;
-    pdt_render_layout(w, h, pdt_replay_nranks(r), &L);
+    pdt_render_layout_panels(w, h, pdt_replay_nranks(r), v ? v->panels : PDT_PANEL_ALL, &L);
     pdt_rect R = L.timeline;
+    if (R.w <= 0 || R.h <= 0) return (size_t)-1;
     if (sx < R.x || sx > R.x + R.w || sy < R.y || sy > R.y + R.h) return (size_t)-1;
     double x0 = R.x + 3.2 * L.font, x1 = R.x + R.w - 0.6 * L.font;
     double t = (sx - x0) / (x1 - x0);
@@ -1574,7 +1608,7 @@ pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, cons
     c.v = v;
     c.nranks = pdt_replay_nranks(r);
     c.P = pdt_replay_points(r, &c.n);
-    pdt_render_layout(w, h, c.nranks, &c.L);
+    pdt_render_layout_panels(w, h, c.nranks, v->panels, &c.L);
     c.X = geo_xform(r, v, w, h);
     c.cur = s->k ? pdt_replay_rec(r, s->k - 1) : NULL;
     c.all_lifted = pdt_replay_kind_count(r, PDT_EV_LIFT) == 0;
@@ -1595,10 +1629,10 @@ pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, cons
     draw_geometry(&c);
     draw_top(&c);
     draw_legend(&c);
-    draw_code(&c);
-    draw_stack_panel(&c);
-    draw_lifted(&c);
-    draw_timeline(&c);
+    if (c.L.code.w > 0) draw_code(&c);
+    if (c.L.stack.w > 0) draw_stack_panel(&c);
+    if (c.L.lifted.w > 0) draw_lifted(&c);
+    if (c.L.timeline.w > 0) draw_timeline(&c);
     if (v->help) draw_help(&c, w, h);
     cairo_restore(cr);
     cairo_status_t cs = cairo_status(cr);

@@ -140,14 +140,14 @@ static void key(shell *sh, SDL_Keycode k, Uint16 mod)
 
 static void click(shell *sh, double x, double y)
 {
-    size_t k = pdt_render_timeline_at(sh->r, sh->tw, sh->th, x, y);
+    size_t k = pdt_render_timeline_at(sh->r, sh->v, sh->tw, sh->th, x, y);
     if (k != (size_t)-1) {
         sh->playing = 0;
         seek(sh, k);
         return;
     }
     pdt_layout L;
-    pdt_render_layout(sh->tw, sh->th, sh->nranks, &L);
+    pdt_render_layout_panels(sh->tw, sh->th, sh->nranks, sh->v->panels, &L);
     if (x < L.geo.x || x > L.geo.x + L.geo.w || y < L.geo.y || y > L.geo.y + L.geo.h) return;
     pdt_render_pick(sh->r, sh->s, sh->v, sh->tw, sh->th, x, y, 0.8 * L.font, &sh->v->sel_point,
                     &sh->v->sel_tri, &sh->v->sel_edge);
@@ -162,7 +162,7 @@ static int in_rect(pdt_rect R, double x, double y)
 static void mouse(shell *sh, const SDL_Event *e)
 {
     pdt_layout L;
-    pdt_render_layout(sh->tw, sh->th, sh->nranks, &L);
+    pdt_render_layout_panels(sh->tw, sh->th, sh->nranks, sh->v->panels, &L);
     switch (e->type) {
     case SDL_MOUSEBUTTONDOWN:
         if (e->button.button != SDL_BUTTON_LEFT) return;

@@ -376,10 +376,10 @@ TEST(pick_and_zoom)
     /* the timeline maps clicks to cursors */
     pdt_layout L;
     pdt_render_layout(W, H, 2, &L);
-    size_t k0 = pdt_render_timeline_at(f.r, W, H, L.timeline.x + 1, L.timeline.y + 10);
-    size_t k1 = pdt_render_timeline_at(f.r, W, H, L.timeline.x + L.timeline.w - 1, L.timeline.y + 10);
+    size_t k0 = pdt_render_timeline_at(f.r, NULL, W, H, L.timeline.x + 1, L.timeline.y + 10);
+    size_t k1 = pdt_render_timeline_at(f.r, NULL, W, H, L.timeline.x + L.timeline.w - 1, L.timeline.y + 10);
     CHECK(k0 == 0 && k1 == pdt_replay_count(f.r));
-    CHECK(pdt_render_timeline_at(f.r, W, H, 5, 5) == (size_t)-1);
+    CHECK(pdt_render_timeline_at(f.r, NULL, W, H, 5, 5) == (size_t)-1);
     teardown(&f);
 }
 
