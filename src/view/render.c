@@ -1,5 +1,6 @@
 /* pdt — the cairo renderer (see pdt/render.h). */
 #include "pdt/render.h"
+#include "pdt/predicates.h"
 
 #include <cairo-pdf.h>
 #include <cairo-svg.h>
@@ -289,7 +290,8 @@ typedef struct ctx {
     int nranks;
     double lw;      /* base line width */
     const pdt_rec *cur;  /* the current event or NULL */
-    int all_lifted;      /* the run has no lift events: show every point lifted */
+    int all_lifted;      /* no lift events but triangles: show every point lifted */
+    int no_lift;         /* no lift events and no triangles (a hull-only run) */
     double spacing;      /* typical distance between points, pixels */
 } ctx;
 
@@ -1300,6 +1302,18 @@ typedef struct proj {
     double ox, oy, s;       /* unit -> screen */
 } proj;
 
+size_t pdt_render_inside_count(const pdt_replay *r, const uint32_t v[3])
+{
+    size_t n;
+    const pdt_point *P = pdt_replay_points(r, &n);
+    if (v[0] >= n || v[1] >= n || v[2] >= n) return 0;
+    int ccw = pdt_orient(P[v[0]], P[v[1]], P[v[2]]);
+    size_t k = 0;
+    if (ccw)
+        for (size_t p = 0; p < n; p++) k += ccw * pdt_incircle0(P[v[0]], P[v[1]], P[v[2]], P[p]) > 0;
+    return k;
+}
+
 static void lift_xy(const proj *J, double u, double w, double z, double *sx, double *sy)
 {
     double X = u * J->cy_ - w * J->sy_, Y = u * J->sy_ + w * J->cy_;
@@ -1394,13 +1408,16 @@ static void draw_lifted(ctx *c)
      * others faint on the floor; those below the plane in red */
     size_t step = c->n > 6000 ? c->n / 6000 : 1;
     double rad = c->n > 1000 ? 1.4 : 2.6;
-    size_t nbelow = 0;
+    /* inside the circle, exactly: every input point, lifted or not (the
+     * drawing below samples large inputs; the count does not) */
+    int ccw = have_plane ? pdt_orient(c->P[tv[0]], c->P[tv[1]], c->P[tv[2]]) : 0;
+    size_t ninside = ccw ? pdt_render_inside_count(c->r, tv) : 0;
     for (int cls = 0; cls < 3; cls++) { /* 0 floor, 1 lifted, 2 below the plane: one fill each */
         for (size_t p = 0; p < c->n; p += step) {
             double u = (c->P[p].x - J.cx) / J.sc, w = (c->P[p].y - J.cy) / J.sc, z = u * u + w * w;
             int lifted = c->all_lifted || (c->s->pflags[p] & PDT_PF_LIFTED) != 0;
-            int below = have_plane && lifted && z < pa * u + pb * w + pc - 1e-12 && p != tv[0] &&
-                        p != tv[1] && p != tv[2];
+            int below = ccw && lifted &&
+                        ccw * pdt_incircle0(c->P[tv[0]], c->P[tv[1]], c->P[tv[2]], c->P[p]) > 0;
             if ((below ? 2 : lifted ? 1 : 0) != cls) continue;
             double sx, sy;
             lift_xy(&J, u, w, lifted ? z : 0, &sx, &sy);
@@ -1410,7 +1427,6 @@ static void draw_lifted(ctx *c)
                 cairo_new_sub_path(cr);
                 cairo_arc(cr, sx, sy, rr, 0, 2 * M_PI);
             }
-            nbelow += below;
         }
         if (cls == 2) rgb(cr, RED, 1);
         else if (cls == 1) rgb(cr, INK, 0.85);
@@ -1430,11 +1446,19 @@ static void draw_lifted(ctx *c)
         set_rank(cr, (int)e->rank, 1);
         cairo_set_line_width(cr, 2);
         cairo_stroke(cr);
-        char lab[96];
-        snprintf(lab, sizeof lab, "%zu point%s below the plane = inside the circle", nbelow,
-                 nbelow == 1 ? "" : "s");
-        rgb(cr, nbelow ? RED : INK, 1);
-        text_at(cr, SANS, 0, 0.72 * f, R.x + 0.5 * f, R.y + R.h - 0.5 * f, lab);
+        char lab[128];
+        snprintf(lab, sizeof lab, "%zu input point%s strictly inside the circle (exact, no tie rule)",
+                 ninside, ninside == 1 ? "" : "s");
+        rgb(cr, ninside ? RED : INK, 1);
+        text_at(cr, SANS, 0, 0.72 * f, R.x + 0.5 * f, R.y + R.h - 1.4 * f, lab);
+        rgb(cr, INK, 1);
+        text_at(cr, SANS, 0, 0.72 * f, R.x + 0.5 * f, R.y + R.h - 0.5 * f,
+                "those already lifted: below the plane (red)");
+    }
+    if (c->no_lift) {
+        rgb(cr, INK, 1);
+        text_at(cr, SANS, 0, 0.8 * f, R.x + 0.5 * f, R.y + R.h - 0.5 * f,
+                "no lift-up in this run (points stay on the floor)");
     }
     cairo_restore(cr);
 }
@@ -1611,7 +1635,9 @@ pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, cons
     pdt_render_layout_panels(w, h, c.nranks, v->panels, &c.L);
     c.X = geo_xform(r, v, w, h);
     c.cur = s->k ? pdt_replay_rec(r, s->k - 1) : NULL;
-    c.all_lifted = pdt_replay_kind_count(r, PDT_EV_LIFT) == 0;
+    c.all_lifted = pdt_replay_kind_count(r, PDT_EV_LIFT) == 0 &&
+                   pdt_replay_kind_count(r, PDT_EV_TRI_NEW) > 0;
+    c.no_lift = pdt_replay_kind_count(r, PDT_EV_LIFT) == 0 && !c.all_lifted;
     /* line width: thick on a projector, thinner when edges are dense */
     size_t nt;
     pdt_replay_tris(r, &nt);

@@ -342,6 +342,61 @@ TEST(graham_hull_closed_at_end)
     pdt_synth_free(&s);
 }
 
+/* The lifted view's count: every input point strictly inside the circle,
+ * lifted or not, exactly (points on the circle are not counted). */
+TEST(inside_count_exact_all_points)
+{
+    /* triangle (0,0) (10,0) (0,10): circle centre (5,5), r^2 = 50 */
+    pdt_point P[] = {{0, 0}, {10, 0}, {0, 10}, {5, 5}, {1, 1}, {9, 8}, {10, 10},
+                     {12, 5}, {-2, 5}, {5, 12}, {20, 20}, {5, -3}, {2, 9}};
+    size_t n = sizeof P / sizeof P[0];
+    pdt_err err = {0};
+    pdt_replay *r = NULL;
+    CHECK(pdt_replay_new(P, n, NULL, 0, 1, &r, &err) == PDT_OK);
+    if (!r) return;
+    uint32_t ccw[3] = {0, 1, 2}, cw[3] = {0, 2, 1}, flat[3] = {0, 1, 1};
+    /* distance^2 from (5,5): inside (5,5) 0, (1,1) 32, (9,8) 25, (12,5) 49, (-2,5) 49,
+     * (5,12) 49, (2,9) 25; on the circle (10,10) 50 and the vertices; outside the rest */
+    CHECK_MSG(pdt_render_inside_count(r, ccw) == 7, "got %zu", pdt_render_inside_count(r, ccw));
+    CHECK(pdt_render_inside_count(r, cw) == 7);
+    CHECK(pdt_render_inside_count(r, flat) == 0);
+    pdt_replay_free(r);
+}
+
+/* A hull-only run (no LIFT, no triangle events): the points are drawn as not
+ * lifted (hollow), not as filled dots. */
+TEST(hull_only_points_not_lifted)
+{
+    pdt_synth s;
+    pdt_err err = {0};
+    CHECK(pdt_synth_graham(30, 7, &s, &err) == PDT_OK);
+    pdt_replay *r = NULL;
+    CHECK(pdt_replay_new(s.pts, s.n, s.recs, s.m, 1, &r, &err) == PDT_OK);
+    if (!r) return;
+    CHECK(pdt_replay_kind_count(r, PDT_EV_LIFT) == 0);
+    pdt_rstate *st = pdt_rstate_new(r);
+    pdt_view v;
+    pdt_view_defaults(&v);
+    cairo_surface_t *sf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
+    pdt_replay_seek(r, st, 0); /* nothing drawn over the points yet */
+    cairo_t *cr = cairo_create(sf);
+    CHECK(pdt_render(cr, W, H, r, st, &v, &err) == PDT_OK);
+    cairo_destroy(cr);
+    cairo_surface_flush(sf);
+    size_t dark = 0;
+    for (size_t p = 0; p < s.n; p++) {
+        double x, y, c[3];
+        pdt_view_to_screen(r, &v, W, H, s.pts[p].x, s.pts[p].y, &x, &y);
+        pixel(sf, (int)lround(x), (int)lround(y), c);
+        dark += c[0] + c[1] + c[2] < 1.0;
+    }
+    CHECK_MSG(dark == 0, "%zu of %zu points drawn filled", dark, s.n);
+    cairo_surface_destroy(sf);
+    pdt_rstate_free(st);
+    pdt_replay_free(r);
+    pdt_synth_free(&s);
+}
+
 TEST(pick_and_zoom)
 {
     fixture f;
@@ -392,6 +447,8 @@ int main(void)
     RUN(files_png_svg_pdf);
     RUN(graham_and_every_cursor);
     RUN(graham_hull_closed_at_end);
+    RUN(inside_count_exact_all_points);
+    RUN(hull_only_points_not_lifted);
     RUN(pick_and_zoom);
     return test_summary();
 }
