@@ -714,6 +714,28 @@ static void draw_points(ctx *c)
     /* Graham: angular numbers and deleted points */
     if (nvis > 600) return;
     double f = 0.72 * c->L.font;
+    /* other runs: the input index beside each point, while few are on screen
+     * and they are far enough apart for the labels not to pile up */
+    if (nvis <= 60 && c->spacing >= 2.5 * f && pdt_replay_kind_count(c->r, PDT_EV_SORT) == 0) {
+        cairo_set_source_rgba(cr, 0.0, 0.25, 0.55, 1);
+        for (size_t p = 0; p < c->n; p++) {
+            double x, y;
+            char lab[24];
+            wpt(c, (uint32_t)p, &x, &y);
+            if (x < c->L.geo.x || x > c->L.geo.x + c->L.geo.w || y < c->L.geo.y ||
+                y > c->L.geo.y + c->L.geo.h)
+                continue;
+            int crowded = 0; /* a point so close that its label would collide */
+            for (size_t q = 0; q < c->n && !crowded; q++) {
+                double qx, qy;
+                wpt(c, (uint32_t)q, &qx, &qy);
+                crowded = q != p && fabs(qx - x) < 1.6 * f && fabs(qy - y) < 0.9 * f;
+            }
+            if (crowded) continue;
+            snprintf(lab, sizeof lab, "%zu", p);
+            text_at(cr, SANS, 0, f, x + 0.45 * f, y - 0.3 * f, lab);
+        }
+    }
     for (size_t p = 0; p < c->n; p++) {
         uint8_t fl = c->s->pflags[p];
         double x, y;

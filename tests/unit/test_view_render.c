@@ -397,6 +397,38 @@ TEST(hull_only_points_not_lifted)
     pdt_synth_free(&s);
 }
 
+/* Pixels of the point-label colour in the geometry area. */
+static size_t label_ink(cairo_surface_t *sf)
+{
+    pdt_layout L;
+    pdt_render_layout(W, H, 2, &L);
+    const double want[3] = {0.0, 0.25, 0.55};
+    size_t n = 0;
+    for (int y = (int)L.geo.y; y < (int)(L.geo.y + L.geo.h); y++)
+        for (int x = (int)L.geo.x; x < (int)(L.geo.x + L.geo.w); x++) {
+            double c[3];
+            pixel(sf, x, y, c);
+            n += cdist(c, want) < 0.12;
+        }
+    return n;
+}
+
+/* Triangulation runs: input indices beside the points when few are on
+ * screen, none when there are many. */
+TEST(point_numbers_when_few)
+{
+    fixture f;
+    CHECK(setup(&f, 6, 4, 2)); /* 24 points */
+    CHECK(draw(&f, 0));
+    size_t few = label_ink(f.sf);
+    teardown(&f);
+    CHECK(setup(&f, 12, 8, 2)); /* 96 points */
+    CHECK(draw(&f, 0));
+    size_t many = label_ink(f.sf);
+    teardown(&f);
+    CHECK_MSG(few > 200 && many == 0, "label pixels: %zu with 24 points, %zu with 96", few, many);
+}
+
 TEST(pick_and_zoom)
 {
     fixture f;
@@ -449,6 +481,7 @@ int main(void)
     RUN(graham_hull_closed_at_end);
     RUN(inside_count_exact_all_points);
     RUN(hull_only_points_not_lifted);
+    RUN(point_numbers_when_few);
     RUN(pick_and_zoom);
     return test_summary();
 }
