@@ -42,12 +42,12 @@ static uint64_t mix(uint64_t hi, uint64_t lo)
     return h;
 }
 
-/* Room for at least `n` keys at load <= 1/2.  Big tables ask for huge pages:
+/* Room for at least `n` keys at load <= 3/4.  Big tables ask for huge pages:
  * lookups are random, and TLB misses otherwise dominate. */
 static int km_alloc(keymap *km, size_t n)
 {
     size_t cap = 1024;
-    while (cap < 2 * n) cap *= 2;
+    while (cap / 4 * 3 < n) cap *= 2;
     size_t bytes = cap * sizeof *km->e;
     if (bytes >= ((size_t)4 << 20)) {
         km->e = aligned_alloc((size_t)2 << 20, bytes);
@@ -87,7 +87,7 @@ static int km_get(const keymap *km, uint64_t hi, uint64_t lo, int32_t *v)
 
 static int km_put(keymap *km, uint64_t hi, uint64_t lo, int32_t v)
 {
-    if (2 * (km->used + 1) > km->cap) {
+    if (km->used + 1 > km->cap / 4 * 3) {
         keymap big;
         if (!km_alloc(&big, km->cap ? km->cap : 512)) return 0;
         for (size_t i = 0; i < km->cap; i++) {
