@@ -48,6 +48,10 @@ int pdt_io_token(pdt_io_cur *c, const char **tok, size_t *len);
 /* Skip the rest of the current line (including its '\n'). */
 void pdt_io_skip_line(pdt_io_cur *c);
 
+/* The current line must hold nothing more: move to the next line, or report
+ * "NAME:LINE: unexpected 'TOKEN' after WHAT" (PDT_ERR_PARSE) in err. */
+pdt_status pdt_io_end_line(pdt_io_cur *c, const char *what, pdt_err *err);
+
 /* Parse a plain decimal integer ([+-]digits).  Returns 0 and *v on success,
  * 1 if the token is not a plain integer, 2 if it has more than 18 digits
  * (*v is then set to INT64_MAX or INT64_MIN by sign). */

@@ -105,23 +105,12 @@ static pdt_status point_xy(reader *r)
     return PDT_OK;
 }
 
-static pdt_status end_of_line(reader *r, const char *what)
-{
-    const char *tok;
-    size_t len;
-    char show[64];
-    if (pdt_io_token(&r->cur, &tok, &len))
-        return pdt_err_set(r->err, PDT_ERR_PARSE, "%s:%zu: unexpected '%s' after %s", r->cur.name,
-                           r->cur.line, pdt_io_show(tok, len, show, sizeof show), what);
-    pdt_io_skip_line(&r->cur);
-    return PDT_OK;
-}
-
 static pdt_status read_text(reader *r)
 {
     while (pdt_io_next_line(&r->cur)) {
         pdt_status st = point_xy(r);
-        if (st == PDT_OK) st = end_of_line(r, "the coordinates (one point 'x y' per line)");
+        if (st == PDT_OK)
+            st = pdt_io_end_line(&r->cur, "the coordinates (one point 'x y' per line)", r->err);
         if (st != PDT_OK) return st;
     }
     return PDT_OK;
@@ -176,11 +165,11 @@ static pdt_status read_node(reader *r)
                                    "markers; must be 0 or 1", c->name, c->line, (long long)nmark);
         }
     }
-    if (count >= UINT32_MAX)  /* before end_of_line, which moves to the next line */
+    if (count >= UINT32_MAX)  /* before pdt_io_end_line, which moves to the next line */
         return pdt_err_set(err, PDT_ERR_PARSE, "%s:%zu: too many points (at most %u)", c->name,
                            c->line, (unsigned)(UINT32_MAX - 1));
-    if ((st = end_of_line(r, "the .node header (count, 2, attributes, markers)")) != PDT_OK)
-        return st;
+    st = pdt_io_end_line(&r->cur, "the .node header (count, 2, attributes, markers)", r->err);
+    if (st != PDT_OK) return st;
 
     int64_t base = 0;
     for (int64_t i = 0; i < count; i++) {
@@ -221,8 +210,8 @@ static pdt_status read_node(reader *r)
                                    "integer", c->name, c->line,
                                    pdt_io_show(tok, len, show, sizeof show));
         }
-        if ((st = end_of_line(r, "the point (index x y, attributes, marker)")) != PDT_OK)
-            return st;
+        st = pdt_io_end_line(&r->cur, "the point (index x y, attributes, marker)", r->err);
+        if (st != PDT_OK) return st;
     }
     if (pdt_io_next_line(c))
         return pdt_err_set(err, PDT_ERR_PARSE, "%s:%zu: more points than the %lld the header "

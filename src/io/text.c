@@ -307,3 +307,15 @@ const char *pdt_io_show(const char *tok, size_t len, char *buf, size_t cap)
     buf[o] = '\0';
     return buf;
 }
+
+pdt_status pdt_io_end_line(pdt_io_cur *c, const char *what, pdt_err *err)
+{
+    const char *tok;
+    size_t len;
+    char show[64];
+    if (pdt_io_token(c, &tok, &len))
+        return pdt_err_set(err, PDT_ERR_PARSE, "%s:%zu: unexpected '%s' after %s", c->name,
+                           c->line, pdt_io_show(tok, len, show, sizeof show), what);
+    pdt_io_skip_line(c);
+    return PDT_OK;
+}

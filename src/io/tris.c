@@ -34,18 +34,6 @@ static pdt_status uint_field(treader *r, const char *what, int64_t *v)
     return PDT_OK;
 }
 
-static pdt_status no_more(treader *r, const char *what)
-{
-    const char *tok;
-    size_t len;
-    char show[64];
-    if (pdt_io_token(&r->cur, &tok, &len))
-        return pdt_err_set(r->err, PDT_ERR_PARSE, "%s:%zu: unexpected '%s' after %s", r->cur.name,
-                           r->cur.line, pdt_io_show(tok, len, show, sizeof show), what);
-    pdt_io_skip_line(&r->cur);
-    return PDT_OK;
-}
-
 /* Three point indices (minus base) appended as one triangle. */
 static pdt_status tri_fields(treader *r, int64_t base)
 {
@@ -83,7 +71,9 @@ static pdt_status read_tri(treader *r)
 {
     while (pdt_io_next_line(&r->cur)) {
         pdt_status st = tri_fields(r, 0);
-        if (st == PDT_OK) st = no_more(r, "the three point indices (one triangle 'i j k' per line)");
+        if (st == PDT_OK)
+            st = pdt_io_end_line(&r->cur, "the three point indices (one triangle 'i j k' per line)",
+                                 r->err);
         if (st != PDT_OK) return st;
     }
     return PDT_OK;
@@ -108,7 +98,8 @@ static pdt_status read_ele(treader *r)
         if ((st = uint_field(r, "attribute count in the .ele header", &nattr)) != PDT_OK)
             return st;
     }
-    if ((st = no_more(r, "the .ele header (count, 3, attributes)")) != PDT_OK) return st;
+    if ((st = pdt_io_end_line(&r->cur, "the .ele header (count, 3, attributes)", r->err)) != PDT_OK)
+        return st;
     int64_t base = 0;
     for (int64_t i = 0; i < count; i++) {
         if (!pdt_io_next_line(c))
@@ -138,7 +129,8 @@ static pdt_status read_ele(treader *r)
                                    "number", c->name, c->line,
                                    pdt_io_show(tok, len, show, sizeof show));
         }
-        if ((st = no_more(r, "the triangle (index a b c, attributes)")) != PDT_OK) return st;
+        st = pdt_io_end_line(&r->cur, "the triangle (index a b c, attributes)", r->err);
+        if (st != PDT_OK) return st;
     }
     if (pdt_io_next_line(c))
         return pdt_err_set(r->err, PDT_ERR_PARSE, "%s:%zu: more triangles than the %lld the "

@@ -233,6 +233,22 @@ static int tri_less(const pdt_tri *a, const pdt_tri *b)
     return 0;
 }
 
+/* Restore the heap order below heap[k]: the block whose next triangle is
+ * smallest comes first. */
+static void sift_down(int *heap, int h, int k, const pdt_tri *a, const size_t *pos)
+{
+    for (;;) {
+        int m = k, l = 2 * k + 1, r = l + 1;
+        if (l < h && tri_less(&a[pos[heap[l]]], &a[pos[heap[m]]])) m = l;
+        if (r < h && tri_less(&a[pos[heap[r]]], &a[pos[heap[m]]])) m = r;
+        if (m == k) return;
+        int t = heap[k];
+        heap[k] = heap[m];
+        heap[m] = t;
+        k = m;
+    }
+}
+
 /* Merge p sorted blocks (count[q] bytes each, contiguous) of *all into one
  * sorted array with a binary heap of block cursors: O(T log p). */
 static pdt_status merge_blocks(pdt_tri **all, const size_t *count, int p, size_t total,
@@ -258,34 +274,14 @@ static pdt_status merge_blocks(pdt_tri **all, const size_t *count, int p, size_t
         end[q] = off;
         if (pos[q] < end[q]) heap[h++] = q;
     }
-#define HLESS(i, j) tri_less(&a[pos[heap[i]]], &a[pos[heap[j]]])
     for (int i = h / 2 - 1; i >= 0; i--) /* heapify */
-        for (int k = i;;) {
-            int m = k, l = 2 * k + 1, r = l + 1;
-            if (l < h && HLESS(l, m)) m = l;
-            if (r < h && HLESS(r, m)) m = r;
-            if (m == k) break;
-            int t = heap[k];
-            heap[k] = heap[m];
-            heap[m] = t;
-            k = m;
-        }
+        sift_down(heap, h, i, a, pos);
     for (size_t o = 0; o < total; o++) {
         int q = heap[0];
         out[o] = a[pos[q]++];
         if (pos[q] == end[q]) heap[0] = heap[--h];
-        for (int k = 0;;) {
-            int m = k, l = 2 * k + 1, r = l + 1;
-            if (l < h && HLESS(l, m)) m = l;
-            if (r < h && HLESS(r, m)) m = r;
-            if (m == k) break;
-            int t = heap[k];
-            heap[k] = heap[m];
-            heap[m] = t;
-            k = m;
-        }
+        sift_down(heap, h, 0, a, pos);
     }
-#undef HLESS
     free(pos);
     free(end);
     free(heap);
