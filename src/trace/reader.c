@@ -67,17 +67,6 @@ static void warnf(pdt_run *run, const char *fmt, ...)
     run->warn[run->wlen] = '\0';
 }
 
-static char *join(const char *dir, const char *name)
-{
-    size_t a = strlen(dir), b = strlen(name);
-    char *p = malloc(a + b + 2);
-    if (!p) return NULL;
-    memcpy(p, dir, a);
-    p[a] = '/';
-    memcpy(p + a + 1, name, b + 1);
-    return p;
-}
-
 static void rank_name(char *buf, size_t cap, int r)
 {
     snprintf(buf, cap, "rank-%04d.trace", r);
@@ -117,7 +106,7 @@ static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
     tf_rank *rk = &run->rk[r];
     char name[32];
     rank_name(name, sizeof name, r);
-    char *path = join(run->dir, name);
+    char *path = pdt_tf_path_join(run->dir, name);
     if (!path) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
     int e = map_file(path, &rk->map, &rk->size);
     free(path);
@@ -255,7 +244,7 @@ static pdt_status guess_manifest(pdt_run *run, pdt_err *err)
     for (;; n++) {
         char name[32];
         rank_name(name, sizeof name, n);
-        char *p = join(run->dir, name);
+        char *p = pdt_tf_path_join(run->dir, name);
         if (!p) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
         int ok = access(p, F_OK) == 0;
         free(p);
@@ -281,8 +270,8 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
     pdt_run *run = calloc(1, sizeof *run);
     if (!run) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
     pdt_status st = PDT_OK;
-    run->dir = join(dir, "");
-    char *mpath = join(dir, "manifest");
+    run->dir = pdt_tf_path_join(dir, "");
+    char *mpath = pdt_tf_path_join(dir, "manifest");
     if (!run->dir || !mpath) {
         free(mpath);
         pdt_run_close(run);
@@ -308,7 +297,7 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
 
     /* points.bin */
     if (run->m.command[0]) {
-        char *ppath = join(dir, "points.bin");
+        char *ppath = pdt_tf_path_join(dir, "points.bin");
         uint8_t *map = NULL;
         size_t size = 0;
         if (!ppath) st = pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__,

@@ -63,6 +63,9 @@ int pdt_tf_decode(const uint8_t *p, size_t len, uint32_t count, uint64_t base_t,
 void pdt_tf_block_header(uint8_t *h, uint32_t magic, const uint8_t *payload, uint32_t len,
                          uint64_t first, uint64_t base_t, uint32_t count);
 
+/* "DIR/NAME" in a malloc'd string (caller frees), or NULL when out of memory. */
+char *pdt_tf_path_join(const char *dir, const char *name);
+
 /* Parse the manifest text (NUL-terminated, modified in place) of file
  * `path` into *m (zeroed first).  Unknown keys are ignored; a different major
  * format version is PDT_ERR_FORMAT naming both versions. */

@@ -94,17 +94,6 @@ static void tw_sink(pdt_trace *tr, const pdt_event *ev)
     if (++w->nbuf == TF_BLOCK_EVENTS) tw_flush(w);
 }
 
-static char *path_join(const char *dir, const char *name)
-{
-    size_t a = strlen(dir), b = strlen(name);
-    char *p = malloc(a + b + 2);
-    if (!p) return NULL;
-    memcpy(p, dir, a);
-    p[a] = '/';
-    memcpy(p + a + 1, name, b + 1);
-    return p;
-}
-
 static pdt_status make_dir(const char *dir, pdt_err *err)
 {
     if (mkdir(dir, 0777) == 0 || errno == EEXIST) {
@@ -129,7 +118,7 @@ pdt_status pdt_tw_open(const char *dir, int rank, int level, pdt_trace_writer **
     w->fd = -1;
     char name[32];
     snprintf(name, sizeof name, "rank-%04d.trace", rank);
-    w->path = path_join(dir, name);
+    w->path = pdt_tf_path_join(dir, name);
     w->buf = malloc(TF_BLOCK_EVENTS * sizeof *w->buf);
     w->enc = malloc(TF_BLOCK_HEADER_SIZE + TF_BLOCK_EVENTS * TF_MAX_EVENT_BYTES);
     if (!w->path || !w->buf || !w->enc) {
@@ -139,7 +128,7 @@ pdt_status pdt_tw_open(const char *dir, int rank, int level, pdt_trace_writer **
     if (rank == 0) {  /* a stale manifest must not describe the new traces */
         const char *stale[] = {"manifest", "points.bin"};
         for (int i = 0; i < 2; i++) {
-            char *p = path_join(dir, stale[i]);
+            char *p = pdt_tf_path_join(dir, stale[i]);
             if (!p) {
                 pdt_tw_abort(w);
                 return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__,
@@ -223,4 +212,15 @@ pdt_status pdt_tw_close(pdt_trace_writer *w, pdt_err *err)
     if (st != PDT_OK) pdt_err_set(err, st, "%s", w->err.msg);
     pdt_tw_abort(w);
     return st;
+}
+
+char *pdt_tf_path_join(const char *dir, const char *name)
+{
+    size_t a = strlen(dir), b = strlen(name);
+    char *p = malloc(a + b + 2);
+    if (!p) return NULL;
+    memcpy(p, dir, a);
+    p[a] = '/';
+    memcpy(p + a + 1, name, b + 1);
+    return p;
 }
