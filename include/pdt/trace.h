@@ -87,6 +87,8 @@ typedef enum pdt_phase {
     PDT_PH_OUTPUT,       /* gather, sort, write */
     PDT_PH_GRAHAM_SORT,  /* Graham Version B: angular sort */
     PDT_PH_GRAHAM_SCAN,  /* Graham Version B: the stack scan */
+    PDT_PH_ORDER,        /* canonical order of the final triangles across ranks */
+    PDT_PH_WRITE,        /* write this rank's share of the output file */
     PDT_PH_COUNT
 } pdt_phase;
 

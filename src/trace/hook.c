@@ -23,7 +23,8 @@ static const char *const phase_names[PDT_PH_COUNT] = {
     [PDT_PH_KERNEL] = "kernel",     [PDT_PH_HULL] = "hull",
     [PDT_PH_CLASSIFY] = "classify", [PDT_PH_MERGE] = "merge",
     [PDT_PH_OUTPUT] = "output",     [PDT_PH_GRAHAM_SORT] = "graham-sort",
-    [PDT_PH_GRAHAM_SCAN] = "graham-scan",
+    [PDT_PH_GRAHAM_SCAN] = "graham-scan", [PDT_PH_ORDER] = "order",
+    [PDT_PH_WRITE] = "write",
 };
 
 static const char *const stack_names[] = {"graham", "lower", "upper", "merge-lower",

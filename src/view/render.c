@@ -56,7 +56,8 @@ static void phase_rgb(int ph, double c[3])
     static const double t[PDT_PH_COUNT][3] = {
         {0.85, 0.85, 0.85}, {0.75, 0.75, 0.75}, {0.70, 0.80, 0.90}, {0.55, 0.75, 0.95},
         {0.45, 0.65, 0.45}, {0.95, 0.80, 0.45}, {0.90, 0.65, 0.65}, {0.70, 0.55, 0.85},
-        {0.75, 0.75, 0.60}, {0.60, 0.85, 0.80}, {0.95, 0.70, 0.40},
+        {0.75, 0.75, 0.60}, {0.60, 0.85, 0.80}, {0.95, 0.70, 0.40}, {0.80, 0.70, 0.55},
+        {0.65, 0.65, 0.80},
     };
     const double *s = t[ph >= 0 && ph < PDT_PH_COUNT ? ph : 0];
     c[0] = s[0];
@@ -1198,7 +1199,8 @@ static int code_line(const ctx *c, int *graham)
     case PDT_EV_RA_DEFER: return in_merge ? 9 : (ev->kind == PDT_EV_TRI_FINAL ? 3 : 4);
     case PDT_EV_SHIP:
     case PDT_EV_SEND:
-    case PDT_EV_RECV: return phase == PDT_PH_OUTPUT ? 10 : 6;
+    case PDT_EV_RECV:
+        return phase == PDT_PH_OUTPUT || phase == PDT_PH_ORDER || phase == PDT_PH_WRITE ? 10 : 6;
     case PDT_EV_DISCARD: return 8;
     case PDT_EV_MERGE_BEGIN: return 7;
     case PDT_EV_MERGE_END: return 9;
@@ -1212,7 +1214,9 @@ static int code_line(const ctx *c, int *graham)
     case PDT_PH_HULL: return 2;
     case PDT_PH_CLASSIFY: return 3;
     case PDT_PH_MERGE: return 5;
-    case PDT_PH_OUTPUT: return 10;
+    case PDT_PH_OUTPUT:
+    case PDT_PH_ORDER:
+    case PDT_PH_WRITE: return 10;
     default: return -1;
     }
 }
