@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { WBUF = 1 << 16 };
+enum { WBUF = 1 << 20 };
 
 typedef struct wbuf {
     FILE *fp;
@@ -29,8 +29,43 @@ static inline char *wb_room(wbuf *w)
     return w->b + w->n;
 }
 
+/* "00" "01" ... "99": two digits per division by 100. */
+static const char digits2[201] =
+    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+    "8081828384858687888990919293949596979899";
+
+static const uint32_t pow10_32[10] = { 1u, 10u, 100u, 1000u, 10000u, 100000u, 1000000u,
+                                       10000000u, 100000000u, 1000000000u };
+
+/* Decimal digits of v: from its bit length (log10(2) ~ 1233 / 4096), then
+ * one comparison. */
+static inline int ndigits32(uint32_t v)
+{
+    uint32_t w = v | 1u; /* as many digits as v, and never 0 */
+    int t = ((32 - __builtin_clz(w)) * 1233) >> 12;
+    return t + (w >= pow10_32[t]);
+}
+
+/* v in decimal at p; returns the end.  The digits are written from the last
+ * one backwards, two at a time (32-bit divisions by a constant: a multiply). */
+static inline char *put_u32(char *p, uint32_t v)
+{
+    char *e = p + ndigits32(v), *q = e;
+    while (v >= 100) {
+        uint32_t r = v % 100;
+        v /= 100;
+        q -= 2;
+        memcpy(q, digits2 + 2 * r, 2);
+    }
+    if (v >= 10) memcpy(q - 2, digits2 + 2 * v, 2);
+    else q[-1] = (char)('0' + v);
+    return e;
+}
+
 static inline char *put_u64(char *p, uint64_t v)
 {
+    if (v <= UINT32_MAX) return put_u32(p, (uint32_t)v);
     char t[24];
     int k = 0;
     do {
@@ -154,10 +189,22 @@ static void emit_tris(wbuf *w, pdt_tri_format fmt, const pdt_point *pts, size_t 
             wb_ints(w, v, 3);
         }
     }
+    if (fmt == PDT_FMT_TRI) {
+        for (size_t i = 0; i < ntri; i++) { /* the common case, without the int64 detour */
+            char *p = wb_room(w), *s = p;
+            p = put_u32(p, t[i].v[0]);
+            *p++ = ' ';
+            p = put_u32(p, t[i].v[1]);
+            *p++ = ' ';
+            p = put_u32(p, t[i].v[2]);
+            *p++ = '\n';
+            w->n += (size_t)(p - s);
+        }
+        return;
+    }
     for (size_t i = 0; i < ntri; i++) {
         int64_t v[4] = { fmt == PDT_FMT_OFF ? 3 : (int64_t)i, t[i].v[0], t[i].v[1], t[i].v[2] };
-        if (fmt == PDT_FMT_TRI) wb_ints(w, v + 1, 3);
-        else wb_ints(w, v, 4);
+        wb_ints(w, v, 4);
     }
 }
 

@@ -296,6 +296,51 @@ TEST(points_write_roundtrip)
     CHECK(entries() == 2); /* no temporaries left */
 }
 
+/* The writers format numbers by hand: every digit count, both sides of every
+ * power of ten, the int32 and uint32 extremes, compared with printf. */
+TEST(numbers_every_digit_count)
+{
+    clean();
+    enum { K = 64 };
+    pdt_point pts[K];
+    pdt_tri t[K];
+    int64_t v[K];
+    int nv = 0;
+    v[nv++] = 0;
+    for (int64_t p = 1; p <= INT64_C(1000000000); p *= 10) {
+        v[nv++] = p - 1;
+        v[nv++] = p;
+        v[nv++] = p + 1;
+    }
+    v[nv++] = INT32_MAX;
+    for (int i = 0; i < nv; i++) {
+        pts[i].x = (int32_t)v[i];
+        pts[i].y = (int32_t)-v[i];
+        t[i].v[0] = (uint32_t)v[i];
+        t[i].v[1] = (uint32_t)v[i] + 2147483648u;
+        t[i].v[2] = UINT32_MAX - (uint32_t)i;
+    }
+    char *want = malloc(1 << 15), *want_t = malloc(1 << 15);
+    size_t o = 0, ot = 0;
+    for (int i = 0; i < nv; i++) {
+        o += (size_t)snprintf(want + o, (1 << 15) - o, "%d %d\n", pts[i].x, pts[i].y);
+        ot += (size_t)snprintf(want_t + ot, (1 << 15) - ot, "%u %u %u\n", t[i].v[0], t[i].v[1],
+                               t[i].v[2]);
+    }
+    pdt_err err;
+    pdt_err_clear(&err);
+    CHECK(pdt_write_points(path("d.txt"), pts, (size_t)nv, &err) == PDT_OK);
+    CHECK(pdt_write_tris(path("d.tri"), PDT_FMT_TRI, pts, (size_t)nv, t, (size_t)nv, &err) ==
+          PDT_OK);
+    char *got = slurp(path("d.txt")), *got_t = slurp(path("d.tri"));
+    CHECK(got && strcmp(got, want) == 0);
+    CHECK(got_t && strcmp(got_t, want_t) == 0);
+    free(got);
+    free(got_t);
+    free(want);
+    free(want_t);
+}
+
 TEST(tris_write_formats)
 {
     clean();
@@ -452,6 +497,7 @@ int main(void)
     RUN(scale_rounding);
     RUN(scale_collisions);
     RUN(points_write_roundtrip);
+    RUN(numbers_every_digit_count);
     RUN(tris_write_formats);
     RUN(tris_read_bad_inputs);
     RUN(atomic_write_leaves_nothing);
