@@ -217,8 +217,4 @@ size_t pdt_replay_find_phase(const pdt_replay *r, size_t k, int dir);
  * (size_t)-1 when none. */
 size_t pdt_replay_find_phase_name(const pdt_replay *r, const char *name);
 
-/* The event before cursor k, in words ("rank 2: pop 17 — right turn at
- * (12,40)").  Writes at most `cap` bytes (always terminated). */
-void pdt_replay_describe(const pdt_replay *r, size_t k, char *buf, size_t cap);
-
 #endif

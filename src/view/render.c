@@ -1,5 +1,6 @@
 /* pdt — the cairo renderer (see pdt/render.h). */
 #include "pdt/render.h"
+#include "pdt/describe.h"
 #include "pdt/predicates.h"
 
 #include <cairo-pdf.h>
@@ -1126,34 +1127,7 @@ static void draw_legend(ctx *c)
     cairo_restore(cr);
 }
 
-/* Pseudo-code: Graham Version B or the SRM phases, with the current line. */
-static const char *const graham_code[] = {
-    "1  find the rightmost lowest point p0",
-    "2  sort the others by angle about p0",
-    "3    tie: delete the closer (or copy)",
-    "4  stack S = (p1, p0); t indexes the top",
-    "5  i = 2",
-    "6  while i < n:",
-    "7    if p_i strictly left of (p_t-1, p_t):",
-    "8      push p_i; i = i + 1",
-    "9    else: pop S",
-    "10 S is the hull",
-};
-
-static const char *const srm_code[] = {
-    "1  P_r = partition(input)",
-    "2  lift(P_r)           # z = x*x + y*y",
-    "3  T = delaunay(P_r); H = hull(P_r)",
-    "4  for t in T: if RA(t) misses all",
-    "5    foreign boxes: final  else: pending",
-    "6  for level in 0 .. L-1:",
-    "7    ship pending t touching partner",
-    "8    B = border set; lift(B); T_B = DT(B)",
-    "9    keep crossing or shipped; discard rest",
-    "10   H = merge hulls; reclassify kept",
-    "11 gather, sort, write",
-};
-
+/* Pseudo-code: Graham Version B or the SRM phases (pdt/describe.h), with the current line. */
 static int code_line(const ctx *c, int *graham)
 {
     const pdt_rec *e = c->cur;
@@ -1228,17 +1202,17 @@ static void draw_code(ctx *c)
     double f = c->L.font;
     int graham;
     int line = code_line(c, &graham);
-    panel(cr, R, graham ? "Graham's scan, Version B" : "SRM, per rank (strips, restricted areas, merges)", f);
+    int id = graham ? PDT_CODE_GRAHAM : PDT_CODE_SRM;
+    panel(cr, R, pdt_code_title(id), f);
     cairo_save(cr);
     clip_rect(cr, R);
-    const char *const *code = graham ? graham_code : srm_code;
-    int nl = graham ? 10 : 11;
+    int nl = (int)pdt_code_count(id);
     double lh = (R.h - 1.9 * f) / nl;
     if (lh > 1.15 * f) lh = 1.15 * f;
     double fs = fmin(0.78 * f, 0.92 * lh);
     /* shrink to fit the width */
     double wmax = 0;
-    for (int i = 0; i < nl; i++) wmax = fmax(wmax, text_w(cr, MONO, fs, code[i]));
+    for (int i = 0; i < nl; i++) wmax = fmax(wmax, text_w(cr, MONO, fs, pdt_code_text(id, (size_t)i)));
     if (wmax > R.w - 1.2 * f) fs *= (R.w - 1.2 * f) / wmax;
     for (int i = 0; i < nl; i++) {
         double y = R.y + 1.7 * f + (i + 1) * lh;
@@ -1248,7 +1222,7 @@ static void draw_code(ctx *c)
             cairo_fill(cr);
         }
         rgb(cr, INK, 1);
-        text_at(cr, MONO, i == line, fs, R.x + 0.6 * f, y - 0.18 * lh, code[i]);
+        text_at(cr, MONO, i == line, fs, R.x + 0.6 * f, y - 0.18 * lh, pdt_code_text(id, (size_t)i));
     }
     cairo_restore(cr);
 }

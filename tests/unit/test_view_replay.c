@@ -2,8 +2,10 @@
  * on synthetic runs with several ranks (and on hand-made event arrays). */
 #include "../harness.h"
 
+#include <stdlib.h>
 #include <string.h>
 
+#include "pdt/describe.h"
 #include "pdt/replay.h"
 #include "pdt/viewsynth.h"
 
@@ -257,6 +259,20 @@ TEST(malformed_events_skipped)
     pdt_replay_free(r);
 }
 
+/* The pseudo-code listings: numbered from 1 in order, bad ids and lines NULL. */
+TEST(code_listings)
+{
+    for (int id = 0; id < PDT_CODE_COUNT; id++) {
+        CHECK(pdt_code_title(id) && pdt_code_count(id) >= 5);
+        for (size_t i = 0; i < pdt_code_count(id); i++) {
+            const char *t = pdt_code_text(id, i);
+            CHECK_MSG(t && strtoul(t, NULL, 10) == i + 1, "listing %d line %zu: %s", id, i, t ? t : "NULL");
+        }
+        CHECK(pdt_code_text(id, pdt_code_count(id)) == NULL);
+    }
+    CHECK(pdt_code_title(PDT_CODE_COUNT) == NULL && pdt_code_count(-1) == 0);
+}
+
 int main(void)
 {
     RUN(seek_equals_step_srm_4_ranks);
@@ -265,5 +281,6 @@ int main(void)
     RUN(srm_end_state);
     RUN(hand_made_story);
     RUN(malformed_events_skipped);
+    RUN(code_listings);
     return test_summary();
 }
