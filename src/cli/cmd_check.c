@@ -44,11 +44,11 @@ int pdt_cmd_check(int argc, char **argv)
         if (st == PDT_OK)
             printf("ok: the %zu triangles of %s are the Delaunay triangulation T* of the %zu "
                    "points of %s\n", ntri, pos[1], n, pos[0]);
-        else if (st == PDT_ERR_CHECK)
-            fprintf(stderr, "pdt check: %s is NOT the Delaunay triangulation T* of %s\n", pos[1],
-                    pos[0]);
+        else if (st == PDT_ERR_CHECK) /* the reason names triangles and edges of pos[1] */
+            fprintf(stderr, "pdt check: %s is NOT the Delaunay triangulation T* of %s\n"
+                    "pdt check: %s: %s\n", pos[1], pos[0], pos[1], err.msg);
     }
-    rc = st == PDT_OK ? PDT_EXIT_OK : pdt_cli_fail(&err);
+    rc = st == PDT_OK ? PDT_EXIT_OK : st == PDT_ERR_CHECK ? PDT_EXIT_CHECK : pdt_cli_fail(&err);
     free(pts);
     free(tris);
     return rc;

@@ -248,7 +248,7 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
 {
     pdt_status st = PDT_OK;
     if (n > UINT32_MAX || ntri > (size_t)UINT32_MAX / 3)
-        return pdt_err_set(err, PDT_ERR_ARG, "check.c:%d: input too large", __LINE__);
+        return pdt_err_set(err, PDT_ERR_ARG, "input too large");
     pidx *s = malloc((n ? n : 1) * sizeof *s);
     uint32_t *rep = malloc((n ? n : 1) * sizeof *rep);
     uint32_t *hull = malloc((2 * n + 2) * sizeof *hull); /* the chains may overshoot */
@@ -256,7 +256,7 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
     uint8_t *usedv = calloc(n ? n : 1, 1);
     dedge *ed = malloc((ntri ? 3 * ntri : 1) * sizeof *ed);
     if (!s || !rep || !hull || !nxt || !usedv || !ed) {
-        st = pdt_err_set(err, PDT_ERR_NOMEM, "check.c:%d: out of memory", __LINE__);
+        st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
         goto done;
     }
 
@@ -296,13 +296,12 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
 
     if (collinear) {
         if (ntri)
-            st = fail(err, "check.c:%d: %zu triangles for %s input (expected none)", __LINE__, ntri,
+            st = fail(err, "%zu triangles for %s input (expected none)", ntri,
                  m < 3 ? "fewer than 3 distinct points" : "all-collinear");
         goto done;
     }
     if (ntri == 0) {
-        st = fail(err, "check.c:%d: no triangles, but the %zu distinct points are not collinear",
-             __LINE__, m);
+        st = fail(err, "no triangles, but the %zu distinct points are not collinear", m);
         goto done;
     }
 
@@ -312,20 +311,20 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
         for (int k = 0; k < 3 && st == PDT_OK; k++) {
             if (v[k] >= n)
                 st = fail(err,
-                          "check.c:%d: triangle %zu (%u %u %u): index %u out of range (n = %zu)",
-                          __LINE__, t, v[0], v[1], v[2], v[k], n);
+                          "triangle %zu (%u %u %u): index %u out of range (n = %zu)", t, v[0],
+                          v[1], v[2], v[k], n);
             else if (rep[v[k]] != v[k])
                 st = fail(err,
-                          "check.c:%d: triangle %zu (%u %u %u) uses %u, a duplicate of point %u "
+                          "triangle %zu (%u %u %u) uses %u, a duplicate of point %u "
                           "(the smallest index must represent it)",
-                          __LINE__, t, v[0], v[1], v[2], v[k], rep[v[k]]);
+                          t, v[0], v[1], v[2], v[k], rep[v[k]]);
         }
         if (st != PDT_OK) break;
         if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2])
-            st = fail(err, "check.c:%d: triangle %zu (%u %u %u) repeats a vertex", __LINE__, t,
+            st = fail(err, "triangle %zu (%u %u %u) repeats a vertex", t,
                       v[0], v[1], v[2]);
         else if (ck_orient(pts[v[0]], pts[v[1]], pts[v[2]]) <= 0)
-            st = fail(err, "check.c:%d: triangle %zu (%u %u %u) is not counter-clockwise", __LINE__,
+            st = fail(err, "triangle %zu (%u %u %u) is not counter-clockwise",
                       t, v[0], v[1], v[2]);
         for (int k = 0; k < 3; k++) {
             uint32_t a = v[k], b = v[(k + 1) % 3];
@@ -343,14 +342,14 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
     /* 3: every distinct point used */
     for (size_t i = 0; i < m && st == PDT_OK; i++)
         if (!usedv[s[i].i])
-            st = fail(err, "check.c:%d: point %u (%d, %d) is in no triangle", __LINE__, s[i].i,
+            st = fail(err, "point %u (%d, %d) is in no triangle", s[i].i,
                       s[i].p.x, s[i].p.y);
     if (st != PDT_OK) goto done;
 
     /* 2: edge multiplicities; collect the boundary */
     size_t ne = 3 * ntri, nb = 0;
     if (!sort_edges(ed, ne, n)) {
-        st = pdt_err_set(err, PDT_ERR_NOMEM, "check.c:%d: out of memory", __LINE__);
+        st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
         goto done;
     }
     for (size_t i = 0; i < n; i++)
@@ -362,16 +361,15 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
         if (j - i > 2 || (j - i == 2 && ed[i].fwd == ed[i + 1].fwd)) {
             const pdt_tri *a = &tris[ed[i].tri], *b = &tris[ed[i + 1].tri];
             st = fail(err,
-                      "check.c:%d: edge %u-%u is used by %zu triangles (%u %u %u), (%u %u %u)%s",
-                      __LINE__, ed[i].lo, ed[i].hi, j - i, a->v[0], a->v[1], a->v[2], b->v[0],
+                      "edge %u-%u is used by %zu triangles (%u %u %u), (%u %u %u)%s",
+                      ed[i].lo, ed[i].hi, j - i, a->v[0], a->v[1], a->v[2], b->v[0],
                       b->v[1], b->v[2], j - i == 2 ? " on the same side" : ", ...");
         } else if (j - i == 1) { /* boundary edge, directed as in its triangle */
             uint32_t from = ed[i].fwd ? ed[i].lo : ed[i].hi, to = ed[i].fwd ? ed[i].hi : ed[i].lo;
             if (nxt[from] != UINT32_MAX)
                 st = fail(err,
-                          "check.c:%d: boundary vertex %u has two outgoing boundary edges (to %u "
-                          "and %u)",
-                          __LINE__, from, nxt[from], to);
+                          "boundary vertex %u has two outgoing boundary edges (to %u "
+                          "and %u)", from, nxt[from], to);
             nxt[from] = to;
             nb++;
         }
@@ -382,9 +380,8 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
     /* the boundary is exactly the hull cycle */
     if (nb != h) {
         st = fail(err,
-                  "check.c:%d: %zu boundary edges, but the convex hull has %zu vertices "
-                  "(collinear boundary points included)",
-                  __LINE__, nb, h);
+                  "%zu boundary edges, but the convex hull has %zu vertices "
+                  "(collinear boundary points included)", nb, h);
         goto done;
     }
     for (size_t k = 0; k < h; k++) {
@@ -392,20 +389,18 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
         if (nxt[a] != b) {
             if (nxt[a] == UINT32_MAX)
                 st = fail(err,
-                          "check.c:%d: hull edge %u-%u is not a boundary edge (hull vertex %u has "
-                          "no outgoing boundary edge)",
-                          __LINE__, a, b, a);
+                          "hull edge %u-%u is not a boundary edge (hull vertex %u has "
+                          "no outgoing boundary edge)", a, b, a);
             else
-                st = fail(err, "check.c:%d: boundary edge %u-%u is not the hull edge %u-%u",
-                          __LINE__, a, nxt[a], a, b);
+                st = fail(err, "boundary edge %u-%u is not the hull edge %u-%u", a, nxt[a], a, b);
             goto done;
         }
     }
 
     /* Euler (thesis D5) */
     if (ntri != 2 * m - h - 2) {
-        st = fail(err, "check.c:%d: %zu triangles, Euler count 2n - h - 2 = %zu (n = %zu, h = %zu)",
-                  __LINE__, ntri, 2 * m - h - 2, m, h);
+        st = fail(err, "%zu triangles, Euler count 2n - h - 2 = %zu (n = %zu, h = %zu)", ntri,
+                  2 * m - h - 2, m, h);
         goto done;
     }
 
@@ -419,9 +414,8 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
         if (r >= 0)
             st = fail(
                 err,
-                "check.c:%d: edge %u-%u is not locally Delaunay: point %u is %s the circle of "
-                "triangle (%u %u %u)%s",
-                __LINE__, ed[i].lo, ed[i].hi, d,
+                "edge %u-%u is not locally Delaunay: point %u is %s the circle of "
+                "triangle (%u %u %u)%s", ed[i].lo, ed[i].hi, d,
                 ck_incircle(pts[a], pts[b], pts[c], pts[d]) > 0 ? "inside" : "on", a, b, c,
                 ck_incircle(pts[a], pts[b], pts[c], pts[d]) > 0 ? ""
                                                                 : " and the tie rule says inside");

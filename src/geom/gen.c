@@ -210,7 +210,7 @@ static pdt_status gen_circle(pdt_point **pp, size_t n, rng *r, pdt_err *err)
     pdt_point *all = malloc(sizeof *all);
     size_t m = 0, cap = 1;
     pdt_status st = PDT_OK;
-    if (!all || l.failed) st = pdt_err_set(err, PDT_ERR_NOMEM, "gen.c:%d: out of memory", __LINE__);
+    if (!all || l.failed) st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     while (st == PDT_OK && m < n) {
         radius *best = NULL, *rich = NULL;
         for (size_t k = 0; k < l.n; k++) {
@@ -222,8 +222,8 @@ static pdt_status gen_circle(pdt_point **pp, size_t n, rng *r, pdt_err *err)
         }
         radius *use = best ? best : rich;
         if (!use) {
-            st = pdt_err_set(err, PDT_ERR_ARG, "gen.c:%d: circle: %zu points do not fit on "
-                             "lattice circles of radius <= 2^30", __LINE__, n);
+            st = pdt_err_set(err, PDT_ERR_ARG, "circle: %zu points do not fit on "
+                             "lattice circles of radius <= 2^30", n);
             break;
         }
         use->used = 1;
@@ -231,7 +231,7 @@ static pdt_status gen_circle(pdt_point **pp, size_t n, rng *r, pdt_err *err)
             cap = m + use->count;
             pdt_point *t = realloc(all, cap * sizeof *t);
             if (!t) {
-                st = pdt_err_set(err, PDT_ERR_NOMEM, "gen.c:%d: out of memory", __LINE__);
+                st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
                 break;
             }
             all = t;
@@ -410,15 +410,14 @@ pdt_status pdt_gen(const char *kind, size_t n, uint64_t seed, pdt_point **pts, p
             int w = snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", kinds[i]);
             if (w > 0) len += (size_t)w;
         }
-        return pdt_err_set(err, PDT_ERR_ARG, "gen.c:%d: unknown kind '%s' (kinds: %s)",
-                           __LINE__, kind, list);
+        return pdt_err_set(err, PDT_ERR_ARG, "unknown kind '%s' (kinds: %s)", kind, list);
     }
     if (n > UINT32_MAX)
-        return pdt_err_set(err, PDT_ERR_ARG, "gen.c:%d: n = %zu is too large", __LINE__, n);
+        return pdt_err_set(err, PDT_ERR_ARG, "n = %zu is too large", n);
     rng r = {seed ^ UINT64_C(0x6a09e667f3bcc909)};
     if (strcmp(kind, "circle") == 0) return gen_circle(pts, n, &r, err);
     pdt_point *p = malloc((n ? n : 1) * sizeof *p);
-    if (!p) return pdt_err_set(err, PDT_ERR_NOMEM, "gen.c:%d: out of memory", __LINE__);
+    if (!p) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     switch (k) {
     case 0: gen_uniform(p, n, &r); break;
     case 1: gen_grid(p, n, &r); break;

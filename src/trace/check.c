@@ -75,7 +75,7 @@ enum { M_SORTED = 1, M_DELETED = 2, M_PUSHED = 4, M_LIFTED = 8, M_REP = 16 };
 
 static pdt_status nomem(chk *c)
 {
-    return pdt_err_set(c->err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+    return pdt_err_set(c->err, PDT_ERR_NOMEM, "out of memory");
 }
 
 static pdt_status viol(chk *c, uint32_t rank, uint64_t seq, const pdt_event *e, const char *fmt,

@@ -34,7 +34,7 @@ static pdt_status af_open(afile *f, const char *dir, const char *name, pdt_err *
     if (!f->path || !f->tmp) {
         free(f->path);
         free(f->tmp);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     }
     snprintf(f->path, len, "%s/%s", dir, name);
     snprintf(f->tmp, len, "%s/.%s.tmp.%ld", dir, name, (long)getpid());
@@ -79,8 +79,7 @@ pdt_status pdt_run_write_meta(const char *dir, const pdt_manifest *m, const pdt_
                               size_t n, pdt_err *err)
 {
     if (m->nranks < 1)
-        return pdt_err_set(err, PDT_ERR_ARG, "%s:%d: manifest needs nranks >= 1", __FILE__,
-                           __LINE__);
+        return pdt_err_set(err, PDT_ERR_ARG, "manifest needs nranks >= 1");
     if (mkdir(dir, 0777) != 0 && errno != EEXIST)
         return pdt_err_set(err, PDT_ERR_IO, "%s: cannot create folder: %s", dir,
                            strerror(errno));
@@ -215,7 +214,7 @@ pdt_status pdt_tf_manifest_parse(const char *path, char *text, pdt_manifest *m, 
         } else if (!strcmp(k, "command_line") || !strcmp(k, "input_name")) {
             char *d = unescape_dup(v);
             if (!d) {
-                st = pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+                st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
                 break;
             }
             char **slot = !strcmp(k, "command_line") ? &m->command_line : &m->input_name;
@@ -256,7 +255,7 @@ pdt_status pdt_tf_manifest_parse(const char *path, char *text, pdt_manifest *m, 
     if (st == PDT_OK) {
         m->clock_offset_ns = calloc((size_t)m->nranks, sizeof *m->clock_offset_ns);
         if (!m->clock_offset_ns)
-            st = pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+            st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     }
     if (st == PDT_OK && offsets) {
         char *p = offsets;
@@ -297,7 +296,7 @@ pdt_status pdt_tf_points_parse(const char *path, const uint8_t *p, size_t len, p
         return pdt_err_set(err, PDT_ERR_CORRUPT, "%s: checksum mismatch in the point data",
                            path);
     pdt_point *a = malloc((cnt ? (size_t)cnt : 1) * sizeof *a);
-    if (!a) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+    if (!a) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     for (size_t i = 0; i < cnt; i++) {
         a[i].x = (int32_t)tf_get32(d + 8 * i);
         a[i].y = (int32_t)tf_get32(d + 8 * i + 4);

@@ -107,7 +107,7 @@ static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
     char name[32];
     rank_name(name, sizeof name, r);
     char *path = pdt_tf_path_join(run->dir, name);
-    if (!path) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+    if (!path) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     int e = map_file(path, &rk->map, &rk->size);
     free(path);
     if (e == ENOENT) {
@@ -200,8 +200,7 @@ static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
         if (rk->nblk == cap) {
             size_t nc = cap ? 2 * cap : 64;
             tf_block *b = realloc(rk->blk, nc * sizeof *b);
-            if (!b) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__,
-                                       __LINE__);
+            if (!b) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
             rk->blk = b;
             cap = nc;
         }
@@ -245,7 +244,7 @@ static pdt_status guess_manifest(pdt_run *run, pdt_err *err)
         char name[32];
         rank_name(name, sizeof name, n);
         char *p = pdt_tf_path_join(run->dir, name);
-        if (!p) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+        if (!p) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
         int ok = access(p, F_OK) == 0;
         free(p);
         if (!ok) break;
@@ -258,7 +257,7 @@ static pdt_status guess_manifest(pdt_run *run, pdt_err *err)
     run->m.nranks = n;
     run->m.clock_offset_ns = calloc((size_t)n, sizeof *run->m.clock_offset_ns);
     if (!run->m.clock_offset_ns)
-        return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     warnf(run, "manifest: missing (run killed before it was written?); found %d rank file%s, "
                "clocks not aligned, no points", n, n == 1 ? "" : "s");
     return PDT_OK;
@@ -268,14 +267,14 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
 {
     *out = NULL;
     pdt_run *run = calloc(1, sizeof *run);
-    if (!run) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+    if (!run) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     pdt_status st = PDT_OK;
     run->dir = pdt_tf_path_join(dir, "");
     char *mpath = pdt_tf_path_join(dir, "manifest");
     if (!run->dir || !mpath) {
         free(mpath);
         pdt_run_close(run);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     }
     run->dir[strlen(dir)] = '\0';  /* join added a '/' */
     int e;
@@ -300,8 +299,7 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
         char *ppath = pdt_tf_path_join(dir, "points.bin");
         uint8_t *map = NULL;
         size_t size = 0;
-        if (!ppath) st = pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__,
-                                     __LINE__);
+        if (!ppath) st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
         else if ((e = map_file(ppath, &map, &size)) != 0)
             warnf(run, "points.bin: %s: the run cannot be replayed or checked", strerror(e));
         else {
@@ -328,7 +326,7 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
     run->rk = calloc((size_t)run->nranks, sizeof *run->rk);
     if (!run->rk) {
         pdt_run_close(run);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     }
     int64_t minoff = 0;
     for (int r = 0; r < run->nranks; r++)
@@ -448,11 +446,11 @@ pdt_status pdt_run_rank_events(pdt_run *run, int rank, const pdt_event **ev, siz
     tf_rank *rk = &run->rk[rank];
     if (!rk->ev && rk->nev) {
         if (rk->nev > SIZE_MAX / sizeof *rk->ev)
-            return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+            return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
         rk->ev = big_alloc((size_t)rk->nev * sizeof *rk->ev);
         if (!rk->ev)
-            return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory (%" PRIu64 " events)",
-                               __FILE__, __LINE__, rk->nev);
+            return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: out of memory (%" PRIu64 " events)",
+                               rank, rk->nev);
         for (size_t b = 0; b < rk->nblk; b++) {
             const tf_block *bk = &rk->blk[b];
             /* validated at open: cannot fail */
@@ -484,7 +482,7 @@ pdt_status pdt_cursor_open(pdt_run *run, int rank, pdt_cursor **out, pdt_err *er
         return pdt_err_set(err, PDT_ERR_ARG, "rank %d: the run has ranks 0..%d", rank,
                            run->nranks - 1);
     pdt_cursor *c = calloc(1, sizeof *c);
-    if (!c) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+    if (!c) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     c->run = run;
     c->rk = &run->rk[rank];
     c->blk = SIZE_MAX;
@@ -727,7 +725,7 @@ pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err
     msg_set sent = {0}, unsent = {0};
     pdt_status st = PDT_OK;
     if (!out || !pos || !h.r || !blocked) {
-        st = pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+        st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
         goto done;
     }
     for (uint32_t r = 0; r < R; r++)
@@ -737,7 +735,7 @@ pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err
             msg_key key = ev_key(e, r);
             msg_slot *u = msg_find(&unsent, &key, 1);
             if (!u) {
-                st = pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+                st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
                 goto done;
             }
             u->count++;
@@ -772,7 +770,7 @@ pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err
         if (e->kind == PDT_EV_SEND) {
             msg_slot *s = msg_find(&sent, &key, 1);
             if (!s) {
-                st = pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+                st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
                 goto done;
             }
             s->count++;

@@ -109,12 +109,11 @@ pdt_status pdt_tw_open(const char *dir, int rank, int level, pdt_trace_writer **
 {
     *out = NULL;
     if (rank < 0 || level < 1 || level > 2)
-        return pdt_err_set(err, PDT_ERR_ARG, "%s:%d: trace writer: bad rank %d or level %d",
-                           __FILE__, __LINE__, rank, level);
+        return pdt_err_set(err, PDT_ERR_ARG, "trace writer: bad rank %d or level %d", rank, level);
     pdt_status st = make_dir(dir, err);
     if (st != PDT_OK) return st;
     pdt_trace_writer *w = calloc(1, sizeof *w);
-    if (!w) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+    if (!w) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     w->fd = -1;
     char name[32];
     snprintf(name, sizeof name, "rank-%04d.trace", rank);
@@ -123,7 +122,7 @@ pdt_status pdt_tw_open(const char *dir, int rank, int level, pdt_trace_writer **
     w->enc = malloc(TF_BLOCK_HEADER_SIZE + TF_BLOCK_EVENTS * TF_MAX_EVENT_BYTES);
     if (!w->path || !w->buf || !w->enc) {
         pdt_tw_abort(w);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     }
     if (rank == 0) {  /* a stale manifest must not describe the new traces */
         const char *stale[] = {"manifest", "points.bin"};
@@ -131,8 +130,7 @@ pdt_status pdt_tw_open(const char *dir, int rank, int level, pdt_trace_writer **
             char *p = pdt_tf_path_join(dir, stale[i]);
             if (!p) {
                 pdt_tw_abort(w);
-                return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__,
-                                   __LINE__);
+                return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
             }
             unlink(p);
             free(p);

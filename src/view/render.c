@@ -1663,7 +1663,7 @@ pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, cons
     cairo_restore(cr);
     cairo_status_t cs = cairo_status(cr);
     if (cs != CAIRO_STATUS_SUCCESS)
-        return pdt_err_set(err, PDT_ERR_IO, "%s:%d: cairo: %s", __FILE__, __LINE__,
+        return pdt_err_set(err, PDT_ERR_IO, "cairo: %s",
                            cairo_status_to_string(cs));
     return PDT_OK;
 }

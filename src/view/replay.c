@@ -546,8 +546,7 @@ out:
     km_free(&b.tri_map);
     km_free(&b.edge_map);
     km_free(&b.msg_map);
-    if (st != PDT_OK) pdt_err_set(err, st, "%s:%d: out of memory indexing %zu events", __FILE__,
-                                  __LINE__, r->m);
+    if (st != PDT_OK) pdt_err_set(err, st, "out of memory indexing %zu events", r->m);
     return st;
 }
 
@@ -556,8 +555,7 @@ pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, s
 {
     *out = NULL;
     if (m >= NONE32 || n >= NONE32)
-        return pdt_err_set(err, PDT_ERR_ARG, "%s:%d: too many events or points (%zu, %zu)",
-                           __FILE__, __LINE__, m, n);
+        return pdt_err_set(err, PDT_ERR_ARG, "too many events or points (%zu, %zu)", m, n);
     if (nranks <= 0) {
         uint32_t mx = 0;
         for (size_t i = 0; i < m; i++)
@@ -565,7 +563,7 @@ pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, s
         nranks = m ? (int)mx + 1 : 1;
     }
     pdt_replay *r = calloc(1, sizeof *r);
-    if (!r) return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+    if (!r) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     r->pts = pts;
     r->n = n;
     r->recs = recs;
@@ -584,8 +582,7 @@ pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, s
     if (!r->ev_obj || !r->ev_ent || !r->lift_ev || !r->sort_ev || !r->del_ev || !r->sort_pos ||
         !r->box_lo || !r->box_hi || !r->has_box) {
         pdt_replay_free(r);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory for %zu events", __FILE__,
-                           __LINE__, m);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for %zu events", m);
     }
     for (size_t p = 0; p < n; p++) {
         r->lift_ev[p] = r->sort_ev[p] = r->del_ev[p] = NONE32;

@@ -137,7 +137,7 @@ static pdt_status gen_finish(gen *g, pdt_point *pts, size_t n, pdt_synth *out, p
     if (g->failed) {
         free(g->recs);
         free(pts);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "%s:%d: out of memory", __FILE__, __LINE__);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     }
     qsort(g->recs, g->m, sizeof *g->recs, cmp_rec);
     out->pts = pts;
@@ -178,8 +178,7 @@ pdt_status pdt_synth_srm(int cols, int rows, int nranks, int level, pdt_synth *o
 {
     memset(out, 0, sizeof *out);
     if (cols < 2 || rows < 2 || nranks < 1 || nranks > cols / 2)
-        return pdt_err_set(err, PDT_ERR_ARG, "%s:%d: bad grid %dx%d for %d ranks", __FILE__,
-                           __LINE__, cols, rows, nranks);
+        return pdt_err_set(err, PDT_ERR_ARG, "bad grid %dx%d for %d ranks", cols, rows, nranks);
     size_t n = (size_t)cols * (size_t)rows, R = (size_t)rows;
     pdt_point *pts = malloc(n * sizeof *pts);
     int *first = malloc(((size_t)nranks + 1) * sizeof *first);  /* first column of each rank */
@@ -455,7 +454,7 @@ static void ang_sort(const sorter *s, uint32_t *v, size_t n, uint32_t *tmp)
 pdt_status pdt_synth_graham(size_t n, uint64_t seed, pdt_synth *out, pdt_err *err)
 {
     memset(out, 0, sizeof *out);
-    if (n < 3) return pdt_err_set(err, PDT_ERR_ARG, "%s:%d: need 3 points", __FILE__, __LINE__);
+    if (n < 3) return pdt_err_set(err, PDT_ERR_ARG, "need 3 points");
     pdt_point *pts = malloc(n * sizeof *pts);
     uint32_t *v = malloc(n * sizeof *v), *tmp = malloc(n * sizeof *tmp);
     uint32_t *stack = malloc(n * sizeof *stack);
