@@ -179,7 +179,8 @@ int pdt_cursor_next(pdt_cursor *c, pdt_event *ev, uint64_t *seq);
 void pdt_cursor_close(pdt_cursor *c);
 
 /* One readable line for an event, without rank or time, e.g.
- * "pop graham pt=17 depth=3 cause=12".  Writes at most cap bytes
+ * "pop graham pt=17 depth=3 cause=12"; a triangle starts at its smallest
+ * index ("ra-defer 9 30 28 rank=0").  Writes at most cap bytes
  * (NUL-terminated); returns buf. */
 char *pdt_event_format(const pdt_event *ev, char *buf, size_t cap);
 /* Kind by name ("push", "tri-final", ...); -1 if unknown. */

@@ -26,9 +26,26 @@ static const char *pt_or_dash(char *tmp, size_t cap, uint32_t v)
     return tmp;
 }
 
-char *pdt_event_format(const pdt_event *e, char *buf, size_t cap)
+/* A triangle event's corners rotated to start at the smallest index: the one
+ * corner order of every text (the events are counter-clockwise already). */
+static pdt_event tri_rotated(const pdt_event *e)
+{
+    pdt_event r = *e;
+    if (e->b < e->a && e->b < e->c) {
+        r.a = e->b; r.b = e->c; r.c = e->a;
+    } else if (e->c < e->a && e->c < e->b) {
+        r.a = e->c; r.b = e->a; r.c = e->b;
+    }
+    return r;
+}
+
+char *pdt_event_format(const pdt_event *e0, char *buf, size_t cap)
 {
     char t1[24], t2[24];
+    int tri = e0->kind == PDT_EV_TRI_NEW || e0->kind == PDT_EV_TRI_FINAL ||
+              e0->kind == PDT_EV_RA_DEFER || e0->kind == PDT_EV_SHIP || e0->kind == PDT_EV_DISCARD;
+    pdt_event rot = tri ? tri_rotated(e0) : *e0;
+    const pdt_event *e = &rot;
     const char *kn = pdt_event_kind_name(e->kind);
     switch (e->kind) {
     case PDT_EV_PHASE_BEGIN:

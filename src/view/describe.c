@@ -6,31 +6,186 @@
 
 #define NONE32 UINT32_MAX
 
+/* ---- names of points and triangles ---------------------------------------------- */
+
+void pdt_replay_tri_order(const pdt_replay *r, const uint32_t in[3], uint32_t out[3])
+{
+    size_t n;
+    const pdt_point *P = pdt_replay_points(r, &n);
+    int k = in[1] < in[0] ? (in[2] < in[1] ? 2 : 1) : (in[2] < in[0] ? 2 : 0);
+    out[0] = in[k];
+    out[1] = in[(k + 1) % 3];
+    out[2] = in[(k + 2) % 3];
+    if (out[0] < n && out[1] < n && out[2] < n) {
+        pdt_point a = P[out[0]], b = P[out[1]], c = P[out[2]];
+        int64_t o = ((int64_t)b.x - a.x) * ((int64_t)c.y - a.y) - ((int64_t)c.x - a.x) * ((int64_t)b.y - a.y);
+        if (o < 0) {
+            uint32_t t = out[1];
+            out[1] = out[2];
+            out[2] = t;
+        }
+    }
+}
+
+void pdt_point_label(const pdt_replay *r, const pdt_rstate *s, size_t p, char *buf, size_t cap)
+{
+    int64_t pos = pdt_replay_sort_pos(r, p);
+    if (pos >= 0 && s && (s->pflags[p] & PDT_PF_SORTED))
+        snprintf(buf, cap, "%zu=p%lld", p, (long long)pos);
+    else
+        snprintf(buf, cap, "%zu", p);
+}
+
+int pdt_replay_disk_touches(const pdt_replay *r, const uint32_t v[3], int rank)
+{
+    size_t n;
+    const pdt_point *P = pdt_replay_points(r, &n);
+    pdt_point lo, hi;
+    uint32_t w[3];
+    pdt_replay_tri_order(r, v, w);
+    if (w[0] >= n || w[1] >= n || w[2] >= n || !pdt_replay_box(r, rank, &lo, &hi)) return 0;
+    pdt_point A = P[w[0]], B = P[w[1]], C = P[w[2]];
+    double bx = (double)B.x - A.x, by = (double)B.y - A.y, cx = (double)C.x - A.x,
+           cy = (double)C.y - A.y;
+    double d = 2 * (bx * cy - by * cx);
+    if (d == 0) return 0;
+    double ux = (cy * (bx * bx + by * by) - by * (cx * cx + cy * cy)) / d;
+    double uy = (bx * (cx * cx + cy * cy) - cx * (bx * bx + by * by)) / d;
+    double ox = A.x + ux, oy = A.y + uy, rr = ux * ux + uy * uy;
+    double qx = ox < lo.x ? lo.x : ox > hi.x ? hi.x : ox;
+    double qy = oy < lo.y ? lo.y : oy > hi.y ? hi.y : oy;
+    return (qx - ox) * (qx - ox) + (qy - oy) * (qy - oy) <= rr * (1 + 1e-9);
+}
+
 /* ---- the event line ------------------------------------------------------------ */
 
+/* "point 7 (0,4)"; a number out of range as it is. */
 static const char *pt_str(const pdt_replay *r, uint32_t p, char *b, size_t cap)
 {
     size_t n;
     const pdt_point *P = pdt_replay_points(r, &n);
-    if (p < n) snprintf(b, cap, "%u (%d,%d)", p, P[p].x, P[p].y);
-    else snprintf(b, cap, "%u", p);
+    if (p < n) snprintf(b, cap, "point %u (%d,%d)", p, P[p].x, P[p].y);
+    else snprintf(b, cap, "point %u", p);
     return b;
 }
 
-/* A point on Graham's stack: "p7 (point 12)" once sorted, else "12". */
+/* A point of Graham's scan: "p7 (point 12)" once it has a place in the
+ * angular order, else "point 12". */
 static const char *gpt(const pdt_replay *r, uint32_t p, char *b, size_t cap)
 {
     int64_t pos = pdt_replay_sort_pos(r, p);
     if (pos >= 0) snprintf(b, cap, "p%lld (point %u)", (long long)pos, p);
-    else snprintf(b, cap, "%u", p);
+    else snprintf(b, cap, "point %u", p);
     return b;
+}
+
+/* Graham's short name of a point: "p7", or "point 12" before the sort. */
+static const char *gshort(const pdt_replay *r, uint32_t p, char *b, size_t cap)
+{
+    int64_t pos = pdt_replay_sort_pos(r, p);
+    if (pos >= 0) snprintf(b, cap, "p%lld", (long long)pos);
+    else snprintf(b, cap, "point %u", p);
+    return b;
+}
+
+/* "9 30 28": a triangle in the one corner order (pdt_replay_tri_order). */
+static const char *tri_str(const pdt_replay *r, const pdt_event *e, char *b, size_t cap)
+{
+    uint32_t v[3];
+    pdt_replay_tri_order(r, (const uint32_t[3]){e->a, e->b, e->c}, v);
+    snprintf(b, cap, "%u %u %u", v[0], v[1], v[2]);
+    return b;
+}
+
+/* The point below the top of rank q's stack `st` in s (the top after a pop
+ * is the point the popped one sat on), or NONE32. */
+static uint32_t stack_top(const pdt_replay *r, const pdt_rstate *s, int q, int st)
+{
+    size_t nn;
+    const pdt_rnode *N = pdt_replay_nodes(r, &nn);
+    int32_t t = s ? pdt_rstate_slot(r, s, q, PDT_SLOT_STACK0 + st) : -1;
+    return t >= 0 && (size_t)t < nn ? N[t].pt : NONE32;
+}
+
+/* The innermost phase (not "run") open on rank q in s, and its merge level. */
+static int open_phase(const pdt_replay *r, const pdt_rstate *s, int q, uint32_t *level)
+{
+    size_t np;
+    const pdt_rphase *Ph = pdt_replay_phases(r, &np);
+    *level = 0;
+    for (int32_t p = s ? pdt_rstate_slot(r, s, q, PDT_SLOT_PHASE) : -1; p >= 0 && (size_t)p < np;
+         p = Ph[p].parent)
+        if (Ph[p].phase != PDT_PH_RUN) {
+            *level = Ph[p].sub;
+            return (int)Ph[p].phase;
+        }
+    return -1;
+}
+
+/* Why a triangle is final, from where its rank is. */
+static const char *final_reason(const pdt_replay *r, const pdt_rstate *s, int q)
+{
+    uint32_t level;
+    int ph = open_phase(r, s, q, &level);
+    if (ph == PDT_PH_CLASSIFY) return "its circle misses every foreign box";
+    if (ph == PDT_PH_MERGE) {
+        size_t ng;
+        const pdt_rmerge *M = pdt_replay_merges(r, &ng);
+        int32_t g = pdt_rstate_slot(r, s, q, PDT_SLOT_MERGE);
+        if (g >= 0 && (size_t)g < ng && M[g].gl == 0 && (int)M[g].gend >= pdt_replay_nranks(r))
+            return "the last merge: no rank is left outside";
+        return "its circle misses every box outside the merged group";
+    }
+    if (pdt_replay_nranks(r) <= 1) return "one rank: the kernel's triangles are the output";
+    return "certified";
+}
+
+/* Area2 of (a, b, c) and its verdict for a pop: "Area2(p1, p2, p3) = 0:
+ * collinear" or "... = -26: right turn". */
+static void pop_reason(const pdt_replay *r, const pdt_rstate *s, const pdt_rec *rec, char *o,
+                       size_t c)
+{
+    const pdt_event *e = &rec->ev;
+    size_t n;
+    const pdt_point *P = pdt_replay_points(r, &n);
+    uint32_t below = stack_top(r, s, (int)rec->rank, e->sub);
+    int gr = e->sub == PDT_STACK_GRAHAM;
+    char a[32], b[32], d[32];
+    if (below >= n || e->a >= n || e->c >= n) {
+        snprintf(o, c, "%s at (%d,%d)", gr ? "no left turn" : "right turn", e->a < n ? P[e->a].x : 0,
+                 e->a < n ? P[e->a].y : 0);
+        return;
+    }
+    pdt_point A = P[below], B = P[e->a], C = P[e->c];
+    long long v = (long long)(((int64_t)B.x - A.x) * ((int64_t)C.y - A.y) -
+                              ((int64_t)C.x - A.x) * ((int64_t)B.y - A.y));
+    if (gr)
+        snprintf(o, c, "Area2(%s, %s, %s) = %lld: %s", gshort(r, below, a, sizeof a),
+                 gshort(r, e->a, b, sizeof b), gshort(r, e->c, d, sizeof d), v,
+                 v == 0 ? "collinear, not a strict left turn" : v < 0 ? "right turn" : "left turn?");
+    else
+        snprintf(o, c, "Area2(%u, %u, %u) = %lld: %s", below, e->a, e->c, v,
+                 v == 0 ? "collinear" : v < 0 ? "right turn" : "left turn");
 }
 
 void pdt_replay_describe(const pdt_replay *r, size_t k, char *buf, size_t cap)
 {
     if (!cap) return;
+    pdt_rstate *s = NULL;
+    const pdt_rec *rec = k && k <= pdt_replay_count(r) ? pdt_replay_rec(r, k - 1) : NULL;
+    if (rec) s = pdt_rstate_new(r);
+    if (s) pdt_replay_seek(r, s, k);
+    pdt_replay_describe_state(r, s, k, buf, cap);
+    pdt_rstate_free(s);
+}
+
+void pdt_replay_describe_state(const pdt_replay *r, const pdt_rstate *s, size_t k, char *buf,
+                               size_t cap)
+{
+    if (!cap) return;
+    if (s) k = s->k;
     size_t m = pdt_replay_count(r), npts;
-    const pdt_point *P = pdt_replay_points(r, &npts);
+    pdt_replay_points(r, &npts);
     if (k == 0 || k > m) {
         snprintf(buf, cap, "start — %zu events, %d ranks; press Space or → to begin", m,
                  pdt_replay_nranks(r));
@@ -38,7 +193,7 @@ void pdt_replay_describe(const pdt_replay *r, size_t k, char *buf, size_t cap)
     }
     const pdt_rec *rec = pdt_replay_rec(r, k - 1);
     const pdt_event *e = &rec->ev;
-    char p1[64], p2[64];
+    char p1[64], p2[64], t3[48], why[192];
     int n = snprintf(buf, cap, "rank %u: ", rec->rank);
     if (n < 0 || (size_t)n >= cap) return;
     char *o = buf + n;
@@ -58,48 +213,78 @@ void pdt_replay_describe(const pdt_replay *r, size_t k, char *buf, size_t cap)
             snprintf(o, c, "push %s on the %s stack (depth %u)", pt_str(r, e->a, p1, sizeof p1), stk, e->b);
         break;
     case PDT_EV_POP:
-        if (e->sub == PDT_STACK_GRAHAM && e->c < npts && e->a < npts)
-            snprintf(o, c, "pop %s — no left turn at (%d,%d) towards %s", gpt(r, e->a, p1, sizeof p1),
-                     P[e->a].x, P[e->a].y, gpt(r, e->c, p2, sizeof p2));
-        else if (e->c != NONE32 && e->c < npts)
-            snprintf(o, c, "pop %u — %s at (%d,%d) when adding %u", e->a,
-                     e->sub == PDT_STACK_GRAHAM ? "no left turn" : "right turn",
-                     e->a < npts ? P[e->a].x : 0, e->a < npts ? P[e->a].y : 0, e->c);
-        else
+        if (e->c != NONE32 && e->c < npts) {
+            pop_reason(r, s, rec, why, sizeof why);
+            if (e->sub == PDT_STACK_GRAHAM)
+                snprintf(o, c, "pop %s — %s", gpt(r, e->a, p1, sizeof p1), why);
+            else
+                snprintf(o, c, "pop %s from the %s stack — %s", pt_str(r, e->a, p1, sizeof p1), stk, why);
+        } else {
             snprintf(o, c, "pop %s from the %s stack", pt_str(r, e->a, p1, sizeof p1), stk);
+        }
         break;
     case PDT_EV_LIFT:
         snprintf(o, c, "lift %s to z = %lld", pt_str(r, e->a, p1, sizeof p1), (long long)e->v);
         break;
     case PDT_EV_SORT:
-        snprintf(o, c, "%s is number %u in the angular order", pt_str(r, e->a, p1, sizeof p1), e->b);
+        if (e->b == 0)
+            snprintf(o, c, "sort: %s is the origin p0 (the rightmost lowest point)",
+                     pt_str(r, e->a, p1, sizeof p1));
+        else
+            snprintf(o, c, "sort: %s becomes p%u", pt_str(r, e->a, p1, sizeof p1), e->b);
         break;
     case PDT_EV_DELETE:
-        snprintf(o, c, "delete %s — %s %u", pt_str(r, e->a, p1, sizeof p1),
-                 e->sub == PDT_DEL_COINCIDENT ? "a copy of" : "same angle as, and closer than,",
-                 e->b);
+        if (e->sub == PDT_DEL_COINCIDENT)
+            snprintf(o, c, "delete %s — a copy of %s", gpt(r, e->a, p1, sizeof p1),
+                     gpt(r, e->b, p2, sizeof p2));
+        else
+            snprintf(o, c, "delete %s — same angle as %s, and closer to p0", gpt(r, e->a, p1, sizeof p1),
+                     gpt(r, e->b, p2, sizeof p2));
         break;
     case PDT_EV_TRI_NEW:
-        snprintf(o, c, "candidate triangle %u %u %u from the %s kernel", e->a, e->b, e->c,
+        snprintf(o, c, "candidate triangle %s from the %s kernel", tri_str(r, e, t3, sizeof t3),
                  e->sub ? "border" : "local");
         break;
     case PDT_EV_TRI_FINAL:
-        snprintf(o, c, "triangle %u %u %u is final — its circle misses every foreign box", e->a,
-                 e->b, e->c);
+        snprintf(o, c, "triangle %s is final — %s", tri_str(r, e, t3, sizeof t3),
+                 final_reason(r, s, (int)rec->rank));
         break;
-    case PDT_EV_RA_DEFER:
-        snprintf(o, c, "defer %u %u %u — its circle touches the box of rank %lld", e->a, e->b, e->c,
-                 (long long)e->v);
+    case PDT_EV_RA_DEFER: {
+        /* every rank whose box the circle touches (the boxes the picture
+         * outlines), and the one the trace records: the merge it waits for */
+        uint32_t v[3] = {e->a, e->b, e->c};
+        int nr = pdt_replay_nranks(r), cnt = 0, last = -1;
+        for (int q = 0; q < nr; q++)
+            if (q != (int)rec->rank && pdt_replay_disk_touches(r, v, q)) cnt++, last = q;
+        size_t w = 0;
+        why[0] = 0;
+        for (int q = 0, i = 0; q < nr && w < sizeof why; q++) {
+            if (q == (int)rec->rank || !pdt_replay_disk_touches(r, v, q)) continue;
+            int d = snprintf(why + w, sizeof why - w, "%s%d", i == 0 ? "" : q == last ? " and " : ", ", q);
+            if (d > 0) w += (size_t)d;
+            i++;
+        }
+        if (cnt == 0)
+            snprintf(o, c, "defer %s — waits for the merge with rank %lld", tri_str(r, e, t3, sizeof t3),
+                     (long long)e->v);
+        else if (cnt == 1 && last == (int)e->v)
+            snprintf(o, c, "defer %s — its circle touches the box of rank %lld",
+                     tri_str(r, e, t3, sizeof t3), (long long)e->v);
+        else
+            snprintf(o, c, "defer %s — its circle touches the box%s of rank%s %s; first merge: with rank %lld",
+                     tri_str(r, e, t3, sizeof t3), cnt > 1 ? "es" : "", cnt > 1 ? "s" : "", why,
+                     (long long)e->v);
         break;
+    }
     case PDT_EV_SHIP:
-        snprintf(o, c, "ship %u %u %u to rank %lld", e->a, e->b, e->c, (long long)e->v);
+        snprintf(o, c, "ship %s to rank %lld", tri_str(r, e, t3, sizeof t3), (long long)e->v);
         break;
     case PDT_EV_DISCARD:
         if (e->v >= 0 && (uint64_t)e->v < npts)
-            snprintf(o, c, "discard %u %u %u — not Delaunay: %s is inside its circle", e->a, e->b,
-                     e->c, pt_str(r, (uint32_t)e->v, p2, sizeof p2));
+            snprintf(o, c, "discard %s — not Delaunay: %s is inside its circle",
+                     tri_str(r, e, t3, sizeof t3), pt_str(r, (uint32_t)e->v, p2, sizeof p2));
         else
-            snprintf(o, c, "discard %u %u %u — not Delaunay", e->a, e->b, e->c);
+            snprintf(o, c, "discard %s — not Delaunay", tri_str(r, e, t3, sizeof t3));
         break;
     case PDT_EV_MERGE_BEGIN:
         snprintf(o, c, "merge level %u: ranks %u–%u with %u–%u at rank %lld", e->sub, e->a,

@@ -227,9 +227,19 @@ TEST(hand_made_story)
     CHECK(check_routes(r, 1) == 0);
     char line[256];
     pdt_replay_describe(r, 4, line, sizeof line);
-    CHECK_MSG(strstr(line, "rank 0: pop 3") && strstr(line, "right turn at (5,3)"), "%s", line);
+    CHECK_MSG(strstr(line, "rank 0: pop point 3 (5,3)") && strstr(line, "= -30: right turn"), "%s", line);
     pdt_replay_describe(r, 10, line, sizeof line);
-    CHECK_MSG(strstr(line, "discard") && strstr(line, "3 (5,3) is inside"), "%s", line);
+    CHECK_MSG(strstr(line, "discard") && strstr(line, "point 3 (5,3) is inside"), "%s", line);
+    {   /* the discard names the triangle in the one corner order, as the defer did */
+        uint32_t v[3];
+        char want[32];
+        pdt_replay_tri_order(r, (const uint32_t[3]){2, 0, 1}, v);
+        snprintf(want, sizeof want, "discard %u %u %u —", v[0], v[1], v[2]);
+        CHECK_MSG(v[0] == 0 && strstr(line, want), "%s", line);
+        pdt_replay_describe(r, 9, line, sizeof line);
+        snprintf(want, sizeof want, "defer %u %u %u —", v[0], v[1], v[2]);
+        CHECK_MSG(strstr(line, want), "%s", line);
+    }
     /* searching */
     CHECK(pdt_replay_find(r, 0, 1, PDT_EVC_STACK, NULL) == 2);
     CHECK(pdt_replay_find(r, 5, 1, PDT_EVC_REJECT, NULL) == 9);
@@ -259,6 +269,45 @@ TEST(malformed_events_skipped)
     pdt_replay_free(r);
 }
 
+/* Graham's words: the sort says which point becomes which p_k, a pop gives
+ * Area2 of (below, popped, new) and tells collinear from a right turn
+ * (the points of lesson 1, already in angular order). */
+TEST(graham_words)
+{
+    pdt_point pts[6] = {{10, 0}, {13, 6}, {9, 8}, {5, 10}, {6, 4}, {2, 2}};
+    pdt_rec ev[20];
+    size_t m = 0;
+    for (uint32_t i = 0; i < 6; i++) ev[m++] = rec(0, PDT_EV_SORT, 0, i, i, 0, 0);
+    ev[m++] = rec(0, PDT_EV_PUSH, PDT_STACK_GRAHAM, 0, 1, 0, 0);
+    ev[m++] = rec(0, PDT_EV_PUSH, PDT_STACK_GRAHAM, 1, 2, 0, 0);
+    ev[m++] = rec(0, PDT_EV_PUSH, PDT_STACK_GRAHAM, 2, 3, 0, 0);
+    ev[m++] = rec(0, PDT_EV_POP, PDT_STACK_GRAHAM, 2, 2, 3, 0);   /* 10 */
+    ev[m++] = rec(0, PDT_EV_PUSH, PDT_STACK_GRAHAM, 3, 3, 0, 0);
+    ev[m++] = rec(0, PDT_EV_PUSH, PDT_STACK_GRAHAM, 4, 4, 0, 0);
+    ev[m++] = rec(0, PDT_EV_POP, PDT_STACK_GRAHAM, 4, 3, 5, 0);   /* 13 */
+    pdt_replay *r = NULL;
+    pdt_err err = {0};
+    CHECK(pdt_replay_new(pts, 6, ev, m, 1, &r, &err) == PDT_OK);
+    if (!r) return;
+    char line[256];
+    pdt_replay_describe(r, 1, line, sizeof line);
+    CHECK_MSG(!strcmp(line, "rank 0: sort: point 0 (10,0) is the origin p0 (the rightmost lowest point)"), "%s", line);
+    pdt_replay_describe(r, 3, line, sizeof line);
+    CHECK_MSG(!strcmp(line, "rank 0: sort: point 2 (9,8) becomes p2"), "%s", line);
+    pdt_replay_describe(r, 10, line, sizeof line);
+    CHECK_MSG(!strcmp(line, "rank 0: pop p2 (point 2) — Area2(p1, p2, p3) = 0: collinear, not a strict left turn"), "%s", line);
+    pdt_replay_describe(r, 13, line, sizeof line);
+    CHECK_MSG(!strcmp(line, "rank 0: pop p4 (point 4) — Area2(p3, p4, p5) = -26: right turn"), "%s", line);
+    pdt_rstate *s = pdt_rstate_new(r);
+    pdt_replay_seek(r, s, 2);
+    pdt_point_label(r, s, 1, line, sizeof line);
+    CHECK_MSG(!strcmp(line, "1=p1"), "%s", line);
+    pdt_point_label(r, s, 4, line, sizeof line);
+    CHECK_MSG(!strcmp(line, "4"), "%s", line);
+    pdt_rstate_free(s);
+    pdt_replay_free(r);
+}
+
 /* The pseudo-code listings: numbered from 1 in order, bad ids and lines NULL. */
 TEST(code_listings)
 {
@@ -282,5 +331,6 @@ int main(void)
     RUN(hand_made_story);
     RUN(malformed_events_skipped);
     RUN(code_listings);
+    RUN(graham_words);
     return test_summary();
 }
