@@ -35,8 +35,9 @@
 # the only code that includes mpi.h is src/par/comm_mpi.c), src/cli (the pdt
 # program), src/view (replay model, cairo renderer, SDL2 shell: every file
 # but shell.c and pdtview.c goes into libpdtview.a, which needs cairo only;
-# bin/pdtview adds SDL2).  Unit tests named tests/unit/test_view*.c are
-# compiled with the cairo/SDL flags and linked with libpdtview.a.
+# bin/pdtview adds SDL2 and the option parser src/cli/opts.c).  Unit tests
+# named tests/unit/test_view*.c are compiled with the cairo/SDL flags and
+# linked with libpdtview.a.
 
 CC      ?= gcc
 ifeq ($(origin CC),default)
@@ -100,7 +101,7 @@ build/$(1)/libpdtview.a: $$(patsubst %.c,build/$(1)/%.o,$(VIEWLIB_SRC))
 $(3)/pdt: $$(patsubst %.c,build/$(1)/%.o,$(CLI_SRC) $(PAR_SRC)) build/$(1)/libpdt.a
 	$$(CC) $(2) -o $$@ $$^ $(MPI_LIBS) $(LIBS)
 
-$(3)/pdtview: $$(patsubst %.c,build/$(1)/%.o,$(VIEWAPP_SRC)) build/$(1)/libpdtview.a build/$(1)/libpdt.a
+$(3)/pdtview: $$(patsubst %.c,build/$(1)/%.o,$(VIEWAPP_SRC) src/cli/opts.c) build/$(1)/libpdtview.a build/$(1)/libpdt.a
 	$$(CC) $(2) -o $$@ $$^ $(SDL_LIBS) $(CAIRO_LIBS) $(LIBS)
 
 $(3)/tests/%: build/$(1)/tests/unit/%.o $(if $(VIEWLIB_SRC),build/$(1)/libpdtview.a) build/$(1)/libpdt.a

@@ -71,12 +71,6 @@ void pdt_render_layout_panels(double w, double h, int nranks, unsigned panels, p
 pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, const pdt_rstate *s,
                       const pdt_view *v, pdt_err *err);
 
-/* Input points strictly inside the circumcircle of triangle v (either
- * orientation), by the exact pdt_incircle0 (no tie rule: points on the
- * circle are not counted); lifted or not.  0 if v is degenerate or names a
- * point out of range.  Costs one in-circle test per input point. */
-size_t pdt_render_inside_count(const pdt_replay *r, const uint32_t v[3]);
-
 /* Draw into a file: the format comes from the extension (.png, .svg, .pdf). */
 pdt_status pdt_render_file(const char *path, int w, int h, const pdt_replay *r,
                            const pdt_rstate *s, const pdt_view *v, pdt_err *err);

@@ -1,6 +1,7 @@
 /* pdt — internals of the pdt program (src/cli): the command table, the
  * option parser, and helpers shared by the commands.  Not a library API:
- * these functions may print and decide exit statuses. */
+ * these functions may print and decide exit statuses.  pdtview links the
+ * option parser too (opts.c: pdt_cli_parse, pdt_cli_usage). */
 #ifndef PDT_CLI_H
 #define PDT_CLI_H
 
@@ -47,7 +48,10 @@ typedef struct pdt_cli_opt {
     void *dst;
 } pdt_cli_opt;
 
-/* Parse argv[1..argc) of command `cmd` against `opts` (terminated by an
+/* `cmd` names the command in messages: a pdt command ("hull": "pdt hull: ...")
+ * or a whole program whose name starts with "pdt" ("pdtview: ...").
+ *
+ * Parse argv[1..argc) of command `cmd` against `opts` (terminated by an
  * entry with name NULL); positional arguments go to pos[0..*npos), at most
  * `maxpos`.  "--" ends the options; a lone "-" is positional.  Returns 0 on
  * success, 1 if --help/-h was given (help already printed from `help`),
@@ -55,8 +59,8 @@ typedef struct pdt_cli_opt {
 int pdt_cli_parse(const char *cmd, const char *help, int argc, char **argv,
                   const pdt_cli_opt *opts, const char **pos, int maxpos, int *npos);
 
-/* Print "pdt CMD: MESSAGE\n(see pdt CMD --help)" to stderr and return
- * PDT_EXIT_USAGE. */
+/* Print "pdt CMD: MESSAGE\n(see: pdt CMD --help)" to stderr (CMD a program
+ * name starting with "pdt": without the "pdt ") and return PDT_EXIT_USAGE. */
 int pdt_cli_usage(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /* Print "pdt: " + the error's message to stderr; return the exit status for

@@ -22,6 +22,9 @@
 #include "pdt/tracefile.h"
 #include "pdt/viewsynth.h"
 #include "shell.h"
+#include "../cli/cli.h"
+
+#define PROG "pdtview"
 
 typedef struct opts {
     const char *run, *out, *frames, *phase, *script, *screenshot, *hide, *write_run;
@@ -31,36 +34,50 @@ typedef struct opts {
     unsigned panels; /* PDT_PANEL_* bits (--panels) */
 } opts;
 
-static void usage(FILE *f)
-{
-    fprintf(f,
-            "usage: pdtview RUN [--size WxH] [--at N|--phase NAME|--end] [--hide R,R..]\n"
-            "               [--panels code,stack,lifted,timeline|all|none]\n"
-            "               [--script KEYS] [--screenshot FILE.png] [--speed EV_PER_S]\n"
-            "       pdtview --headless RUN (--at N | --phase NAME | --end) -o FILE.png|.svg|.pdf\n"
-            "               [--size WxH]\n"
-            "       pdtview --headless RUN --frames DIR --every K [--size WxH]\n"
-            "       pdtview --bench RUN [--size WxH]\n"
-            "       pdtview RUN [--at N|--phase NAME|--end] --counts   (triangles by status)\n"
-            "       pdtview RUN --check     (seek equals stepping, both ways, at every cursor)\n"
-            "       pdtview --write-run DIR RUN\n"
-            "RUN: a run folder, or synth:srm:COLS:ROWS:RANKS, synth:graham:N\n"
-            "The cursor N counts events applied (0 = start, --end = all).\n"
-            "Keys in the window: h or ? (help).  See docs/viewer.md.\n");
-}
+static const char help_text[] =
+    "usage: pdtview RUN [--size WxH] [--at N|--phase NAME|--end] [--hide R,R..]\n"
+    "               [--panels code,stack,lifted,timeline|all|none]\n"
+    "               [--script KEYS] [--screenshot FILE.png] [--speed EV_PER_S]\n"
+    "       pdtview --headless RUN (--at N | --phase NAME | --end) -o FILE.png|.svg|.pdf\n"
+    "               [--size WxH]\n"
+    "       pdtview --headless RUN --frames DIR --every K [--size WxH]\n"
+    "       pdtview --bench RUN [--size WxH]\n"
+    "       pdtview RUN [--at N|--phase NAME|--end] --counts   (triangles by status)\n"
+    "       pdtview RUN --check     (seek equals stepping, both ways, at every cursor)\n"
+    "       pdtview --write-run DIR RUN\n"
+    "RUN: a run folder, or synth:srm:COLS:ROWS:RANKS, synth:graham:N\n"
+    "The cursor N counts events applied (0 = start, --end = all).\n"
+    "Keys in the window: h or ? (help).  See docs/viewer.md.\n";
 
+/* "WxH", each 64 .. 16384. */
 static int parse_size(const char *s, int *w, int *h)
 {
     char *end;
     long a = strtol(s, &end, 10);
-    if (*end != 'x' && *end != 'X') return 0;
-    long b = strtol(end + 1, &end, 10);
-    if (*end || a < 64 || b < 64 || a > 16384 || b > 16384) return 0;
+    if (end == s || (*end != 'x' && *end != 'X')) return 0;
+    const char *b0 = end + 1;
+    long b = strtol(b0, &end, 10);
+    if (end == b0 || *end || a < 64 || b < 64 || a > 16384 || b > 16384) return 0;
     *w = (int)a;
     *h = (int)b;
     return 1;
 }
 
+/* "R,R,..": rank numbers separated by commas. */
+static int valid_rank_list(const char *s)
+{
+    if (!*s) return 0;
+    for (const char *p = s; *p;) {
+        if (*p < '0' || *p > '9') return 0;
+        while (*p >= '0' && *p <= '9') p++;
+        if (*p == ',' && p[1]) p++;
+        else if (*p) return 0;
+    }
+    return 1;
+}
+
+/* Options into *o; returns -1 to go on, else the exit status (0 after
+ * --help, 2 after a usage error, message printed). */
 static int parse_args(int argc, char **argv, opts *o)
 {
     memset(o, 0, sizeof *o);
@@ -68,87 +85,55 @@ static int parse_args(int argc, char **argv, opts *o)
     o->h = 1000;
     o->speed = 20;
     o->panels = PDT_PANEL_ALL;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
-#define NEED()                                                        \
-    do {                                                              \
-        if (!val) {                                                   \
-            fprintf(stderr, "pdtview: %s needs a value\n", a);        \
-            return 0;                                                 \
-        }                                                             \
-        i++;                                                          \
-    } while (0)
-        if (!strcmp(a, "--headless")) o->headless = 1;
-        else if (!strcmp(a, "--bench")) o->bench = 1;
-        else if (!strcmp(a, "--counts")) o->counts = 1;
-        else if (!strcmp(a, "--check")) o->check = 1;
-        else if (!strcmp(a, "--write-run")) { NEED(); o->write_run = val; }
-        else if (!strcmp(a, "--end")) o->end = 1;
-        else if (!strcmp(a, "--quiet")) o->quiet = 1;
-        else if (!strcmp(a, "--at")) {
-            NEED();
-            char *e;
-            o->at = strtoull(val, &e, 10);
-            if (*e) {
-                fprintf(stderr, "pdtview: --at %s: not a number\n", val);
-                return 0;
-            }
-            o->have_at = 1;
-        } else if (!strcmp(a, "--phase")) { NEED(); o->phase = val; }
-        else if (!strcmp(a, "-o")) { NEED(); o->out = val; }
-        else if (!strcmp(a, "--frames")) { NEED(); o->frames = val; }
-        else if (!strcmp(a, "--every")) {
-            NEED();
-            o->every = atoi(val);
-            if (o->every < 1) {
-                fprintf(stderr, "pdtview: --every %s: need a positive number\n", val);
-                return 0;
-            }
-        } else if (!strcmp(a, "--size")) {
-            NEED();
-            if (!parse_size(val, &o->w, &o->h)) {
-                fprintf(stderr, "pdtview: --size %s: want WxH, 64..16384\n", val);
-                return 0;
-            }
-        } else if (!strcmp(a, "--script")) { NEED(); o->script = val; }
-        else if (!strcmp(a, "--screenshot")) { NEED(); o->screenshot = val; }
-        else if (!strcmp(a, "--hide")) { NEED(); o->hide = val; }
-        else if (!strcmp(a, "--panels")) {
-            NEED();
-            if (pdt_panels_parse(val, &o->panels) != 0) {
-                fprintf(stderr, "pdtview: --panels %s: want a list of code, stack, lifted, "
-                                "timeline (or all, none)\n", val);
-                return 0;
-            }
-        }
-        else if (!strcmp(a, "--speed")) {
-            NEED();
-            o->speed = atof(val);
-            if (o->speed <= 0) o->speed = 20;
-        } else if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-            usage(stdout);
-            exit(0);
-        } else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "pdtview: unknown option %s\n", a);
-            return 0;
-        } else if (!o->run) o->run = a;
-        else {
-            fprintf(stderr, "pdtview: more than one run given (%s)\n", a);
-            return 0;
-        }
-#undef NEED
+    const char *size = NULL, *panels = NULL;
+    uint64_t at = UINT64_MAX, every = UINT64_MAX;
+    const pdt_cli_opt table[] = {
+        {"--headless", NULL, PDT_OPT_FLAG, &o->headless},
+        {"--bench", NULL, PDT_OPT_FLAG, &o->bench},
+        {"--counts", NULL, PDT_OPT_FLAG, &o->counts},
+        {"--check", NULL, PDT_OPT_FLAG, &o->check},
+        {"--write-run", NULL, PDT_OPT_STR, &o->write_run},
+        {"--end", NULL, PDT_OPT_FLAG, &o->end},
+        {"--quiet", NULL, PDT_OPT_FLAG, &o->quiet},
+        {"--at", NULL, PDT_OPT_U64, &at},
+        {"--phase", NULL, PDT_OPT_STR, &o->phase},
+        {"--output", "-o", PDT_OPT_STR, &o->out},
+        {"--frames", NULL, PDT_OPT_STR, &o->frames},
+        {"--every", NULL, PDT_OPT_U64, &every},
+        {"--size", NULL, PDT_OPT_STR, &size},
+        {"--script", NULL, PDT_OPT_STR, &o->script},
+        {"--screenshot", NULL, PDT_OPT_STR, &o->screenshot},
+        {"--hide", NULL, PDT_OPT_STR, &o->hide},
+        {"--panels", NULL, PDT_OPT_STR, &panels},
+        {"--speed", NULL, PDT_OPT_POSNUM, &o->speed},
+        {NULL, NULL, PDT_OPT_FLAG, NULL},
+    };
+    const char *pos[1];
+    int npos;
+    int rc = pdt_cli_parse(PROG, help_text, argc, argv, table, pos, 1, &npos);
+    if (rc == 1) return PDT_EXIT_OK;
+    if (rc) return PDT_EXIT_USAGE;
+    if (npos != 1) return pdt_cli_usage(PROG, "needs one RUN (a run folder or synth:...)");
+    o->run = pos[0];
+    if (at != UINT64_MAX) {
+        o->at = (size_t)at;
+        o->have_at = 1;
     }
-    if (!o->run) {
-        fprintf(stderr, "pdtview: no run folder given\n");
-        return 0;
-    }
-    if (o->headless && !o->out && !o->frames && !o->bench && !o->counts) {
-        fprintf(stderr, "pdtview: --headless needs -o FILE or --frames DIR\n");
-        return 0;
-    }
-    if (o->frames && !o->every) o->every = 1;
-    return 1;
+    if (every == UINT64_MAX) every = 1;
+    else if (every == 0 || every > 1000000000)
+        return pdt_cli_usage(PROG, "--every needs a whole number 1 .. 1000000000, not '%llu'",
+                             (unsigned long long)every);
+    o->every = (int)every;
+    if (size && !parse_size(size, &o->w, &o->h))
+        return pdt_cli_usage(PROG, "--size needs WxH, each 64 .. 16384, not '%s'", size);
+    if (panels && pdt_panels_parse(panels, &o->panels) != 0)
+        return pdt_cli_usage(PROG, "--panels needs a list of code, stack, lifted, timeline (or all, "
+                                   "none), not '%s'", panels);
+    if (o->hide && !valid_rank_list(o->hide))
+        return pdt_cli_usage(PROG, "--hide needs rank numbers separated by commas, not '%s'", o->hide);
+    if (o->headless && !o->out && !o->frames && !o->bench && !o->counts)
+        return pdt_cli_usage(PROG, "--headless needs -o FILE or --frames DIR");
+    return -1;
 }
 
 /* ---- the run ----------------------------------------------------------------- */
@@ -402,10 +387,8 @@ static int write_run(const char *dir, const loaded *L, pdt_err *err)
 int main(int argc, char **argv)
 {
     opts o;
-    if (!parse_args(argc, argv, &o)) {
-        usage(stderr);
-        return 2;
-    }
+    int prc = parse_args(argc, argv, &o);
+    if (prc >= 0) return prc;
     pdt_err err = {0};
     loaded L;
     pdt_replay *r = NULL;
@@ -438,7 +421,12 @@ int main(int argc, char **argv)
             char *e;
             long q = strtol(p, &e, 10);
             if (e == p) break;
-            if (q >= 0 && q < pdt_replay_nranks(r)) hidden[q] = 1;
+            if (q >= pdt_replay_nranks(r)) {
+                pdt_err_set(&err, PDT_ERR_ARG, "--hide %ld: the run has %d ranks (0 .. %d)", q,
+                            pdt_replay_nranks(r), pdt_replay_nranks(r) - 1);
+                goto out;
+            }
+            hidden[q] = 1;
             p = *e ? e + 1 : e;
         }
     }

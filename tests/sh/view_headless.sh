@@ -48,4 +48,29 @@ if ! "$V" --headless "$RUN" --at 99999999 -o "$TMP/n.png" 2>"$TMP/e2" && grep -q
 if ! "$V" --headless "$RUN" --end -o "$TMP/n.bmp" 2>"$TMP/e3" && grep -q 'unknown picture format' "$TMP/e3"; then
     ok error_format; else fail error_format; fi
 if ! "$V" --headless "$TMP/no-such-run" --end -o "$TMP/n.png" 2>"$TMP/e4"; then ok error_run; else fail error_run; fi
+
+# option errors: exit status 2, the message names the option and the value,
+# nothing written (bad values are never silently replaced by defaults)
+opt_error() { # NAME PATTERN ARGS...
+    name=$1 pat=$2
+    shift 2
+    rm -f "$TMP/o.png"
+    "$V" "$@" 2>"$TMP/oe"
+    rc=$?
+    if [ $rc -eq 2 ] && grep -q -- "$pat" "$TMP/oe" && [ ! -e "$TMP/o.png" ]; then ok "option_$name"
+    else fail "option_$name" "rc $rc: $(head -1 "$TMP/oe")"; fi
+}
+opt_error speed_zero "--speed needs a positive number, not '0'" "$RUN" --speed 0
+opt_error speed_text "--speed needs a positive number, not 'fast'" "$RUN" --speed=fast
+opt_error every_zero "--every needs a whole number" --headless "$RUN" --frames "$TMP/fr0" --every 0
+opt_error at_text "--at needs a whole number, not '12x'" --headless "$RUN" --at 12x -o "$TMP/o.png"
+opt_error size "--size needs WxH" --headless "$RUN" --end --size 100 -o "$TMP/o.png"
+opt_error panels "--panels needs a list" --headless "$RUN" --end --panels code,nope -o "$TMP/o.png"
+opt_error hide "--hide needs rank numbers" --headless "$RUN" --end --hide 1,a -o "$TMP/o.png"
+opt_error unknown "unknown option '--bogus'" --headless "$RUN" --end --bogus -o "$TMP/o.png"
+opt_error missing_value "--speed needs a value" "$RUN" --speed
+opt_error no_run "needs one RUN" --headless --end -o "$TMP/o.png"
+if ! "$V" --headless "$RUN" --end --hide 9 -o "$TMP/o.png" 2>"$TMP/oe" && grep -q -- '--hide 9: the run has' "$TMP/oe" &&
+   [ ! -e "$TMP/o.png" ]; then ok option_hide_range; else fail option_hide_range "$(head -1 "$TMP/oe")"; fi
+if "$V" --help | grep -q '^usage: pdtview'; then ok option_help; else fail option_help; fi
 summary

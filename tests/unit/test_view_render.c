@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "pdt/query.h"
 #include "pdt/render.h"
 #include "pdt/replay.h"
 #include "pdt/viewsynth.h"
@@ -357,9 +358,9 @@ TEST(inside_count_exact_all_points)
     uint32_t ccw[3] = {0, 1, 2}, cw[3] = {0, 2, 1}, flat[3] = {0, 1, 1};
     /* distance^2 from (5,5): inside (5,5) 0, (1,1) 32, (9,8) 25, (12,5) 49, (-2,5) 49,
      * (5,12) 49, (2,9) 25; on the circle (10,10) 50 and the vertices; outside the rest */
-    CHECK_MSG(pdt_render_inside_count(r, ccw) == 7, "got %zu", pdt_render_inside_count(r, ccw));
-    CHECK(pdt_render_inside_count(r, cw) == 7);
-    CHECK(pdt_render_inside_count(r, flat) == 0);
+    CHECK_MSG(pdt_replay_inside_count(r, ccw) == 7, "got %zu", pdt_replay_inside_count(r, ccw));
+    CHECK(pdt_replay_inside_count(r, cw) == 7);
+    CHECK(pdt_replay_inside_count(r, flat) == 0);
     pdt_replay_free(r);
 }
 

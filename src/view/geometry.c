@@ -1,0 +1,583 @@
+/* pdt — the world picture of the viewer: strip boxes, triangles by status
+ * and rank, kernel edges, hulls and stacks, points and their labels, the
+ * merge in progress, the current event's highlight, the selection. */
+#include "render_int.h"
+
+static int disk_touches_box(double ox, double oy, double rr, pdt_point lo, pdt_point hi)
+{
+    double qx = fmax(lo.x, fmin(ox, hi.x)), qy = fmax(lo.y, fmin(oy, hi.y));
+    return (qx - ox) * (qx - ox) + (qy - oy) * (qy - oy) <= rr * rr * (1 + 1e-9);
+}
+
+/* ---- the geometry --------------------------------------------------------------------- */
+
+/* The strip boxes (labels = 0) or their labels (labels = 1, drawn last, on a
+ * white ground so that edges and hulls do not hide them). */
+static void draw_boxes(ctx *c, int cur_tri_ok, double ox, double oy, double rr, int labels)
+{
+    cairo_t *cr = c->cr;
+    int cur_rank = c->cur ? (int)c->cur->rank : -1;
+    for (int q = 0; q < c->nranks; q++) {
+        pdt_point lo, hi;
+        if (!shown(c, (uint32_t)q) || !pdt_replay_box(c->r, q, &lo, &hi)) continue;
+        double x0 = c->X.ox + c->X.s * lo.x, x1 = c->X.ox + c->X.s * hi.x;
+        double y0 = c->X.oy - c->X.s * hi.y, y1 = c->X.oy - c->X.s * lo.y;
+        double pad = 0.4 * c->L.font;
+        int touched = cur_tri_ok && q != cur_rank && disk_touches_box(ox, oy, rr, lo, hi);
+        if (!labels) {
+            cairo_rectangle(cr, x0 - pad, y0 - pad, x1 - x0 + 2 * pad, y1 - y0 + 2 * pad);
+            /* opaque tint (rank colour over white): much cheaper than alpha on big areas */
+            double col[3], a = touched ? 0.16 : 0.05;
+            pdt_rank_rgb(q, col);
+            cairo_set_source_rgb(cr, 1 - a + a * col[0], 1 - a + a * col[1], 1 - a + a * col[2]);
+            cairo_fill_preserve(cr);
+            set_rank(cr, q, touched ? 0.95 : 0.5);
+            double d[2] = {4, 3};
+            cairo_set_dash(cr, touched ? NULL : d, touched ? 0 : 2, 0);
+            cairo_set_line_width(cr, touched ? 2.5 * c->lw : 1);
+            cairo_stroke(cr);
+            cairo_set_dash(cr, NULL, 0, 0);
+            continue;
+        }
+        char lab[32];
+        double fs = 0.8 * c->L.font;
+        snprintf(lab, sizeof lab, touched ? "rank %d (touched)" : "rank %d", q);
+        if (text_wb(cr, SANS, touched, fs, lab) > x1 - x0 + 2 * pad + 0.3 * c->L.font)
+            snprintf(lab, sizeof lab, touched ? "r%d!" : "r%d", q); /* narrow strips */
+        double tw = text_wb(cr, SANS, touched, fs, lab);
+        double ly = q % 2 ? y1 + pad + 0.95 * c->L.font : y0 - pad - 0.25 * c->L.font;
+        cairo_rectangle(cr, x0 - pad - 0.1 * fs, ly - 0.85 * fs, tw + 0.2 * fs, 1.1 * fs);
+        cairo_set_source_rgba(cr, 1, 1, 1, 0.8);
+        cairo_fill(cr);
+        set_rank(cr, q, 1);
+        text_at(cr, SANS, touched, fs, x0 - pad, ly, lab);
+    }
+}
+
+static void draw_triangles(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    size_t nt;
+    const pdt_rtri *T = pdt_replay_tris(c->r, &nt);
+    const pdt_rtri_hist *H = pdt_replay_tri_hist(c->r);
+    if (!nt) return;
+    /* bucket by (status, maker) so that each bucket is one stroke */
+    size_t nb = (size_t)PDT_TS_COUNT * (size_t)c->nranks;
+    size_t *start = calloc(nb + 1, sizeof *start);
+    uint32_t *order = malloc(nt * sizeof *order);
+    if (!start || !order) {
+        free(start);
+        free(order);
+        return;
+    }
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t h = pdt_rstate_tri_entry(c->r, c->s, t);
+        if (h == NONE32 || !shown(c, T[t].maker)) continue;
+        start[(size_t)H[h].status * (size_t)c->nranks + T[t].maker + 1]++;
+    }
+    for (size_t b = 0; b < nb; b++) start[b + 1] += start[b];
+    size_t *fill = malloc((nb + 1) * sizeof *fill);
+    if (!fill) {
+        free(start);
+        free(order);
+        return;
+    }
+    memcpy(fill, start, (nb + 1) * sizeof *fill);
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t h = pdt_rstate_tri_entry(c->r, c->s, t);
+        if (h == NONE32 || !shown(c, T[t].maker)) continue;
+        order[fill[(size_t)H[h].status * (size_t)c->nranks + T[t].maker]++] = (uint32_t)t;
+    }
+    free(fill);
+    cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+    double gx0 = c->L.geo.x, gx1 = c->L.geo.x + c->L.geo.w, gy0 = c->L.geo.y, gy1 = c->L.geo.y + c->L.geo.h;
+    /* dense pictures: thin lines without antialiasing (a mesh of 10^5 edges
+     * looks the same and draws several times faster) */
+    int dense = start[nb] > 10000;
+    cairo_save(cr);
+    cairo_set_line_cap(cr, dense ? CAIRO_LINE_CAP_BUTT : CAIRO_LINE_CAP_ROUND);
+    if (dense) cairo_set_antialias(cr, CAIRO_ANTIALIAS_NONE);
+    /* discarded first (underneath), fading; then candidate, shipped, deferred, final */
+    static const int order_st[] = {PDT_TS_DISCARDED, PDT_TS_CANDIDATE, PDT_TS_SHIPPED,
+                                   PDT_TS_DEFERRED, PDT_TS_FINAL};
+    for (int oi = 0; oi < 5; oi++) {
+        int st = order_st[oi];
+        for (int q = 0; q < c->nranks; q++) {
+            size_t b = (size_t)st * (size_t)c->nranks + (size_t)q;
+            if (start[b] == start[b + 1]) continue;
+            if (st == PDT_TS_DISCARDED) {
+                for (size_t i = start[b]; i < start[b + 1]; i++) {
+                    uint32_t t = order[i];
+                    double age = (double)c->s->k - H[pdt_rstate_tri_entry(c->r, c->s, t)].ev;
+                    double a = c->v->fade > 0 ? 1 - age / c->v->fade : 1;
+                    if (a <= 0.02) continue;
+                    pdt_status_style(cr, st, c->lw);
+                    tri_path(c, T[t].v);
+                    set_rank(cr, q, 0.6 * a);
+                    cairo_stroke(cr);
+                    double x = 0, y = 0, px, py;
+                    for (int j = 0; j < 3; j++) {
+                        wpt(c, T[t].v[j], &px, &py);
+                        x += px / 3;
+                        y += py / 3;
+                    }
+                    cairo_set_line_width(cr, 1.6 * c->lw);
+                    cross(cr, x, y, 0.35 * c->L.font);
+                    rgb(cr, RED, a);
+                    cairo_stroke(cr);
+                }
+                continue;
+            }
+            pdt_status_style(cr, st, dense ? 0.8 : c->lw);
+            set_rank(cr, q, st == PDT_TS_CANDIDATE ? 0.75 : 1);
+            /* separate segments (no joins), stroked in chunks: much faster
+             * than one long path of closed triangles */
+            size_t seg = 0;
+            for (size_t i = start[b]; i < start[b + 1]; i++) {
+                const uint32_t *v = T[order[i]].v;
+                double x[3], y[3];
+                for (int j = 0; j < 3; j++) wpt(c, v[j], &x[j], &y[j]);
+                if ((x[0] < gx0 && x[1] < gx0 && x[2] < gx0) || (x[0] > gx1 && x[1] > gx1 && x[2] > gx1) ||
+                    (y[0] < gy0 && y[1] < gy0 && y[2] < gy0) || (y[0] > gy1 && y[1] > gy1 && y[2] > gy1))
+                    continue;
+                for (int j = 0; j < 3; j++) {
+                    cairo_move_to(cr, x[j], y[j]);
+                    cairo_line_to(cr, x[(j + 1) % 3], y[(j + 1) % 3]);
+                }
+                if ((seg += 3) >= 3000) {
+                    cairo_stroke(cr);
+                    seg = 0;
+                }
+            }
+            cairo_stroke(cr);
+        }
+    }
+    cairo_restore(cr);
+    cairo_set_dash(cr, NULL, 0, 0);
+    free(start);
+    free(order);
+}
+
+static void draw_kernel_edges(ctx *c)
+{
+    size_t ne;
+    const pdt_redge *E = pdt_replay_edges(c->r, &ne);
+    if (!ne) return;
+    cairo_t *cr = c->cr;
+    size_t np;
+    const pdt_rphase *Ph = pdt_replay_phases(c->r, &np);
+    cairo_save(cr);
+    cairo_set_line_width(cr, 0.5 * c->lw);
+    if (ne > 20000) cairo_set_antialias(cr, CAIRO_ANTIALIAS_NONE);
+    for (int q = 0; q < c->nranks; q++) {
+        if (!shown(c, (uint32_t)q)) continue;
+        /* the kernel's edges show its progress; once its phase is over the
+         * triangles tell the story */
+        int in_kernel = 0;
+        for (int32_t p = pdt_rstate_slot(c->r, c->s, q, PDT_SLOT_PHASE); p >= 0; p = Ph[p].parent)
+            if (Ph[p].phase == PDT_PH_KERNEL || Ph[p].phase == PDT_PH_MERGE) in_kernel = 1;
+        if (!in_kernel) continue;
+        int any = 0;
+        for (size_t e = 0; e < ne; e++) {
+            if (!c->s->ealive[e] || E[e].rank != (uint32_t)q) continue;
+            double x, y;
+            wpt(c, E[e].a, &x, &y);
+            cairo_move_to(cr, x, y);
+            wpt(c, E[e].b, &x, &y);
+            cairo_line_to(cr, x, y);
+            any = 1;
+        }
+        if (any) {
+            set_rank(cr, q, 0.45);
+            cairo_stroke(cr);
+        }
+    }
+    cairo_restore(cr);
+}
+
+static void draw_hulls_and_stacks(ctx *c, uint32_t *buf, size_t cap)
+{
+    cairo_t *cr = c->cr;
+    size_t nh;
+    const pdt_rhull *Hs = pdt_replay_hulls(c->r, &nh);
+    cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+    cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+    for (int q = 0; q < c->nranks; q++) {
+        if (!shown(c, (uint32_t)q)) continue;
+        int32_t h = pdt_rstate_slot(c->r, c->s, q, PDT_SLOT_HULL);
+        if (h < 0 || !pdt_replay_hull_live(c->r, c->s, q, h)) continue;
+        /* the hull: the first stack bottom..top, then the second (upper chain) */
+        size_t k = pdt_replay_stack_list(c->r, Hs[h].top, buf, cap);
+        size_t k2 = Hs[h].top2 >= 0 ? pdt_replay_stack_list(c->r, Hs[h].top2, buf + k, cap - k) : 0;
+        if (k + k2 < 2) continue;
+        double x, y;
+        for (size_t i = 0; i < k + k2; i++) {
+            wpt(c, buf[i], &x, &y);
+            if (i) cairo_line_to(cr, x, y);
+            else cairo_move_to(cr, x, y);
+        }
+        if (!k2) cairo_close_path(cr);
+        double col[3];
+        pdt_rank_rgb(q, col);
+        cairo_set_line_width(cr, 3.2 * c->lw);
+        cairo_set_source_rgba(cr, 0.6 * col[0], 0.6 * col[1], 0.6 * col[2], 0.9);
+        cairo_stroke(cr);
+    }
+    /* open stacks (not yet a reported hull): the chain bottom -> top, top marked */
+    for (int q = 0; q < c->nranks; q++) {
+        if (!shown(c, (uint32_t)q)) continue;
+        for (int st = 0; st < 5; st++) {
+            int32_t top = pdt_rstate_slot(c->r, c->s, q, PDT_SLOT_STACK0 + st);
+            if (top < 0 || !pdt_replay_stack_open(c->r, c->s, top)) continue;
+            size_t k = pdt_replay_stack_list(c->r, top, buf, cap);
+            int closed = st == PDT_STACK_GRAHAM && k >= 3 && pdt_replay_graham_scan_ended(c->r, c->s, q);
+            double x, y;
+            for (size_t i = 0; i < k; i++) {
+                wpt(c, buf[i], &x, &y);
+                if (i) cairo_line_to(cr, x, y);
+                else cairo_move_to(cr, x, y);
+            }
+            if (closed) { /* the scan is over: the stack is the hull, drawn like one */
+                cairo_close_path(cr);
+                double col[3];
+                pdt_rank_rgb(q, col);
+                cairo_set_line_width(cr, 3.2 * c->lw);
+                cairo_set_source_rgba(cr, 0.6 * col[0], 0.6 * col[1], 0.6 * col[2], 0.9);
+                cairo_stroke(cr);
+                continue;
+            }
+            set_rank(cr, q, 0.9);
+            cairo_set_line_width(cr, 2.6 * c->lw);
+            cairo_stroke(cr);
+            if (k) { /* top marker: a filled triangle above the top point */
+                wpt(c, buf[k - 1], &x, &y);
+                double a = 0.55 * c->L.font;
+                cairo_move_to(cr, x, y - 0.35 * a);
+                cairo_line_to(cr, x - 0.6 * a, y - 1.5 * a);
+                cairo_line_to(cr, x + 0.6 * a, y - 1.5 * a);
+                cairo_close_path(cr);
+                rgb(cr, INK, 1);
+                cairo_fill(cr);
+                double tw = text_wb(cr, SANS, 1, 0.7 * c->L.font, "top");
+                text_at(cr, SANS, 1, 0.7 * c->L.font, x - 0.8 * a - tw, y - 1.0 * a, "top");
+            }
+        }
+    }
+}
+
+static void draw_points(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    double rad = fmax(1.5, fmin(0.28 * c->L.font, c->spacing / 5));
+    size_t nvis = 0;
+    for (size_t p = 0; p < c->n; p++) {
+        double x, y;
+        wpt(c, (uint32_t)p, &x, &y);
+        if (x < c->L.geo.x || x > c->L.geo.x + c->L.geo.w || y < c->L.geo.y ||
+            y > c->L.geo.y + c->L.geo.h)
+            continue;
+        nvis++;
+    }
+    if (nvis > 4000) rad = fmin(rad, 1.5);
+    if (nvis > 4000 && c->spacing < 5) return; /* the points would only hide the edges */
+    /* not yet lifted: hollow grey; lifted: filled dark */
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t p = 0; p < c->n; p++) {
+            int lifted = c->all_lifted || (c->s->pflags[p] & PDT_PF_LIFTED) != 0;
+            if (lifted != pass) continue;
+            double x, y;
+            wpt(c, (uint32_t)p, &x, &y);
+            if (nvis > 4000) /* pixel-aligned squares: cairo fills them as boxes, fast */
+                cairo_rectangle(cr, floor(x) - 1, floor(y) - 1, 2, 2);
+            else {
+                cairo_new_sub_path(cr);
+                cairo_arc(cr, x, y, rad, 0, 2 * M_PI);
+            }
+        }
+        if (pass == 0) {
+            cairo_set_source_rgba(cr, 0.55, 0.55, 0.55, 1);
+            cairo_set_line_width(cr, 1);
+            cairo_stroke(cr);
+        } else {
+            rgb(cr, INK, 1);
+            cairo_fill(cr);
+        }
+    }
+    /* Graham: angular numbers and deleted points */
+    if (nvis > 600) return;
+    double f = 0.72 * c->L.font;
+    /* other runs: the input index beside each point, while few are on screen
+     * and they are far enough apart for the labels not to pile up */
+    if (nvis <= 60 && c->spacing >= 2.5 * f && pdt_replay_kind_count(c->r, PDT_EV_SORT) == 0) {
+        cairo_set_source_rgba(cr, 0.0, 0.25, 0.55, 1);
+        for (size_t p = 0; p < c->n; p++) {
+            double x, y;
+            char lab[24];
+            wpt(c, (uint32_t)p, &x, &y);
+            if (x < c->L.geo.x || x > c->L.geo.x + c->L.geo.w || y < c->L.geo.y ||
+                y > c->L.geo.y + c->L.geo.h)
+                continue;
+            int crowded = 0; /* a point so close that its label would collide */
+            for (size_t q = 0; q < c->n && !crowded; q++) {
+                double qx, qy;
+                wpt(c, (uint32_t)q, &qx, &qy);
+                crowded = q != p && fabs(qx - x) < 1.6 * f && fabs(qy - y) < 0.9 * f;
+            }
+            if (crowded) continue;
+            snprintf(lab, sizeof lab, "%zu", p);
+            text_at(cr, SANS, 0, f, x + 0.45 * f, y - 0.3 * f, lab);
+        }
+    }
+    for (size_t p = 0; p < c->n; p++) {
+        uint8_t fl = c->s->pflags[p];
+        double x, y;
+        wpt(c, (uint32_t)p, &x, &y);
+        if (fl & PDT_PF_SORTED) {
+            char lab[24];
+            int64_t pos = pdt_replay_sort_pos(c->r, p);
+            if (pos == 0) snprintf(lab, sizeof lab, "p0");
+            else snprintf(lab, sizeof lab, "%lld", (long long)pos);
+            cairo_set_source_rgba(cr, 0.0, 0.25, 0.55, 1);
+            text_at(cr, SANS, pos == 0, f, x + 0.45 * f, y - 0.3 * f, lab);
+        }
+        if (fl & PDT_PF_DELETED) {
+            cairo_set_line_width(cr, 0.18 * f);
+            cross(cr, x, y, 0.55 * f);
+            rgb(cr, RED, 1);
+            cairo_stroke(cr);
+        }
+    }
+}
+static void ring(ctx *c, uint32_t p, double rad, const double col[3], double lwf)
+{
+    double x, y;
+    wpt(c, p, &x, &y);
+    cairo_new_sub_path(c->cr);
+    cairo_arc(c->cr, x, y, rad, 0, 2 * M_PI);
+    rgb(c->cr, col, 1);
+    cairo_set_line_width(c->cr, lwf);
+    cairo_stroke(c->cr);
+}
+
+/* The merge step in progress on some rank: border set rings and group boxes. */
+static void draw_merge(ctx *c)
+{
+    size_t ng;
+    const pdt_rmerge *M = pdt_replay_merges(c->r, &ng);
+    for (int q = 0; q < c->nranks; q++) {
+        int32_t g = pdt_rstate_slot(c->r, c->s, q, PDT_SLOT_MERGE);
+        if (g < 0 || !shown(c, (uint32_t)q)) continue;
+        const pdt_rmerge *mg = &M[g];
+        /* the two groups' boxes */
+        for (int side = 0; side < 2; side++) {
+            uint32_t a = side ? mg->gr : mg->gl, b = side ? mg->gend : mg->gr;
+            int have = 0;
+            pdt_point lo = {0, 0}, hi = {0, 0};
+            for (uint32_t o = a; o < b; o++) {
+                pdt_point l, h;
+                if (!pdt_replay_box(c->r, (int)o, &l, &h)) continue;
+                if (!have) lo = l, hi = h, have = 1;
+                lo.x = l.x < lo.x ? l.x : lo.x;
+                lo.y = l.y < lo.y ? l.y : lo.y;
+                hi.x = h.x > hi.x ? h.x : hi.x;
+                hi.y = h.y > hi.y ? h.y : hi.y;
+            }
+            if (!have) continue;
+            double pad = 1.6 * c->L.font;
+            double x0 = c->X.ox + c->X.s * lo.x - pad, x1 = c->X.ox + c->X.s * hi.x + pad;
+            double y0 = c->X.oy - c->X.s * hi.y - pad, y1 = c->X.oy - c->X.s * lo.y + pad;
+            cairo_rectangle(c->cr, x0, y0, x1 - x0, y1 - y0);
+            rgb(c->cr, INK, 0.8);
+            cairo_set_line_width(c->cr, 1.5);
+            double d[2] = {10, 5};
+            cairo_set_dash(c->cr, d, 2, 0);
+            cairo_stroke(c->cr);
+            cairo_set_dash(c->cr, NULL, 0, 0);
+            char lab[64];
+            snprintf(lab, sizeof lab, "%s", side ? "G_R" : "G_L");
+            double tw = text_wb(c->cr, SANS, 1, 0.8 * c->L.font, lab);
+            text_at(c->cr, SANS, 1, 0.8 * c->L.font, side ? x1 - tw : x0, y0 - 0.3 * c->L.font, lab);
+        }
+        /* the border set B: points the merge rank lifted since the merge began */
+        size_t from = mg->begin_ev, to = c->s->k;
+        if (to - from > 2000000) from = to - 2000000;
+        double col[3] = {0.0, 0.0, 0.0};
+        for (size_t i = from; i < to; i++) {
+            const pdt_rec *e = pdt_replay_rec(c->r, i);
+            if (e->rank == mg->rank && e->ev.kind == PDT_EV_LIFT && e->ev.a < c->n)
+                ring(c, e->ev.a, 0.45 * c->L.font, col, 1.4);
+        }
+    }
+}
+
+/* The current event's highlight: circumdisk, turn, point rings. */
+static void draw_current(ctx *c, uint32_t *buf, size_t cap)
+{
+    const pdt_rec *e = c->cur;
+    if (!e) return;
+    cairo_t *cr = c->cr;
+    const pdt_event *ev = &e->ev;
+    double hl[3] = {0.85, 0.1, 0.1};
+    if (is_tri_event(ev->kind) && ev->a < c->n && ev->b < c->n && ev->c < c->n) {
+        uint32_t v[3] = {ev->a, ev->b, ev->c};
+        double ox, oy, rr;
+        tri_path(c, v);
+        set_rank(cr, (int)e->rank, 0.25);
+        cairo_fill(cr);
+        if (circum(c->P, v, &ox, &oy, &rr)) {
+            cairo_new_sub_path(cr);
+            cairo_arc(cr, c->X.ox + c->X.s * ox, c->X.oy - c->X.s * oy, c->X.s * rr, 0, 2 * M_PI);
+            cairo_set_source_rgba(cr, 1.0, 0.85, 0.2, 0.18);
+            cairo_fill_preserve(cr);
+            cairo_set_source_rgba(cr, 0.8, 0.45, 0.0, 0.95);
+            cairo_set_line_width(cr, 2 * c->lw);
+            cairo_stroke(cr);
+        }
+        if (ev->kind == PDT_EV_DISCARD && ev->v >= 0 && (uint64_t)ev->v < c->n)
+            ring(c, (uint32_t)ev->v, 0.7 * c->L.font, hl, 2.5);
+        return;
+    }
+    if ((ev->kind == PDT_EV_PUSH || ev->kind == PDT_EV_POP || ev->kind == PDT_EV_LIFT ||
+         ev->kind == PDT_EV_SORT || ev->kind == PDT_EV_DELETE) && ev->a < c->n) {
+        ring(c, ev->a, 0.75 * c->L.font, hl, 2.5);
+        if (ev->kind == PDT_EV_POP && ev->c < c->n) {
+            /* the turn that caused the pop: below -> popped -> new point */
+            int32_t top = pdt_rstate_slot(c->r, c->s, (int)e->rank, PDT_SLOT_STACK0 + ev->sub);
+            size_t k = pdt_replay_stack_list(c->r, top, buf, cap);
+            if (k >= 1) {
+                double x, y;
+                wpt(c, buf[k - 1], &x, &y);
+                cairo_move_to(cr, x, y);
+                wpt(c, ev->a, &x, &y);
+                cairo_line_to(cr, x, y);
+                wpt(c, ev->c, &x, &y);
+                cairo_line_to(cr, x, y);
+                double d[2] = {5, 4};
+                cairo_set_dash(cr, d, 2, 0);
+                rgb(cr, hl, 0.9);
+                cairo_set_line_width(cr, 2 * c->lw);
+                cairo_stroke(cr);
+                cairo_set_dash(cr, NULL, 0, 0);
+            }
+            ring(c, ev->c, 0.75 * c->L.font, (double[3]){0.0, 0.45, 0.0}, 2.5);
+        }
+        if (ev->kind == PDT_EV_DELETE && ev->b < c->n)
+            ring(c, ev->b, 0.75 * c->L.font, (double[3]){0.0, 0.45, 0.0}, 2.5);
+    }
+    if ((ev->kind == PDT_EV_EDGE_ADD || ev->kind == PDT_EV_EDGE_DEL) && ev->a < c->n && ev->b < c->n) {
+        double x, y;
+        wpt(c, ev->a, &x, &y);
+        cairo_move_to(cr, x, y);
+        wpt(c, ev->b, &x, &y);
+        cairo_line_to(cr, x, y);
+        rgb(cr, hl, 0.8);
+        cairo_set_line_width(cr, 3 * c->lw);
+        cairo_stroke(cr);
+    }
+}
+
+static void draw_selection(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    char lines[5][160];
+    int nl = 0;
+    if (c->v->sel_point >= 0 && (size_t)c->v->sel_point < c->n) {
+        size_t p = (size_t)c->v->sel_point;
+        pdt_point q = c->P[p];
+        double col[3] = {0.0, 0.3, 0.9};
+        ring(c, (uint32_t)p, 0.8 * c->L.font, col, 3);
+        snprintf(lines[nl++], sizeof lines[0], "point %zu at (%d, %d)", p, q.x, q.y);
+        snprintf(lines[nl++], sizeof lines[0], "lifted z = %lld%s",
+                 (long long)((int64_t)q.x * q.x + (int64_t)q.y * q.y),
+                 c->s->pflags[p] & PDT_PF_LIFTED ? "" : " (not lifted yet)");
+        int64_t pos = pdt_replay_sort_pos(c->r, p);
+        if (c->s->pflags[p] & PDT_PF_SORTED)
+            snprintf(lines[nl++], sizeof lines[0], "angular position %lld%s", (long long)pos,
+                     c->s->pflags[p] & PDT_PF_DELETED ? ", deleted" : "");
+        for (int q2 = 0; q2 < c->nranks; q2++) {
+            pdt_point lo, hi;
+            if (pdt_replay_box(c->r, q2, &lo, &hi) && q.x >= lo.x && q.x <= hi.x && q.y >= lo.y &&
+                q.y <= hi.y) {
+                snprintf(lines[nl++], sizeof lines[0], "in the box of rank %d", q2);
+                break;
+            }
+        }
+    } else if (c->v->sel_tri >= 0) {
+        size_t nt;
+        const pdt_rtri *T = pdt_replay_tris(c->r, &nt);
+        if ((size_t)c->v->sel_tri < nt) {
+            const pdt_rtri *t = &T[c->v->sel_tri];
+            static const char *const sn[] = {"not created", "candidate", "final", "deferred",
+                                             "shipped", "discarded"};
+            int e = c->v->sel_edge;
+            if (e >= 0 && e < 3) {
+                uint32_t a = t->v[e], b = t->v[(e + 1) % 3];
+                double x, y;
+                wpt(c, a, &x, &y);
+                cairo_move_to(cr, x, y);
+                wpt(c, b, &x, &y);
+                cairo_line_to(cr, x, y);
+                cairo_set_source_rgba(cr, 0.0, 0.3, 0.9, 0.9);
+                cairo_set_line_width(cr, 5);
+                cairo_stroke(cr);
+                double dx = (double)c->P[b].x - c->P[a].x, dy = (double)c->P[b].y - c->P[a].y;
+                snprintf(lines[nl++], sizeof lines[0], "edge %u–%u, length %.1f", a, b, sqrt(dx * dx + dy * dy));
+            }
+            tri_path(c, t->v);
+            cairo_set_source_rgba(cr, 0.0, 0.3, 0.9, 0.9);
+            cairo_set_line_width(cr, 3);
+            cairo_stroke(cr);
+            snprintf(lines[nl++], sizeof lines[0], "%s %u %u %u", e >= 0 ? "of triangle" : "triangle",
+                     t->v[0], t->v[1], t->v[2]);
+            snprintf(lines[nl++], sizeof lines[0], "made by rank %u, now %s", t->maker,
+                     pdt_rstate_tri_visible(c->r, c->s, (size_t)c->v->sel_tri)
+                         ? sn[pdt_replay_tri_hist(c->r)[pdt_rstate_tri_entry(c->r, c->s, (size_t)c->v->sel_tri)].status]
+                         : "dropped by its merge");
+            double ox, oy, rr;
+            if (circum(c->P, t->v, &ox, &oy, &rr))
+                snprintf(lines[nl++], sizeof lines[0], "circle centre (%.1f, %.1f) radius %.1f", ox,
+                         oy, rr);
+        }
+    }
+    if (!nl) return;
+    double f = 0.85 * c->L.font, w = 0;
+    for (int i = 0; i < nl; i++) w = fmax(w, text_w(cr, SANS, f, lines[i]));
+    pdt_rect R = {c->L.geo.x + 0.5 * f, c->L.geo.y + c->L.geo.h - (nl + 0.8) * 1.3 * f, w + 1.2 * f,
+                  (nl + 0.5) * 1.3 * f};
+    cairo_rectangle(cr, R.x, R.y, R.w, R.h);
+    cairo_set_source_rgba(cr, 1, 1, 1, 0.92);
+    cairo_fill_preserve(cr);
+    cairo_set_source_rgb(cr, 0.0, 0.3, 0.9);
+    cairo_set_line_width(cr, 1.5);
+    cairo_stroke(cr);
+    rgb(cr, INK, 1);
+    for (int i = 0; i < nl; i++) text_at(cr, SANS, i == 0, f, R.x + 0.6 * f, R.y + (i + 1.1) * 1.3 * f, lines[i]);
+}
+
+void pdt_draw_geometry(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    cairo_save(cr);
+    clip_rect(cr, c->L.geo);
+
+    size_t cap = c->n + 1;
+    uint32_t *buf = malloc(2 * cap * sizeof *buf);
+    int cur_tri = 0;
+    double ox = 0, oy = 0, rr = 0;
+    if (c->cur && is_tri_event(c->cur->ev.kind) && c->cur->ev.a < c->n && c->cur->ev.b < c->n &&
+        c->cur->ev.c < c->n) {
+        uint32_t v[3] = {c->cur->ev.a, c->cur->ev.b, c->cur->ev.c};
+        cur_tri = circum(c->P, v, &ox, &oy, &rr);
+    }
+    draw_boxes(c, cur_tri, ox, oy, rr, 0);
+    draw_kernel_edges(c);
+    draw_triangles(c);
+    if (buf) draw_hulls_and_stacks(c, buf, 2 * cap);
+    draw_merge(c);
+    draw_points(c);
+    if (buf) draw_current(c, buf, 2 * cap);
+    draw_boxes(c, cur_tri, ox, oy, rr, 1);
+    draw_selection(c);
+    free(buf);
+    cairo_restore(cr);
+}

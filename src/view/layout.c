@@ -1,0 +1,144 @@
+/* pdt — the viewer's layout: view defaults, panel rectangles, and the
+ * transform between the screen and the world of the geometry area. */
+#include "render_int.h"
+
+/* ---- view and layout ----------------------------------------------------------- */
+
+void pdt_view_defaults(pdt_view *v)
+{
+    memset(v, 0, sizeof *v);
+    v->zoom = 1;
+    v->yaw = 0.5;
+    v->pitch = 0.45;
+    v->fade = 400;
+    v->ev_class = PDT_EVC_STACK;
+    v->sel_point = v->sel_tri = -1;
+    v->sel_edge = -1;
+    v->panels = PDT_PANEL_ALL;
+}
+
+int pdt_panels_parse(const char *list, unsigned *panels)
+{
+    static const struct { const char *name; unsigned bit; } names[] = {
+        {"code", PDT_PANEL_CODE}, {"stack", PDT_PANEL_STACK}, {"lifted", PDT_PANEL_LIFTED},
+        {"timeline", PDT_PANEL_TIMELINE}, {"all", PDT_PANEL_ALL}, {"none", 0}};
+    unsigned bits = 0;
+    const char *p = list;
+    while (*p) {
+        size_t len = strcspn(p, ",");
+        size_t i;
+        for (i = 0; i < sizeof names / sizeof *names; i++)
+            if (strlen(names[i].name) == len && !strncmp(p, names[i].name, len)) break;
+        if (i == sizeof names / sizeof *names) return -1;
+        bits |= names[i].bit;
+        p += len;
+        if (*p == ',') p++;
+    }
+    *panels = bits;
+    return 0;
+}
+
+void pdt_render_layout(double w, double h, int nranks, pdt_layout *L)
+{
+    pdt_render_layout_panels(w, h, nranks, PDT_PANEL_ALL, L);
+}
+
+void pdt_render_layout_panels(double w, double h, int nranks, unsigned panels, pdt_layout *L)
+{
+    double f = h / 46;
+    if (f > w / 72) f = w / 72;
+    if (f < 10) f = 10;
+    L->font = f;
+    double top = 2.0 * f;
+    int rows = nranks < 1 ? 1 : nranks > 16 ? 16 : nranks;
+    double tl = (rows + 1.6) * f * 1.15;
+    if (tl > 0.28 * h) tl = 0.28 * h;
+    if (!(panels & PDT_PANEL_TIMELINE)) tl = 0;
+    double side = 0.34 * w;
+    if (side < 22 * f) side = 22 * f;
+    if (side > 0.5 * w) side = 0.5 * w;
+    L->top = (pdt_rect){0, 0, w, top};
+    L->timeline = (pdt_rect){0, h - tl, tl > 0 ? w : 0, tl};
+    double mid = h - tl - top;
+    L->geo = (pdt_rect){0, top, w - side, mid};
+    double x = w - side, y = top;
+    int has_code = (panels & PDT_PANEL_CODE) != 0, has_stack = (panels & PDT_PANEL_STACK) != 0,
+        has_lifted = (panels & PDT_PANEL_LIFTED) != 0;
+    double leg = 7.6 * f, code = has_code ? 12.2 * f * 0.9 : 0;
+    double rest = mid - leg - code;
+    if (has_code && rest < 10 * f) { /* small pictures: shrink the code panel first */
+        code = mid - leg - 10 * f;
+        if (code < 4 * f) code = 4 * f;
+        rest = mid - leg - code;
+    }
+    double stk = has_stack ? (has_lifted ? rest * 0.38 : rest) : 0;
+    double lifted = has_lifted ? rest - stk : 0;
+    if (!has_stack && !has_lifted && has_code) code += rest; /* the code panel takes the column */
+    L->legend = (pdt_rect){x, y, side, leg};
+    L->code = (pdt_rect){x, y + leg, has_code ? side : 0, code};
+    L->stack = (pdt_rect){x, y + leg + code, has_stack ? side : 0, stk};
+    L->lifted = (pdt_rect){x, y + leg + code + stk, has_lifted ? side : 0, lifted};
+    /* whole pixels: clipping to them stays a fast box clip */
+    pdt_rect *all[] = {&L->top, &L->geo, &L->legend, &L->code, &L->stack, &L->lifted, &L->timeline};
+    for (size_t i = 0; i < sizeof all / sizeof *all; i++) {
+        double x1 = round(all[i]->x + all[i]->w), y1 = round(all[i]->y + all[i]->h);
+        all[i]->x = round(all[i]->x);
+        all[i]->y = round(all[i]->y);
+        all[i]->w = x1 - all[i]->x;
+        all[i]->h = y1 - all[i]->y;
+    }
+}
+
+xform pdt_geo_xform(const pdt_replay *r, const pdt_view *v, double w, double h)
+{
+    pdt_layout L;
+    pdt_render_layout_panels(w, h, pdt_replay_nranks(r), v->panels, &L);
+    pdt_point lo = {0, 0}, hi = {1, 1};
+    pdt_replay_bbox(r, &lo, &hi);
+    double bw = (double)hi.x - lo.x, bh = (double)hi.y - lo.y;
+    if (bw < 1) bw = 1;
+    if (bh < 1) bh = 1;
+    double mx = 2.0 * L.font, my = 3.2 * L.font; /* room for the box labels */
+    double s = fmin((L.geo.w - 2 * mx) / bw, (L.geo.h - 2 * my) / bh) * (v->zoom > 0 ? v->zoom : 1);
+    double cx = v->centred ? v->cx : lo.x + bw / 2, cy = v->centred ? v->cy : lo.y + bh / 2;
+    xform X = {s, L.geo.x + L.geo.w / 2 - s * cx, L.geo.y + L.geo.h / 2 + s * cy};
+    return X;
+}
+
+void pdt_view_to_world(const pdt_replay *r, const pdt_view *v, double w, double h, double sx,
+                       double sy, double *wx, double *wy)
+{
+    xform X = pdt_geo_xform(r, v, w, h);
+    *wx = (sx - X.ox) / X.s;
+    *wy = (X.oy - sy) / X.s;
+}
+
+void pdt_view_to_screen(const pdt_replay *r, const pdt_view *v, double w, double h, double wx,
+                        double wy, double *sx, double *sy)
+{
+    xform X = pdt_geo_xform(r, v, w, h);
+    *sx = X.ox + X.s * wx;
+    *sy = X.oy - X.s * wy;
+}
+
+void pdt_view_zoom_at(const pdt_replay *r, pdt_view *v, double w, double h, double sx, double sy,
+                      double f)
+{
+    double wx, wy, cx, cy;
+    pdt_view_to_world(r, v, w, h, sx, sy, &wx, &wy);
+    pdt_layout L;
+    pdt_render_layout_panels(w, h, pdt_replay_nranks(r), v->panels, &L);
+    pdt_view_to_world(r, v, w, h, L.geo.x + L.geo.w / 2, L.geo.y + L.geo.h / 2, &cx, &cy);
+    v->zoom *= f;
+    if (v->zoom < 0.05) v->zoom = 0.05;
+    if (v->zoom > 1e6) v->zoom = 1e6;
+    /* keep (wx,wy) under the cursor: move the centre towards it */
+    double nx, ny;
+    v->cx = cx;
+    v->cy = cy;
+    v->centred = 1;
+    pdt_view_to_screen(r, v, w, h, wx, wy, &nx, &ny);
+    xform X = pdt_geo_xform(r, v, w, h);
+    v->cx += (nx - sx) / X.s;
+    v->cy -= (ny - sy) / X.s;
+}

@@ -1,0 +1,159 @@
+/* pdt — the viewer's lifted view: the paraboloid z = x^2 + y^2, the lifted
+ * points, and for a triangle event its plane and the points below it. */
+#include "render_int.h"
+#include "pdt/predicates.h"
+
+typedef struct proj {
+    double cx, cy, sc;      /* world -> unit square */
+    double cy_, sy_, cp, sp;/* yaw and pitch */
+    double ox, oy, s;       /* unit -> screen */
+} proj;
+
+static void lift_xy(const proj *J, double u, double w, double z, double *sx, double *sy)
+{
+    double X = u * J->cy_ - w * J->sy_, Y = u * J->sy_ + w * J->cy_;
+    *sx = J->ox + J->s * X;
+    *sy = J->oy - J->s * (z * J->cp + Y * J->sp);
+}
+
+void pdt_draw_lifted(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    pdt_rect R = c->L.lifted;
+    double f = c->L.font;
+    panel(cr, R, "Lifted view: z = x² + y² (drag to rotate)", f);
+    cairo_save(cr);
+    clip_rect(cr, R);
+    pdt_point lo = {0, 0}, hi = {1, 1};
+    pdt_replay_bbox(c->r, &lo, &hi);
+    proj J;
+    J.cx = ((double)lo.x + hi.x) / 2;
+    J.cy = ((double)lo.y + hi.y) / 2;
+    J.sc = fmax(1, fmax((double)hi.x - lo.x, (double)hi.y - lo.y) / 2);
+    J.cy_ = cos(c->v->yaw);
+    J.sy_ = sin(c->v->yaw);
+    J.cp = cos(c->v->pitch);
+    J.sp = sin(c->v->pitch);
+    double top = R.y + 1.6 * f, H = R.h - 1.9 * f;
+    /* vertical extent: z in [0,2], Y in [-1.42,1.42] */
+    double ext_y = 2 * J.cp + 2.9 * J.sp, ext_x = 2.9;
+    J.s = fmin((R.w - f) / ext_x, H / ext_y);
+    J.ox = R.x + R.w / 2;
+    J.oy = top + H / 2 + J.s * (J.cp * 1.0);
+    /* the paraboloid: rings and meridians */
+    cairo_set_line_width(cr, 1);
+    cairo_set_source_rgba(cr, 0.5, 0.55, 0.65, 0.5);
+    for (int ring_i = 1; ring_i <= 5; ring_i++) {
+        double rho = 0.28 * ring_i;
+        for (int i = 0; i <= 48; i++) {
+            double a = 2 * M_PI * i / 48, sx, sy;
+            lift_xy(&J, rho * cos(a), rho * sin(a), rho * rho, &sx, &sy);
+            if (i) cairo_line_to(cr, sx, sy);
+            else cairo_move_to(cr, sx, sy);
+        }
+    }
+    for (int mi = 0; mi < 12; mi++) {
+        double a = 2 * M_PI * mi / 12;
+        for (int i = 0; i <= 20; i++) {
+            double rho = 1.4 * i / 20, sx, sy;
+            lift_xy(&J, rho * cos(a), rho * sin(a), rho * rho, &sx, &sy);
+            if (i) cairo_line_to(cr, sx, sy);
+            else cairo_move_to(cr, sx, sy);
+        }
+    }
+    cairo_stroke(cr);
+    /* the current triangle's lifted plane */
+    const pdt_rec *e = c->cur;
+    int have_plane = 0;
+    double pa = 0, pb = 0, pc = 0;
+    uint32_t tv[3] = {0, 0, 0};
+    if (e && is_tri_event(e->ev.kind) && e->ev.a < c->n && e->ev.b < c->n && e->ev.c < c->n) {
+        tv[0] = e->ev.a;
+        tv[1] = e->ev.b;
+        tv[2] = e->ev.c;
+        double U[3], W[3], Z[3];
+        for (int j = 0; j < 3; j++) {
+            U[j] = (c->P[tv[j]].x - J.cx) / J.sc;
+            W[j] = (c->P[tv[j]].y - J.cy) / J.sc;
+            Z[j] = U[j] * U[j] + W[j] * W[j];
+        }
+        /* z = pa*u + pb*w + pc through the three lifted points */
+        double d = (U[1] - U[0]) * (W[2] - W[0]) - (U[2] - U[0]) * (W[1] - W[0]);
+        if (fabs(d) > 1e-15) {
+            pa = ((Z[1] - Z[0]) * (W[2] - W[0]) - (Z[2] - Z[0]) * (W[1] - W[0])) / d;
+            pb = ((U[1] - U[0]) * (Z[2] - Z[0]) - (U[2] - U[0]) * (Z[1] - Z[0])) / d;
+            pc = Z[0] - pa * U[0] - pb * W[0];
+            have_plane = 1;
+            static const double cu[4] = {-1.3, 1.3, 1.3, -1.3}, cw[4] = {-1.3, -1.3, 1.3, 1.3};
+            for (int j = 0; j < 4; j++) {
+                double sx, sy;
+                lift_xy(&J, cu[j], cw[j], pa * cu[j] + pb * cw[j] + pc, &sx, &sy);
+                if (j) cairo_line_to(cr, sx, sy);
+                else cairo_move_to(cr, sx, sy);
+            }
+            cairo_close_path(cr);
+            cairo_set_source_rgba(cr, 1.0, 0.8, 0.2, 0.22);
+            cairo_fill_preserve(cr);
+            cairo_set_source_rgba(cr, 0.8, 0.45, 0.0, 0.7);
+            cairo_set_line_width(cr, 1);
+            cairo_stroke(cr);
+        }
+    }
+    /* the points: lifted ones on the paraboloid (rank colour of their box),
+     * others faint on the floor; those below the plane in red */
+    size_t step = c->n > 6000 ? c->n / 6000 : 1;
+    double rad = c->n > 1000 ? 1.4 : 2.6;
+    /* inside the circle, exactly: every input point, lifted or not (the
+     * drawing below samples large inputs; the count does not) */
+    int ccw = have_plane ? pdt_orient(c->P[tv[0]], c->P[tv[1]], c->P[tv[2]]) : 0;
+    size_t ninside = ccw ? pdt_replay_inside_count(c->r, tv) : 0;
+    for (int cls = 0; cls < 3; cls++) { /* 0 floor, 1 lifted, 2 below the plane: one fill each */
+        for (size_t p = 0; p < c->n; p += step) {
+            double u = (c->P[p].x - J.cx) / J.sc, w = (c->P[p].y - J.cy) / J.sc, z = u * u + w * w;
+            int lifted = c->all_lifted || (c->s->pflags[p] & PDT_PF_LIFTED) != 0;
+            int below = ccw && lifted &&
+                        ccw * pdt_incircle0(c->P[tv[0]], c->P[tv[1]], c->P[tv[2]], c->P[p]) > 0;
+            if ((below ? 2 : lifted ? 1 : 0) != cls) continue;
+            double sx, sy;
+            lift_xy(&J, u, w, lifted ? z : 0, &sx, &sy);
+            double rr = below ? rad * 1.8 : rad;
+            if (step > 1 || c->n > 2000) cairo_rectangle(cr, floor(sx) - 1, floor(sy) - 1, 2, 2);
+            else {
+                cairo_new_sub_path(cr);
+                cairo_arc(cr, sx, sy, rr, 0, 2 * M_PI);
+            }
+        }
+        if (cls == 2) rgb(cr, RED, 1);
+        else if (cls == 1) rgb(cr, INK, 0.85);
+        else cairo_set_source_rgba(cr, 0.6, 0.6, 0.6, 0.5);
+        cairo_fill(cr);
+    }
+    if (have_plane) {
+        for (int j = 0; j < 3; j++) {
+            double u = (c->P[tv[j]].x - J.cx) / J.sc, w = (c->P[tv[j]].y - J.cy) / J.sc, sx, sy;
+            lift_xy(&J, u, w, u * u + w * w, &sx, &sy);
+            if (j) cairo_line_to(cr, sx, sy);
+            else cairo_move_to(cr, sx, sy);
+        }
+        cairo_close_path(cr);
+        set_rank(cr, (int)e->rank, 0.5);
+        cairo_fill_preserve(cr);
+        set_rank(cr, (int)e->rank, 1);
+        cairo_set_line_width(cr, 2);
+        cairo_stroke(cr);
+        char lab[128];
+        snprintf(lab, sizeof lab, "%zu input point%s strictly inside the circle (exact, no tie rule)",
+                 ninside, ninside == 1 ? "" : "s");
+        rgb(cr, ninside ? RED : INK, 1);
+        text_at(cr, SANS, 0, 0.72 * f, R.x + 0.5 * f, R.y + R.h - 1.4 * f, lab);
+        rgb(cr, INK, 1);
+        text_at(cr, SANS, 0, 0.72 * f, R.x + 0.5 * f, R.y + R.h - 0.5 * f,
+                "those already lifted: below the plane (red)");
+    }
+    if (c->no_lift) {
+        rgb(cr, INK, 1);
+        text_at(cr, SANS, 0, 0.8 * f, R.x + 0.5 * f, R.y + R.h - 0.5 * f,
+                "no lift-up in this run (points stay on the floor)");
+    }
+    cairo_restore(cr);
+}

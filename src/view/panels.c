@@ -1,0 +1,285 @@
+/* pdt — the viewer's text panels: the event line at the top, the legend,
+ * the pseudo-code with the current line, the stacks being built, the help
+ * overlay. */
+#include "pdt/describe.h"
+#include "render_int.h"
+
+
+void pdt_draw_top(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    pdt_rect R = c->L.top;
+    cairo_rectangle(cr, R.x, R.y, R.w, R.h);
+    cairo_set_source_rgb(cr, 0.93, 0.94, 0.96);
+    cairo_fill(cr);
+    char line[512], head[64];
+    pdt_replay_describe(c->r, c->s->k, line, sizeof line);
+    snprintf(head, sizeof head, "%zu / %zu", c->s->k, pdt_replay_count(c->r));
+    double f = c->L.font;
+    rgb(cr, INK, 0.7);
+    text_at(cr, MONO, 0, 0.9 * f, 0.5 * f, 1.35 * f, head);
+    double x = 0.5 * f + text_w(cr, MONO, 0.9 * f, head) + 1.0 * f;
+    if (c->cur) {
+        set_rank(cr, (int)c->cur->rank, 1);
+        cairo_rectangle(cr, x, 0.45 * f, 0.7 * f, 1.1 * f);
+        cairo_fill(cr);
+        x += 1.1 * f;
+    }
+    rgb(cr, INK, 1);
+    text_at(cr, SANS, 1, 1.05 * f, x, 1.4 * f, line);
+    if (c->v->status) {
+        double tw = text_w(cr, SANS, 0.85 * f, c->v->status);
+        rgb(cr, INK, 0.7);
+        text_at(cr, SANS, 0, 0.85 * f, R.w - tw - 0.6 * f, 1.35 * f, c->v->status);
+    }
+}
+
+static void legend_line(cairo_t *cr, double x, double y, double len, int st, double lw,
+                        const double col[3])
+{
+    pdt_status_style(cr, st, lw);
+    cairo_move_to(cr, x, y);
+    cairo_line_to(cr, x + len, y);
+    rgb(cr, col, 1);
+    cairo_stroke(cr);
+    cairo_set_dash(cr, NULL, 0, 0);
+}
+
+void pdt_draw_legend(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    pdt_rect R = c->L.legend;
+    double f = c->L.font, fs = 0.8 * f;
+    panel(cr, R, "Legend", f);
+    cairo_save(cr);
+    clip_rect(cr, R);
+    /* ranks */
+    double x = R.x + 0.5 * f, y = R.y + 2.3 * f;
+    rgb(cr, INK, 1);
+    text_at(cr, SANS, 0, fs, x, y, "ranks:");
+    x += text_w(cr, SANS, fs, "ranks:") + 0.4 * f;
+    for (int q = 0; q < c->nranks; q++) {
+        char lab[16];
+        snprintf(lab, sizeof lab, "%d", q);
+        double tw = text_w(cr, SANS, fs, lab);
+        if (x + 1.2 * f + tw > R.x + R.w - 0.5 * f) {
+            text_at(cr, SANS, 0, fs, x, y, "…");
+            break;
+        }
+        cairo_rectangle(cr, x, y - 0.75 * f, 0.8 * f, 0.8 * f);
+        set_rank(cr, q, shown(c, (uint32_t)q) ? 1 : 0.2);
+        cairo_fill(cr);
+        rgb(cr, INK, shown(c, (uint32_t)q) ? 1 : 0.4);
+        text_at(cr, SANS, 0, fs, x + 0.95 * f, y, lab);
+        x += 1.3 * f + tw;
+    }
+    /* statuses, two columns */
+    static const char *const names[] = {"candidate", "final", "deferred (RA)", "shipped",
+                                        "discarded"};
+    static const int sts[] = {PDT_TS_CANDIDATE, PDT_TS_FINAL, PDT_TS_DEFERRED, PDT_TS_SHIPPED,
+                              PDT_TS_DISCARDED};
+    double col0[3];
+    pdt_rank_rgb(0, col0);
+    double lw = fmax(1.5, 0.14 * f), colw = (R.w - f) / 2;
+    for (int i = 0; i < 5; i++) {
+        double lx = R.x + 0.5 * f + (i % 2) * colw, ly = R.y + (3.6 + 1.25 * (i / 2)) * f;
+        legend_line(cr, lx, ly - 0.3 * f, 2.2 * f, sts[i], lw, col0);
+        if (sts[i] == PDT_TS_DISCARDED) {
+            cairo_set_line_width(cr, lw);
+            cross(cr, lx + 1.1 * f, ly - 0.3 * f, 0.35 * f);
+            rgb(cr, RED, 1);
+            cairo_stroke(cr);
+        }
+        rgb(cr, INK, 1);
+        text_at(cr, SANS, 0, fs, lx + 2.6 * f, ly, names[i]);
+    }
+    {   /* hull, in the sixth cell */
+        double lx = R.x + 0.5 * f + colw, ly = R.y + (3.6 + 1.25 * 2) * f;
+        cairo_set_line_width(cr, 3.2 * lw);
+        cairo_move_to(cr, lx, ly - 0.3 * f);
+        cairo_line_to(cr, lx + 2.2 * f, ly - 0.3 * f);
+        cairo_set_source_rgb(cr, 0.6 * col0[0], 0.6 * col0[1], 0.6 * col0[2]);
+        cairo_stroke(cr);
+        rgb(cr, INK, 1);
+        text_at(cr, SANS, 0, fs, lx + 2.6 * f, ly, "hull / stack");
+    }
+    /* markers */
+    double ly = R.y + 7.05 * f, lx = R.x + 0.5 * f;
+    cairo_new_sub_path(cr);
+    cairo_arc(cr, lx + 0.4 * f, ly - 0.3 * f, 0.25 * f, 0, 2 * M_PI);
+    rgb(cr, INK, 1);
+    cairo_fill(cr);
+    text_at(cr, SANS, 0, fs, lx + 0.9 * f, ly, "lifted");
+    lx += 0.9 * f + text_w(cr, SANS, fs, "lifted") + 0.8 * f;
+    cairo_new_sub_path(cr);
+    cairo_arc(cr, lx + 0.4 * f, ly - 0.3 * f, 0.25 * f, 0, 2 * M_PI);
+    cairo_set_source_rgb(cr, 0.55, 0.55, 0.55);
+    cairo_set_line_width(cr, 1);
+    cairo_stroke(cr);
+    rgb(cr, INK, 1);
+    text_at(cr, SANS, 0, fs, lx + 0.9 * f, ly, "not yet");
+    lx += 0.9 * f + text_w(cr, SANS, fs, "not yet") + 0.8 * f;
+    cairo_set_line_width(cr, 0.15 * f);
+    cross(cr, lx + 0.4 * f, ly - 0.3 * f, 0.3 * f);
+    rgb(cr, RED, 1);
+    cairo_stroke(cr);
+    rgb(cr, INK, 1);
+    text_at(cr, SANS, 0, fs, lx + 0.9 * f, ly, "deleted");
+    lx += 0.9 * f + text_w(cr, SANS, fs, "deleted") + 0.8 * f;
+    cairo_new_sub_path(cr);
+    cairo_arc(cr, lx + 0.4 * f, ly - 0.3 * f, 0.35 * f, 0, 2 * M_PI);
+    cairo_set_source_rgba(cr, 1.0, 0.85, 0.2, 0.4);
+    cairo_fill_preserve(cr);
+    cairo_set_source_rgb(cr, 0.8, 0.45, 0.0);
+    cairo_stroke(cr);
+    rgb(cr, INK, 1);
+    text_at(cr, SANS, 0, fs, lx + 0.95 * f, ly, "circumdisk (RA)");
+    cairo_restore(cr);
+}
+
+void pdt_draw_code(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    pdt_rect R = c->L.code;
+    double f = c->L.font;
+    int id;
+    int line = pdt_replay_code_line(c->r, c->s, &id);
+    panel(cr, R, pdt_code_title(id), f);
+    cairo_save(cr);
+    clip_rect(cr, R);
+    int nl = (int)pdt_code_count(id);
+    double lh = (R.h - 1.9 * f) / nl;
+    if (lh > 1.15 * f) lh = 1.15 * f;
+    double fs = fmin(0.78 * f, 0.92 * lh);
+    /* shrink to fit the width */
+    double wmax = 0;
+    for (int i = 0; i < nl; i++) wmax = fmax(wmax, text_w(cr, MONO, fs, pdt_code_text(id, (size_t)i)));
+    if (wmax > R.w - 1.2 * f) fs *= (R.w - 1.2 * f) / wmax;
+    for (int i = 0; i < nl; i++) {
+        double y = R.y + 1.7 * f + (i + 1) * lh;
+        if (i == line) {
+            cairo_rectangle(cr, R.x + 0.3 * f, y - 0.85 * lh, R.w - 0.6 * f, lh);
+            cairo_set_source_rgba(cr, 1.0, 0.85, 0.2, 0.8);
+            cairo_fill(cr);
+        }
+        rgb(cr, INK, 1);
+        text_at(cr, MONO, i == line, fs, R.x + 0.6 * f, y - 0.18 * lh, pdt_code_text(id, (size_t)i));
+    }
+    cairo_restore(cr);
+}
+
+/* A stack element as text: p<angular number> on Graham's stack, else the index. */
+static void stack_item(const ctx *c, int st, uint32_t p, int space, char *b, size_t cap)
+{
+    int64_t pos = st == PDT_STACK_GRAHAM ? pdt_replay_sort_pos(c->r, p) : -1;
+    if (pos >= 0) snprintf(b, cap, space ? "p%lld " : "p%lld", (long long)pos);
+    else snprintf(b, cap, space ? "%u " : "%u", p);
+}
+
+void pdt_draw_stack_panel(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    pdt_rect R = c->L.stack;
+    double f = c->L.font;
+    panel(cr, R, "Stacks being built (top at the right ▸)", f);
+    cairo_save(cr);
+    clip_rect(cr, R);
+    double fs = 0.75 * f, lh = 1.15 * fs, y = R.y + 1.6 * f + lh;
+    uint32_t *buf = malloc((c->n + 1) * sizeof *buf);
+    int any = 0;
+    for (int q = 0; q < c->nranks && buf; q++) {
+        if (!shown(c, (uint32_t)q)) continue;
+        for (int st = 0; st < 5; st++) {
+            if (y > R.y + R.h - 0.3 * f) break;
+            int32_t top = pdt_rstate_slot(c->r, c->s, q, PDT_SLOT_STACK0 + st);
+            if (top < 0 || !pdt_replay_stack_open(c->r, c->s, top)) continue;
+            size_t k = pdt_replay_stack_list(c->r, top, buf, c->n + 1);
+            char head[48];
+            snprintf(head, sizeof head, "r%d %s (%zu):", q, pdt_stack_name(st), k);
+            set_rank(cr, q, 1);
+            text_at(cr, SANS, 1, fs, R.x + 0.5 * f, y, head);
+            double x0 = R.x + 0.5 * f + text_wb(cr, SANS, 1, fs, head) + 0.4 * f;
+            /* as many elements from the top as fit */
+            double room = R.x + R.w - 0.5 * f - x0 - 1.5 * f;
+            size_t first = k;
+            double wsum = 0;
+            char num[24];
+            while (first > 0) {
+                stack_item(c, st, buf[first - 1], 1, num, sizeof num);
+                double tw = text_w(cr, MONO, fs, num);
+                if (wsum + tw > room) break;
+                wsum += tw;
+                first--;
+            }
+            double x = x0;
+            rgb(cr, INK, 1);
+            if (first > 0) {
+                text_at(cr, MONO, 0, fs, x, y, "…");
+                x += text_w(cr, MONO, fs, "… ");
+            }
+            for (size_t i = first; i < k; i++) {
+                stack_item(c, st, buf[i], i + 1 < k, num, sizeof num);
+                text_at(cr, MONO, i + 1 == k, fs, x, y, num);
+                x += text_w(cr, MONO, fs, num);
+            }
+            if (k) text_at(cr, SANS, 1, fs, x + 0.2 * f, y, "▸");
+            y += lh;
+            any = 1;
+        }
+    }
+    if (!any) {
+        rgb(cr, INK, 0.5);
+        text_at(cr, SANS, 0, fs, R.x + 0.5 * f, y, "(no stack in use)");
+    }
+    free(buf);
+    cairo_restore(cr);
+}
+
+void pdt_draw_help(ctx *c, double w, double h)
+{
+    static const char *const keys[][2] = {
+        {"Space", "play / pause"},
+        {"→  ←", "one event forwards / backwards"},
+        {"Shift + → ←", "next / previous event of the selected kind"},
+        {"k", "select the kind: push/pop, lift-up, rejection, merge, triangle"},
+        {"PgDn  PgUp", "next / previous phase"},
+        {"Home  End", "first / last event"},
+        {"+  −", "faster / slower playback"},
+        {"1 … 9", "show / hide rank 0 … 8"},
+        {"0", "show all ranks"},
+        {"wheel", "zoom at the cursor"},
+        {"drag", "pan (in the lifted view: rotate)"},
+        {"click", "details of a point, edge or triangle; timeline: seek"},
+        {"f", "fit the points in the window"},
+        {"h  ?", "this help"},
+        {"s", "screenshot (PNG)"},
+        {"Esc  q", "quit"},
+    };
+    int nk = (int)(sizeof keys / sizeof *keys);
+    cairo_t *cr = c->cr;
+    double f = c->L.font * 1.05, kw = 0, dw = 0;
+    for (int i = 0; i < nk; i++) {
+        kw = fmax(kw, text_wb(cr, MONO, 1, 0.9 * f, keys[i][0]));
+        dw = fmax(dw, text_w(cr, SANS, 0.9 * f, keys[i][1]));
+    }
+    double bw = fmin(w * 0.96, kw + dw + 3.5 * f), bh = (nk + 2.6) * 1.45 * f;
+    double bx = (w - bw) / 2, by = (h - bh) / 2;
+    cairo_rectangle(cr, 0, 0, w, h);
+    cairo_set_source_rgba(cr, 0, 0, 0, 0.35);
+    cairo_fill(cr);
+    cairo_rectangle(cr, bx, by, bw, bh);
+    cairo_set_source_rgba(cr, 1, 1, 1, 0.97);
+    cairo_fill_preserve(cr);
+    rgb(cr, INK, 1);
+    cairo_set_line_width(cr, 2);
+    cairo_stroke(cr);
+    text_at(cr, SANS, 1, 1.2 * f, bx + f, by + 1.7 * f, "Keys");
+    char sel[96];
+    snprintf(sel, sizeof sel, "(selected kind: %s)", pdt_ev_class_name(c->v->ev_class));
+    text_at(cr, SANS, 0, 0.85 * f, bx + 5 * f, by + 1.7 * f, sel);
+    for (int i = 0; i < nk; i++) {
+        double y = by + (i + 2.4) * 1.45 * f + 0.4 * f;
+        text_at(cr, MONO, 1, 0.9 * f, bx + f, y, keys[i][0]);
+        text_at(cr, SANS, 0, 0.9 * f, bx + kw + 2.5 * f, y, keys[i][1]);
+    }
+}

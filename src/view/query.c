@@ -1,0 +1,131 @@
+/* pdt — questions about a replay state (see pdt/query.h). */
+#include "pdt/query.h"
+#include "pdt/describe.h"
+#include "pdt/predicates.h"
+
+size_t pdt_replay_stack_list(const pdt_replay *r, int32_t top, uint32_t *out, size_t cap)
+{
+    size_t nn;
+    const pdt_rnode *N = pdt_replay_nodes(r, &nn);
+    size_t d = top >= 0 ? N[top].depth : 0;
+    if (d > cap) d = cap;
+    size_t i = d;
+    for (int32_t t = top; t >= 0 && i > 0; t = N[t].parent) out[--i] = N[t].pt;
+    return d;
+}
+
+int pdt_replay_hull_live(const pdt_replay *r, const pdt_rstate *s, int q, int32_t h)
+{
+    size_t nh, ng;
+    const pdt_rhull *Hs = pdt_replay_hulls(r, &nh);
+    const pdt_rmerge *M = pdt_replay_merges(r, &ng);
+    for (size_t g = 0; g < ng; g++) {
+        if (M[g].begin_ev <= Hs[h].ev || M[g].begin_ev >= s->k) continue;
+        if ((uint32_t)q < M[g].gl || (uint32_t)q >= M[g].gend) continue;
+        int32_t h2 = pdt_rstate_slot(r, s, (int)M[g].rank, PDT_SLOT_HULL);
+        if (h2 >= 0 && h2 != h && Hs[h2].ev > M[g].begin_ev) return 0;
+    }
+    return 1;
+}
+
+int pdt_replay_graham_scan_ended(const pdt_replay *r, const pdt_rstate *s, int q)
+{
+    size_t np;
+    const pdt_rphase *Ph = pdt_replay_phases(r, &np);
+    int ended = 0;
+    uint32_t last = 0;
+    for (size_t i = 0; i < np; i++) {
+        if (Ph[i].rank != (uint32_t)q || Ph[i].phase != PDT_PH_GRAHAM_SCAN) continue;
+        if (Ph[i].begin_ev >= s->k || (ended && Ph[i].begin_ev < last)) continue;
+        last = Ph[i].begin_ev;
+        ended = Ph[i].end_ev != UINT32_MAX && Ph[i].end_ev < s->k;
+    }
+    return ended;
+}
+
+int pdt_replay_stack_open(const pdt_replay *r, const pdt_rstate *s, int32_t top)
+{
+    size_t nn;
+    const pdt_rnode *N = pdt_replay_nodes(r, &nn);
+    return N[top].hull_ev >= s->k;
+}
+
+size_t pdt_replay_inside_count(const pdt_replay *r, const uint32_t v[3])
+{
+    size_t n;
+    const pdt_point *P = pdt_replay_points(r, &n);
+    if (v[0] >= n || v[1] >= n || v[2] >= n) return 0;
+    int ccw = pdt_orient(P[v[0]], P[v[1]], P[v[2]]);
+    size_t k = 0;
+    if (ccw)
+        for (size_t p = 0; p < n; p++) k += ccw * pdt_incircle0(P[v[0]], P[v[1]], P[v[2]], P[p]) > 0;
+    return k;
+}
+
+int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
+{
+    const pdt_rec *e = s->k ? pdt_replay_rec(r, s->k - 1) : NULL;
+    *id = PDT_CODE_SRM;
+    if (!e) return -1;
+    const pdt_event *ev = &e->ev;
+    int32_t ph = pdt_rstate_slot(r, s, (int)e->rank, PDT_SLOT_PHASE);
+    size_t np;
+    const pdt_rphase *Ph = pdt_replay_phases(r, &np);
+    int in_merge = pdt_rstate_slot(r, s, (int)e->rank, PDT_SLOT_MERGE) >= 0;
+    int phase = -1;
+    for (int32_t p = ph; p >= 0; p = Ph[p].parent) {
+        if (phase < 0 && Ph[p].phase != PDT_PH_RUN) phase = (int)Ph[p].phase;
+        if (Ph[p].phase == PDT_PH_MERGE) in_merge = 1;
+    }
+    if (ev->kind == PDT_EV_PHASE_BEGIN || ev->kind == PDT_EV_PHASE_END) phase = ev->sub;
+    int gr = phase == PDT_PH_GRAHAM_SORT || phase == PDT_PH_GRAHAM_SCAN || ev->kind == PDT_EV_SORT ||
+             ev->kind == PDT_EV_DELETE ||
+             ((ev->kind == PDT_EV_PUSH || ev->kind == PDT_EV_POP) && ev->sub == PDT_STACK_GRAHAM);
+    if (gr) {
+        *id = PDT_CODE_GRAHAM;
+        switch (ev->kind) {
+        case PDT_EV_SORT: return ev->b == 0 ? 0 : 1;
+        case PDT_EV_DELETE: return 2;
+        case PDT_EV_PUSH: return ev->b <= 2 ? 3 : 7;
+        case PDT_EV_POP: return 8;
+        case PDT_EV_HULL: return 9;
+        case PDT_EV_PHASE_BEGIN: return phase == PDT_PH_GRAHAM_SCAN ? 4 : 0;
+        case PDT_EV_PHASE_END: return phase == PDT_PH_GRAHAM_SCAN ? 9 : 2;
+        default: return 5;
+        }
+    }
+    switch (ev->kind) {
+    case PDT_EV_LIFT: return in_merge ? 7 : 1;
+    case PDT_EV_TRI_NEW: return in_merge ? 7 : 2;
+    case PDT_EV_EDGE_ADD:
+    case PDT_EV_EDGE_DEL:
+    case PDT_EV_INCIRCLE: return in_merge ? 7 : 2;
+    case PDT_EV_PUSH:
+    case PDT_EV_POP:
+    case PDT_EV_HULL: return in_merge ? 9 : 2;
+    case PDT_EV_TRI_FINAL:
+    case PDT_EV_RA_DEFER: return in_merge ? 9 : (ev->kind == PDT_EV_TRI_FINAL ? 3 : 4);
+    case PDT_EV_SHIP:
+    case PDT_EV_SEND:
+    case PDT_EV_RECV:
+        return phase == PDT_PH_OUTPUT || phase == PDT_PH_ORDER || phase == PDT_PH_WRITE ? 10 : 6;
+    case PDT_EV_DISCARD: return 8;
+    case PDT_EV_MERGE_BEGIN: return 7;
+    case PDT_EV_MERGE_END: return 9;
+    default: break;
+    }
+    switch (phase) {
+    case PDT_PH_READ:
+    case PDT_PH_PARTITION: return 0;
+    case PDT_PH_LIFT: return 1;
+    case PDT_PH_KERNEL:
+    case PDT_PH_HULL: return 2;
+    case PDT_PH_CLASSIFY: return 3;
+    case PDT_PH_MERGE: return 5;
+    case PDT_PH_OUTPUT:
+    case PDT_PH_ORDER:
+    case PDT_PH_WRITE: return 10;
+    default: return -1;
+    }
+}
+
