@@ -45,8 +45,10 @@ const char *pdt_comm_host(const pdt_comm *c);
 /* Wall clock in seconds (MPI_Wtime, or CLOCK_MONOTONIC in serial mode). */
 double pdt_comm_wtime(const pdt_comm *c);
 
-/* Collectives.  Byte counts; every count must be <= INT_MAX (else
- * PDT_ERR_MPI "message too large").  Receive buffers are the caller's. */
+/* Collectives.  Byte counts are size_t with no 32-bit limit: a transfer
+ * larger than the chunk size (1 GiB, or PDT_COMM_CHUNK=bytes in the
+ * environment — rank 0's value, read at pdt_comm_init) goes as several
+ * messages of at most one chunk each.  Receive buffers are the caller's. */
 pdt_status pdt_comm_barrier(pdt_comm *c, pdt_err *err);
 /* A barrier during which waiting ranks sleep (0.1 ms polls) instead of
  * spinning: call it before a collective that some ranks reach much later. */
@@ -59,7 +61,8 @@ pdt_status pdt_comm_allgather(pdt_comm *c, const void *send, size_t bytes, void 
 pdt_status pdt_comm_alltoall(pdt_comm *c, const void *send, size_t bytes, void *recv,
                              pdt_err *err);
 /* Block i of send (scount[i] bytes, blocks contiguous in rank order) goes to
- * rank i; block j of recv (rcount[j] bytes, contiguous) comes from rank j. */
+ * rank i; block j of recv (rcount[j] bytes, contiguous) comes from rank j.
+ * Requires rcount[j] at rank i == scount[i] at rank j. */
 pdt_status pdt_comm_alltoallv(pdt_comm *c, const void *send, const size_t *scount, void *recv,
                               const size_t *rcount, pdt_err *err);
 /* Root sends count[i] bytes (contiguous blocks) to rank i; every rank
@@ -72,6 +75,32 @@ pdt_status pdt_comm_gatherv(pdt_comm *c, const void *send, size_t bytes, void *r
                             const size_t *count, int root, pdt_err *err);
 /* Element-wise maximum / sum of n doubles over all ranks, result everywhere. */
 pdt_status pdt_comm_allmax(pdt_comm *c, double *v, int n, pdt_err *err);
+
+typedef enum pdt_comm_op { PDT_COMM_SUM, PDT_COMM_MAX, PDT_COMM_MIN } pdt_comm_op;
+/* In place: v[0..n) becomes, at every rank, the element-wise op over all
+ * ranks' v (sums wrap modulo 2^64).  Requires the same n and op everywhere. */
+pdt_status pdt_comm_allreduce_u64(pdt_comm *c, uint64_t *v, size_t n, pdt_comm_op op,
+                                  pdt_err *err);
+/* Exclusive prefix sum: *out = sum of v over ranks 0..rank-1 (0 at rank 0). */
+pdt_status pdt_comm_exscan_u64(pdt_comm *c, uint64_t v, uint64_t *out, pdt_err *err);
+
+/* ---- one file written by all ranks together ---- */
+typedef struct pdt_comm_file pdt_comm_file;
+/* Collective: create `path` (or truncate it) for writing by every rank
+ * (MPI-IO in an MPI job; open(2) in serial mode).  All ranks return the same
+ * status: if any rank failed, every rank gets PDT_ERR_IO naming the path and
+ * *f = NULL.  On success *f is owned by the caller (pdt_comm_file_close). */
+pdt_status pdt_comm_file_open(pdt_comm *c, const char *path, pdt_comm_file **f, pdt_err *err);
+/* Collective: every rank writes its own `bytes` bytes of buf at byte
+ * `offset` of the file (ranges must not overlap; bytes may be 0, buf then
+ * unused).  MPI_File_write_at_all in chunks, pwrite(2) in serial mode.  All
+ * ranks return the same status (PDT_ERR_IO naming the path and the failing
+ * rank). */
+pdt_status pdt_comm_file_write_at(pdt_comm_file *f, uint64_t offset, const void *buf,
+                                  size_t bytes, pdt_err *err);
+/* Collective: close and free f (f may be NULL on every rank).  Same status
+ * at every rank.  Does not remove the file, even after a failed write. */
+pdt_status pdt_comm_file_close(pdt_comm_file *f, pdt_err *err);
 
 /* Point to point, blocking.  recv: waits (sleeping between polls) for the
  * message, *buf is malloc'd (caller frees; may be non-NULL even for 0

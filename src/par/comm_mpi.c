@@ -4,11 +4,20 @@
  * goes to the context's private communicator (a duplicate of the world one,
  * with MPI_ERRORS_RETURN), every return code is checked and turned into
  * PDT_ERR_MPI with MPI's own error string.  A context created without a
- * launcher is "serial": size 1, no MPI call at all. */
+ * launcher is "serial": size 1, no MPI call at all.
+ *
+ * No 32-bit limit: MPI counts are ints (Open MPI 4.1 has no MPI-4 "_c"
+ * calls), so every transfer goes in chunks of at most c->chunk bytes.  The
+ * v-collectives and the large uniform ones run on point-to-point messages of
+ * a second private communicator (c->xcomm), chunk by chunk in rounds, so no
+ * int displacement is ever needed. */
 #include "pdt/par.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <mpi.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -17,9 +26,24 @@
 struct pdt_comm {
     int mpi;        /* 1 if MPI was initialised by us */
     int rank, size;
-    MPI_Comm comm;
+    MPI_Comm comm;  /* collectives and the caller's point-to-point messages */
+    MPI_Comm xcomm; /* the chunked exchanges (no tag clash with comm) */
+    size_t chunk;   /* largest single message, bytes (<= INT_MAX) */
     char host[256];
 };
+
+/* 1 GiB by default; PDT_COMM_CHUNK=bytes (tests force tiny chunks). */
+static size_t chunk_from_env(void)
+{
+    const char *e = getenv("PDT_COMM_CHUNK");
+    if (e && *e) {
+        char *end;
+        errno = 0;
+        unsigned long long v = strtoull(e, &end, 10);
+        if (!errno && !*end && v >= 1 && v <= (unsigned long long)INT_MAX) return (size_t)v;
+    }
+    return (size_t)1 << 30;
+}
 
 int pdt_comm_launched(void)
 {
@@ -44,49 +68,13 @@ static pdt_status mpi_check(int rc, const char *what, const pdt_comm *c, pdt_err
                        len ? msg : "unknown MPI error");
 }
 
-static pdt_status to_int(const pdt_comm *c, size_t v, int *out, const char *what, pdt_err *err)
-{
-    *out = 0;
-    if (v > (size_t)INT_MAX)
-        return pdt_err_set(err, PDT_ERR_MPI, "rank %d: %s: message too large (%zu bytes)",
-                           c->rank, what, v);
-    *out = (int)v;
-    return PDT_OK;
-}
-
-/* counts/displacements as ints for the v-collectives (malloc'd pair). */
-static pdt_status int_counts(const pdt_comm *c, const size_t *count, int **cnt, int **dsp,
-                             const char *what, pdt_err *err)
-{
-    *cnt = malloc((size_t)c->size * sizeof **cnt);
-    *dsp = malloc((size_t)c->size * sizeof **dsp);
-    if (!*cnt || !*dsp) {
-        free(*cnt);
-        free(*dsp);
-        *cnt = *dsp = NULL;
-        return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", c->rank, what);
-    }
-    size_t off = 0;
-    for (int i = 0; i < c->size; i++) {
-        pdt_status s = to_int(c, count[i], &(*cnt)[i], what, err);
-        if (s == PDT_OK) s = to_int(c, off, &(*dsp)[i], what, err);
-        if (s != PDT_OK) {
-            free(*cnt);
-            free(*dsp);
-            *cnt = *dsp = NULL;
-            return s;
-        }
-        off += count[i];
-    }
-    return to_int(c, off, &(int){0}, what, err);
-}
-
 pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out, pdt_err *err)
 {
     *out = NULL;
     pdt_comm *c = calloc(1, sizeof *c);
     if (!c) return pdt_err_set(err, PDT_ERR_NOMEM, "comm: out of memory");
     c->size = 1;
+    c->chunk = chunk_from_env();
     if (gethostname(c->host, sizeof c->host - 1) != 0) strcpy(c->host, "?");
     if (!force_mpi && !pdt_comm_launched()) {
         *out = c;
@@ -107,6 +95,13 @@ pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out,
                       "MPI_Comm_set_errhandler", c, err);
     if (s == PDT_OK) s = mpi_check(MPI_Comm_rank(c->comm, &c->rank), "MPI_Comm_rank", c, err);
     if (s == PDT_OK) s = mpi_check(MPI_Comm_size(c->comm, &c->size), "MPI_Comm_size", c, err);
+    if (s == PDT_OK) s = mpi_check(MPI_Comm_dup(c->comm, &c->xcomm), "MPI_Comm_dup", c, err);
+    /* Every rank must cut transfers the same way: rank 0's chunk size wins. */
+    unsigned long long chunk = c->chunk;
+    if (s == PDT_OK)
+        s = mpi_check(MPI_Bcast(&chunk, 1, MPI_UNSIGNED_LONG_LONG, 0, c->comm), "MPI_Bcast", c,
+                      err);
+    c->chunk = (size_t)chunk;
     if (s != PDT_OK) {
         MPI_Finalize();
         free(c);
@@ -121,7 +116,9 @@ pdt_status pdt_comm_finalize(pdt_comm *c, pdt_err *err)
     if (!c) return PDT_OK;
     pdt_status s = PDT_OK;
     if (c->mpi) {
-        s = mpi_check(MPI_Comm_free(&c->comm), "MPI_Comm_free", c, err);
+        s = mpi_check(MPI_Comm_free(&c->xcomm), "MPI_Comm_free", c, err);
+        pdt_status s1 = mpi_check(MPI_Comm_free(&c->comm), "MPI_Comm_free", c, err);
+        if (s == PDT_OK) s = s1;
         pdt_status s2 = mpi_check(MPI_Finalize(), "MPI_Finalize", c, err);
         if (s == PDT_OK) s = s2;
     }
@@ -176,13 +173,90 @@ pdt_status pdt_comm_quiet_barrier(pdt_comm *c, pdt_err *err)
     return s;
 }
 
+/* ---- the chunked exchange ------------------------------------------------ */
+
+/* One exchange: rank i gets sn[i] bytes from sp[i], and rn[i] bytes from
+ * rank i land at rp[i] (sn at rank j == rn[j's peer] by the caller's
+ * contract).  Round r moves chunk r of every pair that still has one; each
+ * side knows its own pair's sizes, so the ranks need not agree on the number
+ * of rounds.  The self block is a plain copy. */
+typedef struct xchg {
+    const char **sp;
+    size_t *sn;
+    char **rp;
+    size_t *rn;
+} xchg;
+
+static pdt_status xchg_new(const pdt_comm *c, xchg *x, const char *what, pdt_err *err)
+{
+    size_t P = (size_t)c->size;
+    x->sp = calloc(P, sizeof *x->sp);
+    x->sn = calloc(P, sizeof *x->sn);
+    x->rp = calloc(P, sizeof *x->rp);
+    x->rn = calloc(P, sizeof *x->rn);
+    if (x->sp && x->sn && x->rp && x->rn) return PDT_OK;
+    return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", c->rank, what);
+}
+
+static void xchg_free(xchg *x)
+{
+    free(x->sp);
+    free(x->sn);
+    free(x->rp);
+    free(x->rn);
+}
+
+static size_t min_size(size_t a, size_t b) { return a < b ? a : b; }
+
+static pdt_status xchg_run(pdt_comm *c, const xchg *x, const char *what, pdt_err *err)
+{
+    int P = c->size, me = c->rank;
+    if (x->sn[me] != x->rn[me])
+        return pdt_err_set(err, PDT_ERR_MPI, "rank %d: %s: count mismatch with itself", me, what);
+    if (x->sn[me]) memmove(x->rp[me], x->sp[me], x->sn[me]);
+    MPI_Request *rq = malloc(2 * (size_t)P * sizeof *rq);
+    if (!rq) return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", me, what);
+    pdt_status s = PDT_OK;
+    for (size_t off = 0; s == PDT_OK; off += c->chunk) {
+        int nrq = 0;
+        for (int i = 0; i < P && s == PDT_OK; i++) {
+            if (i == me || off >= x->rn[i]) continue;
+            int len = (int)min_size(c->chunk, x->rn[i] - off);
+            s = mpi_check(MPI_Irecv(x->rp[i] + off, len, MPI_BYTE, i, 0, c->xcomm, &rq[nrq++]),
+                          "MPI_Irecv", c, err);
+        }
+        for (int i = 0; i < P && s == PDT_OK; i++) {
+            if (i == me || off >= x->sn[i]) continue;
+            int len = (int)min_size(c->chunk, x->sn[i] - off);
+            s = mpi_check(MPI_Isend(x->sp[i] + off, len, MPI_BYTE, i, 0, c->xcomm, &rq[nrq++]),
+                          "MPI_Isend", c, err);
+        }
+        if (nrq == 0) break;
+        pdt_status w = mpi_check(MPI_Waitall(nrq, rq, MPI_STATUSES_IGNORE), "MPI_Waitall", c, err);
+        if (s == PDT_OK) s = w;
+    }
+    free(rq);
+    return s;
+}
+
+/* ---- collectives ---------------------------------------------------------- */
+
 pdt_status pdt_comm_bcast(pdt_comm *c, void *buf, size_t bytes, int root, pdt_err *err)
 {
     if (!c->mpi) return PDT_OK;
-    int nb = 0;
-    pdt_status s = to_int(c, bytes, &nb, "bcast", err);
-    if (s != PDT_OK) return s;
-    return mpi_check(MPI_Bcast(buf, nb, MPI_BYTE, root, c->comm), "MPI_Bcast", c, err);
+    pdt_status s = PDT_OK;
+    for (size_t off = 0; off < bytes && s == PDT_OK; off += c->chunk)
+        s = mpi_check(MPI_Bcast((char *)buf + off, (int)min_size(c->chunk, bytes - off), MPI_BYTE,
+                                root, c->comm),
+                      "MPI_Bcast", c, err);
+    return s;
+}
+
+/* Uniform collectives whose whole receive buffer fits in one chunk use MPI's
+ * own call (same decision at every rank: bytes, size and chunk agree). */
+static int one_chunk(const pdt_comm *c, size_t bytes)
+{
+    return bytes <= c->chunk / (size_t)c->size;
 }
 
 pdt_status pdt_comm_allgather(pdt_comm *c, const void *send, size_t bytes, void *recv,
@@ -192,11 +266,20 @@ pdt_status pdt_comm_allgather(pdt_comm *c, const void *send, size_t bytes, void 
         if (bytes) memmove(recv, send, bytes);
         return PDT_OK;
     }
-    int nb = 0;
-    pdt_status s = to_int(c, bytes * (size_t)c->size, &nb, "allgather", err);
-    if (s != PDT_OK) return s;
-    return mpi_check(MPI_Allgather(send, (int)bytes, MPI_BYTE, recv, (int)bytes, MPI_BYTE, c->comm),
-                     "MPI_Allgather", c, err);
+    if (one_chunk(c, bytes))
+        return mpi_check(MPI_Allgather(send, (int)bytes, MPI_BYTE, recv, (int)bytes, MPI_BYTE,
+                                       c->comm),
+                         "MPI_Allgather", c, err);
+    xchg x;
+    pdt_status s = xchg_new(c, &x, "allgather", err);
+    for (int i = 0; s == PDT_OK && i < c->size; i++) {
+        x.sp[i] = send;
+        x.sn[i] = x.rn[i] = bytes;
+        x.rp[i] = (char *)recv + (size_t)i * bytes;
+    }
+    if (s == PDT_OK) s = xchg_run(c, &x, "allgather", err);
+    xchg_free(&x);
+    return s;
 }
 
 pdt_status pdt_comm_alltoall(pdt_comm *c, const void *send, size_t bytes, void *recv,
@@ -206,11 +289,20 @@ pdt_status pdt_comm_alltoall(pdt_comm *c, const void *send, size_t bytes, void *
         if (bytes) memmove(recv, send, bytes);
         return PDT_OK;
     }
-    int nb = 0;
-    pdt_status s = to_int(c, bytes * (size_t)c->size, &nb, "alltoall", err);
-    if (s != PDT_OK) return s;
-    return mpi_check(MPI_Alltoall(send, (int)bytes, MPI_BYTE, recv, (int)bytes, MPI_BYTE, c->comm),
-                     "MPI_Alltoall", c, err);
+    if (one_chunk(c, bytes))
+        return mpi_check(MPI_Alltoall(send, (int)bytes, MPI_BYTE, recv, (int)bytes, MPI_BYTE,
+                                      c->comm),
+                         "MPI_Alltoall", c, err);
+    xchg x;
+    pdt_status s = xchg_new(c, &x, "alltoall", err);
+    for (int i = 0; s == PDT_OK && i < c->size; i++) {
+        x.sp[i] = (const char *)send + (size_t)i * bytes;
+        x.rp[i] = (char *)recv + (size_t)i * bytes;
+        x.sn[i] = x.rn[i] = bytes;
+    }
+    if (s == PDT_OK) s = xchg_run(c, &x, "alltoall", err);
+    xchg_free(&x);
+    return s;
 }
 
 pdt_status pdt_comm_alltoallv(pdt_comm *c, const void *send, const size_t *scount, void *recv,
@@ -222,18 +314,17 @@ pdt_status pdt_comm_alltoallv(pdt_comm *c, const void *send, const size_t *scoun
         if (scount[0]) memmove(recv, send, scount[0]);
         return PDT_OK;
     }
-    int *sc, *sd, *rc, *rd;
-    pdt_status s = int_counts(c, scount, &sc, &sd, "alltoallv", err);
-    if (s != PDT_OK) return s;
-    s = int_counts(c, rcount, &rc, &rd, "alltoallv", err);
-    if (s == PDT_OK) {
-        s = mpi_check(MPI_Alltoallv(send, sc, sd, MPI_BYTE, recv, rc, rd, MPI_BYTE, c->comm),
-                      "MPI_Alltoallv", c, err);
-        free(rc);
-        free(rd);
+    xchg x;
+    pdt_status s = xchg_new(c, &x, "alltoallv", err);
+    size_t so = 0, ro = 0;
+    for (int i = 0; s == PDT_OK && i < c->size; i++) {
+        x.sp[i] = (const char *)send + so;
+        x.rp[i] = (char *)recv + ro;
+        so += x.sn[i] = scount[i];
+        ro += x.rn[i] = rcount[i];
     }
-    free(sc);
-    free(sd);
+    if (s == PDT_OK) s = xchg_run(c, &x, "alltoallv", err);
+    xchg_free(&x);
     return s;
 }
 
@@ -245,14 +336,19 @@ pdt_status pdt_comm_scatterv(pdt_comm *c, const void *send, const size_t *count,
         if (rbytes) memmove(recv, send, rbytes);
         return PDT_OK;
     }
-    int *sc = NULL, *sd = NULL, nr = 0;
-    pdt_status s = to_int(c, rbytes, &nr, "scatterv", err);
-    if (s == PDT_OK && c->rank == root) s = int_counts(c, count, &sc, &sd, "scatterv", err);
-    if (s == PDT_OK)
-        s = mpi_check(MPI_Scatterv(send, sc, sd, MPI_BYTE, recv, nr, MPI_BYTE, root, c->comm),
-                      "MPI_Scatterv", c, err);
-    free(sc);
-    free(sd);
+    xchg x;
+    pdt_status s = xchg_new(c, &x, "scatterv", err);
+    if (s == PDT_OK) {
+        x.rp[root] = recv;
+        x.rn[root] = rbytes;
+    }
+    size_t off = 0;
+    for (int i = 0; s == PDT_OK && c->rank == root && i < c->size; i++) {
+        x.sp[i] = (const char *)send + off;
+        off += x.sn[i] = count[i];
+    }
+    if (s == PDT_OK) s = xchg_run(c, &x, "scatterv", err);
+    xchg_free(&x);
     return s;
 }
 
@@ -264,14 +360,19 @@ pdt_status pdt_comm_gatherv(pdt_comm *c, const void *send, size_t bytes, void *r
         if (bytes) memmove(recv, send, bytes);
         return PDT_OK;
     }
-    int *rc = NULL, *rd = NULL, ns = 0;
-    pdt_status s = to_int(c, bytes, &ns, "gatherv", err);
-    if (s == PDT_OK && c->rank == root) s = int_counts(c, count, &rc, &rd, "gatherv", err);
-    if (s == PDT_OK)
-        s = mpi_check(MPI_Gatherv(send, ns, MPI_BYTE, recv, rc, rd, MPI_BYTE, root, c->comm),
-                      "MPI_Gatherv", c, err);
-    free(rc);
-    free(rd);
+    xchg x;
+    pdt_status s = xchg_new(c, &x, "gatherv", err);
+    if (s == PDT_OK) {
+        x.sp[root] = send;
+        x.sn[root] = bytes;
+    }
+    size_t off = 0;
+    for (int i = 0; s == PDT_OK && c->rank == root && i < c->size; i++) {
+        x.rp[i] = (char *)recv + off;
+        off += x.rn[i] = count[i];
+    }
+    if (s == PDT_OK) s = xchg_run(c, &x, "gatherv", err);
+    xchg_free(&x);
     return s;
 }
 
@@ -282,15 +383,49 @@ pdt_status pdt_comm_allmax(pdt_comm *c, double *v, int n, pdt_err *err)
                      "MPI_Allreduce", c, err);
 }
 
+pdt_status pdt_comm_allreduce_u64(pdt_comm *c, uint64_t *v, size_t n, pdt_comm_op op,
+                                  pdt_err *err)
+{
+    if (!c->mpi) return PDT_OK;
+    MPI_Op mop = op == PDT_COMM_SUM ? MPI_SUM : op == PDT_COMM_MAX ? MPI_MAX : MPI_MIN;
+    size_t step = c->chunk / sizeof *v ? c->chunk / sizeof *v : 1;
+    pdt_status s = PDT_OK;
+    for (size_t i = 0; i < n && s == PDT_OK; i += step)
+        s = mpi_check(MPI_Allreduce(MPI_IN_PLACE, v + i, (int)min_size(step, n - i), MPI_UINT64_T,
+                                    mop, c->comm),
+                      "MPI_Allreduce", c, err);
+    return s;
+}
+
+pdt_status pdt_comm_exscan_u64(pdt_comm *c, uint64_t v, uint64_t *out, pdt_err *err)
+{
+    *out = 0;
+    if (!c->mpi) return PDT_OK;
+    uint64_t r = 0;
+    pdt_status s = mpi_check(MPI_Exscan(&v, &r, 1, MPI_UINT64_T, MPI_SUM, c->comm), "MPI_Exscan",
+                             c, err);
+    if (s == PDT_OK && c->rank > 0) *out = r; /* MPI leaves rank 0's result undefined */
+    return s;
+}
+
+/* ---- point to point --------------------------------------------------------
+ * A message is a header (its size, one uint64) then the bytes in chunks, all
+ * with the caller's tag: MPI keeps messages of one sender, tag and
+ * communicator in order. */
+
 pdt_status pdt_comm_send(pdt_comm *c, int peer, int tag, const void *buf, size_t bytes,
                          pdt_err *err)
 {
     if (!c->mpi || peer == c->rank)
         return pdt_err_set(err, PDT_ERR_MPI, "rank %d: send to itself", c->rank);
-    int nb = 0;
-    pdt_status s = to_int(c, bytes, &nb, "send", err);
-    if (s != PDT_OK) return s;
-    return mpi_check(MPI_Send(buf, nb, MPI_BYTE, peer, tag, c->comm), "MPI_Send", c, err);
+    uint64_t head = bytes;
+    pdt_status s = mpi_check(MPI_Send(&head, 1, MPI_UINT64_T, peer, tag, c->comm), "MPI_Send", c,
+                             err);
+    for (size_t off = 0; off < bytes && s == PDT_OK; off += c->chunk)
+        s = mpi_check(MPI_Send((const char *)buf + off, (int)min_size(c->chunk, bytes - off),
+                               MPI_BYTE, peer, tag, c->comm),
+                      "MPI_Send", c, err);
+    return s;
 }
 
 pdt_status pdt_comm_recv(pdt_comm *c, int peer, int tag, void **buf, size_t *bytes, pdt_err *err)
@@ -299,26 +434,167 @@ pdt_status pdt_comm_recv(pdt_comm *c, int peer, int tag, void **buf, size_t *byt
     *bytes = 0;
     if (!c->mpi || peer == c->rank)
         return pdt_err_set(err, PDT_ERR_MPI, "rank %d: receive from itself", c->rank);
-    MPI_Status st;
     int flag = 0;
     pdt_status s = PDT_OK;
     while (s == PDT_OK && !flag) {
-        s = mpi_check(MPI_Iprobe(peer, tag, c->comm, &flag, &st), "MPI_Iprobe", c, err);
+        s = mpi_check(MPI_Iprobe(peer, tag, c->comm, &flag, MPI_STATUS_IGNORE), "MPI_Iprobe", c,
+                      err);
         if (s == PDT_OK && !flag) nap();
     }
-    int nb = 0;
-    if (s == PDT_OK) s = mpi_check(MPI_Get_count(&st, MPI_BYTE, &nb), "MPI_Get_count", c, err);
+    uint64_t head = 0;
+    if (s == PDT_OK)
+        s = mpi_check(MPI_Recv(&head, 1, MPI_UINT64_T, peer, tag, c->comm, MPI_STATUS_IGNORE),
+                      "MPI_Recv", c, err);
     if (s != PDT_OK) return s;
-    if (nb < 0) return pdt_err_set(err, PDT_ERR_MPI, "rank %d: bad message size", c->rank);
-    void *b = malloc(nb ? (size_t)nb : 1);
+    if (head > SIZE_MAX - 1) return pdt_err_set(err, PDT_ERR_MPI, "rank %d: bad message size", c->rank);
+    size_t n = (size_t)head;
+    char *b = malloc(n ? n : 1);
     if (!b) return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: recv: out of memory", c->rank);
-    s = mpi_check(MPI_Recv(b, nb, MPI_BYTE, peer, tag, c->comm, MPI_STATUS_IGNORE), "MPI_Recv",
-                  c, err);
+    for (size_t off = 0; off < n && s == PDT_OK; off += c->chunk)
+        s = mpi_check(MPI_Recv(b + off, (int)min_size(c->chunk, n - off), MPI_BYTE, peer, tag,
+                               c->comm, MPI_STATUS_IGNORE),
+                      "MPI_Recv", c, err);
     if (s != PDT_OK) {
         free(b);
         return s;
     }
     *buf = b;
-    *bytes = (size_t)nb;
+    *bytes = n;
     return PDT_OK;
+}
+
+/* ---- one file written by all ranks ----------------------------------------- */
+
+struct pdt_comm_file {
+    pdt_comm *c;
+    MPI_File fh; /* MPI mode */
+    int fd;      /* serial mode */
+    char *path;
+};
+
+/* Every rank learns whether any rank failed (the lowest failing rank is
+ * named); a rank that did not fail itself gets PDT_ERR_IO too. */
+static pdt_status agree(pdt_comm *c, pdt_status mine, const char *path, const char *what,
+                        pdt_err *err)
+{
+    if (!c->mpi) return mine;
+    uint64_t bad = mine != PDT_OK, who = mine != PDT_OK ? (uint64_t)c->rank : UINT64_MAX;
+    pdt_status s = pdt_comm_allreduce_u64(c, &bad, 1, PDT_COMM_MAX, err);
+    if (s == PDT_OK) s = pdt_comm_allreduce_u64(c, &who, 1, PDT_COMM_MIN, err);
+    if (s != PDT_OK) return s;
+    if (mine != PDT_OK) return mine;
+    if (bad)
+        return pdt_err_set(err, PDT_ERR_IO, "%s: %s failed at rank %llu", path, what,
+                           (unsigned long long)who);
+    return PDT_OK;
+}
+
+static pdt_status mpi_io_check(int rc, const pdt_comm *c, const char *path, const char *what,
+                               pdt_err *err)
+{
+    if (rc == MPI_SUCCESS) return PDT_OK;
+    char msg[MPI_MAX_ERROR_STRING + 1];
+    int len = 0;
+    if (MPI_Error_string(rc, msg, &len) != MPI_SUCCESS) len = 0;
+    msg[len] = '\0';
+    return pdt_err_set(err, PDT_ERR_IO, "%s: %s failed at rank %d: %s", path, what, c->rank,
+                       len ? msg : "unknown MPI-IO error");
+}
+
+pdt_status pdt_comm_file_open(pdt_comm *c, const char *path, pdt_comm_file **out, pdt_err *err)
+{
+    *out = NULL;
+    pdt_comm_file *f = calloc(1, sizeof *f);
+    char *p = strdup(path);
+    pdt_status s = PDT_OK;
+    if (!f || !p) s = pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: file open: out of memory", c->rank);
+    int opened = 0;
+    MPI_File fh = MPI_FILE_NULL;
+    if (s == PDT_OK && !c->mpi) {
+        f->fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+        if (f->fd < 0) s = pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+        opened = f->fd >= 0;
+    } else if (c->mpi) {
+        /* Every rank must call MPI_File_open, even one short of memory. */
+        int rc = MPI_File_open(c->comm, path, MPI_MODE_WRONLY | MPI_MODE_CREATE, MPI_INFO_NULL, &fh);
+        pdt_status o = mpi_io_check(rc, c, path, "create", err);
+        if (s == PDT_OK) s = o;
+        /* open collectively succeeded or failed everywhere; truncate is collective too */
+        if (rc == MPI_SUCCESS) {
+            opened = 1;
+            pdt_status t = mpi_io_check(MPI_File_set_size(fh, 0), c, path, "truncate", err);
+            if (s == PDT_OK) s = t;
+        }
+    }
+    s = agree(c, s, path, "create", err);
+    if (s != PDT_OK) {
+        if (opened && !c->mpi) close(f->fd);
+        if (opened && c->mpi) MPI_File_close(&fh);
+        free(p);
+        free(f);
+        return s;
+    }
+    f->c = c;
+    f->fh = fh;
+    f->path = p;
+    *out = f;
+    return PDT_OK;
+}
+
+pdt_status pdt_comm_file_write_at(pdt_comm_file *f, uint64_t offset, const void *buf,
+                                  size_t bytes, pdt_err *err)
+{
+    pdt_comm *c = f->c;
+    pdt_status s = PDT_OK;
+    if (!c->mpi) {
+        const char *b = buf;
+        size_t done = 0;
+        while (done < bytes && s == PDT_OK) {
+            ssize_t w = pwrite(f->fd, b + done, min_size(c->chunk, bytes - done),
+                               (off_t)(offset + done));
+            if (w < 0 && errno == EINTR) continue;
+            if (w <= 0)
+                s = pdt_err_set(err, PDT_ERR_IO, "%s: write failed: %s", f->path,
+                                w < 0 ? strerror(errno) : "no progress");
+            else
+                done += (size_t)w;
+        }
+        return s;
+    }
+    /* write_at_all is collective: every rank calls it as often as the rank
+     * with the most chunks, with 0 bytes once done (or after a failure). */
+    uint64_t rounds = (bytes + c->chunk - 1) / c->chunk;
+    s = pdt_comm_allreduce_u64(c, &rounds, 1, PDT_COMM_MAX, err);
+    if (s != PDT_OK) return s;
+    pdt_status mine = PDT_OK;
+    for (uint64_t r = 0; r < rounds; r++) {
+        size_t off = (size_t)r * c->chunk;
+        int len = mine == PDT_OK && off < bytes ? (int)min_size(c->chunk, bytes - off) : 0;
+        const char *p = len ? (const char *)buf + off : (const char *)buf;
+        MPI_Status st;
+        int rc = MPI_File_write_at_all(f->fh, (MPI_Offset)(offset + off), p, len, MPI_BYTE, &st);
+        pdt_status w = mpi_io_check(rc, c, f->path, "write", err);
+        int got = 0;
+        if (w == PDT_OK && len && (MPI_Get_count(&st, MPI_BYTE, &got) != MPI_SUCCESS || got != len))
+            w = pdt_err_set(err, PDT_ERR_IO, "%s: short write at rank %d", f->path, c->rank);
+        if (mine == PDT_OK) mine = w;
+    }
+    return agree(c, mine, f->path, "write", err);
+}
+
+pdt_status pdt_comm_file_close(pdt_comm_file *f, pdt_err *err)
+{
+    if (!f) return PDT_OK;
+    pdt_comm *c = f->c;
+    pdt_status s = PDT_OK;
+    if (!c->mpi) {
+        if (close(f->fd) != 0)
+            s = pdt_err_set(err, PDT_ERR_IO, "%s: close failed: %s", f->path, strerror(errno));
+    } else {
+        s = mpi_io_check(MPI_File_close(&f->fh), c, f->path, "close", err);
+        s = agree(c, s, f->path, "close", err);
+    }
+    free(f->path);
+    free(f);
+    return s;
 }
