@@ -13,21 +13,30 @@
  * child hulls per merge (linear in the hull sizes), so O(n log n) expected on
  * every input; the merges themselves are O(n log n) in the worst case.
  *
- * Edge structure: directed edges in flat arrays (no per-edge malloc).  Edge e
- * and its twin e ^ 1 form an undirected edge; org[e] is the origin, onext[e]
- * / oprev[e] the next / previous edge counter-clockwise around org[e] (a
- * doubly linked ring: the primal half of a quad-edge, with the dual's work
- * done by oprev).  Identities used: sym(e) = e ^ 1, lnext(e) = oprev(sym e),
- * rprev(e) = onext(sym e), lprev(e) = sym(onext e).
+ * Order in memory: all cuts are made first (cut_order), the points are
+ * copied in the order of the leaves, and the recursion then runs on that
+ * copy, so every sub-problem is one contiguous block of points, and the edges
+ * it makes one contiguous block of edge records: the caches see the
+ * recursion's locality instead of the lexicographic order's.
+ *
+ * Edge structure: one flat array of 12-byte records {org, onext, oprev}
+ * indexed by directed edge (no per-edge malloc).  Edge e and its twin e ^ 1
+ * form an undirected edge; org is the origin, onext / oprev the next /
+ * previous edge counter-clockwise around org (a doubly linked ring: the
+ * primal half of a quad-edge, with the dual's work done by oprev).
+ * Identities used: sym(e) = e ^ 1, lnext(e) = oprev(sym e), rprev(e) =
+ * onext(sym e), lprev(e) = sym(onext e).
  *
  * Memory: at most 3n undirected edges are alive at any time (the union of the
  * sub-triangulations plus the cross edges is planar), freed edges are
  * reused, so 12 bytes per directed edge, ~72 bytes per point.  The triangle
- * list is written over the oprev array once the merge is done (it needs
- * only org and onext), so it costs no extra memory. */
+ * list is written over the edge records once the merge is done, so it costs
+ * no extra memory. */
 #include "pdt/delaunay.h"
 
 #include "pdt/predicates.h"
+
+#include "bigmem.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -35,9 +44,15 @@
 
 #define NIL UINT32_MAX
 
+/* One directed edge: 12 bytes, e and its twin e ^ 1 side by side, so the
+ * three fields an operation reads share a cache line. */
+typedef struct edge {
+    uint32_t org, onext, oprev;
+} edge;
+
 typedef struct dt {
-    const pdt_point *p;
-    uint32_t *org, *onext, *oprev;
+    const pdt_point *p; /* the points in leaf order (see cut_order) */
+    edge *e;
     size_t cap;   /* directed edges allocated */
     size_t used;  /* directed edges ever handed out (even) */
     uint32_t freelist; /* a free even edge, chained through onext, or NIL */
@@ -50,57 +65,54 @@ static inline uint32_t sym(uint32_t e)
     return e ^ 1u;
 }
 
+static inline uint32_t org(const dt *d, uint32_t e)
+{
+    return d->e[e].org;
+}
+
+static inline uint32_t onext(const dt *d, uint32_t e)
+{
+    return d->e[e].onext;
+}
+
+static inline uint32_t oprev(const dt *d, uint32_t e)
+{
+    return d->e[e].oprev;
+}
+
 static inline uint32_t dest(const dt *d, uint32_t e)
 {
-    return d->org[e ^ 1u];
+    return d->e[e ^ 1u].org;
 }
 
 static inline uint32_t lnext(const dt *d, uint32_t e)
 {
-    return d->oprev[e ^ 1u];
+    return d->e[e ^ 1u].oprev;
 }
 
 static inline uint32_t rprev(const dt *d, uint32_t e)
 {
-    return d->onext[e ^ 1u];
+    return d->e[e ^ 1u].onext;
 }
 
-static int grow(dt *d)
-{
-    size_t cap = d->cap ? 2 * d->cap : 64;
-    if (cap > (size_t)UINT32_MAX) return 0;
-    uint32_t *o = realloc(d->org, cap * sizeof *o);
-    if (!o) return 0;
-    d->org = o;
-    o = realloc(d->onext, cap * sizeof *o);
-    if (!o) return 0;
-    d->onext = o;
-    o = realloc(d->oprev, cap * sizeof *o);
-    if (!o) return 0;
-    d->oprev = o;
-    d->cap = cap;
-    return 1;
-}
-
-/* A new isolated edge a -> b; returns NIL when out of memory. */
+/* A new isolated edge a -> b; returns NIL when out of memory (the array is
+ * sized for the planar bound up front, so that never happens in practice). */
 static uint32_t make_edge(dt *d, uint32_t a, uint32_t b)
 {
     uint32_t e;
     if (d->freelist != NIL) {
         e = d->freelist;
-        d->freelist = d->onext[e];
+        d->freelist = d->e[e].onext;
     } else {
-        if (d->used + 2 > d->cap && !grow(d)) {
+        if (d->used + 2 > d->cap) {
             d->nomem = 1;
             return NIL;
         }
         e = (uint32_t)d->used;
         d->used += 2;
     }
-    d->org[e] = a;
-    d->org[e ^ 1] = b;
-    d->onext[e] = d->oprev[e] = e;
-    d->onext[e ^ 1] = d->oprev[e ^ 1] = e ^ 1;
+    d->e[e] = (edge){ a, e, e };
+    d->e[e ^ 1] = (edge){ b, e ^ 1, e ^ 1 };
     PDT_TRACE(d->tr, 2, PDT_EV_EDGE_ADD, 0, PDT_TRACE_PT(d->tr, a), PDT_TRACE_PT(d->tr, b), 0, 0);
     return e;
 }
@@ -108,17 +120,17 @@ static uint32_t make_edge(dt *d, uint32_t a, uint32_t b)
 /* Guibas–Stolfi splice, primal part: exchange onext of a and b. */
 static inline void splice(dt *d, uint32_t a, uint32_t b)
 {
-    uint32_t an = d->onext[a], bn = d->onext[b];
-    d->onext[a] = bn;
-    d->onext[b] = an;
-    d->oprev[bn] = a;
-    d->oprev[an] = b;
+    uint32_t an = d->e[a].onext, bn = d->e[b].onext;
+    d->e[a].onext = bn;
+    d->e[b].onext = an;
+    d->e[bn].oprev = a;
+    d->e[an].oprev = b;
 }
 
 /* New edge from dest(a) to org(b), left faces of a, e, b the same. */
 static uint32_t connect(dt *d, uint32_t a, uint32_t b)
 {
-    uint32_t e = make_edge(d, dest(d, a), d->org[b]);
+    uint32_t e = make_edge(d, dest(d, a), org(d, b));
     if (e == NIL) return NIL;
     splice(d, e, lnext(d, a));
     splice(d, sym(e), b);
@@ -127,13 +139,13 @@ static uint32_t connect(dt *d, uint32_t a, uint32_t b)
 
 static void delete_edge(dt *d, uint32_t e)
 {
-    PDT_TRACE(d->tr, 2, PDT_EV_EDGE_DEL, 0, PDT_TRACE_PT(d->tr, d->org[e]),
+    PDT_TRACE(d->tr, 2, PDT_EV_EDGE_DEL, 0, PDT_TRACE_PT(d->tr, org(d, e)),
               PDT_TRACE_PT(d->tr, dest(d, e)), 0, 0);
-    splice(d, e, d->oprev[e]);
-    splice(d, sym(e), d->oprev[sym(e)]);
+    splice(d, e, oprev(d, e));
+    splice(d, sym(e), oprev(d, sym(e)));
     e &= ~1u;
-    d->org[e] = d->org[e ^ 1] = NIL;
-    d->onext[e] = d->freelist;
+    d->e[e].org = d->e[e ^ 1].org = NIL;
+    d->e[e].onext = d->freelist;
     d->freelist = e;
 }
 
@@ -145,12 +157,12 @@ static inline int ccw(const dt *d, uint32_t a, uint32_t b, uint32_t c)
 /* x strictly right of edge e (i.e. x, dest e, org e counter-clockwise) */
 static inline int right_of(const dt *d, uint32_t x, uint32_t e)
 {
-    return ccw(d, x, dest(d, e), d->org[e]);
+    return ccw(d, x, dest(d, e), org(d, e));
 }
 
 static inline int left_of(const dt *d, uint32_t x, uint32_t e)
 {
-    return ccw(d, x, d->org[e], dest(d, e));
+    return ccw(d, x, org(d, e), dest(d, e));
 }
 
 /* d strictly inside the circle of counter-clockwise a, b, c, ties by SoS */
@@ -218,53 +230,66 @@ static uint64_t kth_key(uint64_t *v, size_t n, size_t k)
     return v[k];
 }
 
-/* Split perm[lo, hi) (in frame-0 order) at the frame-1 median: the mid - lo
+/* ---- the cut tree, computed before any edge exists ----
+ * The recursion's splits depend only on the points, so they are all made
+ * first: afterwards id[0, n) lists the points in the order of the leaves
+ * (every node's points form one contiguous range, each leaf sorted in its
+ * frame).  The kernel then runs on a copy of the points in that order, so a
+ * sub-problem touches one contiguous block of points, and its edges, made
+ * while it runs, one contiguous block of edge records. */
+
+typedef struct cutter {
+    const pdt_point *pts; /* indexed by the ids */
+    uint32_t *id;
+    uint64_t *k, *ks;     /* scratch: frame-1 keys, twice */
+    uint32_t *tp;         /* scratch: the upper part of a split */
+} cutter;
+
+/* Split id[lo, hi) (in frame-0 order) at the frame-1 median: the mid - lo
  * frame-1 smallest points first; both parts stay in frame-0 order (a stable
- * partition), so frame-0 nodes never need a selection.
- * Scratch (5 words per point): the unused tail of the org array.  When this
- * node starts, only edges among the n - m points of finished subtrees exist,
- * at most 3(n - m) of them, so at least 6m + 12 words of org are free; those
- * pages would be touched by later edges anyway, so the scratch adds nothing
- * to the peak memory.  (malloc is the fallback.)  Returns 0 when out of
- * memory. */
-static int split_frame1(dt *d, uint32_t *perm, uint32_t lo, uint32_t hi, uint32_t mid)
+ * partition), so frame-0 nodes never need a selection. */
+static void split_frame1(const cutter *c, uint32_t lo, uint32_t hi, uint32_t mid)
 {
     size_t m = hi - lo;
-    void *heap = NULL;
-    uint64_t *k;
-    if (d->cap - d->used >= 5 * m + 2) {
-        k = (uint64_t *)(void *)(d->org + d->used + (d->used & 1)); /* 8-byte aligned */
-    } else {
-        heap = malloc(m * (2 * sizeof(uint64_t) + sizeof(uint32_t)));
-        if (!heap) return 0;
-        k = heap;
-    }
-    uint64_t *ks = k + m;
-    uint32_t *tp = (uint32_t *)(void *)(ks + m);
-    for (size_t i = 0; i < m; i++) ks[i] = k[i] = frame_key(d->p[perm[lo + i]], 1);
-    uint64_t piv = kth_key(ks, m, mid - lo); /* the smallest key of the upper part */
-    size_t a = lo, b = 0;
+    uint32_t *id = c->id + lo;
+    for (size_t i = 0; i < m; i++) c->ks[i] = c->k[i] = frame_key(c->pts[id[i]], 1);
+    uint64_t piv = kth_key(c->ks, m, mid - lo); /* the smallest key of the upper part */
+    size_t a = 0, b = 0;
     for (size_t i = 0; i < m; i++) {
-        if (k[i] < piv) perm[a++] = perm[lo + i];
-        else tp[b++] = perm[lo + i];
+        if (c->k[i] < piv) id[a++] = id[i];
+        else c->tp[b++] = id[i];
     }
-    memcpy(perm + a, tp, b * sizeof *tp);
-    free(heap);
-    return 1;
+    memcpy(id + a, c->tp, b * sizeof *c->tp);
 }
 
-/* Sort perm[lo, hi) (at most 3 points) in frame `axis`. */
-static void sort_small(const dt *d, uint32_t *perm, uint32_t lo, uint32_t hi, int axis)
+/* Sort id[lo, hi) (at most 3 points) in frame `axis`. */
+static void sort_small(const cutter *c, uint32_t lo, uint32_t hi, int axis)
 {
+    uint32_t *id = c->id;
     for (uint32_t i = lo + 1; i < hi; i++) {
-        uint32_t v = perm[i], j = i;
-        uint64_t kv = frame_key(d->p[v], axis);
-        while (j > lo && frame_key(d->p[perm[j - 1]], axis) > kv) {
-            perm[j] = perm[j - 1];
+        uint32_t v = id[i], j = i;
+        uint64_t kv = frame_key(c->pts[v], axis);
+        while (j > lo && frame_key(c->pts[id[j - 1]], axis) > kv) {
+            id[j] = id[j - 1];
             j--;
         }
-        perm[j] = v;
+        id[j] = v;
     }
+}
+
+/* The cuts of node [lo, hi) in frame `axis` and of all nodes below it. */
+static void cut_order(const cutter *c, uint32_t lo, uint32_t hi, int axis)
+{
+    uint32_t n = hi - lo;
+    if (n <= 3) {
+        sort_small(c, lo, hi, axis);
+        return;
+    }
+    uint32_t mid = lo + n / 2;
+    /* invariant: id[lo, hi) is in frame-0 order */
+    if (axis == 1) split_frame1(c, lo, hi, mid);
+    cut_order(c, lo, mid, 1 - axis);
+    cut_order(c, mid, hi, 1 - axis);
 }
 
 /* Walk the hull from any hull edge e (counter-clockwise walk: e <- rprev e)
@@ -277,7 +302,7 @@ static void frame_extremes(const dt *d, uint32_t e0, int axis, uint32_t *le, uin
     uint64_t klo = 0, khi = 0;
     int hi_at_start = 0;
     do {
-        uint64_t k = frame_key(d->p[d->org[e]], axis);
+        uint64_t k = frame_key(d->p[org(d, e)], axis);
         if (lo_e == NIL || k < klo) {
             klo = k;
             lo_e = e;
@@ -303,36 +328,36 @@ static int merge(dt *d, uint32_t ldo, uint32_t ldi, uint32_t rdi, uint32_t rdo, 
 {
     /* lower common tangent */
     for (;;) {
-        if (left_of(d, d->org[rdi], ldi))
+        if (left_of(d, org(d, rdi), ldi))
             ldi = lnext(d, ldi);
-        else if (right_of(d, d->org[ldi], rdi))
+        else if (right_of(d, org(d, ldi), rdi))
             rdi = rprev(d, rdi);
         else
             break;
     }
     uint32_t basel = connect(d, sym(rdi), ldi);
     if (basel == NIL) return 0;
-    if (d->org[ldi] == d->org[ldo]) ldo = sym(basel);
-    if (d->org[rdi] == d->org[rdo]) rdo = basel;
+    if (org(d, ldi) == org(d, ldo)) ldo = sym(basel);
+    if (org(d, rdi) == org(d, rdo)) rdo = basel;
 
     /* the rising bubble */
     for (;;) {
-        uint32_t bo = d->org[basel], bd = dest(d, basel);
-        uint32_t lcand = d->onext[sym(basel)];
+        uint32_t bo = org(d, basel), bd = dest(d, basel);
+        uint32_t lcand = onext(d, sym(basel));
         int lvalid = right_of(d, dest(d, lcand), basel);
         if (lvalid) {
             for (;;) {
-                uint32_t nx = d->onext[lcand];
+                uint32_t nx = onext(d, lcand);
                 if (nx == sym(basel) || !in_circle(d, bd, bo, dest(d, lcand), dest(d, nx))) break;
                 delete_edge(d, lcand);
                 lcand = nx;
             }
         }
-        uint32_t rcand = d->oprev[basel];
+        uint32_t rcand = oprev(d, basel);
         int rvalid = right_of(d, dest(d, rcand), basel);
         if (rvalid) {
             for (;;) {
-                uint32_t nx = d->oprev[rcand];
+                uint32_t nx = oprev(d, rcand);
                 if (nx == basel || !in_circle(d, bd, bo, dest(d, rcand), dest(d, nx))) break;
                 delete_edge(d, rcand);
                 rcand = nx;
@@ -340,7 +365,7 @@ static int merge(dt *d, uint32_t ldo, uint32_t ldi, uint32_t rdi, uint32_t rdo, 
         }
         if (!lvalid && !rvalid) break;
         if (!lvalid ||
-            (rvalid && in_circle(d, dest(d, lcand), d->org[lcand], d->org[rcand], dest(d, rcand))))
+            (rvalid && in_circle(d, dest(d, lcand), org(d, lcand), org(d, rcand), dest(d, rcand))))
             basel = connect(d, rcand, sym(basel));
         else
             basel = connect(d, sym(basel), sym(lcand));
@@ -351,17 +376,15 @@ static int merge(dt *d, uint32_t ldo, uint32_t ldi, uint32_t rdi, uint32_t rdo, 
     return 1;
 }
 
-/* Triangulate the points perm[lo, hi) (hi - lo >= 2), cutting at the median
- * of frame `axis`.  *le: counter-clockwise hull edge out of the frame-smallest
- * point; *re: clockwise hull edge out of the frame-largest point.  Returns 0
- * when out of memory. */
-static int build(dt *d, uint32_t *perm, uint32_t lo, uint32_t hi, int axis, uint32_t *le,
-                 uint32_t *re)
+/* Triangulate the points [lo, hi) (hi - lo >= 2, in leaf order: the cuts are
+ * made), the node cutting at the median of frame `axis`.  *le: counter-
+ * clockwise hull edge out of the frame-smallest point; *re: clockwise hull
+ * edge out of the frame-largest point.  Returns 0 when out of memory. */
+static int build(dt *d, uint32_t lo, uint32_t hi, int axis, uint32_t *le, uint32_t *re)
 {
     uint32_t n = hi - lo;
-    if (n <= 3) {
-        sort_small(d, perm, lo, hi, axis);
-        uint32_t s1 = perm[lo], s2 = perm[lo + 1];
+    if (n <= 3) { /* sorted in frame `axis` by cut_order */
+        uint32_t s1 = lo, s2 = lo + 1;
         uint32_t a = make_edge(d, s1, s2);
         if (a == NIL) return 0;
         if (n == 2) {
@@ -369,7 +392,7 @@ static int build(dt *d, uint32_t *perm, uint32_t lo, uint32_t hi, int axis, uint
             *re = sym(a);
             return 1;
         }
-        uint32_t s3 = perm[lo + 2];
+        uint32_t s3 = lo + 2;
         uint32_t b = make_edge(d, s2, s3);
         if (b == NIL) return 0;
         splice(d, sym(a), b);
@@ -390,19 +413,106 @@ static int build(dt *d, uint32_t *perm, uint32_t lo, uint32_t hi, int axis, uint
         return 1;
     }
     uint32_t mid = lo + n / 2;
-    /* invariant: perm[lo, hi) is in frame-0 order */
-    if (axis == 1 && !split_frame1(d, perm, lo, hi, mid)) {
-        d->nomem = 1;
-        return 0;
-    }
     uint32_t ldo, ldi, rdi, rdo;
-    if (!build(d, perm, lo, mid, 1 - axis, &ldo, &ldi) ||
-        !build(d, perm, mid, hi, 1 - axis, &rdi, &rdo))
+    if (!build(d, lo, mid, 1 - axis, &ldo, &ldi) || !build(d, mid, hi, 1 - axis, &rdi, &rdo))
         return 0;
     /* the children answered in the other frame: find this frame's extremes */
     frame_extremes(d, ldo, axis, &ldo, &ldi);
     frame_extremes(d, rdi, axis, &rdi, &rdo);
     return merge(d, ldo, ldi, rdi, rdo, le, re);
+}
+
+/* Collect the counter-clockwise triangles: walk each left face with lprev
+ * (org and onext only) and report it at its smallest edge, so every face is
+ * seen once, in the order of its smallest edge.  Triangle k is written over
+ * edge record k: k <= the current edge, and only larger edges are read from
+ * then on.  Vertices are written as id[v].  Returns the number of triangles. */
+static size_t collect(dt *d, const uint32_t *id, const uint32_t *tid, int run)
+{
+    pdt_trace *tr = d->tr;
+    pdt_tri *out = (pdt_tri *)(void *)d->e; /* 12 bytes each, like an edge */
+    size_t nt = 0;
+    for (uint32_t e = 0; e < (uint32_t)d->used; e++) {
+        if (d->e[e].org == NIL) continue;
+        uint32_t e1 = sym(d->e[e].onext);  /* lprev(e) */
+        if (e1 < e) continue;
+        uint32_t e2 = sym(d->e[e1].onext); /* lprev(lprev(e)) */
+        if (e2 < e || sym(d->e[e2].onext) != e) continue;
+        uint32_t a = d->e[e].org, b = d->e[e2].org, c = d->e[e1].org;
+        if (pdt_orient(d->p[a], d->p[b], d->p[c]) <= 0) continue; /* the outer face */
+        PDT_TRACE(tr, 1, PDT_EV_TRI_NEW, run, tid[a], tid[b], tid[c], 0);
+        out[nt].v[0] = id[a];
+        out[nt].v[1] = id[b];
+        out[nt].v[2] = id[c];
+        nt++;
+    }
+    return nt;
+}
+
+/* T* of the n >= 2 distinct points pts[id[0]], ..., pts[id[n-1]], listed in
+ * lexicographic order (id is reordered: leaf order).  Triangles come out as
+ * ids; the trace sees ids through tr->gid when there is one. */
+static pdt_status kernel(const pdt_point *pts, uint32_t *id, size_t n, pdt_tri **tris,
+                         size_t *ntri, int run, pdt_trace *tr)
+{
+    *tris = NULL;
+    *ntri = 0;
+    dt d;
+    memset(&d, 0, sizeof d);
+    d.freelist = NIL;
+    d.cap = 6 * n + 12; /* at most 3n undirected edges alive */
+    d.e = malloc(d.cap * sizeof *d.e); /* becomes the triangle array */
+    pdt_point *q = pdt_big_alloc(n * sizeof *q);
+    if (!d.e || !q) {
+        free(d.e);
+        pdt_big_free(q, n * sizeof *q);
+        return PDT_ERR_NOMEM;
+    }
+    pdt_big_advise(d.e, d.cap * sizeof *d.e);
+    /* the cuts, with scratch (5 words per point) in the unused edge array */
+    cutter c = { pts, id, (uint64_t *)(void *)d.e, NULL, NULL };
+    c.ks = c.k + n;
+    c.tp = (uint32_t *)(void *)(c.ks + n);
+    cut_order(&c, 0, (uint32_t)n, 0);
+    for (size_t i = 0; i < n; i++) q[i] = pts[id[i]];
+    d.p = q;
+
+    /* kernel vertex v is point id[v]; the trace names it tr->gid[id[v]] */
+    pdt_trace ktr;
+    uint32_t *tid = id, *tmap = NULL;
+    if (tr) {
+        if (tr->gid) {
+            tmap = malloc(n * sizeof *tmap);
+            if (!tmap) {
+                free(d.e);
+                pdt_big_free(q, n * sizeof *q);
+                return PDT_ERR_NOMEM;
+            }
+            for (size_t i = 0; i < n; i++) tmap[i] = tr->gid[id[i]];
+            tid = tmap;
+        }
+        ktr = *tr;
+        ktr.gid = tid;
+        d.tr = &ktr;
+    }
+    uint32_t le, re;
+    int ok = build(&d, 0, (uint32_t)n, 0, &le, &re);
+    size_t nt = ok ? collect(&d, id, tid, run) : 0;
+    free(tmap);
+    pdt_big_free(q, n * sizeof *q);
+    if (!ok) {
+        free(d.e);
+        return PDT_ERR_NOMEM;
+    }
+    if (nt == 0) {
+        free(d.e);
+        return PDT_OK;
+    }
+    pdt_tri *out = (pdt_tri *)(void *)d.e;
+    pdt_tri *shrunk = realloc(out, nt * sizeof *shrunk);
+    *tris = shrunk ? shrunk : out;
+    *ntri = nt;
+    return PDT_OK;
 }
 
 pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri, int run,
@@ -414,68 +524,12 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
     if (n > (size_t)(UINT32_MAX / 8)) return PDT_ERR_ARG;
     for (size_t i = 1; i < n; i++) /* the precondition: distinct and sorted */
         if (pdt_key(pts[i - 1]) >= pdt_key(pts[i])) return PDT_ERR_ARG;
-    dt d;
-    memset(&d, 0, sizeof d);
-    d.p = pts;
-    d.tr = tr;
-    d.freelist = NIL;
-    d.cap = 6 * n + 12; /* at most 3n undirected edges alive */
-    d.org = malloc(d.cap * sizeof *d.org);
-    d.onext = malloc(d.cap * sizeof *d.onext);
-    d.oprev = malloc(d.cap * sizeof *d.oprev);
-    uint32_t *perm = malloc(n * sizeof *perm);
-    uint32_t le, re;
-    if (perm)
-        for (uint32_t i = 0; i < (uint32_t)n; i++) perm[i] = i;
-    int ok = perm && d.org && d.onext && d.oprev && build(&d, perm, 0, (uint32_t)n, 0, &le, &re);
-    free(perm);
-    if (!ok) {
-        free(d.org);
-        free(d.onext);
-        free(d.oprev);
-        return PDT_ERR_NOMEM;
-    }
-
-    /* Collect the counter-clockwise triangles: walk each left face with
-     * lprev (needs only org and onext) and write triangles over oprev. */
-    size_t words = (d.used + 63) / 64;
-    uint64_t *seen = calloc(words ? words : 1, sizeof *seen);
-    if (!seen) {
-        free(d.org);
-        free(d.onext);
-        free(d.oprev);
-        return PDT_ERR_NOMEM;
-    }
-    pdt_tri *out = (pdt_tri *)(void *)d.oprev; /* 3 words per triangle, <= 2n triangles */
-    size_t nt = 0;
-    for (uint32_t e = 0; e < (uint32_t)d.used; e++) {
-        if (d.org[e] == NIL || (seen[e >> 6] >> (e & 63) & 1)) continue;
-        uint32_t e1 = sym(d.onext[e]);  /* lprev(e) */
-        uint32_t e2 = sym(d.onext[e1]); /* lprev(lprev(e)) */
-        if (sym(d.onext[e2]) != e) continue;
-        seen[e >> 6] |= UINT64_C(1) << (e & 63);
-        seen[e1 >> 6] |= UINT64_C(1) << (e1 & 63);
-        seen[e2 >> 6] |= UINT64_C(1) << (e2 & 63);
-        uint32_t a = d.org[e], b = d.org[e2], c = d.org[e1];
-        if (pdt_orient(pts[a], pts[b], pts[c]) <= 0) continue; /* the outer face */
-        out[nt].v[0] = a;
-        out[nt].v[1] = b;
-        out[nt].v[2] = c;
-        nt++;
-        PDT_TRACE(tr, 1, PDT_EV_TRI_NEW, run, PDT_TRACE_PT(tr, a), PDT_TRACE_PT(tr, b),
-                  PDT_TRACE_PT(tr, c), 0);
-    }
-    free(seen);
-    free(d.org);
-    free(d.onext);
-    if (nt == 0) {
-        free(d.oprev);
-        return PDT_OK;
-    }
-    pdt_tri *shrunk = realloc(out, nt * sizeof *shrunk);
-    *tris = shrunk ? shrunk : out;
-    *ntri = nt;
-    return PDT_OK;
+    uint32_t *id = malloc(n * sizeof *id);
+    if (!id) return PDT_ERR_NOMEM;
+    for (uint32_t i = 0; i < (uint32_t)n; i++) id[i] = i;
+    pdt_status s = kernel(pts, id, n, tris, ntri, run, tr);
+    free(id);
+    return s;
 }
 
 /* ---- canonical order ---- */
@@ -566,11 +620,11 @@ pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size
     *nu = 0;
     if (n == 0) return PDT_OK;
     if (n > UINT32_MAX) return PDT_ERR_ARG;
-    keyed *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+    keyed *a = pdt_big_alloc(n * sizeof *a), *b = pdt_big_alloc(n * sizeof *b);
     size_t *cnt = malloc(65536 * sizeof *cnt);
     if (!a || !b || !cnt) {
-        free(a);
-        free(b);
+        pdt_big_free(a, n * sizeof *a);
+        pdt_big_free(b, n * sizeof *b);
         free(cnt);
         return PDT_ERR_NOMEM;
     }
@@ -602,8 +656,8 @@ pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size
     for (size_t i = 0; i < n; i++)
         if (i == 0 || a[i].key != a[i - 1].key) order[u++] = a[i].idx;
     *nu = u;
-    free(a);
-    free(b);
+    pdt_big_free(a, n * sizeof *a);
+    pdt_big_free(b, n * sizeof *b);
     free(cnt);
     return PDT_OK;
 }
@@ -637,61 +691,31 @@ pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_
         free(order);
         return s;
     }
-    pdt_point *sp = malloc((nu ? nu : 1) * sizeof *sp);
-    if (!sp) {
-        free(order);
-        return PDT_ERR_NOMEM;
-    }
-    for (size_t i = 0; i < nu; i++) sp[i] = pts[order[i]];
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_PARTITION, 0, 0, 0, 0);
     st.n_unique = nu;
     st.n_dup = n - nu;
     double t1 = now();
 
-    /* Kernel trace: kernel indices are positions in sp; translate to input
-     * indices (composed with the caller's own translation, if any). */
-    pdt_trace ktr, *kt = NULL;
-    uint32_t *gid = NULL;
-    if (tr) {
-        ktr = *tr;
-        if (tr->gid) {
-            gid = malloc((nu ? nu : 1) * sizeof *gid);
-            if (!gid) {
-                free(order);
-                free(sp);
-                return PDT_ERR_NOMEM;
-            }
-            for (size_t i = 0; i < nu; i++) gid[i] = tr->gid[order[i]];
-            ktr.gid = gid;
-        } else {
-            ktr.gid = order;
-        }
-        kt = &ktr;
-    }
     if (PDT_TRACING(tr, 1)) {
         PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_LIFT, 0, 0, 0, 0);
         for (size_t i = 0; i < nu; i++)
-            PDT_TRACE(kt, 1, PDT_EV_LIFT, 0, PDT_TRACE_PT(kt, i), 0, 0, (int64_t)pdt_lift(sp[i]).z);
+            PDT_TRACE(tr, 1, PDT_EV_LIFT, 0, PDT_TRACE_PT(tr, order[i]), 0, 0,
+                      (int64_t)pdt_lift(pts[order[i]]).z);
         PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_LIFT, 0, 0, 0, 0);
     }
 
+    /* the kernel on the input points through `order`: triangles come out as
+     * input indices, the trace names points as before (tr->gid composed) */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_KERNEL, 0, 0, 0, 0);
     pdt_tri *t = NULL;
     size_t nt = 0;
-    s = pdt_delaunay(sp, nu, &t, &nt, 0, kt);
+    s = nu >= 2 ? kernel(pts, order, nu, &t, &nt, 0, tr) : PDT_OK;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
-    free(gid);
-    free(sp);
-    if (s != PDT_OK) {
-        free(order);
-        return s;
-    }
+    free(order);
+    if (s != PDT_OK) return s;
     double t2 = now();
 
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_OUTPUT, 0, 0, 0, 0);
-    for (size_t i = 0; i < nt; i++)
-        for (int k = 0; k < 3; k++) t[i].v[k] = order[t[i].v[k]];
-    free(order);
     pdt_tri_canonical(t, nt);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_OUTPUT, 0, 0, 0, 0);
     double t3 = now();
