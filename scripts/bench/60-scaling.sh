@@ -1,0 +1,104 @@
+#!/bin/bash
+# make bench, section "scaling": the sequential pipeline's cost per point as n
+# grows (issue 11).  For each input, `pdt triangulate --stats -o OUT.tri`
+# gives the seconds of every phase (read, sort, kernel, canonical, write);
+# the table shows them as seconds and as nanoseconds per input point, the
+# peak resident memory in bytes per point (/usr/bin/time), and CGAL's
+# Delaunay_triangulation_2 range insert on the same file in the same run
+# (tools/cgal_dt.cpp, exact predicates, spatial sort included) with the ratio
+# (pdt sort + kernel) / (CGAL insert).  Medians of SCALING_RUNS runs (default 1).
+#
+# Sizes (override for a quick run, e.g. SCALING_UNIFORM="1e5 1e6" SCALING_OTHER="1e6"):
+#   SCALING_UNIFORM  uniform points in [0, 2^20)^2   (default 1e5 1e6 4e6 1e7 3e7)
+#   SCALING_OTHER    grid (k x k) and clusters        (default 1e6 1e7)
+#   SCALING_QUICK=1  the same as SCALING_UNIFORM="1e5 1e6" SCALING_OTHER="1e6"
+# Inputs are cached in build/bench/scaling/.  The load average is printed
+# before and after: on a loaded machine the seconds measure the contention.
+set -u
+cd "$(dirname "$0")/../.."
+ROOT=$(pwd)
+B=$ROOT/build/bench
+W=$B/scaling
+PDT=$ROOT/bin/pdt
+mkdir -p "$W"
+if [ "${SCALING_QUICK:-0}" = 1 ]; then
+    UNI=${SCALING_UNIFORM:-"1e5 1e6"}
+    OTH=${SCALING_OTHER:-"1e6"}
+else
+    UNI=${SCALING_UNIFORM:-"1e5 1e6 4e6 1e7 3e7"}
+    OTH=${SCALING_OTHER:-"1e6 1e7"}
+fi
+RUNS=${SCALING_RUNS:-1}
+[ -x "$PDT" ] || { echo "bin/pdt is missing: run make first"; exit 1; }
+TIME=/usr/bin/time
+[ -x "$TIME" ] || { echo "scaling: /usr/bin/time missing (Debian package 'time'), skipped"; exit 0; }
+
+HAVE_CGAL=0
+if [ -d /usr/include/CGAL ] && command -v g++ > /dev/null; then
+    if [ ! -x "$B/cgal_dt" ] || [ scripts/bench/tools/cgal_dt.cpp -nt "$B/cgal_dt" ]; then
+        echo "compiling build/bench/cgal_dt (CGAL) ..."
+        g++ -O2 -DNDEBUG -o "$B/cgal_dt" scripts/bench/tools/cgal_dt.cpp -lgmp -lmpfr 2> "$B/cgal_dt.log" \
+            || echo "skip CGAL: compilation failed (see build/bench/cgal_dt.log)"
+    fi
+    [ -x "$B/cgal_dt" ] && HAVE_CGAL=1
+else
+    echo "skip CGAL: libcgal-dev or g++ not installed"
+fi
+
+num() { python3 -c "print(int(float('$1')))"; }
+
+RES=$W/results.tsv
+: > "$RES"
+echo "load before: $(uptime)"
+inputs=()
+for s in $UNI; do inputs+=("uniform:$s"); done
+for s in $OTH; do inputs+=("grid:$s" "clusters:$s"); done
+for spec in "${inputs[@]}"; do
+    kind=${spec%%:*}
+    n=$(num "${spec#*:}")
+    in=$W/$kind-$n.txt
+    [ -s "$in" ] || "$PDT" gen "$kind" "$n" --seed 1 -o "$in" || exit 1
+    echo "measuring $kind $n ..."
+    for ((r = 1; r <= RUNS; r++)); do
+        "$TIME" -f '%M' -o "$W/time.out" "$PDT" triangulate "$in" -o "$W/out.tri" --stats \
+            2> "$W/run.err" > /dev/null || { echo "  pdt failed: $(tail -2 "$W/run.err")"; exit 1; }
+        stats=$(grep '^{' "$W/run.err" | tail -1)
+        kib=$(tail -1 "$W/time.out")
+        cg=-
+        if [ $HAVE_CGAL = 1 ]; then
+            cg=$("$B/cgal_dt" "$in" | python3 -c 'import json,sys; print(json.load(sys.stdin)["build"])') || cg=-
+        fi
+        printf '%s\t%s\t%s\t%s\t%s\n' "$kind" "$n" "$kib" "$cg" "$stats" >> "$RES"
+    done
+done
+rm -f "$W/out.tri" "$W/time.out" "$W/run.err"
+echo "load after:  $(uptime)"
+
+python3 - "$RES" "$RUNS" <<'PY'
+import json, statistics, sys
+from collections import OrderedDict
+rows = OrderedDict()
+for line in open(sys.argv[1]):
+    kind, n, kib, cg, st = line.rstrip("\n").split("\t", 4)
+    rows.setdefault((kind, int(n)), []).append((int(kib), None if cg == "-" else float(cg), json.loads(st)))
+ph = ["read", "sort", "kernel", "canonical", "write", "total"]
+print()
+print(f"pdt triangulate IN -o OUT.tri --stats, per phase (medians of {sys.argv[2]} run(s)); CGAL insert in the same run")
+hdr = f"{'input':<9} {'n':>10} " + " ".join(f"{p:>9}" for p in ph) + f" {'CGAL':>8} {'(s+k)/CGAL':>10} {'peak B/pt':>9}"
+print(hdr)
+print("-" * len(hdr))
+for (kind, n), r in rows.items():
+    sec = {p: statistics.median(x[2]["seconds"][p] for x in r) for p in ph}
+    kib = max(x[0] for x in r)
+    cgs = [x[1] for x in r if x[1] is not None]
+    cg = statistics.median(cgs) if cgs else None
+    ratio = (sec["sort"] + sec["kernel"]) / cg if cg else None
+    print(f"{kind:<9} {n:>10} " + " ".join(f"{sec[p]:>9.3f}" for p in ph) +
+          (f" {cg:>8.3f} {ratio:>10.2f}" if cg else f" {'-':>8} {'-':>10}") + f" {kib * 1024 / n:>9.1f}")
+    print(f"{'  ns/pt':<20} " + " ".join(f"{sec[p] * 1e9 / n:>9.1f}" for p in ph) +
+          (f" {cg * 1e9 / n:>8.1f}" if cg else f" {'-':>8}"))
+print()
+print("seconds per phase from --stats (read: text parse; write: the .tri file); ns/pt: the same per")
+print("input point; CGAL: Delaunay_triangulation_2::insert of the range (s, then ns/pt); (s+k)/CGAL:")
+print("pdt sort + kernel over CGAL's insert (below 1: pdt faster); peak: max RSS / n (time -f %M).")
+PY
