@@ -31,6 +31,7 @@ typedef struct pdt_io_cur {
     const char *name; /* file name for messages */
     size_t line;      /* number of the current line, 1-based */
     int done;         /* the end was reached (line then names the last line) */
+    int fields;       /* 1: ',' and ';' also end a token (point text files: CSV) */
 } pdt_io_cur;
 
 void pdt_io_cur_init(pdt_io_cur *c, const pdt_io_text *t, const char *name);
@@ -45,11 +46,18 @@ int pdt_io_next_line(pdt_io_cur *c);
  * line end. */
 int pdt_io_token(pdt_io_cur *c, const char **tok, size_t *len);
 
+/* With c->fields set: skip blanks and at most one field separator (',' or
+ * ';') between two tokens of a line, so "x y", "x,y", "x;y", "x\ty" and
+ * "x , y" all read as two tokens; a second separator (",,") then stops
+ * pdt_io_token, which reports no token.  Without c->fields: skips blanks. */
+void pdt_io_field_sep(pdt_io_cur *c);
+
 /* Skip the rest of the current line (including its '\n'). */
 void pdt_io_skip_line(pdt_io_cur *c);
 
 /* The current line must hold nothing more: move to the next line, or report
- * "NAME:LINE: unexpected 'TOKEN' after WHAT" (PDT_ERR_PARSE) in err. */
+ * "NAME:LINE: unexpected 'TOKEN' after WHAT" (PDT_ERR_PARSE) in err (a
+ * leftover field separator counts as a token). */
 pdt_status pdt_io_end_line(pdt_io_cur *c, const char *what, pdt_err *err);
 
 /* Parse a plain decimal integer ([+-]digits).  Returns 0 and *v on success,

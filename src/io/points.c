@@ -89,6 +89,7 @@ static pdt_status point_xy(reader *r)
                            r->cur.line);
     pdt_status st = coord(r, tok, len, &p.x, &ox);
     if (st != PDT_OK) return st;
+    pdt_io_field_sep(&r->cur);
     if (!pdt_io_token(&r->cur, &tok, &len))
         return pdt_err_set(r->err, PDT_ERR_PARSE, "%s:%zu: missing y coordinate", r->cur.name,
                            r->cur.line);
@@ -105,8 +106,49 @@ static pdt_status point_xy(reader *r)
     return PDT_OK;
 }
 
+/* A column name of a header line: letters, digits and '_', starting with a
+ * letter, optionally in double quotes ("x", X, "lon"). */
+static int is_name(const char *tok, size_t len)
+{
+    if (len >= 2 && tok[0] == '"' && tok[len - 1] == '"') {
+        tok++;
+        len -= 2;
+    }
+    if (len == 0 || !((tok[0] | 0x20) >= 'a' && (tok[0] | 0x20) <= 'z')) return 0;
+    for (size_t i = 0; i < len; i++) {
+        char ch = tok[i];
+        if (!(ch == '_' || (ch >= '0' && ch <= '9') || ((ch | 0x20) >= 'a' && (ch | 0x20) <= 'z')))
+            return 0;
+    }
+    return 1;
+}
+
+/* The first line of a point text file may name the two columns ("x,y",
+ * "X;Y", "x<TAB>y", "\"x\",\"y\""): skip it when it holds exactly two names. */
+static void skip_header(reader *r)
+{
+    pdt_io_cur save = r->cur;
+    const char *tok;
+    size_t len;
+    int two_names = pdt_io_token(&r->cur, &tok, &len) && is_name(tok, len);
+    if (two_names) {
+        pdt_io_field_sep(&r->cur);
+        two_names = pdt_io_token(&r->cur, &tok, &len) && is_name(tok, len);
+    }
+    if (two_names && !pdt_io_token(&r->cur, &tok, &len) &&
+        !(r->cur.p < r->cur.end && (*r->cur.p == ',' || *r->cur.p == ';'))) {
+        pdt_io_skip_line(&r->cur);
+        return;
+    }
+    r->cur = save;
+}
+
+/* One point per line: "x y", "x,y", "x;y" or "x<TAB>y", after an optional
+ * header line naming the columns. */
 static pdt_status read_text(reader *r)
 {
+    r->cur.fields = 1;
+    if (pdt_io_next_line(&r->cur)) skip_header(r);
     while (pdt_io_next_line(&r->cur)) {
         pdt_status st = point_xy(r);
         if (st == PDT_OK)

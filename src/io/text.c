@@ -88,6 +88,7 @@ void pdt_io_cur_init(pdt_io_cur *c, const pdt_io_text *t, const char *name)
     c->name = name;
     c->line = 1;
     c->done = 0;
+    c->fields = 0;
     /* A UTF-8 byte-order mark at the start is not part of the data. */
     if (t->len >= 3 && memcmp(t->buf, "\xEF\xBB\xBF", 3) == 0) c->p += 3;
 }
@@ -130,20 +131,36 @@ int pdt_io_next_line(pdt_io_cur *c)
     return 0;
 }
 
+static inline int is_sep(char ch)
+{
+    return ch == ',' || ch == ';';
+}
+
 int pdt_io_token(pdt_io_cur *c, const char **tok, size_t *len)
 {
     const char *p = c->p, *end = c->end;
     while (p < end && is_blank(*p)) p++;
-    if (p == end || *p == '\n' || *p == '#') {
+    if (p == end || *p == '\n' || *p == '#' || (c->fields && is_sep(*p))) {
         c->p = p;
         return 0;
     }
     const char *s = p;
-    while (p < end && !is_blank(*p) && *p != '\n' && *p != '#') p++;
+    if (c->fields)
+        while (p < end && !is_blank(*p) && *p != '\n' && *p != '#' && !is_sep(*p)) p++;
+    else
+        while (p < end && !is_blank(*p) && *p != '\n' && *p != '#') p++;
     *tok = s;
     *len = (size_t)(p - s);
     c->p = p;
     return 1;
+}
+
+void pdt_io_field_sep(pdt_io_cur *c)
+{
+    const char *p = c->p, *end = c->end;
+    while (p < end && is_blank(*p)) p++;
+    if (c->fields && p < end && is_sep(*p)) p++;
+    c->p = p;
 }
 
 /* ---- numbers ---------------------------------------------------------------- */
@@ -313,7 +330,16 @@ pdt_status pdt_io_end_line(pdt_io_cur *c, const char *what, pdt_err *err)
     const char *tok;
     size_t len;
     char show[64];
-    if (pdt_io_token(c, &tok, &len))
+    int more = pdt_io_token(c, &tok, &len);
+    if (!more && c->fields && c->p < c->end && is_sep(*c->p)) { /* "x,y,z": show ",z" */
+        const char *e = c->p + 1;
+        while (e < c->end && *e != '\n' && *e != '#') e++;
+        while (e > c->p + 1 && is_blank(e[-1])) e--;
+        tok = c->p;
+        len = (size_t)(e - c->p);
+        more = 1;
+    }
+    if (more)
         return pdt_err_set(err, PDT_ERR_PARSE, "%s:%zu: unexpected '%s' after %s", c->name,
                            c->line, pdt_io_show(tok, len, show, sizeof show), what);
     pdt_io_skip_line(c);

@@ -110,6 +110,46 @@ TEST(text_basic)
     free(p);
 }
 
+/* Spreadsheet exports: comma-, semicolon- or tab-separated, an optional
+ * header line naming the columns, decimals under --scale. */
+TEST(text_csv)
+{
+    const char *ok_texts[] = {
+        "x,y\n1,2\n-3,4\n",
+        "X;Y\r\n1;2\r\n-3;4\r\n",
+        "x\ty\n1\t2\n-3\t4\n",
+        "\"x\",\"y\"\n1 , 2\n-3,4\n",
+        "# exported\n\nlon,lat\n1,2\n-3,4 # comment\n",
+        "1,2\n-3 4\n",
+    };
+    for (size_t i = 0; i < sizeof ok_texts / sizeof *ok_texts; i++) {
+        pdt_point *p = NULL;
+        size_t n = 0;
+        pdt_err err;
+        pdt_status st = rd("c.txt", ok_texts[i], 0, &p, &n, NULL, &err);
+        CHECK_MSG(st == PDT_OK && n == 2 && p[0].x == 1 && p[0].y == 2 && p[1].x == -3 &&
+                      p[1].y == 4, "case %zu: %s", i, err.msg);
+        free(p);
+    }
+    pdt_point *p = NULL;
+    size_t n = 0;
+    pdt_err err;
+    pdt_status st = rd("d.txt", "x,y\n1.5,2.25\n", 100, &p, &n, NULL, &err);
+    CHECK_MSG(st == PDT_OK && n == 1 && p[0].x == 150 && p[0].y == 225, "%s", err.msg);
+    free(p);
+    CHECK(bad("c.txt", "x,y\n1,,2\n", 0, "2: missing y coordinate"));
+    CHECK(bad("c.txt", "x,y\n1,2,3\n", 0,
+              "2: unexpected ',3' after the coordinates (one point 'x y' per line)"));
+    CHECK(bad("c.txt", "x,y\n1,2,\n", 0,
+              "2: unexpected ',' after the coordinates (one point 'x y' per line)"));
+    CHECK(bad("c.txt", "x,y,z\n1,2,3\n", 0, "1: 'x' is not a number"));
+    CHECK(bad("c.txt", "x,y\nx,y\n", 0, "2: 'x' is not a number"));  /* one header only */
+    CHECK(bad("c.txt", "1,2\nx,y\n", 0, "2: 'x' is not a number"));  /* only on top */
+    CHECK(bad("c.txt", ",1,2\n", 0, "1: missing x coordinate"));
+    CHECK(bad("c.txt", "x,y\n1.5,2\n", 0,
+              "2: coordinate 1.5 is not an integer (decimal coordinates need --scale K)"));
+}
+
 TEST(empty_file_is_zero_points)
 {
     pdt_point *p = (pdt_point *)1;
@@ -131,7 +171,8 @@ TEST(text_bad_inputs)
     CHECK(bad("b.txt", "1 99999999999999999999999\n", 0,
               "1: coordinate 99999999999999999999999 does not fit in 32 bits"));
     CHECK(bad("b.txt", "1 2\n\nabc 3\n", 0, "3: 'abc' is not a number"));
-    CHECK(bad("b.txt", "1,2 3\n", 0, "1: '1,2' is not a number"));
+    CHECK(bad("b.txt", "1,2 3\n", 0,
+              "1: unexpected '3' after the coordinates (one point 'x y' per line)"));
     CHECK(bad("b.txt", "1 2\n- 3\n", 0, "2: '-' is not a number"));
     CHECK(bad("b.txt", "1 0x10\n", 0, "1: '0x10' is not a number"));
     CHECK(bad("b.txt", "1 \x01\n", 0, "1: '\\x01' is not a number"));
@@ -492,6 +533,7 @@ int main(void)
     RUN(text_basic);
     RUN(empty_file_is_zero_points);
     RUN(text_bad_inputs);
+    RUN(text_csv);
     RUN(file_errors);
     RUN(node_format);
     RUN(scale_rounding);
