@@ -46,6 +46,21 @@ Every line of `checks` states one fact the lesson text relies on.  Lines:
                                 thesis' H has the opposite sign: H > 0 means outside)
     output-same RUN             this run printed exactly what run RUN printed
 
+What the viewer itself shows (from `pdtview --describe`, written by
+scripts/lesson.sh into RUNS_DIR/RUN/describe.txt: the window's own functions):
+
+    line POS = "TEXT"           the event line at POS reads exactly TEXT
+    line POS ~ "TEXT"           the event line at POS contains TEXT
+    code POS = N                the code panel lights line N (as numbered on screen)
+    code POS = LISTING N        ... of listing LISTING (graham or srm)
+    start = K                   the lesson's start position (lesson.conf) is cursor K
+    listing LISTING             the text holds the panel's pseudo-code LISTING line for line
+                                (an indented block, numbers and all)
+
+POS is a counter K (the viewer at "K / total"), `start` (where the lesson opens) or
+`first KIND [W..] [F=V..]` / `last ...` (as in lesson.conf: stable across runs of
+several ranks).
+
 Fields F=V are compared with the fields of the dump line (same names as
 `pdt trace dump` prints, e.g. pt=5 cause=3); words W with the words that
 follow the kind (`pop graham ...`: graham; `ra-defer 5 8 2 rank=1`: 5 8 2).
@@ -257,6 +272,43 @@ def incircle(a, b, c, d):
             + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
 
 
+def read_describe(path):
+    """pdtview --describe output: (start, {K: (listing, line, text)}, {listing: [lines]})."""
+    start, ev, lst = None, {}, {}
+    with open(path, encoding='utf-8') as f:
+        for raw in f:
+            t = raw.rstrip('\n').split('\t')
+            if t[0] == 'start':
+                start = int(t[1])
+            elif t[0] == 'listing':
+                lst.setdefault(t[1], []).append(t[3])
+            elif t[0] == 'event':
+                ev[int(t[1])] = (t[2], int(t[3]) if t[3] != '-' else None, t[4])
+    return start, ev, lst
+
+
+def resolve_pos(toks, events, order, start):
+    """Cursor K of a position: `K`, `start`, `first|last KIND ...`."""
+    if toks[0] == 'start':
+        if start is None:
+            raise AssertionError('no start position recorded')
+        return start
+    if toks[0] in ('first', 'last'):
+        want = parse_fields(toks[2:])
+        hits = [i for i in order if match(events[i][0], events[i][1], toks[1], want)]
+        if not hits:
+            raise AssertionError('no event %s' % ' '.join(toks[1:]))
+        return (hits[0] if toks[0] == 'first' else hits[-1]) + 1 - DUMP_FIRST
+    return int(toks[0])
+
+
+def quoted(rhs):
+    rhs = rhs.strip()
+    if len(rhs) < 2 or rhs[0] != '"' or rhs[-1] != '"':
+        raise ValueError('the text must be in double quotes: %s' % rhs)
+    return rhs[1:-1]
+
+
 def main():
     if len(sys.argv) >= 5 and sys.argv[1] == '--find':
         k = find(sys.argv[2], sys.argv[3], sys.argv[4:])
@@ -285,13 +337,18 @@ def main():
             pfile = sections[run].get('points', glob.get('points', 'points.txt'))
             pts = read_points(os.path.join(ldir, pfile)) if os.path.exists(
                 os.path.join(ldir, pfile)) else []
-            cache[run] = (events, order, out, pts)
+            dp = os.path.join(d, 'describe.txt')
+            desc = read_describe(dp) if os.path.exists(dp) else None
+            cache[run] = (events, order, out, pts, desc)
         return cache[run]
 
     run = runs[0]
     bad = 0
+    skipped = 0
     nchecks = 0
-    with open(os.path.join(ldir, 'checks')) as f:
+    with open(os.path.join(ldir, 'README.md'), encoding='utf-8') as f:
+        text_lines = f.read().split('\n')
+    with open(os.path.join(ldir, 'checks'), encoding='utf-8') as f:
         lines = list(f)
     for lineno, raw in enumerate(lines, 1):
         line = raw.split('#', 1)[0].strip()
@@ -306,8 +363,45 @@ def main():
                 run = toks[1]
                 continue
             nchecks += 1
-            events, order, out, pts = run_data(run)
+            events, order, out, pts, desc = run_data(run)
             ltoks, rhs = toks, None
+            if toks[0] in ('line', 'code', 'start', 'listing'):
+                if desc is None:
+                    skipped += 1
+                    print('SKIP %s\n     no describe.txt (pdtview is not built)' % where)
+                    continue
+                dstart, dev, dlst = desc
+                if toks[0] == 'listing':
+                    block = [l[4:].rstrip() for l in text_lines if l.startswith('    ')]
+                    want = dlst.get(toks[1])
+                    if not want:
+                        raise ValueError('pdtview has no listing %r' % toks[1])
+                    if not any(block[i:i + len(want)] == want for i in range(len(block))):
+                        raise AssertionError('README.md has no block of the %d panel lines, '
+                                             'from "%s"' % (len(want), want[0]))
+                    continue
+                op = ' ~ ' if ' ~ ' in line and toks[0] == 'line' else ' = '
+                lhs, _, rhs = line.partition(op)
+                lt = lhs.split()
+                k = dstart if toks[0] == 'start' else resolve_pos(lt[1:], events, order, dstart)
+                if toks[0] == 'start':
+                    if k != int(rhs):
+                        raise AssertionError('the lesson starts at %s' % k)
+                    continue
+                if k not in dev:
+                    raise AssertionError('the viewer has no event %s' % k)
+                listing, cl, text = dev[k]
+                if toks[0] == 'line':
+                    want = quoted(rhs)
+                    if (op == ' = ' and text != want) or (op == ' ~ ' and want not in text):
+                        raise AssertionError('the event line at %d reads "%s"' % (k, text))
+                else:
+                    r = rhs.split()
+                    got = '%s %s' % (listing, cl if cl else '-')
+                    if (len(r) == 1 and str(cl) != r[0]) or (len(r) == 2 and got != ' '.join(r)):
+                        raise AssertionError('at %d the code panel lights %s line %s' % (
+                            k, listing, cl if cl else '(none)'))
+                continue
             if ' = ' in line and toks[0] != 'sum':
                 lhs, rhs = line.rsplit(' = ', 1)
                 ltoks = lhs.split()
@@ -397,7 +491,8 @@ def main():
         except (AssertionError, ValueError, IndexError, KeyError, OSError) as e:
             bad += 1
             print('FAIL %s\n     %s' % (where, e))
-    print('%s: %d checks, %d failed' % (os.path.basename(os.path.normpath(ldir)), nchecks, bad))
+    print('%s: %d checks, %d failed%s' % (os.path.basename(os.path.normpath(ldir)), nchecks, bad,
+                                          ', %d skipped' % skipped if skipped else ''))
     return 1 if bad else 0
 
 

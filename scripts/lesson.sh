@@ -9,14 +9,16 @@
 #      when the lesson uses R > 1 ranks) into build/lessons/NN/RUN/trace, or uses
 #      the recorded run the lesson names (`recorded = ...`);
 #   2. checks the recording with `pdt trace check` and writes `pdt trace dump`
-#      into build/lessons/NN/RUN/dump.txt;
+#      into build/lessons/NN/RUN/dump.txt, and what the viewer says about every
+#      event (`pdtview --describe`: event line, lit code line, the start) into
+#      build/lessons/NN/RUN/describe.txt (when pdtview is built);
 #   3. with a display ($DISPLAY or $WAYLAND_DISPLAY set): opens `pdtview` on the
 #      run at the lesson's start point; without one (or with --headless): renders
 #      the start frame and the key frames into build/lessons/NN/RUN/frames/.
 #
 # Options
 #   --headless     never open a window, render frames (default without a display)
-#   --record-only  record and check, render nothing, open nothing
+#   --record-only  record, check and describe, render nothing, open nothing
 #   --out DIR      where to put the runs (default: build/lessons/NN)
 #   --quiet        print only where things are
 #
@@ -143,7 +145,7 @@ for run in "${RUNS[@]}"; do
     view=$(conf "$run" view "")
     recorded=$(conf "$run" recorded "")
     mkdir -p "$rdir"
-    rm -rf "$rdir/frames" "$rdir/dump.txt" "$rdir/output.txt" "$rdir/log.txt"
+    rm -rf "$rdir/frames" "$rdir/dump.txt" "$rdir/describe.txt" "$rdir/output.txt" "$rdir/log.txt"
 
     # 1. record (or use the recorded run)
     if [ -n "$recorded" ]; then
@@ -178,10 +180,16 @@ for run in "${RUNS[@]}"; do
     fi
     "$PDT" trace dump "$trace" >"$rdir/dump.txt" 2>>"$rdir/log.txt" || { echo "lesson: [$run] pdt trace dump failed" >&2; status=1; continue; }
     say "  [$run] trace: $trace ($(wc -l <"$rdir/dump.txt") events, pdt trace check passed)"
-    [ "$record_only" = 1 ] && continue
 
-    # 3. view or render
+    # 3. what the viewer says (event lines, lit code lines, the start) for the
+    #    checks, then view or render
     startargs=$(pos_args "$start" "$rdir/dump.txt") || { status=1; continue; }
+    if [ -x "$PDTVIEW" ]; then
+        # shellcheck disable=SC2086
+        "$PDTVIEW" "$trace" $startargs --describe >"$rdir/describe.txt" 2>>"$rdir/log.txt" ||
+            { echo "lesson: [$run] pdtview --describe failed (see $rdir/log.txt)" >&2; status=1; continue; }
+    fi
+    [ "$record_only" = 1 ] && continue
     if [ "$have_display" = 1 ]; then
         VIEW_QUEUE+=("$trace|$startargs $view|$run")
         continue

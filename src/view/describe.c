@@ -316,15 +316,15 @@ void pdt_replay_describe_state(const pdt_replay *r, const pdt_rstate *s, size_t 
 /* ---- the pseudo-code listings -------------------------------------------------- */
 
 static const char *const graham_code[] = {
-    "1  find the rightmost lowest point p0",
-    "2  sort the others by angle about p0",
-    "3    tie: delete the closer (or copy)",
-    "4  stack S = (p1, p0); t indexes the top",
-    "5  i = 2",
+    "1  p0 := the rightmost lowest point",
+    "2  sort the others by angle around p0",
+    "3    tie: delete the closer point (or the copy)",
+    "4  S := (p0, p1)",
+    "5  i := 2",
     "6  while i < n:",
-    "7    if p_i strictly left of (p_t-1, p_t):",
-    "8      push p_i; i = i + 1",
-    "9    else: pop S",
+    "7    if Area2(second, top, p_i) > 0:",
+    "8      push p_i; i := i + 1",
+    "9    else: pop       (not a strict left turn)",
     "10 S is the hull",
 };
 

@@ -2,18 +2,14 @@
  * and rank, kernel edges, hulls and stacks, points and their labels, the
  * merge in progress, the current event's highlight, the selection. */
 #include "render_int.h"
+#include "pdt/describe.h"
 
-static int disk_touches_box(double ox, double oy, double rr, pdt_point lo, pdt_point hi)
-{
-    double qx = fmax(lo.x, fmin(ox, hi.x)), qy = fmax(lo.y, fmin(oy, hi.y));
-    return (qx - ox) * (qx - ox) + (qy - oy) * (qy - oy) <= rr * rr * (1 + 1e-9);
-}
 
 /* ---- the geometry --------------------------------------------------------------------- */
 
 /* The strip boxes (labels = 0) or their labels (labels = 1, drawn last, on a
  * white ground so that edges and hulls do not hide them). */
-static void draw_boxes(ctx *c, int cur_tri_ok, double ox, double oy, double rr, int labels)
+static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
 {
     cairo_t *cr = c->cr;
     int cur_rank = c->cur ? (int)c->cur->rank : -1;
@@ -23,7 +19,9 @@ static void draw_boxes(ctx *c, int cur_tri_ok, double ox, double oy, double rr, 
         double x0 = c->X.ox + c->X.s * lo.x, x1 = c->X.ox + c->X.s * hi.x;
         double y0 = c->X.oy - c->X.s * hi.y, y1 = c->X.oy - c->X.s * lo.y;
         double pad = 0.4 * c->L.font;
-        int touched = cur_tri_ok && q != cur_rank && disk_touches_box(ox, oy, rr, lo, hi);
+        /* the same test as the event line's (a deferral names these ranks) */
+        int touched = cur_tri_ok && q != cur_rank &&
+                      pdt_replay_disk_touches(c->r, (const uint32_t[3]){c->cur->ev.a, c->cur->ev.b, c->cur->ev.c}, q);
         if (!labels) {
             cairo_rectangle(cr, x0 - pad, y0 - pad, x1 - x0 + 2 * pad, y1 - y0 + 2 * pad);
             /* opaque tint (rank colour over white): much cheaper than alpha on big areas */
@@ -303,43 +301,43 @@ static void draw_points(ctx *c)
             cairo_fill(cr);
         }
     }
-    /* Graham: angular numbers and deleted points */
+    /* labels (pdt_point_label): the input index beside each point from the
+     * first event, in Graham's scan also p_k once sorted ("2=p4"), while few
+     * are on screen; a label that would collide with a neighbour's is left
+     * out (of coincident copies only the first is labelled) */
     if (nvis > 600) return;
     double f = 0.72 * c->L.font;
-    /* other runs: the input index beside each point, while few are on screen
-     * and they are far enough apart for the labels not to pile up */
-    if (nvis <= 60 && c->spacing >= 2.5 * f && pdt_replay_kind_count(c->r, PDT_EV_SORT) == 0) {
+    int graham = pdt_replay_kind_count(c->r, PDT_EV_SORT) > 0;
+    if (nvis <= 60 && (graham || c->spacing >= 2.5 * f)) {
         cairo_set_source_rgba(cr, 0.0, 0.25, 0.55, 1);
         for (size_t p = 0; p < c->n; p++) {
             double x, y;
-            char lab[24];
+            char lab[32];
             wpt(c, (uint32_t)p, &x, &y);
             if (x < c->L.geo.x || x > c->L.geo.x + c->L.geo.w || y < c->L.geo.y ||
                 y > c->L.geo.y + c->L.geo.h)
                 continue;
             int crowded = 0; /* a point so close that its label would collide */
             for (size_t q = 0; q < c->n && !crowded; q++) {
+                if (q == p) continue;
+                if (c->P[q].x == c->P[p].x && c->P[q].y == c->P[p].y) {
+                    crowded = q < p;
+                    continue;
+                }
                 double qx, qy;
                 wpt(c, (uint32_t)q, &qx, &qy);
-                crowded = q != p && fabs(qx - x) < 1.6 * f && fabs(qy - y) < 0.9 * f;
+                crowded = fabs(qx - x) < 1.6 * f && fabs(qy - y) < 0.9 * f;
             }
             if (crowded) continue;
-            snprintf(lab, sizeof lab, "%zu", p);
-            text_at(cr, SANS, 0, f, x + 0.45 * f, y - 0.3 * f, lab);
+            pdt_point_label(c->r, c->s, p, lab, sizeof lab);
+            int p0 = graham && pdt_replay_sort_pos(c->r, p) == 0 && (c->s->pflags[p] & PDT_PF_SORTED);
+            text_at(cr, SANS, p0, f, x + 0.45 * f, y - 0.3 * f, lab);
         }
     }
     for (size_t p = 0; p < c->n; p++) {
         uint8_t fl = c->s->pflags[p];
         double x, y;
         wpt(c, (uint32_t)p, &x, &y);
-        if (fl & PDT_PF_SORTED) {
-            char lab[24];
-            int64_t pos = pdt_replay_sort_pos(c->r, p);
-            if (pos == 0) snprintf(lab, sizeof lab, "p0");
-            else snprintf(lab, sizeof lab, "%lld", (long long)pos);
-            cairo_set_source_rgba(cr, 0.0, 0.25, 0.55, 1);
-            text_at(cr, SANS, pos == 0, f, x + 0.45 * f, y - 0.3 * f, lab);
-        }
         if (fl & PDT_PF_DELETED) {
             cairo_set_line_width(cr, 0.18 * f);
             cross(cr, x, y, 0.55 * f);
@@ -487,12 +485,13 @@ static void draw_selection(ctx *c)
         double col[3] = {0.0, 0.3, 0.9};
         ring(c, (uint32_t)p, 0.8 * c->L.font, col, 3);
         snprintf(lines[nl++], sizeof lines[0], "point %zu at (%d, %d)", p, q.x, q.y);
-        snprintf(lines[nl++], sizeof lines[0], "lifted z = %lld%s",
-                 (long long)((int64_t)q.x * q.x + (int64_t)q.y * q.y),
-                 c->s->pflags[p] & PDT_PF_LIFTED ? "" : " (not lifted yet)");
+        if (pdt_replay_kind_count(c->r, PDT_EV_LIFT) > 0) /* a hull run lifts nothing */
+            snprintf(lines[nl++], sizeof lines[0], "lifted z = %lld%s",
+                     (long long)((int64_t)q.x * q.x + (int64_t)q.y * q.y),
+                     c->s->pflags[p] & PDT_PF_LIFTED ? "" : " (not lifted yet)");
         int64_t pos = pdt_replay_sort_pos(c->r, p);
         if (c->s->pflags[p] & PDT_PF_SORTED)
-            snprintf(lines[nl++], sizeof lines[0], "angular position %lld%s", (long long)pos,
+            snprintf(lines[nl++], sizeof lines[0], "p%lld in the angular order%s", (long long)pos,
                      c->s->pflags[p] & PDT_PF_DELETED ? ", deleted" : "");
         for (int q2 = 0; q2 < c->nranks; q2++) {
             pdt_point lo, hi;
@@ -527,8 +526,10 @@ static void draw_selection(ctx *c)
             cairo_set_source_rgba(cr, 0.0, 0.3, 0.9, 0.9);
             cairo_set_line_width(cr, 3);
             cairo_stroke(cr);
+            uint32_t w[3];
+            pdt_replay_tri_order(c->r, t->v, w);
             snprintf(lines[nl++], sizeof lines[0], "%s %u %u %u", e >= 0 ? "of triangle" : "triangle",
-                     t->v[0], t->v[1], t->v[2]);
+                     w[0], w[1], w[2]);
             snprintf(lines[nl++], sizeof lines[0], "made by rank %u, now %s", t->maker,
                      pdt_rstate_tri_visible(c->r, c->s, (size_t)c->v->sel_tri)
                          ? sn[pdt_replay_tri_hist(c->r)[pdt_rstate_tri_entry(c->r, c->s, (size_t)c->v->sel_tri)].status]
@@ -569,14 +570,14 @@ void pdt_draw_geometry(ctx *c)
         uint32_t v[3] = {c->cur->ev.a, c->cur->ev.b, c->cur->ev.c};
         cur_tri = circum(c->P, v, &ox, &oy, &rr);
     }
-    draw_boxes(c, cur_tri, ox, oy, rr, 0);
+    draw_boxes(c, cur_tri, 0);
     draw_kernel_edges(c);
     draw_triangles(c);
     if (buf) draw_hulls_and_stacks(c, buf, 2 * cap);
     draw_merge(c);
     draw_points(c);
     if (buf) draw_current(c, buf, 2 * cap);
-    draw_boxes(c, cur_tri, ox, oy, rr, 1);
+    draw_boxes(c, cur_tri, 1);
     draw_selection(c);
     free(buf);
     cairo_restore(cr);

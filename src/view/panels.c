@@ -13,7 +13,7 @@ void pdt_draw_top(ctx *c)
     cairo_set_source_rgb(cr, 0.93, 0.94, 0.96);
     cairo_fill(cr);
     char line[512], head[64];
-    pdt_replay_describe(c->r, c->s->k, line, sizeof line);
+    pdt_replay_describe_state(c->r, c->s, c->s->k, line, sizeof line);
     snprintf(head, sizeof head, "%zu / %zu", c->s->k, pdt_replay_count(c->r));
     double f = c->L.font;
     rgb(cr, INK, 0.7);

@@ -17,6 +17,8 @@
 
 #include <cairo.h>
 
+#include "pdt/describe.h"
+#include "pdt/query.h"
 #include "pdt/render.h"
 #include "pdt/replay.h"
 #include "pdt/tracefile.h"
@@ -28,7 +30,7 @@
 
 typedef struct opts {
     const char *run, *out, *frames, *phase, *script, *screenshot, *hide, *write_run;
-    int headless, end, every, w, h, have_at, quiet, bench, counts, check;
+    int headless, end, every, w, h, have_at, quiet, bench, counts, check, describe;
     size_t at;
     double speed;
     unsigned panels; /* PDT_PANEL_* bits (--panels) */
@@ -44,6 +46,9 @@ static const char help_text[] =
     "       pdtview --bench RUN [--size WxH]\n"
     "       pdtview RUN [--at N|--phase NAME|--end] --counts   (triangles by status)\n"
     "       pdtview RUN --check     (seek equals stepping, both ways, at every cursor)\n"
+    "       pdtview RUN [--at N|--phase NAME|--end] --describe\n"
+    "               (what the window says: the start cursor, the pseudo-code, and for every\n"
+    "                event K its event line and lit code line; tab-separated)\n"
     "       pdtview --write-run DIR RUN\n"
     "RUN: a run folder, or synth:srm:COLS:ROWS:RANKS, synth:graham:N\n"
     "The cursor N counts events applied (0 = start, --end = all).\n"
@@ -92,6 +97,7 @@ static int parse_args(int argc, char **argv, opts *o)
         {"--bench", NULL, PDT_OPT_FLAG, &o->bench},
         {"--counts", NULL, PDT_OPT_FLAG, &o->counts},
         {"--check", NULL, PDT_OPT_FLAG, &o->check},
+        {"--describe", NULL, PDT_OPT_FLAG, &o->describe},
         {"--write-run", NULL, PDT_OPT_STR, &o->write_run},
         {"--end", NULL, PDT_OPT_FLAG, &o->end},
         {"--quiet", NULL, PDT_OPT_FLAG, &o->quiet},
@@ -308,6 +314,37 @@ static void counts(const pdt_replay *r, const pdt_rstate *s)
            c[PDT_TS_SHIPPED], c[PDT_TS_DISCARDED], dropped);
 }
 
+/* What the window would show, for the lesson checks (scripts/lesson-check.py),
+ * from the window's own functions: "start K" (the cursor the options give),
+ * "listing NAME I TEXT" (the code panel's lines), and per event K
+ * "event K LISTING LINE TEXT" (the lit code line, 1-based, or "-"; the event
+ * line).  Tab-separated, one record per line. */
+static int describe(const pdt_replay *r, size_t start)
+{
+    static const char *const names[PDT_CODE_COUNT] = {"graham", "srm"};
+    printf("start\t%zu\n", start);
+    for (int id = 0; id < PDT_CODE_COUNT; id++)
+        for (size_t i = 0; i < pdt_code_count(id); i++)
+            printf("listing\t%s\t%zu\t%s\n", names[id], i + 1, pdt_code_text(id, i));
+    pdt_rstate *s = pdt_rstate_new(r);
+    if (!s) {
+        fprintf(stderr, "pdtview: out of memory\n");
+        return 1;
+    }
+    char line[512];
+    for (size_t k = 1; k <= pdt_replay_count(r); k++) {
+        pdt_replay_step(r, s, 1);
+        int id = -1, cl = pdt_replay_code_line(r, s, &id);
+        pdt_replay_describe_state(r, s, k, line, sizeof line);
+        if (cl >= 0 && id >= 0 && id < PDT_CODE_COUNT)
+            printf("event\t%zu\t%s\t%d\t%s\n", k, names[id], cl + 1, line);
+        else
+            printf("event\t%zu\t-\t-\t%s\n", k, line);
+    }
+    pdt_rstate_free(s);
+    return ferror(stdout) ? 1 : 0;
+}
+
 /* Seek(k) == stepping forwards from 0 == stepping backwards from the end. */
 static int check(const pdt_replay *r)
 {
@@ -452,6 +489,8 @@ int main(int argc, char **argv)
     v.panels = o.panels;
     if (o.check) {
         rc = check(r);
+    } else if (o.describe) {
+        rc = describe(r, k);
     } else if (o.counts) {
         counts(r, s);
         rc = 0;

@@ -81,6 +81,11 @@ int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
     int gr = phase == PDT_PH_GRAHAM_SORT || phase == PDT_PH_GRAHAM_SCAN || ev->kind == PDT_EV_SORT ||
              ev->kind == PDT_EV_DELETE ||
              ((ev->kind == PDT_EV_PUSH || ev->kind == PDT_EV_POP) && ev->sub == PDT_STACK_GRAHAM);
+    /* a hull run keeps Graham's listing to its last event ("run" lights no line) */
+    int graham_run = pdt_replay_kind_count(r, PDT_EV_SORT) > 0 &&
+                     pdt_replay_kind_count(r, PDT_EV_TRI_NEW) == 0;
+    if (graham_run) *id = PDT_CODE_GRAHAM;
+    if (graham_run && !gr) return -1;
     if (gr) {
         *id = PDT_CODE_GRAHAM;
         switch (ev->kind) {
@@ -90,7 +95,7 @@ int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
         case PDT_EV_POP: return 8;
         case PDT_EV_HULL: return 9;
         case PDT_EV_PHASE_BEGIN: return phase == PDT_PH_GRAHAM_SCAN ? 4 : 0;
-        case PDT_EV_PHASE_END: return phase == PDT_PH_GRAHAM_SCAN ? 9 : 2;
+        case PDT_EV_PHASE_END: return phase == PDT_PH_GRAHAM_SCAN ? 9 : 1;
         default: return 5;
         }
     }
@@ -104,7 +109,10 @@ int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
     case PDT_EV_POP:
     case PDT_EV_HULL: return in_merge ? 9 : 2;
     case PDT_EV_TRI_FINAL:
-    case PDT_EV_RA_DEFER: return in_merge ? 9 : (ev->kind == PDT_EV_TRI_FINAL ? 3 : 4);
+    case PDT_EV_RA_DEFER:
+        if (in_merge) return 9;
+        if (phase == PDT_PH_OUTPUT || phase == PDT_PH_ORDER || phase == PDT_PH_WRITE) return 10;
+        return ev->kind == PDT_EV_TRI_FINAL ? 3 : 4;
     case PDT_EV_SHIP:
     case PDT_EV_SEND:
     case PDT_EV_RECV:
