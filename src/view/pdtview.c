@@ -317,8 +317,8 @@ static void counts(const pdt_replay *r, const pdt_rstate *s)
 /* What the window would show, for the lesson checks (scripts/lesson-check.py),
  * from the window's own functions: "start K" (the cursor the options give),
  * "listing NAME I TEXT" (the code panel's lines), and per event K
- * "event K LISTING LINE TEXT" (the lit code line, 1-based, or "-"; the event
- * line).  Tab-separated, one record per line. */
+ * "event K LISTING LINE TEXT" (the listing the panel shows, the lit line,
+ * 1-based, or "-" for none; the event line).  Tab-separated, one record per line. */
 static int describe(const pdt_replay *r, size_t start)
 {
     static const char *const names[PDT_CODE_COUNT] = {"graham", "srm"};
@@ -336,10 +336,9 @@ static int describe(const pdt_replay *r, size_t start)
         pdt_replay_step(r, s, 1);
         int id = -1, cl = pdt_replay_code_line(r, s, &id);
         pdt_replay_describe_state(r, s, k, line, sizeof line);
-        if (cl >= 0 && id >= 0 && id < PDT_CODE_COUNT)
-            printf("event\t%zu\t%s\t%d\t%s\n", k, names[id], cl + 1, line);
-        else
-            printf("event\t%zu\t-\t-\t%s\n", k, line);
+        const char *nm = id >= 0 && id < PDT_CODE_COUNT ? names[id] : "-";
+        if (cl >= 0) printf("event\t%zu\t%s\t%d\t%s\n", k, nm, cl + 1, line);
+        else printf("event\t%zu\t%s\t-\t%s\n", k, nm, line);
     }
     pdt_rstate_free(s);
     return ferror(stdout) ? 1 : 0;

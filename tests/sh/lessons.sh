@@ -1,7 +1,10 @@
 #!/bin/bash
 # Lessons: every lesson's run is recorded, passes `pdt trace check`, its start
 # frame and key frames render headless, and every line of its `checks` file
-# (the facts its text states) holds against the recorded trace.
+# (the facts its text states) holds against the recorded trace and against
+# what the viewer itself shows (`pdtview --describe`: event lines, lit code
+# lines, the start); every counter and every event line the text quotes is
+# one of those checks.
 . "$(dirname "$0")/lib.sh"
 unset DISPLAY WAYLAND_DISPLAY
 have_view=0
@@ -57,8 +60,15 @@ for ldir in "$ROOT"/lessons/[0-9][0-9]-*/; do
     for km in $(grep -oE '[0-9]+ / [0-9]+' "$ldir/README.md" | tr -d ' ' | sort -u); do
         k=${km%/*}; m=${km#*/}
         grep -qE "^count \* = $m( |$)" "$ldir/checks" || missing="$missing total-$m"
-        [ "$k" = 0 ] || [ "$k" = "$m" ] || grep -qE "^(at $k |first .* = $k$)" "$ldir/checks" || missing="$missing $k/$m"
+        [ "$k" = 0 ] || [ "$k" = "$m" ] || grep -qE "^(at $k |line $k |code $k |first .* = $k$)" "$ldir/checks" || missing="$missing $k/$m"
     done
+    # every event line the text quotes ("rank 2: defer ...") is checked
+    # against what the viewer shows (a `line` check with the same text), and
+    # no quoted event line is broken over two lines of the text
+    while IFS= read -r q; do
+        grep -qF -- "$q" "$ldir/checks" || missing="$missing [$q]"
+    done < <(grep -oE '"rank [0-9]+: [^"]*"' "$ldir/README.md")
+    if grep -qE '"rank [0-9]+: [^"]*$' "$ldir/README.md"; then missing="$missing [a quoted event line broken over two lines]"; fi
     if [ -z "$missing" ] && ! grep -qE 'TODO|FACTS|ANSWERS|ANSWER[0-9_]|RECORDED|CLUSTER|EXAMPLE$' "$ldir/README.md"; then
         ok "$name: every event the text names is checked; no placeholders left"
     else
