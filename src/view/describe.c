@@ -97,6 +97,14 @@ static const char *tri_str(const pdt_replay *r, const pdt_event *e, char *b, siz
     return b;
 }
 
+/* A group of ranks [lo, end): "rank 2" or "ranks 0–1". */
+static const char *group_str(uint32_t lo, uint32_t end, char *b, size_t cap)
+{
+    if (end <= lo + 1) snprintf(b, cap, "rank %u", lo);
+    else snprintf(b, cap, "ranks %u–%u", lo, end - 1);
+    return b;
+}
+
 /* The point below the top of rank q's stack `st` in s (the top after a pop
  * is the point the popped one sat on), or NONE32. */
 static uint32_t stack_top(const pdt_replay *r, const pdt_rstate *s, int q, int st)
@@ -265,13 +273,14 @@ void pdt_replay_describe_state(const pdt_replay *r, const pdt_rstate *s, size_t 
             i++;
         }
         if (cnt == 0)
-            snprintf(o, c, "defer %s — waits for the merge with rank %lld", tri_str(r, e, t3, sizeof t3),
-                     (long long)e->v);
+            snprintf(o, c, "defer %s — waits for the merge with rank %lld's group",
+                     tri_str(r, e, t3, sizeof t3), (long long)e->v);
         else if (cnt == 1 && last == (int)e->v)
             snprintf(o, c, "defer %s — its circle touches the box of rank %lld",
                      tri_str(r, e, t3, sizeof t3), (long long)e->v);
         else
-            snprintf(o, c, "defer %s — its circle touches the box%s of rank%s %s; first merge: with rank %lld",
+            snprintf(o, c, "defer %s — its circle touches the box%s of rank%s %s (waits for rank "
+                     "%lld's group)",
                      tri_str(r, e, t3, sizeof t3), cnt > 1 ? "es" : "", cnt > 1 ? "s" : "", why,
                      (long long)e->v);
         break;
@@ -287,8 +296,9 @@ void pdt_replay_describe_state(const pdt_replay *r, const pdt_rstate *s, size_t 
             snprintf(o, c, "discard %s — not Delaunay", tri_str(r, e, t3, sizeof t3));
         break;
     case PDT_EV_MERGE_BEGIN:
-        snprintf(o, c, "merge level %u: ranks %u–%u with %u–%u at rank %lld", e->sub, e->a,
-                 e->b ? e->b - 1 : 0, e->b, e->c ? e->c - 1 : 0, (long long)e->v);
+        snprintf(o, c, "merge level %u: %s with %s, at rank %lld", e->sub,
+                 group_str(e->a, e->b, p1, sizeof p1), group_str(e->b, e->c, p2, sizeof p2),
+                 (long long)e->v);
         break;
     case PDT_EV_MERGE_END:
         snprintf(o, c, "merge level %u done: %u shipped, border %u, %u kept, %lld discarded",
