@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "pdt/describe.h"
+#include "pdt/query.h"
 #include "pdt/replay.h"
 #include "pdt/viewsynth.h"
 
@@ -299,12 +300,32 @@ TEST(graham_words)
     pdt_replay_describe(r, 13, line, sizeof line);
     CHECK_MSG(!strcmp(line, "rank 0: pop p4 (point 4) — Area2(p3, p4, p5) = -26: right turn"), "%s", line);
     pdt_rstate *s = pdt_rstate_new(r);
+    int id = -1;
+    pdt_replay_seek(r, s, 10);  /* a pop: "else: pop" */
+    CHECK_MSG(pdt_replay_code_line(r, s, &id) == 8 && id == PDT_CODE_GRAHAM, "id %d", id);
     pdt_replay_seek(r, s, 2);
     pdt_point_label(r, s, 1, line, sizeof line);
     CHECK_MSG(!strcmp(line, "1=p1"), "%s", line);
     pdt_point_label(r, s, 4, line, sizeof line);
     CHECK_MSG(!strcmp(line, "4"), "%s", line);
     pdt_rstate_free(s);
+    /* a hull run keeps Graham's listing to its last event (the end of "run") */
+    pdt_synth sy;
+    CHECK(pdt_synth_graham(30, 3, &sy, &err) == PDT_OK);
+    pdt_replay *g = NULL;
+    CHECK(pdt_replay_new(sy.pts, sy.n, sy.recs, sy.m, 1, &g, &err) == PDT_OK);
+    if (g) {
+        pdt_rstate *gs = pdt_rstate_new(g);
+        for (size_t k = 1; k <= pdt_replay_count(g); k++) {
+            pdt_replay_seek(g, gs, k);
+            id = -1;
+            pdt_replay_code_line(g, gs, &id);
+            CHECK_MSG(id == PDT_CODE_GRAHAM, "event %zu: listing %d", k, id);
+        }
+        pdt_rstate_free(gs);
+        pdt_replay_free(g);
+    }
+    pdt_synth_free(&sy);
     pdt_replay_free(r);
 }
 
