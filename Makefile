@@ -61,7 +61,7 @@ MPI_LIBS    := $(shell pkg-config --libs ompi-c 2>/dev/null)
 VIEW_CFLAGS := $(shell pkg-config --cflags cairo sdl2 2>/dev/null)
 CAIRO_LIBS  := $(shell pkg-config --libs cairo 2>/dev/null)
 SDL_LIBS    := $(shell pkg-config --libs sdl2 2>/dev/null)
-LIBS        := -lm
+LIBS        := -lm -pthread
 
 # Debian packages the build, the tests and the demo need.
 DEB_BUILD := build-essential pkg-config libopenmpi-dev openmpi-bin libsdl2-dev libcairo2-dev fonts-dejavu-core
@@ -69,8 +69,10 @@ DEB_TEST  := qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-
 DEB_BENCH := hyperfine libcgal-dev g++ nodejs npm valgrind time
 DEB_FUZZ  := clang libclang-rt-dev
 
-LIB_SRC  := $(wildcard src/geom/*.c src/io/*.c src/trace/*.c)
-PAR_SRC  := $(wildcard src/par/*.c)
+# the comm front and its local (threads) backend need no MPI: in libpdt.a
+COMM_SRC := src/par/comm.c src/par/comm_local.c
+LIB_SRC  := $(wildcard src/geom/*.c src/io/*.c src/trace/*.c) $(COMM_SRC)
+PAR_SRC  := $(filter-out $(COMM_SRC),$(wildcard src/par/*.c))
 CLI_SRC  := $(wildcard src/cli/*.c)
 VIEWLIB_SRC := $(filter-out src/view/shell.c src/view/pdtview.c,$(wildcard src/view/*.c))
 VIEWAPP_SRC := $(filter src/view/shell.c src/view/pdtview.c,$(wildcard src/view/*.c))

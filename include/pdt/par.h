@@ -18,7 +18,8 @@
 #include "pdt/common.h"
 #include "pdt/trace.h"
 
-/* ---- communication layer (src/par/comm_mpi.c) --------------------------- */
+/* ---- communication layer (src/par/comm.c: the front; backends MPI
+ * (src/par/comm_mpi.c) and local (src/par/comm_local.c: threads) --------- */
 
 typedef struct pdt_comm pdt_comm;
 
@@ -29,7 +30,7 @@ int pdt_comm_launched(void);
 
 /* Create the context: MPI_Init and a private duplicate of the world
  * communicator if launched (or if force_mpi), otherwise a serial context of
- * size 1.  *c is owned by the caller (pdt_comm_finalize frees it). */
+ * size 1 (the local backend with one rank; no MPI call at all).  *c is owned by the caller (pdt_comm_finalize frees it). */
 pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **c, pdt_err *err);
 /* Free the context; MPI_Finalize if MPI was initialised.  c may be NULL. */
 pdt_status pdt_comm_finalize(pdt_comm *c, pdt_err *err);
@@ -109,6 +110,17 @@ pdt_status pdt_comm_send(pdt_comm *c, int peer, int tag, const void *buf, size_t
                          pdt_err *err);
 pdt_status pdt_comm_recv(pdt_comm *c, int peer, int tag, void **buf, size_t *bytes,
                          pdt_err *err);
+
+/* ---- the local backend (src/par/comm_local.c) ---- */
+/* One rank's work in a local run: returns a status, message in *err. */
+typedef pdt_status (*pdt_comm_rank_fn)(pdt_comm *c, void *arg, pdt_err *err);
+/* Run fn on nranks ranks, each a thread of this process with its own context
+ * (pdt_comm_is_mpi 0, size nranks), messages moved in memory; every
+ * collective and the file API work as under MPI.  Returns when every rank
+ * has returned: PDT_OK, or the status and message of the first rank that
+ * failed (the others then get PDT_ERR_MPI from any collective or receive
+ * instead of waiting forever).  pdt_comm_abort must not be called inside. */
+pdt_status pdt_comm_local_run(int nranks, pdt_comm_rank_fn fn, void *arg, pdt_err *err);
 
 /* ---- the parallel triangulation (src/par/driver.c) ----------------------- */
 

@@ -1,17 +1,18 @@
-/* pdt — the communication layer: the only file that includes mpi.h.
+/* pdt — the communication layer's MPI backend: the only file that includes
+ * mpi.h.  pdt_comm_init lives here: it starts MPI when a launcher started the
+ * process, and otherwise returns the serial context (src/par/comm_local.c).
  *
  * Small wrappers over the MPI calls the parallel driver needs.  Every call
  * goes to the context's private communicator (a duplicate of the world one,
  * with MPI_ERRORS_RETURN), every return code is checked and turned into
- * PDT_ERR_MPI with MPI's own error string.  A context created without a
- * launcher is "serial": size 1, no MPI call at all.
+ * PDT_ERR_MPI with MPI's own error string.
  *
  * No 32-bit limit: MPI counts are ints (Open MPI 4.1 has no MPI-4 "_c"
  * calls), so every transfer goes in chunks of at most c->chunk bytes.  The
  * v-collectives and the large uniform ones run on point-to-point messages of
- * a second private communicator (c->xcomm), chunk by chunk in rounds, so no
+ * a second private communicator (xcomm_of(c)), chunk by chunk in rounds, so no
  * int displacement is ever needed. */
-#include "pdt/par.h"
+#include "comm_int.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -23,38 +24,13 @@
 #include <time.h>
 #include <unistd.h>
 
-struct pdt_comm {
-    int mpi;        /* 1 if MPI was initialised by us */
-    int rank, size;
+typedef struct mpi_be {
     MPI_Comm comm;  /* collectives and the caller's point-to-point messages */
     MPI_Comm xcomm; /* the chunked exchanges (no tag clash with comm) */
-    size_t chunk;   /* largest single message, bytes (<= INT_MAX) */
-    char host[256];
-};
+} mpi_be;
 
-/* 1 GiB by default; PDT_COMM_CHUNK=bytes (tests force tiny chunks). */
-static size_t chunk_from_env(void)
-{
-    const char *e = getenv("PDT_COMM_CHUNK");
-    if (e && *e) {
-        char *end;
-        errno = 0;
-        unsigned long long v = strtoull(e, &end, 10);
-        if (!errno && !*end && v >= 1 && v <= (unsigned long long)INT_MAX) return (size_t)v;
-    }
-    return (size_t)1 << 30;
-}
-
-int pdt_comm_launched(void)
-{
-    const char *force = getenv("PDT_MPI");
-    if (force && *force) return strcmp(force, "0") != 0;
-    static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_SIZE",
-                                       "PMI_RANK", "MPI_LOCALNRANKS", "MV2_COMM_WORLD_SIZE"};
-    for (size_t i = 0; i < sizeof vars / sizeof *vars; i++)
-        if (getenv(vars[i])) return 1;
-    return 0;
-}
+static MPI_Comm comm_of(const pdt_comm *c) { return ((const mpi_be *)c->be)->comm; }
+static MPI_Comm xcomm_of(const pdt_comm *c) { return ((const mpi_be *)c->be)->xcomm; }
 
 /* Turn an MPI return code into a pdt status (the first error sticks). */
 static pdt_status mpi_check(int rc, const char *what, const pdt_comm *c, pdt_err *err)
@@ -68,42 +44,49 @@ static pdt_status mpi_check(int rc, const char *what, const pdt_comm *c, pdt_err
                        len ? msg : "unknown MPI error");
 }
 
+static const pdt_comm_ops mpi_ops;
+
 pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out, pdt_err *err)
 {
     *out = NULL;
+    if (!force_mpi && !pdt_comm_launched()) return pdt_comm_serial_new(out, err);
     pdt_comm *c = calloc(1, sizeof *c);
-    if (!c) return pdt_err_set(err, PDT_ERR_NOMEM, "comm: out of memory");
-    c->size = 1;
-    c->chunk = chunk_from_env();
-    if (gethostname(c->host, sizeof c->host - 1) != 0) strcpy(c->host, "?");
-    if (!force_mpi && !pdt_comm_launched()) {
-        *out = c;
-        return PDT_OK;
+    mpi_be *m = calloc(1, sizeof *m);
+    if (!c || !m) {
+        free(c);
+        free(m);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "comm: out of memory");
     }
+    c->ops = &mpi_ops;
+    c->be = m;
+    c->size = 1;
+    c->chunk = pdt_comm_chunk_from_env();
+    if (gethostname(c->host, sizeof c->host - 1) != 0) strcpy(c->host, "?");
     int rc = MPI_Init(argc, argv);
     if (rc != MPI_SUCCESS) {
+        free(m);
         free(c);
         return pdt_err_set(err, PDT_ERR_MPI, "MPI_Init failed (code %d)", rc);
     }
-    c->mpi = 1;
     /* From here on errors come back as codes instead of aborting. */
     pdt_status s = mpi_check(MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN),
                              "MPI_Comm_set_errhandler", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_dup(MPI_COMM_WORLD, &c->comm), "MPI_Comm_dup", c, err);
+    if (s == PDT_OK) s = mpi_check(MPI_Comm_dup(MPI_COMM_WORLD, &m->comm), "MPI_Comm_dup", c, err);
     if (s == PDT_OK)
-        s = mpi_check(MPI_Comm_set_errhandler(c->comm, MPI_ERRORS_RETURN),
+        s = mpi_check(MPI_Comm_set_errhandler(m->comm, MPI_ERRORS_RETURN),
                       "MPI_Comm_set_errhandler", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_rank(c->comm, &c->rank), "MPI_Comm_rank", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_size(c->comm, &c->size), "MPI_Comm_size", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_dup(c->comm, &c->xcomm), "MPI_Comm_dup", c, err);
+    if (s == PDT_OK) s = mpi_check(MPI_Comm_rank(m->comm, &c->rank), "MPI_Comm_rank", c, err);
+    if (s == PDT_OK) s = mpi_check(MPI_Comm_size(m->comm, &c->size), "MPI_Comm_size", c, err);
+    if (s == PDT_OK) s = mpi_check(MPI_Comm_dup(m->comm, &m->xcomm), "MPI_Comm_dup", c, err);
     /* Every rank must cut transfers the same way: rank 0's chunk size wins. */
     unsigned long long chunk = c->chunk;
     if (s == PDT_OK)
-        s = mpi_check(MPI_Bcast(&chunk, 1, MPI_UNSIGNED_LONG_LONG, 0, c->comm), "MPI_Bcast", c,
+        s = mpi_check(MPI_Bcast(&chunk, 1, MPI_UNSIGNED_LONG_LONG, 0, m->comm), "MPI_Bcast", c,
                       err);
     c->chunk = (size_t)chunk;
     if (s != PDT_OK) {
         MPI_Finalize();
+        free(m);
         free(c);
         return s;
     }
@@ -111,44 +94,30 @@ pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out,
     return PDT_OK;
 }
 
-pdt_status pdt_comm_finalize(pdt_comm *c, pdt_err *err)
+static void mpi_finalize(pdt_comm *c)
 {
-    if (!c) return PDT_OK;
-    pdt_status s = PDT_OK;
-    if (c->mpi) {
-        s = mpi_check(MPI_Comm_free(&c->xcomm), "MPI_Comm_free", c, err);
-        pdt_status s1 = mpi_check(MPI_Comm_free(&c->comm), "MPI_Comm_free", c, err);
-        if (s == PDT_OK) s = s1;
-        pdt_status s2 = mpi_check(MPI_Finalize(), "MPI_Finalize", c, err);
-        if (s == PDT_OK) s = s2;
-    }
-    free(c);
-    return s;
+    mpi_be *m = c->be;
+    MPI_Comm_free(&m->xcomm);
+    MPI_Comm_free(&m->comm);
+    MPI_Finalize();
+    free(m);
 }
 
 void pdt_comm_abort(pdt_comm *c, int code)
 {
-    if (c && c->mpi) MPI_Abort(c->comm, code);
+    if (c && c->ops->is_mpi) MPI_Abort(comm_of(c), code);
     exit(code);
 }
 
-int pdt_comm_rank(const pdt_comm *c) { return c->rank; }
-int pdt_comm_size(const pdt_comm *c) { return c->size; }
-int pdt_comm_is_mpi(const pdt_comm *c) { return c->mpi; }
-const char *pdt_comm_host(const pdt_comm *c) { return c->host; }
-
-double pdt_comm_wtime(const pdt_comm *c)
+static double mpi_wtime(const pdt_comm *c)
 {
-    if (c && c->mpi) return MPI_Wtime();
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    (void)c;
+    return MPI_Wtime();
 }
 
-pdt_status pdt_comm_barrier(pdt_comm *c, pdt_err *err)
+static pdt_status mpi_barrier(pdt_comm *c, pdt_err *err)
 {
-    if (!c->mpi) return PDT_OK;
-    return mpi_check(MPI_Barrier(c->comm), "MPI_Barrier", c, err);
+    return mpi_check(MPI_Barrier(comm_of(c)), "MPI_Barrier", c, err);
 }
 
 /* Waiting ranks sleep between polls instead of spinning in MPI's progress
@@ -160,11 +129,10 @@ static void nap(void)
     nanosleep(&ts, NULL);
 }
 
-pdt_status pdt_comm_quiet_barrier(pdt_comm *c, pdt_err *err)
+static pdt_status mpi_quiet_barrier(pdt_comm *c, pdt_err *err)
 {
-    if (!c->mpi) return PDT_OK;
     MPI_Request rq;
-    pdt_status s = mpi_check(MPI_Ibarrier(c->comm, &rq), "MPI_Ibarrier", c, err);
+    pdt_status s = mpi_check(MPI_Ibarrier(comm_of(c), &rq), "MPI_Ibarrier", c, err);
     int done = 0;
     while (s == PDT_OK && !done) {
         s = mpi_check(MPI_Test(&rq, &done, MPI_STATUS_IGNORE), "MPI_Test", c, err);
@@ -222,13 +190,13 @@ static pdt_status xchg_run(pdt_comm *c, const xchg *x, const char *what, pdt_err
         for (int i = 0; i < P && s == PDT_OK; i++) {
             if (i == me || off >= x->rn[i]) continue;
             int len = (int)min_size(c->chunk, x->rn[i] - off);
-            s = mpi_check(MPI_Irecv(x->rp[i] + off, len, MPI_BYTE, i, 0, c->xcomm, &rq[nrq++]),
+            s = mpi_check(MPI_Irecv(x->rp[i] + off, len, MPI_BYTE, i, 0, xcomm_of(c), &rq[nrq++]),
                           "MPI_Irecv", c, err);
         }
         for (int i = 0; i < P && s == PDT_OK; i++) {
             if (i == me || off >= x->sn[i]) continue;
             int len = (int)min_size(c->chunk, x->sn[i] - off);
-            s = mpi_check(MPI_Isend(x->sp[i] + off, len, MPI_BYTE, i, 0, c->xcomm, &rq[nrq++]),
+            s = mpi_check(MPI_Isend(x->sp[i] + off, len, MPI_BYTE, i, 0, xcomm_of(c), &rq[nrq++]),
                           "MPI_Isend", c, err);
         }
         if (nrq == 0) break;
@@ -241,13 +209,12 @@ static pdt_status xchg_run(pdt_comm *c, const xchg *x, const char *what, pdt_err
 
 /* ---- collectives ---------------------------------------------------------- */
 
-pdt_status pdt_comm_bcast(pdt_comm *c, void *buf, size_t bytes, int root, pdt_err *err)
+static pdt_status mpi_bcast(pdt_comm *c, void *buf, size_t bytes, int root, pdt_err *err)
 {
-    if (!c->mpi) return PDT_OK;
     pdt_status s = PDT_OK;
     for (size_t off = 0; off < bytes && s == PDT_OK; off += c->chunk)
         s = mpi_check(MPI_Bcast((char *)buf + off, (int)min_size(c->chunk, bytes - off), MPI_BYTE,
-                                root, c->comm),
+                                root, comm_of(c)),
                       "MPI_Bcast", c, err);
     return s;
 }
@@ -259,16 +226,12 @@ static int one_chunk(const pdt_comm *c, size_t bytes)
     return bytes <= c->chunk / (size_t)c->size;
 }
 
-pdt_status pdt_comm_allgather(pdt_comm *c, const void *send, size_t bytes, void *recv,
+static pdt_status mpi_allgather(pdt_comm *c, const void *send, size_t bytes, void *recv,
                               pdt_err *err)
 {
-    if (!c->mpi) {
-        if (bytes) memmove(recv, send, bytes);
-        return PDT_OK;
-    }
     if (one_chunk(c, bytes))
         return mpi_check(MPI_Allgather(send, (int)bytes, MPI_BYTE, recv, (int)bytes, MPI_BYTE,
-                                       c->comm),
+                                       comm_of(c)),
                          "MPI_Allgather", c, err);
     xchg x;
     pdt_status s = xchg_new(c, &x, "allgather", err);
@@ -282,16 +245,12 @@ pdt_status pdt_comm_allgather(pdt_comm *c, const void *send, size_t bytes, void 
     return s;
 }
 
-pdt_status pdt_comm_alltoall(pdt_comm *c, const void *send, size_t bytes, void *recv,
+static pdt_status mpi_alltoall(pdt_comm *c, const void *send, size_t bytes, void *recv,
                              pdt_err *err)
 {
-    if (!c->mpi) {
-        if (bytes) memmove(recv, send, bytes);
-        return PDT_OK;
-    }
     if (one_chunk(c, bytes))
         return mpi_check(MPI_Alltoall(send, (int)bytes, MPI_BYTE, recv, (int)bytes, MPI_BYTE,
-                                      c->comm),
+                                      comm_of(c)),
                          "MPI_Alltoall", c, err);
     xchg x;
     pdt_status s = xchg_new(c, &x, "alltoall", err);
@@ -305,15 +264,9 @@ pdt_status pdt_comm_alltoall(pdt_comm *c, const void *send, size_t bytes, void *
     return s;
 }
 
-pdt_status pdt_comm_alltoallv(pdt_comm *c, const void *send, const size_t *scount, void *recv,
+static pdt_status mpi_alltoallv(pdt_comm *c, const void *send, const size_t *scount, void *recv,
                               const size_t *rcount, pdt_err *err)
 {
-    if (!c->mpi) {
-        if (scount[0] != rcount[0])
-            return pdt_err_set(err, PDT_ERR_MPI, "alltoallv: count mismatch");
-        if (scount[0]) memmove(recv, send, scount[0]);
-        return PDT_OK;
-    }
     xchg x;
     pdt_status s = xchg_new(c, &x, "alltoallv", err);
     size_t so = 0, ro = 0;
@@ -328,14 +281,9 @@ pdt_status pdt_comm_alltoallv(pdt_comm *c, const void *send, const size_t *scoun
     return s;
 }
 
-pdt_status pdt_comm_scatterv(pdt_comm *c, const void *send, const size_t *count, void *recv,
+static pdt_status mpi_scatterv(pdt_comm *c, const void *send, const size_t *count, void *recv,
                              size_t rbytes, int root, pdt_err *err)
 {
-    if (!c->mpi) {
-        if (count[0] != rbytes) return pdt_err_set(err, PDT_ERR_MPI, "scatterv: count mismatch");
-        if (rbytes) memmove(recv, send, rbytes);
-        return PDT_OK;
-    }
     xchg x;
     pdt_status s = xchg_new(c, &x, "scatterv", err);
     if (s == PDT_OK) {
@@ -352,14 +300,9 @@ pdt_status pdt_comm_scatterv(pdt_comm *c, const void *send, const size_t *count,
     return s;
 }
 
-pdt_status pdt_comm_gatherv(pdt_comm *c, const void *send, size_t bytes, void *recv,
+static pdt_status mpi_gatherv(pdt_comm *c, const void *send, size_t bytes, void *recv,
                             const size_t *count, int root, pdt_err *err)
 {
-    if (!c->mpi) {
-        if (count[0] != bytes) return pdt_err_set(err, PDT_ERR_MPI, "gatherv: count mismatch");
-        if (bytes) memmove(recv, send, bytes);
-        return PDT_OK;
-    }
     xchg x;
     pdt_status s = xchg_new(c, &x, "gatherv", err);
     if (s == PDT_OK) {
@@ -376,33 +319,30 @@ pdt_status pdt_comm_gatherv(pdt_comm *c, const void *send, size_t bytes, void *r
     return s;
 }
 
-pdt_status pdt_comm_allmax(pdt_comm *c, double *v, int n, pdt_err *err)
+static pdt_status mpi_allmax(pdt_comm *c, double *v, int n, pdt_err *err)
 {
-    if (!c->mpi) return PDT_OK;
-    return mpi_check(MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_MAX, c->comm),
+    return mpi_check(MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_MAX, comm_of(c)),
                      "MPI_Allreduce", c, err);
 }
 
-pdt_status pdt_comm_allreduce_u64(pdt_comm *c, uint64_t *v, size_t n, pdt_comm_op op,
+static pdt_status mpi_allreduce_u64(pdt_comm *c, uint64_t *v, size_t n, pdt_comm_op op,
                                   pdt_err *err)
 {
-    if (!c->mpi) return PDT_OK;
     MPI_Op mop = op == PDT_COMM_SUM ? MPI_SUM : op == PDT_COMM_MAX ? MPI_MAX : MPI_MIN;
     size_t step = c->chunk / sizeof *v ? c->chunk / sizeof *v : 1;
     pdt_status s = PDT_OK;
     for (size_t i = 0; i < n && s == PDT_OK; i += step)
         s = mpi_check(MPI_Allreduce(MPI_IN_PLACE, v + i, (int)min_size(step, n - i), MPI_UINT64_T,
-                                    mop, c->comm),
+                                    mop, comm_of(c)),
                       "MPI_Allreduce", c, err);
     return s;
 }
 
-pdt_status pdt_comm_exscan_u64(pdt_comm *c, uint64_t v, uint64_t *out, pdt_err *err)
+static pdt_status mpi_exscan_u64(pdt_comm *c, uint64_t v, uint64_t *out, pdt_err *err)
 {
     *out = 0;
-    if (!c->mpi) return PDT_OK;
     uint64_t r = 0;
-    pdt_status s = mpi_check(MPI_Exscan(&v, &r, 1, MPI_UINT64_T, MPI_SUM, c->comm), "MPI_Exscan",
+    pdt_status s = mpi_check(MPI_Exscan(&v, &r, 1, MPI_UINT64_T, MPI_SUM, comm_of(c)), "MPI_Exscan",
                              c, err);
     if (s == PDT_OK && c->rank > 0) *out = r; /* MPI leaves rank 0's result undefined */
     return s;
@@ -413,37 +353,33 @@ pdt_status pdt_comm_exscan_u64(pdt_comm *c, uint64_t v, uint64_t *out, pdt_err *
  * with the caller's tag: MPI keeps messages of one sender, tag and
  * communicator in order. */
 
-pdt_status pdt_comm_send(pdt_comm *c, int peer, int tag, const void *buf, size_t bytes,
+static pdt_status mpi_send(pdt_comm *c, int peer, int tag, const void *buf, size_t bytes,
                          pdt_err *err)
 {
-    if (!c->mpi || peer == c->rank)
-        return pdt_err_set(err, PDT_ERR_MPI, "rank %d: send to itself", c->rank);
-    uint64_t head = bytes;
-    pdt_status s = mpi_check(MPI_Send(&head, 1, MPI_UINT64_T, peer, tag, c->comm), "MPI_Send", c,
+        uint64_t head = bytes;
+    pdt_status s = mpi_check(MPI_Send(&head, 1, MPI_UINT64_T, peer, tag, comm_of(c)), "MPI_Send", c,
                              err);
     for (size_t off = 0; off < bytes && s == PDT_OK; off += c->chunk)
         s = mpi_check(MPI_Send((const char *)buf + off, (int)min_size(c->chunk, bytes - off),
-                               MPI_BYTE, peer, tag, c->comm),
+                               MPI_BYTE, peer, tag, comm_of(c)),
                       "MPI_Send", c, err);
     return s;
 }
 
-pdt_status pdt_comm_recv(pdt_comm *c, int peer, int tag, void **buf, size_t *bytes, pdt_err *err)
+static pdt_status mpi_recv(pdt_comm *c, int peer, int tag, void **buf, size_t *bytes, pdt_err *err)
 {
     *buf = NULL;
     *bytes = 0;
-    if (!c->mpi || peer == c->rank)
-        return pdt_err_set(err, PDT_ERR_MPI, "rank %d: receive from itself", c->rank);
-    int flag = 0;
+        int flag = 0;
     pdt_status s = PDT_OK;
     while (s == PDT_OK && !flag) {
-        s = mpi_check(MPI_Iprobe(peer, tag, c->comm, &flag, MPI_STATUS_IGNORE), "MPI_Iprobe", c,
+        s = mpi_check(MPI_Iprobe(peer, tag, comm_of(c), &flag, MPI_STATUS_IGNORE), "MPI_Iprobe", c,
                       err);
         if (s == PDT_OK && !flag) nap();
     }
     uint64_t head = 0;
     if (s == PDT_OK)
-        s = mpi_check(MPI_Recv(&head, 1, MPI_UINT64_T, peer, tag, c->comm, MPI_STATUS_IGNORE),
+        s = mpi_check(MPI_Recv(&head, 1, MPI_UINT64_T, peer, tag, comm_of(c), MPI_STATUS_IGNORE),
                       "MPI_Recv", c, err);
     if (s != PDT_OK) return s;
     if (head > SIZE_MAX - 1) return pdt_err_set(err, PDT_ERR_MPI, "rank %d: bad message size", c->rank);
@@ -452,7 +388,7 @@ pdt_status pdt_comm_recv(pdt_comm *c, int peer, int tag, void **buf, size_t *byt
     if (!b) return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: recv: out of memory", c->rank);
     for (size_t off = 0; off < n && s == PDT_OK; off += c->chunk)
         s = mpi_check(MPI_Recv(b + off, (int)min_size(c->chunk, n - off), MPI_BYTE, peer, tag,
-                               c->comm, MPI_STATUS_IGNORE),
+                               comm_of(c), MPI_STATUS_IGNORE),
                       "MPI_Recv", c, err);
     if (s != PDT_OK) {
         free(b);
@@ -465,29 +401,7 @@ pdt_status pdt_comm_recv(pdt_comm *c, int peer, int tag, void **buf, size_t *byt
 
 /* ---- one file written by all ranks ----------------------------------------- */
 
-struct pdt_comm_file {
-    pdt_comm *c;
-    MPI_File fh; /* MPI mode */
-    int fd;      /* serial mode */
-    char *path;
-};
-
-/* Every rank learns whether any rank failed (the lowest failing rank is
- * named); a rank that did not fail itself gets PDT_ERR_IO too. */
-static pdt_status agree(pdt_comm *c, pdt_status mine, const char *path, const char *what,
-                        pdt_err *err)
-{
-    if (!c->mpi) return mine;
-    uint64_t bad = mine != PDT_OK, who = mine != PDT_OK ? (uint64_t)c->rank : UINT64_MAX;
-    pdt_status s = pdt_comm_allreduce_u64(c, &bad, 1, PDT_COMM_MAX, err);
-    if (s == PDT_OK) s = pdt_comm_allreduce_u64(c, &who, 1, PDT_COMM_MIN, err);
-    if (s != PDT_OK) return s;
-    if (mine != PDT_OK) return mine;
-    if (bad)
-        return pdt_err_set(err, PDT_ERR_IO, "%s: %s failed at rank %llu", path, what,
-                           (unsigned long long)who);
-    return PDT_OK;
-}
+/* ---- one file written by all ranks (MPI-IO) --------------------------------- */
 
 static pdt_status mpi_io_check(int rc, const pdt_comm *c, const char *path, const char *what,
                                pdt_err *err)
@@ -501,70 +415,41 @@ static pdt_status mpi_io_check(int rc, const pdt_comm *c, const char *path, cons
                        len ? msg : "unknown MPI-IO error");
 }
 
-pdt_status pdt_comm_file_open(pdt_comm *c, const char *path, pdt_comm_file **out, pdt_err *err)
+static pdt_status mpi_file_open(pdt_comm *c, pdt_comm_file *f, pdt_err *err)
 {
-    *out = NULL;
-    pdt_comm_file *f = calloc(1, sizeof *f);
-    char *p = strdup(path);
+    MPI_File *fh = malloc(sizeof *fh);
     pdt_status s = PDT_OK;
-    if (!f || !p) s = pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: file open: out of memory", c->rank);
-    int opened = 0;
-    MPI_File fh = MPI_FILE_NULL;
-    if (s == PDT_OK && !c->mpi) {
-        f->fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-        if (f->fd < 0) s = pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
-        opened = f->fd >= 0;
-    } else if (c->mpi) {
-        /* Every rank must call MPI_File_open, even one short of memory. */
-        int rc = MPI_File_open(c->comm, path, MPI_MODE_WRONLY | MPI_MODE_CREATE, MPI_INFO_NULL, &fh);
-        pdt_status o = mpi_io_check(rc, c, path, "create", err);
-        if (s == PDT_OK) s = o;
-        /* open collectively succeeded or failed everywhere; truncate is collective too */
-        if (rc == MPI_SUCCESS) {
-            opened = 1;
-            pdt_status t = mpi_io_check(MPI_File_set_size(fh, 0), c, path, "truncate", err);
-            if (s == PDT_OK) s = t;
-        }
+    if (!fh) s = pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", c->rank, f->path);
+    /* every rank takes part in the collective open, even one short of memory */
+    MPI_File h = MPI_FILE_NULL;
+    int rc = MPI_File_open(comm_of(c), f->path, MPI_MODE_WRONLY | MPI_MODE_CREATE, MPI_INFO_NULL,
+                           &h);
+    pdt_status o = mpi_io_check(rc, c, f->path, "create", err);
+    if (s == PDT_OK) s = o;
+    if (rc == MPI_SUCCESS) { /* the open is collective: it succeeded at every rank */
+        pdt_status t = mpi_io_check(MPI_File_set_size(h, 0), c, f->path, "truncate", err);
+        if (s == PDT_OK) s = t;
     }
-    s = agree(c, s, path, "create", err);
+    s = pdt_comm_agree(c, s, f->path, "create", err);
     if (s != PDT_OK) {
-        if (opened && !c->mpi) close(f->fd);
-        if (opened && c->mpi) MPI_File_close(&fh);
-        free(p);
-        free(f);
+        if (rc == MPI_SUCCESS) MPI_File_close(&h);
+        free(fh);
         return s;
     }
-    f->c = c;
-    f->fh = fh;
-    f->path = p;
-    *out = f;
+    *fh = h;
+    f->be = fh;
     return PDT_OK;
 }
 
-pdt_status pdt_comm_file_write_at(pdt_comm_file *f, uint64_t offset, const void *buf,
-                                  size_t bytes, pdt_err *err)
+static pdt_status mpi_file_write_at(pdt_comm_file *f, uint64_t offset, const void *buf,
+                                    size_t bytes, pdt_err *err)
 {
     pdt_comm *c = f->c;
-    pdt_status s = PDT_OK;
-    if (!c->mpi) {
-        const char *b = buf;
-        size_t done = 0;
-        while (done < bytes && s == PDT_OK) {
-            ssize_t w = pwrite(f->fd, b + done, min_size(c->chunk, bytes - done),
-                               (off_t)(offset + done));
-            if (w < 0 && errno == EINTR) continue;
-            if (w <= 0)
-                s = pdt_err_set(err, PDT_ERR_IO, "%s: write failed: %s", f->path,
-                                w < 0 ? strerror(errno) : "no progress");
-            else
-                done += (size_t)w;
-        }
-        return s;
-    }
+    MPI_File *fh = f->be;
     /* write_at_all is collective: every rank calls it as often as the rank
      * with the most chunks, with 0 bytes once done (or after a failure). */
     uint64_t rounds = (bytes + c->chunk - 1) / c->chunk;
-    s = pdt_comm_allreduce_u64(c, &rounds, 1, PDT_COMM_MAX, err);
+    pdt_status s = mpi_allreduce_u64(c, &rounds, 1, PDT_COMM_MAX, err);
     if (s != PDT_OK) return s;
     pdt_status mine = PDT_OK;
     for (uint64_t r = 0; r < rounds; r++) {
@@ -572,29 +457,42 @@ pdt_status pdt_comm_file_write_at(pdt_comm_file *f, uint64_t offset, const void 
         int len = mine == PDT_OK && off < bytes ? (int)min_size(c->chunk, bytes - off) : 0;
         const char *p = len ? (const char *)buf + off : (const char *)buf;
         MPI_Status st;
-        int rc = MPI_File_write_at_all(f->fh, (MPI_Offset)(offset + off), p, len, MPI_BYTE, &st);
+        int rc = MPI_File_write_at_all(*fh, (MPI_Offset)(offset + off), p, len, MPI_BYTE, &st);
         pdt_status w = mpi_io_check(rc, c, f->path, "write", err);
         int got = 0;
         if (w == PDT_OK && len && (MPI_Get_count(&st, MPI_BYTE, &got) != MPI_SUCCESS || got != len))
             w = pdt_err_set(err, PDT_ERR_IO, "%s: short write at rank %d", f->path, c->rank);
         if (mine == PDT_OK) mine = w;
     }
-    return agree(c, mine, f->path, "write", err);
+    return pdt_comm_agree(c, mine, f->path, "write", err);
 }
 
-pdt_status pdt_comm_file_close(pdt_comm_file *f, pdt_err *err)
+static pdt_status mpi_file_close(pdt_comm_file *f, pdt_err *err)
 {
-    if (!f) return PDT_OK;
-    pdt_comm *c = f->c;
-    pdt_status s = PDT_OK;
-    if (!c->mpi) {
-        if (close(f->fd) != 0)
-            s = pdt_err_set(err, PDT_ERR_IO, "%s: close failed: %s", f->path, strerror(errno));
-    } else {
-        s = mpi_io_check(MPI_File_close(&f->fh), c, f->path, "close", err);
-        s = agree(c, s, f->path, "close", err);
-    }
-    free(f->path);
-    free(f);
-    return s;
+    MPI_File *fh = f->be;
+    pdt_status s = mpi_io_check(MPI_File_close(fh), f->c, f->path, "close", err);
+    free(fh);
+    return pdt_comm_agree(f->c, s, f->path, "close", err);
 }
+
+static const pdt_comm_ops mpi_ops = {
+    .is_mpi = 1,
+    .finalize = mpi_finalize,
+    .wtime = mpi_wtime,
+    .barrier = mpi_barrier,
+    .quiet_barrier = mpi_quiet_barrier,
+    .bcast = mpi_bcast,
+    .allgather = mpi_allgather,
+    .alltoall = mpi_alltoall,
+    .alltoallv = mpi_alltoallv,
+    .scatterv = mpi_scatterv,
+    .gatherv = mpi_gatherv,
+    .allmax = mpi_allmax,
+    .allreduce_u64 = mpi_allreduce_u64,
+    .exscan_u64 = mpi_exscan_u64,
+    .send = mpi_send,
+    .recv = mpi_recv,
+    .file_open = mpi_file_open,
+    .file_write_at = mpi_file_write_at,
+    .file_close = mpi_file_close,
+};

@@ -1,0 +1,181 @@
+/* pdt — the communication layer's front: every pdt_comm_* call goes to the
+ * context's backend through its table of operations (src/par/comm_int.h).
+ * Backends: MPI (src/par/comm_mpi.c, the only file that includes mpi.h) and
+ * local (src/par/comm_local.c: ranks as threads of one process; with one
+ * rank it is the serial context of a plain run). */
+#include "comm_int.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <stdlib.h>
+#include <string.h>
+
+int pdt_comm_launched(void)
+{
+    const char *force = getenv("PDT_MPI");
+    if (force && *force) return strcmp(force, "0") != 0;
+    static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_SIZE",
+                                       "PMI_RANK", "MPI_LOCALNRANKS", "MV2_COMM_WORLD_SIZE"};
+    for (size_t i = 0; i < sizeof vars / sizeof *vars; i++)
+        if (getenv(vars[i])) return 1;
+    return 0;
+}
+
+size_t pdt_comm_chunk_from_env(void)
+{
+    const char *e = getenv("PDT_COMM_CHUNK");
+    if (e && *e) {
+        char *end;
+        errno = 0;
+        unsigned long long v = strtoull(e, &end, 10);
+        if (!errno && !*end && v >= 1 && v <= (unsigned long long)INT_MAX) return (size_t)v;
+    }
+    return (size_t)1 << 30;
+}
+
+pdt_status pdt_comm_finalize(pdt_comm *c, pdt_err *err)
+{
+    (void)err;
+    if (!c) return PDT_OK;
+    c->ops->finalize(c);
+    free(c);
+    return PDT_OK;
+}
+
+int pdt_comm_rank(const pdt_comm *c) { return c->rank; }
+int pdt_comm_size(const pdt_comm *c) { return c->size; }
+int pdt_comm_is_mpi(const pdt_comm *c) { return c->ops->is_mpi; }
+const char *pdt_comm_host(const pdt_comm *c) { return c->host; }
+double pdt_comm_wtime(const pdt_comm *c) { return c->ops->wtime(c); }
+
+pdt_status pdt_comm_barrier(pdt_comm *c, pdt_err *err) { return c->ops->barrier(c, err); }
+
+pdt_status pdt_comm_quiet_barrier(pdt_comm *c, pdt_err *err)
+{
+    return c->ops->quiet_barrier(c, err);
+}
+
+pdt_status pdt_comm_bcast(pdt_comm *c, void *buf, size_t bytes, int root, pdt_err *err)
+{
+    return c->ops->bcast(c, buf, bytes, root, err);
+}
+
+pdt_status pdt_comm_allgather(pdt_comm *c, const void *send, size_t bytes, void *recv,
+                              pdt_err *err)
+{
+    return c->ops->allgather(c, send, bytes, recv, err);
+}
+
+pdt_status pdt_comm_alltoall(pdt_comm *c, const void *send, size_t bytes, void *recv,
+                             pdt_err *err)
+{
+    return c->ops->alltoall(c, send, bytes, recv, err);
+}
+
+pdt_status pdt_comm_alltoallv(pdt_comm *c, const void *send, const size_t *scount, void *recv,
+                              const size_t *rcount, pdt_err *err)
+{
+    return c->ops->alltoallv(c, send, scount, recv, rcount, err);
+}
+
+pdt_status pdt_comm_scatterv(pdt_comm *c, const void *send, const size_t *count, void *recv,
+                             size_t rbytes, int root, pdt_err *err)
+{
+    return c->ops->scatterv(c, send, count, recv, rbytes, root, err);
+}
+
+pdt_status pdt_comm_gatherv(pdt_comm *c, const void *send, size_t bytes, void *recv,
+                            const size_t *count, int root, pdt_err *err)
+{
+    return c->ops->gatherv(c, send, bytes, recv, count, root, err);
+}
+
+pdt_status pdt_comm_allmax(pdt_comm *c, double *v, int n, pdt_err *err)
+{
+    return c->ops->allmax(c, v, n, err);
+}
+
+pdt_status pdt_comm_allreduce_u64(pdt_comm *c, uint64_t *v, size_t n, pdt_comm_op op,
+                                  pdt_err *err)
+{
+    return c->ops->allreduce_u64(c, v, n, op, err);
+}
+
+pdt_status pdt_comm_exscan_u64(pdt_comm *c, uint64_t v, uint64_t *out, pdt_err *err)
+{
+    return c->ops->exscan_u64(c, v, out, err);
+}
+
+pdt_status pdt_comm_send(pdt_comm *c, int peer, int tag, const void *buf, size_t bytes,
+                         pdt_err *err)
+{
+    if (peer == c->rank || peer < 0 || peer >= c->size)
+        return pdt_err_set(err, PDT_ERR_MPI, "rank %d: send to rank %d", c->rank, peer);
+    return c->ops->send(c, peer, tag, buf, bytes, err);
+}
+
+pdt_status pdt_comm_recv(pdt_comm *c, int peer, int tag, void **buf, size_t *bytes, pdt_err *err)
+{
+    *buf = NULL;
+    *bytes = 0;
+    if (peer == c->rank || peer < 0 || peer >= c->size)
+        return pdt_err_set(err, PDT_ERR_MPI, "rank %d: receive from rank %d", c->rank, peer);
+    return c->ops->recv(c, peer, tag, buf, bytes, err);
+}
+
+pdt_status pdt_comm_agree(pdt_comm *c, pdt_status mine, const char *path, const char *what,
+                          pdt_err *err)
+{
+    if (c->size == 1) return mine;
+    uint64_t bad = mine != PDT_OK, who = mine != PDT_OK ? (uint64_t)c->rank : UINT64_MAX;
+    pdt_err e2 = {0};
+    pdt_status s = pdt_comm_allreduce_u64(c, &bad, 1, PDT_COMM_MAX, &e2);
+    if (s == PDT_OK) s = pdt_comm_allreduce_u64(c, &who, 1, PDT_COMM_MIN, &e2);
+    if (mine != PDT_OK) return mine;
+    if (s != PDT_OK) {
+        *err = e2;
+        return s;
+    }
+    if (bad)
+        return pdt_err_set(err, PDT_ERR_IO, "%s: %s failed at rank %llu", path, what,
+                           (unsigned long long)who);
+    return PDT_OK;
+}
+
+pdt_status pdt_comm_file_open(pdt_comm *c, const char *path, pdt_comm_file **out, pdt_err *err)
+{
+    *out = NULL;
+    pdt_comm_file *f = calloc(1, sizeof *f);
+    char *p = strdup(path);
+    if (!f || !p) {
+        free(f);
+        free(p);
+        /* (a few bytes short: the other ranks may then wait in the open) */
+        return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", c->rank, path);
+    }
+    f->c = c;
+    f->path = p;
+    pdt_status s = c->ops->file_open(c, f, err);
+    if (s != PDT_OK) {
+        free(p);
+        free(f);
+        return s;
+    }
+    *out = f;
+    return PDT_OK;
+}
+
+pdt_status pdt_comm_file_write_at(pdt_comm_file *f, uint64_t offset, const void *buf,
+                                  size_t bytes, pdt_err *err)
+{
+    return f->c->ops->file_write_at(f, offset, buf, bytes, err);
+}
+
+pdt_status pdt_comm_file_close(pdt_comm_file *f, pdt_err *err)
+{
+    if (!f) return PDT_OK;
+    pdt_status s = f->c->ops->file_close(f, err);
+    free(f->path);
+    free(f);
+    return s;
+}
