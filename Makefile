@@ -65,7 +65,7 @@ LIBS        := -lm -pthread
 
 # Debian packages the build, the tests and the demo need.
 DEB_BUILD := build-essential pkg-config libopenmpi-dev openmpi-bin libsdl2-dev libcairo2-dev fonts-dejavu-core
-DEB_TEST  := qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps
+DEB_TEST  := qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps slurmctld slurmd slurm-client munge
 DEB_BENCH := hyperfine libcgal-dev g++ nodejs npm valgrind time
 DEB_FUZZ  := clang libclang-rt-dev
 

@@ -1,5 +1,4 @@
 #!/bin/bash
-# san: yes
 # The chunked transfer path of the comm layer (src/par/comm_mpi.c): with
 # PDT_COMM_CHUNK forcing tiny messages, every collective and every
 # point-to-point message of a parallel triangulation is cut into many pieces
