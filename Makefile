@@ -15,6 +15,8 @@
 #                   seed corpus tests/fuzz/corpus/, without libFuzzer); the
 #                   grown corpus stays in build/fuzz/corpus/ (tests/fuzz/run.sh)
 #   make fuzz-seeds rewrite the binary trace seeds of tests/fuzz/corpus/
+#   make install    install into $(DESTDIR)$(PREFIX) (see "install" below)
+#   make uninstall  remove what make install put there
 #   make deps       only install missing Debian packages
 #   make clean
 #
@@ -24,6 +26,8 @@
 #   SAN       sanitizer flags, sanitizer build   (default: ASan + UBSan)
 #   NP        ranks for demo runs                (default: 4)
 #   TRACE=0   compile tracing out entirely (-DPDT_NO_TRACE)
+#   PREFIX    install prefix                     (default: /usr/local)
+#   DESTDIR   staging root for packaging         (default: empty)
 #   FUZZ_SECONDS  time per fuzz target        (default: 60)
 #   FUZZ_TARGETS  which fuzz targets to run   (default: all of them)
 #   FUZZ_JOBS     targets fuzzed at once      (default: 1)
@@ -65,7 +69,7 @@ LIBS        := -lm -pthread
 
 # Debian packages the build, the tests and the demo need.
 DEB_BUILD := build-essential pkg-config libopenmpi-dev openmpi-bin libsdl2-dev libcairo2-dev fonts-dejavu-core
-DEB_TEST  := qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps slurmctld slurmd slurm-client munge
+DEB_TEST  := mandoc bash-completion qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps slurmctld slurmd slurm-client munge
 DEB_BENCH := hyperfine libcgal-dev g++ nodejs npm valgrind time
 DEB_FUZZ  := clang libclang-rt-dev
 
@@ -190,3 +194,36 @@ fuzz-seeds: build/fuzz-seeds/make_seeds
 
 clean:
 	rm -rf build bin
+
+# ---- install / uninstall ------------------------------------------------------
+# make install [PREFIX=/usr/local] [DESTDIR=/staging] puts
+#   PREFIX/bin/pdt, pdtview, pdt-lesson (scripts/lesson.sh: finds its lessons
+#       in ../share/pdt beside itself, or in $PDT_DATADIR)
+#   PREFIX/share/pdt/lessons/, assets/, lesson-check.py
+#   PREFIX/share/man/man1/pdt.1, pdtview.1 (mdoc; `mandoc -T lint` in make test)
+#   PREFIX/share/bash-completion/completions/pdt, pdtview
+# pdtview reads no data files (fonts come from fontconfig).  Nothing in the
+# installed tree refers to the checkout, so it works with the checkout gone.
+PREFIX  ?= /usr/local
+DESTDIR ?=
+I_BIN   := $(DESTDIR)$(PREFIX)/bin
+I_DATA  := $(DESTDIR)$(PREFIX)/share/pdt
+I_MAN   := $(DESTDIR)$(PREFIX)/share/man/man1
+I_COMP  := $(DESTDIR)$(PREFIX)/share/bash-completion/completions
+
+.PHONY: install uninstall
+install: rel-all
+	install -d $(I_BIN) $(I_DATA) $(I_MAN) $(I_COMP)
+	install -m 755 bin/pdt bin/pdtview $(I_BIN)/
+	install -m 755 scripts/lesson.sh $(I_BIN)/pdt-lesson
+	rm -rf $(I_DATA)/lessons $(I_DATA)/assets
+	cp -R lessons assets $(I_DATA)/
+	install -m 644 scripts/lesson-check.py $(I_DATA)/
+	install -m 644 man/pdt.1 man/pdtview.1 $(I_MAN)/
+	install -m 644 completions/pdt completions/pdtview $(I_COMP)/
+
+uninstall:
+	rm -f $(I_BIN)/pdt $(I_BIN)/pdtview $(I_BIN)/pdt-lesson
+	rm -rf $(I_DATA)
+	rm -f $(I_MAN)/pdt.1 $(I_MAN)/pdtview.1
+	rm -f $(I_COMP)/pdt $(I_COMP)/pdtview

@@ -19,7 +19,8 @@
 # Options
 #   --headless     never open a window, render frames (default without a display)
 #   --record-only  record, check and describe, render nothing, open nothing
-#   --out DIR      where to put the runs (default: build/lessons/NN)
+#   --out DIR      where to put the runs (default: build/lessons/NN in a checkout,
+#                  ./pdt-lessons/NN when installed as pdt-lesson)
 #   --quiet        print only where things are
 #
 # lesson.conf: `key = value` lines, `#` comments; optional `[NAME]` sections, one
@@ -39,8 +40,23 @@
 #
 # Exit status: 0 when every run was recorded, checked and shown/rendered; 1 otherwise.
 set -u
-ROOT=$(cd "$(dirname "$0")/.." && pwd)
-BIN=${BIN:-$ROOT/bin}
+# Where its files are: in a checkout, ROOT (lessons/, scripts/, bin/); installed by
+# `make install` as PREFIX/bin/pdt-lesson, PREFIX/share/pdt (lessons/, assets/,
+# lesson-check.py) beside PREFIX/bin, runs going to ./pdt-lessons/NN.
+# PDT_DATADIR overrides the data folder.
+HERE=$(cd "$(dirname "$0")" && pwd)
+if [ -z "${PDT_DATADIR:-}" ] && [ -f "$HERE/lesson-check.py" ] && [ -d "$HERE/../lessons" ]; then
+    ROOT=$(cd "$HERE/.." && pwd)           # the checkout
+    BIN=${BIN:-$ROOT/bin}
+    CHECKPY=$ROOT/scripts/lesson-check.py
+    OUTBASE=$ROOT/build/lessons
+else
+    ROOT=${PDT_DATADIR:-$(cd "$HERE/../share/pdt" 2>/dev/null && pwd)}
+    [ -d "$ROOT/lessons" ] || { echo "lesson: no lessons in '$ROOT' (set PDT_DATADIR)" >&2; exit 2; }
+    BIN=${BIN:-$HERE}
+    CHECKPY=$ROOT/lesson-check.py
+    OUTBASE=$(pwd)/pdt-lessons
+fi
 PDT=${PDT:-$BIN/pdt}
 PDTVIEW=${PDTVIEW:-$BIN/pdtview}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
@@ -70,7 +86,7 @@ fi
 LDIR=$(cd "$lesson" && pwd)
 LNAME=$(basename "$LDIR")
 NN=${LNAME%%-*}
-[ -n "$out" ] || out=$ROOT/build/lessons/$NN
+[ -n "$out" ] || out=$OUTBASE/$NN
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 
@@ -116,7 +132,7 @@ pos_args() {
         end) echo "--end" ;;
         first|last)
             # shellcheck disable=SC2086
-            k=$(python3 -B "$ROOT/scripts/lesson-check.py" --find "$2" $1) || return 1
+            k=$(python3 -B "$CHECKPY" --find "$2" $1) || return 1
             echo "--at $k" ;;
         *) echo "lesson: bad viewer position '$1' (at N | phase NAME | end | first/last KIND ...)" >&2; return 1 ;;
     esac

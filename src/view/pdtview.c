@@ -502,10 +502,13 @@ int main(int argc, char **argv)
         rc = pdt_shell_run(r, s, &v, &so);
     }
 out:
-    if (err.code != PDT_OK) fprintf(stderr, "pdtview: %s\n", err.msg);
+    if (err.code != PDT_OK) { /* unreadable run, bad argument: 2, as for pdt */
+        fprintf(stderr, "pdtview: %s\n", err.msg);
+        rc = err.code == PDT_ERR_CHECK ? 1 : 2;
+    }
     free(hidden);
     pdt_rstate_free(s);
     pdt_replay_free(r);
     unload(&L);
-    return err.code != PDT_OK ? 1 : rc;
+    return rc;
 }
