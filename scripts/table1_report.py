@@ -1,0 +1,96 @@
+#!/usr/bin/env python3
+"""pdt — the figures of `make table1` (scripts/table1.sh) from its runs.
+
+Usage: table1_report.py DIR CORES "SIZES" "PS"
+DIR holds LABEL.runs files (lines "wall_seconds stats.json"), LABEL = seq-N
+(the plain run) or pP-N (mpirun -np P)."""
+import json
+import statistics
+import sys
+
+PHASES = ("read", "partition", "local", "merge", "order", "write")
+
+
+def load(w, label):
+    rows = []
+    for line in open(f"{w}/{label}.runs"):
+        wall, path = line.split()
+        text = open(path).read()
+        rows.append((float(wall), json.loads(text[text.index("{"):])))
+    return rows
+
+
+def rank_phases(j):
+    """{phase: seconds, max over ranks}, and whether the per-rank seconds were there."""
+    par = j.get("parallel") or {}
+    ranks = par.get("per_rank") or []
+    native = bool(ranks) and all(isinstance(r.get("seconds"), dict) for r in ranks)
+    out = dict.fromkeys(PHASES, 0.0)
+    for q, r in enumerate(ranks):
+        if native:
+            sec = r["seconds"]
+        else:  # older builds: rank 0 read and wrote, "gather" was the order phase
+            top = j.get("seconds", {})
+            sec = {"read": top.get("read", 0.0) if q == 0 else 0.0,
+                   "partition": r.get("partition_s", 0.0), "local": r.get("local_s", 0.0),
+                   "merge": r.get("merge_s", 0.0), "order": r.get("gather_s", 0.0),
+                   "write": top.get("write", 0.0) if q == 0 else 0.0}
+        for k in PHASES:
+            out[k] = max(out[k], float(sec.get(k, 0.0)))
+    return out, native
+
+
+def peak_kib(j):
+    ranks = (j.get("parallel") or {}).get("per_rank") or []
+    vals = [r.get("peak_rss_kib", 0) for r in ranks] or [j.get("peak_rss_kib", 0)]
+    return max(vals)
+
+
+def main():
+    w, cores, sizes, ps = sys.argv[1], int(sys.argv[2]), sys.argv[3].split(), sys.argv[4].split()
+    med = statistics.median
+    hdr = ("n", "run", "wall s", "speedup") + tuple(f"{k} s" for k in PHASES) + ("",)
+    print("| " + " | ".join(hdr) + " |")
+    print("|" + "|".join("---" for _ in hdr) + "|")
+    all_native = True
+    extra = []
+    for n in sizes:
+        seq = load(w, f"seq-{n}")
+        seq_wall = med([wall for wall, _ in seq])
+        s = [j.get("seconds", {}) for _, j in seq]
+        seq_read = med([x.get("read", 0.0) for x in s])
+        seq_write = med([x.get("write", 0.0) for x in s])
+        seq_peak = med([j.get("peak_rss_kib", 0) for _, j in seq])
+        print(f"| {int(n):,} | plain | {seq_wall:.3f} | 1.00 | {seq_read:.3f} | | "
+              f"{seq_wall - seq_read - seq_write:.3f}† | | | {seq_write:.3f} | |")
+        for p in ps:
+            runs = load(w, f"p{p}-{n}")
+            wall = med([wall for wall, _ in runs])
+            ph = [rank_phases(j) for _, j in runs]
+            all_native = all_native and all(nat for _, nat in ph)
+            cols = " | ".join(f"{med([x[k] for x, _ in ph]):.3f}" for k in PHASES)
+            mark = "* P > cores" if int(p) > cores else ""
+            print(f"| {int(n):,} | mpirun -np {p} | {wall:.3f} | {seq_wall / wall:.2f} | {cols} | {mark} |")
+        big = max(ps, key=int)
+        j = load(w, f"p{big}-{n}")[0][1]["parallel"]
+        rel = 100 * j["merge_bytes_rel_input"]
+        line = f"n = {int(n):,}: merge traffic at P = {big}: {j['merge_bytes']:,} bytes = {rel:.3f}% of the input"
+        if "2" in ps:
+            p2 = med([peak_kib(j) for _, j in load(w, f"p2-{n}")])
+            line += (f"; peak memory, largest rank at P = 2: {p2:,.0f} KiB vs plain {seq_peak:,.0f} KiB"
+                     f" = {p2 / seq_peak:.2f}x" if seq_peak else "")
+        extra.append(line)
+    print()
+    for line in extra:
+        print(line)
+    print()
+    print("wall = the whole command (MPI start-up, read, compute, write); speedup = plain wall / wall.")
+    print("Phases: seconds, the largest over the ranks, median over the runs.  † plain run:")
+    print("everything between read and write (sort, kernel, canonical order).")
+    if not all_native:
+        print("(This build's --stats has no per_rank[].seconds: read and write are rank 0's,")
+        print(" \"order\" is the gather to rank 0.)")
+
+
+if __name__ == "__main__":
+    main()
