@@ -33,7 +33,7 @@ RUNS=${RUNS:-3}
 NICE=${NICE:-0}
 PDT=$PWD/bin/pdt
 CORES=$(nproc)
-W=build/table1
+W=${TABLE1_DIR:-build/table1}
 mkdir -p "$W"
 command -v mpirun > /dev/null || { echo "table1: mpirun not found" >&2; exit 1; }
 command -v python3 > /dev/null || { echo "table1: python3 not found" >&2; exit 1; }

@@ -1,0 +1,24 @@
+#!/bin/bash
+# make table1 and the scaling projection still run end to end (tiny sizes,
+# one run each): the table has its rows and phase columns, the merge-traffic
+# and peak-memory lines are there, and scripts/projection.py prints its
+# projection from the P = 2 run's --stats.  No figure is asserted.
+source "$(dirname "$0")/lib.sh"
+if ! command -v mpirun > /dev/null; then fail mpirun_available "mpirun not found"; summary; exit; fi
+out=$TMP/table1.txt
+if ! TABLE1_DIR=$TMP/t1 SIZES=3000 PS="1 2" RUNS=1 timeout 300 "$ROOT/scripts/table1.sh" > "$out" 2>&1; then
+    fail table1_runs "$(tail -5 "$out")"; summary; exit
+fi
+ok table1_runs
+check table1_header grep -q '| n | run | wall s | speedup | read s | partition s | local s | merge s | order s | write s |' "$out"
+check table1_rows test "$(grep -cE '^\| 3,000 \| (plain|mpirun -np [12]) \|' "$out")" -eq 3
+check table1_merge_and_memory grep -qE 'merge traffic at P = 2: .*% of the input; peak memory, largest rank at P = 2' "$out"
+check table1_uptime grep -q '^uptime after:' "$out"
+if python3 "$ROOT/scripts/projection.py" "$TMP/t1/p2-3000.1.json" > "$TMP/proj.txt" 2>&1; then
+    ok projection_runs
+    check projection_says_so grep -q '^PROJECTION' "$TMP/proj.txt"
+    check projection_rows test "$(grep -cE '^\| 1e\+0[6-9] \| [0-9]+ \|' "$TMP/proj.txt")" -eq 44
+else
+    fail projection_runs "$(tail -5 "$TMP/proj.txt")"
+fi
+summary
