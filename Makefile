@@ -35,8 +35,10 @@
 # Layout: build/rel/... and build/san/... hold objects; bin/ the release
 # programs; bin/san/ the sanitizer programs.  Sources are picked up by
 # wildcard: src/geom (predicates, hull, kernel, checker), src/io (files,
-# generators), src/trace (hook, writer, reader), src/par (parallel driver —
-# the only code that includes mpi.h is src/par/comm_mpi.c), src/cli (the pdt
+# generators), src/trace (hook, writer, reader), src/par (parallel driver:
+# every file but comm_mpi.c goes into libpdtpar.a, which unit tests link; the
+# only code that includes mpi.h is src/par/comm_mpi.c, linked into bin/pdt
+# alone), src/cli (the pdt
 # program), src/view (replay model, cairo renderer, SDL2 shell: every file
 # but shell.c and pdtview.c goes into libpdtview.a, which needs cairo only;
 # bin/pdtview adds SDL2 and the option parser src/cli/opts.c).  Unit tests
@@ -76,7 +78,7 @@ DEB_FUZZ  := clang libclang-rt-dev
 # the comm front and its local (threads) backend need no MPI: in libpdt.a
 COMM_SRC := src/par/comm.c src/par/comm_local.c
 LIB_SRC  := $(wildcard src/geom/*.c src/io/*.c src/trace/*.c) $(COMM_SRC)
-PAR_SRC  := $(filter-out $(COMM_SRC),$(wildcard src/par/*.c))
+PAR_SRC  := $(filter-out $(COMM_SRC) src/par/comm_mpi.c,$(wildcard src/par/*.c))
 CLI_SRC  := $(wildcard src/cli/*.c)
 VIEWLIB_SRC := $(filter-out src/view/shell.c src/view/pdtview.c,$(wildcard src/view/*.c))
 VIEWAPP_SRC := $(filter src/view/shell.c src/view/pdtview.c,$(wildcard src/view/*.c))
@@ -87,6 +89,7 @@ define variant
 $(1)_OBJ := build/$(1)
 $(1)_LIB := build/$(1)/libpdt.a
 $(1)_VIEWLIB := build/$(1)/libpdtview.a
+$(1)_PARLIB := build/$(1)/libpdtpar.a
 
 build/$(1)/%.o: %.c $$(wildcard include/pdt/*.h src/*/*.h) | build/$(1)/.dirs
 	@mkdir -p $$(dir $$@)
@@ -100,17 +103,21 @@ build/$(1)/libpdt.a: $$(patsubst %.c,build/$(1)/%.o,$(LIB_SRC))
 	@rm -f $$@
 	ar rcs $$@ $$^
 
+build/$(1)/libpdtpar.a: $$(patsubst %.c,build/$(1)/%.o,$(PAR_SRC))
+	@rm -f $$@
+	ar rcs $$@ $$^
+
 build/$(1)/libpdtview.a: $$(patsubst %.c,build/$(1)/%.o,$(VIEWLIB_SRC))
 	@rm -f $$@
 	ar rcs $$@ $$^
 
-$(3)/pdt: $$(patsubst %.c,build/$(1)/%.o,$(CLI_SRC) $(PAR_SRC)) build/$(1)/libpdt.a
+$(3)/pdt: $$(patsubst %.c,build/$(1)/%.o,$(CLI_SRC) src/par/comm_mpi.c) build/$(1)/libpdtpar.a build/$(1)/libpdt.a
 	$$(CC) $(2) -o $$@ $$^ $(MPI_LIBS) $(LIBS)
 
 $(3)/pdtview: $$(patsubst %.c,build/$(1)/%.o,$(VIEWAPP_SRC) src/cli/opts.c) build/$(1)/libpdtview.a build/$(1)/libpdt.a
 	$$(CC) $(2) -o $$@ $$^ $(SDL_LIBS) $(CAIRO_LIBS) $(LIBS)
 
-$(3)/tests/%: build/$(1)/tests/unit/%.o $(if $(VIEWLIB_SRC),build/$(1)/libpdtview.a) build/$(1)/libpdt.a
+$(3)/tests/%: build/$(1)/tests/unit/%.o $(if $(VIEWLIB_SRC),build/$(1)/libpdtview.a) build/$(1)/libpdtpar.a build/$(1)/libpdt.a
 	@mkdir -p $$(dir $$@)
 	$$(CC) $(2) -o $$@ $$^ $(CAIRO_LIBS) $(LIBS)
 

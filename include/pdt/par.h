@@ -16,6 +16,7 @@
 #include <stdio.h>
 
 #include "pdt/common.h"
+#include "pdt/io.h"
 #include "pdt/trace.h"
 
 /* ---- communication layer (src/par/comm.c: the front; backends MPI
@@ -122,9 +123,42 @@ typedef pdt_status (*pdt_comm_rank_fn)(pdt_comm *c, void *arg, pdt_err *err);
  * instead of waiting forever).  pdt_comm_abort must not be called inside. */
 pdt_status pdt_comm_local_run(int nranks, pdt_comm_rank_fn fn, void *arg, pdt_err *err);
 
-/* ---- the parallel triangulation (src/par/driver.c) ----------------------- */
+/* ---- the parallel triangulation (src/par: libpdtpar) ---------------------- */
+/*
+ * One `pdt triangulate` run on P ranks, as the cli drives it:
+ *   pdt_par_read          every rank gets a consecutive block of the input
+ *   pdt_par_triangulate   sample sort, local kernels, merges, canonical order:
+ *                         every rank ends with a consecutive block of T*
+ *   pdt_par_write         all ranks write the one output file together
+ *   pdt_par_stats_collect the per-rank figures, at rank 0
+ * With P = 1 (a plain run, or mpirun -np 1) the same calls run the
+ * sequential kernel.  None of these functions prints or exits: each returns a
+ * status, and err holds the message of this rank's failure. */
 
-/* Per-rank figures of one run (collected at rank 0). */
+/* This rank's share of the input: the points of global input indices
+ * first .. first + n - 1 (rank q's block comes before rank q+1's). */
+typedef struct pdt_par_input {
+    pdt_point *pts;      /* malloc'd; pdt_par_input_free */
+    size_t n;
+    uint64_t first;      /* global index of pts[0] */
+    uint64_t n_total;    /* points in the whole input (every rank) */
+    uint64_t collisions; /* --scale: points that became equal to a point written
+                          * differently, over the whole input (every rank) */
+} pdt_par_input;
+
+/* This rank's share of T*: triangles first .. first + ntri - 1 of the
+ * canonical output (pdt_tri_canonical order across all ranks). */
+typedef struct pdt_par_output {
+    pdt_tri *tris;       /* malloc'd; pdt_par_output_free */
+    size_t ntri;
+    uint64_t first;      /* index of tris[0] in the whole output */
+    uint64_t n_total;    /* triangles in the whole output (every rank) */
+} pdt_par_output;
+
+void pdt_par_input_free(pdt_par_input *in);
+void pdt_par_output_free(pdt_par_output *out);
+
+/* Figures of one rank. */
 typedef struct pdt_par_rank_stats {
     uint64_t points;        /* distinct points in this rank's strip */
     uint64_t received;      /* points received in the partition (with duplicates) */
@@ -137,15 +171,21 @@ typedef struct pdt_par_rank_stats {
     uint64_t kept;          /* triangles kept by merges done here */
     uint64_t discarded;     /* shipped triangles discarded (non-Delaunay) here */
     uint64_t final_merge;   /* triangles made final by merges done here */
-    uint64_t emitted;       /* triangles this rank contributed to the output */
+    uint64_t emitted;       /* final triangles this rank found */
+    uint64_t written;       /* triangles of the output this rank wrote */
     uint64_t bytes_sent, bytes_recv;          /* all traffic of this rank */
     uint64_t merge_bytes_sent, merge_bytes_recv; /* merge-step traffic only */
-    double t_partition, t_local, t_classify, t_merge, t_gather; /* seconds */
+    uint64_t n_dup;         /* duplicates dropped in this rank's strip */
+    uint64_t hull;          /* vertices of the hull this rank holds */
+    int32_t holds_final_hull, hull_degenerate;
+    /* seconds per phase of the pipeline */
+    double t_read, t_partition, t_local, t_merge, t_order, t_write;
     double critical_path;   /* seconds: longest chain of dependent compute ending here */
     double critical_cpu;    /* the same chain in CPU seconds */
     int64_t peak_rss_kib;   /* peak resident memory of this rank's process */
 } pdt_par_rank_stats;
 
+/* The figures of the whole run (rank 0). */
 typedef struct pdt_par_stats {
     int nranks;
     uint64_t n_in, n_unique, n_dup, n_tri;
@@ -156,47 +196,49 @@ typedef struct pdt_par_stats {
     uint64_t merge_bytes;     /* sum of merge-step bytes sent */
     double critical_path;     /* seconds, max over ranks */
     double critical_cpu;      /* CPU seconds, max over ranks */
-    double t_total;           /* seconds, driver wall time at rank 0 */
+    double t_compute;         /* seconds, max over ranks of partition .. order */
     pdt_par_rank_stats *rank; /* nranks entries (malloc'd; pdt_par_stats_free) */
 } pdt_par_stats;
 
 void pdt_par_stats_free(pdt_par_stats *s);
 
-/* Write the figures as one JSON object (no trailing newline) to f. */
-void pdt_par_stats_json(const pdt_par_stats *s, FILE *f);
+/* Collective: the status every rank agrees on after a step that may have
+ * failed on some ranks only.  Returns PDT_OK if st is PDT_OK on every rank;
+ * otherwise, at every rank, the status of the lowest failing rank, and *who
+ * (if not NULL) = that rank (err at that rank holds the message; the other
+ * ranks' err are left alone).  Never blocks on a rank that already failed: call it from every
+ * rank after the step. */
+pdt_status pdt_par_agree(pdt_comm *c, pdt_status st, int *who, pdt_err *err);
 
-/* The SRM triangulation, collective over c.
- * Requires: at rank 0, pts[0..n) is the whole input (other ranks: pts
- * ignored, n ignored).  Returns at rank 0 *tris (malloc'd, caller frees) =
- * T*(P) as 0-based input indices in canonical order (pdt_tri_canonical),
- * *ntri their count; other ranks get *tris = NULL, *ntri = 0.  stats, if not
- * NULL, is filled at rank 0 (free with pdt_par_stats_free).  tr (may be
- * NULL) is this rank's trace hook; points are reported as global input
- * indices.  On error every rank returns as soon as it notices, but ranks that
- * wait for a failed peer may block: call pdt_comm_abort after reporting. */
-pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n, pdt_tri **tris,
-                               size_t *ntri, pdt_par_stats *stats, pdt_trace *tr,
-                               pdt_err *err);
+/* Collective: read the points of `path` ("-" = standard input; ".node" =
+ * Triangle's format; else text), scaled by `scale` as pdt_read_points does.
+ * Every rank gets its block in *in (pdt_par_input_free); the
+ * collision count is the whole input's.  Same status at every rank
+ * (pdt_par_agree): a parse error is reported, at the rank that found it, as
+ * "FILE:LINE: what". */
+pdt_status pdt_par_read(pdt_comm *c, const char *path, double scale, pdt_par_input *in,
+                        pdt_err *err);
 
-/* ---- the command (src/par/par_cmd.c) -------------------------------------- */
+/* Collective: T* of the whole input (every rank passes its block).  *out is
+ * this rank's block of the canonical output (pdt_par_output_free).  me gets
+ * this rank's figures (partition .. order).  tr (may be NULL) is this rank's
+ * trace hook; events name global input indices.  On error ranks that wait for
+ * a failed peer may block: the caller reports and calls pdt_comm_abort. */
+pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_par_input *in, pdt_par_output *out,
+                               pdt_par_rank_stats *me, pdt_trace *tr, pdt_err *err);
 
-/* What `pdt triangulate` asks of a parallel run. */
-typedef struct pdt_par_job {
-    const char *input;     /* points file */
-    const char *output;    /* NULL or "-" = standard output */
-    double scale;          /* --scale (0 = integers only) */
-    int stats;             /* --stats: print JSON to stderr at rank 0 */
-    const char *trace_dir; /* --trace DIR, or NULL */
-    int trace_level;       /* 1 or 2 */
-    int argc;              /* the command's arguments, for the trace manifest */
-    char **argv;           /* (argv may be NULL) */
-} pdt_par_job;
+/* Collective: write the output to `path` (NULL or "-" = standard output,
+ * gathered at rank 0) in format `fmt` (.ele also
+ * writes the .node beside it, .off and .node need every rank's points in
+ * `in`).  The file is written by all ranks at their offsets into a
+ * temporary name and renamed by rank 0 once every rank succeeded; on any
+ * failure nothing is left.  Same status at every rank (pdt_par_agree). */
+pdt_status pdt_par_write(pdt_comm *c, const char *path, pdt_tri_format fmt, const pdt_par_input *in,
+                         const pdt_par_output *out, pdt_err *err);
 
-/* Run `pdt triangulate` on every rank of an MPI job (initialises and
- * finalises MPI itself): rank 0 reads and writes (atomically), all ranks
- * compute.  Prints messages on standard error (rank 0, or the failing rank).
- * Returns the process exit status (0 ok, 2 bad input, 1 other errors); on an
- * error with several ranks the job is aborted. */
-int pdt_par_cmd_triangulate(int *argc, char ***argv, const pdt_par_job *job);
+/* Collective: gather every rank's figures at rank 0 into *all (other ranks:
+ * *all zeroed).  Free with pdt_par_stats_free. */
+pdt_status pdt_par_stats_collect(pdt_comm *c, const pdt_par_rank_stats *me, uint64_t n_in,
+                                 pdt_par_stats *all, pdt_err *err);
 
 #endif

@@ -1,10 +1,13 @@
 /* pdt triangulate — read points, compute T*, write the canonical triangles.
- * The three steps are separate functions (run_opts.h) so that a driver (the
- * MPI one) can reuse them. */
+ *
+ * One pipeline for every run: a plain run is one rank (a serial context, no
+ * MPI), a run under mpirun / srun has P ranks, and every rank goes through
+ * the same steps (pdt/par.h): read its block of the input, triangulate,
+ * write its block of the output, then the figures.  The library returns
+ * statuses; this file alone prints and chooses exit codes (cli.h). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "cli.h"
 #include "pdt/delaunay.h"
@@ -38,92 +41,256 @@ static const char help[] =
     "Duplicate points are represented by their first occurrence.  Fewer than 3\n"
     "distinct points, or all collinear: no triangles, and a message says why.\n"
     "\n"
-    "Exit status: 0 success, 2 usage or input error.\n";
+    "Under mpirun / srun every rank reads, computes and writes its share; the\n"
+    "output is the same bytes as a plain run's.\n"
+    "\n"
+    "Exit status: 0 success, 2 usage, input or write error (or a failed rank).\n";
 
-pdt_status pdt_tri_job_read(const pdt_run_opts *o, pdt_tri_job *j, pdt_err *err)
+/* The state of one run at this rank. */
+typedef struct run {
+    const pdt_run_opts *o;
+    pdt_comm *c;
+    int rank, p;
+    pdt_par_input in;        /* this rank's block of the input */
+    pdt_par_output out;      /* this rank's block of T* */
+    pdt_par_rank_stats me;   /* this rank's figures */
+    pdt_cli_trace *trace;    /* NULL = not traced */
+    double t_start;
+    const char *phase;       /* the step running, for messages */
+} run;
+
+/* Print the failure of a step, at the rank that failed (who): the message
+ * alone when it names the user's input or options, else with the rank and
+ * the step.  Returns st. */
+static pdt_status report_failure(const run *R, pdt_status st, int who, const pdt_err *err)
 {
-    double t0 = pdt_cli_now();
-    pdt_status st = pdt_read_points(o->input, o->scale, &j->pts, &j->n, &j->collisions, err);
-    j->t_read = pdt_cli_now() - t0;
+    if (st == PDT_OK || who != R->rank) return st;
+    const char *msg = err->msg[0] ? err->msg : pdt_status_str(err->code);
+    if (R->p == 1 || st == PDT_ERR_PARSE || st == PDT_ERR_ARG || strncmp(msg, "rank ", 5) == 0)
+        fprintf(stderr, "pdt: %s\n", msg);
+    else
+        fprintf(stderr, "pdt: rank %d, %s: %s\n", R->rank, R->phase, msg);
+    fflush(stderr);
     return st;
 }
 
-pdt_status pdt_tri_job_compute(const pdt_run_opts *o, pdt_tri_job *j, pdt_err *err)
+/* A step every rank ends together: agree on its status, report a failure. */
+static pdt_status agreed(run *R, pdt_status st, pdt_err *err)
 {
-    pdt_status st = pdt_cli_trace_open(o, j->pts, j->n, &j->trace, err);
-    if (st != PDT_OK) return st;
-    st = pdt_triangulate(j->pts, j->n, &j->tris, &j->ntri, &j->st,
-                         pdt_cli_trace_hook(j->trace));
-    if (st != PDT_OK) pdt_err_set(err, st, "triangulation failed: %s", pdt_status_str(st));
-    else pdt_cli_trace_finals(j->trace, j->tris, j->ntri);
-    pdt_status cst = pdt_cli_trace_close(j->trace, err);
-    j->trace = NULL;
-    return st != PDT_OK ? st : cst;
+    int who = -1;
+    st = pdt_par_agree(R->c, st, &who, err);
+    return report_failure(R, st, who, err);
 }
 
-pdt_status pdt_tri_job_write(const pdt_run_opts *o, pdt_tri_job *j, pdt_err *err)
+/* The output (or the .node written beside an .ele) must not replace the
+ * input (checked at rank 0). */
+static pdt_status check_output(run *R, pdt_err *err)
 {
-    double t0 = pdt_cli_now();
-    pdt_tri_format fmt = pdt_tri_format_of(o->output);
-    if (fmt == PDT_FMT_ELE) {
-        /* The .node written beside OUT.ele must not replace the input. */
-        size_t len = strlen(o->output);
-        char *node = malloc(len + 2);
-        if (!node) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-        memcpy(node, o->output, len - 4);
-        memcpy(node + len - 4, ".node", 6);
-        int clash = strcmp(o->input, "-") != 0 && pdt_cli_same_file(node, o->input);
-        pdt_status st = clash ? pdt_err_set(err, PDT_ERR_ARG, "%s: writing %s would replace "
-                                            "the input %s; choose another -o name",
-                                            o->output, node, o->input)
-                              : PDT_OK;
-        free(node);
-        if (st != PDT_OK) return st;
-    } else if (o->output && strcmp(o->input, "-") != 0 && pdt_cli_same_file(o->output, o->input)) {
-        return pdt_err_set(err, PDT_ERR_ARG, "%s: output would replace the input; choose "
-                           "another -o name", o->output);
+    const pdt_run_opts *o = R->o;
+    pdt_status st = PDT_OK;
+    R->phase = "options";
+    if (R->rank == 0 && o->output && strcmp(o->input, "-") != 0) {
+        if (pdt_tri_format_of(o->output) == PDT_FMT_ELE) {
+            size_t len = strlen(o->output);
+            char *node = malloc(len + 2);
+            if (!node) return agreed(R, pdt_err_set(err, PDT_ERR_NOMEM, "out of memory"), err);
+            memcpy(node, o->output, len - 4);
+            memcpy(node + len - 4, ".node", 6);
+            if (pdt_cli_same_file(node, o->input))
+                st = pdt_err_set(err, PDT_ERR_ARG, "%s: writing %s would replace the input %s; "
+                                 "choose another -o name", o->output, node, o->input);
+            free(node);
+        } else if (pdt_cli_same_file(o->output, o->input)) {
+            st = pdt_err_set(err, PDT_ERR_ARG, "%s: output would replace the input; choose "
+                             "another -o name", o->output);
+        }
     }
-    pdt_status st = pdt_write_tris(o->output, fmt, j->pts, j->n, j->tris, j->ntri, err);
-    j->t_write = pdt_cli_now() - t0;
+    return agreed(R, st, err);
+}
+
+static pdt_status open_trace(run *R, pdt_err *err)
+{
+    R->phase = "trace";
+    return agreed(R, pdt_cli_trace_open_ranks(R->o, R->c, &R->trace, err), err);
+}
+
+/* The hook that records the read and write phases: parallel runs only (the
+ * lessons name the events of plain runs by their place in the trace). */
+static pdt_trace *io_hook(const run *R)
+{
+    return R->p > 1 ? pdt_cli_trace_hook(R->trace) : NULL;
+}
+
+static pdt_status read_input(run *R, pdt_err *err)
+{
+    pdt_trace *tr = io_hook(R);
+    R->phase = "read";
+    double t0 = pdt_comm_wtime(R->c);
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_READ, 0, 0, 0, 0);
+    pdt_status st = agreed(R, pdt_par_read(R->c, R->o->input, R->o->scale, &R->in, err), err);
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_READ, 0, 0, 0, 0);
+    R->me.t_read = pdt_comm_wtime(R->c) - t0;
+    if (st == PDT_OK) {
+        R->phase = "trace";
+        st = agreed(R, pdt_cli_trace_manifest(R->trace, R->o, R->c, &R->in, err), err);
+    }
     return st;
 }
 
-void pdt_tri_job_report(const pdt_run_opts *o, const pdt_tri_job *j)
+/* The triangulation.  A rank that fails here cannot wait for the others
+ * (they may wait for it): it reports and ends the whole job. */
+static pdt_status compute(run *R, pdt_err *err)
 {
-    const pdt_tri_stats *s = &j->st;
-    if (j->collisions)
-        fprintf(stderr, "pdt: warning: %zu point%s became equal to a different point after "
-                "rounding with --scale %g\n", j->collisions, j->collisions == 1 ? "" : "s",
-                o->scale);
-    if (s->n_dup)
-        fprintf(stderr, "pdt: %zu duplicate point%s dropped (each copy is represented by its "
-                "first occurrence)\n", s->n_dup, s->n_dup == 1 ? "" : "s");
-    if (s->n_unique < 3)
-        fprintf(stderr, "pdt: 0 triangles: only %zu distinct point%s (a triangle needs 3)\n",
-                s->n_unique, s->n_unique == 1 ? "" : "s");
-    else if (j->ntri == 0)
-        fprintf(stderr, "pdt: 0 triangles: all %zu distinct points are collinear\n",
-                s->n_unique);
-    if (o->stats) {
-        double total = pdt_cli_now() - j->t_start;
-        fprintf(stderr,
-                "{\"command\": \"triangulate\", \"n\": %zu, \"unique\": %zu, \"duplicates\": %zu, "
-                "\"collisions\": %zu, \"triangles\": %zu, \"hull\": %zu, \"collinear\": %s, "
-                "\"seconds\": {\"read\": %.6f, \"sort\": %.6f, \"kernel\": %.6f, "
-                "\"canonical\": %.6f, \"write\": %.6f, \"total\": %.6f}, "
-                "\"peak_rss_kib\": %ld}\n",
-                j->n, s->n_unique, s->n_dup, j->collisions, j->ntri, s->n_hull,
-                s->collinear ? "true" : "false", j->t_read, s->t_sort, s->t_kernel, s->t_canon,
-                j->t_write, total, pdt_cli_peak_kib());
+    R->phase = "triangulate";
+    pdt_status st = pdt_par_triangulate(R->c, &R->in, &R->out, &R->me,
+                                        pdt_cli_trace_hook(R->trace), err);
+    if (st != PDT_OK && R->p > 1) {
+        report_failure(R, st, R->rank, err);
+        pdt_comm_abort(R->c, PDT_EXIT_USAGE);
     }
+    return report_failure(R, st, R->rank, err);
 }
 
-void pdt_tri_job_free(pdt_tri_job *j)
+static pdt_status write_output(run *R, pdt_err *err)
 {
-    if (j->trace) pdt_cli_trace_close(j->trace, NULL);
-    free(j->pts);
-    free(j->tris);
-    memset(j, 0, sizeof *j);
+    pdt_trace *tr = io_hook(R);
+    R->phase = "write";
+    double t0 = pdt_comm_wtime(R->c);
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_WRITE, 0, 0, 0, 0);
+    pdt_status st = pdt_par_write(R->c, R->o->output, pdt_tri_format_of(R->o->output), &R->in,
+                                  &R->out, err);
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_WRITE, 0, 0, 0, 0);
+    R->me.t_write = pdt_comm_wtime(R->c) - t0;
+    R->me.written = R->out.ntri;
+    st = agreed(R, st, err);
+    if (st == PDT_OK) {
+        R->phase = "trace";
+        pdt_status tst = pdt_cli_trace_close(R->trace, err);
+        R->trace = NULL;
+        st = agreed(R, tst, err);
+    }
+    return st;
+}
+
+/* ---- what the user reads -------------------------------------------------------- */
+
+static void json_seconds(const pdt_par_rank_stats *r)
+{
+    fprintf(stderr, "{\"read\": %.6f, \"partition\": %.6f, \"local\": %.6f, \"merge\": %.6f, "
+            "\"order\": %.6f, \"write\": %.6f}", r->t_read, r->t_partition, r->t_local,
+            r->t_merge, r->t_order, r->t_write);
+}
+
+static void json_rank(int q, const pdt_par_rank_stats *r)
+{
+    fprintf(stderr,
+            "%s{\"rank\": %d, \"seconds\": ", q ? ", " : "", q);
+    json_seconds(r);
+    fprintf(stderr,
+            ", \"peak_rss_kib\": %lld, \"points\": %llu, \"local_triangles\": %llu, "
+            "\"final_at_once\": %llu, \"deferred\": %llu, \"shipped\": %llu, "
+            "\"merges\": %llu, \"border_max\": %llu, \"kept\": %llu, \"discarded\": %llu, "
+            "\"final_by_merge\": %llu, \"emitted\": %llu, \"written\": %llu, "
+            "\"bytes_sent\": %llu, \"bytes_received\": %llu, \"merge_bytes_sent\": %llu, "
+            "\"merge_bytes_received\": %llu, \"critical_path_s\": %.6f}",
+            (long long)r->peak_rss_kib, (unsigned long long)r->points,
+            (unsigned long long)r->local_tris, (unsigned long long)r->final_at_once,
+            (unsigned long long)r->deferred, (unsigned long long)r->shipped,
+            (unsigned long long)r->merges, (unsigned long long)r->border_max,
+            (unsigned long long)r->kept, (unsigned long long)r->discarded,
+            (unsigned long long)r->final_merge, (unsigned long long)r->emitted,
+            (unsigned long long)r->written, (unsigned long long)r->bytes_sent,
+            (unsigned long long)r->bytes_recv, (unsigned long long)r->merge_bytes_sent,
+            (unsigned long long)r->merge_bytes_recv, r->critical_path);
+}
+
+/* The communication figures of an MPI run (what make table1 reads). */
+static void json_parallel(const pdt_par_stats *s)
+{
+    fprintf(stderr,
+            ", \"parallel\": {\"ranks\": %d, \"n\": %llu, \"unique\": %llu, \"duplicates\": %llu, "
+            "\"triangles\": %llu, \"hull\": %llu, \"collinear\": %s, "
+            "\"largest_border_set\": %llu, \"largest_border_set_rel_n\": %.6f, "
+            "\"sequential_merge\": %s, "
+            "\"bytes_total\": %llu, \"merge_bytes\": %llu, \"merge_bytes_rel_input\": %.6f, "
+            "\"critical_path_s\": %.6f, \"critical_path_cpu_s\": %.6f, \"time_s\": %.6f}",
+            s->nranks, (unsigned long long)s->n_in, (unsigned long long)s->n_unique,
+            (unsigned long long)s->n_dup, (unsigned long long)s->n_tri,
+            (unsigned long long)s->hull, s->collinear ? "true" : "false",
+            (unsigned long long)s->border_max,
+            s->n_unique ? (double)s->border_max / (double)s->n_unique : 0.0,
+            s->n_unique >= 64 && 2 * s->border_max > s->n_unique ? "true" : "false",
+            (unsigned long long)s->bytes_total, (unsigned long long)s->merge_bytes,
+            s->n_in ? (double)s->merge_bytes / (8.0 * (double)s->n_in) : 0.0, s->critical_path,
+            s->critical_cpu, s->t_compute);
+}
+
+/* --stats: one JSON object on one line.  "seconds" holds the largest time of each phase
+ * over the ranks (a plain run also keeps its historical names: sort, kernel,
+ * canonical); per_rank[] every rank's phases and peak memory. */
+static void json_stats(const run *R, const pdt_par_stats *s, double total)
+{
+    pdt_par_rank_stats mx;
+    memset(&mx, 0, sizeof mx);
+    for (int q = 0; q < s->nranks; q++) {
+        const pdt_par_rank_stats *r = &s->rank[q];
+#define PDT_MAX_(f) if (r->f > mx.f) mx.f = r->f
+        PDT_MAX_(t_read);
+        PDT_MAX_(t_partition);
+        PDT_MAX_(t_local);
+        PDT_MAX_(t_merge);
+        PDT_MAX_(t_order);
+        PDT_MAX_(t_write);
+        PDT_MAX_(peak_rss_kib);
+#undef PDT_MAX_
+    }
+    fprintf(stderr,
+            "{\"command\": \"triangulate\", \"ranks\": %d, \"n\": %llu, \"unique\": %llu, "
+            "\"duplicates\": %llu, \"collisions\": %llu, \"triangles\": %llu, \"hull\": %llu, "
+            "\"collinear\": %s, \"seconds\": {\"read\": %.6f, \"partition\": %.6f, "
+            "\"local\": %.6f, \"merge\": %.6f, \"order\": %.6f, \"write\": %.6f, ",
+            s->nranks, (unsigned long long)s->n_in, (unsigned long long)s->n_unique,
+            (unsigned long long)s->n_dup, (unsigned long long)R->in.collisions,
+            (unsigned long long)s->n_tri, (unsigned long long)s->hull,
+            s->collinear ? "true" : "false", mx.t_read, mx.t_partition, mx.t_local, mx.t_merge,
+            mx.t_order, mx.t_write);
+    if (s->nranks == 1)
+        fprintf(stderr, "\"sort\": %.6f, \"kernel\": %.6f, \"canonical\": %.6f, ",
+                mx.t_partition, mx.t_local, mx.t_order);
+    fprintf(stderr, "\"total\": %.6f}, \"peak_rss_kib\": %lld, \"per_rank\": [", total,
+            (long long)mx.peak_rss_kib);
+    for (int q = 0; q < s->nranks; q++) json_rank(q, &s->rank[q]);
+    fprintf(stderr, "]");
+    if (pdt_comm_is_mpi(R->c)) json_parallel(s);
+    fprintf(stderr, "}\n");
+}
+
+/* Messages about the input (rounding collisions, duplicates, why there are
+ * no triangles) and, with --stats, the figures: rank 0, on stderr. */
+static pdt_status report(run *R, pdt_err *err)
+{
+    R->phase = "figures";
+    R->me.peak_rss_kib = pdt_cli_peak_kib();
+    pdt_par_stats s;
+    pdt_status st = agreed(R, pdt_par_stats_collect(R->c, &R->me, R->in.n_total, &s, err), err);
+    if (st != PDT_OK || R->rank != 0) return st;
+    uint64_t coll = R->in.collisions;
+    if (coll)
+        fprintf(stderr, "pdt: warning: %llu point%s became equal to a different point after "
+                "rounding with --scale %g\n", (unsigned long long)coll, coll == 1 ? "" : "s",
+                R->o->scale);
+    if (s.n_dup)
+        fprintf(stderr, "pdt: %llu duplicate point%s dropped (each copy is represented by its "
+                "first occurrence)\n", (unsigned long long)s.n_dup, s.n_dup == 1 ? "" : "s");
+    if (s.n_unique < 3)
+        fprintf(stderr, "pdt: 0 triangles: only %llu distinct point%s (a triangle needs 3)\n",
+                (unsigned long long)s.n_unique, s.n_unique == 1 ? "" : "s");
+    else if (s.n_tri == 0)
+        fprintf(stderr, "pdt: 0 triangles: all %llu distinct points are collinear\n",
+                (unsigned long long)s.n_unique);
+    if (R->o->stats) json_stats(R, &s, pdt_comm_wtime(R->c) - R->t_start);
+    pdt_par_stats_free(&s);
+    return PDT_OK;
 }
 
 int pdt_cmd_triangulate(int argc, char **argv)
@@ -131,20 +298,25 @@ int pdt_cmd_triangulate(int argc, char **argv)
     pdt_run_opts o;
     int rc = pdt_cli_parse_run_opts("triangulate", help, argc, argv, &o);
     if (rc >= 0) return rc;
-    if (pdt_comm_launched()) { /* under mpirun / srun: the parallel driver (src/par) */
-        pdt_par_job pj = {o.input, o.output, o.scale, o.stats, o.trace_dir, o.trace_level,
-                          o.argc, o.argv};
-        return pdt_par_cmd_triangulate(NULL, NULL, &pj);
-    }
-
-    pdt_tri_job job = { .t_start = pdt_cli_now() };
+    run R;
+    memset(&R, 0, sizeof R);
+    R.o = &o;
     pdt_err err = { PDT_OK, "" };
-    pdt_status st = pdt_tri_job_read(&o, &job, &err);
-    if (st == PDT_OK) st = pdt_tri_job_compute(&o, &job, &err);
-    if (st == PDT_OK) st = pdt_tri_job_write(&o, &job, &err);
-    if (st == PDT_OK) pdt_tri_job_report(&o, &job);
+    if (pdt_comm_init(NULL, NULL, 0, &R.c, &err) != PDT_OK) return pdt_cli_fail(&err);
+    R.rank = pdt_comm_rank(R.c);
+    R.p = pdt_comm_size(R.c);
+    R.t_start = pdt_comm_wtime(R.c);
 
-    rc = st == PDT_OK ? PDT_EXIT_OK : pdt_cli_fail(&err);
-    pdt_tri_job_free(&job);
-    return rc;
+    pdt_status st = check_output(&R, &err);
+    if (st == PDT_OK) st = open_trace(&R, &err);
+    if (st == PDT_OK) st = read_input(&R, &err);
+    if (st == PDT_OK) st = compute(&R, &err);
+    if (st == PDT_OK) st = write_output(&R, &err);
+    if (st == PDT_OK) st = report(&R, &err);
+
+    if (R.trace) pdt_cli_trace_close(R.trace, NULL);
+    pdt_par_input_free(&R.in);
+    pdt_par_output_free(&R.out);
+    pdt_comm_finalize(R.c, NULL);
+    return st == PDT_OK ? PDT_EXIT_OK : PDT_EXIT_USAGE;
 }

@@ -3,8 +3,7 @@
  *
  * Kept small and separate so that the tracing and parallel parts can add
  * fields: tracing fills trace_dir / trace_level (parsed here, written by the
- * trace module through pdt_cli_trace_open), the MPI driver reuses the
- * read / compute / write steps of cmd_triangulate.c. */
+ * trace module through pdt_cli_trace_open). */
 #ifndef PDT_RUN_OPTS_H
 #define PDT_RUN_OPTS_H
 
@@ -12,6 +11,7 @@
 
 #include "pdt/common.h"
 #include "pdt/delaunay.h"
+#include "pdt/par.h"
 #include "pdt/trace.h"
 
 typedef struct pdt_run_opts {
@@ -48,28 +48,15 @@ void pdt_cli_trace_finals(pdt_cli_trace *t, const pdt_tri *tris, size_t ntri);
 /* Finish the run folder and free t (t may be NULL). */
 pdt_status pdt_cli_trace_close(pdt_cli_trace *t, pdt_err *err);
 
-/* The state of one `pdt triangulate` run, step by step. */
-typedef struct pdt_tri_job {
-    pdt_point *pts;          /* input points (malloc'd) */
-    size_t n;
-    size_t collisions;       /* points merged by --scale rounding */
-    pdt_tri *tris;           /* canonical triangles (malloc'd) */
-    size_t ntri;
-    pdt_tri_stats st;        /* filled by the computation */
-    double t_read, t_write;  /* seconds */
-    double t_start;          /* pdt_cli_now() at the start */
-    pdt_cli_trace *trace;    /* NULL = not traced */
-} pdt_tri_job;
-
-/* The three steps of `pdt triangulate`, reusable by a driver: read the input
- * named by o, compute T*, write it where o says.  Each returns PDT_OK or an
- * error described in err; pdt_tri_job_free releases what they allocated. */
-pdt_status pdt_tri_job_read(const pdt_run_opts *o, pdt_tri_job *j, pdt_err *err);
-pdt_status pdt_tri_job_compute(const pdt_run_opts *o, pdt_tri_job *j, pdt_err *err);
-pdt_status pdt_tri_job_write(const pdt_run_opts *o, pdt_tri_job *j, pdt_err *err);
-/* Messages about the input (duplicates, rounding collisions, why there are
- * no triangles) and, with --stats, the JSON figures: all on stderr. */
-void pdt_tri_job_report(const pdt_run_opts *o, const pdt_tri_job *j);
-void pdt_tri_job_free(pdt_tri_job *j);
+/* The trace of a `pdt triangulate` run on every rank of c (collective; the
+ * same status at every rank): rank 0 creates the folder, then every rank
+ * opens its rank file and the clocks are compared.  *t = NULL and PDT_OK
+ * when o->trace_dir is NULL.  Records the beginning of the run. */
+pdt_status pdt_cli_trace_open_ranks(const pdt_run_opts *o, pdt_comm *c, pdt_cli_trace **t,
+                                    pdt_err *err);
+/* Collective: the manifest and points.bin of the input read into `in`
+ * (every rank's block; written by rank 0).  Nothing if t is NULL. */
+pdt_status pdt_cli_trace_manifest(pdt_cli_trace *t, const pdt_run_opts *o, pdt_comm *c,
+                                  const pdt_par_input *in, pdt_err *err);
 
 #endif

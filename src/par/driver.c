@@ -1,14 +1,17 @@
 /* pdt — the SRM driver: moves the data between the phases of algorithm.md §3
- * with the pdt_comm wrappers.
+ * with the pdt_comm wrappers.  pdt_par_triangulate reads as its phases:
  *
- *   Phase 0  rank 0 scatters index blocks; sample sort by key (equal keys to
- *            one rank); duplicates removed (smallest index kept); strip
- *            descriptors allgathered.
- *   Phase 1-2 pdt_srm_local: lift-up, kernel, strip hull, classification.
- *   Phase 3  for each level: every rank of a pair sends one message (its
- *            pending triangles for that level, and the hull if it holds one)
- *            to the merge rank, which runs pdt_srm_merge.
- *   Phase 4  final triangles gathered at rank 0 and put in canonical order. */
+ *   partition  every rank's input block is sample-sorted by key (equal keys
+ *              to one rank); duplicates removed (smallest index kept); strip
+ *              descriptors allgathered.
+ *   local      pdt_srm_local: lift-up, kernel, strip hull, classification.
+ *   merge      for each level: every rank of a pair sends one message (its
+ *              pending triangles for that level, and the hull if it holds
+ *              one) to the merge rank, which runs pdt_srm_merge.
+ *   order      the final triangles are sample-sorted across ranks into the
+ *              canonical order: rank q ends with a consecutive block.
+ *
+ * With one rank the sequential pipeline (pdt_triangulate) does all of it. */
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
@@ -19,23 +22,31 @@
 #include "srm.h"
 
 enum {
-    TAG_SCATTER = 1,
     TAG_SAMPLES = 2,
     TAG_COUNTS = 3,
     TAG_RECORDS = 4,
     TAG_STRIPS = 5,
     TAG_GATHER = 6,
     TAG_STATS = 7,
+    TAG_ORDER = 8,
     TAG_MERGE = 100 /* + level */
 };
 
-/* Per-rank bookkeeping of the driver. */
+/* Per-rank state of the driver through the phases. */
 typedef struct drv {
     pdt_comm *c;
     int rank, p;
     pdt_trace *tr;
     uint32_t *seq_send, *seq_recv; /* per-peer message sequence numbers */
     uint64_t bytes_sent, bytes_recv, merge_sent, merge_recv;
+    srm_rec *rec;                  /* partition: this rank's distinct records */
+    size_t m;
+    uint64_t nrecv;
+    srm_strip *strip;              /* p strip descriptors */
+    srm_rank s;
+    int s_init;
+    pdt_par_rank_stats *me;
+    pdt_err *err;
 } drv;
 
 /* Trace one message (or one pair's share of a collective) and count it. */
@@ -65,9 +76,24 @@ static void note_all(drv *d, int tag, size_t bytes)
         }
 }
 
+/* An alltoallv: count what went to and came from each peer. */
+static void note_v(drv *d, int tag, const size_t *sent, const size_t *recvd)
+{
+    for (int q = 0; q < d->p; q++) {
+        if (q == d->rank) continue;
+        if (sent[q]) note_send(d, tag, q, sent[q]);
+        if (recvd[q]) note_recv(d, tag, q, recvd[q]);
+    }
+}
+
 static double wclock(void *user)
 {
     return pdt_comm_wtime(user);
+}
+
+static pdt_status nomem(drv *d, const char *phase)
+{
+    return pdt_err_set(d->err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", d->rank, phase);
 }
 
 /* Test-only: PDT_TEST_SLEEP_BEFORE_MERGE="RANK:SECONDS" makes RANK sleep
@@ -83,13 +109,6 @@ static void test_sleep(int rank)
     }
 }
 
-/* Everything the driver gathers at rank 0 from each rank. */
-typedef struct rank_report {
-    pdt_par_rank_stats st;
-    uint64_t n_dup, hull, holds_final_hull;
-    int64_t hull_degenerate;
-} rank_report;
-
 void pdt_par_stats_free(pdt_par_stats *s)
 {
     if (!s) return;
@@ -97,41 +116,29 @@ void pdt_par_stats_free(pdt_par_stats *s)
     s->rank = NULL;
 }
 
-/* ---- Phase 0 ---------------------------------------------------------------- */
+void pdt_par_output_free(pdt_par_output *out)
+{
+    free(out->tris);
+    memset(out, 0, sizeof *out);
+}
 
-static pdt_status partition(drv *d, const pdt_point *pts, uint64_t n, srm_rec **out, size_t *m,
-                            uint64_t *nrecv, pdt_err *err)
+/* ---- partition -------------------------------------------------------------- */
+
+/* Sample sort of this rank's input block by key: d->rec[0..d->m) are the
+ * distinct records of this rank's strip, key-sorted. */
+static pdt_status partition(drv *d, const pdt_par_input *in, pdt_err *err)
 {
     int p = d->p, r = d->rank;
     pdt_status st = PDT_OK;
+    size_t mine_n = in->n;
     size_t *cnt = calloc((size_t)p, sizeof *cnt), *rcnt = calloc((size_t)p, sizeof *rcnt);
     uint64_t *samp = NULL, *all = NULL, *split = NULL, *sc = NULL, *rc = NULL;
     srm_rec *rec = NULL, *tmp = NULL, *got = NULL;
-    pdt_point *mine = NULL;
-    if (!cnt || !rcnt) goto nomem;
-    /* index blocks: rank q gets [n q / p, n (q+1) / p) */
-    uint64_t lo = n * (uint64_t)r / (uint64_t)p, hi = n * (uint64_t)(r + 1) / (uint64_t)p;
-    size_t mine_n = (size_t)(hi - lo);
-    for (int q = 0; q < p; q++)
-        cnt[q] = (size_t)(n * (uint64_t)(q + 1) / (uint64_t)p - n * (uint64_t)q / (uint64_t)p) *
-                 sizeof(pdt_point);
-    mine = malloc((mine_n + 1) * sizeof *mine);
-    if (!mine) goto nomem;
-    st = pdt_comm_scatterv(d->c, pts, cnt, mine, mine_n * sizeof *mine, 0, err);
-    if (st != PDT_OK) goto done;
-    if (r == 0) {
-        for (int q = 1; q < p; q++)
-            if (cnt[q]) note_send(d, TAG_SCATTER, q, cnt[q]);
-    } else if (mine_n) {
-        note_recv(d, TAG_SCATTER, 0, mine_n * sizeof *mine);
-    }
-
     rec = malloc((mine_n + 1) * sizeof *rec);
     tmp = malloc((mine_n + 1) * sizeof *tmp);
-    if (!rec || !tmp) goto nomem;
-    for (size_t i = 0; i < mine_n; i++) rec[i] = (srm_rec){pdt_key(mine[i]), (uint32_t)(lo + i), 0};
-    free(mine);
-    mine = NULL;
+    if (!cnt || !rcnt || !rec || !tmp) goto nomem;
+    for (size_t i = 0; i < mine_n; i++)
+        rec[i] = (srm_rec){pdt_key(in->pts[i]), (uint32_t)(in->first + i), 0};
     /* samples at a regular stride of the input order (no sort needed here),
      * allgathered: [count, S keys] per rank */
     size_t S = (size_t)64 * (size_t)p;
@@ -190,11 +197,7 @@ static pdt_status partition(drv *d, const pdt_point *pts, uint64_t n, srm_rec **
     if (!got) goto nomem;
     st = pdt_comm_alltoallv(d->c, rec, cnt, got, rcnt, err);
     if (st != PDT_OK) goto done;
-    for (int q = 0; q < p; q++) {
-        if (q == r) continue;
-        if (cnt[q]) note_send(d, TAG_RECORDS, q, cnt[q]);
-        if (rcnt[q]) note_recv(d, TAG_RECORDS, q, rcnt[q]);
-    }
+    note_v(d, TAG_RECORDS, cnt, rcnt);
     free(rec);
     rec = NULL;
     free(tmp);
@@ -204,9 +207,9 @@ static pdt_status partition(drv *d, const pdt_point *pts, uint64_t n, srm_rec **
      * are all below rank q+1's, so a stable sort by key orders equal keys by
      * index: the first copy is the smallest index */
     pdt_srm_radix_sort(got, tmp, total);
-    *nrecv = total;
-    *m = pdt_srm_dedupe(got, total);
-    *out = got;
+    d->nrecv = total;
+    d->m = pdt_srm_dedupe(got, total);
+    d->rec = got;
     got = NULL;
     goto done;
 nomem:
@@ -222,15 +225,123 @@ done:
     free(rec);
     free(tmp);
     free(got);
-    free(mine);
     return st;
 }
+
+
+/* The local strip from the partition's records: points, global indices and
+ * the strip descriptor, allgathered into d->strip. */
+static pdt_status strips(drv *d, pdt_point **lp, uint32_t **lg, pdt_err *err)
+{
+    size_t m = d->m;
+    *lp = malloc((m + 1) * sizeof **lp);
+    *lg = malloc((m + 1) * sizeof **lg);
+    d->strip = malloc((size_t)d->p * sizeof *d->strip);
+    if (!*lp || !*lg || !d->strip) return nomem(d, "partition");
+    srm_strip mine = {m, 0, 0, 0, 0, 0, 0};
+    for (size_t i = 0; i < m; i++) {
+        (*lp)[i] = srm_key_point(d->rec[i].key);
+        (*lg)[i] = d->rec[i].idx;
+        if (i == 0 || (*lp)[i].y < mine.ymin) mine.ymin = (*lp)[i].y;
+        if (i == 0 || (*lp)[i].y > mine.ymax) mine.ymax = (*lp)[i].y;
+    }
+    if (m) {
+        mine.first_key = d->rec[0].key;
+        mine.last_key = d->rec[m - 1].key;
+        mine.xmin = (*lp)[0].x;
+        mine.xmax = (*lp)[m - 1].x;
+    }
+    free(d->rec);
+    d->rec = NULL;
+    pdt_status st = pdt_comm_allgather(d->c, &mine, sizeof mine, d->strip, err);
+    if (st == PDT_OK) note_all(d, TAG_STRIPS, sizeof mine);
+    return st;
+}
+
+/* Phases 1 and 2 on this rank's strip. */
+static pdt_status local(drv *d, const pdt_point *lp, const uint32_t *lg, pdt_err *err)
+{
+    pdt_status st = pdt_srm_init(&d->s, d->rank, d->p, d->strip, d->tr, err);
+    if (st != PDT_OK) return st;
+    d->s_init = 1;
+    d->s.clock = wclock;
+    d->s.clock_user = d->c;
+    return pdt_srm_local(&d->s, lp, lg, d->m, err);
+}
+
+/* ---- merge --------------------------------------------------------------------- */
+
+/* At the merge rank of a level: receive the other ranks' messages of the pair
+ * [gl, ge) (own = this rank's message, freed here) and merge them. */
+static pdt_status merge_at(drv *d, int level, int gl, int ge, void *own, size_t own_len,
+                           pdt_err *err)
+{
+    int r = d->rank, nm = ge - gl;
+    test_sleep(r);
+    void **msg = calloc((size_t)nm, sizeof *msg);
+    size_t *lens = calloc((size_t)nm, sizeof *lens);
+    pdt_status st = PDT_OK;
+    if (!msg || !lens) {
+        free(msg);
+        free(lens);
+        free(own);
+        return nomem(d, "merge");
+    }
+    msg[r - gl] = own;
+    lens[r - gl] = own_len;
+    for (int q = gl; q < ge && st == PDT_OK; q++) {
+        if (q == r) continue;
+        st = pdt_comm_recv(d->c, q, TAG_MERGE + level, &msg[q - gl], &lens[q - gl], err);
+        if (st == PDT_OK) note_recv(d, TAG_MERGE + level, q, lens[q - gl]);
+    }
+    if (st == PDT_OK) st = pdt_srm_merge(&d->s, level, msg, lens, err);
+    for (int i = 0; i < nm; i++) free(msg[i]);
+    free(msg);
+    free(lens);
+    return st;
+}
+
+/* Phase 3: the merge tree, level by level; this rank takes part in the
+ * levels where its group has a partner. */
+static pdt_status merge_tree(drv *d, pdt_err *err)
+{
+    pdt_status st = PDT_OK;
+    for (int level = 0; level < d->s.levels && st == PDT_OK; level++) {
+        int gl, gr, ge;
+        if (!pdt_srm_pair(d->rank, d->p, level, &gl, &gr, &ge)) continue;
+        PDT_TRACE(d->tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_MERGE, level, 0, 0, 0);
+        void *buf = NULL;
+        size_t len = 0;
+        st = pdt_srm_pack(&d->s, level, &buf, &len, err);
+        if (st != PDT_OK) return st;
+        if (d->rank != gr) {
+            st = pdt_comm_send(d->c, gr, TAG_MERGE + level, buf, len, err);
+            if (st == PDT_OK) note_send(d, TAG_MERGE + level, gr, len);
+            free(buf);
+        } else {
+            st = merge_at(d, level, gl, ge, buf, len, err);
+        }
+        if (st == PDT_OK) PDT_TRACE(d->tr, 1, PDT_EV_PHASE_END, PDT_PH_MERGE, level, 0, 0, 0);
+    }
+    if (st == PDT_OK && d->s.npend)
+        st = pdt_err_set(err, PDT_ERR_CHECK, "rank %d: %zu triangles still pending after the "
+                         "last merge", d->rank, d->s.npend);
+    return st;
+}
+
+/* ---- canonical order across ranks ------------------------------------------------ */
 
 static int tri_less(const pdt_tri *a, const pdt_tri *b)
 {
     for (int k = 0; k < 3; k++)
         if (a->v[k] != b->v[k]) return a->v[k] < b->v[k];
     return 0;
+}
+
+static int tri_cmp(const void *x, const void *y)
+{
+    const pdt_tri *a = x, *b = y;
+    return tri_less(a, b) ? -1 : tri_less(b, a) ? 1 : 0;
 }
 
 /* Restore the heap order below heap[k]: the block whose next triangle is
@@ -251,9 +362,9 @@ static void sift_down(int *heap, int h, int k, const pdt_tri *a, const size_t *p
 
 /* Merge p sorted blocks (count[q] bytes each, contiguous) of *all into one
  * sorted array with a binary heap of block cursors: O(T log p). */
-static pdt_status merge_blocks(pdt_tri **all, const size_t *count, int p, size_t total,
-                               pdt_err *err)
+static pdt_status merge_blocks(drv *d, pdt_tri **all, const size_t *count, size_t total)
 {
+    int p = d->p;
     size_t *pos = malloc((size_t)p * sizeof *pos), *end = malloc((size_t)p * sizeof *end);
     int *heap = malloc((size_t)p * sizeof *heap);
     pdt_tri *out = malloc((total + 1) * sizeof *out);
@@ -262,8 +373,7 @@ static pdt_status merge_blocks(pdt_tri **all, const size_t *count, int p, size_t
         free(end);
         free(heap);
         free(out);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "rank 0: out of memory merging %zu triangles",
-                           total);
+        return nomem(d, "order");
     }
     const pdt_tri *a = *all;
     size_t off = 0;
@@ -290,320 +400,313 @@ static pdt_status merge_blocks(pdt_tri **all, const size_t *count, int p, size_t
     return PDT_OK;
 }
 
+/* p - 1 splitter triangles from evenly spaced samples of every rank's
+ * sorted final triangles (allgathered). */
+static pdt_status order_splitters(drv *d, const pdt_tri *t, size_t n, pdt_tri *split,
+                                  size_t *nsplit, pdt_err *err)
+{
+    int p = d->p;
+    size_t S = (size_t)32 * (size_t)p, blk = S + 1;
+    pdt_tri *samp = calloc(blk, sizeof *samp), *all = malloc((size_t)p * blk * sizeof *all);
+    if (!samp || !all) {
+        free(samp);
+        free(all);
+        return nomem(d, "order");
+    }
+    size_t k = n < S ? n : S;
+    samp[0].v[0] = (uint32_t)k; /* block = [count, k samples] */
+    for (size_t i = 0; i < k; i++) samp[1 + i] = t[i * n / k];
+    pdt_status st = pdt_comm_allgather(d->c, samp, blk * sizeof *samp, all, err);
+    if (st == PDT_OK) {
+        note_all(d, TAG_ORDER, blk * sizeof *samp);
+        size_t ns = 0;
+        for (int q = 0; q < p; q++) {
+            const pdt_tri *b = all + (size_t)q * blk;
+            for (size_t i = 0; i < b[0].v[0] && i < S; i++) all[ns++] = b[1 + i];
+        }
+        qsort(all, ns, sizeof *all, tri_cmp);
+        *nsplit = ns ? (size_t)p - 1 : 0;
+        for (size_t i = 0; i < *nsplit; i++) split[i] = all[(i + 1) * ns / (size_t)p];
+    }
+    free(samp);
+    free(all);
+    return st;
+}
+
+/* Phase 4: this rank's final triangles in canonical order, then a sample
+ * sort across ranks: rank q ends with the q-th block of the canonical output
+ * in out (and its place in the whole output). */
+static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
+{
+    int p = d->p;
+    pdt_tri *t = d->s.fin;
+    size_t n = d->s.nfin;
+    pdt_tri_canonical(t, n);
+    pdt_status st = pdt_comm_quiet_barrier(d->c, err); /* ranks done early sleep */
+    if (st != PDT_OK) return st;
+    size_t *cnt = calloc((size_t)p, sizeof *cnt), *rcnt = calloc((size_t)p, sizeof *rcnt);
+    uint64_t *sc = calloc((size_t)p, sizeof *sc), *rc = calloc((size_t)p, sizeof *rc);
+    pdt_tri *split = malloc((size_t)p * sizeof *split), *got = NULL;
+    size_t nsplit = 0;
+    if (!cnt || !rcnt || !sc || !rc || !split) {
+        st = nomem(d, "order");
+        goto done;
+    }
+    st = order_splitters(d, t, n, split, &nsplit, err);
+    if (st != PDT_OK) goto done;
+    /* rank q gets the triangles in [split[q-1], split[q]): a contiguous run
+     * of the sorted local array */
+    size_t lo = 0;
+    for (int q = 0; q < p; q++) {
+        size_t hi = n;
+        if ((size_t)q < nsplit) {
+            size_t a = lo, b = n;
+            while (a < b) {
+                size_t mid = a + (b - a) / 2;
+                if (tri_less(&t[mid], &split[q])) a = mid + 1;
+                else b = mid;
+            }
+            hi = a;
+        }
+        sc[q] = hi - lo;
+        lo = hi;
+    }
+    st = pdt_comm_alltoall(d->c, sc, sizeof *sc, rc, err);
+    if (st != PDT_OK) goto done;
+    note_all(d, TAG_COUNTS, sizeof *sc);
+    size_t total = 0;
+    for (int q = 0; q < p; q++) {
+        cnt[q] = (size_t)sc[q] * sizeof(pdt_tri);
+        rcnt[q] = (size_t)rc[q] * sizeof(pdt_tri);
+        total += (size_t)rc[q];
+    }
+    got = malloc((total + 1) * sizeof *got);
+    if (!got) {
+        st = nomem(d, "order");
+        goto done;
+    }
+    st = pdt_comm_alltoallv(d->c, t, cnt, got, rcnt, err);
+    if (st != PDT_OK) goto done;
+    note_v(d, TAG_ORDER, cnt, rcnt);
+    free(d->s.fin); /* every triangle went somewhere (itself included) */
+    d->s.fin = NULL;
+    d->s.nfin = d->s.capfin = 0;
+    int blocks = 0;
+    for (int q = 0; q < p; q++) blocks += rcnt[q] != 0;
+    if (blocks > 1) st = merge_blocks(d, &got, rcnt, total);
+    if (st != PDT_OK) goto done;
+    uint64_t mine = total, first = 0, all = 0;
+    {   /* place in the whole output: prefix sum of the block sizes */
+        uint64_t *cnts = malloc((size_t)p * sizeof *cnts);
+        if (!cnts) {
+            st = nomem(d, "order");
+            goto done;
+        }
+        st = pdt_comm_allgather(d->c, &mine, sizeof mine, cnts, err);
+        if (st == PDT_OK) note_all(d, TAG_ORDER, sizeof mine);
+        for (int q = 0; q < p; q++) {
+            if (q < d->rank) first += cnts[q];
+            all += cnts[q];
+        }
+        free(cnts);
+    }
+    if (st != PDT_OK) goto done;
+    out->tris = got;
+    out->ntri = total;
+    out->first = first;
+    out->n_total = all;
+    got = NULL;
+done:
+    free(cnt);
+    free(rcnt);
+    free(sc);
+    free(rc);
+    free(split);
+    free(got);
+    return st;
+}
+
+/* ---- figures -------------------------------------------------------------------- */
+
+static void figures(drv *d)
+{
+    pdt_par_rank_stats *me = d->me;
+    const srm_rank *s = &d->s;
+    me->points = d->m;
+    me->received = d->nrecv;
+    me->n_dup = d->nrecv - d->m;
+    me->local_tris = s->cnt.local_tris;
+    me->final_at_once = s->cnt.final_at_once;
+    me->deferred = s->cnt.deferred;
+    me->shipped = s->cnt.shipped;
+    me->merges = s->cnt.merges;
+    me->border_max = s->cnt.border_max;
+    me->kept = s->cnt.kept;
+    me->discarded = s->cnt.discarded;
+    me->final_merge = s->cnt.final_merge;
+    me->bytes_sent = d->bytes_sent;
+    me->bytes_recv = d->bytes_recv;
+    me->merge_bytes_sent = d->merge_sent;
+    me->merge_bytes_recv = d->merge_recv;
+    me->critical_path = s->cnt.critical_path;
+    me->critical_cpu = s->cnt.critical_cpu;
+    me->holds_final_hull = s->holds_hull && pdt_srm_holder(d->rank, d->p, s->levels) == d->rank;
+    me->hull = s->nhull;
+    me->hull_degenerate = s->hull_degenerate;
+}
+
+static double cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* One rank: the sequential pipeline on the whole input, its figures in the
+ * same shape; the trace gets the final triangles as a parallel run does. */
+static pdt_status sequential(pdt_comm *c, const pdt_par_input *in, pdt_par_output *out,
+                             pdt_par_rank_stats *me, pdt_trace *tr, pdt_err *err)
+{
+    pdt_tri_stats ts;
+    double c0 = cpu_seconds(), w0 = pdt_comm_wtime(c);
+    pdt_status st = pdt_triangulate(in->pts, in->n, &out->tris, &out->ntri, &ts, tr);
+    if (st != PDT_OK) return pdt_err_set(err, st, "triangulation failed: %s", pdt_status_str(st));
+    out->first = 0;
+    out->n_total = out->ntri;
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_OUTPUT, 0, 0, 0, 0);
+    for (size_t i = 0; i < out->ntri && PDT_TRACING(tr, 1); i++)
+        PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, out->tris[i].v[0], out->tris[i].v[1],
+                  out->tris[i].v[2], 0);
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_OUTPUT, 0, 0, 0, 0);
+    me->points = ts.n_unique;
+    me->received = ts.n_in;
+    me->n_dup = ts.n_dup;
+    me->local_tris = me->final_at_once = me->emitted = ts.n_tri;
+    me->hull = ts.n_hull;
+    me->holds_final_hull = 1;
+    me->hull_degenerate = ts.collinear;
+    me->t_partition = ts.t_sort;
+    me->t_local = ts.t_kernel;
+    me->t_order = ts.t_canon;
+    me->critical_path = pdt_comm_wtime(c) - w0;
+    me->critical_cpu = cpu_seconds() - c0;
+    return PDT_OK;
+}
+
 /* ---- the whole run ------------------------------------------------------------ */
 
-pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_point *pts, size_t n_in, pdt_tri **tris,
-                               size_t *ntri, pdt_par_stats *stats, pdt_trace *tr, pdt_err *err)
+pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_par_input *in, pdt_par_output *out,
+                               pdt_par_rank_stats *me, pdt_trace *tr, pdt_err *err)
 {
-    *tris = NULL;
-    *ntri = 0;
-    if (stats) memset(stats, 0, sizeof *stats);
-    drv d = {c, pdt_comm_rank(c), pdt_comm_size(c), tr, NULL, NULL, 0, 0, 0, 0};
-    int p = d.p, r = d.rank;
-    pdt_status st = PDT_OK;
-    srm_rec *rec = NULL;
-    pdt_point *lp = NULL;
-    uint32_t *lg = NULL;
-    srm_strip *strip = NULL;
-    srm_rank s;
-    int s_init = 0;
-    pdt_tri *all = NULL;
-    size_t *counts = NULL;
-    rank_report *reps = NULL;
-    rank_report me;
-    memset(&me, 0, sizeof me);
+    memset(out, 0, sizeof *out);
+    if (in->n_total > UINT32_MAX - 1)
+        return pdt_err_set(err, PDT_ERR_ARG, "%llu points: more than 2^32 - 2",
+                           (unsigned long long)in->n_total);
     const uint32_t *saved_gid = tr ? tr->gid : NULL;
     if (tr) tr->gid = NULL; /* the driver reports global indices itself */
-
-    d.seq_send = calloc((size_t)p, sizeof *d.seq_send);
-    d.seq_recv = calloc((size_t)p, sizeof *d.seq_recv);
+    if (pdt_comm_size(c) == 1) {
+        pdt_status st = sequential(c, in, out, me, tr, err);
+        if (tr) tr->gid = saved_gid;
+        return st;
+    }
+    drv d;
+    memset(&d, 0, sizeof d);
+    d.c = c;
+    d.rank = pdt_comm_rank(c);
+    d.p = pdt_comm_size(c);
+    d.tr = tr;
+    d.me = me;
+    d.err = err;
+    pdt_point *lp = NULL;
+    uint32_t *lg = NULL;
+    pdt_status st = PDT_OK;
+    d.seq_send = calloc((size_t)d.p, sizeof *d.seq_send);
+    d.seq_recv = calloc((size_t)d.p, sizeof *d.seq_recv);
     if (!d.seq_send || !d.seq_recv) {
-        st = pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: out of memory", r);
+        st = nomem(&d, "start");
         goto done;
     }
-    double t_start = pdt_comm_wtime(c);
-    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_RUN, 0, 0, 0, 0);
-
-    /* Phase 0 */
+    double t0 = pdt_comm_wtime(c);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_PARTITION, 0, 0, 0, 0);
-    uint64_t n = n_in;
-    st = pdt_comm_bcast(c, &n, sizeof n, 0, err);
+    st = partition(&d, in, err);
+    if (st == PDT_OK) st = strips(&d, &lp, &lg, err);
     if (st != PDT_OK) goto done;
-    if (n > UINT32_MAX) {
-        st = pdt_err_set(err, PDT_ERR_ARG, "%llu points: more than 2^32 - 1",
-                         (unsigned long long)n);
-        goto done;
-    }
-    size_t m = 0;
-    uint64_t nrecv = 0;
-    st = partition(&d, pts, n, &rec, &m, &nrecv, err);
-    if (st != PDT_OK) goto done;
-    lp = malloc((m + 1) * sizeof *lp);
-    lg = malloc((m + 1) * sizeof *lg);
-    strip = malloc((size_t)p * sizeof *strip);
-    if (!lp || !lg || !strip) {
-        st = pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: out of memory", r);
-        goto done;
-    }
-    srm_strip mine = {m, 0, 0, 0, 0, 0, 0};
-    for (size_t i = 0; i < m; i++) {
-        lp[i] = srm_key_point(rec[i].key);
-        lg[i] = rec[i].idx;
-        if (i == 0 || lp[i].y < mine.ymin) mine.ymin = lp[i].y;
-        if (i == 0 || lp[i].y > mine.ymax) mine.ymax = lp[i].y;
-    }
-    if (m) {
-        mine.first_key = rec[0].key;
-        mine.last_key = rec[m - 1].key;
-        mine.xmin = lp[0].x;
-        mine.xmax = lp[m - 1].x;
-    }
-    free(rec);
-    rec = NULL;
-    st = pdt_comm_allgather(c, &mine, sizeof mine, strip, err);
-    if (st != PDT_OK) goto done;
-    note_all(&d, TAG_STRIPS, sizeof mine);
-    me.st.points = m;
-    me.st.received = nrecv;
-    me.n_dup = nrecv - m;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_PARTITION, 0, 0, 0, 0);
-    double t_part = pdt_comm_wtime(c);
-    me.st.t_partition = t_part - t_start;
-
-    /* Phases 1 and 2 */
-    st = pdt_srm_init(&s, r, p, strip, tr, err);
-    if (st != PDT_OK) goto done;
-    s_init = 1;
-    s.clock = wclock;
-    s.clock_user = c;
-    st = pdt_srm_local(&s, lp, lg, m, err);
+    double t1 = pdt_comm_wtime(c);
+    st = local(&d, lp, lg, err);
     if (st != PDT_OK) goto done;
     free(lp);
     free(lg);
     lp = NULL;
     lg = NULL;
-    double t_local = pdt_comm_wtime(c);
-    me.st.t_local = t_local - t_part;
-
-    /* Phase 3: the merge tree */
-    for (int level = 0; level < s.levels; level++) {
-        int gl, gr, ge;
-        if (!pdt_srm_pair(r, p, level, &gl, &gr, &ge)) continue;
-        PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_MERGE, level, 0, 0, 0);
-        void *buf = NULL;
-        size_t len = 0;
-        st = pdt_srm_pack(&s, level, &buf, &len, err);
-        if (st != PDT_OK) goto done;
-        if (r != gr) {
-            st = pdt_comm_send(c, gr, TAG_MERGE + level, buf, len, err);
-            if (st == PDT_OK) note_send(&d, TAG_MERGE + level, gr, len);
-            free(buf);
-            if (st != PDT_OK) goto done;
-        } else {
-            test_sleep(r);
-            int nm = ge - gl;
-            void **msg = calloc((size_t)nm, sizeof *msg);
-            size_t *lens = calloc((size_t)nm, sizeof *lens);
-            if (!msg || !lens) {
-                free(msg);
-                free(lens);
-                free(buf);
-                st = pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: out of memory", r);
-                goto done;
-            }
-            msg[r - gl] = buf;
-            lens[r - gl] = len;
-            for (int q = gl; q < ge && st == PDT_OK; q++) {
-                if (q == r) continue;
-                st = pdt_comm_recv(c, q, TAG_MERGE + level, &msg[q - gl], &lens[q - gl], err);
-                if (st == PDT_OK) note_recv(&d, TAG_MERGE + level, q, lens[q - gl]);
-            }
-            if (st == PDT_OK) st = pdt_srm_merge(&s, level, msg, lens, err);
-            for (int i = 0; i < nm; i++) free(msg[i]);
-            free(msg);
-            free(lens);
-            if (st != PDT_OK) goto done;
-        }
-        PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_MERGE, level, 0, 0, 0);
-    }
-    if (s.npend) {
-        st = pdt_err_set(err, PDT_ERR_CHECK, "rank %d: %zu triangles still pending after the "
-                                             "last merge", r, s.npend);
-        goto done;
-    }
-    double t_merge = pdt_comm_wtime(c);
-    me.st.t_merge = t_merge - t_local;
-
-    /* Phase 4: every rank puts its triangles in canonical order, rank 0
-     * gathers the sorted blocks and merges them */
-    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_OUTPUT, 0, 0, 0, 0);
-    pdt_tri_canonical(s.fin, s.nfin);
-    st = pdt_comm_quiet_barrier(c, err); /* ranks done early sleep until the last merge ends */
+    double t2 = pdt_comm_wtime(c);
+    st = merge_tree(&d, err);
     if (st != PDT_OK) goto done;
-    uint64_t nf = s.nfin, *nfs = malloc((size_t)p * sizeof *nfs);
-    counts = malloc((size_t)p * sizeof *counts);
-    if (!nfs || !counts) {
-        free(nfs);
-        st = pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: out of memory", r);
-        goto done;
-    }
-    st = pdt_comm_allgather(c, &nf, sizeof nf, nfs, err);
-    if (st == PDT_OK) note_all(&d, TAG_GATHER, sizeof nf);
-    size_t total = 0;
-    for (int q = 0; q < p; q++) {
-        counts[q] = (size_t)nfs[q] * sizeof(pdt_tri);
-        total += (size_t)nfs[q];
-    }
-    free(nfs);
+    double t3 = pdt_comm_wtime(c);
+    me->emitted = d.s.nfin;
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_ORDER, 0, 0, 0, 0);
+    st = order(&d, out, err);
     if (st != PDT_OK) goto done;
-    if (r == 0) {
-        all = malloc((total + 1) * sizeof *all);
-        if (!all) {
-            st = pdt_err_set(err, PDT_ERR_NOMEM, "rank 0: out of memory (%zu triangles)", total);
-            goto done;
-        }
-    }
-    st = pdt_comm_gatherv(c, s.fin, s.nfin * sizeof(pdt_tri), all, counts, 0, err);
-    if (st != PDT_OK) goto done;
-    if (r == 0) {
-        for (int q = 1; q < p; q++)
-            if (counts[q]) note_recv(&d, TAG_GATHER, q, counts[q]);
-        int blocks = 0;
-        for (int q = 0; q < p; q++) blocks += counts[q] != 0;
-        if (blocks > 1) st = merge_blocks(&all, counts, p, total, err);
-        if (st != PDT_OK) goto done;
-    } else if (s.nfin) {
-        note_send(&d, TAG_GATHER, 0, s.nfin * sizeof(pdt_tri));
-    }
-    PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_OUTPUT, 0, 0, 0, 0);
-    double t_end = pdt_comm_wtime(c);
-
-    /* figures */
-    me.st.local_tris = s.cnt.local_tris;
-    me.st.final_at_once = s.cnt.final_at_once;
-    me.st.deferred = s.cnt.deferred;
-    me.st.shipped = s.cnt.shipped;
-    me.st.merges = s.cnt.merges;
-    me.st.border_max = s.cnt.border_max;
-    me.st.kept = s.cnt.kept;
-    me.st.discarded = s.cnt.discarded;
-    me.st.final_merge = s.cnt.final_merge;
-    me.st.emitted = s.nfin;
-    me.st.bytes_sent = d.bytes_sent;
-    me.st.bytes_recv = d.bytes_recv;
-    me.st.merge_bytes_sent = d.merge_sent;
-    me.st.merge_bytes_recv = d.merge_recv;
-    me.st.t_gather = t_end - t_merge;
-    me.st.critical_path = s.cnt.critical_path;
-    me.st.critical_cpu = s.cnt.critical_cpu;
-    {
-        struct rusage ru;
-        me.st.peak_rss_kib = getrusage(RUSAGE_SELF, &ru) == 0 ? (int64_t)ru.ru_maxrss : -1;
-    }
-    me.holds_final_hull = s.holds_hull && pdt_srm_holder(r, p, s.levels) == r;
-    me.hull = s.nhull;
-    me.hull_degenerate = s.hull_degenerate;
-    reps = r == 0 ? malloc((size_t)p * sizeof *reps) : NULL;
-    if (r == 0 && !reps) {
-        st = pdt_err_set(err, PDT_ERR_NOMEM, "rank 0: out of memory");
-        goto done;
-    }
-    for (int q = 0; q < p; q++) counts[q] = sizeof me;
-    st = pdt_comm_gatherv(c, &me, sizeof me, reps, counts, 0, err);
-    if (st != PDT_OK) goto done;
-    if (r == 0) {
-        if (stats) {
-            stats->nranks = p;
-            stats->rank = malloc((size_t)p * sizeof *stats->rank);
-            if (!stats->rank) {
-                st = pdt_err_set(err, PDT_ERR_NOMEM, "rank 0: out of memory");
-                goto done;
-            }
-            stats->n_in = n;
-            for (int q = 0; q < p; q++) {
-                const rank_report *rp = &reps[q];
-                stats->rank[q] = rp->st;
-                stats->n_unique += rp->st.points;
-                stats->n_dup += rp->n_dup;
-                stats->bytes_total += rp->st.bytes_sent;
-                stats->merge_bytes += rp->st.merge_bytes_sent;
-                if (rp->st.critical_path > stats->critical_path)
-                    stats->critical_path = rp->st.critical_path;
-                if (rp->st.critical_cpu > stats->critical_cpu)
-                    stats->critical_cpu = rp->st.critical_cpu;
-                if (rp->st.border_max > stats->border_max) stats->border_max = rp->st.border_max;
-                if (rp->holds_final_hull) {
-                    stats->hull = rp->hull;
-                    stats->collinear = (int)rp->hull_degenerate;
-                }
-            }
-            stats->n_tri = total;
-            stats->t_total = t_end - t_start;
-        }
-        *tris = all;
-        *ntri = total;
-        all = NULL;
-    }
-    PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_RUN, 0, 0, 0, 0);
-
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_ORDER, 0, 0, 0, 0);
+    double t4 = pdt_comm_wtime(c);
+    me->t_partition = t1 - t0;
+    me->t_local = t2 - t1;
+    me->t_merge = t3 - t2;
+    me->t_order = t4 - t3;
+    figures(&d);
 done:
     if (tr) tr->gid = saved_gid;
-    if (s_init) pdt_srm_free(&s);
-    free(rec);
+    if (d.s_init) pdt_srm_free(&d.s);
+    free(d.rec);
     free(lp);
     free(lg);
-    free(strip);
-    free(all);
-    free(counts);
-    free(reps);
+    free(d.strip);
     free(d.seq_send);
     free(d.seq_recv);
     return st;
 }
 
-/* ---- JSON ------------------------------------------------------------------------ */
+/* ---- figures of the whole run ------------------------------------------------------ */
 
-void pdt_par_stats_json(const pdt_par_stats *s, FILE *f)
+pdt_status pdt_par_stats_collect(pdt_comm *c, const pdt_par_rank_stats *me, uint64_t n_in,
+                                 pdt_par_stats *all, pdt_err *err)
 {
-    fprintf(f,
-            "{\"ranks\": %d, \"n\": %llu, \"unique\": %llu, \"duplicates\": %llu, "
-            "\"triangles\": %llu, \"hull\": %llu, \"collinear\": %s, "
-            "\"largest_border_set\": %llu, \"largest_border_set_rel_n\": %.6f, "
-            "\"sequential_merge\": %s, "
-            "\"bytes_total\": %llu, \"merge_bytes\": %llu, \"merge_bytes_rel_input\": %.6f, "
-            "\"critical_path_s\": %.6f, \"critical_path_cpu_s\": %.6f, \"time_s\": %.6f,\n"
-            " \"per_rank\": [",
-            s->nranks, (unsigned long long)s->n_in, (unsigned long long)s->n_unique,
-            (unsigned long long)s->n_dup, (unsigned long long)s->n_tri,
-            (unsigned long long)s->hull, s->collinear ? "true" : "false",
-            (unsigned long long)s->border_max,
-            s->n_unique ? (double)s->border_max / (double)s->n_unique : 0.0,
-            s->n_unique >= 64 && 2 * s->border_max > s->n_unique ? "true" : "false",
-            (unsigned long long)s->bytes_total, (unsigned long long)s->merge_bytes,
-            s->n_in ? (double)s->merge_bytes / (8.0 * (double)s->n_in) : 0.0, s->critical_path,
-            s->critical_cpu,
-            s->t_total);
-    for (int q = 0; q < s->nranks; q++) {
-        const pdt_par_rank_stats *r = &s->rank[q];
-        fprintf(f,
-                "%s\n  {\"rank\": %d, \"points\": %llu, \"local_triangles\": %llu, "
-                "\"final_at_once\": %llu, \"deferred\": %llu, \"shipped\": %llu, "
-                "\"merges\": %llu, \"border_max\": %llu, \"kept\": %llu, \"discarded\": %llu, "
-                "\"final_by_merge\": %llu, \"emitted\": %llu, \"bytes_sent\": %llu, "
-                "\"bytes_received\": %llu, \"merge_bytes_sent\": %llu, "
-                "\"merge_bytes_received\": %llu, \"partition_s\": %.6f, \"local_s\": %.6f, "
-                "\"merge_s\": %.6f, \"gather_s\": %.6f, \"critical_path_s\": %.6f, "
-                "\"peak_rss_kib\": %lld}",
-                q ? "," : "", q, (unsigned long long)r->points,
-                (unsigned long long)r->local_tris, (unsigned long long)r->final_at_once,
-                (unsigned long long)r->deferred, (unsigned long long)r->shipped,
-                (unsigned long long)r->merges, (unsigned long long)r->border_max,
-                (unsigned long long)r->kept, (unsigned long long)r->discarded,
-                (unsigned long long)r->final_merge, (unsigned long long)r->emitted,
-                (unsigned long long)r->bytes_sent, (unsigned long long)r->bytes_recv,
-                (unsigned long long)r->merge_bytes_sent, (unsigned long long)r->merge_bytes_recv,
-                r->t_partition, r->t_local, r->t_merge, r->t_gather, r->critical_path,
-                (long long)r->peak_rss_kib);
+    memset(all, 0, sizeof *all);
+    int p = pdt_comm_size(c), r = pdt_comm_rank(c);
+    pdt_par_rank_stats *reps = r == 0 ? malloc((size_t)p * sizeof *reps) : NULL;
+    size_t *counts = malloc((size_t)p * sizeof *counts);
+    if ((r == 0 && !reps) || !counts) {
+        free(reps);
+        free(counts);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: out of memory", r);
     }
-    fprintf(f, "]}");
+    for (int q = 0; q < p; q++) counts[q] = sizeof *me;
+    pdt_status st = pdt_comm_gatherv(c, me, sizeof *me, reps, counts, 0, err);
+    free(counts);
+    if (st != PDT_OK || r != 0) {
+        free(reps);
+        return st;
+    }
+    all->nranks = p;
+    all->rank = reps;
+    all->n_in = n_in;
+    for (int q = 0; q < p; q++) {
+        const pdt_par_rank_stats *rp = &reps[q];
+        all->n_unique += rp->points;
+        all->n_dup += rp->n_dup;
+        all->n_tri += rp->written;
+        all->bytes_total += rp->bytes_sent;
+        all->merge_bytes += rp->merge_bytes_sent;
+        if (rp->critical_path > all->critical_path) all->critical_path = rp->critical_path;
+        if (rp->critical_cpu > all->critical_cpu) all->critical_cpu = rp->critical_cpu;
+        if (rp->border_max > all->border_max) all->border_max = rp->border_max;
+        double tc = rp->t_partition + rp->t_local + rp->t_merge + rp->t_order;
+        if (tc > all->t_compute) all->t_compute = tc;
+        if (rp->holds_final_hull) {
+            all->hull = rp->hull;
+            all->collinear = rp->hull_degenerate || all->n_unique < 3;
+        }
+    }
+    if (all->n_unique < 3) all->collinear = 1;
+    return PDT_OK;
 }

@@ -483,132 +483,162 @@ static size_t facing(const srm_rank *s, const msg_view *hv, int q0, int q1, srm_
     return n;
 }
 
-pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len, pdt_err *err)
-{
-    pdt_trace *tr = s->tr;
-    int gl, gr, ge;
-    pdt_srm_pair(s->rank, s->p, level, &gl, &gr, &ge);
-    int nm = ge - gl;
-    double t0 = now(s);
-    pdt_status st = PDT_OK;
-    msg_view *mv = calloc((size_t)nm, sizeof *mv);
-    gtri *shipped = NULL, *tb = NULL;
-    srm_pt *B = NULL, *hp = NULL;
-    pdt_point *bp = NULL;
-    uint32_t *bg = NULL, *hidx = NULL;
-    pdt_tri *tris = NULL;
-    size_t ntri = 0;
-    if (!mv) return nomem(err, s->rank, "merge");
-    PDT_TRACE(tr, 1, PDT_EV_MERGE_BEGIN, level, gl, gr, ge, s->rank);
+/* The state of one merge step at the merge rank, phase by phase. */
+typedef struct merge_job {
+    srm_rank *s;
+    int level, gl, gr, ge, nm;
+    pdt_err *err;
+    msg_view *mv;            /* the decoded messages, one per rank of the pair */
+    int hl, hr;              /* message holding the hull of G_L / G_R, or -1 */
+    double cp_in, cpu_in;    /* longest critical path among the senders */
+    gtri *shipped;           /* R_L ∪ R_R, canonical, sorted */
+    size_t ns;
+    srm_pt *B;               /* the border set, key-sorted, distinct */
+    size_t nb;
+    pdt_point *bp;           /* B as points, and their global indices */
+    uint32_t *bg;
+    pdt_tri *tris;           /* T*(B), indices into B */
+    size_t ntri;
+    gtri *tb;                /* T*(B) as canonical global triangles */
+    size_t ntb, kept, ndisc;
+} merge_job;
 
-    double cp_in = s->cnt.critical_path, cpu_in = s->cnt.critical_cpu, c0 = cpu_now();
-    size_t nship = 0, nshipL = 0, nbmax = 0;
-    int hl = -1, hr = -1;
-    for (int i = 0; i < nm; i++) {
-        st = decode(msg[i], len[i], level, gl + i, &mv[i], err);
-        if (st != PDT_OK) goto done;
-        if (mv[i].h.cp > cp_in) cp_in = mv[i].h.cp;
-        if (mv[i].h.cp_cpu > cpu_in) cpu_in = mv[i].h.cp_cpu;
-        nship += mv[i].h.ntri;
-        if (gl + i < gr) nshipL += mv[i].h.ntri;
-        nbmax += 3 * (size_t)mv[i].h.ntri + 2 * (size_t)mv[i].h.nhull;
-        if (mv[i].h.flags & MSG_HAS_HULL) {
-            int *side = gl + i < gr ? &hl : &hr;
-            if (*side >= 0) {
-                st = pdt_err_set(err, PDT_ERR_CORRUPT, "merge at level %d: two hulls", level);
-                goto done;
-            }
+static void merge_job_free(merge_job *j)
+{
+    for (int i = 0; j->mv && i < j->nm; i++) msg_view_free(&j->mv[i]);
+    free(j->mv);
+    free(j->shipped);
+    free(j->tb);
+    free(j->B);
+    free(j->bp);
+    free(j->bg);
+    free(j->tris);
+}
+
+/* Decode every message; find the two hulls and the longest critical path. */
+static pdt_status read_messages(merge_job *j, void *const *msg, const size_t *len)
+{
+    srm_rank *s = j->s;
+    j->mv = calloc((size_t)j->nm, sizeof *j->mv);
+    if (!j->mv) return nomem(j->err, s->rank, "merge");
+    j->cp_in = s->cnt.critical_path;
+    j->cpu_in = s->cnt.critical_cpu;
+    j->hl = j->hr = -1;
+    for (int i = 0; i < j->nm; i++) {
+        pdt_status st = decode(msg[i], len[i], j->level, j->gl + i, &j->mv[i], j->err);
+        if (st != PDT_OK) return st;
+        const msg_view *v = &j->mv[i];
+        if (v->h.cp > j->cp_in) j->cp_in = v->h.cp;
+        if (v->h.cp_cpu > j->cpu_in) j->cpu_in = v->h.cp_cpu;
+        if (v->h.flags & MSG_HAS_HULL) {
+            int *side = j->gl + i < j->gr ? &j->hl : &j->hr;
+            if (*side >= 0)
+                return pdt_err_set(j->err, PDT_ERR_CORRUPT, "merge at level %d: two hulls",
+                                   j->level);
             *side = i;
         }
     }
+    return PDT_OK;
+}
 
-    /* shipped set R_L ∪ R_R, canonical, sorted */
-    shipped = malloc((nship + 1) * sizeof *shipped);
-    B = malloc((nbmax + 1) * sizeof *B);
-    if (!shipped || !B) {
-        st = nomem(err, s->rank, "merge");
-        goto done;
+/* The shipped set and the border set B: the vertices of the shipped
+ * triangles and the facing hull vertices (the hull-vertex rule of the Merge
+ * Lemma), key-sorted and distinct. */
+static pdt_status border_set(merge_job *j)
+{
+    srm_rank *s = j->s;
+    size_t nship = 0, nbmax = 0;
+    for (int i = 0; i < j->nm; i++) {
+        nship += j->mv[i].h.ntri;
+        nbmax += 3 * (size_t)j->mv[i].h.ntri + 2 * (size_t)j->mv[i].h.nhull;
     }
+    j->shipped = malloc((nship + 1) * sizeof *j->shipped);
+    j->B = malloc((nbmax + 1) * sizeof *j->B);
+    if (!j->shipped || !j->B) return nomem(j->err, s->rank, "merge");
     size_t ns = 0, nb = 0;
-    for (int i = 0; i < nm; i++) {
-        const msg_view *v = &mv[i];
+    srm_pt *B = j->B;
+    for (int i = 0; i < j->nm; i++) {
+        const msg_view *v = &j->mv[i];
         for (size_t t = 0; t < v->h.ntri; t++) {
             srm_pt a = v->pts[v->tri[3 * t]], b = v->pts[v->tri[3 * t + 1]],
                    c = v->pts[v->tri[3 * t + 2]];
-            shipped[ns++] = canon3(a.gid, b.gid, c.gid);
+            j->shipped[ns++] = canon3(a.gid, b.gid, c.gid);
             B[nb++] = a;
             B[nb++] = b;
             B[nb++] = c;
         }
     }
-    qsort(shipped, ns, sizeof *shipped, cmp_gtri);
-    /* facing hull vertices (the hull-vertex rule of the Merge Lemma) */
-    if (hl >= 0) nb += facing(s, &mv[hl], gr, ge, B + nb);
-    if (hr >= 0) nb += facing(s, &mv[hr], gl, gr, B + nb);
+    qsort(j->shipped, ns, sizeof *j->shipped, cmp_gtri);
+    if (j->hl >= 0) nb += facing(s, &j->mv[j->hl], j->gr, j->ge, B + nb);
+    if (j->hr >= 0) nb += facing(s, &j->mv[j->hr], j->gl, j->gr, B + nb);
     qsort(B, nb, sizeof *B, cmp_key);
-    {
-        size_t u = 0;
-        for (size_t i = 0; i < nb; i++)
-            if (u == 0 || B[i].gid != B[u - 1].gid) B[u++] = B[i];
-        nb = u;
-    }
-    if (nb > s->cnt.border_max) s->cnt.border_max = nb;
+    size_t u = 0;
+    for (size_t i = 0; i < nb; i++)
+        if (u == 0 || B[i].gid != B[u - 1].gid) B[u++] = B[i];
+    j->ns = ns;
+    j->nb = u;
+    if (u > s->cnt.border_max) s->cnt.border_max = u;
+    return PDT_OK;
+}
 
-    /* lift-up of B and T*(B) */
-    bp = malloc((nb + 1) * sizeof *bp);
-    bg = malloc((nb + 1) * sizeof *bg);
-    if (!bp || !bg) {
-        st = nomem(err, s->rank, "merge");
-        goto done;
-    }
+/* Lift-up of B (traced) and T*(B) by the kernel (run 1). */
+static pdt_status border_kernel(merge_job *j)
+{
+    srm_rank *s = j->s;
+    pdt_trace *tr = s->tr;
+    size_t nb = j->nb;
+    j->bp = malloc((nb + 1) * sizeof *j->bp);
+    j->bg = malloc((nb + 1) * sizeof *j->bg);
+    if (!j->bp || !j->bg) return nomem(j->err, s->rank, "merge");
     for (size_t i = 0; i < nb; i++) {
-        bp[i] = (pdt_point){B[i].x, B[i].y};
-        bg[i] = B[i].gid;
+        srm_pt b = j->B[i];
+        j->bp[i] = (pdt_point){b.x, b.y};
+        j->bg[i] = b.gid;
         if (PDT_TRACING(tr, 1)) {
-            uint64_t z = (uint64_t)((int64_t)B[i].x * B[i].x) + (uint64_t)((int64_t)B[i].y * B[i].y);
-            PDT_TRACE(tr, 1, PDT_EV_LIFT, 0, B[i].gid, 0, 0, (int64_t)z);
+            uint64_t z = (uint64_t)((int64_t)b.x * b.x) + (uint64_t)((int64_t)b.y * b.y);
+            PDT_TRACE(tr, 1, PDT_EV_LIFT, 0, b.gid, 0, 0, (int64_t)z);
         }
     }
-    {
-        const uint32_t *saved = tr ? tr->gid : NULL;
-        if (tr) tr->gid = bg;
-        st = pdt_delaunay(bp, nb, &tris, &ntri, 1, tr);
-        if (tr) tr->gid = saved;
-        if (st != PDT_OK) {
-            pdt_err_set(err, st, "rank %d: border kernel failed", s->rank);
-            goto done;
-        }
-    }
+    const uint32_t *saved = tr ? tr->gid : NULL;
+    if (tr) tr->gid = j->bg;
+    pdt_status st = pdt_delaunay(j->bp, nb, &j->tris, &j->ntri, 1, tr);
+    if (tr) tr->gid = saved;
+    if (st != PDT_OK) return pdt_err_set(j->err, st, "rank %d: border kernel failed", s->rank);
+    return PDT_OK;
+}
 
-    /* selection: keep multi-group triangles and shipped ones */
+/* Selection: keep the triangles of T*(B) with vertices in both groups and
+ * the shipped ones it contains; each kept one is final or waits for a later
+ * level (reclassified against the boxes outside the merged group). */
+static pdt_status select_kept(merge_job *j)
+{
+    srm_rank *s = j->s;
+    pdt_trace *tr = s->tr;
+    const srm_pt *B = j->B;
     uint64_t first_r = UINT64_MAX;
     int have_r = 0;
-    for (int q = gr; q < ge; q++)
+    for (int q = j->gr; q < j->ge; q++)
         if (s->strip[q].count) {
             first_r = s->strip[q].first_key;
             have_r = 1;
             break;
         }
-    tb = malloc((ntri + 1) * sizeof *tb);
-    if (!tb) {
-        st = nomem(err, s->rank, "merge");
-        goto done;
-    }
-    size_t kept = 0, ntb = 0;
-    for (size_t i = 0; i < ntri; i++) {
-        const uint32_t *v = tris[i].v;
-        gtri g = canon3(bg[v[0]], bg[v[1]], bg[v[2]]);
-        tb[ntb++] = g;
+    j->tb = malloc((j->ntri + 1) * sizeof *j->tb);
+    if (!j->tb) return nomem(j->err, s->rank, "merge");
+    for (size_t i = 0; i < j->ntri; i++) {
+        const uint32_t *v = j->tris[i].v;
+        gtri g = canon3(j->bg[v[0]], j->bg[v[1]], j->bg[v[2]]);
+        j->tb[j->ntb++] = g;
         int nl = 0;
         for (int k = 0; k < 3; k++) nl += !have_r || srm_key(B[v[k]]) < first_r;
         int multi = nl > 0 && nl < 3;
-        if (!multi && !has_gtri(shipped, ns, g)) continue;
-        kept++;
-        /* reclassify against the boxes outside the merged group */
+        if (!multi && !has_gtri(j->shipped, j->ns, g)) continue;
+        j->kept++;
         int who;
-        int lev = level + 1 < s->levels
-                      ? send_level(s, s->rank, level + 1, B[v[0]], B[v[1]], B[v[2]], &who)
+        int lev = j->level + 1 < s->levels
+                      ? send_level(s, s->rank, j->level + 1, B[v[0]], B[v[1]], B[v[2]], &who)
                       : -1;
+        pdt_status st;
         if (lev < 0) {
             st = add_final(s, B[v[0]], B[v[1]], B[v[2]]);
             s->cnt.final_merge++;
@@ -616,113 +646,133 @@ pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t 
             st = add_pending(s, B[v[0]], B[v[1]], B[v[2]], lev);
             PDT_TRACE(tr, 1, PDT_EV_RA_DEFER, 0, B[v[0]].gid, B[v[1]].gid, B[v[2]].gid, who);
         }
-        if (st != PDT_OK) {
-            st = nomem(err, s->rank, "merge");
-            goto done;
-        }
+        if (st != PDT_OK) return nomem(j->err, s->rank, "merge");
     }
-    s->cnt.kept += kept;
+    s->cnt.kept += j->kept;
+    return PDT_OK;
+}
 
-    /* discards: shipped triangles that T*(B) does not contain */
-    qsort(tb, ntb, sizeof *tb, cmp_gtri);
-    size_t ndisc = 0;
+/* A point of B strictly inside the circle of shipped triangle t (tie rule),
+ * or -1: a non-border point may be the real cause.  byg: B sorted by gid. */
+static int64_t witness(const srm_pt *byg, size_t nb, gtri t)
+{
+    pdt_point t3[3];
+    for (int k = 0; k < 3; k++) {
+        srm_pt q = byg[find_gid(byg, nb, t.v[k])];
+        t3[k] = (pdt_point){q.x, q.y};
+    }
+    for (size_t i = 0; i < nb; i++) {
+        uint32_t g = byg[i].gid;
+        if (g == t.v[0] || g == t.v[1] || g == t.v[2]) continue;
+        if (pdt_incircle_sos(t3[0], t3[1], t3[2], (pdt_point){byg[i].x, byg[i].y}) > 0)
+            return g;
+    }
+    return -1;
+}
+
+/* Discards: the shipped triangles T*(B) does not contain (traced with a
+ * witness when tracing). */
+static void note_discards(merge_job *j)
+{
+    pdt_trace *tr = j->s->tr;
+    qsort(j->tb, j->ntb, sizeof *j->tb, cmp_gtri);
     srm_pt *byg = NULL;
     if (PDT_TRACING(tr, 1)) {
-        byg = malloc((nb + 1) * sizeof *byg);
+        byg = malloc((j->nb + 1) * sizeof *byg);
         if (byg) {
-            memcpy(byg, B, nb * sizeof *B);
-            qsort(byg, nb, sizeof *byg, cmp_gid);
+            memcpy(byg, j->B, j->nb * sizeof *j->B);
+            qsort(byg, j->nb, sizeof *byg, cmp_gid);
         }
     }
-    for (size_t i = 0; i < ns; i++) {
-        if (has_gtri(tb, ntb, shipped[i])) continue;
-        ndisc++;
+    for (size_t i = 0; i < j->ns; i++) {
+        gtri t = j->shipped[i];
+        if (has_gtri(j->tb, j->ntb, t)) continue;
+        j->ndisc++;
         if (!PDT_TRACING(tr, 1)) continue;
-        /* witness: a point of B strictly inside the circle (tie rule); a
-         * non-border point may be the real cause, then there is none */
-        int64_t wit = -1;
-        if (byg) {
-            pdt_point t3[3];
-            for (int k = 0; k < 3; k++) {
-                srm_pt q = byg[find_gid(byg, nb, shipped[i].v[k])];
-                t3[k] = (pdt_point){q.x, q.y};
-            }
-            for (size_t j = 0; j < nb && wit < 0; j++) {
-                uint32_t g = byg[j].gid;
-                if (g == shipped[i].v[0] || g == shipped[i].v[1] || g == shipped[i].v[2]) continue;
-                if (pdt_incircle_sos(t3[0], t3[1], t3[2], (pdt_point){byg[j].x, byg[j].y}) > 0)
-                    wit = g;
-            }
-        }
-        PDT_TRACE(tr, 1, PDT_EV_DISCARD, 0, shipped[i].v[0], shipped[i].v[1], shipped[i].v[2],
-                  wit);
+        int64_t wit = byg ? witness(byg, j->nb, t) : -1;
+        PDT_TRACE(tr, 1, PDT_EV_DISCARD, 0, t.v[0], t.v[1], t.v[2], wit);
     }
     free(byg);
-    s->cnt.discarded += ndisc;
+    j->s->cnt.discarded += j->ndisc;
+}
 
-    /* hull merge: monotone chain over both hulls (lex-sorted union) */
-    {
-        size_t n1 = hl >= 0 ? mv[hl].h.nhull : 0, n2 = hr >= 0 ? mv[hr].h.nhull : 0;
-        size_t nh = n1 + n2;
-        hp = malloc((nh + 1) * sizeof *hp);
-        hidx = malloc((nh + 2) * sizeof *hidx);
-        pdt_point *pp = malloc((nh + 1) * sizeof *pp);
-        uint32_t *pg = malloc((nh + 1) * sizeof *pg);
-        srm_pt *nhull = malloc((nh + 1) * sizeof *nhull);
-        if (!hp || !hidx || !pp || !pg || !nhull) {
-            free(pp);
-            free(pg);
-            free(nhull);
-            st = nomem(err, s->rank, "hull merge");
-            goto done;
-        }
-        size_t k = 0;
-        for (size_t i = 0; i < n1; i++) hp[k++] = mv[hl].pts[mv[hl].hull[i]];
-        for (size_t i = 0; i < n2; i++) hp[k++] = mv[hr].pts[mv[hr].hull[i]];
-        qsort(hp, nh, sizeof *hp, cmp_key);
-        for (size_t i = 0; i < nh; i++) {
-            pp[i] = (pdt_point){hp[i].x, hp[i].y};
-            pg[i] = hp[i].gid;
-        }
-        size_t nout = 0;
-        int deg = 0;
-        const uint32_t *saved = tr ? tr->gid : NULL;
-        if (tr) tr->gid = pg;
-        st = pdt_hull_chain(pp, nh, hidx, &nout, &deg, PDT_STACK_MERGE_LOWER,
-                            PDT_STACK_MERGE_UPPER, tr);
-        if (tr) tr->gid = saved;
-        if (st == PDT_OK) {
-            for (size_t i = 0; i < nout; i++) nhull[i] = hp[hidx[i]];
-            free(s->hull);
-            s->hull = nhull;
-            s->nhull = nout;
-            s->hull_degenerate = deg;
-            s->holds_hull = 1;
-            PDT_TRACE(tr, 1, PDT_EV_HULL, 0, nout, deg, 0, 0);
-        } else {
-            free(nhull);
-            pdt_err_set(err, st, "rank %d: hull merge failed", s->rank);
-        }
-        free(pp);
-        free(pg);
-        if (st != PDT_OK) goto done;
+/* The hull of the merged group: monotone chain over both hulls
+ * (lex-sorted union); this rank now holds it. */
+static pdt_status merge_hulls(merge_job *j)
+{
+    srm_rank *s = j->s;
+    pdt_trace *tr = s->tr;
+    const msg_view *ml = j->hl >= 0 ? &j->mv[j->hl] : NULL, *mr = j->hr >= 0 ? &j->mv[j->hr] : NULL;
+    size_t n1 = ml ? ml->h.nhull : 0, n2 = mr ? mr->h.nhull : 0, nh = n1 + n2;
+    srm_pt *hp = malloc((nh + 1) * sizeof *hp), *nhull = malloc((nh + 1) * sizeof *nhull);
+    uint32_t *hidx = malloc((nh + 2) * sizeof *hidx), *pg = malloc((nh + 1) * sizeof *pg);
+    pdt_point *pp = malloc((nh + 1) * sizeof *pp);
+    pdt_status st = PDT_OK;
+    if (!hp || !hidx || !pp || !pg || !nhull) {
+        st = nomem(j->err, s->rank, "hull merge");
+        goto done;
     }
-    s->cnt.merges++;
-    PDT_TRACE(tr, 1, PDT_EV_MERGE_END, level, ns, nb, kept, (int64_t)ndisc);
-    (void)nshipL;
-    s->cnt.critical_path = cp_in + (now(s) - t0);
-    s->cnt.critical_cpu = cpu_in + (cpu_now() - c0);
-
+    size_t k = 0;
+    for (size_t i = 0; i < n1; i++) hp[k++] = ml->pts[ml->hull[i]];
+    for (size_t i = 0; i < n2; i++) hp[k++] = mr->pts[mr->hull[i]];
+    qsort(hp, nh, sizeof *hp, cmp_key);
+    for (size_t i = 0; i < nh; i++) {
+        pp[i] = (pdt_point){hp[i].x, hp[i].y};
+        pg[i] = hp[i].gid;
+    }
+    size_t nout = 0;
+    int deg = 0;
+    const uint32_t *saved = tr ? tr->gid : NULL;
+    if (tr) tr->gid = pg;
+    st = pdt_hull_chain(pp, nh, hidx, &nout, &deg, PDT_STACK_MERGE_LOWER, PDT_STACK_MERGE_UPPER,
+                        tr);
+    if (tr) tr->gid = saved;
+    if (st != PDT_OK) {
+        pdt_err_set(j->err, st, "rank %d: hull merge failed", s->rank);
+        goto done;
+    }
+    for (size_t i = 0; i < nout; i++) nhull[i] = hp[hidx[i]];
+    free(s->hull);
+    s->hull = nhull;
+    nhull = NULL;
+    s->nhull = nout;
+    s->hull_degenerate = deg;
+    s->holds_hull = 1;
+    PDT_TRACE(tr, 1, PDT_EV_HULL, 0, nout, deg, 0, 0);
 done:
-    for (int i = 0; i < nm; i++) msg_view_free(&mv[i]);
-    free(mv);
-    free(shipped);
-    free(tb);
-    free(B);
     free(hp);
-    free(bp);
-    free(bg);
+    free(nhull);
     free(hidx);
-    free(tris);
+    free(pg);
+    free(pp);
+    return st;
+}
+
+pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len, pdt_err *err)
+{
+    merge_job j;
+    memset(&j, 0, sizeof j);
+    j.s = s;
+    j.level = level;
+    j.err = err;
+    pdt_srm_pair(s->rank, s->p, level, &j.gl, &j.gr, &j.ge);
+    j.nm = j.ge - j.gl;
+    double t0 = now(s), c0 = cpu_now();
+    PDT_TRACE(s->tr, 1, PDT_EV_MERGE_BEGIN, level, j.gl, j.gr, j.ge, s->rank);
+
+    pdt_status st = read_messages(&j, msg, len);
+    if (st == PDT_OK) st = border_set(&j);
+    if (st == PDT_OK) st = border_kernel(&j);
+    if (st == PDT_OK) st = select_kept(&j);
+    if (st == PDT_OK) note_discards(&j);
+    if (st == PDT_OK) st = merge_hulls(&j);
+
+    if (st == PDT_OK) {
+        s->cnt.merges++;
+        PDT_TRACE(s->tr, 1, PDT_EV_MERGE_END, level, j.ns, j.nb, j.kept, (int64_t)j.ndisc);
+        s->cnt.critical_path = j.cp_in + (now(s) - t0);
+        s->cnt.critical_cpu = j.cpu_in + (cpu_now() - c0);
+    }
+    merge_job_free(&j);
     return st;
 }

@@ -2,15 +2,12 @@
  * the restricted-area tests against exact arithmetic, the partition helpers
  * (radix sort, duplicates, splitters) and the merge schedule.
  *
- * src/par is linked only into the pdt program, so the sources under test are
- * compiled into this test directly. */
+ * The code under test comes from libpdtpar.a (src/par without MPI). */
 #include "../harness.h"
 
 #include <string.h>
 
-#include "../../src/par/partition.c"
-#include "../../src/par/schedule.c"
-#include "../../src/par/touch.c"
+#include "../../src/par/srm.h"
 
 static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
 static uint64_t rnd(void)

@@ -3,17 +3,15 @@
  * random strip cuts (empty, 1- and 2-point strips included), compared with
  * one kernel run on all points.  Also: dropping the hull-vertex rule of the
  * Merge Lemma must break it (the test can fail).
- *
- * src/par is linked only into the pdt program, so the MPI-free SRM sources
- * are compiled into this test directly. */
+
+ * The code under test comes from libpdtpar.a (src/par without MPI). */
 #include "../harness.h"
 
+#include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
-#include "../../src/par/partition.c"
-#include "../../src/par/schedule.c"
-#include "../../src/par/srm.c"
-#include "../../src/par/touch.c"
+#include "../../src/par/srm.h"
 #include "pdt/delaunay.h"
 #include "pdt/gen.h"
 
