@@ -204,7 +204,8 @@ static void json_rank(int q, const pdt_par_rank_stats *r)
             (unsigned long long)r->merge_bytes_recv, r->critical_path);
 }
 
-/* The communication figures of an MPI run (what make table1 reads). */
+/* The communication figures of an MPI run and per_rank[] again (what make
+ * table1 and scripts/projection.py read). */
 static void json_parallel(const pdt_par_stats *s)
 {
     fprintf(stderr,
@@ -213,7 +214,7 @@ static void json_parallel(const pdt_par_stats *s)
             "\"largest_border_set\": %llu, \"largest_border_set_rel_n\": %.6f, "
             "\"sequential_merge\": %s, "
             "\"bytes_total\": %llu, \"merge_bytes\": %llu, \"merge_bytes_rel_input\": %.6f, "
-            "\"critical_path_s\": %.6f, \"critical_path_cpu_s\": %.6f, \"time_s\": %.6f}",
+            "\"critical_path_s\": %.6f, \"critical_path_cpu_s\": %.6f, \"time_s\": %.6f",
             s->nranks, (unsigned long long)s->n_in, (unsigned long long)s->n_unique,
             (unsigned long long)s->n_dup, (unsigned long long)s->n_tri,
             (unsigned long long)s->hull, s->collinear ? "true" : "false",
@@ -223,6 +224,9 @@ static void json_parallel(const pdt_par_stats *s)
             (unsigned long long)s->bytes_total, (unsigned long long)s->merge_bytes,
             s->n_in ? (double)s->merge_bytes / (8.0 * (double)s->n_in) : 0.0, s->critical_path,
             s->critical_cpu, s->t_compute);
+    fprintf(stderr, ", \"per_rank\": [");
+    for (int q = 0; q < s->nranks; q++) json_rank(q, &s->rank[q]);
+    fprintf(stderr, "]}");
 }
 
 /* --stats: one JSON object on one line.  "seconds" holds the largest time of each phase
