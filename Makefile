@@ -40,10 +40,11 @@
 # only code that includes mpi.h is src/par/comm_mpi.c, linked into bin/pdt
 # alone), src/cli (the pdt
 # program), src/view (replay model, cairo renderer, SDL2 shell: every file
-# but shell.c and pdtview.c goes into libpdtview.a, which needs cairo only;
-# bin/pdtview adds SDL2 and the option parser src/cli/opts.c).  Unit tests
-# named tests/unit/test_view*.c are compiled with the cairo/SDL flags and
-# linked with libpdtview.a.
+# but shell.c and pdtview.c goes into libpdtview.a, which needs cairo, and
+# for anim.c giflib (FFmpeg's libraries are opened with dlopen); bin/pdtview
+# adds SDL2 and the option parser src/cli/opts.c).  Unit tests named
+# tests/unit/test_view*.c are compiled with the cairo/SDL flags and linked
+# with libpdtview.a.
 
 CC      ?= gcc
 ifeq ($(origin CC),default)
@@ -67,11 +68,18 @@ MPI_LIBS    := $(shell pkg-config --libs ompi-c 2>/dev/null)
 VIEW_CFLAGS := $(shell pkg-config --cflags cairo sdl2 2>/dev/null)
 CAIRO_LIBS  := $(shell pkg-config --libs cairo 2>/dev/null)
 SDL_LIBS    := $(shell pkg-config --libs sdl2 2>/dev/null)
+# animation export (src/view/anim.c): giflib (no pkg-config file on Debian
+# 12) is linked; FFmpeg's libraries are opened with dlopen when a video is
+# written (their codec libraries' start-up code is more than valgrind runs)
+AV_PKGS     := libavformat libavcodec libswscale libavutil
+VIEW_CFLAGS += $(shell pkg-config --cflags $(AV_PKGS) 2>/dev/null)
+ANIM_LIBS   := -lgif -ldl
 LIBS        := -lm -pthread
 
 # Debian packages the build, the tests and the demo need.
-DEB_BUILD := build-essential pkg-config libopenmpi-dev openmpi-bin libsdl2-dev libcairo2-dev fonts-dejavu-core
-DEB_TEST  := mandoc bash-completion qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps slurmctld slurmd slurm-client munge
+DEB_BUILD := build-essential pkg-config libopenmpi-dev openmpi-bin libsdl2-dev libcairo2-dev fonts-dejavu-core \
+             libgif-dev libavcodec-dev libavformat-dev libswscale-dev libavutil-dev
+DEB_TEST  := mandoc bash-completion qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps slurmctld slurmd slurm-client munge ffmpeg
 DEB_BENCH := hyperfine libcgal-dev g++ nodejs npm valgrind time
 DEB_FUZZ  := clang libclang-rt-dev
 
@@ -115,11 +123,11 @@ $(3)/pdt: $$(patsubst %.c,build/$(1)/%.o,$(CLI_SRC) src/par/comm_mpi.c) build/$(
 	$$(CC) $(2) -o $$@ $$^ $(MPI_LIBS) $(LIBS)
 
 $(3)/pdtview: $$(patsubst %.c,build/$(1)/%.o,$(VIEWAPP_SRC) src/cli/opts.c) build/$(1)/libpdtview.a build/$(1)/libpdt.a
-	$$(CC) $(2) -o $$@ $$^ $(SDL_LIBS) $(CAIRO_LIBS) $(LIBS)
+	$$(CC) $(2) -o $$@ $$^ $(SDL_LIBS) $(CAIRO_LIBS) $(ANIM_LIBS) $(LIBS)
 
 $(3)/tests/%: build/$(1)/tests/unit/%.o $(if $(VIEWLIB_SRC),build/$(1)/libpdtview.a) build/$(1)/libpdtpar.a build/$(1)/libpdt.a
 	@mkdir -p $$(dir $$@)
-	$$(CC) $(2) -o $$@ $$^ $(CAIRO_LIBS) $(LIBS)
+	$$(CC) $(2) -o $$@ $$^ $(CAIRO_LIBS) $(ANIM_LIBS) $(LIBS)
 
 $(1)-all: $(3)/pdt $(if $(VIEWAPP_SRC),$(3)/pdtview) $(patsubst tests/unit/%.c,$(3)/tests/%,$(UNIT_SRC))
 endef

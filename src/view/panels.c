@@ -253,6 +253,7 @@ void pdt_draw_help(ctx *c, double w, double h)
         {"f", "fit the points in the window"},
         {"h  ?", "this help"},
         {"s", "screenshot (PNG)"},
+        {"m  r", "mark an event; record mark → current as GIF/video"},
         {"Esc  q", "quit"},
     };
     int nk = (int)(sizeof keys / sizeof *keys);

@@ -3,6 +3,9 @@
  *   pdtview RUN                                   the window
  *   pdtview --headless RUN (--at N | --phase NAME | --end) -o FILE.png|.svg|.pdf [--size WxH]
  *   pdtview --headless RUN --frames DIR --every K [--size WxH]
+ *   pdtview --headless RUN --gif OUT.gif | --video OUT.mp4|OUT.webm
+ *           [--phase P | --from N --to M] [--every K] [--fps F] [--hold S] [--size WxH]
+ *   pdtview --edit FILE [--hull] [--ranks P]   the point editor
  *   pdtview --bench RUN [--size WxH]        open / seek / draw figures
  *   pdtview --write-run DIR RUN             copy a (synthetic) run to a run folder
  *
@@ -17,12 +20,14 @@
 
 #include <cairo.h>
 
+#include "pdt/anim.h"
 #include "pdt/describe.h"
 #include "pdt/query.h"
 #include "pdt/render.h"
 #include "pdt/replay.h"
 #include "pdt/tracefile.h"
 #include "pdt/viewsynth.h"
+#include "edit.h"
 #include "shell.h"
 #include "../cli/cli.h"
 
@@ -34,15 +39,27 @@ typedef struct opts {
     size_t at;
     double speed;
     unsigned panels; /* PDT_PANEL_* bits (--panels) */
+    /* animation export (--gif / --video) and the window's record key */
+    const char *gif, *video, *record;
+    double fps, hold;
+    size_t from, to;
+    int have_from, have_to;
+    const char *edit;  /* --edit FILE: the point editor */
+    int ranks, hull;
 } opts;
 
 static const char help_text[] =
     "usage: pdtview RUN [--size WxH] [--at N|--phase NAME|--end] [--hide R,R..]\n"
     "               [--panels code,stack,lifted,timeline|all|none]\n"
     "               [--script KEYS] [--screenshot FILE.png] [--speed EV_PER_S]\n"
+    "               [--record FILE.gif|.mp4|.webm] [--fps F] [--every K]\n"
     "       pdtview --headless RUN (--at N | --phase NAME | --end) -o FILE.png|.svg|.pdf\n"
     "               [--size WxH]\n"
     "       pdtview --headless RUN --frames DIR --every K [--size WxH]\n"
+    "       pdtview --headless RUN --gif OUT.gif | --video OUT.mp4|OUT.webm\n"
+    "               [--phase P | --from N --to M] [--every K] [--fps F] [--hold S]\n"
+    "               [--size WxH]   (an animation: all events, a phase, or N..M)\n"
+    "       pdtview --edit FILE [--ranks P] [--hull] [--size WxH]   (click points in)\n"
     "       pdtview --bench RUN [--size WxH]\n"
     "       pdtview RUN [--at N|--phase NAME|--end] --counts   (triangles by status)\n"
     "       pdtview RUN --check     (seek equals stepping, both ways, at every cursor)\n"
@@ -91,7 +108,9 @@ static int parse_args(int argc, char **argv, opts *o)
     o->speed = 20;
     o->panels = PDT_PANEL_ALL;
     const char *size = NULL, *panels = NULL;
-    uint64_t at = UINT64_MAX, every = UINT64_MAX;
+    uint64_t at = UINT64_MAX, every = UINT64_MAX, from = UINT64_MAX, to = UINT64_MAX,
+             ranks = 1;
+    double hold = 0;
     const pdt_cli_opt table[] = {
         {"--headless", NULL, PDT_OPT_FLAG, &o->headless},
         {"--bench", NULL, PDT_OPT_FLAG, &o->bench},
@@ -112,6 +131,16 @@ static int parse_args(int argc, char **argv, opts *o)
         {"--hide", NULL, PDT_OPT_STR, &o->hide},
         {"--panels", NULL, PDT_OPT_STR, &panels},
         {"--speed", NULL, PDT_OPT_POSNUM, &o->speed},
+        {"--gif", NULL, PDT_OPT_STR, &o->gif},
+        {"--video", NULL, PDT_OPT_STR, &o->video},
+        {"--record", NULL, PDT_OPT_STR, &o->record},
+        {"--fps", NULL, PDT_OPT_POSNUM, &o->fps},
+        {"--hold", NULL, PDT_OPT_POSNUM, &hold},
+        {"--from", NULL, PDT_OPT_U64, &from},
+        {"--to", NULL, PDT_OPT_U64, &to},
+        {"--edit", NULL, PDT_OPT_STR, &o->edit},
+        {"--hull", NULL, PDT_OPT_FLAG, &o->hull},
+        {"--ranks", NULL, PDT_OPT_U64, &ranks},
         {NULL, NULL, PDT_OPT_FLAG, NULL},
     };
     const char *pos[1];
@@ -119,8 +148,31 @@ static int parse_args(int argc, char **argv, opts *o)
     int rc = pdt_cli_parse(PROG, help_text, argc, argv, table, pos, 1, &npos);
     if (rc == 1) return PDT_EXIT_OK;
     if (rc) return PDT_EXIT_USAGE;
-    if (npos != 1) return pdt_cli_usage(PROG, "needs one RUN (a run folder or synth:...)");
-    o->run = pos[0];
+    if (o->edit) {
+        if (npos != 0 || o->headless)
+            return pdt_cli_usage(PROG, "--edit FILE opens the editor window: no RUN, no --headless");
+        if (ranks < 1 || ranks > 64)
+            return pdt_cli_usage(PROG, "--ranks needs 1 .. 64, not '%llu'", (unsigned long long)ranks);
+        o->ranks = (int)ranks;
+    } else if (npos != 1) {
+        return pdt_cli_usage(PROG, "needs one RUN (a run folder or synth:...)");
+    }
+    o->run = npos ? pos[0] : NULL;
+    o->hold = hold;
+    if (!o->fps) o->fps = 10;
+    if (from != UINT64_MAX) o->from = (size_t)from, o->have_from = 1;
+    if (to != UINT64_MAX) o->to = (size_t)to, o->have_to = 1;
+    if (o->video && pdt_anim_format_of(o->video) != PDT_ANIM_MP4 &&
+        pdt_anim_format_of(o->video) != PDT_ANIM_WEBM)
+        return pdt_cli_usage(PROG, "--video %s: want a name ending in .mp4 or .webm", o->video);
+    if (o->gif && pdt_anim_format_of(o->gif) != PDT_ANIM_GIF)
+        return pdt_cli_usage(PROG, "--gif %s: want a name ending in .gif", o->gif);
+    if (o->record && pdt_anim_format_of(o->record) < 0)
+        return pdt_cli_usage(PROG, "--record %s: want a name ending in .gif, .mp4 or .webm", o->record);
+    if ((o->gif || o->video) && !o->headless)
+        return pdt_cli_usage(PROG, "--gif and --video write files headless: add --headless");
+    if ((o->have_from || o->have_to) && o->phase)
+        return pdt_cli_usage(PROG, "give --phase or --from/--to, not both");
     if (at != UINT64_MAX) {
         o->at = (size_t)at;
         o->have_at = 1;
@@ -137,8 +189,8 @@ static int parse_args(int argc, char **argv, opts *o)
                                    "none), not '%s'", panels);
     if (o->hide && !valid_rank_list(o->hide))
         return pdt_cli_usage(PROG, "--hide needs rank numbers separated by commas, not '%s'", o->hide);
-    if (o->headless && !o->out && !o->frames && !o->bench && !o->counts)
-        return pdt_cli_usage(PROG, "--headless needs -o FILE or --frames DIR");
+    if (o->headless && !o->out && !o->frames && !o->bench && !o->counts && !o->gif && !o->video)
+        return pdt_cli_usage(PROG, "--headless needs -o FILE, --frames DIR, --gif FILE or --video FILE");
     return -1;
 }
 
@@ -213,6 +265,60 @@ static int headless(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const opts 
             if (k == m) break;
         }
         if (!o->quiet) printf("pdtview: wrote %zu frames to %s\n", count, o->frames);
+    }
+    return 0;
+}
+
+/* The cursors of phase `name` ("merge", "merge:1", ...): from its first
+ * PHASE_BEGIN to after the last PHASE_END of that phase on any rank.
+ * Returns 0 when the run has no such phase. */
+static int phase_range(const pdt_replay *r, const char *name, size_t *from, size_t *to)
+{
+    size_t k = pdt_replay_find_phase_name(r, name);
+    if (k == (size_t)-1) return 0;
+    size_t np, m = pdt_replay_count(r), len = strcspn(name, ":");
+    const pdt_rphase *P = pdt_replay_phases(r, &np);
+    int id = -1;
+    for (int q = 0; q < PDT_PH_COUNT; q++)
+        if (pdt_phase_name(q) && strlen(pdt_phase_name(q)) == len &&
+            !strncmp(pdt_phase_name(q), name, len))
+            id = q;
+    long sub = name[len] ? strtol(name + len + 1, NULL, 10) : -1;
+    *from = k ? k - 1 : 0;
+    *to = *from;
+    for (size_t i = 0; i < np; i++) {
+        if ((int)P[i].phase != id || (sub >= 0 && P[i].sub != (uint32_t)sub)) continue;
+        size_t end = P[i].end_ev == UINT32_MAX ? m : (size_t)P[i].end_ev + 1;
+        if (end > *to) *to = end;
+    }
+    return 1;
+}
+
+/* --gif / --video: the events of the run, of a phase, or --from..--to. */
+static int animate(const pdt_replay *r, pdt_rstate *s, const pdt_view *v, const opts *o,
+                   pdt_err *err)
+{
+    size_t m = pdt_replay_count(r);
+    pdt_anim_opts ao = {o->w, o->h, o->fps, 0, m, o->every ? (size_t)o->every : 1, o->hold};
+    if (o->phase && !phase_range(r, o->phase, &ao.from, &ao.to)) {
+        pdt_err_set(err, PDT_ERR_ARG, "%s: no phase named \"%s\" in this run", o->run, o->phase);
+        return 1;
+    }
+    if (o->have_from) ao.from = o->from;
+    if (o->have_to) ao.to = o->to;
+    if (ao.to > m || ao.from > ao.to) {
+        pdt_err_set(err, PDT_ERR_ARG, "--from %zu --to %zu: want from <= to <= %zu (the run's "
+                    "events)", ao.from, ao.to, m);
+        return 1;
+    }
+    const char *outs[2] = {o->gif, o->video};
+    for (int i = 0; i < 2; i++) {
+        if (!outs[i]) continue;
+        size_t frames = 0;
+        if (pdt_anim_replay(outs[i], &ao, r, s, v, &frames, err) != PDT_OK) return 2;
+        if (!o->quiet)
+            printf("pdtview: wrote %s (%zu frames of %dx%d at %g frames/s: events %zu to %zu, "
+                   "every %zu)\n", outs[i], frames, o->w, o->h, o->fps, ao.from, ao.to, ao.every);
     }
     return 0;
 }
@@ -420,11 +526,34 @@ static int write_run(const char *dir, const loaded *L, pdt_err *err)
     return st == PDT_OK ? 0 : 1;
 }
 
+/* --edit FILE: the editor's replay in the window, re-run after every change. */
+static int edit(const opts *o)
+{
+    pdt_live_opts lo = {o->hull, o->ranks ? o->ranks : 1, 1};
+    pdt_editor *ed;
+    pdt_err err = {0};
+    if (pdt_editor_open(o->edit, &lo, &ed, &err) != PDT_OK) {
+        fprintf(stderr, "pdtview: %s\n", err.msg);
+        return 2;
+    }
+    pdt_view v;
+    pdt_view_defaults(&v);
+    v.panels = o->panels;
+    char title[512];
+    snprintf(title, sizeof title, "editing %s", o->edit);
+    pdt_shell_opts so = {o->w, o->h, title, o->script, o->screenshot, o->speed,
+                         o->record, o->fps, o->every, pdt_editor_hook(ed)};
+    int rc = pdt_shell_run(pdt_editor_replay(ed), pdt_editor_state(ed), &v, &so);
+    pdt_editor_free(ed);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     opts o;
     int prc = parse_args(argc, argv, &o);
     if (prc >= 0) return prc;
+    if (o.edit) return edit(&o);
     pdt_err err = {0};
     loaded L;
     pdt_replay *r = NULL;
@@ -495,10 +624,18 @@ int main(int argc, char **argv)
         rc = 0;
     } else if (o.bench) {
         rc = bench(r, s, &v, &o);
+    } else if (o.headless && (o.gif || o.video)) {
+        rc = animate(r, s, &v, &o, &err);
+        if (rc) {
+            fprintf(stderr, "pdtview: %s\n", err.msg);
+            pdt_err_clear(&err);
+            rc = 2;
+        }
     } else if (o.headless) {
         rc = headless(r, s, &v, &o, &err);
     } else {
-        pdt_shell_opts so = {o.w, o.h, o.run, o.script, o.screenshot, o.speed};
+        pdt_shell_opts so = {o.w, o.h, o.run, o.script, o.screenshot, o.speed,
+                             o.record, o.fps, o.every, NULL};
         rc = pdt_shell_run(r, s, &v, &so);
     }
 out:

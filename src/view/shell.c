@@ -7,15 +7,22 @@
  * it is sharp on high-DPI screens; mouse positions are scaled to match. */
 #include "shell.h"
 
+#include "pdt/anim.h"
+
 #include <SDL.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+/* hidden[] has room for this many ranks more than the first replay has (a
+ * hook may switch to a replay with more ranks). */
+enum { MAX_RANKS_SHOWN = 64 };
+
 typedef struct shell {
     const pdt_replay *r;
     pdt_rstate *s;
+    int cap_ranks;          /* room in hidden[] */
     pdt_view *v;
     const pdt_shell_opts *o;
     SDL_Window *win;
@@ -25,7 +32,8 @@ typedef struct shell {
     double sx, sy;          /* drawable / window scale */
     uint8_t *hidden;        /* writable copy of the view's hidden ranks */
     int nranks;
-    int playing, quit, dirty, shots;
+    int playing, quit, dirty, shots, recs;
+    size_t mark;            /* `m`: one end of the next recording (SIZE_MAX: none) */
     double speed, acc;      /* events per second; fraction carried over */
     uint64_t last;          /* performance counter at the last frame */
     /* mouse */
@@ -73,6 +81,33 @@ static int screenshot(shell *sh, const char *path)
     }
     fprintf(stderr, "pdtview: screenshot %s (%dx%d, event %zu)\n", path, sh->tw, sh->th, sh->s->k);
     return 1;
+}
+
+/* `r`: write the events between the mark (`m`; else the end) and the
+ * current event as an animation, drawn as the window shows them. */
+static void record(shell *sh)
+{
+    char name[64];
+    const char *path = sh->o->record;
+    if (!path) {
+        snprintf(name, sizeof name, "pdtview-rec-%03d.gif", sh->recs++);
+        path = name;
+    }
+    size_t a = sh->s->k, b = sh->mark == SIZE_MAX ? pdt_replay_count(sh->r) : sh->mark;
+    pdt_anim_opts ao = {sh->tw & ~1, sh->th & ~1, sh->o->fps > 0 ? sh->o->fps : 10,
+                        a < b ? a : b, a < b ? b : a, sh->o->every > 0 ? (size_t)sh->o->every : 1, 0};
+    pdt_view v = *sh->v;
+    v.status = NULL;
+    v.help = 0;
+    pdt_err err = {0};
+    size_t frames = 0;
+    pdt_rstate *scratch = pdt_rstate_new(sh->r);
+    if (!scratch) pdt_err_set(&err, PDT_ERR_NOMEM, "out of memory");
+    else pdt_anim_replay(path, &ao, sh->r, scratch, &v, &frames, &err);
+    pdt_rstate_free(scratch);
+    if (err.code != PDT_OK) fprintf(stderr, "pdtview: %s\n", err.msg);
+    else fprintf(stderr, "pdtview: recorded %s (%zu frames, events %zu to %zu)\n", path, frames,
+                 ao.from, ao.to);
 }
 
 static void key(shell *sh, SDL_Keycode k, Uint16 mod)
@@ -128,6 +163,11 @@ static void key(shell *sh, SDL_Keycode k, Uint16 mod)
         if (shift) sh->v->help = !sh->v->help;
         break;
     case SDLK_s: screenshot(sh, sh->o->screenshot); break;
+    case SDLK_m:
+        sh->mark = cur;
+        fprintf(stderr, "pdtview: mark at event %zu (r records from here to the current event)\n", cur);
+        break;
+    case SDLK_r: record(sh); break;
     default:
         if (k >= SDLK_1 && k <= SDLK_9) {
             int q = (int)(k - SDLK_1);
@@ -218,8 +258,9 @@ static void mouse(shell *sh, const SDL_Event *e)
 
 /* Feed the next script token as SDL events.  Tokens (space separated):
  * key names (space right left S-right S-left pgdn pgup home end plus minus
- * 0-9 h k f s q), wait:N (frames), click:X,Y and wheel:X,Y,N (window
- * coordinates), drag:X0,Y0,X1,Y1. */
+ * 0-9 h k f s m r q), key:NAME / key:C-NAME (any SDL key name, C- = with
+ * Ctrl), wait:N (frames), click:X,Y, rclick:X,Y (right button) and
+ * wheel:X,Y,N (window coordinates), drag:X0,Y0,X1,Y1. */
 static void script_step(shell *sh)
 {
     if (!sh->script) return;
@@ -245,6 +286,7 @@ static void script_step(shell *sh)
         {"end", SDLK_END, 0},       {"plus", SDLK_PLUS, 0},    {"minus", SDLK_MINUS, 0},
         {"h", SDLK_h, 0},           {"k", SDLK_k, 0},          {"f", SDLK_f, 0},
         {"s", SDLK_s, 0},           {"q", SDLK_q, 0},          {"esc", SDLK_ESCAPE, 0},
+        {"m", SDLK_m, 0},           {"r", SDLK_r, 0},
     };
     SDL_Event e;
     memset(&e, 0, sizeof e);
@@ -262,8 +304,27 @@ static void script_step(shell *sh)
         SDL_PushEvent(&e);
         return;
     }
+    if (!strncmp(tok, "key:", 4)) { /* key:NAME or key:C-NAME (SDL key names: z, F1, ...) */
+        const char *name = tok + 4;
+        int ctrl = !strncmp(name, "C-", 2);
+        e.type = SDL_KEYDOWN;
+        e.key.keysym.sym = SDL_GetKeyFromName(ctrl ? name + 2 : name);
+        e.key.keysym.mod = ctrl ? KMOD_LCTRL : 0;
+        if (e.key.keysym.sym != SDLK_UNKNOWN) {
+            SDL_PushEvent(&e);
+            return;
+        }
+    }
     int a, b, c, d;
-    if (sscanf(tok, "wait:%d", &a) == 1) {
+    if (sscanf(tok, "rclick:%d,%d", &a, &b) == 2) {
+        e.type = SDL_MOUSEBUTTONDOWN;
+        e.button.button = SDL_BUTTON_RIGHT;
+        e.button.x = a;
+        e.button.y = b;
+        SDL_PushEvent(&e);
+        e.type = SDL_MOUSEBUTTONUP;
+        SDL_PushEvent(&e);
+    } else if (sscanf(tok, "wait:%d", &a) == 1) {
         sh->wait_frames = a;
     } else if (sscanf(tok, "click:%d,%d", &a, &b) == 2) {
         e.type = SDL_MOUSEBUTTONDOWN;
@@ -299,6 +360,51 @@ static void script_step(shell *sh)
     }
 }
 
+/* Offer an SDL event to the hook; 1 if it took it. */
+static int hook_input(shell *sh, const SDL_Event *e)
+{
+    const pdt_shell_hook *hk = sh->o->hook;
+    if (!hk || !hk->input) return 0;
+    pdt_shell_input in;
+    memset(&in, 0, sizeof in);
+    SDL_Keymod mod = SDL_GetModState();
+    switch (e->type) {
+    case SDL_MOUSEBUTTONDOWN:
+    case SDL_MOUSEBUTTONUP:
+        in.type = e->type == SDL_MOUSEBUTTONDOWN ? PDT_IN_DOWN : PDT_IN_UP;
+        in.button = e->button.button;
+        in.x = e->button.x * sh->sx;
+        in.y = e->button.y * sh->sy;
+        break;
+    case SDL_MOUSEMOTION:
+        in.type = PDT_IN_MOVE;
+        in.x = e->motion.x * sh->sx;
+        in.y = e->motion.y * sh->sy;
+        break;
+    case SDL_KEYDOWN:
+        in.type = PDT_IN_KEY;
+        in.key = (int)e->key.keysym.sym;
+        mod = (SDL_Keymod)(mod | e->key.keysym.mod);
+        break;
+    default: return 0;
+    }
+    in.ctrl = (mod & KMOD_CTRL) != 0;
+    in.shift = (mod & KMOD_SHIFT) != 0;
+    if (!hk->input(hk->user, &in, sh->tw, sh->th, sh->v)) return 0;
+    sh->dirty = 1;
+    return 1;
+}
+
+/* Take the hook's replay if it changed. */
+static void hook_current(shell *sh)
+{
+    const pdt_shell_hook *hk = sh->o->hook;
+    if (!hk || !hk->current || !hk->current(hk->user, &sh->r, &sh->s)) return;
+    int n = pdt_replay_nranks(sh->r);
+    sh->nranks = n < sh->cap_ranks ? n : sh->cap_ranks;
+    sh->dirty = 1;
+}
+
 static int make_texture(shell *sh)
 {
     int w, h, ww, wh;
@@ -326,6 +432,8 @@ static int draw(shell *sh)
     pdt_err err = {0};
     set_status(sh);
     pdt_status st = pdt_render(cr, sh->tw, sh->th, sh->r, sh->s, sh->v, &err);
+    const pdt_shell_hook *hk = sh->o->hook;
+    if (st == PDT_OK && hk && hk->overlay) hk->overlay(hk->user, cr, sh->tw, sh->th, sh->v);
     cairo_destroy(cr);
     cairo_surface_flush(sf);
     cairo_surface_destroy(sf);
@@ -342,6 +450,10 @@ static void loop(shell *sh)
     int got = sh->playing || sh->dirty || sh->script ? SDL_PollEvent(&e)
                                                     : SDL_WaitEventTimeout(&e, 100);
     while (got) {
+        if (hook_input(sh, &e)) {
+            got = SDL_PollEvent(&e);
+            continue;
+        }
         switch (e.type) {
         case SDL_QUIT: sh->quit = 1; break;
         case SDL_KEYDOWN: key(sh, e.key.keysym.sym, e.key.keysym.mod); break;
@@ -367,6 +479,7 @@ static void loop(shell *sh)
         }
         got = SDL_PollEvent(&e);
     }
+    hook_current(sh);
     uint64_t now = SDL_GetPerformanceCounter();
     double dt = (double)(now - sh->last) / (double)SDL_GetPerformanceFrequency();
     sh->last = now;
@@ -419,8 +532,10 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
     sh.nranks = pdt_replay_nranks(r);
     sh.speed = o->speed > 0 ? o->speed : 20;
     sh.script = o->script;
-    sh.hidden = calloc((size_t)sh.nranks + 1, 1);
+    sh.mark = SIZE_MAX;
+    sh.hidden = calloc(MAX_RANKS_SHOWN + (size_t)sh.nranks + 1, 1);
     if (!sh.hidden) return 1;
+    sh.cap_ranks = MAX_RANKS_SHOWN + sh.nranks;
     if (v->hidden) memcpy(sh.hidden, v->hidden, (size_t)sh.nranks);
     v->hidden = sh.hidden;
     SDL_SetHint(SDL_HINT_VIDEO_X11_NET_WM_BYPASS_COMPOSITOR, "0");

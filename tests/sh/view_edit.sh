@@ -1,0 +1,77 @@
+#!/bin/bash
+# pdtview --edit FILE in a real window under Xvfb: real X clicks (xdotool)
+# add points, a right click deletes one, Ctrl+Z brings it back; the file is
+# rewritten after every change and `pdt` reads it as is (the triangles the
+# editor's replay ends with are `pdt triangulate`'s); a file that does not
+# parse is refused (exit 2, file:line) and left as it was.
+. "$(dirname "$0")/lib.sh"
+V=$BIN/pdtview
+for t in Xvfb xdotool import; do
+    command -v $t >/dev/null || { fail "have_$t" "$t is not installed (DEB_TEST)"; summary; exit 1; }
+done
+
+# refused: a file that does not parse is never overwritten
+printf '0 0\n1 2\n3 4294967296\n' >"$TMP/bad.txt"
+cp "$TMP/bad.txt" "$TMP/bad.orig"
+"$V" --edit "$TMP/bad.txt" 2>"$TMP/bad.err"; rc=$?
+if [ "$rc" -eq 2 ] && grep -q 'bad.txt:3' "$TMP/bad.err" && cmp -s "$TMP/bad.txt" "$TMP/bad.orig"; then
+    ok edit_refuses_bad_file; else fail edit_refuses_bad_file "exit $rc: $(cat "$TMP/bad.err")"; fi
+
+W=900; H=600
+d=130
+while [ -e /tmp/.X$d-lock ] || [ -e /tmp/.X11-unix/X$d ]; do d=$((d + 1)); done
+Xvfb :$d -screen 0 ${W}x${H}x24 -nolisten tcp >"$TMP/xvfb.log" 2>&1 &
+XPID=$!
+export DISPLAY=:$d
+for i in $(seq 50); do xdotool getdisplaygeometry >/dev/null 2>&1 && break; sleep 0.1; done
+cleanup() { [ -n "${VPID:-}" ] && kill "$VPID" 2>/dev/null; kill "$XPID" 2>/dev/null; rm -rf "$TMP"; }
+trap cleanup EXIT
+
+F=$TMP/mine.txt
+"$V" --edit "$F" --size ${W}x${H} --screenshot "$TMP/edit.png" >"$TMP/out.log" 2>"$TMP/err.log" &
+VPID=$!
+wid=
+for i in $(seq 100); do wid=$(xdotool search --name 'pdtview' 2>/dev/null | head -1); [ -n "$wid" ] && break; sleep 0.1; done
+if [ -n "$wid" ] && [ -f "$F" ] && [ ! -s "$F" ]; then ok edit_creates_missing_file
+else fail edit_creates_missing_file "window '$wid', file: $(ls -l "$F" 2>&1)"; fi
+sleep 0.5
+npts() { grep -cE '^-?[0-9]' "$F" 2>/dev/null || echo 0; }
+# wait until the file has $1 points
+wait_pts() { for i in $(seq 100); do [ "$(npts)" = "$1" ] && return 0; sleep 0.1; done; return 1; }
+clicks=("120 120" "400 110" "260 380" "330 230" "150 420" "480 400")
+for c in "${clicks[@]}"; do
+    read -r x y <<<"$c"
+    xdotool mousemove --window "$wid" "$x" "$y" click 1
+    sleep 0.3
+done
+if wait_pts 6; then ok edit_clicks_add_points; else fail edit_clicks_add_points "$(npts) points: $(cat "$F")"; fi
+cp "$F" "$TMP/six.txt"
+xdotool mousemove --window "$wid" 330 230 click 3
+if wait_pts 5; then ok edit_right_click_deletes; else fail edit_right_click_deletes "$(npts) points"; fi
+xdotool key --window "$wid" ctrl+z
+if wait_pts 6 && cmp -s "$F" "$TMP/six.txt"; then ok edit_undo; else fail edit_undo "$(cat "$F")"; fi
+xdotool key --window "$wid" ctrl+y
+if wait_pts 5; then ok edit_redo; else fail edit_redo "$(npts) points"; fi
+xdotool key --window "$wid" ctrl+z
+wait_pts 6
+# pdt reads the file as it is
+if "$PDT" triangulate "$F" -o "$TMP/mine.tri" 2>"$TMP/tri.err"; then ok pdt_reads_saved_file
+else fail pdt_reads_saved_file "$(cat "$TMP/tri.err")"; fi
+sleep 0.3
+import -window root "$TMP/x11.png" 2>/dev/null
+xdotool key --window "$wid" s
+for i in $(seq 50); do grep -q screenshot "$TMP/err.log" && break; sleep 0.1; done
+xdotool key --window "$wid" q
+for i in $(seq 50); do kill -0 "$VPID" 2>/dev/null || break; sleep 0.1; done
+if ! kill -0 "$VPID" 2>/dev/null; then wait "$VPID"; rc=$?; VPID=
+    if [ "$rc" -eq 0 ]; then ok edit_quit; else fail edit_quit "exit $rc: $(cat "$TMP/err.log")"; fi
+else fail edit_quit "still running"; fi
+if [ -s "$TMP/edit.png" ] && [ -s "$TMP/x11.png" ]; then ok edit_screenshots; else fail edit_screenshots; fi
+[ -n "${KEEP_SHOTS:-}" ] && cp "$TMP/edit.png" "$TMP/x11.png" "$F" "$KEEP_SHOTS"/
+
+# the same points, the same triangles: the editor's replay ends where pdt does
+"$PDT" triangulate "$F" -o "$TMP/a.tri" --trace "$TMP/run" 2>/dev/null
+c1=$("$V" "$TMP/run" --end --counts | sed -n 's/.* final \([0-9]*\).*/\1/p')
+if [ -n "$c1" ] && [ "$c1" -eq "$(grep -c . "$TMP/a.tri")" ] && [ "$c1" -gt 0 ]; then ok edit_file_triangulates
+else fail edit_file_triangulates "final $c1"; fi
+summary
