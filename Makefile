@@ -25,6 +25,8 @@
 #   OPT       optimisation flags, release build  (default: -O2 -g)
 #   SAN       sanitizer flags, sanitizer build   (default: ASan + UBSan)
 #   NP        ranks for demo runs                (default: 4)
+#   POINTS    your own point file for make demo / make lesson (default: the
+#             bundled points; a lesson's checked facts hold for its own only)
 #   TRACE=0   compile tracing out entirely (-DPDT_NO_TRACE)
 #   PREFIX    install prefix                     (default: /usr/local)
 #   DESTDIR   staging root for packaging         (default: empty)
@@ -154,12 +156,12 @@ test: deps
 
 demo: deps
 	$(MAKE) rel-all
-	scripts/demo.sh
+	scripts/demo.sh $(if $(POINTS),$(abspath $(POINTS)))
 
 lesson: deps
 	@test -n "$(L)" || { echo "usage: make lesson L=NN   (lessons: $(notdir $(wildcard lessons/[0-9]*)))"; exit 2; }
 	$(MAKE) rel-all
-	scripts/lesson.sh $(L)
+	scripts/lesson.sh $(if $(POINTS),--points $(abspath $(POINTS))) $(L)
 
 bench: deps-bench
 	$(MAKE) rel-all

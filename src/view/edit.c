@@ -208,7 +208,7 @@ pdt_status pdt_editor_open(const char *path, const pdt_live_opts *o, pdt_editor 
         pdt_editor_free(ed);
         return st;
     }
-    snprintf(ed->msg, sizeof ed->msg, "click: add · drag: move · right click: delete · h: keys");
+    snprintf(ed->msg, sizeof ed->msg, "click: add · drag: move · right click: delete · Ctrl+Z/Y · g snap · n random · F1-F4 presets · x hull");
     *out = ed;
     return PDT_OK;
 }
