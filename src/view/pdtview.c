@@ -17,6 +17,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <cairo.h>
 
@@ -46,6 +47,7 @@ typedef struct opts {
     int have_from, have_to;
     const char *edit;  /* --edit FILE: the point editor */
     int ranks, hull;
+    uint64_t bench_live; /* --bench-live N: editor re-run figures on N points */
 } opts;
 
 static const char help_text[] =
@@ -141,6 +143,7 @@ static int parse_args(int argc, char **argv, opts *o)
         {"--edit", NULL, PDT_OPT_STR, &o->edit},
         {"--hull", NULL, PDT_OPT_FLAG, &o->hull},
         {"--ranks", NULL, PDT_OPT_U64, &ranks},
+        {"--bench-live", NULL, PDT_OPT_U64, &o->bench_live},
         {NULL, NULL, PDT_OPT_FLAG, NULL},
     };
     const char *pos[1];
@@ -148,7 +151,11 @@ static int parse_args(int argc, char **argv, opts *o)
     int rc = pdt_cli_parse(PROG, help_text, argc, argv, table, pos, 1, &npos);
     if (rc == 1) return PDT_EXIT_OK;
     if (rc) return PDT_EXIT_USAGE;
-    if (o->edit) {
+    if (o->bench_live) {
+        if (npos != 0 || o->edit)
+            return pdt_cli_usage(PROG, "--bench-live N takes no RUN and no --edit");
+        o->ranks = ranks < 1 ? 1 : (int)ranks;
+    } else if (o->edit) {
         if (npos != 0 || o->headless)
             return pdt_cli_usage(PROG, "--edit FILE opens the editor window: no RUN, no --headless");
         if (ranks < 1 || ranks > 64)
@@ -548,11 +555,71 @@ static int edit(const opts *o)
     return rc;
 }
 
+/* --bench-live N: what a click costs in the editor on N points: the change
+ * (save + re-run + replay index + seek) and one frame drawn at --size;
+ * 101 changes (adds and deletes alternating), median and worst. */
+static int bench_live(const opts *o)
+{
+    char dir[] = "/tmp/pdtview-bench-XXXXXX", path[64];
+    if (!mkdtemp(dir)) {
+        perror("pdtview: mkdtemp");
+        return 1;
+    }
+    snprintf(path, sizeof path, "%s/points.txt", dir);
+    pdt_live_opts lo = {o->hull, o->ranks, 1};
+    pdt_editor *ed = NULL;
+    pdt_err err = {0};
+    enum { NCLICK = 101 };
+    double t[NCLICK], tc[NCLICK], tr[NCLICK];
+    int rc = 1;
+    cairo_surface_t *sf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, o->w, o->h);
+    pdt_view v;
+    pdt_view_defaults(&v);
+    v.panels = o->panels;
+    if (pdt_editor_open(path, &lo, &ed, &err) != PDT_OK ||
+        pdt_editor_random(ed, (size_t)o->bench_live, 0, 0, 10000, 10000, &err) != PDT_OK)
+        goto out;
+    uint64_t x = 88172645463325252ull;
+    for (int i = 0; i < NCLICK; i++) {
+        x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+        double t0 = now_s(), c0 = cpu_s();
+        size_t n;
+        pdt_editor_points(ed, &n);
+        pdt_status st = i % 2 ? pdt_editor_delete(ed, n - 1, &err)
+                              : pdt_editor_add(ed, (int64_t)(x % 10001), (int64_t)(x / 10001 % 10001), &err);
+        if (st != PDT_OK) goto out;
+        tr[i] = pdt_editor_last_run_s(ed);
+        cairo_t *cr = cairo_create(sf);
+        st = pdt_render(cr, o->w, o->h, pdt_editor_replay(ed), pdt_editor_state(ed), &v, &err);
+        cairo_destroy(cr);
+        cairo_surface_flush(sf);
+        if (st != PDT_OK) goto out;
+        t[i] = now_s() - t0;
+        tc[i] = cpu_s() - c0;
+    }
+    double worst = 0;
+    for (int i = 0; i < NCLICK; i++) worst = t[i] > worst ? t[i] : worst;
+    printf("live edit, %llu points, %s, %d rank%s, frame %dx%d: click to redrawn frame median %.2f ms "
+           "wall (%.2f ms CPU), worst %.2f ms; of which save + re-run + index + seek median %.2f ms "
+           "(%d changes)\n", (unsigned long long)o->bench_live, o->hull ? "hull" : "triangulate",
+           o->ranks, o->ranks > 1 ? "s" : "", o->w, o->h, 1e3 * median(t, NCLICK),
+           1e3 * median(tc, NCLICK), 1e3 * worst, 1e3 * median(tr, NCLICK), NCLICK);
+    rc = 0;
+out:
+    if (rc) fprintf(stderr, "pdtview: %s\n", err.msg);
+    cairo_surface_destroy(sf);
+    pdt_editor_free(ed);
+    unlink(path);
+    rmdir(dir);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     opts o;
     int prc = parse_args(argc, argv, &o);
     if (prc >= 0) return prc;
+    if (o.bench_live) return bench_live(&o);
     if (o.edit) return edit(&o);
     pdt_err err = {0};
     loaded L;
