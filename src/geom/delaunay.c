@@ -239,41 +239,53 @@ static uint64_t kth_key(uint64_t *v, size_t n, size_t k)
  * while it runs, one contiguous block of edge records. */
 
 typedef struct cutter {
-    const pdt_point *pts; /* indexed by the ids */
+    pdt_point *q;         /* the points, permuted along with id */
     uint32_t *id;
     uint64_t *k, *ks;     /* scratch: frame-1 keys, twice */
-    uint32_t *tp;         /* scratch: the upper part of a split */
+    uint32_t *tp;         /* scratch: the upper part of a split (ids) */
+    pdt_point *tq;        /* scratch: the upper part of a split (points) */
 } cutter;
 
-/* Split id[lo, hi) (in frame-0 order) at the frame-1 median: the mid - lo
+/* Split [lo, hi) (in frame-0 order) at the frame-1 median: the mid - lo
  * frame-1 smallest points first; both parts stay in frame-0 order (a stable
  * partition), so frame-0 nodes never need a selection. */
 static void split_frame1(const cutter *c, uint32_t lo, uint32_t hi, uint32_t mid)
 {
     size_t m = hi - lo;
     uint32_t *id = c->id + lo;
-    for (size_t i = 0; i < m; i++) c->ks[i] = c->k[i] = frame_key(c->pts[id[i]], 1);
+    pdt_point *q = c->q + lo;
+    for (size_t i = 0; i < m; i++) c->ks[i] = c->k[i] = frame_key(q[i], 1);
     uint64_t piv = kth_key(c->ks, m, mid - lo); /* the smallest key of the upper part */
     size_t a = 0, b = 0;
     for (size_t i = 0; i < m; i++) {
-        if (c->k[i] < piv) id[a++] = id[i];
-        else c->tp[b++] = id[i];
+        if (c->k[i] < piv) {
+            id[a] = id[i];
+            q[a++] = q[i];
+        } else {
+            c->tp[b] = id[i];
+            c->tq[b++] = q[i];
+        }
     }
     memcpy(id + a, c->tp, b * sizeof *c->tp);
+    memcpy(q + a, c->tq, b * sizeof *c->tq);
 }
 
-/* Sort id[lo, hi) (at most 3 points) in frame `axis`. */
+/* Sort [lo, hi) (at most 3 points) in frame `axis`. */
 static void sort_small(const cutter *c, uint32_t lo, uint32_t hi, int axis)
 {
     uint32_t *id = c->id;
+    pdt_point *q = c->q;
     for (uint32_t i = lo + 1; i < hi; i++) {
         uint32_t v = id[i], j = i;
-        uint64_t kv = frame_key(c->pts[v], axis);
-        while (j > lo && frame_key(c->pts[id[j - 1]], axis) > kv) {
+        pdt_point pv = q[i];
+        uint64_t kv = frame_key(pv, axis);
+        while (j > lo && frame_key(q[j - 1], axis) > kv) {
             id[j] = id[j - 1];
+            q[j] = q[j - 1];
             j--;
         }
         id[j] = v;
+        q[j] = pv;
     }
 }
 
@@ -469,12 +481,15 @@ static pdt_status kernel(const pdt_point *pts, uint32_t *id, size_t n, pdt_tri *
         return PDT_ERR_NOMEM;
     }
     pdt_big_advise(d.e, d.cap * sizeof *d.e);
-    /* the cuts, with scratch (5 words per point) in the unused edge array */
-    cutter c = { pts, id, (uint64_t *)(void *)d.e, NULL, NULL };
+    /* the cuts, on the points gathered in lexicographic order and moved
+     * along with their ids (scratch: 7 words per point, in the edge array
+     * before any edge exists) */
+    for (size_t i = 0; i < n; i++) q[i] = pts[id[i]];
+    cutter c = { q, id, (uint64_t *)(void *)d.e, NULL, NULL, NULL };
     c.ks = c.k + n;
     c.tp = (uint32_t *)(void *)(c.ks + n);
+    c.tq = (pdt_point *)(void *)(c.tp + n);
     cut_order(&c, 0, (uint32_t)n, 0);
-    for (size_t i = 0; i < n; i++) q[i] = pts[id[i]];
     d.p = q;
 
     /* kernel vertex v is point id[v]; the trace names it tr->gid[id[v]] */
