@@ -76,12 +76,13 @@ SDL_LIBS    := $(shell pkg-config --libs sdl2 2>/dev/null)
 AV_PKGS     := libavformat libavcodec libswscale libavutil
 VIEW_CFLAGS += $(shell pkg-config --cflags $(AV_PKGS) 2>/dev/null)
 ANIM_LIBS   := -lgif -ldl
+OTF2_LIBS   := $(shell pkg-config --libs otf2 2>/dev/null || echo -lopen-trace-format2)
 LIBS        := -lm -pthread
 
 # Debian packages the build, the tests and the demo need.
 DEB_BUILD := build-essential pkg-config libopenmpi-dev openmpi-bin libsdl2-dev libcairo2-dev fonts-dejavu-core \
-             libgif-dev libavcodec-dev libavformat-dev libswscale-dev libavutil-dev
-DEB_TEST  := mandoc bash-completion qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps slurmctld slurmd slurm-client munge ffmpeg
+             libgif-dev libavcodec-dev libavformat-dev libswscale-dev libavutil-dev libopen-trace-format2-dev
+DEB_TEST  := otf2-tools mandoc bash-completion qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps slurmctld slurmd slurm-client munge ffmpeg
 DEB_BENCH := hyperfine libcgal-dev g++ nodejs npm valgrind time
 DEB_FUZZ  := clang libclang-rt-dev
 
@@ -122,7 +123,7 @@ build/$(1)/libpdtview.a: $$(patsubst %.c,build/$(1)/%.o,$(VIEWLIB_SRC))
 	ar rcs $$@ $$^
 
 $(3)/pdt: $$(patsubst %.c,build/$(1)/%.o,$(CLI_SRC) src/par/comm_mpi.c) build/$(1)/libpdtpar.a build/$(1)/libpdt.a
-	$$(CC) $(2) -o $$@ $$^ $(MPI_LIBS) $(LIBS)
+	$$(CC) $(2) -o $$@ $$^ $(MPI_LIBS) $(OTF2_LIBS) $(LIBS)
 
 $(3)/pdtview: $$(patsubst %.c,build/$(1)/%.o,$(VIEWAPP_SRC) src/cli/opts.c) build/$(1)/libpdtview.a build/$(1)/libpdt.a
 	$$(CC) $(2) -o $$@ $$^ $(SDL_LIBS) $(CAIRO_LIBS) $(ANIM_LIBS) $(LIBS)

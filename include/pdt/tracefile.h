@@ -186,6 +186,25 @@ char *pdt_event_format(const pdt_event *ev, char *buf, size_t cap);
 /* Kind by name ("push", "tri-final", ...); -1 if unknown. */
 int pdt_event_kind_by_name(const char *name);
 
+/* ---- export ------------------------------------------------------------------ */
+
+/* What pdt_run_export_otf2 wrote (over all ranks). */
+typedef struct pdt_otf2_counts {
+    uint64_t enters, leaves;  /* phases and merge steps (regions) */
+    uint64_t sends, recvs;    /* MPI point-to-point records */
+    uint64_t skipped;         /* unbalanced ends, messages naming no rank */
+} pdt_otf2_counts;
+
+/* Write the run as an OTF2 archive in folder `dir` (absent or empty; the
+ * anchor file is dir/run.otf2): one location per rank, a region per phase id
+ * and per merge level (Enter/Leave), MpiSend/MpiRecv records for SEND/RECV
+ * on one communicator of all ranks, clock properties from the manifest (1 ns
+ * resolution, wall_start_ns).  Other events are left out.  Memory O(one
+ * OTF2 chunk), independent of the run's size.  Written into a temporary
+ * folder and renamed: on error nothing is left.  counts may be NULL. */
+pdt_status pdt_run_export_otf2(pdt_run *run, const char *dir, pdt_otf2_counts *counts,
+                               pdt_err *err);
+
 /* ---- verification (pdt trace check) ------------------------------------------ */
 
 /* Check the invariants a correct run satisfies (docs/trace-format.md,

@@ -14,6 +14,7 @@ static const char help_main[] =
     "       pdt trace dump DIR [--rank R] [--kind K] [--from N] [--count M]\n"
     "       pdt trace check DIR\n"
     "       pdt trace export --chrome DIR -o run.json [--events]\n"
+    "       pdt trace export --otf2 DIR -o ARCHIVE_DIR\n"
     "\n"
     "DIR is a run folder written by `pdt triangulate --trace DIR` or `pdt hull --trace DIR`\n"
     "(format: docs/trace-format.md).\n"
@@ -21,7 +22,8 @@ static const char help_main[] =
     "  dump    one line per event: rank, index in the rank, aligned time, event\n"
     "  check   verify the invariants of a correct run; exit 1 naming the first violation\n"
     "  export  Chrome trace-event JSON (chrome://tracing, ui.perfetto.dev): one row per\n"
-    "          rank, phases and merge steps as slices, messages as flow arrows\n";
+    "          rank, phases and merge steps as slices, messages as flow arrows; or an\n"
+    "          OTF2 archive (Vampir, otf2-print): ARCHIVE_DIR/run.otf2\n";
 
 static const char help_dump[] =
     "usage: pdt trace dump DIR [--rank R] [--kind K] [--from N] [--count M]\n"
@@ -308,6 +310,10 @@ static void chrome_ev(FILE *f, int *first, const char *ph, const char *name, con
     *first = 0;
 }
 
+/* --events adds one instant per event only up to this many events: beyond,
+ * the JSON would be too big for a browser to open. */
+#define CHROME_EVENTS_MAX 2000000u
+
 static int export_chrome(pdt_run *run, FILE *f, int all_events)
 {
     const pdt_manifest *m = pdt_run_manifest(run);
@@ -320,6 +326,17 @@ static int export_chrome(pdt_run *run, FILE *f, int all_events)
     fprintf(f, "\n{\"ph\":\"M\",\"name\":\"process_name\",\"pid\":0,\"args\":{\"name\":\"pdt %s\"}}",
             m->command);
     first = 0;
+    uint64_t total = 0;
+    for (int r = 0; r < p; r++) {
+        pdt_rank_info in;
+        pdt_run_rank_info(run, r, &in);
+        total += in.events;
+    }
+    if (all_events && total > CHROME_EVENTS_MAX) {
+        fprintf(stderr, "warning: the run has %" PRIu64 " events: --events ignored above %u "
+                        "(phases, merge steps and messages only)\n", total, CHROME_EVENTS_MAX);
+        all_events = 0;
+    }
     for (int r = 0; r < p; r++) {
         fprintf(f, ",\n{\"ph\":\"M\",\"name\":\"thread_name\",\"pid\":0,\"tid\":%d,"
                    "\"args\":{\"name\":\"rank %d\"}}", r, r);
@@ -396,17 +413,35 @@ static int export_chrome(pdt_run *run, FILE *f, int all_events)
     return PDT_EXIT_OK;
 }
 
+static int export_otf2(pdt_run *run, const char *out)
+{
+    pdt_err err = {0};
+    pdt_otf2_counts n;
+    if (pdt_run_export_otf2(run, out, &n, &err) != PDT_OK) return pdt_cli_fail(&err);
+    fprintf(stderr, "%s/run.otf2: %" PRIu64 " phase and merge-step enters, %" PRIu64
+                    " sends, %" PRIu64 " recvs\n", out, n.enters, n.sends, n.recvs);
+    if (n.skipped)
+        fprintf(stderr, "warning: %" PRIu64 " unbalanced phase ends or messages to no rank "
+                        "left out\n", n.skipped);
+    return PDT_EXIT_OK;
+}
+
 static int cmd_export(int argc, char **argv)
 {
     static const char help[] =
         "usage: pdt trace export --chrome DIR -o run.json [--events]\n"
-        "Write the run as Chrome trace-event JSON (open in ui.perfetto.dev or\n"
-        "chrome://tracing): one row per rank, phases and merge steps as slices,\n"
-        "messages as flow arrows.  --events adds every other event as an instant.\n";
+        "       pdt trace export --otf2 DIR -o ARCHIVE_DIR\n"
+        "--chrome  Chrome trace-event JSON (open in ui.perfetto.dev or chrome://tracing):\n"
+        "          one row per rank, phases and merge steps as slices, messages as flow\n"
+        "          arrows.  --events adds every other event as an instant.\n"
+        "--otf2    an OTF2 archive in the new folder ARCHIVE_DIR (open ARCHIVE_DIR/run.otf2\n"
+        "          in Vampir, or read it with otf2-print): one location per rank, phases\n"
+        "          and merge steps as regions, messages as MPI send/recv records.\n";
     const char *pos[1], *out = NULL;
-    int npos = 0, chrome = 0, events = 0;
+    int npos = 0, chrome = 0, otf2 = 0, events = 0;
     const pdt_cli_opt opts[] = {
         {"--chrome", NULL, PDT_OPT_FLAG, &chrome},
+        {"--otf2", NULL, PDT_OPT_FLAG, &otf2},
         {"--output", "-o", PDT_OPT_STR, &out},
         {"--events", NULL, PDT_OPT_FLAG, &events},
         {NULL, NULL, PDT_OPT_FLAG, NULL},
@@ -414,11 +449,20 @@ static int cmd_export(int argc, char **argv)
     int rc = pdt_cli_parse("trace export", help, argc, argv, opts, pos, 1, &npos);
     if (rc == 1) return PDT_EXIT_OK;
     if (rc) return PDT_EXIT_USAGE;
-    if (!chrome) return pdt_cli_usage("trace export", "only --chrome is available");
+    if (chrome == otf2) return pdt_cli_usage("trace export", "choose one of --chrome and --otf2");
     if (npos != 1) return pdt_cli_usage("trace export", "needs one run folder DIR");
+    if (otf2 && (!out || !strcmp(out, "-")))
+        return pdt_cli_usage("trace export", "--otf2 needs -o ARCHIVE_DIR (a new folder)");
+    if (otf2 && events)
+        return pdt_cli_usage("trace export", "--events is for --chrome only");
     pdt_run *run;
     if ((rc = open_run(pos[0], &run))) return rc;
     print_warnings(run, stderr);
+    if (otf2) {
+        rc = export_otf2(run, out);
+        pdt_run_close(run);
+        return rc;
+    }
     pdt_outfile o;
     pdt_err err = {0};
     if (pdt_out_open(&o, out, &err) != PDT_OK) {
