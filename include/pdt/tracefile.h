@@ -149,6 +149,17 @@ pdt_status pdt_run_rank_events(pdt_run *run, int rank, const pdt_event **ev, siz
  * and noted in the warnings.  Owned by run. */
 pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err *err);
 
+/* The same merged order, streamed: memory one decoded block per rank plus
+ * the messages' index, whatever the number of events (pdt_run_merged keeps
+ * 40 bytes per event).  Opening reads every rank once to index the SENDs.
+ * The caller owns *m (pdt_merge_close); run must outlive it. */
+typedef struct pdt_merge pdt_merge;
+pdt_status pdt_merge_open(pdt_run *run, pdt_merge **m, pdt_err *err);
+/* The next record of the merged order into *rec: 1, 0 at the end, -1 on an
+ * error (out of memory; err set). */
+int pdt_merge_next(pdt_merge *m, pdt_rec *rec, pdt_err *err);
+void pdt_merge_close(pdt_merge *m);
+
 /* Facts about one rank's file, known after pdt_run_open without decoding. */
 typedef struct pdt_rank_info {
     uint64_t events;     /* intact events */
@@ -217,5 +228,17 @@ pdt_status pdt_run_export_otf2(pdt_run *run, const char *dir, pdt_otf2_counts *c
  * Returns PDT_OK and a one-line summary in `summary` (cap bytes), or
  * PDT_ERR_CHECK with the first violation in err. */
 pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err);
+
+/* Default memory budget of the trace tools (pdt trace check|dump|info|export). */
+#define PDT_TRACE_MEM_DEFAULT ((uint64_t)1 << 30)
+
+/* pdt_run_check with a memory budget in bytes for what grows with the
+ * number of events: the final triangles are sorted in memory up to half the
+ * budget, beyond it in sorted runs spilled to temporary files (in $TMPDIR,
+ * else /tmp; removed at once, so never left behind) and merged.  Memory that grows with the number of points
+ * (the points, a byte of marks per point, T* recomputed by the kernel) and
+ * with the number of messages and merge steps is not part of the budget. */
+pdt_status pdt_run_check_mem(pdt_run *run, uint64_t budget, char *summary, size_t cap,
+                             pdt_err *err);
 
 #endif

@@ -1,4 +1,5 @@
 /* pdt trace — look into a run folder: info, dump, check, export --chrome. */
+#include <errno.h>
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,7 +13,7 @@
 static const char help_main[] =
     "usage: pdt trace info DIR\n"
     "       pdt trace dump DIR [--rank R] [--kind K] [--from N] [--count M]\n"
-    "       pdt trace check DIR\n"
+    "       pdt trace check DIR [--mem BYTES]\n"
     "       pdt trace export --chrome DIR -o run.json [--events]\n"
     "       pdt trace export --otf2 DIR -o ARCHIVE_DIR\n"
     "\n"
@@ -20,7 +21,10 @@ static const char help_main[] =
     "(format: docs/trace-format.md).\n"
     "  info    ranks, events per kind per rank, phases with durations, bytes\n"
     "  dump    one line per event: rank, index in the rank, aligned time, event\n"
-    "  check   verify the invariants of a correct run; exit 1 naming the first violation\n"
+    "  check   verify the invariants of a correct run; exit 1 naming the first violation,\n"
+    "          2 if DIR cannot be read as a run folder.  --mem BYTES (or $PDT_TRACE_MEM;\n"
+    "          e.g. 64M, default 1G): memory for sorting the final triangles; beyond it\n"
+    "          they are sorted in runs on temporary files ($TMPDIR)\n"
     "  export  Chrome trace-event JSON (chrome://tracing, ui.perfetto.dev): one row per\n"
     "          rank, phases and merge steps as slices, messages as flow arrows; or an\n"
     "          OTF2 archive (Vampir, otf2-print): ARCHIVE_DIR/run.otf2\n";
@@ -244,16 +248,22 @@ static int cmd_dump(int argc, char **argv)
         }
         pdt_cursor_close(c);
     } else {
-        const pdt_rec *rec;
-        size_t n;
-        if (pdt_run_merged(run, &rec, &n, &err) != PDT_OK) {
+        pdt_merge *mg;  /* streamed: memory independent of the run's size */
+        if (pdt_merge_open(run, &mg, &err) != PDT_OK) {
             pdt_run_close(run);
             return pdt_cli_fail(&err);
         }
-        for (size_t i = from; i < n && count > 0; i++) {
-            if (k >= 0 && rec[i].ev.kind != k) continue;
-            dump_line(rec[i].rank, rec[i].seq, &rec[i].ev);
+        pdt_rec rec;
+        int got = 0;
+        for (uint64_t i = 0; count > 0 && (got = pdt_merge_next(mg, &rec, &err)) == 1; i++) {
+            if (i < from || (k >= 0 && rec.ev.kind != k)) continue;
+            dump_line(rec.rank, rec.seq, &rec.ev);
             count--;
+        }
+        pdt_merge_close(mg);
+        if (got < 0) {
+            pdt_run_close(run);
+            return pdt_cli_fail(&err);
         }
     }
     pdt_run_close(run);
@@ -262,16 +272,50 @@ static int cmd_dump(int argc, char **argv)
 
 /* ---- check ------------------------------------------------------------------ */
 
-static int cmd_check(const char *dir)
+/* A byte count: digits with an optional K, M or G (powers of 1024).
+ * Returns 0, or -1 if `s` is not one (or is 0). */
+static int parse_bytes(const char *s, uint64_t *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (end == s || errno || *s == '-') return -1;
+    unsigned shift = 0;
+    if (*end == 'K' || *end == 'k') shift = 10;
+    else if (*end == 'M' || *end == 'm') shift = 20;
+    else if (*end == 'G' || *end == 'g') shift = 30;
+    if (shift) end++;
+    if (*end == 'B' || *end == 'b') end++;
+    if (*end || v == 0 || v > (UINT64_MAX >> shift)) return -1;
+    *out = (uint64_t)v << shift;
+    return 0;
+}
+
+/* The memory budget: --mem, else $PDT_TRACE_MEM, else the default. */
+static int trace_budget(const char *cmd, const char *opt, uint64_t *budget)
+{
+    const char *env = getenv("PDT_TRACE_MEM");
+    *budget = PDT_TRACE_MEM_DEFAULT;
+    if (opt && parse_bytes(opt, budget))
+        return pdt_cli_usage(cmd, "--mem %s: not a byte count (e.g. 4096, 64M, 1G)", opt);
+    if (!opt && env && *env && parse_bytes(env, budget))
+        return pdt_cli_usage(cmd, "PDT_TRACE_MEM=%s: not a byte count (e.g. 4096, 64M, 1G)", env);
+    return PDT_EXIT_OK;
+}
+
+/* Exit 0 when the run passes, 1 naming the first violated invariant (or the
+ * damage found), 2 when the folder cannot be read as a run at all (no
+ * manifest nor rank file, a malformed manifest, another major version). */
+static int cmd_check(const char *dir, uint64_t budget)
 {
     pdt_run *run;
     pdt_err err = {0};
     if (pdt_run_open(dir, &run, &err) != PDT_OK) {
         fprintf(stderr, "pdt trace check: %s\n", err.msg);
-        return PDT_EXIT_CHECK;
+        return PDT_EXIT_USAGE;
     }
     char summary[512];
-    pdt_status st = pdt_run_check(run, summary, sizeof summary, &err);
+    pdt_status st = pdt_run_check_mem(run, budget, summary, sizeof summary, &err);
     pdt_run_close(run);
     if (st != PDT_OK) {
         fprintf(stderr, "pdt trace check: %s: %s\n", dir, err.msg);
@@ -489,16 +533,19 @@ int pdt_cmd_trace(int argc, char **argv)
     if (!strcmp(sub, "dump")) return cmd_dump(argc - 1, argv + 1);
     if (!strcmp(sub, "export")) return cmd_export(argc - 1, argv + 1);
     if (!strcmp(sub, "info") || !strcmp(sub, "check")) {
-        const char *pos[1];
+        const char *pos[1], *mem = NULL;
         int npos = 0;
-        const pdt_cli_opt opts[] = {{NULL, NULL, PDT_OPT_FLAG, NULL}};
+        const pdt_cli_opt opts[] = {{"--mem", NULL, PDT_OPT_STR, &mem},
+                                    {NULL, NULL, PDT_OPT_FLAG, NULL}};
         char cmd[32];
         snprintf(cmd, sizeof cmd, "trace %s", sub);
         int rc = pdt_cli_parse(cmd, help_main, argc - 1, argv + 1, opts, pos, 1, &npos);
         if (rc == 1) return PDT_EXIT_OK;
         if (rc) return PDT_EXIT_USAGE;
         if (npos != 1) return pdt_cli_usage(cmd, "needs one run folder DIR");
-        return !strcmp(sub, "info") ? cmd_info(pos[0]) : cmd_check(pos[0]);
+        uint64_t budget;
+        if ((rc = trace_budget(cmd, mem, &budget))) return rc;
+        return !strcmp(sub, "info") ? cmd_info(pos[0]) : cmd_check(pos[0], budget);
     }
     return pdt_cli_usage("trace", "unknown subcommand '%s' (info, dump, check, export)", sub);
 }

@@ -3,11 +3,13 @@
  * One streaming pass per rank (cursor: memory O(block) plus what is being
  * checked), then the cross-rank checks.  The first violation found is
  * reported as "rank R event #K (the event as text): what is wrong". */
+#include <errno.h>
 #include <inttypes.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "pdt/delaunay.h"
 #include "pdt/hull.h"
@@ -58,8 +60,13 @@ typedef struct chk {
     size_t npts;
     int is_tri, is_hull;
     uint8_t *mark;          /* per point: see M_* */
-    fin *fin;
+    fin *fin;               /* final triangles not yet spilled (see spill_finals) */
     size_t nfin, capfin;
+    size_t maxfin;          /* finals held in memory before a spill (from the budget) */
+    FILE **runs;            /* sorted runs of finals spilled to temporary files */
+    size_t nruns, capruns;
+    uint64_t totfin;        /* final triangles recorded in all */
+    uint64_t spills;        /* sorted runs written (before any compaction) */
     msg *msg;
     size_t nmsg, capmsg;
     merge *mg;
@@ -248,6 +255,175 @@ static pdt_status scope_close(chk *c, rank_state *rs, uint32_t r, uint64_t seq,
     return st;
 }
 
+static int cmp_tri(const void *a, const void *b)
+{
+    const uint32_t *x = a, *y = b;
+    for (int i = 0; i < 3; i++)
+        if (x[i] != y[i]) return x[i] < y[i] ? -1 : 1;
+    return 0;
+}
+
+static int cmp_fin(const void *a, const void *b)
+{
+    int k = cmp_tri(&((const fin *)a)->t, &((const fin *)b)->t);
+    if (k) return k;
+    const fin *x = a, *y = b;
+    if (x->rank != y->rank) return x->rank < y->rank ? -1 : 1;
+    return x->seq < y->seq ? -1 : x->seq > y->seq;
+}
+
+/* ---- final triangles in bounded memory --------------------------------------
+ *
+ * The finals are collected in a buffer of at most c->maxfin records (from the
+ * memory budget).  A full buffer is sorted and written to a temporary file as
+ * one sorted run; at the end the runs (and what is left in memory) are merged
+ * into one sorted stream, which is compared with T* of the run's points.  When
+ * more than MAX_RUNS runs pile up they are first merged into one, so the
+ * number of open files stays bounded too. */
+#define MAX_RUNS 64
+
+/* A sorted source of finals: a temporary file or the memory buffer. */
+typedef struct fin_src {
+    FILE *f;                /* NULL: the memory buffer */
+    const fin *mem;
+    size_t nmem, imem;
+    fin head;
+    int has;
+} fin_src;
+
+static void src_advance(fin_src *s)
+{
+    if (s->f) s->has = fread(&s->head, sizeof s->head, 1, s->f) == 1;
+    else if ((s->has = s->imem < s->nmem)) s->head = s->mem[s->imem++];
+}
+
+/* The sources merged in sorted order: a small heap of source indices. */
+typedef struct fin_merge {
+    fin_src *src;
+    size_t *heap, n;
+} fin_merge;
+
+static int src_less(const fin_merge *m, size_t a, size_t b)
+{
+    return cmp_fin(&m->src[a].head, &m->src[b].head) < 0;
+}
+
+static void fm_sift(fin_merge *m, size_t i)
+{
+    for (;;) {
+        size_t l = 2 * i + 1, k = i;
+        if (l < m->n && src_less(m, m->heap[l], m->heap[k])) k = l;
+        if (l + 1 < m->n && src_less(m, m->heap[l + 1], m->heap[k])) k = l + 1;
+        if (k == i) return;
+        size_t t = m->heap[i];
+        m->heap[i] = m->heap[k];
+        m->heap[k] = t;
+        i = k;
+    }
+}
+
+/* Open a merge over the spilled runs and mem[0..nmem) (sorted).  0 or -1. */
+static int fm_open(fin_merge *m, FILE **runs, size_t nruns, const fin *mem, size_t nmem)
+{
+    m->src = calloc(nruns + 1, sizeof *m->src);
+    m->heap = calloc(nruns + 1, sizeof *m->heap);
+    m->n = 0;
+    if (!m->src || !m->heap) return -1;
+    for (size_t i = 0; i <= nruns; i++) {
+        fin_src *s = &m->src[i];
+        if (i < nruns) {
+            s->f = runs[i];
+            rewind(s->f);
+        } else {
+            s->mem = mem;
+            s->nmem = nmem;
+        }
+        src_advance(s);
+        if (s->has) m->heap[m->n++] = i;
+    }
+    for (size_t i = m->n / 2; i-- > 0;) fm_sift(m, i);
+    return 0;
+}
+
+/* The next final in sorted order into *f: 1, or 0 at the end. */
+static int fm_next(fin_merge *m, fin *f)
+{
+    if (!m->n) return 0;
+    fin_src *s = &m->src[m->heap[0]];
+    *f = s->head;
+    src_advance(s);
+    if (!s->has) m->heap[0] = m->heap[--m->n];
+    fm_sift(m, 0);
+    return 1;
+}
+
+static void fm_close(fin_merge *m)
+{
+    free(m->src);
+    free(m->heap);
+}
+
+static pdt_status io_fail(chk *c, const char *what)
+{
+    const char *dir = getenv("TMPDIR");
+    return pdt_err_set(c->err, PDT_ERR_IO, "temporary file for the final triangles in %s: %s: %s",
+                       dir && *dir ? dir : "/tmp", what, strerror(errno));
+}
+
+/* A new anonymous temporary file in $TMPDIR (else /tmp), or NULL (errno). */
+static FILE *spill_file(void)
+{
+    const char *dir = getenv("TMPDIR");
+    char path[4096];
+    snprintf(path, sizeof path, "%s/pdt-finals.XXXXXX", dir && *dir ? dir : "/tmp");
+    int fd = mkstemp(path);
+    if (fd < 0) return NULL;
+    unlink(path);  /* gone when closed, even if we are killed */
+    FILE *f = fdopen(fd, "w+b");
+    if (!f) close(fd);
+    return f;
+}
+
+/* Merge every spilled run into one (when too many piled up). */
+static pdt_status compact_runs(chk *c)
+{
+    FILE *out = spill_file();
+    if (!out) return io_fail(c, "cannot create");
+    fin_merge m;
+    pdt_status st = PDT_OK;
+    if (fm_open(&m, c->runs, c->nruns, NULL, 0)) st = nomem(c);
+    fin f;
+    while (st == PDT_OK && fm_next(&m, &f))
+        if (fwrite(&f, sizeof f, 1, out) != 1) st = io_fail(c, "cannot write");
+    fm_close(&m);
+    if (st == PDT_OK && fflush(out) != 0) st = io_fail(c, "cannot write");
+    if (st != PDT_OK) {
+        fclose(out);
+        return st;
+    }
+    for (size_t i = 0; i < c->nruns; i++) fclose(c->runs[i]);
+    c->runs[0] = out;
+    c->nruns = 1;
+    return PDT_OK;
+}
+
+/* Sort the buffered finals and write them out as one run; empties the buffer. */
+static pdt_status spill_finals(chk *c)
+{
+    if (!c->nfin) return PDT_OK;
+    qsort(c->fin, c->nfin, sizeof *c->fin, cmp_fin);
+    if (grow((void **)&c->runs, &c->capruns, c->nruns, sizeof *c->runs)) return nomem(c);
+    FILE *f = spill_file();
+    if (!f) return io_fail(c, "cannot create");
+    c->runs[c->nruns++] = f;
+    c->spills++;
+    if (fwrite(c->fin, sizeof *c->fin, c->nfin, f) != c->nfin || fflush(f) != 0)
+        return io_fail(c, "cannot write");
+    c->nfin = 0;
+    if (c->nruns >= MAX_RUNS) return compact_runs(c);
+    return PDT_OK;
+}
+
 static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, const pdt_event *e)
 {
     pdt_status st = PDT_OK;
@@ -363,7 +539,9 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
         if (pdt_orient(c->pts[v[0]], c->pts[v[1]], c->pts[v[2]]) <= 0)
             return viol(c, r, seq, e, "the triangle is not counter-clockwise");
         int k = v[0] < v[1] ? (v[0] < v[2] ? 0 : 2) : (v[1] < v[2] ? 1 : 2);
+        if (c->nfin == c->maxfin && (st = spill_finals(c)) != PDT_OK) return st;
         if (grow((void **)&c->fin, &c->capfin, c->nfin, sizeof *c->fin)) return nomem(c);
+        c->totfin++;
         fin *f = &c->fin[c->nfin++];
         for (int i = 0; i < 3; i++) f->t.v[i] = v[(k + i) % 3];
         f->rank = r;
@@ -474,34 +652,20 @@ static pdt_status check_rank(chk *c, uint32_t r)
     return st;
 }
 
-static int cmp_tri(const void *a, const void *b)
-{
-    const uint32_t *x = a, *y = b;
-    for (int i = 0; i < 3; i++)
-        if (x[i] != y[i]) return x[i] < y[i] ? -1 : 1;
-    return 0;
-}
-
-static int cmp_fin(const void *a, const void *b)
-{
-    int k = cmp_tri(&((const fin *)a)->t, &((const fin *)b)->t);
-    if (k) return k;
-    const fin *x = a, *y = b;
-    if (x->rank != y->rank) return x->rank < y->rank ? -1 : 1;
-    return x->seq < y->seq ? -1 : x->seq > y->seq;
-}
-
+/* Every final triangle once, and their set equals T* of the run's points.
+ * The finals come sorted out of the runs and the buffer; T* is recomputed
+ * after the buffer has been given back (the kernel needs its memory). */
 static pdt_status check_finals(chk *c)
 {
-    if (c->nfin) qsort(c->fin, c->nfin, sizeof *c->fin, cmp_fin);
-    for (size_t i = 1; i < c->nfin; i++)
-        if (!cmp_tri(&c->fin[i].t, &c->fin[i - 1].t)) {
-            const fin *f = &c->fin[i], *g = &c->fin[i - 1];
-            return viol(c, 0, 0, NULL, "triangle %" PRIu32 " %" PRIu32 " %" PRIu32
-                                       " made final twice: rank %" PRIu32 " event #%" PRIu64
-                                       " and rank %" PRIu32 " event #%" PRIu64,
-                        f->t.v[0], f->t.v[1], f->t.v[2], g->rank, g->seq, f->rank, f->seq);
-        }
+    if (c->nruns) {  /* out of memory's reach: the rest goes to disk too */
+        pdt_status st = spill_finals(c);
+        if (st != PDT_OK) return st;
+        free(c->fin);
+        c->fin = NULL;
+        c->capfin = 0;
+    } else if (c->nfin) {
+        qsort(c->fin, c->nfin, sizeof *c->fin, cmp_fin);
+    }
     pdt_tri *ref = NULL;
     size_t nref = 0;
     pdt_status st = pdt_triangulate(c->pts, c->npts, &ref, &nref, NULL, NULL);
@@ -510,24 +674,43 @@ static pdt_status check_finals(chk *c)
         return pdt_err_set(c->err, st, "recomputing T* of the run's points failed: %s",
                            pdt_status_str(st));
     }
-    size_t i = 0, j = 0;
-    while (st == PDT_OK && (i < c->nfin || j < nref)) {
-        int k = i == c->nfin ? 1 : j == nref ? -1 : cmp_tri(&c->fin[i].t, &ref[j]);
+    fin_merge m;
+    if (fm_open(&m, c->runs, c->nruns, c->fin, c->nfin)) {
+        fm_close(&m);
+        free(ref);
+        return nomem(c);
+    }
+    fin f, prev;
+    int have = fm_next(&m, &f), had = 0;
+    size_t j = 0;
+    while (st == PDT_OK && (have || j < nref)) {
+        if (have && had && !cmp_tri(&f.t, &prev.t)) {
+            st = viol(c, 0, 0, NULL, "triangle %" PRIu32 " %" PRIu32 " %" PRIu32
+                                     " made final twice: rank %" PRIu32 " event #%" PRIu64
+                                     " and rank %" PRIu32 " event #%" PRIu64,
+                      f.t.v[0], f.t.v[1], f.t.v[2], prev.rank, prev.seq, f.rank, f.seq);
+            break;
+        }
+        int k = !have ? 1 : j == nref ? -1 : cmp_tri(&f.t, &ref[j]);
         if (k < 0) {
-            const fin *f = &c->fin[i];
             st = viol(c, 0, 0, NULL, "rank %" PRIu32 " event #%" PRIu64 ": final triangle %"
                                      PRIu32 " %" PRIu32 " %" PRIu32 " is not in T* of the "
-                                     "run's points", f->rank, f->seq, f->t.v[0], f->t.v[1],
-                      f->t.v[2]);
+                                     "run's points", f.rank, f.seq, f.t.v[0], f.t.v[1], f.t.v[2]);
         } else if (k > 0) {
             st = viol(c, 0, 0, NULL, "triangle %" PRIu32 " %" PRIu32 " %" PRIu32 " of T* was "
-                                     "never made final (%zu final triangles recorded, T* has %zu)",
-                      ref[j].v[0], ref[j].v[1], ref[j].v[2], c->nfin, nref);
+                                     "never made final (%" PRIu64 " final triangles recorded, "
+                                     "T* has %zu)", ref[j].v[0], ref[j].v[1], ref[j].v[2],
+                      c->totfin, nref);
         } else {
-            i++;
             j++;
         }
+        if (k <= 0) {
+            prev = f;
+            had = 1;
+            have = fm_next(&m, &f);
+        }
     }
+    fm_close(&m);
     free(ref);
     return st;
 }
@@ -598,6 +781,12 @@ static pdt_status check_merges(chk *c)
 
 pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
 {
+    return pdt_run_check_mem(run, PDT_TRACE_MEM_DEFAULT, summary, cap, err);
+}
+
+pdt_status pdt_run_check_mem(pdt_run *run, uint64_t budget, char *summary, size_t cap,
+                             pdt_err *err)
+{
     if (cap) summary[0] = '\0';
     const char *w = pdt_run_warnings(run);
     if (*w) {
@@ -610,6 +799,9 @@ pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
     c.run = run;
     c.err = err;
     c.pts = pdt_run_points(run, &c.npts);
+    /* half the budget for the finals' buffer; at least a few, so that a tiny
+     * budget spills often instead of failing */
+    c.maxfin = (size_t)(budget / 2 / sizeof(fin) < 16 ? 16 : budget / 2 / sizeof(fin));
     const pdt_manifest *m = pdt_run_manifest(run);
     c.is_tri = !strcmp(m->command, "triangulate");
     c.is_hull = !strcmp(m->command, "hull");
@@ -682,13 +874,20 @@ pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
                  " merge lift-ups, %zu final triangles%s, %zu merge steps, %zu messages, "
                  "%" PRIu64 " kernel runs with edges replayed",
                  pdt_run_nranks(run), pdt_run_nranks(run) == 1 ? "" : "s", c.events, c.instances,
-                 c.pushes, c.pops, c.hulls, c.lifts_local, c.lifts_merge, c.nfin,
+                 c.pushes, c.pops, c.hulls, c.lifts_local, c.lifts_merge, (size_t)c.totfin,
                  c.is_tri ? " = T*" : "", c.nmg, c.nmsg / 2, c.edge_scopes);
+    if (st == PDT_OK && cap && c.spills) {
+        size_t len = strlen(summary);
+        snprintf(summary + len, cap - len, " (final triangles sorted on disk in %" PRIu64
+                 " runs: over the memory budget)", c.spills);
+    }
     free(c.mark);
     free(c.kmin);
     free(c.kmax);
     free(c.nlocal);
     free(c.fin);
+    for (size_t i = 0; i < c.nruns; i++) fclose(c.runs[i]);
+    free(c.runs);
     free(c.msg);
     free(c.mg);
     free(c.graham_final.v);

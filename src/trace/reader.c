@@ -100,6 +100,23 @@ static int map_file(const char *path, uint8_t **map, size_t *size)
     return 0;
 }
 
+/* Mapped trace pages already read are given back to the kernel in steps of
+ * this many bytes, so that reading a file of any size keeps resident only
+ * about this much of it (the pages are file-backed: reading them again just
+ * faults them in from the page cache). */
+#define RELEASE_STEP ((size_t)16 << 20)
+
+/* Drop the resident pages of map[from, to) (whole pages inside it only).
+ * Returns the new release mark: `to` rounded down to a page. */
+static size_t release_pages(uint8_t *map, size_t from, size_t to)
+{
+    static size_t page;
+    if (!page) page = (size_t)sysconf(_SC_PAGESIZE);
+    size_t a = (from + page - 1) / page * page, b = to / page * page;
+    if (map && b > a) madvise(map + a, b - a, MADV_DONTNEED);
+    return b > from ? b : from;
+}
+
 /* Validate the header and index the blocks of one rank file. */
 static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
 {
@@ -141,10 +158,11 @@ static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
     rk->level = (int)tf_get32(p + 20);
     rk->present = 1;
 
-    size_t cap = 0;
+    size_t cap = 0, released = 0;
     uint64_t off = hsize, expect = 0;
     int damaged = 0;
     for (size_t k = 0; off < rk->size; k++) {
+        if (off - released >= RELEASE_STEP) released = release_pages(rk->map, released, off);
         uint64_t left = rk->size - off;
         if (left < TF_BLOCK_HEADER_SIZE) {
             warnf(run, "%s: block %zu at byte %" PRIu64 ": truncated block header (%" PRIu64
@@ -208,6 +226,7 @@ static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
         expect += count;
         off += TF_BLOCK_HEADER_SIZE + len;
     }
+    release_pages(rk->map, released, rk->size);
     rk->nev = expect;
     if (damaged)
         warnf(run, "%s: read %" PRIu64 " events in %zu intact blocks before the damage", name,
@@ -473,6 +492,7 @@ struct pdt_cursor {
     pdt_event *buf;
     size_t cap;
     uint64_t pos;      /* index of the next event */
+    size_t released;   /* mapped bytes before this were given back (release_pages) */
 };
 
 pdt_status pdt_cursor_open(pdt_run *run, int rank, pdt_cursor **out, pdt_err *err)
@@ -513,6 +533,10 @@ static int cursor_load(pdt_cursor *c, size_t b)
                   c->buf);
     shift_times(c->buf, bk->count, c->rk->shift);
     c->blk = b;
+    if (bk->off > c->released + RELEASE_STEP)  /* reading forwards: drop what is behind */
+        c->released = release_pages(c->rk->map, c->released, (size_t)bk->off);
+    else if (bk->off < c->released)            /* a seek backwards */
+        c->released = (size_t)bk->off;
     return 0;
 }
 
@@ -626,78 +650,236 @@ static msg_key ev_key(const pdt_event *e, uint32_t rank)
     return k;
 }
 
-typedef struct heap {
-    uint32_t *r;     /* ranks */
-    size_t n;
-} heap;
+/* ---- the streaming merge ------------------------------------------------------
+ *
+ * One cursor per rank; a heap of the ranks whose next event (head) may go
+ * next, ordered by (aligned time, rank); a rank whose head is a RECV whose
+ * SEND is still to come waits ("blocked") until that SEND has gone out.
+ * Memory: one decoded block per rank plus the message sets — independent of
+ * the number of events. */
 
-static int head_less(pdt_run *run, const size_t *pos, uint32_t a, uint32_t b)
+struct pdt_merge {
+    pdt_run *run;
+    uint32_t R;
+    pdt_cursor **cur;    /* per rank */
+    pdt_event *head;     /* per rank: its next event, valid while has[r] */
+    uint64_t *pos;       /* per rank: index of head in the rank */
+    uint8_t *has;
+    uint32_t *heap;      /* ranks whose head may go next */
+    size_t nheap;
+    uint8_t *blocked;    /* ranks whose head is a RECV waiting for its SEND */
+    size_t nblocked;
+    msg_set sent;        /* sends placed and not yet received */
+    msg_set unsent;      /* sends not yet placed (all SENDs of the run at the start) */
+    uint32_t next;       /* a rank known to go next without asking the heap, or UINT32_MAX */
+    uint64_t left;       /* events not yet delivered */
+};
+
+static int head_less(const pdt_merge *m, uint32_t a, uint32_t b)
 {
-    uint64_t ta = run->rk[a].ev[pos[a]].t, tb = run->rk[b].ev[pos[b]].t;
+    uint64_t ta = m->head[a].t, tb = m->head[b].t;
     return ta != tb ? ta < tb : a < b;
 }
 
-static void heap_push(heap *h, pdt_run *run, const size_t *pos, uint32_t r)
+static void heap_push(pdt_merge *m, uint32_t r)
 {
-    size_t i = h->n++;
-    h->r[i] = r;
+    size_t i = m->nheap++;
+    m->heap[i] = r;
     while (i > 0) {
         size_t p = (i - 1) / 2;
-        if (!head_less(run, pos, h->r[i], h->r[p])) break;
-        uint32_t t = h->r[i];
-        h->r[i] = h->r[p];
-        h->r[p] = t;
+        if (!head_less(m, m->heap[i], m->heap[p])) break;
+        uint32_t t = m->heap[i];
+        m->heap[i] = m->heap[p];
+        m->heap[p] = t;
         i = p;
     }
 }
 
-static uint32_t heap_pop(heap *h, pdt_run *run, const size_t *pos)
+static uint32_t heap_pop(pdt_merge *m)
 {
-    uint32_t top = h->r[0];
-    h->r[0] = h->r[--h->n];
+    uint32_t top = m->heap[0];
+    m->heap[0] = m->heap[--m->nheap];
     size_t i = 0;
     for (;;) {
-        size_t l = 2 * i + 1, m = i;
-        if (l < h->n && head_less(run, pos, h->r[l], h->r[m])) m = l;
-        if (l + 1 < h->n && head_less(run, pos, h->r[l + 1], h->r[m])) m = l + 1;
-        if (m == i) break;
-        uint32_t t = h->r[i];
-        h->r[i] = h->r[m];
-        h->r[m] = t;
-        i = m;
+        size_t l = 2 * i + 1, k = i;
+        if (l < m->nheap && head_less(m, m->heap[l], m->heap[k])) k = l;
+        if (l + 1 < m->nheap && head_less(m, m->heap[l + 1], m->heap[k])) k = l + 1;
+        if (k == i) break;
+        uint32_t t = m->heap[i];
+        m->heap[i] = m->heap[k];
+        m->heap[k] = t;
+        i = k;
     }
     return top;
 }
 
-typedef struct merge_ctx {
-    pdt_run *run;
-    const size_t *pos;   /* next event of each rank */
-    heap *h;             /* ranks whose head may go next */
-    uint8_t *blocked;    /* ranks whose head is a RECV waiting for its SEND */
-    size_t nblocked;
-    msg_set *sent;       /* sends not yet received */
-    msg_set *unsent;     /* sends not yet placed (all SENDs of the run at the start) */
-} merge_ctx;
+/* Load rank r's next event into head[r]. */
+static void advance(pdt_merge *m, uint32_t r)
+{
+    m->has[r] = (uint8_t)pdt_cursor_next(m->cur[r], &m->head[r], &m->pos[r]);
+}
 
 /* Put rank r's head event into the heap, or mark it blocked.  A RECV waits
  * only for a SEND that is still to come: one whose SEND is in no file (a
  * lost or damaged rank file) is placed by its time at once, so it cannot
  * hold up, or be forced ahead of, messages that are all there. */
-static void schedule(merge_ctx *mc, uint32_t r)
+static void schedule(pdt_merge *m, uint32_t r)
 {
-    if (mc->pos[r] >= mc->run->rk[r].nev) return;
-    const pdt_event *e = &mc->run->rk[r].ev[mc->pos[r]];
+    if (!m->has[r]) return;
+    const pdt_event *e = &m->head[r];
     if (e->kind == PDT_EV_RECV) {
         msg_key key = ev_key(e, r);
-        msg_slot *s = msg_find(mc->sent, &key, 0);
-        msg_slot *u = msg_find(mc->unsent, &key, 0);
+        msg_slot *s = msg_find(&m->sent, &key, 0);
+        msg_slot *u = msg_find(&m->unsent, &key, 0);
         if ((!s || s->count == 0) && u && u->count > 0) {
-            mc->blocked[r] = 1;
-            mc->nblocked++;
+            m->blocked[r] = 1;
+            m->nblocked++;
             return;
         }
     }
-    heap_push(mc->h, mc->run, mc->pos, r);
+    heap_push(m, r);
+}
+
+/* Every SEND of the run into m->unsent (one pass over the events). */
+static pdt_status count_sends(pdt_merge *m, pdt_err *err)
+{
+    for (uint32_t r = 0; r < m->R; r++) {
+        pdt_cursor *c;
+        pdt_status st = pdt_cursor_open(m->run, (int)r, &c, err);
+        if (st != PDT_OK) return st;
+        pdt_event e;
+        while (pdt_cursor_next(c, &e, NULL)) {
+            if (e.kind != PDT_EV_SEND) continue;
+            msg_key key = ev_key(&e, r);
+            msg_slot *u = msg_find(&m->unsent, &key, 1);
+            if (!u) {
+                pdt_cursor_close(c);
+                return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory (message index)");
+            }
+            u->count++;
+        }
+        pdt_cursor_close(c);
+    }
+    return PDT_OK;
+}
+
+pdt_status pdt_merge_open(pdt_run *run, pdt_merge **out, pdt_err *err)
+{
+    *out = NULL;
+    pdt_merge *m = calloc(1, sizeof *m);
+    if (!m) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    size_t R = (size_t)run->nranks;
+    m->run = run;
+    m->R = (uint32_t)R;
+    m->next = UINT32_MAX;
+    m->cur = calloc(R ? R : 1, sizeof *m->cur);
+    m->head = calloc(R ? R : 1, sizeof *m->head);
+    m->pos = calloc(R ? R : 1, sizeof *m->pos);
+    m->has = calloc(R ? R : 1, 1);
+    m->heap = calloc(R ? R : 1, sizeof *m->heap);
+    m->blocked = calloc(R ? R : 1, 1);
+    pdt_status st = PDT_OK;
+    if (!m->cur || !m->head || !m->pos || !m->has || !m->heap || !m->blocked)
+        st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    if (st == PDT_OK) st = count_sends(m, err);
+    for (uint32_t r = 0; st == PDT_OK && r < R; r++) {
+        st = pdt_cursor_open(run, (int)r, &m->cur[r], err);
+        m->left += run->rk[r].nev;
+    }
+    if (st != PDT_OK) {
+        pdt_merge_close(m);
+        return st;
+    }
+    for (uint32_t r = 0; r < R; r++) {
+        advance(m, r);
+        schedule(m, r);
+    }
+    *out = m;
+    return PDT_OK;
+}
+
+/* Bookkeeping of the messages when event e of rank r is placed. */
+static int place_message(pdt_merge *m, const pdt_event *e, uint32_t r, uint64_t seq)
+{
+    msg_key key = ev_key(e, r);
+    if (e->kind == PDT_EV_SEND) {
+        msg_slot *s = msg_find(&m->sent, &key, 1);
+        if (!s) return -1;
+        s->count++;
+        msg_slot *u = msg_find(&m->unsent, &key, 0);
+        if (u && u->count) u->count--;
+        uint32_t d = key.dst;  /* wake the receiver waiting for this message */
+        if (m->nblocked && d < m->R && m->blocked[d]) {
+            msg_key wk = ev_key(&m->head[d], d);
+            if (key_eq(&wk, &key)) {
+                m->blocked[d] = 0;
+                m->nblocked--;
+                heap_push(m, d);
+            }
+        }
+    } else {
+        msg_slot *s = msg_find(&m->sent, &key, 0);
+        if (s && s->count) s->count--;
+        else  /* its SEND is in no file, or a cycle forced it */
+            warnf(m->run, "rank %u event #%" PRIu64 ": recv from rank %u (tag %u, seq %" PRId64
+                          ") has no matching send", r, seq, e->a, e->sub, e->v);
+    }
+    return 0;
+}
+
+int pdt_merge_next(pdt_merge *m, pdt_rec *rec, pdt_err *err)
+{
+    if (m->left == 0) return 0;
+    uint32_t r = UINT32_MAX;
+    if (m->next != UINT32_MAX) {
+        r = m->next;
+        m->next = UINT32_MAX;
+    } else if (m->nheap > 0) {
+        r = heap_pop(m);
+    } else {  /* every remaining head is a RECV whose SEND is missing: force one */
+        for (uint32_t q = 0; q < m->R; q++)
+            if (m->blocked[q] && (r == UINT32_MAX || head_less(m, q, r))) r = q;
+        if (r == UINT32_MAX) {  /* a cursor stopped early: it could not get memory */
+            pdt_err_set(err, PDT_ERR_NOMEM, "out of memory decoding a trace block");
+            return -1;
+        }
+        m->blocked[r] = 0;
+        m->nblocked--;
+    }
+    rec->ev = m->head[r];
+    rec->rank = r;
+    rec->seq = (uint32_t)m->pos[r];
+    m->left--;
+    advance(m, r);
+    if ((rec->ev.kind == PDT_EV_SEND || rec->ev.kind == PDT_EV_RECV) &&
+        place_message(m, &rec->ev, r, m->pos[r] - 1) != 0) {
+        pdt_err_set(err, PDT_ERR_NOMEM, "out of memory (message index)");
+        return -1;
+    }
+    /* Fast path: if r's next event is no RECV and comes before every head in
+     * the heap, pushing r and popping the heap would give r again (the order
+     * (t, rank) is total), so skip both. */
+    if (m->has[r] && m->head[r].kind != PDT_EV_RECV &&
+        (m->nheap == 0 || head_less(m, r, m->heap[0])))
+        m->next = r;
+    else
+        schedule(m, r);
+    return 1;
+}
+
+void pdt_merge_close(pdt_merge *m)
+{
+    if (!m) return;
+    for (uint32_t r = 0; m->cur && r < m->R; r++) pdt_cursor_close(m->cur[r]);
+    free(m->cur);
+    free(m->head);
+    free(m->pos);
+    free(m->has);
+    free(m->heap);
+    free(m->blocked);
+    free(m->sent.s);
+    free(m->unsent.s);
+    free(m);
 }
 
 pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err *err)
@@ -709,113 +891,30 @@ pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err
         *n = run->nmerged;
         return PDT_OK;
     }
-    size_t total = 0;
-    for (int r = 0; r < run->nranks; r++) {
-        const pdt_event *ev;
-        size_t k;
-        pdt_status st = pdt_run_rank_events(run, r, &ev, &k, err);
-        if (st != PDT_OK) return st;
-        total += k;
+    uint64_t total = 0;
+    for (int r = 0; r < run->nranks; r++) total += run->rk[r].nev;
+    if (total > SIZE_MAX / sizeof(pdt_rec))
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory (%" PRIu64 " events)", total);
+    pdt_merge *m;
+    pdt_status st = pdt_merge_open(run, &m, err);
+    if (st != PDT_OK) return st;
+    pdt_rec *out = big_alloc((size_t)total * sizeof *out);
+    if (!out) {
+        pdt_merge_close(m);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory (%" PRIu64 " events)", total);
     }
-    size_t R = (size_t)run->nranks;
-    pdt_rec *out = big_alloc(total * sizeof *out);
-    size_t *pos = calloc(R, sizeof *pos);
-    heap h = {malloc(R * sizeof(uint32_t)), 0};
-    uint8_t *blocked = calloc(R, 1);
-    msg_set sent = {0}, unsent = {0};
-    pdt_status st = PDT_OK;
-    if (!out || !pos || !h.r || !blocked) {
-        st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-        goto done;
-    }
-    for (uint32_t r = 0; r < R; r++)
-        for (size_t i = 0; i < run->rk[r].nev; i++) {
-            const pdt_event *e = &run->rk[r].ev[i];
-            if (e->kind != PDT_EV_SEND) continue;
-            msg_key key = ev_key(e, r);
-            msg_slot *u = msg_find(&unsent, &key, 1);
-            if (!u) {
-                st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-                goto done;
-            }
-            u->count++;
-        }
-    merge_ctx mc = {run, pos, &h, blocked, 0, &sent, &unsent};
     size_t k = 0;
-    for (uint32_t r = 0; r < R; r++) schedule(&mc, r);
-    /* `next`: a rank known to go next without asking the heap (see the end
-     * of the loop), or UINT32_MAX. */
-    uint32_t next = UINT32_MAX;
-    while (k < total) {
-        uint32_t r;
-        if (next != UINT32_MAX) {
-            r = next;
-            next = UINT32_MAX;
-        } else if (h.n > 0) {
-            r = heap_pop(&h, run, pos);
-        } else {  /* every remaining head is a RECV whose SEND is missing: force one */
-            r = UINT32_MAX;
-            for (uint32_t q = 0; q < R; q++)
-                if (blocked[q] && (r == UINT32_MAX || head_less(run, pos, q, r))) r = q;
-            blocked[r] = 0;
-            mc.nblocked--;
-        }
-        const pdt_event *e = &run->rk[r].ev[pos[r]];
-        out[k].ev = *e;
-        out[k].rank = r;
-        out[k].seq = (uint32_t)pos[r];
-        k++;
-        pos[r]++;
-        msg_key key = ev_key(e, r);
-        if (e->kind == PDT_EV_SEND) {
-            msg_slot *s = msg_find(&sent, &key, 1);
-            if (!s) {
-                st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-                goto done;
-            }
-            s->count++;
-            msg_slot *u = msg_find(&unsent, &key, 0);
-            if (u && u->count) u->count--;
-            if (mc.nblocked) {  /* wake the receiver waiting for this message */
-                uint32_t d = key.dst;
-                if (d < R && blocked[d]) {
-                    const pdt_event *w = &run->rk[d].ev[pos[d]];
-                    msg_key wk = ev_key(w, d);
-                    if (key_eq(&wk, &key)) {
-                        blocked[d] = 0;
-                        mc.nblocked--;
-                        heap_push(&h, run, pos, d);
-                    }
-                }
-            }
-        } else if (e->kind == PDT_EV_RECV) {
-            msg_slot *s = msg_find(&sent, &key, 0);
-            if (s && s->count) s->count--;
-            else  /* its SEND is in no file, or a cycle forced it */
-                warnf(run, "rank %u event #%zu: recv from rank %u (tag %u, seq %" PRId64
-                           ") has no matching send", r, pos[r] - 1, e->a, e->sub, e->v);
-        }
-        /* Fast path: if r's next event is no RECV and comes before every
-         * head in the heap, pushing r and popping the heap would give r
-         * again (the order (t, rank) is total), so skip both. */
-        if (pos[r] < run->rk[r].nev && run->rk[r].ev[pos[r]].kind != PDT_EV_RECV &&
-            (h.n == 0 || head_less(run, pos, r, h.r[0])))
-            next = r;
-        else
-            schedule(&mc, r);
+    int got;
+    while (k < total && (got = pdt_merge_next(m, &out[k], err)) == 1) k++;
+    pdt_merge_close(m);
+    if (k < total) {
+        free(out);
+        return err->code ? err->code : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     }
     run->merged = out;
-    run->nmerged = total;
+    run->nmerged = (size_t)total;
     run->merged_done = 1;
-    out = NULL;
     *recs = run->merged;
     *n = run->nmerged;
-done:
-    free(out);
-    free(pos);
-    free(h.r);
-    free(blocked);
-    free(sent.s);
-    free(unsent.s);
-    return st;
+    return PDT_OK;
 }

@@ -13,9 +13,12 @@
 #include "pdt/delaunay.h"
 #include "pdt/gen.h"
 #include "pdt/hull.h"
+#include "pdt/predicates.h"
 #include "pdt/tracefile.h"
 
 static char tmpdir[256];
+/* memory budget of the checks (tiny_budget_spills makes it tiny) */
+static uint64_t budget = PDT_TRACE_MEM_DEFAULT;
 
 static void meta(const char *dir, const char *command, const pdt_point *pts, size_t n, int nranks)
 {
@@ -74,7 +77,7 @@ static pdt_status check_dir(const char *dir, char *msg, size_t cap)
         return err.code;
     }
     char summary[512];
-    pdt_status st = pdt_run_check(run, summary, sizeof summary, &err);
+    pdt_status st = pdt_run_check_mem(run, budget, summary, sizeof summary, &err);
     snprintf(msg, cap, "%s", st == PDT_OK ? summary : err.msg);
     pdt_run_close(run);
     return st;
@@ -238,6 +241,20 @@ static void cw(pdt_event *e)
     e->c = t;
 }
 
+/* Replace a triangle's third point by another point of the run that keeps it
+ * counter-clockwise (the first such one): a triangle T* does not have. */
+static const pdt_point *edit_pts;
+static size_t edit_n;
+static void swap_point(pdt_event *e)
+{
+    for (uint32_t p = 0; p < edit_n; p++)
+        if (p != e->a && p != e->b && p != e->c &&
+            pdt_orient(edit_pts[e->a], edit_pts[e->b], edit_pts[p]) > 0) {
+            e->c = p;
+            return;
+        }
+}
+
 TEST(edited_events_are_named)
 {
     pdt_point *pts = uniform(200);
@@ -363,6 +380,58 @@ TEST(chain_hull_counts)
     expect_fail(sub("chain-bad"), "(hull vertices=5): the lower and upper stacks hold 4 hull vertices");
 }
 
+/* A traced triangulation whose final triangle `dup` is reported a second
+ * time at the very end (far from the first: another sorted run). */
+static void record_tri_dup(const char *dir, const pdt_point *pts, size_t n, size_t dup)
+{
+    pdt_trace_writer *w;
+    pdt_err err = {0};
+    CHECK(pdt_tw_open(dir, 0, 1, &w, &err) == PDT_OK);
+    meta(dir, "triangulate", pts, n, 1);
+    pdt_trace *tr = pdt_tw_hook(w);
+    pdt_tri *t;
+    size_t nt;
+    CHECK(pdt_triangulate(pts, n, &t, &nt, NULL, tr) == PDT_OK);
+    for (size_t i = 0; i < nt; i++)
+        PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, t[i].v[0], t[i].v[1], t[i].v[2], 0);
+    if (dup < nt) PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, t[dup].v[1], t[dup].v[2], t[dup].v[0], 0);
+    free(t);
+    CHECK(pdt_tw_close(w, &err) == PDT_OK);
+}
+
+/* With a budget of a few hundred bytes the final triangles go to disk in
+ * sorted runs of 16 (more than 64 runs: merged into one on the way): the
+ * verdicts are the same as in memory. */
+TEST(tiny_budget_spills)
+{
+    char msg[1100];
+    pdt_point *pts = uniform(2000);
+    budget = 256;
+    edit_pts = pts;
+    edit_n = 2000;
+    record_tri(sub("tb"), pts, 2000, 1);
+    CHECK_MSG(check_dir(sub("tb"), msg, sizeof msg) == PDT_OK, "%s", msg);
+    CHECK_MSG(strstr(msg, "= T*") && strstr(msg, "sorted on disk in"), "%s", msg);
+    budget = PDT_TRACE_MEM_DEFAULT;
+    CHECK_MSG(check_dir(sub("tb"), msg, sizeof msg) == PDT_OK && !strstr(msg, "on disk"), "%s",
+              msg);
+    budget = 256;
+    uint64_t k = find_kind(sub("tb"), PDT_EV_TRI_FINAL, 1000);
+    copy_run(sub("tb"), sub("tb-nofinal"), k, UINT64_MAX, NULL);
+    expect_fail(sub("tb-nofinal"), "was never made final");
+    record_tri_dup(sub("tb-dup"), pts, 2000, 7);
+    expect_fail(sub("tb-dup"), "made final twice");
+    k = find_kind(sub("tb"), PDT_EV_TRI_FINAL, 3000);
+    copy_run(sub("tb"), sub("tb-cw"), UINT64_MAX, k, cw);
+    expect_fail(sub("tb-cw"), "not counter-clockwise");
+    /* a foreign triangle in place of a true one */
+    k = find_kind(sub("tb"), PDT_EV_TRI_FINAL, 2500);
+    copy_run(sub("tb"), sub("tb-wrong"), UINT64_MAX, k, swap_point);
+    expect_fail(sub("tb-wrong"), "is not in T* of the run's points");
+    budget = PDT_TRACE_MEM_DEFAULT;
+    free(pts);
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "%s/pdt-ttc.XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -373,6 +442,7 @@ int main(void)
     RUN(damaged_files_fail);
     RUN(messages_and_merges);
     RUN(chain_hull_counts);
+    RUN(tiny_budget_spills);
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
     if (system(cmd) != 0) return 1;
