@@ -1,0 +1,61 @@
+#!/bin/bash
+# Replaying cluster-sized runs (issue 12): a 10^7-point level-1 run on 1 rank
+# (about 5*10^7 events) and a 10^6-point run on 8 ranks.  For each: the trace
+# tools (check, dump of the merged order, OTF2 export) and the viewer (first
+# and second opening, seek, frame time), each with its wall time and peak
+# resident memory (GNU time's maxrss).  Smaller sizes: REPLAY_N1=... and
+# REPLAY_N8=... (points).  The runs are kept in build/bench/replay/ and
+# re-used.  Prints figures; never fails on a time.
+set -u
+cd "$(dirname "$0")/../.."
+N1=${REPLAY_N1:-10000000}
+N8=${REPLAY_N8:-1000000}
+OUT=build/bench/replay
+mkdir -p "$OUT"
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+if [ ! -x /usr/bin/time ]; then echo "GNU time (/usr/bin/time) missing: make deps-bench"; exit 1; fi
+
+# measure LABEL CMD...: one line "LABEL  wall s  peak MiB" (output of CMD dropped)
+measure() {
+    local label=$1; shift
+    /usr/bin/time -f "%e %M" -o "$OUT/time.txt" "$@" >"$OUT/cmd.out" 2>"$OUT/cmd.err" ||
+        { echo "$label: failed: $(tail -2 "$OUT/cmd.err")"; return 1; }
+    read -r wall kib <"$OUT/time.txt"
+    printf '  %-37s %8.2f s  %8.1f MiB peak\n' "$label" "$wall" "$(echo "$kib / 1024" | bc -l)"
+}
+
+# record N RANKS DIR: a level-1 traced uniform run (once)
+record() {
+    local n=$1 p=$2 dir=$3
+    [ -f "$dir/manifest" ] && return 0
+    echo "recording $dir ($n points, $p rank(s)) ..."
+    bin/pdt gen uniform "$n" -o "$OUT/pts-$n.txt" || return 1
+    if [ "$p" = 1 ]; then
+        bin/pdt triangulate "$OUT/pts-$n.txt" -o "$OUT/out.tri" --trace "$dir" || return 1
+    else
+        mpirun -np "$p" bin/pdt triangulate "$OUT/pts-$n.txt" -o "$OUT/out.tri" --trace "$dir" || return 1
+    fi
+    rm -f "$OUT/pts-$n.txt" "$OUT/out.tri"
+}
+
+one_run() {
+    local dir=$1
+    local ev
+    ev=$(bin/pdt trace info "$dir" | awk '$1 == "all" {print $2; f = 1} $1 == "0" && NF >= 5 && !f {e = $2} END {if (!f) print e}')
+    echo "-- $dir: $ev events, $(du -sh "$dir" | cut -f1) on disk (load: $(cut -d' ' -f1-3 /proc/loadavg))"
+    measure "pdt trace check" bin/pdt trace check "$dir"
+    measure "pdt trace check --mem 64M" bin/pdt trace check "$dir" --mem 64M
+    grep -o 'sorted on disk in [0-9]* runs' "$OUT/cmd.out" | sed 's/^/    /'
+    measure "pdt trace dump (merged) >/dev/null" bin/pdt trace dump "$dir"
+    rm -rf "$OUT/otf2"
+    measure "pdt trace export --otf2" bin/pdt trace export --otf2 "$dir" -o "$OUT/otf2"
+    rm -rf "$OUT/otf2"
+    measure "pdtview first opening (--end frame)" bin/pdtview --headless "$dir" --end -o "$OUT/end.png" --size 1280x800
+    measure "pdtview second opening" bin/pdtview --headless "$dir" --end -o "$OUT/end.png" --size 1280x800
+    bin/pdtview --bench "$dir" --size 1280x800 | sed 's/^/    /'
+}
+
+record "$N1" 1 "$OUT/run-$N1-p1" && one_run "$OUT/run-$N1-p1"
+record "$N8" 8 "$OUT/run-$N8-p8" && one_run "$OUT/run-$N8-p8"
+echo "(the viewer indexes the whole run at every opening: no index is kept between openings yet,"
+echo " so the second opening costs what the first does, less what the page cache saves)"
