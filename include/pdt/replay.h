@@ -191,6 +191,33 @@ uint32_t pdt_rstate_tri_entry(const pdt_replay *r, const pdt_rstate *s, size_t t
 /* pdt_rstate_tri_entry() != UINT32_MAX; discarded triangles count as visible. */
 int pdt_rstate_tri_visible(const pdt_replay *r, const pdt_rstate *s, size_t t);
 
+/* ---- level of detail ------------------------------------------------------------ */
+
+/* One cell of a coverage grid: the visible triangles (pdt_rstate_tri_entry
+ * != UINT32_MAX, discarded ones included) that touch the cell (a triangle
+ * larger than a cell counts in every cell it touches, so big triangles
+ * leave no holes). */
+typedef struct pdt_cov_cell {
+    uint32_t n;                          /* triangles */
+    uint32_t by_status[PDT_TS_COUNT];    /* of them, by the status that decides their look */
+    uint32_t rank;                       /* the maker rank of all of them, or
+                                          * PDT_COV_MIXED when makers differ (seams,
+                                          * merge regions); meaningless when n == 0 */
+} pdt_cov_cell;
+#define PDT_COV_MIXED UINT32_MAX
+
+/* Aggregate the triangles of state s over a cols x rows grid covering the
+ * world box [x0, x1) x [y0, y1) (cell (0, 0) holds x0, y0; row-major, cell
+ * (i, j) at cells[j * cols + i]).  Triangles of ranks with rank_visible[q] ==
+ * 0 are left out (rank_visible NULL: all shown).  cells must hold cols * rows
+ * entries; they are overwritten.  Returns the number of triangles that touch
+ * the box.  Cost O(triangles + cells touched): for drawing runs of millions of triangles as a
+ * picture of their density, ranks and statuses when they are too many to
+ * draw one by one (pdt_draw_lod). */
+size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, double y0,
+                           double x1, double y1, int cols, int rows,
+                           const uint8_t *rank_visible, pdt_cov_cell *cells);
+
 /* Searching the event list (for the controls).  Kinds of "selected event": */
 typedef enum pdt_ev_class {
     PDT_EVC_ANY = 0,

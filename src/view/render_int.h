@@ -10,6 +10,7 @@
  *   timeline.c  the timeline and seeking by a click on it
  *   export.c    pdt_render_file(): PNG, SVG, PDF
  *   pick.c      what is under the mouse
+ *   render_lod.c  millions of triangles drawn as their coverage per cell
  *
  * The questions about the replay these files ask (is a hull still live,
  * which pseudo-code line, ...) are the model's: pdt/query.h. */
@@ -60,6 +61,10 @@ typedef struct ctx {
 
 /* The parts of the frame, each clipped to its rectangle of c->L. */
 void pdt_draw_geometry(ctx *c);                 /* geometry.c */
+/* Level of detail (render_lod.c): when the triangles in the geometry area are
+ * too many to draw one by one, paint their coverage per cell instead and
+ * return 1; else draw nothing and return 0. */
+int pdt_draw_lod(ctx *c);
 void pdt_draw_top(ctx *c);                      /* panels.c */
 void pdt_draw_legend(ctx *c);
 void pdt_draw_code(ctx *c);

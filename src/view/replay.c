@@ -1,6 +1,7 @@
 /* pdt — the replay model: index the events once, then answer "state at k". */
 #include "pdt/replay.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -836,6 +837,86 @@ uint32_t pdt_rstate_tri_entry(const pdt_replay *r, const pdt_rstate *s, size_t t
 int pdt_rstate_tri_visible(const pdt_replay *r, const pdt_rstate *s, size_t t)
 {
     return pdt_rstate_tri_entry(r, s, t) != NONE32;
+}
+
+/* ---- level of detail ------------------------------------------------------------ */
+
+/* Add triangle t (status st, maker q) to cell (i, j). */
+static void cov_add(pdt_cov_cell *cell, uint32_t q, uint8_t st)
+{
+    cell->rank = cell->n == 0 || cell->rank == q ? q : PDT_COV_MIXED;
+    cell->n++;
+    cell->by_status[st]++;
+}
+
+/* The x range of triangle (grid coordinates x[], y[]) within the band
+ * lo <= y <= hi: from its vertices in the band and its edges' crossings of
+ * the band's two lines.  0 if it does not reach the band. */
+static int band_range(const double x[3], const double y[3], double lo, double hi, double *xmin,
+                      double *xmax)
+{
+    int any = 0;
+    *xmin = INFINITY;
+    *xmax = -INFINITY;
+    for (int k = 0; k < 3; k++) {
+        double ax = x[k], ay = y[k], bx = x[(k + 1) % 3], by = y[(k + 1) % 3];
+        if (ay >= lo && ay <= hi) {
+            *xmin = fmin(*xmin, ax);
+            *xmax = fmax(*xmax, ax);
+            any = 1;
+        }
+        const double lines[2] = {lo, hi};
+        for (int l = 0; l < 2; l++) {
+            double yl = lines[l];
+            if ((ay < yl && by > yl) || (ay > yl && by < yl)) {
+                double xc = ax + (bx - ax) * (yl - ay) / (by - ay);
+                *xmin = fmin(*xmin, xc);
+                *xmax = fmax(*xmax, xc);
+                any = 1;
+            }
+        }
+    }
+    return any;
+}
+
+size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, double y0,
+                           double x1, double y1, int cols, int rows,
+                           const uint8_t *rank_visible, pdt_cov_cell *cells)
+{
+    if (cols <= 0 || rows <= 0) return 0;
+    memset(cells, 0, (size_t)cols * (size_t)rows * sizeof *cells);
+    if (!(x1 > x0) || !(y1 > y0)) return 0;
+    double sx = cols / (x1 - x0), sy = rows / (y1 - y0);
+    size_t binned = 0;
+    for (size_t t = 0; t < r->ntri; t++) {
+        uint32_t h = pdt_rstate_tri_entry(r, s, t);
+        if (h == NONE32) continue;
+        const pdt_rtri *tr = &r->tris[t];
+        if (rank_visible && !rank_visible[tr->maker]) continue;
+        double x[3], y[3];
+        for (int k = 0; k < 3; k++) {
+            x[k] = (r->pts[tr->v[k]].x - x0) * sx;
+            y[k] = (r->pts[tr->v[k]].y - y0) * sy;
+        }
+        double xlo = fmin(x[0], fmin(x[1], x[2])), xhi = fmax(x[0], fmax(x[1], x[2]));
+        double ylo = fmin(y[0], fmin(y[1], y[2])), yhi = fmax(y[0], fmax(y[1], y[2]));
+        if (xhi < 0 || xlo >= cols || yhi < 0 || ylo >= rows) continue;  /* outside the box */
+        uint8_t st = r->hist[h].status;
+        binned++;
+        int j0 = ylo < 0 ? 0 : (int)ylo, j1 = yhi >= rows ? rows - 1 : (int)yhi;
+        if ((int)xlo == (int)xhi && j0 == j1 && xlo >= 0) {  /* the usual case: one cell */
+            cov_add(&cells[(size_t)j0 * (size_t)cols + (size_t)xlo], tr->maker, st);
+            continue;
+        }
+        for (int j = j0; j <= j1; j++) {  /* every cell the triangle touches, band by band */
+            double a, b;
+            if (!band_range(x, y, j, j + 1.0, &a, &b)) continue;
+            int i0 = a < 0 ? 0 : (int)a, i1 = b >= cols ? cols - 1 : (int)b;
+            for (int i = i0; i <= i1; i++)
+                cov_add(&cells[(size_t)j * (size_t)cols + (size_t)i], tr->maker, st);
+        }
+    }
+    return binned;
 }
 
 /* ---- searching --------------------------------------------------------------- */
