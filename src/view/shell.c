@@ -360,11 +360,15 @@ static void script_step(shell *sh)
     }
 }
 
+static int make_texture(shell *sh);
+
 /* Offer an SDL event to the hook; 1 if it took it. */
 static int hook_input(shell *sh, const SDL_Event *e)
 {
     const pdt_shell_hook *hk = sh->o->hook;
     if (!hk || !hk->input) return 0;
+    /* input before the first frame: the hook needs the drawable size */
+    if (!sh->tex && !make_texture(sh)) return 0;
     pdt_shell_input in;
     memset(&in, 0, sizeof in);
     SDL_Keymod mod = SDL_GetModState();

@@ -34,7 +34,7 @@ wid=
 for i in $(seq 100); do wid=$(xdotool search --name 'pdtview' 2>/dev/null | head -1); [ -n "$wid" ] && break; sleep 0.1; done
 if [ -n "$wid" ] && [ -f "$F" ] && [ ! -s "$F" ]; then ok edit_creates_missing_file
 else fail edit_creates_missing_file "window '$wid', file: $(ls -l "$F" 2>&1)"; fi
-sleep 0.5
+sleep 1.5
 npts() { grep -cE '^-?[0-9]' "$F" 2>/dev/null || echo 0; }
 # wait until the file has $1 points
 wait_pts() { for i in $(seq 100); do [ "$(npts)" = "$1" ] && return 0; sleep 0.1; done; return 1; }
