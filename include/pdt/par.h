@@ -205,8 +205,8 @@ void pdt_par_stats_free(pdt_par_stats *s);
 /* Collective: the status every rank agrees on after a step that may have
  * failed on some ranks only.  Returns PDT_OK if st is PDT_OK on every rank;
  * otherwise, at every rank, the status of the lowest failing rank, and *who
- * (if not NULL) = that rank (err at that rank holds the message; the other
- * ranks' err are left alone).  Never blocks on a rank that already failed: call it from every
+ * (if not NULL) = that rank (err at that rank holds the message; at a rank
+ * whose own st was PDT_OK, err gets the status and an empty message).  Never blocks on a rank that already failed: call it from every
  * rank after the step. */
 pdt_status pdt_par_agree(pdt_comm *c, pdt_status st, int *who, pdt_err *err);
 

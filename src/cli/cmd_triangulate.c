@@ -74,10 +74,13 @@ static pdt_status report_failure(const run *R, pdt_status st, int who, const pdt
     return st;
 }
 
-/* A step every rank ends together: agree on its status, report a failure. */
+/* A step every rank ends together: agree on its status, report a failure.
+ * A status the library already agreed on carries an empty message at the
+ * ranks where it did not start: they are not the ones to report. */
 static pdt_status agreed(run *R, pdt_status st, pdt_err *err)
 {
     int who = -1;
+    if (st != PDT_OK && !err->msg[0]) st = PDT_OK;
     st = pdt_par_agree(R->c, st, &who, err);
     return report_failure(R, st, who, err);
 }

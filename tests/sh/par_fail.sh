@@ -68,6 +68,21 @@ mpirun -np 2 "$PDT" triangulate u.txt -o nodir/out.tri > /dev/null 2> w.err; rc=
 if [ $rc -ne 0 ] && grep -q 'nodir/out.tri' w.err && [ ! -e nodir ]; then ok write_error_nonzero_exit
 else fail write_error_nonzero_exit "rc=$rc $(head -3 w.err)"; fi
 
+# --- a rank fails its share of the parallel write (test-only variable): the
+# message names that rank and the write, nothing is left (not even the temporary)
+mkdir -p wdir
+PDT_TEST_FAIL_WRITE=1 mpirun -np 3 -x PDT_TEST_FAIL_WRITE "$PDT" triangulate u.txt -o wdir/fw.tri \
+    > /dev/null 2> fw.err; rc=$?
+if [ $rc -eq 2 ] && grep -q 'rank 1, write: wdir/fw.tri' fw.err && [ -z "$(ls -A wdir)" ]; then
+    ok write_fails_on_one_rank
+else fail write_fails_on_one_rank "rc=$rc files=$(ls -A wdir) $(grep pdt fw.err | head -3)"; fi
+
+# --- the parallel write gives the plain run's bytes
+"$PDT" triangulate u.txt -o u.plain.tri
+mpirun -np 3 "$PDT" triangulate u.txt -o u.par.tri > /dev/null 2> pw.err; rc=$?
+if [ $rc -eq 0 ] && cmp -s u.plain.tri u.par.tri; then ok parallel_write_same_bytes
+else fail parallel_write_same_bytes "rc=$rc $(head -3 pw.err)"; fi
+
 # --- standard input is read by rank 0
 "$PDT" triangulate u.txt -o u.ref
 mpirun -np 3 "$PDT" triangulate - -o u.stdin.tri < u.txt > /dev/null 2> in.err; rc=$?
@@ -95,7 +110,7 @@ else fail stats_run_3_ranks "rc=$rc $(head -5 cl.err)"; fi
 # --- the partition balances by count even when every point has the same x
 seq 0 7999 | awk '{ print 5, ($1 * 7919) % 100003 }' > col8k.txt   # one vertical line, shuffled
 mpirun -np 4 "$PDT" triangulate col8k.txt -o col8k.tri --stats > /dev/null 2> col8k.err; rc=$?
-pts=$(grep -o '"points": [0-9]*' col8k.err | awk '{print $2}' | tr '\n' ' ')
+pts=$(grep -o '"points": [0-9]*' col8k.err | head -4 | awk '{print $2}' | tr '\n' ' ')
 uniq=$(grep -o '"unique": [0-9]*' col8k.err | head -1 | awk '{print $2}')
 if [ $rc -eq 0 ] && [ -n "$uniq" ] && echo "$pts" | awk -v u="$uniq" '
     { for (i = 1; i <= NF; i++) if ($i < 0.8 * u / NF || $i > 1.2 * u / NF) bad = 1; n = NF }
