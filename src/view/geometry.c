@@ -331,7 +331,9 @@ static void draw_points(ctx *c)
             if (crowded) continue;
             pdt_point_label(c->r, c->s, p, lab, sizeof lab);
             int p0 = graham && pdt_replay_sort_pos(c->r, p) == 0 && (c->s->pflags[p] & PDT_PF_SORTED);
-            text_at(cr, SANS, p0, f, x + 0.45 * f, y - 0.3 * f, lab);
+            double lw = text_w(cr, SANS, f, lab), lx = x + 0.45 * f;
+            if (lx + lw > c->L.geo.x + c->L.geo.w) lx = x - 0.45 * f - lw; /* keep it on screen */
+            text_at(cr, SANS, p0, f, lx, y - 0.3 * f, lab);
         }
     }
     for (size_t p = 0; p < c->n; p++) {
