@@ -781,7 +781,8 @@ pdt_status pdt_merge_open(pdt_run *run, pdt_merge **out, pdt_err *err)
     pdt_status st = PDT_OK;
     if (!m->cur || !m->head || !m->pos || !m->has || !m->heap || !m->blocked)
         st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    if (st == PDT_OK) st = count_sends(m, err);
+    /* one rank: the order is its file order whatever the messages say */
+    if (st == PDT_OK && R > 1) st = count_sends(m, err);
     for (uint32_t r = 0; st == PDT_OK && r < R; r++) {
         st = pdt_cursor_open(run, (int)r, &m->cur[r], err);
         m->left += run->rk[r].nev;
