@@ -39,4 +39,13 @@ size_t pdt_replay_inside_count(const pdt_replay *r, const uint32_t v[3]);
  * an event outside both listings). */
 int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id);
 
+/* Cursor just after the next (dir > 0: events k, k+1, ...) or previous
+ * (dir < 0: events before the current one, k-2, k-3, ...) event of `rank`;
+ * k when there is none. */
+size_t pdt_replay_find_rank(const pdt_replay *r, size_t k, int dir, int rank);
+
+/* Cursor just after the event of `rank` nearest to event k-1 (ties: the
+ * later one); (size_t)-1 when the rank has no event. */
+size_t pdt_replay_nearest_of_rank(const pdt_replay *r, size_t k, int rank);
+
 #endif

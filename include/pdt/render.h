@@ -30,7 +30,27 @@ typedef struct pdt_view {
     int sel_edge;         /* 0..2: the edge v[e]-v[e+1] of sel_tri is selected, or -1 */
     const char *status;   /* short text for the status corner ("playing 8 ev/s"), or NULL */
     unsigned panels;      /* PDT_PANEL_* bits: the optional panels shown (legend always) */
+    double font_scale;    /* all text (and the panels holding it) scaled by this; 1 = default */
+    int theme;            /* PDT_THEME_* */
+    int clean;            /* clean picture: only final triangles (by rank) and hulls, no
+                           * crosses, faded discards, candidates or current-event marks */
+    int circles;          /* draw the circumcircle of every drawn triangle */
+    int voronoi;          /* draw the Voronoi diagram of the final triangles */
+    const char *prompt;   /* a line being typed ("go to event: 75"), drawn over the
+                           * picture, or NULL */
 } pdt_view;
+
+/* Colour themes (pdt_view.theme).  Every theme keeps the colour-blind-safe
+ * rank palette (pdt_rank_rgb). */
+enum {
+    PDT_THEME_LIGHT = 0,  /* dark ink on white */
+    PDT_THEME_DARK,       /* light ink on near-black (dim rooms) */
+    PDT_THEME_CONTRAST,   /* black on white, thicker lines, no tints (washed-out projectors) */
+    PDT_THEME_COUNT
+};
+
+/* "light", "dark" or "contrast" into *theme; -1 on another name. */
+int pdt_theme_parse(const char *name, int *theme);
 
 /* The optional panels (pdt_view.panels).  A hidden panel gets no room: the
  * geometry and the other panels grow instead. */
@@ -52,18 +72,28 @@ typedef struct pdt_rect {
 } pdt_rect;
 
 typedef struct pdt_layout {
-    double font;          /* base font size in pixels */
+    double font;          /* base font size in pixels (event line) */
+    double body;          /* panel text (legend, stacks, code), pixels */
+    double label;         /* point and box labels, pixels */
     pdt_rect top, geo, legend, code, stack, lifted, timeline;
 } pdt_layout;
 
-/* Defaults: fit, all ranks, yaw 30°, pitch 25°, fade 400 events. */
+/* Defaults: fit, all ranks, yaw 30°, pitch 25°, fade 400 events, font scale 1,
+ * light theme. */
 void pdt_view_defaults(pdt_view *v);
 
 /* Layout with every panel shown. */
 void pdt_render_layout(double w, double h, int nranks, pdt_layout *L);
 /* Layout with the panels of `panels` (PDT_PANEL_* bits); hidden ones have
- * zero width and height. */
+ * zero width and height.  When code, stack and lifted view are all hidden
+ * the picture takes the whole width and the legend is a strip under it. */
 void pdt_render_layout_panels(double w, double h, int nranks, unsigned panels, pdt_layout *L);
+/* The same with the font scaled by `scale` (clamped to 0.4 .. 4). */
+void pdt_render_layout_scaled(double w, double h, int nranks, unsigned panels, double scale,
+                              pdt_layout *L);
+/* The layout view v asks for (its panels and font scale; v NULL: defaults).
+ * Every drawing, picking and timeline function uses this one. */
+void pdt_render_layout_view(double w, double h, int nranks, const pdt_view *v, pdt_layout *L);
 
 /* Draw state s of replay r on cr, in the rectangle (0,0)-(w,h).  Leaves the
  * cairo state as it found it.  Returns PDT_OK, or an error if cairo reports
@@ -96,8 +126,10 @@ void pdt_render_pick(const pdt_replay *r, const pdt_rstate *s, const pdt_view *v
                      double h, double sx, double sy, double radius, int64_t *point, int64_t *tri,
                      int *edge);
 
-/* Cursor for a click at x in the timeline rectangle, or (size_t)-1 when x,y is
- * not in it. */
+/* Cursor for a click at (sx,sy) in the timeline rectangle: in a rank's row,
+ * just after that rank's event nearest the clicked time
+ * (pdt_replay_nearest_of_rank); elsewhere the clicked time itself.
+ * (size_t)-1 when (sx,sy) is not in the timeline. */
 size_t pdt_render_timeline_at(const pdt_replay *r, const pdt_view *v, double w, double h, double sx,
                               double sy);
 

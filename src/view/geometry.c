@@ -1,8 +1,8 @@
 /* pdt — the world picture of the viewer: strip boxes, triangles by status
  * and rank, kernel edges, hulls and stacks, points and their labels, the
  * merge in progress, the current event's highlight, the selection. */
-#include "render_int.h"
 #include "pdt/describe.h"
+#include "render_int.h"
 
 
 /* ---- the geometry --------------------------------------------------------------------- */
@@ -25,9 +25,11 @@ static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
         if (!labels) {
             cairo_rectangle(cr, x0 - pad, y0 - pad, x1 - x0 + 2 * pad, y1 - y0 + 2 * pad);
             /* opaque tint (rank colour over white): much cheaper than alpha on big areas */
-            double col[3], a = touched ? 0.16 : 0.05;
+            double col[3], a = (touched ? 0.16 : 0.05) * c->T->tint;
+            const double *bg = c->T->bg;
             pdt_rank_rgb(q, col);
-            cairo_set_source_rgb(cr, 1 - a + a * col[0], 1 - a + a * col[1], 1 - a + a * col[2]);
+            cairo_set_source_rgb(cr, (1 - a) * bg[0] + a * col[0], (1 - a) * bg[1] + a * col[1],
+                                 (1 - a) * bg[2] + a * col[2]);
             cairo_fill_preserve(cr);
             set_rank(cr, q, touched ? 0.95 : 0.5);
             double d[2] = {4, 3};
@@ -45,7 +47,7 @@ static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
         double tw = text_wb(cr, SANS, touched, fs, lab);
         double ly = q % 2 ? y1 + pad + 0.95 * c->L.font : y0 - pad - 0.25 * c->L.font;
         cairo_rectangle(cr, x0 - pad - 0.1 * fs, ly - 0.85 * fs, tw + 0.2 * fs, 1.1 * fs);
-        cairo_set_source_rgba(cr, 1, 1, 1, 0.8);
+        rgb(cr, c->T->bg, 0.8);
         cairo_fill(cr);
         set_rank(cr, q, 1);
         text_at(cr, SANS, touched, fs, x0 - pad, ly, lab);
@@ -215,10 +217,8 @@ static void draw_hulls_and_stacks(ctx *c, uint32_t *buf, size_t cap)
             else cairo_move_to(cr, x, y);
         }
         if (!k2) cairo_close_path(cr);
-        double col[3];
-        pdt_rank_rgb(q, col);
         cairo_set_line_width(cr, 3.2 * c->lw);
-        cairo_set_source_rgba(cr, 0.6 * col[0], 0.6 * col[1], 0.6 * col[2], 0.9);
+        set_hull(c, q, 0.9);
         cairo_stroke(cr);
     }
     /* open stacks (not yet a reported hull): the chain bottom -> top, top marked */
@@ -237,10 +237,8 @@ static void draw_hulls_and_stacks(ctx *c, uint32_t *buf, size_t cap)
             }
             if (closed) { /* the scan is over: the stack is the hull, drawn like one */
                 cairo_close_path(cr);
-                double col[3];
-                pdt_rank_rgb(q, col);
                 cairo_set_line_width(cr, 3.2 * c->lw);
-                cairo_set_source_rgba(cr, 0.6 * col[0], 0.6 * col[1], 0.6 * col[2], 0.9);
+                set_hull(c, q, 0.9);
                 cairo_stroke(cr);
                 continue;
             }
@@ -254,7 +252,7 @@ static void draw_hulls_and_stacks(ctx *c, uint32_t *buf, size_t cap)
                 cairo_line_to(cr, x - 0.6 * a, y - 1.5 * a);
                 cairo_line_to(cr, x + 0.6 * a, y - 1.5 * a);
                 cairo_close_path(cr);
-                rgb(cr, INK, 1);
+                rgb(cr, c->T->ink, 1);
                 cairo_fill(cr);
                 double tw = text_wb(cr, SANS, 1, 0.7 * c->L.font, "top");
                 text_at(cr, SANS, 1, 0.7 * c->L.font, x - 0.8 * a - tw, y - 1.0 * a, "top");
@@ -293,61 +291,168 @@ static void draw_points(ctx *c)
             }
         }
         if (pass == 0) {
-            cairo_set_source_rgba(cr, 0.55, 0.55, 0.55, 1);
+            rgb(cr, c->T->hollow, 1);
             cairo_set_line_width(cr, 1);
             cairo_stroke(cr);
         } else {
-            rgb(cr, INK, 1);
+            rgb(cr, c->T->ink, 1);
             cairo_fill(cr);
         }
     }
-    /* labels (pdt_point_label): the input index beside each point from the
-     * first event, in Graham's scan also p_k once sorted ("2=p4"), while few
-     * are on screen; a label that would collide with a neighbour's is left
-     * out (of coincident copies only the first is labelled) */
+    /* deleted points (Graham's ties and copies) crossed out */
     if (nvis > 600) return;
-    double f = 0.72 * c->L.font;
-    int graham = pdt_replay_kind_count(c->r, PDT_EV_SORT) > 0;
-    if (nvis <= 60 && (graham || c->spacing >= 2.5 * f)) {
-        cairo_set_source_rgba(cr, 0.0, 0.25, 0.55, 1);
-        for (size_t p = 0; p < c->n; p++) {
-            double x, y;
-            char lab[32];
-            wpt(c, (uint32_t)p, &x, &y);
-            if (x < c->L.geo.x || x > c->L.geo.x + c->L.geo.w || y < c->L.geo.y ||
-                y > c->L.geo.y + c->L.geo.h)
-                continue;
-            int crowded = 0; /* a point so close that its label would collide */
-            for (size_t q = 0; q < c->n && !crowded; q++) {
-                if (q == p) continue;
-                if (c->P[q].x == c->P[p].x && c->P[q].y == c->P[p].y) {
-                    crowded = q < p;
-                    continue;
-                }
-                double qx, qy;
-                wpt(c, (uint32_t)q, &qx, &qy);
-                crowded = fabs(qx - x) < 1.6 * f && fabs(qy - y) < 0.9 * f;
-            }
-            if (crowded) continue;
-            pdt_point_label(c->r, c->s, p, lab, sizeof lab);
-            int p0 = graham && pdt_replay_sort_pos(c->r, p) == 0 && (c->s->pflags[p] & PDT_PF_SORTED);
-            double lw = text_w(cr, SANS, f, lab), lx = x + 0.45 * f;
-            if (lx + lw > c->L.geo.x + c->L.geo.w) lx = x - 0.45 * f - lw; /* keep it on screen */
-            text_at(cr, SANS, p0, f, lx, y - 0.3 * f, lab);
-        }
-    }
+    double f = c->L.label;
     for (size_t p = 0; p < c->n; p++) {
-        uint8_t fl = c->s->pflags[p];
+        if (!(c->s->pflags[p] & PDT_PF_DELETED)) continue;
         double x, y;
         wpt(c, (uint32_t)p, &x, &y);
-        if (fl & PDT_PF_DELETED) {
-            cairo_set_line_width(cr, 0.18 * f);
-            cross(cr, x, y, 0.55 * f);
-            rgb(cr, RED, 1);
-            cairo_stroke(cr);
-        }
+        cairo_set_line_width(cr, 0.18 * f);
+        cross(cr, x, y, 0.55 * f);
+        rgb(cr, RED, 1);
+        cairo_stroke(cr);
     }
 }
+
+/* Text with a halo of the background colour around its glyphs, so that the
+ * lines under it do not hide it. */
+static void halo_text(ctx *c, int bold, double size, double x, double y, const char *s,
+                      const double col[3])
+{
+    cairo_t *cr = c->cr;
+    cairo_select_font_face(cr, SANS, CAIRO_FONT_SLANT_NORMAL,
+                           bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_set_font_size(cr, size);
+    cairo_move_to(cr, x, y);
+    cairo_text_path(cr, s);
+    rgb(cr, c->T->bg, 0.9);
+    cairo_set_line_width(cr, 0.28 * size);
+    cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+    cairo_stroke_preserve(cr);
+    rgb(cr, col, 1);
+    cairo_fill(cr);
+}
+
+/* The points the current event names, most important first (at most 4). */
+static int named_points(const ctx *c, uint32_t out[4])
+{
+    int k = 0;
+    const pdt_rec *e = c->cur;
+    if (!e) return 0;
+    const pdt_event *ev = &e->ev;
+    uint32_t cand[4] = {NONE32, NONE32, NONE32, NONE32};
+    switch (ev->kind) {
+    case PDT_EV_PUSH: case PDT_EV_LIFT: case PDT_EV_SORT: cand[0] = ev->a; break;
+    case PDT_EV_POP: cand[0] = ev->a; cand[1] = ev->c; break;
+    case PDT_EV_DELETE: cand[0] = ev->a; cand[1] = ev->b; break;
+    case PDT_EV_EDGE_ADD: case PDT_EV_EDGE_DEL: cand[0] = ev->a; cand[1] = ev->b; break;
+    default:
+        if (is_tri_event(ev->kind)) {
+            cand[0] = ev->a;
+            cand[1] = ev->b;
+            cand[2] = ev->c;
+            if (ev->kind == PDT_EV_DISCARD && ev->v >= 0 && (uint64_t)ev->v < c->n)
+                cand[3] = (uint32_t)ev->v;
+        }
+    }
+    for (int i = 0; i < 4; i++)
+        if (cand[i] < c->n) out[k++] = cand[i];
+    return k;
+}
+
+typedef struct lbox {
+    double x0, y0, x1, y1;
+} lbox;
+
+static int overlaps(const lbox *B, size_t nb, lbox b)
+{
+    for (size_t i = 0; i < nb; i++)
+        if (b.x0 < B[i].x1 && B[i].x0 < b.x1 && b.y0 < B[i].y1 && B[i].y0 < b.y1) return 1;
+    return 0;
+}
+
+/* Point labels, drawn over every line and ring: the input index ("7"), in
+ * Graham runs with the angular place once sorted (pdt_point_label).  The
+ * points the current event names are placed first (trying four sides), then
+ * the selected one, then the others in index order; a label that would
+ * overlap one already placed gives way. */
+static void draw_labels(ctx *c)
+{
+    size_t nvis = 0;
+    for (size_t p = 0; p < c->n; p++) {
+        double x, y;
+        wpt(c, (uint32_t)p, &x, &y);
+        nvis += x >= c->L.geo.x && x <= c->L.geo.x + c->L.geo.w && y >= c->L.geo.y &&
+                y <= c->L.geo.y + c->L.geo.h;
+    }
+    uint32_t named[4];
+    int nn = named_points(c, named);
+    int many = nvis > 400; /* only the named (and selected) points get labels */
+    size_t cap = (many ? 0 : c->n) + 6;
+    lbox *B = malloc(cap * sizeof *B);
+    uint32_t *order = malloc(cap * sizeof *order);
+    if (!B || !order) {
+        free(B);
+        free(order);
+        return;
+    }
+    size_t no = 0, nb = 0;
+    for (int i = 0; i < nn; i++) order[no++] = named[i];
+    if (c->v->sel_point >= 0 && (size_t)c->v->sel_point < c->n) order[no++] = (uint32_t)c->v->sel_point;
+    size_t first_other = no;
+    if (!many)
+        for (size_t p = 0; p < c->n; p++) order[no++] = (uint32_t)p;
+    double f = c->L.label, rad = 0.45 * f;
+    /* the points themselves are obstacles for the labels of the others */
+    lbox *P = NULL;
+    size_t np = 0;
+    if (!many && (P = malloc(c->n * sizeof *P)) != NULL)
+        for (size_t p = 0; p < c->n; p++) {
+            double x, y;
+            wpt(c, (uint32_t)p, &x, &y);
+            P[np++] = (lbox){x - rad, y - rad, x + rad, y + rad};
+        }
+    for (size_t i = 0; i < no; i++) {
+        uint32_t p = order[i];
+        int dup = 0;
+        for (size_t j = 0; j < i && j < first_other; j++) dup |= order[j] == p;
+        if (dup) continue;
+        double x, y;
+        wpt(c, p, &x, &y);
+        if (x < c->L.geo.x || x > c->L.geo.x + c->L.geo.w || y < c->L.geo.y ||
+            y > c->L.geo.y + c->L.geo.h)
+            continue;
+        char lab[48];
+        pdt_point_label(c->r, c->s, p, lab, sizeof lab);
+        int prio = i < first_other;
+        double fs = prio ? 1.15 * f : f;
+        double tw = text_wb(c->cr, SANS, prio, fs, lab), th = 0.8 * fs;
+        /* right-up, left-up, right-down, left-down */
+        double ox[4] = {0.55 * f, -0.55 * f - tw, 0.55 * f, -0.55 * f - tw};
+        double oy[4] = {-0.4 * f, -0.4 * f, 0.4 * f + th, 0.4 * f + th};
+        int placed = -1;
+        for (int k = 0; k < (prio ? 4 : 2) && placed < 0; k++) {
+            lbox b = {x + ox[k] - 1, y + oy[k] - th - 1, x + ox[k] + tw + 1, y + oy[k] + 0.2 * fs + 1};
+            if (overlaps(B, nb, b) || b.x1 > c->L.geo.x + c->L.geo.w || b.x0 < c->L.geo.x ||
+                b.y0 < c->L.geo.y)
+                continue;
+            if (!prio && P) { /* not over another point */
+                lbox bp = b;
+                int hit = 0;
+                for (size_t q = 0; q < np && !hit; q++) hit = q != p && overlaps(&P[q], 1, bp);
+                if (hit) continue;
+            }
+            placed = k;
+            B[nb++] = b;
+        }
+        if (placed < 0 && prio) placed = 0; /* the named points always get theirs */
+        if (placed < 0) continue;
+        halo_text(c, prio, fs, x + ox[placed], y + oy[placed], lab, prio ? c->T->ink : c->T->label);
+    }
+    free(P);
+    free(B);
+    free(order);
+}
+
 static void ring(ctx *c, uint32_t p, double rad, const double col[3], double lwf)
 {
     double x, y;
@@ -387,7 +492,7 @@ static void draw_merge(ctx *c)
             double x0 = c->X.ox + c->X.s * lo.x - pad, x1 = c->X.ox + c->X.s * hi.x + pad;
             double y0 = c->X.oy - c->X.s * hi.y - pad, y1 = c->X.oy - c->X.s * lo.y + pad;
             cairo_rectangle(c->cr, x0, y0, x1 - x0, y1 - y0);
-            rgb(c->cr, INK, 0.8);
+            rgb(c->cr, c->T->ink, 0.8);
             cairo_set_line_width(c->cr, 1.5);
             double d[2] = {10, 5};
             cairo_set_dash(c->cr, d, 2, 0);
@@ -427,9 +532,9 @@ static void draw_current(ctx *c, uint32_t *buf, size_t cap)
         if (circum(c->P, v, &ox, &oy, &rr)) {
             cairo_new_sub_path(cr);
             cairo_arc(cr, c->X.ox + c->X.s * ox, c->X.oy - c->X.s * oy, c->X.s * rr, 0, 2 * M_PI);
-            cairo_set_source_rgba(cr, 1.0, 0.85, 0.2, 0.18);
+            rgb(cr, c->T->mark, 0.18);
             cairo_fill_preserve(cr);
-            cairo_set_source_rgba(cr, 0.8, 0.45, 0.0, 0.95);
+            rgb(cr, c->T->disk, 0.95);
             cairo_set_line_width(cr, 2 * c->lw);
             cairo_stroke(cr);
         }
@@ -484,8 +589,7 @@ static void draw_selection(ctx *c)
     if (c->v->sel_point >= 0 && (size_t)c->v->sel_point < c->n) {
         size_t p = (size_t)c->v->sel_point;
         pdt_point q = c->P[p];
-        double col[3] = {0.0, 0.3, 0.9};
-        ring(c, (uint32_t)p, 0.8 * c->L.font, col, 3);
+        ring(c, (uint32_t)p, 0.8 * c->L.font, c->T->select, 3);
         snprintf(lines[nl++], sizeof lines[0], "point %zu at (%d, %d)", p, q.x, q.y);
         if (pdt_replay_kind_count(c->r, PDT_EV_LIFT) > 0) /* a hull run lifts nothing */
             snprintf(lines[nl++], sizeof lines[0], "lifted z = %lld%s",
@@ -518,14 +622,14 @@ static void draw_selection(ctx *c)
                 cairo_move_to(cr, x, y);
                 wpt(c, b, &x, &y);
                 cairo_line_to(cr, x, y);
-                cairo_set_source_rgba(cr, 0.0, 0.3, 0.9, 0.9);
+                rgb(cr, c->T->select, 0.9);
                 cairo_set_line_width(cr, 5);
                 cairo_stroke(cr);
                 double dx = (double)c->P[b].x - c->P[a].x, dy = (double)c->P[b].y - c->P[a].y;
                 snprintf(lines[nl++], sizeof lines[0], "edge %u–%u, length %.1f", a, b, sqrt(dx * dx + dy * dy));
             }
             tri_path(c, t->v);
-            cairo_set_source_rgba(cr, 0.0, 0.3, 0.9, 0.9);
+            rgb(cr, c->T->select, 0.9);
             cairo_set_line_width(cr, 3);
             cairo_stroke(cr);
             uint32_t w[3];
@@ -548,12 +652,12 @@ static void draw_selection(ctx *c)
     pdt_rect R = {c->L.geo.x + 0.5 * f, c->L.geo.y + c->L.geo.h - (nl + 0.8) * 1.3 * f, w + 1.2 * f,
                   (nl + 0.5) * 1.3 * f};
     cairo_rectangle(cr, R.x, R.y, R.w, R.h);
-    cairo_set_source_rgba(cr, 1, 1, 1, 0.92);
+    rgb(cr, c->T->bg, 0.92);
     cairo_fill_preserve(cr);
-    cairo_set_source_rgb(cr, 0.0, 0.3, 0.9);
+    rgb(cr, c->T->select, 1);
     cairo_set_line_width(cr, 1.5);
     cairo_stroke(cr);
-    rgb(cr, INK, 1);
+    rgb(cr, c->T->ink, 1);
     for (int i = 0; i < nl; i++) text_at(cr, SANS, i == 0, f, R.x + 0.6 * f, R.y + (i + 1.1) * 1.3 * f, lines[i]);
 }
 
@@ -579,6 +683,7 @@ void pdt_draw_geometry(ctx *c)
     draw_merge(c);
     draw_points(c);
     if (buf) draw_current(c, buf, 2 * cap);
+    draw_labels(c);
     draw_boxes(c, cur_tri, 1);
     draw_selection(c);
     free(buf);

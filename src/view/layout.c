@@ -2,6 +2,8 @@
  * transform between the screen and the world of the geometry area. */
 #include "render_int.h"
 
+static void layout_round(pdt_layout *L);
+
 /* ---- view and layout ----------------------------------------------------------- */
 
 void pdt_view_defaults(pdt_view *v)
@@ -15,6 +17,19 @@ void pdt_view_defaults(pdt_view *v)
     v->sel_point = v->sel_tri = -1;
     v->sel_edge = -1;
     v->panels = PDT_PANEL_ALL;
+    v->font_scale = 1;
+    v->theme = PDT_THEME_LIGHT;
+}
+
+int pdt_theme_parse(const char *name, int *theme)
+{
+    static const char *const names[PDT_THEME_COUNT] = {"light", "dark", "contrast"};
+    for (int i = 0; i < PDT_THEME_COUNT; i++)
+        if (!strcmp(name, names[i])) {
+            *theme = i;
+            return 0;
+        }
+    return -1;
 }
 
 int pdt_panels_parse(const char *list, unsigned *panels)
@@ -45,15 +60,50 @@ void pdt_render_layout(double w, double h, int nranks, pdt_layout *L)
 
 void pdt_render_layout_panels(double w, double h, int nranks, unsigned panels, pdt_layout *L)
 {
-    double f = h / 46;
-    if (f > w / 72) f = w / 72;
-    if (f < 10) f = 10;
+    pdt_render_layout_scaled(w, h, nranks, panels, 1, L);
+}
+
+void pdt_render_layout_view(double w, double h, int nranks, const pdt_view *v, pdt_layout *L)
+{
+    pdt_render_layout_scaled(w, h, nranks, v ? v->panels : PDT_PANEL_ALL, v ? v->font_scale : 1, L);
+}
+
+void pdt_render_layout_scaled(double w, double h, int nranks, unsigned panels, double scale,
+                              pdt_layout *L)
+{
+    /* the base font: 1/40 of the height or 1/54 of the width, whichever is
+     * smaller (19 px at 1024x768); panel text is 0.9 of it, point labels 0.72 */
+    if (!(scale > 0)) scale = 1;
+    if (scale < 0.4) scale = 0.4;
+    if (scale > 4) scale = 4;
+    double f = fmin(h / 40, w / 54) * scale;
+    if (f < 8) f = 8;
     L->font = f;
+    L->body = 0.9 * f;
+    L->label = 0.72 * f;
     double top = 2.0 * f;
     int rows = nranks < 1 ? 1 : nranks > 16 ? 16 : nranks;
     double tl = (rows + 1.6) * f * 1.15;
     if (tl > 0.28 * h) tl = 0.28 * h;
     if (!(panels & PDT_PANEL_TIMELINE)) tl = 0;
+    int has_code = (panels & PDT_PANEL_CODE) != 0, has_stack = (panels & PDT_PANEL_STACK) != 0,
+        has_lifted = (panels & PDT_PANEL_LIFTED) != 0;
+    if (!has_code && !has_stack && !has_lifted) {
+        /* no side column: the picture takes the whole width, the legend is
+         * a strip under it (its items flow in rows) */
+        int lrows = (int)ceil(64 * f / fmax(w - f, f));
+        if (lrows < 1) lrows = 1;
+        if (lrows > 4) lrows = 4;
+        double leg = lrows * 1.45 * f + 0.6 * f;
+        double mid = h - tl - top - leg;
+        L->top = (pdt_rect){0, 0, w, top};
+        L->geo = (pdt_rect){0, top, w, mid};
+        L->legend = (pdt_rect){0, top + mid, w, leg};
+        L->timeline = (pdt_rect){0, h - tl, tl > 0 ? w : 0, tl};
+        L->code = L->stack = L->lifted = (pdt_rect){w, top, 0, 0};
+        layout_round(L);
+        return;
+    }
     double side = 0.34 * w;
     if (side < 22 * f) side = 22 * f;
     if (side > 0.5 * w) side = 0.5 * w;
@@ -62,8 +112,6 @@ void pdt_render_layout_panels(double w, double h, int nranks, unsigned panels, p
     double mid = h - tl - top;
     L->geo = (pdt_rect){0, top, w - side, mid};
     double x = w - side, y = top;
-    int has_code = (panels & PDT_PANEL_CODE) != 0, has_stack = (panels & PDT_PANEL_STACK) != 0,
-        has_lifted = (panels & PDT_PANEL_LIFTED) != 0;
     double leg = 7.6 * f, code = has_code ? 12.2 * f * 0.9 : 0;
     double rest = mid - leg - code;
     if (has_code && rest < 10 * f) { /* small pictures: shrink the code panel first */
@@ -78,7 +126,12 @@ void pdt_render_layout_panels(double w, double h, int nranks, unsigned panels, p
     L->code = (pdt_rect){x, y + leg, has_code ? side : 0, code};
     L->stack = (pdt_rect){x, y + leg + code, has_stack ? side : 0, stk};
     L->lifted = (pdt_rect){x, y + leg + code + stk, has_lifted ? side : 0, lifted};
-    /* whole pixels: clipping to them stays a fast box clip */
+    layout_round(L);
+}
+
+/* Whole pixels: clipping to them stays a fast box clip. */
+static void layout_round(pdt_layout *L)
+{
     pdt_rect *all[] = {&L->top, &L->geo, &L->legend, &L->code, &L->stack, &L->lifted, &L->timeline};
     for (size_t i = 0; i < sizeof all / sizeof *all; i++) {
         double x1 = round(all[i]->x + all[i]->w), y1 = round(all[i]->y + all[i]->h);
@@ -92,7 +145,7 @@ void pdt_render_layout_panels(double w, double h, int nranks, unsigned panels, p
 xform pdt_geo_xform(const pdt_replay *r, const pdt_view *v, double w, double h)
 {
     pdt_layout L;
-    pdt_render_layout_panels(w, h, pdt_replay_nranks(r), v->panels, &L);
+    pdt_render_layout_view(w, h, pdt_replay_nranks(r), v, &L);
     pdt_point lo = {0, 0}, hi = {1, 1};
     pdt_replay_bbox(r, &lo, &hi);
     double bw = (double)hi.x - lo.x, bh = (double)hi.y - lo.y;
@@ -127,7 +180,7 @@ void pdt_view_zoom_at(const pdt_replay *r, pdt_view *v, double w, double h, doub
     double wx, wy, cx, cy;
     pdt_view_to_world(r, v, w, h, sx, sy, &wx, &wy);
     pdt_layout L;
-    pdt_render_layout_panels(w, h, pdt_replay_nranks(r), v->panels, &L);
+    pdt_render_layout_view(w, h, pdt_replay_nranks(r), v, &L);
     pdt_view_to_world(r, v, w, h, L.geo.x + L.geo.w / 2, L.geo.y + L.geo.h / 2, &cx, &cy);
     v->zoom *= f;
     if (v->zoom < 0.05) v->zoom = 0.05;

@@ -21,7 +21,7 @@ void pdt_draw_lifted(ctx *c)
     cairo_t *cr = c->cr;
     pdt_rect R = c->L.lifted;
     double f = c->L.font;
-    panel(cr, R, "Lifted view: z = x² + y² (drag to rotate)", f);
+    panel(cr, c->T, R, "Lifted view: z = x² + y² (drag to rotate)", f);
     cairo_save(cr);
     clip_rect(cr, R);
     pdt_point lo = {0, 0}, hi = {1, 1};
@@ -42,7 +42,7 @@ void pdt_draw_lifted(ctx *c)
     J.oy = top + H / 2 + J.s * (J.cp * 1.0);
     /* the paraboloid: rings and meridians */
     cairo_set_line_width(cr, 1);
-    cairo_set_source_rgba(cr, 0.5, 0.55, 0.65, 0.5);
+    rgb(cr, c->T->hollow, 0.5);
     for (int ring_i = 1; ring_i <= 5; ring_i++) {
         double rho = 0.28 * ring_i;
         for (int i = 0; i <= 48; i++) {
@@ -92,9 +92,9 @@ void pdt_draw_lifted(ctx *c)
                 else cairo_move_to(cr, sx, sy);
             }
             cairo_close_path(cr);
-            cairo_set_source_rgba(cr, 1.0, 0.8, 0.2, 0.22);
+            rgb(cr, c->T->mark, 0.22);
             cairo_fill_preserve(cr);
-            cairo_set_source_rgba(cr, 0.8, 0.45, 0.0, 0.7);
+            rgb(cr, c->T->disk, 0.7);
             cairo_set_line_width(cr, 1);
             cairo_stroke(cr);
         }
@@ -124,8 +124,8 @@ void pdt_draw_lifted(ctx *c)
             }
         }
         if (cls == 2) rgb(cr, RED, 1);
-        else if (cls == 1) rgb(cr, INK, 0.85);
-        else cairo_set_source_rgba(cr, 0.6, 0.6, 0.6, 0.5);
+        else if (cls == 1) rgb(cr, c->T->ink, 0.85);
+        else rgb(cr, c->T->hollow, 0.5);
         cairo_fill(cr);
     }
     if (have_plane) {
@@ -144,14 +144,14 @@ void pdt_draw_lifted(ctx *c)
         char lab[128];
         snprintf(lab, sizeof lab, "%zu input point%s strictly inside the circle (exact, no tie rule)",
                  ninside, ninside == 1 ? "" : "s");
-        rgb(cr, ninside ? RED : INK, 1);
+        rgb(cr, ninside ? RED : c->T->ink, 1);
         text_at(cr, SANS, 0, 0.72 * f, R.x + 0.5 * f, R.y + R.h - 1.4 * f, lab);
-        rgb(cr, INK, 1);
+        rgb(cr, c->T->ink, 1);
         text_at(cr, SANS, 0, 0.72 * f, R.x + 0.5 * f, R.y + R.h - 0.5 * f,
                 "those already lifted: below the plane (red)");
     }
     if (c->no_lift) {
-        rgb(cr, INK, 1);
+        rgb(cr, c->T->ink, 1);
         text_at(cr, SANS, 0, 0.8 * f, R.x + 0.5 * f, R.y + R.h - 0.5 * f,
                 "no lift-up in this run (points stay on the floor)");
     }

@@ -4,19 +4,21 @@
 #include "pdt/describe.h"
 #include "render_int.h"
 
+static void draw_prompt(ctx *c);
+
 
 void pdt_draw_top(ctx *c)
 {
     cairo_t *cr = c->cr;
     pdt_rect R = c->L.top;
     cairo_rectangle(cr, R.x, R.y, R.w, R.h);
-    cairo_set_source_rgb(cr, 0.93, 0.94, 0.96);
+    rgb(cr, c->T->topbar, 1);
     cairo_fill(cr);
     char line[512], head[64];
     pdt_replay_describe_state(c->r, c->s, c->s->k, line, sizeof line);
     snprintf(head, sizeof head, "%zu / %zu", c->s->k, pdt_replay_count(c->r));
     double f = c->L.font;
-    rgb(cr, INK, 0.7);
+    rgb(cr, c->T->ink, 0.7);
     text_at(cr, MONO, 0, 0.9 * f, 0.5 * f, 1.35 * f, head);
     double x = 0.5 * f + text_w(cr, MONO, 0.9 * f, head) + 1.0 * f;
     if (c->cur) {
@@ -25,13 +27,48 @@ void pdt_draw_top(ctx *c)
         cairo_fill(cr);
         x += 1.1 * f;
     }
-    rgb(cr, INK, 1);
-    text_at(cr, SANS, 1, 1.05 * f, x, 1.4 * f, line);
+    /* the event line gets the bar; the status goes under it, at the
+     * picture's top right, when both do not fit */
+    double room = R.w - x - 0.5 * f, sw = 0, sf = 0.85 * f;
+    if (c->v->status) sw = text_w(cr, SANS, sf, c->v->status) + 1.2 * f;
+    double fs = 1.05 * f, lw = text_wb(cr, SANS, 1, fs, line);
+    int status_in_bar = c->v->status && lw + sw <= room;
+    double avail = status_in_bar ? room - sw : room;
+    if (lw > avail) fs = fmax(0.8 * f, fs * avail / lw);
+    rgb(cr, c->T->ink, 1);
+    cairo_save(cr);
+    clip_rect(cr, (pdt_rect){R.x, R.y, x + avail, R.h});
+    text_at(cr, SANS, 1, fs, x, 1.4 * f, line);
+    cairo_restore(cr);
     if (c->v->status) {
-        double tw = text_w(cr, SANS, 0.85 * f, c->v->status);
-        rgb(cr, INK, 0.7);
-        text_at(cr, SANS, 0, 0.85 * f, R.w - tw - 0.6 * f, 1.35 * f, c->v->status);
+        double tw = sw - 1.2 * f;
+        double sx = R.w - tw - 0.6 * f, sy = status_in_bar ? 1.35 * f : R.y + R.h + 1.1 * f;
+        if (!status_in_bar) {
+            cairo_rectangle(cr, sx - 0.3 * f, sy - 0.95 * sf, tw + 0.6 * f, 1.3 * sf);
+            rgb(cr, c->T->topbar, 0.9);
+            cairo_fill(cr);
+        }
+        rgb(cr, c->T->ink, 0.75);
+        text_at(cr, SANS, 0, sf, sx, sy, c->v->status);
     }
+    if (c->v->prompt) draw_prompt(c);
+}
+
+/* The line being typed (go to event N), in a box under the event line. */
+static void draw_prompt(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    double f = c->L.font, fs = 1.2 * f;
+    double tw = text_wb(cr, SANS, 1, fs, c->v->prompt);
+    pdt_rect B = {c->L.geo.x + 0.6 * f, c->L.geo.y + 0.6 * f, tw + 1.4 * f, 1.9 * fs};
+    cairo_rectangle(cr, B.x, B.y, B.w, B.h);
+    rgb(cr, c->T->panel, 0.97);
+    cairo_fill_preserve(cr);
+    rgb(cr, c->T->select, 1);
+    cairo_set_line_width(cr, 3);
+    cairo_stroke(cr);
+    rgb(cr, c->T->ink, 1);
+    text_at(cr, SANS, 1, fs, B.x + 0.7 * f, B.y + 1.3 * fs, c->v->prompt);
 }
 
 static void legend_line(cairo_t *cr, double x, double y, double len, int st, double lw,
@@ -50,12 +87,12 @@ void pdt_draw_legend(ctx *c)
     cairo_t *cr = c->cr;
     pdt_rect R = c->L.legend;
     double f = c->L.font, fs = 0.8 * f;
-    panel(cr, R, "Legend", f);
+    panel(cr, c->T, R, "Legend", f);
     cairo_save(cr);
     clip_rect(cr, R);
     /* ranks */
     double x = R.x + 0.5 * f, y = R.y + 2.3 * f;
-    rgb(cr, INK, 1);
+    rgb(cr, c->T->ink, 1);
     text_at(cr, SANS, 0, fs, x, y, "ranks:");
     x += text_w(cr, SANS, fs, "ranks:") + 0.4 * f;
     for (int q = 0; q < c->nranks; q++) {
@@ -69,7 +106,7 @@ void pdt_draw_legend(ctx *c)
         cairo_rectangle(cr, x, y - 0.75 * f, 0.8 * f, 0.8 * f);
         set_rank(cr, q, shown(c, (uint32_t)q) ? 1 : 0.2);
         cairo_fill(cr);
-        rgb(cr, INK, shown(c, (uint32_t)q) ? 1 : 0.4);
+        rgb(cr, c->T->ink, shown(c, (uint32_t)q) ? 1 : 0.4);
         text_at(cr, SANS, 0, fs, x + 0.95 * f, y, lab);
         x += 1.3 * f + tw;
     }
@@ -90,7 +127,7 @@ void pdt_draw_legend(ctx *c)
             rgb(cr, RED, 1);
             cairo_stroke(cr);
         }
-        rgb(cr, INK, 1);
+        rgb(cr, c->T->ink, 1);
         text_at(cr, SANS, 0, fs, lx + 2.6 * f, ly, names[i]);
     }
     {   /* hull, in the sixth cell */
@@ -98,41 +135,41 @@ void pdt_draw_legend(ctx *c)
         cairo_set_line_width(cr, 3.2 * lw);
         cairo_move_to(cr, lx, ly - 0.3 * f);
         cairo_line_to(cr, lx + 2.2 * f, ly - 0.3 * f);
-        cairo_set_source_rgb(cr, 0.6 * col0[0], 0.6 * col0[1], 0.6 * col0[2]);
+        set_hull(c, 0, 1);
         cairo_stroke(cr);
-        rgb(cr, INK, 1);
+        rgb(cr, c->T->ink, 1);
         text_at(cr, SANS, 0, fs, lx + 2.6 * f, ly, "hull / stack");
     }
     /* markers */
     double ly = R.y + 7.05 * f, lx = R.x + 0.5 * f;
     cairo_new_sub_path(cr);
     cairo_arc(cr, lx + 0.4 * f, ly - 0.3 * f, 0.25 * f, 0, 2 * M_PI);
-    rgb(cr, INK, 1);
+    rgb(cr, c->T->ink, 1);
     cairo_fill(cr);
     text_at(cr, SANS, 0, fs, lx + 0.9 * f, ly, "lifted");
     lx += 0.9 * f + text_w(cr, SANS, fs, "lifted") + 0.8 * f;
     cairo_new_sub_path(cr);
     cairo_arc(cr, lx + 0.4 * f, ly - 0.3 * f, 0.25 * f, 0, 2 * M_PI);
-    cairo_set_source_rgb(cr, 0.55, 0.55, 0.55);
+    rgb(cr, c->T->hollow, 1);
     cairo_set_line_width(cr, 1);
     cairo_stroke(cr);
-    rgb(cr, INK, 1);
+    rgb(cr, c->T->ink, 1);
     text_at(cr, SANS, 0, fs, lx + 0.9 * f, ly, "not yet");
     lx += 0.9 * f + text_w(cr, SANS, fs, "not yet") + 0.8 * f;
     cairo_set_line_width(cr, 0.15 * f);
     cross(cr, lx + 0.4 * f, ly - 0.3 * f, 0.3 * f);
     rgb(cr, RED, 1);
     cairo_stroke(cr);
-    rgb(cr, INK, 1);
+    rgb(cr, c->T->ink, 1);
     text_at(cr, SANS, 0, fs, lx + 0.9 * f, ly, "deleted");
     lx += 0.9 * f + text_w(cr, SANS, fs, "deleted") + 0.8 * f;
     cairo_new_sub_path(cr);
     cairo_arc(cr, lx + 0.4 * f, ly - 0.3 * f, 0.35 * f, 0, 2 * M_PI);
-    cairo_set_source_rgba(cr, 1.0, 0.85, 0.2, 0.4);
+    rgb(cr, c->T->mark, 0.4);
     cairo_fill_preserve(cr);
-    cairo_set_source_rgb(cr, 0.8, 0.45, 0.0);
+    rgb(cr, c->T->disk, 1);
     cairo_stroke(cr);
-    rgb(cr, INK, 1);
+    rgb(cr, c->T->ink, 1);
     text_at(cr, SANS, 0, fs, lx + 0.95 * f, ly, "circumdisk (RA)");
     cairo_restore(cr);
 }
@@ -144,7 +181,7 @@ void pdt_draw_code(ctx *c)
     double f = c->L.font;
     int id;
     int line = pdt_replay_code_line(c->r, c->s, &id);
-    panel(cr, R, pdt_code_title(id), f);
+    panel(cr, c->T, R, pdt_code_title(id), f);
     cairo_save(cr);
     clip_rect(cr, R);
     int nl = (int)pdt_code_count(id);
@@ -159,10 +196,10 @@ void pdt_draw_code(ctx *c)
         double y = R.y + 1.7 * f + (i + 1) * lh;
         if (i == line) {
             cairo_rectangle(cr, R.x + 0.3 * f, y - 0.85 * lh, R.w - 0.6 * f, lh);
-            cairo_set_source_rgba(cr, 1.0, 0.85, 0.2, 0.8);
+            rgb(cr, c->T->mark, 0.8);
             cairo_fill(cr);
         }
-        rgb(cr, INK, 1);
+        rgb(cr, c->T->ink, 1);
         text_at(cr, MONO, i == line, fs, R.x + 0.6 * f, y - 0.18 * lh, pdt_code_text(id, (size_t)i));
     }
     cairo_restore(cr);
@@ -181,10 +218,10 @@ void pdt_draw_stack_panel(ctx *c)
     cairo_t *cr = c->cr;
     pdt_rect R = c->L.stack;
     double f = c->L.font;
-    panel(cr, R, "Stacks being built (top at the right ▸)", f);
+    panel(cr, c->T, R, "Stacks being built (top at the right ▸)", f);
     cairo_save(cr);
     clip_rect(cr, R);
-    double fs = 0.75 * f, lh = 1.15 * fs, y = R.y + 1.6 * f + lh;
+    double fs = c->L.body, lh = 1.2 * fs, y = R.y + 1.6 * f + lh;
     uint32_t *buf = malloc((c->n + 1) * sizeof *buf);
     int any = 0;
     for (int q = 0; q < c->nranks && buf; q++) {
@@ -212,7 +249,7 @@ void pdt_draw_stack_panel(ctx *c)
                 first--;
             }
             double x = x0;
-            rgb(cr, INK, 1);
+            rgb(cr, c->T->ink, 1);
             if (first > 0) {
                 text_at(cr, MONO, 0, fs, x, y, "…");
                 x += text_w(cr, MONO, fs, "… ");
@@ -228,7 +265,7 @@ void pdt_draw_stack_panel(ctx *c)
         }
     }
     if (!any) {
-        rgb(cr, INK, 0.5);
+        rgb(cr, c->T->ink, 0.5);
         text_at(cr, SANS, 0, fs, R.x + 0.5 * f, y, "(no stack in use)");
     }
     free(buf);
@@ -244,13 +281,21 @@ void pdt_draw_help(ctx *c, double w, double h)
         {"k", "select the kind: push/pop, lift-up, rejection, merge, triangle"},
         {"PgDn  PgUp", "next / previous phase"},
         {"Home  End", "first / last event"},
+        {"g N Enter", "go to event N (cursor N)"},
+        {"Ctrl + → ←", "next / previous event of the current event's rank"},
+        {"timeline click", "seek to the clicked rank's nearest event"},
         {"+  −", "faster / slower playback"},
         {"1 … 9", "show / hide rank 0 … 8"},
         {"0", "show all ranks"},
         {"wheel", "zoom at the cursor"},
         {"drag", "pan (in the lifted view: rotate)"},
-        {"click", "details of a point, edge or triangle; timeline: seek"},
+        {"click", "details of a point, edge or triangle (its circle drawn)"},
         {"f", "fit the points in the window"},
+        {"Ctrl + =  −  0", "larger / smaller / default text"},
+        {"F11", "full screen"},
+        {"t", "theme: light, dark, high contrast"},
+        {"c", "clean picture (final triangles by rank)"},
+        {"o  v", "all circumcircles / Voronoi diagram"},
         {"h  ?", "this help"},
         {"s", "screenshot (PNG)"},
         {"m  r", "mark an event; record mark → current as GIF/video"},
@@ -258,7 +303,7 @@ void pdt_draw_help(ctx *c, double w, double h)
     };
     int nk = (int)(sizeof keys / sizeof *keys);
     cairo_t *cr = c->cr;
-    double f = c->L.font * 1.05, kw = 0, dw = 0;
+    double f = fmin(c->L.font * 1.05, 0.96 * h / ((nk + 2.6) * 1.45)), kw = 0, dw = 0;
     for (int i = 0; i < nk; i++) {
         kw = fmax(kw, text_wb(cr, MONO, 1, 0.9 * f, keys[i][0]));
         dw = fmax(dw, text_w(cr, SANS, 0.9 * f, keys[i][1]));
@@ -269,9 +314,9 @@ void pdt_draw_help(ctx *c, double w, double h)
     cairo_set_source_rgba(cr, 0, 0, 0, 0.35);
     cairo_fill(cr);
     cairo_rectangle(cr, bx, by, bw, bh);
-    cairo_set_source_rgba(cr, 1, 1, 1, 0.97);
+    rgb(cr, c->T->panel, 0.97);
     cairo_fill_preserve(cr);
-    rgb(cr, INK, 1);
+    rgb(cr, c->T->ink, 1);
     cairo_set_line_width(cr, 2);
     cairo_stroke(cr);
     text_at(cr, SANS, 1, 1.2 * f, bx + f, by + 1.7 * f, "Keys");

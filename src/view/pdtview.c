@@ -48,6 +48,8 @@ typedef struct opts {
     const char *edit;  /* --edit FILE: the point editor */
     int ranks, hull;
     uint64_t bench_live; /* --bench-live N: editor re-run figures on N points */
+    double font_scale;
+    int theme, fullscreen, clean, circles, voronoi;
 } opts;
 
 static const char help_text[] =
@@ -55,6 +57,8 @@ static const char help_text[] =
     "               [--panels code,stack,lifted,timeline|all|none]\n"
     "               [--script KEYS] [--screenshot FILE.png] [--speed EV_PER_S]\n"
     "               [--record FILE.gif|.mp4|.webm] [--fps F] [--every K]\n"
+    "               [--font-scale F] [--theme light|dark|contrast] [--fullscreen]\n"
+    "               [--clean] [--circles] [--voronoi]\n"
     "       pdtview --headless RUN (--at N | --phase NAME | --end) -o FILE.png|.svg|.pdf\n"
     "               [--size WxH]\n"
     "       pdtview --headless RUN --frames DIR --every K [--size WxH]\n"
@@ -109,7 +113,8 @@ static int parse_args(int argc, char **argv, opts *o)
     o->h = 1000;
     o->speed = 20;
     o->panels = PDT_PANEL_ALL;
-    const char *size = NULL, *panels = NULL;
+    const char *size = NULL, *panels = NULL, *theme = NULL;
+    o->font_scale = 1;
     uint64_t at = UINT64_MAX, every = UINT64_MAX, from = UINT64_MAX, to = UINT64_MAX,
              ranks = 1;
     double hold = 0;
@@ -144,6 +149,12 @@ static int parse_args(int argc, char **argv, opts *o)
         {"--hull", NULL, PDT_OPT_FLAG, &o->hull},
         {"--ranks", NULL, PDT_OPT_U64, &ranks},
         {"--bench-live", NULL, PDT_OPT_U64, &o->bench_live},
+        {"--font-scale", NULL, PDT_OPT_POSNUM, &o->font_scale},
+        {"--theme", NULL, PDT_OPT_STR, &theme},
+        {"--fullscreen", NULL, PDT_OPT_FLAG, &o->fullscreen},
+        {"--clean", NULL, PDT_OPT_FLAG, &o->clean},
+        {"--circles", NULL, PDT_OPT_FLAG, &o->circles},
+        {"--voronoi", NULL, PDT_OPT_FLAG, &o->voronoi},
         {NULL, NULL, PDT_OPT_FLAG, NULL},
     };
     const char *pos[1];
@@ -194,6 +205,10 @@ static int parse_args(int argc, char **argv, opts *o)
     if (panels && pdt_panels_parse(panels, &o->panels) != 0)
         return pdt_cli_usage(PROG, "--panels needs a list of code, stack, lifted, timeline (or all, "
                                    "none), not '%s'", panels);
+    if (o->font_scale < 0.4 || o->font_scale > 4)
+        return pdt_cli_usage(PROG, "--font-scale needs a number 0.4 .. 4, not '%g'", o->font_scale);
+    if (theme && pdt_theme_parse(theme, &o->theme) != 0)
+        return pdt_cli_usage(PROG, "--theme needs light, dark or contrast, not '%s'", theme);
     if (o->hide && !valid_rank_list(o->hide))
         return pdt_cli_usage(PROG, "--hide needs rank numbers separated by commas, not '%s'", o->hide);
     if (o->headless && !o->out && !o->frames && !o->bench && !o->counts && !o->gif && !o->video)
@@ -549,7 +564,7 @@ static int edit(const opts *o)
     char title[512];
     snprintf(title, sizeof title, "editing %s", o->edit);
     pdt_shell_opts so = {o->w, o->h, title, o->script, o->screenshot, o->speed,
-                         o->record, o->fps, o->every, pdt_editor_hook(ed)};
+                         o->record, o->fps, o->every, pdt_editor_hook(ed), o->fullscreen};
     int rc = pdt_shell_run(pdt_editor_replay(ed), pdt_editor_state(ed), &v, &so);
     pdt_editor_free(ed);
     return rc;
@@ -682,6 +697,11 @@ int main(int argc, char **argv)
     pdt_view_defaults(&v);
     v.hidden = hidden;
     v.panels = o.panels;
+    v.font_scale = o.font_scale;
+    v.theme = o.theme;
+    v.clean = o.clean;
+    v.circles = o.circles;
+    v.voronoi = o.voronoi;
     if (o.check) {
         rc = check(r);
     } else if (o.describe) {
@@ -702,7 +722,7 @@ int main(int argc, char **argv)
         rc = headless(r, s, &v, &o, &err);
     } else {
         pdt_shell_opts so = {o.w, o.h, o.run, o.script, o.screenshot, o.speed,
-                             o.record, o.fps, o.every, NULL};
+                             o.record, o.fps, o.every, NULL, o.fullscreen};
         rc = pdt_shell_run(r, s, &v, &so);
     }
 out:

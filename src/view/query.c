@@ -137,3 +137,31 @@ int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
     }
 }
 
+
+size_t pdt_replay_find_rank(const pdt_replay *r, size_t k, int dir, int rank)
+{
+    size_t m = pdt_replay_count(r);
+    if (k > m) k = m;
+    if (dir > 0) {
+        for (size_t i = k; i < m; i++)
+            if (pdt_replay_rec(r, i)->rank == (uint32_t)rank) return i + 1;
+    } else {
+        for (size_t i = k > 1 ? k - 1 : 0; i-- > 0;)
+            if (pdt_replay_rec(r, i)->rank == (uint32_t)rank) return i + 1;
+    }
+    return k;
+}
+
+size_t pdt_replay_nearest_of_rank(const pdt_replay *r, size_t k, int rank)
+{
+    size_t m = pdt_replay_count(r);
+    if (m == 0) return (size_t)-1;
+    size_t e = k ? k - 1 : 0; /* the event at that cursor */
+    if (e >= m) e = m - 1;
+    for (size_t d = 0; d < m; d++) {
+        if (e + d < m && pdt_replay_rec(r, e + d)->rank == (uint32_t)rank) return e + d + 1;
+        if (d <= e && pdt_replay_rec(r, e - d)->rank == (uint32_t)rank) return e - d + 1;
+        if (e + d >= m && d > e) break;
+    }
+    return (size_t)-1;
+}

@@ -27,6 +27,32 @@ void pdt_rank_rgb(int rank, double rgb[3])
         rgb[i] = cycle == 0 ? c[i] : cycle == 1 ? 0.55 * c[i] : c[i] + 0.5 * (1 - c[i]);
 }
 
+static const pdt_theme themes[PDT_THEME_COUNT] = {
+    {   /* light */
+        .bg = {1, 1, 1}, .panel = {0.975, 0.975, 0.97}, .border = {0.72, 0.72, 0.72},
+        .topbar = {0.93, 0.94, 0.96}, .ink = {0.1, 0.1, 0.12}, .hollow = {0.55, 0.55, 0.55},
+        .label = {0.0, 0.25, 0.55}, .select = {0.0, 0.3, 0.9}, .disk = {0.8, 0.45, 0.0},
+        .mark = {1.0, 0.85, 0.2}, .hull = 0.4, .tint = 1, .lwf = 1,
+    },
+    {   /* dark */
+        .bg = {0.09, 0.09, 0.11}, .panel = {0.14, 0.14, 0.17}, .border = {0.35, 0.35, 0.4},
+        .topbar = {0.17, 0.18, 0.22}, .ink = {0.93, 0.93, 0.9}, .hollow = {0.6, 0.6, 0.62},
+        .label = {0.65, 0.85, 1.0}, .select = {0.35, 0.75, 1.0}, .disk = {1.0, 0.65, 0.2},
+        .mark = {0.75, 0.6, 0.1}, .hull = 0.35, .tint = 1.6, .lwf = 1.15,
+    },
+    {   /* contrast */
+        .bg = {1, 1, 1}, .panel = {1, 1, 1}, .border = {0, 0, 0},
+        .topbar = {1, 1, 1}, .ink = {0, 0, 0}, .hollow = {0.25, 0.25, 0.25},
+        .label = {0, 0, 0}, .select = {0.0, 0.2, 0.8}, .disk = {0.6, 0.3, 0.0},
+        .mark = {1.0, 0.8, 0.0}, .hull = 0.55, .tint = 0, .lwf = 1.6,
+    },
+};
+
+const pdt_theme *pdt_theme_get(int id)
+{
+    return &themes[id >= 0 && id < PDT_THEME_COUNT ? id : 0];
+}
+
 /* Line style of a status: width factor and dash. */
 void pdt_status_style(cairo_t *cr, int st, double lw)
 {
@@ -71,7 +97,8 @@ pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, cons
     c.v = v;
     c.nranks = pdt_replay_nranks(r);
     c.P = pdt_replay_points(r, &c.n);
-    pdt_render_layout_panels(w, h, c.nranks, v->panels, &c.L);
+    c.T = pdt_theme_get(v->theme);
+    pdt_render_layout_view(w, h, c.nranks, v, &c.L);
     c.X = pdt_geo_xform(r, v, w, h);
     c.cur = s->k ? pdt_replay_rec(r, s->k - 1) : NULL;
     c.all_lifted = pdt_replay_kind_count(r, PDT_EV_LIFT) == 0 &&
@@ -84,12 +111,12 @@ pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, cons
     pdt_point lo, hi;
     if (pdt_replay_bbox(r, &lo, &hi))
         spacing = c.X.s * sqrt(fmax(1.0, ((double)hi.x - lo.x) * ((double)hi.y - lo.y)) / (double)(c.n ? c.n : 1));
-    c.lw = fmax(0.5, fmin(0.16 * c.L.font, spacing / 9));
+    c.lw = fmax(0.5, fmin(0.16 * c.L.font, spacing / 9)) * c.T->lwf;
     c.spacing = spacing;
 
     cairo_save(cr);
     cairo_rectangle(cr, 0, 0, w, h);
-    cairo_set_source_rgb(cr, 1, 1, 1);
+    rgb(cr, c.T->bg, 1);
     cairo_fill(cr);
     pdt_draw_geometry(&c);
     pdt_draw_top(&c);

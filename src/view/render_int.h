@@ -31,7 +31,27 @@
 
 #define PDT_UNUSED __attribute__((unused))
 static const double RED[3] PDT_UNUSED = {0.85, 0.0, 0.0};
-static const double INK[3] PDT_UNUSED = {0.1, 0.1, 0.12};
+
+/* The colours of a theme (pdt_view.theme).  Rank colours are the same in
+ * every theme (pdt_rank_rgb). */
+typedef struct pdt_theme {
+    double bg[3];       /* picture background */
+    double panel[3];    /* panel background */
+    double border[3];   /* panel border */
+    double topbar[3];   /* event line background */
+    double ink[3];      /* text, lifted points, hull-ish marks */
+    double hollow[3];   /* points not yet lifted */
+    double label[3];    /* point labels */
+    double select[3];   /* the clicked point, edge or triangle */
+    double disk[3];     /* circumdisk outline */
+    double mark[3];     /* current code line, disk fill */
+    double hull;        /* hull colour = rank colour mixed towards ink by this */
+    double tint;        /* strip box tint (0: none) */
+    double lwf;         /* line width factor */
+} pdt_theme;
+
+/* The theme of id PDT_THEME_* (light for an unknown id). */
+const pdt_theme *pdt_theme_get(int id);
 
 /* World -> screen of the geometry area: screen = (ox + s*x, oy - s*y). */
 typedef struct xform {
@@ -57,6 +77,7 @@ typedef struct ctx {
     int all_lifted;      /* no lift events but triangles: show every point lifted */
     int no_lift;         /* no lift events and no triangles (a hull-only run) */
     double spacing;      /* typical distance between points, pixels */
+    const pdt_theme *T;  /* colours */
 } ctx;
 
 /* The parts of the frame, each clipped to its rectangle of c->L. */
@@ -115,17 +136,19 @@ static inline double text_w(cairo_t *cr, const char *face, double size, const ch
     return text_wb(cr, face, 0, size, s);
 }
 
-static inline void panel(cairo_t *cr, pdt_rect R, const char *title, double f)
+static inline void panel(cairo_t *cr, const pdt_theme *T, pdt_rect R, const char *title, double f)
 {
     cairo_rectangle(cr, R.x + 2, R.y + 2, R.w - 4, R.h - 4);
-    cairo_set_source_rgb(cr, 0.975, 0.975, 0.97);
+    rgb(cr, T->panel, 1);
     cairo_fill_preserve(cr);
-    cairo_set_source_rgb(cr, 0.72, 0.72, 0.72);
+    rgb(cr, T->border, 1);
     cairo_set_line_width(cr, 1);
     cairo_stroke(cr);
     if (title) {
-        rgb(cr, INK, 1);
-        text_at(cr, SANS, 1, 0.85 * f, R.x + 0.5 * f, R.y + 1.15 * f, title);
+        double fs = 0.85 * f, tw = text_wb(cr, SANS, 1, fs, title);
+        if (tw > R.w - f) fs *= fmax(0.7, (R.w - f) / tw); /* long titles: smaller */
+        rgb(cr, T->ink, 1);
+        text_at(cr, SANS, 1, fs, R.x + 0.5 * f, R.y + 1.15 * f, title);
     }
 }
 
@@ -187,6 +210,16 @@ static inline void cross(cairo_t *cr, double x, double y, double a)
     cairo_line_to(cr, x + a, y + a);
     cairo_move_to(cr, x - a, y + a);
     cairo_line_to(cr, x + a, y - a);
+}
+
+/* The colour of rank q's hulls: its rank colour mixed towards the ink. */
+static inline void set_hull(const ctx *c, int q, double alpha)
+{
+    double col[3];
+    pdt_rank_rgb(q, col);
+    double m = c->T->hull;
+    cairo_set_source_rgba(c->cr, (1 - m) * col[0] + m * c->T->ink[0], (1 - m) * col[1] + m * c->T->ink[1],
+                          (1 - m) * col[2] + m * c->T->ink[2], alpha);
 }
 
 /* Line style of a triangle status: width and dash (render.c). */

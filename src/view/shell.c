@@ -6,6 +6,7 @@
  * One quit path (shell_quit).  The frame is drawn at the drawable size, so
  * it is sharp on high-DPI screens; mouse positions are scaled to match. */
 #include "shell.h"
+#include "pdt/query.h"
 
 #include "pdt/anim.h"
 
@@ -43,6 +44,10 @@ typedef struct shell {
     const char *script;
     int wait_frames;
     char status[160];
+    /* go to event N: the number being typed after `g` */
+    int typing;
+    char num[24], prompt[64];
+    int fullscreen;
 } shell;
 
 static void set_status(shell *sh)
@@ -110,9 +115,73 @@ static void record(shell *sh)
                  ao.from, ao.to);
 }
 
+/* The `g` prompt: digits, Backspace, Enter (go), Esc (cancel).  Returns 1
+ * if the key was the prompt's. */
+static int goto_key(shell *sh, SDL_Keycode k)
+{
+    size_t len = strlen(sh->num);
+    if (k >= SDLK_0 && k <= SDLK_9) {
+        if (len + 1 < sizeof sh->num) sh->num[len] = (char)('0' + (k - SDLK_0)), sh->num[len + 1] = 0;
+    } else if (k >= SDLK_KP_1 && k <= SDLK_KP_0) {
+        int d = k == SDLK_KP_0 ? 0 : (int)(k - SDLK_KP_1) + 1;
+        if (len + 1 < sizeof sh->num) sh->num[len] = (char)('0' + d), sh->num[len + 1] = 0;
+    } else if (k == SDLK_BACKSPACE) {
+        if (len) sh->num[len - 1] = 0;
+    } else if (k == SDLK_RETURN || k == SDLK_KP_ENTER) {
+        sh->typing = 0;
+        sh->v->prompt = NULL;
+        if (len) {
+            sh->playing = 0;
+            seek(sh, (size_t)strtoull(sh->num, NULL, 10));
+        }
+        return 1;
+    } else if (k == SDLK_ESCAPE || k == SDLK_g) {
+        sh->typing = 0;
+        sh->v->prompt = NULL;
+        return 1;
+    } else if (k != SDLK_UNKNOWN) {
+        return 1; /* other keys are ignored while typing */
+    }
+    snprintf(sh->prompt, sizeof sh->prompt, "go to event: %s▏  (Enter: go, Esc: cancel)", sh->num);
+    sh->v->prompt = sh->prompt;
+    return 1;
+}
+
+static void set_font_scale(shell *sh, double f)
+{
+    sh->v->font_scale = fmin(4, fmax(0.4, f));
+}
+
 static void key(shell *sh, SDL_Keycode k, Uint16 mod)
 {
-    int shift = (mod & KMOD_SHIFT) != 0;
+    int shift = (mod & KMOD_SHIFT) != 0, ctrl = (mod & KMOD_CTRL) != 0;
+    if (sh->typing) {
+        goto_key(sh, k);
+        sh->dirty = 1;
+        return;
+    }
+    if (ctrl) { /* Ctrl: font scale, and stepping by rank */
+        sh->dirty = 1;
+        switch (k) {
+        case SDLK_EQUALS:
+        case SDLK_PLUS:
+        case SDLK_KP_PLUS: set_font_scale(sh, sh->v->font_scale * 1.15); return;
+        case SDLK_MINUS:
+        case SDLK_KP_MINUS: set_font_scale(sh, sh->v->font_scale / 1.15); return;
+        case SDLK_0:
+        case SDLK_KP_0: set_font_scale(sh, 1); return;
+        case SDLK_RIGHT:
+        case SDLK_LEFT: {
+            /* next / previous event of the current event's rank */
+            size_t cur = sh->s->k;
+            int q = cur ? (int)pdt_replay_rec(sh->r, cur - 1)->rank : 0;
+            sh->playing = 0;
+            seek(sh, pdt_replay_find_rank(sh->r, cur, k == SDLK_RIGHT ? 1 : -1, q));
+            return;
+        }
+        default: sh->dirty = 0; return;
+        }
+    }
     size_t m = pdt_replay_count(sh->r), cur = sh->s->k;
     uint8_t *vis = NULL;
     sh->dirty = 1;
@@ -168,6 +237,19 @@ static void key(shell *sh, SDL_Keycode k, Uint16 mod)
         fprintf(stderr, "pdtview: mark at event %zu (r records from here to the current event)\n", cur);
         break;
     case SDLK_r: record(sh); break;
+    case SDLK_g:
+        sh->typing = 1;
+        sh->num[0] = 0;
+        goto_key(sh, SDLK_UNKNOWN);
+        break;
+    case SDLK_F11:
+        sh->fullscreen = !sh->fullscreen;
+        SDL_SetWindowFullscreen(sh->win, sh->fullscreen ? SDL_WINDOW_FULLSCREEN_DESKTOP : 0);
+        break;
+    case SDLK_t: sh->v->theme = (sh->v->theme + 1) % PDT_THEME_COUNT; break;
+    case SDLK_c: sh->v->clean = !sh->v->clean; break;
+    case SDLK_o: sh->v->circles = !sh->v->circles; break;
+    case SDLK_v: sh->v->voronoi = !sh->v->voronoi; break;
     default:
         if (k >= SDLK_1 && k <= SDLK_9) {
             int q = (int)(k - SDLK_1);
@@ -187,7 +269,7 @@ static void click(shell *sh, double x, double y)
         return;
     }
     pdt_layout L;
-    pdt_render_layout_panels(sh->tw, sh->th, sh->nranks, sh->v->panels, &L);
+    pdt_render_layout_view(sh->tw, sh->th, sh->nranks, sh->v, &L);
     if (x < L.geo.x || x > L.geo.x + L.geo.w || y < L.geo.y || y > L.geo.y + L.geo.h) return;
     pdt_render_pick(sh->r, sh->s, sh->v, sh->tw, sh->th, x, y, 0.8 * L.font, &sh->v->sel_point,
                     &sh->v->sel_tri, &sh->v->sel_edge);
@@ -202,7 +284,7 @@ static int in_rect(pdt_rect R, double x, double y)
 static void mouse(shell *sh, const SDL_Event *e)
 {
     pdt_layout L;
-    pdt_render_layout_panels(sh->tw, sh->th, sh->nranks, sh->v->panels, &L);
+    pdt_render_layout_view(sh->tw, sh->th, sh->nranks, sh->v, &L);
     switch (e->type) {
     case SDL_MOUSEBUTTONDOWN:
         if (e->button.button != SDL_BUTTON_LEFT) return;
@@ -258,9 +340,10 @@ static void mouse(shell *sh, const SDL_Event *e)
 
 /* Feed the next script token as SDL events.  Tokens (space separated):
  * key names (space right left S-right S-left pgdn pgup home end plus minus
- * 0-9 h k f s m r q), key:NAME / key:C-NAME (any SDL key name, C- = with
- * Ctrl), wait:N (frames), click:X,Y, rclick:X,Y (right button) and
- * wheel:X,Y,N (window coordinates), drag:X0,Y0,X1,Y1. */
+ * 0-9 h k f s m r q g enter bksp t c o v f11 C-plus C-minus C-0 C-right
+ * C-left), key:NAME / key:C-NAME (any SDL key name, C- = with Ctrl), wait:N
+ * (frames), click:X,Y, rclick:X,Y (right button) and wheel:X,Y,N (window
+ * coordinates), drag:X0,Y0,X1,Y1. */
 static void script_step(shell *sh)
 {
     if (!sh->script) return;
@@ -287,6 +370,12 @@ static void script_step(shell *sh)
         {"h", SDLK_h, 0},           {"k", SDLK_k, 0},          {"f", SDLK_f, 0},
         {"s", SDLK_s, 0},           {"q", SDLK_q, 0},          {"esc", SDLK_ESCAPE, 0},
         {"m", SDLK_m, 0},           {"r", SDLK_r, 0},
+        {"g", SDLK_g, 0},           {"enter", SDLK_RETURN, 0}, {"bksp", SDLK_BACKSPACE, 0},
+        {"t", SDLK_t, 0},           {"c", SDLK_c, 0},          {"o", SDLK_o, 0},
+        {"v", SDLK_v, 0},           {"f11", SDLK_F11, 0},
+        {"C-plus", SDLK_EQUALS, KMOD_LCTRL}, {"C-minus", SDLK_MINUS, KMOD_LCTRL},
+        {"C-0", SDLK_0, KMOD_LCTRL}, {"C-right", SDLK_RIGHT, KMOD_LCTRL},
+        {"C-left", SDLK_LEFT, KMOD_LCTRL},
     };
     SDL_Event e;
     memset(&e, 0, sizeof e);
@@ -549,8 +638,10 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
     }
     char title[512];
     snprintf(title, sizeof title, "pdtview — %s", o->title ? o->title : "");
+    sh.fullscreen = o->fullscreen;
     sh.win = SDL_CreateWindow(title, SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, o->w, o->h,
-                              SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI);
+                              SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI |
+                                  (o->fullscreen ? SDL_WINDOW_FULLSCREEN_DESKTOP : 0));
     if (!sh.win) {
         fprintf(stderr, "pdtview: window: %s\n", SDL_GetError());
         return shell_quit(&sh, 1);

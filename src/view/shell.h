@@ -37,6 +37,7 @@ typedef struct pdt_shell_opts {
     double fps;               /* frames per second of a recording (0: 10) */
     int every;                /* events per frame of a recording (0: 1) */
     const pdt_shell_hook *hook; /* or NULL */
+    int fullscreen;           /* start full screen (F11 toggles) */
 } pdt_shell_opts;
 
 /* Open the window and run until the user (or the script) quits.  The state

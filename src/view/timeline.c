@@ -28,7 +28,7 @@ void pdt_draw_timeline(ctx *c)
     cairo_t *cr = c->cr;
     pdt_rect R = c->L.timeline;
     double f = c->L.font;
-    panel(cr, R, NULL, f);
+    panel(cr, c->T, R, NULL, f);
     cairo_save(cr);
     clip_rect(cr, R);
     size_t m = pdt_replay_count(c->r);
@@ -61,7 +61,7 @@ void pdt_draw_timeline(ctx *c)
         else snprintf(lb, sizeof lb, "%s", nm ? nm : "?");
         double fs = fmin(0.7 * f, 0.6 * rh);
         if (bx1 - bx0 > text_w(cr, SANS, fs, lb) + 4 && depth == 0) {
-            rgb(cr, INK, 0.85);
+            cairo_set_source_rgba(cr, 0.1, 0.1, 0.12, 0.9); /* on the pastel bar, in every theme */
             text_at(cr, SANS, 0, fs, bx0 + 2, ry + rh / 2 + 0.35 * fs, lb);
         }
     }
@@ -72,7 +72,7 @@ void pdt_draw_timeline(ctx *c)
         set_rank(cr, q, shown(c, (uint32_t)q) ? 1 : 0.3);
         cairo_rectangle(cr, R.x + 0.4 * f, y0 + rh * q + rh * 0.2, 0.5 * f, rh * 0.6);
         cairo_fill(cr);
-        rgb(cr, INK, 1);
+        rgb(cr, c->T->ink, 1);
         text_at(cr, SANS, 0, fmin(0.75 * f, 0.8 * rh), R.x + 1.1 * f, y0 + rh * (q + 0.5) + 0.25 * fmin(0.75 * f, 0.8 * rh), lb);
     }
     /* messages as arrows */
@@ -88,7 +88,8 @@ void pdt_draw_timeline(ctx *c)
         cairo_move_to(cr, ax, ay);
         cairo_line_to(cr, bx, by);
         int fl = c->s->mflight[i];
-        cairo_set_source_rgba(cr, fl ? 0.85 : 0.2, fl ? 0.1 : 0.2, fl ? 0.1 : 0.2, fl ? 1 : 0.6);
+        if (fl) rgb(cr, RED, 1);
+        else rgb(cr, c->T->ink, 0.6);
         cairo_stroke(cr);
         double ang = atan2(by - ay, bx - ax), a = 0.35 * f;
         cairo_move_to(cr, bx, by);
@@ -107,7 +108,7 @@ void pdt_draw_timeline(ctx *c)
     /* axis text */
     char ax[96];
     snprintf(ax, sizeof ax, "timeline: events 0 … %zu (bars = phases, arrows = messages; click to seek)", m);
-    rgb(cr, INK, 0.75);
+    rgb(cr, c->T->ink, 0.75);
     text_at(cr, SANS, 0, 0.7 * f, x0, R.y + R.h - 0.35 * f, ax);
     cairo_restore(cr);
 }
@@ -116,7 +117,7 @@ size_t pdt_render_timeline_at(const pdt_replay *r, const pdt_view *v, double w, 
                               double sy)
 {
     pdt_layout L;
-    pdt_render_layout_panels(w, h, pdt_replay_nranks(r), v ? v->panels : PDT_PANEL_ALL, &L);
+    pdt_render_layout_view(w, h, pdt_replay_nranks(r), v, &L);
     pdt_rect R = L.timeline;
     if (R.w <= 0 || R.h <= 0) return (size_t)-1;
     if (sx < R.x || sx > R.x + R.w || sy < R.y || sy > R.y + R.h) return (size_t)-1;
@@ -125,5 +126,16 @@ size_t pdt_render_timeline_at(const pdt_replay *r, const pdt_view *v, double w, 
     double t = (sx - x0) / (x1 - x0);
     if (t < 0) t = 0;
     if (t > 1) t = 1;
-    return (size_t)(t * (double)pdt_replay_count(r) + 0.5);
+    size_t k = (size_t)(t * (double)pdt_replay_count(r) + 0.5);
+    /* in a rank's row: that rank's event nearest the clicked time */
+    int rows = pdt_replay_nranks(r);
+    double y0 = R.y + 0.4 * L.font, y1 = R.y + R.h - 1.3 * L.font;
+    double rh = (y1 - y0) / (rows ? rows : 1);
+    if (rows > 0 && sy >= y0 && sy < y1) {
+        int q = (int)((sy - y0) / rh);
+        if (q >= rows) q = rows - 1;
+        size_t kq = pdt_replay_nearest_of_rank(r, k, q);
+        if (kq != (size_t)-1) return kq;
+    }
+    return k;
 }

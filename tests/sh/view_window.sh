@@ -63,4 +63,18 @@ for i in $(seq 50); do kill -0 "$VPID" 2>/dev/null || break; sleep 0.1; done
 if ! kill -0 "$VPID" 2>/dev/null; then wait "$VPID"; rc=$?; VPID=
     if [ "$rc" -eq 0 ]; then ok quit_with_q; else fail quit_with_q "exit $rc"; fi
 else fail quit_with_q "still running"; fi
+
+# go to event N: g, the digits, Enter; then Ctrl+→ (the next event of the
+# same rank) and the font scale keys, F11 (full screen) and the toggles
+"$V" "$RUN" --size ${W}x${H} --screenshot "$TMP/goto.png" \
+     --script "g 7 5 enter wait:3 s C-right wait:3 s C-plus C-plus t c o v f11 wait:5 s wait:3 q" \
+     >"$TMP/g.out" 2>"$TMP/g.err"
+rc=$?
+evs=$(sed -n 's/.*event \([0-9]*\)).*/\1/p' "$TMP/g.err" | tr '\n' ' ')
+set -- $evs
+if [ "$rc" -eq 0 ] && [ "${1:-}" = 75 ]; then ok goto_event_75; else fail goto_event_75 "rc $rc, events: $evs"; fi
+if [ -n "${2:-}" ] && [ "$2" -gt 75 ]; then ok ctrl_right_next_of_rank; else fail ctrl_right_next_of_rank "events: $evs"; fi
+# the keys above leave a working window that still writes its screenshot
+if [ -s "$TMP/goto.png" ] && grep -q "screenshot.*(${W}x${H}, event" "$TMP/g.err"; then ok keys_font_theme_toggles_f11
+else fail keys_font_theme_toggles_f11 "$(tail -2 "$TMP/g.err")"; fi
 summary

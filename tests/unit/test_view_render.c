@@ -414,8 +414,9 @@ static size_t label_ink(cairo_surface_t *sf)
     return n;
 }
 
-/* Triangulation runs: input indices beside the points when few are on
- * screen, none when there are many. */
+/* Triangulation runs: input indices beside the points while there is room
+ * (crowded labels give way), none when hundreds of points are on screen
+ * (only those the current event names, and there is none at cursor 0). */
 TEST(point_numbers_when_few)
 {
     fixture f;
@@ -423,11 +424,11 @@ TEST(point_numbers_when_few)
     CHECK(draw(&f, 0));
     size_t few = label_ink(f.sf);
     teardown(&f);
-    CHECK(setup(&f, 12, 8, 2)); /* 96 points */
+    CHECK(setup(&f, 30, 20, 2)); /* 600 points */
     CHECK(draw(&f, 0));
     size_t many = label_ink(f.sf);
     teardown(&f);
-    CHECK_MSG(few > 200 && many == 0, "label pixels: %zu with 24 points, %zu with 96", few, many);
+    CHECK_MSG(few > 200 && many == 0, "label pixels: %zu with 24 points, %zu with 600", few, many);
 }
 
 TEST(pick_and_zoom)
@@ -464,15 +465,83 @@ TEST(pick_and_zoom)
     /* the timeline maps clicks to cursors */
     pdt_layout L;
     pdt_render_layout(W, H, 2, &L);
-    size_t k0 = pdt_render_timeline_at(f.r, NULL, W, H, L.timeline.x + 1, L.timeline.y + 10);
-    size_t k1 = pdt_render_timeline_at(f.r, NULL, W, H, L.timeline.x + L.timeline.w - 1, L.timeline.y + 10);
+    double ty = L.timeline.y + L.timeline.h - 2; /* the axis line, under the rank rows */
+    size_t k0 = pdt_render_timeline_at(f.r, NULL, W, H, L.timeline.x + 1, ty);
+    size_t k1 = pdt_render_timeline_at(f.r, NULL, W, H, L.timeline.x + L.timeline.w - 1, ty);
     CHECK(k0 == 0 && k1 == pdt_replay_count(f.r));
     CHECK(pdt_render_timeline_at(f.r, NULL, W, H, 5, 5) == (size_t)-1);
     teardown(&f);
 }
 
+/* A click in rank q's timeline row lands on an event of rank q, and no
+ * event of q is nearer to the clicked time. */
+TEST(timeline_click_picks_rank)
+{
+    fixture f;
+    CHECK(setup(&f, 16, 6, 4));
+    if (!f.s) return;
+    pdt_layout L;
+    pdt_render_layout(W, H, 4, &L);
+    size_t m = pdt_replay_count(f.r);
+    double y0 = L.timeline.y + 0.4 * L.font, y1 = L.timeline.y + L.timeline.h - 1.3 * L.font;
+    int checked = 0;
+    for (int q = 0; q < 4; q++)
+        for (int xi = 1; xi < 10; xi++) {
+            double sx = L.timeline.x + L.timeline.w * xi / 10.0, sy = y0 + (y1 - y0) * (q + 0.5) / 4;
+            size_t k = pdt_render_timeline_at(f.r, &f.v, W, H, sx, sy);
+            size_t kt = pdt_render_timeline_at(f.r, &f.v, W, H, sx, L.timeline.y + L.timeline.h - 2);
+            CHECK(k >= 1 && k <= m);
+            if (k < 1 || k > m) continue;
+            CHECK_MSG((int)pdt_replay_rec(f.r, k - 1)->rank == q, "row %d gave rank %u", q,
+                      pdt_replay_rec(f.r, k - 1)->rank);
+            size_t e = kt ? kt - 1 : 0, got = k - 1, dist = got > e ? got - e : e - got;
+            for (size_t i = 0; i < m; i++)
+                if ((int)pdt_replay_rec(f.r, i)->rank == q)
+                    CHECK((i > e ? i - e : e - i) >= dist);
+            checked++;
+        }
+    CHECK(checked == 36);
+    teardown(&f);
+}
+
+/* Themes: the background of the picture and of the event line differ as
+ * the theme says; rank colours stay the same. */
+TEST(theme_colours)
+{
+    fixture f;
+    CHECK(setup(&f, 8, 4, 2));
+    if (!f.s) return;
+    pdt_layout L;
+    pdt_render_layout(W, H, 2, &L);
+    const double white[3] = {1, 1, 1}, black[3] = {0, 0, 0};
+    double c[3];
+    CHECK(draw(&f, 0));
+    pixel(f.sf, (int)L.geo.x + 2, (int)L.geo.y + 2, c);
+    CHECK_MSG(cdist(c, white) < 0.02, "light background %g %g %g", c[0], c[1], c[2]);
+    f.v.theme = PDT_THEME_DARK;
+    CHECK(draw(&f, 0));
+    pixel(f.sf, (int)L.geo.x + 2, (int)L.geo.y + 2, c);
+    CHECK_MSG(cdist(c, black) < 0.4, "dark background %g %g %g", c[0], c[1], c[2]);
+    pixel(f.sf, (int)L.legend.x + (int)L.legend.w / 2, (int)L.legend.y + (int)L.legend.h - 4, c);
+    CHECK_MSG(cdist(c, black) < 0.55, "dark panel %g %g %g", c[0], c[1], c[2]);
+    double x, y, rk[3];
+    pdt_rank_rgb(1, rk);
+    pdt_replay_seek(f.r, f.s, pdt_replay_count(f.r));
+    if (final_diagonal(&f, 1, &x, &y)) {
+        CHECK(draw(&f, pdt_replay_count(f.r)));
+        CHECK_MSG(near_colour(f.sf, x, y, rk) < 0.12, "rank 1 colour on dark: %g", near_colour(f.sf, x, y, rk));
+    } else CHECK(0);
+    f.v.theme = PDT_THEME_CONTRAST;
+    CHECK(draw(&f, 0));
+    pixel(f.sf, (int)L.top.x + (int)L.top.w - 3, (int)L.top.y + 2, c);
+    CHECK_MSG(cdist(c, white) < 0.02, "contrast event bar %g %g %g", c[0], c[1], c[2]);
+    teardown(&f);
+}
+
 int main(void)
 {
+    RUN(theme_colours);
+    RUN(timeline_click_picks_rank);
     RUN(final_edge_has_rank_colour);
     RUN(discarded_drawn_differently);
     RUN(panels_present);
