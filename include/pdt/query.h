@@ -48,4 +48,22 @@ size_t pdt_replay_find_rank(const pdt_replay *r, size_t k, int dir, int rank);
  * later one); (size_t)-1 when the rank has no event. */
 size_t pdt_replay_nearest_of_rank(const pdt_replay *r, size_t k, int rank);
 
+/* One edge of the Voronoi diagram: dual of the Delaunay edge a-b.  A
+ * segment between the circumcentres of the two final triangles on a-b, or,
+ * for a hull edge (one final triangle), a ray from (x0,y0) in the unit
+ * direction (x1,y1) pointing away from the triangle. */
+typedef struct pdt_vseg {
+    double x0, y0, x1, y1;
+    int ray;
+    uint32_t a, b;
+} pdt_vseg;
+
+/* The Voronoi diagram of the final triangles of state s (ranks with
+ * hidden[rank] set left out; hidden may be NULL): one element per distinct
+ * edge of those triangles, so for a triangulation of n points with T
+ * triangles there are n + T - 1 (Euler).  Circumcentres in double precision
+ * (drawing only).  *out is malloc'd (free it); PDT_ERR_NOMEM otherwise. */
+pdt_status pdt_replay_voronoi(const pdt_replay *r, const pdt_rstate *s, const uint8_t *hidden,
+                              pdt_vseg **out, size_t *nout, pdt_err *err);
+
 #endif

@@ -118,6 +118,13 @@ void pdt_view_to_screen(const pdt_replay *r, const pdt_view *v, double w, double
 void pdt_view_zoom_at(const pdt_replay *r, pdt_view *v, double w, double h, double sx, double sy,
                       double f);
 
+/* If the circle (ox,oy,rr) in world coordinates does not fit in the
+ * geometry area, centre the view on it and zoom out so that it does (its
+ * diameter 90 % of the area's smaller side); returns 1 if the view
+ * changed, 0 if the circle was already in view. */
+int pdt_view_fit_circle(const pdt_replay *r, pdt_view *v, double w, double h, double ox, double oy,
+                        double rr);
+
 /* What is under screen point (sx,sy): the nearest point within `radius`
  * pixels (*point, else -1); otherwise the nearest edge within radius/2 of a
  * triangle drawn in state s (*tri and *edge = 0..2, the edge v[e]-v[e+1]);

@@ -102,6 +102,7 @@ static void draw_triangles(ctx *c)
                                    PDT_TS_DEFERRED, PDT_TS_FINAL};
     for (int oi = 0; oi < 5; oi++) {
         int st = order_st[oi];
+        if (c->v->clean && st != PDT_TS_FINAL) continue; /* the clean picture: T* only */
         for (int q = 0; q < c->nranks; q++) {
             size_t b = (size_t)st * (size_t)c->nranks + (size_t)q;
             if (start[b] == start[b + 1]) continue;
@@ -127,6 +128,11 @@ static void draw_triangles(ctx *c)
                     cairo_stroke(cr);
                 }
                 continue;
+            }
+            if (c->v->clean && !dense) { /* T* filled by rank */
+                for (size_t i = start[b]; i < start[b + 1]; i++) tri_path(c, T[order[i]].v);
+                set_rank(cr, q, 0.16);
+                cairo_fill(cr);
             }
             pdt_status_style(cr, st, dense ? 0.8 : c->lw);
             set_rank(cr, q, st == PDT_TS_CANDIDATE ? 0.75 : 1);
@@ -254,8 +260,6 @@ static void draw_hulls_and_stacks(ctx *c, uint32_t *buf, size_t cap)
                 cairo_close_path(cr);
                 rgb(cr, c->T->ink, 1);
                 cairo_fill(cr);
-                double tw = text_wb(cr, SANS, 1, 0.7 * c->L.font, "top");
-                text_at(cr, SANS, 1, 0.7 * c->L.font, x - 0.8 * a - tw, y - 1.0 * a, "top");
             }
         }
     }
@@ -300,7 +304,7 @@ static void draw_points(ctx *c)
         }
     }
     /* deleted points (Graham's ties and copies) crossed out */
-    if (nvis > 600) return;
+    if (nvis > 600 || c->v->clean) return;
     double f = c->L.label;
     for (size_t p = 0; p < c->n; p++) {
         if (!(c->s->pflags[p] & PDT_PF_DELETED)) continue;
@@ -337,7 +341,7 @@ static int named_points(const ctx *c, uint32_t out[4])
 {
     int k = 0;
     const pdt_rec *e = c->cur;
-    if (!e) return 0;
+    if (!e || c->v->clean) return 0;
     const pdt_event *ev = &e->ev;
     uint32_t cand[4] = {NONE32, NONE32, NONE32, NONE32};
     switch (ev->kind) {
@@ -641,6 +645,16 @@ static void draw_selection(ctx *c)
                          ? sn[pdt_replay_tri_hist(c->r)[pdt_rstate_tri_entry(c->r, c->s, (size_t)c->v->sel_tri)].status]
                          : "dropped by its merge");
             double ox, oy, rr;
+            if (circum(c->P, t->v, &ox, &oy, &rr)) {
+                double d[2] = {8, 5};
+                cairo_new_sub_path(cr);
+                cairo_arc(cr, c->X.ox + c->X.s * ox, c->X.oy - c->X.s * oy, c->X.s * rr, 0, 2 * M_PI);
+                rgb(cr, c->T->select, 0.9);
+                cairo_set_dash(cr, d, 2, 0);
+                cairo_set_line_width(cr, 2.5);
+                cairo_stroke(cr);
+                cairo_set_dash(cr, NULL, 0, 0);
+            }
             if (circum(c->P, t->v, &ox, &oy, &rr))
                 snprintf(lines[nl++], sizeof lines[0], "circle centre (%.1f, %.1f) radius %.1f", ox,
                          oy, rr);
@@ -661,6 +675,56 @@ static void draw_selection(ctx *c)
     for (int i = 0; i < nl; i++) text_at(cr, SANS, i == 0, f, R.x + 0.6 * f, R.y + (i + 1.1) * 1.3 * f, lines[i]);
 }
 
+/* The circumcircle of every drawn (not discarded) triangle, thin, in its
+ * maker's colour (up to 20000 triangles). */
+static void draw_circles(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    size_t nt;
+    const pdt_rtri *T = pdt_replay_tris(c->r, &nt);
+    const pdt_rtri_hist *H = pdt_replay_tri_hist(c->r);
+    cairo_set_line_width(cr, fmax(0.6, 0.5 * c->lw));
+    size_t drawn = 0;
+    for (int q = 0; q < c->nranks; q++) {
+        if (!shown(c, (uint32_t)q)) continue;
+        for (size_t t = 0; t < nt && drawn < 20000; t++) {
+            uint32_t h = pdt_rstate_tri_entry(c->r, c->s, t);
+            if (T[t].maker != (uint32_t)q || h == NONE32 || H[h].status == PDT_TS_DISCARDED) continue;
+            if (c->v->clean && H[h].status != PDT_TS_FINAL) continue;
+            double ox, oy, rr;
+            if (!circum(c->P, T[t].v, &ox, &oy, &rr)) continue;
+            cairo_new_sub_path(cr);
+            cairo_arc(cr, c->X.ox + c->X.s * ox, c->X.oy - c->X.s * oy, c->X.s * rr, 0, 2 * M_PI);
+            drawn++;
+        }
+        set_rank(cr, q, 0.45);
+        cairo_stroke(cr);
+    }
+}
+
+/* The Voronoi diagram of the final triangles (pdt_replay_voronoi): the
+ * centres as small dots, the edges dark; rays run past the picture's edge
+ * (the clip cuts them). */
+static void draw_voronoi(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    pdt_vseg *S;
+    size_t ns;
+    pdt_err err = {0};
+    if (pdt_replay_voronoi(c->r, c->s, c->v->hidden, &S, &ns, &err) != PDT_OK) return;
+    double far = 4 * (c->L.geo.w + c->L.geo.h) / c->X.s;
+    for (size_t i = 0; i < ns; i++) {
+        double x1 = S[i].ray ? S[i].x0 + far * S[i].x1 : S[i].x1;
+        double y1 = S[i].ray ? S[i].y0 + far * S[i].y1 : S[i].y1;
+        cairo_move_to(cr, c->X.ox + c->X.s * S[i].x0, c->X.oy - c->X.s * S[i].y0);
+        cairo_line_to(cr, c->X.ox + c->X.s * x1, c->X.oy - c->X.s * y1);
+    }
+    rgb(cr, c->T->ink, 0.85);
+    cairo_set_line_width(cr, fmax(1.2, 1.1 * c->lw));
+    cairo_stroke(cr);
+    free(S);
+}
+
 void pdt_draw_geometry(ctx *c)
 {
     cairo_t *cr = c->cr;
@@ -676,13 +740,16 @@ void pdt_draw_geometry(ctx *c)
         uint32_t v[3] = {c->cur->ev.a, c->cur->ev.b, c->cur->ev.c};
         cur_tri = circum(c->P, v, &ox, &oy, &rr);
     }
+    if (c->v->clean) cur_tri = 0;
     draw_boxes(c, cur_tri, 0);
-    draw_kernel_edges(c);
+    if (!c->v->clean) draw_kernel_edges(c);
     draw_triangles(c);
+    if (c->v->circles) draw_circles(c);
+    if (c->v->voronoi) draw_voronoi(c);
     if (buf) draw_hulls_and_stacks(c, buf, 2 * cap);
-    draw_merge(c);
+    if (!c->v->clean) draw_merge(c);
     draw_points(c);
-    if (buf) draw_current(c, buf, 2 * cap);
+    if (buf && !c->v->clean) draw_current(c, buf, 2 * cap);
     draw_labels(c);
     draw_boxes(c, cur_tri, 1);
     draw_selection(c);

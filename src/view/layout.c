@@ -195,3 +195,25 @@ void pdt_view_zoom_at(const pdt_replay *r, pdt_view *v, double w, double h, doub
     v->cx += (nx - sx) / X.s;
     v->cy -= (ny - sy) / X.s;
 }
+
+int pdt_view_fit_circle(const pdt_replay *r, pdt_view *v, double w, double h, double ox, double oy,
+                        double rr)
+{
+    pdt_layout L;
+    pdt_render_layout_view(w, h, pdt_replay_nranks(r), v, &L);
+    xform X = pdt_geo_xform(r, v, w, h);
+    double sx = X.ox + X.s * ox, sy = X.oy - X.s * oy, sr = X.s * rr;
+    if (sx - sr >= L.geo.x && sx + sr <= L.geo.x + L.geo.w && sy - sr >= L.geo.y &&
+        sy + sr <= L.geo.y + L.geo.h)
+        return 0;
+    /* centre on the circle and zoom out until its diameter takes 90 % of
+     * the smaller side */
+    double want = 0.9 * fmin(L.geo.w, L.geo.h) / (2 * rr);
+    v->cx = ox;
+    v->cy = oy;
+    v->centred = 1;
+    v->zoom = 1;
+    xform X1 = pdt_geo_xform(r, v, w, h);
+    v->zoom = fmin(1, want / X1.s);
+    return 1;
+}

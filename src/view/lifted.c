@@ -99,6 +99,38 @@ void pdt_draw_lifted(ctx *c)
             cairo_stroke(cr);
         }
     }
+    /* the lower hull: the lifted faces of the triangles drawn in the picture
+     * (not discarded), coloured like them (Theorem 1.1: the Delaunay
+     * triangles are the lower faces of the lifted points' hull) */
+    size_t nt;
+    const pdt_rtri *Tr = pdt_replay_tris(c->r, &nt);
+    const pdt_rtri_hist *Hh = pdt_replay_tri_hist(c->r);
+    if (nt <= 20000) {
+        for (int q = 0; q < c->nranks; q++) {
+            if (!shown(c, (uint32_t)q)) continue;
+            int any = 0;
+            for (size_t t = 0; t < nt; t++) {
+                uint32_t h = pdt_rstate_tri_entry(c->r, c->s, t);
+                if (Tr[t].maker != (uint32_t)q || h == NONE32 || Hh[h].status == PDT_TS_DISCARDED) continue;
+                if (c->v->clean && Hh[h].status != PDT_TS_FINAL) continue;
+                for (int j = 0; j < 3; j++) {
+                    const pdt_point *pp = &c->P[Tr[t].v[j]];
+                    double u = (pp->x - J.cx) / J.sc, w = (pp->y - J.cy) / J.sc, sx, sy;
+                    lift_xy(&J, u, w, u * u + w * w, &sx, &sy);
+                    if (j) cairo_line_to(cr, sx, sy);
+                    else cairo_move_to(cr, sx, sy);
+                }
+                cairo_close_path(cr);
+                any = 1;
+            }
+            if (!any) continue;
+            set_rank(cr, q, 0.22);
+            cairo_fill_preserve(cr);
+            set_rank(cr, q, 0.7);
+            cairo_set_line_width(cr, 0.8);
+            cairo_stroke(cr);
+        }
+    }
     /* the points: lifted ones on the paraboloid (rank colour of their box),
      * others faint on the floor; those below the plane in red */
     size_t step = c->n > 6000 ? c->n / 6000 : 1;
@@ -127,6 +159,37 @@ void pdt_draw_lifted(ctx *c)
         else if (cls == 1) rgb(cr, c->T->ink, 0.85);
         else rgb(cr, c->T->hollow, 0.5);
         cairo_fill(cr);
+    }
+    /* labels of the lifted points (few points), the current event's
+     * points ringed */
+    if (c->n <= 60) {
+        double fs = 0.8 * c->L.label;
+        for (size_t p = 0; p < c->n; p++) {
+            int lifted = c->all_lifted || (c->s->pflags[p] & PDT_PF_LIFTED) != 0;
+            double u = (c->P[p].x - J.cx) / J.sc, w = (c->P[p].y - J.cy) / J.sc, sx, sy;
+            lift_xy(&J, u, w, lifted ? u * u + w * w : 0, &sx, &sy);
+            char lab[24];
+            snprintf(lab, sizeof lab, "%zu", p);
+            rgb(cr, c->T->label, lifted ? 1 : 0.5);
+            text_at(cr, SANS, 0, fs, sx + 0.25 * fs, sy - 0.25 * fs, lab);
+        }
+    }
+    if (e && !c->v->clean) {
+        uint32_t cur[3] = {NONE32, NONE32, NONE32};
+        if (e->ev.kind == PDT_EV_LIFT || e->ev.kind == PDT_EV_PUSH || e->ev.kind == PDT_EV_POP ||
+            e->ev.kind == PDT_EV_SORT)
+            cur[0] = e->ev.a;
+        for (int j = 0; j < 1; j++) {
+            if (cur[j] >= c->n) continue;
+            int lifted = c->all_lifted || (c->s->pflags[cur[j]] & PDT_PF_LIFTED) != 0;
+            double u = (c->P[cur[j]].x - J.cx) / J.sc, w = (c->P[cur[j]].y - J.cy) / J.sc, sx, sy;
+            lift_xy(&J, u, w, lifted ? u * u + w * w : 0, &sx, &sy);
+            cairo_new_sub_path(cr);
+            cairo_arc(cr, sx, sy, 0.45 * f, 0, 2 * M_PI);
+            rgb(cr, RED, 1);
+            cairo_set_line_width(cr, 2.5);
+            cairo_stroke(cr);
+        }
     }
     if (have_plane) {
         for (int j = 0; j < 3; j++) {

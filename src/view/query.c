@@ -3,6 +3,9 @@
 #include "pdt/describe.h"
 #include "pdt/predicates.h"
 
+#include <math.h>
+#include <stdlib.h>
+
 size_t pdt_replay_stack_list(const pdt_replay *r, int32_t top, uint32_t *out, size_t cap)
 {
     size_t nn;
@@ -164,4 +167,92 @@ size_t pdt_replay_nearest_of_rank(const pdt_replay *r, size_t k, int rank)
         if (e + d >= m && d > e) break;
     }
     return (size_t)-1;
+}
+
+typedef struct vedge {
+    uint32_t a, b, t; /* a < b; triangle */
+} vedge;
+
+static int cmp_vedge(const void *x, const void *y)
+{
+    const vedge *p = x, *q = y;
+    if (p->a != q->a) return p->a < q->a ? -1 : 1;
+    if (p->b != q->b) return p->b < q->b ? -1 : 1;
+    return (p->t > q->t) - (p->t < q->t);
+}
+
+/* Circumcentre in double precision; 0 if degenerate. */
+static int centre(const pdt_point *P, const uint32_t v[3], double *ox, double *oy)
+{
+    double ax = P[v[0]].x, ay = P[v[0]].y;
+    double bx = P[v[1]].x - ax, by = P[v[1]].y - ay, cx = P[v[2]].x - ax, cy = P[v[2]].y - ay;
+    double d = 2 * (bx * cy - by * cx);
+    if (d == 0) return 0;
+    *ox = ax + (cy * (bx * bx + by * by) - by * (cx * cx + cy * cy)) / d;
+    *oy = ay + (bx * (cx * cx + cy * cy) - cx * (bx * bx + by * by)) / d;
+    return 1;
+}
+
+pdt_status pdt_replay_voronoi(const pdt_replay *r, const pdt_rstate *s, const uint8_t *hidden,
+                              pdt_vseg **out, size_t *nout, pdt_err *err)
+{
+    *out = NULL;
+    *nout = 0;
+    size_t nt, n;
+    const pdt_rtri *T = pdt_replay_tris(r, &nt);
+    const pdt_rtri_hist *H = pdt_replay_tri_hist(r);
+    const pdt_point *P = pdt_replay_points(r, &n);
+    int nr = pdt_replay_nranks(r);
+    vedge *E = malloc((3 * nt + 1) * sizeof *E);
+    if (!E) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    size_t ne = 0;
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t h = pdt_rstate_tri_entry(r, s, t);
+        if (h == UINT32_MAX || H[h].status != PDT_TS_FINAL) continue;
+        if (hidden && T[t].maker < (uint32_t)nr && hidden[T[t].maker]) continue;
+        for (int j = 0; j < 3; j++) {
+            uint32_t a = T[t].v[j], b = T[t].v[(j + 1) % 3];
+            E[ne++] = (vedge){a < b ? a : b, a < b ? b : a, (uint32_t)t};
+        }
+    }
+    qsort(E, ne, sizeof *E, cmp_vedge);
+    pdt_vseg *S = malloc((ne + 1) * sizeof *S);
+    if (!S) {
+        free(E);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    }
+    size_t ns = 0;
+    for (size_t i = 0; i < ne;) {
+        size_t j = i + 1;
+        while (j < ne && E[j].a == E[i].a && E[j].b == E[i].b) j++;
+        double x0, y0, x1, y1;
+        if (!centre(P, T[E[i].t].v, &x0, &y0)) {
+            i = j;
+            continue;
+        }
+        pdt_vseg g = {x0, y0, 0, 0, 0, E[i].a, E[i].b};
+        if (j - i >= 2 && centre(P, T[E[i + 1].t].v, &x1, &y1)) {
+            g.x1 = x1;
+            g.y1 = y1;
+        } else {
+            /* a hull edge: a ray from the centre, perpendicular to the edge,
+             * away from the triangle's third corner */
+            const uint32_t *v = T[E[i].t].v;
+            uint32_t third = v[0] != E[i].a && v[0] != E[i].b ? v[0] : v[1] != E[i].a && v[1] != E[i].b ? v[1] : v[2];
+            double ex = (double)P[E[i].b].x - P[E[i].a].x, ey = (double)P[E[i].b].y - P[E[i].a].y;
+            double nx = ey, ny = -ex;
+            double mx = ((double)P[E[i].a].x + P[E[i].b].x) / 2, my = ((double)P[E[i].a].y + P[E[i].b].y) / 2;
+            if (nx * ((double)P[third].x - mx) + ny * ((double)P[third].y - my) > 0) nx = -nx, ny = -ny;
+            double len = sqrt(nx * nx + ny * ny);
+            g.x1 = nx / len;
+            g.y1 = ny / len;
+            g.ray = 1;
+        }
+        S[ns++] = g;
+        i = j;
+    }
+    free(E);
+    *out = S;
+    *nout = ns;
+    return PDT_OK;
 }

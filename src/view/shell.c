@@ -273,6 +273,19 @@ static void click(shell *sh, double x, double y)
     if (x < L.geo.x || x > L.geo.x + L.geo.w || y < L.geo.y || y > L.geo.y + L.geo.h) return;
     pdt_render_pick(sh->r, sh->s, sh->v, sh->tw, sh->th, x, y, 0.8 * L.font, &sh->v->sel_point,
                     &sh->v->sel_tri, &sh->v->sel_edge);
+    if (sh->v->sel_tri >= 0) { /* a large circle: zoom out to show it whole */
+        size_t nt, n;
+        const pdt_rtri *T = pdt_replay_tris(sh->r, &nt);
+        const pdt_point *P = pdt_replay_points(sh->r, &n);
+        const uint32_t *v = T[sh->v->sel_tri].v;
+        double ax = P[v[0]].x, ay = P[v[0]].y, bx = P[v[1]].x - ax, by = P[v[1]].y - ay;
+        double cx = P[v[2]].x - ax, cy = P[v[2]].y - ay, d = 2 * (bx * cy - by * cx);
+        if (d != 0) {
+            double ux = (cy * (bx * bx + by * by) - by * (cx * cx + cy * cy)) / d;
+            double uy = (bx * (cx * cx + cy * cy) - cx * (bx * bx + by * by)) / d;
+            pdt_view_fit_circle(sh->r, sh->v, sh->tw, sh->th, ax + ux, ay + uy, sqrt(ux * ux + uy * uy));
+        }
+    }
     sh->dirty = 1;
 }
 

@@ -1,6 +1,7 @@
 /* pdt — the replay queries of pdt/query.h (no cairo): stacks listed from
  * their top node against stacks kept by hand from the push/pop events,
  * Graham's scan ending, hulls still live, the pseudo-code line of events. */
+#include <stdlib.h>
 #include <string.h>
 
 #include "../harness.h"
@@ -187,8 +188,59 @@ TEST(code_lines)
     close_fix(&f);
 }
 
+/* The Voronoi diagram of the final triangulation has one edge per Delaunay
+ * edge: n + T - 1 of them (Euler), of which the rays are the hull edges;
+ * the finite ones join two circumcentres. */
+TEST(voronoi_edges_euler)
+{
+    fix f;
+    CHECK(open_fix(&f, 0));
+    pdt_replay_seek(f.r, f.s, pdt_replay_count(f.r));
+    size_t nt, T = 0;
+    pdt_replay_tris(f.r, &nt);
+    for (size_t t = 0; t < nt; t++) T += pdt_rstate_tri_status(f.r, f.s, t) == PDT_TS_FINAL;
+    pdt_vseg *S = NULL;
+    size_t ns = 0, rays = 0;
+    pdt_err err = {0};
+    CHECK(pdt_replay_voronoi(f.r, f.s, NULL, &S, &ns, &err) == PDT_OK);
+    for (size_t i = 0; i < ns; i++) rays += S[i].ray;
+    /* a 16 x 6 grid: 96 points, 150 triangles, hull of 2 * (15 + 5) = 40 edges */
+    CHECK_MSG(T == 150 && ns == f.syn.n + T - 1, "n %zu, T %zu, Voronoi edges %zu", f.syn.n, T, ns);
+    CHECK_MSG(rays == 40, "rays %zu", rays);
+    free(S);
+    /* hiding a rank leaves out its triangles' edges */
+    uint8_t hidden[4] = {1, 0, 0, 0};
+    CHECK(pdt_replay_voronoi(f.r, f.s, hidden, &S, &ns, &err) == PDT_OK && ns < f.syn.n + T - 1);
+    free(S);
+    /* at cursor 0 there is no final triangle */
+    pdt_replay_seek(f.r, f.s, 0);
+    CHECK(pdt_replay_voronoi(f.r, f.s, NULL, &S, &ns, &err) == PDT_OK && ns == 0);
+    free(S);
+    close_fix(&f);
+}
+
+/* Stepping by rank: the cursor lands just after an event of that rank, with
+ * no event of the rank skipped. */
+TEST(find_rank)
+{
+    fix f;
+    CHECK(open_fix(&f, 0));
+    size_t m = pdt_replay_count(f.r);
+    for (size_t k = 0; k < m; k += 37) {
+        size_t nx = pdt_replay_find_rank(f.r, k, 1, 2);
+        if (nx == k) continue;
+        CHECK(nx > k && pdt_replay_rec(f.r, nx - 1)->rank == 2);
+        for (size_t i = k; i + 1 < nx; i++) CHECK(pdt_replay_rec(f.r, i)->rank != 2);
+        size_t pv = pdt_replay_find_rank(f.r, nx, -1, 2);
+        CHECK(pv == nx || (pv < nx && pdt_replay_rec(f.r, pv - 1)->rank == 2));
+    }
+    close_fix(&f);
+}
+
 int main(void)
 {
+    RUN(voronoi_edges_euler);
+    RUN(find_rank);
     RUN(stack_list_graham_equals_events);
     RUN(stack_list_srm_equals_events);
     RUN(graham_scan_ended_after_phase_end);

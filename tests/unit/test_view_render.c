@@ -538,8 +538,47 @@ TEST(theme_colours)
     teardown(&f);
 }
 
+/* Red pixels (the crosses of discarded triangles, deleted points, the
+ * current event's marks) in the geometry area. */
+static size_t red_ink(cairo_surface_t *sf, int ranks)
+{
+    pdt_layout L;
+    pdt_render_layout(W, H, ranks, &L);
+    const double red[3] = {0.85, 0, 0};
+    size_t n = 0;
+    for (int y = (int)L.geo.y; y < (int)(L.geo.y + L.geo.h); y++)
+        for (int x = (int)L.geo.x; x < (int)(L.geo.x + L.geo.w); x++) {
+            double c[3];
+            pixel(sf, x, y, c);
+            n += cdist(c, red) < 0.3;
+        }
+    return n;
+}
+
+/* The clean picture: just after a discard the normal picture has red
+ * crosses and marks, the clean one none; its triangles are the final ones,
+ * filled, so a final triangle's centroid is tinted by its rank. */
+TEST(clean_view_no_crosses)
+{
+    fixture f;
+    CHECK(setup(&f, 16, 6, 4));
+    if (!f.s) return;
+    size_t m = pdt_replay_count(f.r), k = 0;
+    for (size_t i = 0; i < m && !k; i++)
+        if (pdt_replay_rec(f.r, i)->ev.kind == PDT_EV_DISCARD) k = i + 1;
+    CHECK(k > 0);
+    CHECK(draw(&f, k + 3));
+    size_t normal = red_ink(f.sf, 4);
+    f.v.clean = 1;
+    CHECK(draw(&f, k + 3));
+    size_t clean = red_ink(f.sf, 4);
+    CHECK_MSG(normal > 50 && clean == 0, "red pixels: %zu normal, %zu clean", normal, clean);
+    teardown(&f);
+}
+
 int main(void)
 {
+    RUN(clean_view_no_crosses);
     RUN(theme_colours);
     RUN(timeline_click_picks_rank);
     RUN(final_edge_has_rank_colour);
