@@ -162,7 +162,7 @@ void pdt_draw_lifted(ctx *c)
     }
     /* labels of the lifted points (few points), the current event's
      * points ringed */
-    if (c->n <= 60) {
+    if (c->n <= 60 && !c->no_lift) {
         double fs = 0.8 * c->L.label;
         for (size_t p = 0; p < c->n; p++) {
             int lifted = c->all_lifted || (c->s->pflags[p] & PDT_PF_LIFTED) != 0;

@@ -46,7 +46,7 @@ typedef struct shell {
     char status[160];
     /* go to event N: the number being typed after `g` */
     int typing;
-    char num[24], prompt[64];
+    char num[24], prompt[96];
     int fullscreen;
 } shell;
 
