@@ -169,7 +169,8 @@ pdt_status pdt_hull_graham(const pdt_point *pts, size_t n, uint32_t *out, size_t
     free(tmp);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_GRAHAM_SORT, 0, 0, 0, 0);
 
-    /* 3: stack S = (p1, p0); push p_i only on a strict left turn. */
+    /* 4-9 of the pseudo-code (lessons/02, the viewer's panel): S := (p0, p1),
+     * then push p_i only on a strict left turn, else pop. */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_GRAHAM_SCAN, 0, 0, 0, 0);
     pdt_stack s;
     pdt_status st = pdt_stack_init(&s, m, PDT_STACK_GRAHAM, tr);
