@@ -160,18 +160,39 @@ void pdt_draw_lifted(ctx *c)
         else rgb(cr, c->T->hollow, 0.5);
         cairo_fill(cr);
     }
-    /* labels of the lifted points (few points), the current event's
-     * points ringed */
+    /* labels of the lifted points (few points): the current event's point
+     * and the plane's corners first, then the others in index order; a label
+     * that would overlap one already placed gives way (the panel is small) */
     if (c->n <= 60 && !c->no_lift) {
         double fs = 0.8 * c->L.label;
-        for (size_t p = 0; p < c->n; p++) {
+        uint32_t first[4] = {NONE32, NONE32, NONE32, NONE32};
+        if (e && (e->ev.kind == PDT_EV_LIFT || e->ev.kind == PDT_EV_PUSH ||
+                  e->ev.kind == PDT_EV_POP || e->ev.kind == PDT_EV_SORT))
+            first[0] = e->ev.a;
+        for (int j = 0; j < 3 && have_plane; j++) first[j + 1] = tv[j];
+        double bx[64][4];
+        int nb = 0;
+        for (size_t i = 0; i < 4 + c->n; i++) {
+            uint32_t p = i < 4 ? first[i] : (uint32_t)(i - 4);
+            if (p >= c->n) continue;
+            int dup = 0;
+            for (int j = 0; j < 4 && i >= 4; j++) dup |= first[j] == p;
+            if (dup) continue;
             int lifted = c->all_lifted || (c->s->pflags[p] & PDT_PF_LIFTED) != 0;
+            if (!lifted && i >= 4) continue;
             double u = (c->P[p].x - J.cx) / J.sc, w = (c->P[p].y - J.cy) / J.sc, sx, sy;
             lift_xy(&J, u, w, lifted ? u * u + w * w : 0, &sx, &sy);
             char lab[24];
-            snprintf(lab, sizeof lab, "%zu", p);
-            rgb(cr, c->T->label, lifted ? 1 : 0.5);
-            text_at(cr, SANS, 0, fs, sx + 0.25 * fs, sy - 0.25 * fs, lab);
+            snprintf(lab, sizeof lab, "%u", p);
+            double x0 = sx + 0.25 * fs, y1 = sy - 0.25 * fs;
+            double b[4] = {x0, y1 - 0.8 * fs, x0 + text_wb(cr, SANS, i < 4, fs, lab), y1};
+            int hit = 0;
+            for (int j = 0; j < nb && !hit; j++)
+                hit = b[0] < bx[j][2] && bx[j][0] < b[2] && b[1] < bx[j][3] && bx[j][1] < b[3];
+            if (hit && i >= 4) continue;
+            if (nb < 64) memcpy(bx[nb++], b, sizeof b);
+            rgb(cr, c->T->label, 1);
+            text_at(cr, SANS, i < 4, fs, x0, y1, lab);
         }
     }
     if (e && !c->v->clean) {
