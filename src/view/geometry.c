@@ -41,9 +41,18 @@ static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
         }
         char lab[32];
         double fs = 0.8 * c->L.font;
+        /* the label may run past a narrow strip up to the next strip whose
+         * label is on the same side (ranks alternate above and below) */
+        double room = c->L.geo.x + c->L.geo.w - x0;
+        pdt_point lo2, hi2;
+        if (q + 2 < c->nranks && pdt_replay_box(c->r, q + 2, &lo2, &hi2))
+            room = fmin(room, c->X.ox + c->X.s * lo2.x - x0 - pad);
+        room = fmax(room, x1 - x0 + 2 * pad + 0.3 * c->L.font);
         snprintf(lab, sizeof lab, touched ? "rank %d (touched)" : "rank %d", q);
-        if (text_wb(cr, SANS, touched, fs, lab) > x1 - x0 + 2 * pad + 0.3 * c->L.font)
-            snprintf(lab, sizeof lab, touched ? "r%d!" : "r%d", q); /* narrow strips */
+        if (text_wb(cr, SANS, touched, fs, lab) > room)
+            snprintf(lab, sizeof lab, touched ? "r%d touched" : "r%d", q);
+        if (text_wb(cr, SANS, touched, fs, lab) > room)
+            snprintf(lab, sizeof lab, touched ? "r%d!" : "r%d", q); /* very narrow strips */
         double tw = text_wb(cr, SANS, touched, fs, lab);
         double ly = q % 2 ? y1 + pad + 0.95 * c->L.font : y0 - pad - 0.25 * c->L.font;
         cairo_rectangle(cr, x0 - pad - 0.1 * fs, ly - 0.85 * fs, tw + 0.2 * fs, 1.1 * fs);

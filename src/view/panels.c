@@ -35,11 +35,36 @@ void pdt_draw_top(ctx *c)
     int status_in_bar = c->v->status && lw + sw <= room;
     double avail = status_in_bar ? room - sw : room;
     if (lw > avail) fs = fmax(0.8 * f, fs * avail / lw);
+    /* still too long at the smallest size: the words that fit stay in the
+     * bar, the rest goes on a second line in a box under it (never cut) */
+    char first[512];
+    const char *rest = NULL;
+    snprintf(first, sizeof first, "%s", line);
+    if (text_wb(cr, SANS, 1, fs, first) > avail) {
+        size_t len = strlen(first);
+        while (len > 0) {
+            while (len > 0 && first[len - 1] != ' ') len--;
+            if (len == 0) break;
+            first[len - 1] = 0;
+            if (text_wb(cr, SANS, 1, fs, first) <= avail) break;
+            len--;
+        }
+        if (len > 0) rest = line + len;
+        else snprintf(first, sizeof first, "%s", line);
+    }
     rgb(cr, c->T->ink, 1);
     cairo_save(cr);
     clip_rect(cr, (pdt_rect){R.x, R.y, x + avail, R.h});
-    text_at(cr, SANS, 1, fs, x, 1.4 * f, line);
+    text_at(cr, SANS, 1, fs, x, 1.4 * f, first);
     cairo_restore(cr);
+    if (rest) {
+        double rw = text_wb(cr, SANS, 1, fs, rest);
+        cairo_rectangle(cr, x - 0.3 * f, R.y + R.h, rw + 0.6 * f, 1.35 * fs);
+        rgb(cr, c->T->topbar, 0.92);
+        cairo_fill(cr);
+        rgb(cr, c->T->ink, 1);
+        text_at(cr, SANS, 1, fs, x, R.y + R.h + 1.05 * fs, rest);
+    }
     if (c->v->status) {
         double tw = sw - 1.2 * f;
         double sx = R.w - tw - 0.6 * f, sy = status_in_bar ? 1.35 * f : R.y + R.h + 1.1 * f;
