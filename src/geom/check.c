@@ -415,8 +415,9 @@ pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tri
             st = fail(
                 err,
                 "edge %u-%u is not locally Delaunay: point %u is %s the circle of "
-                "triangle (%u %u %u)%s", ed[i].lo, ed[i].hi, d,
+                "triangle (%u %u %u), the file's triangle %zu%s", ed[i].lo, ed[i].hi, d,
                 ck_incircle(pts[a], pts[b], pts[c], pts[d]) > 0 ? "inside" : "on", a, b, c,
+                (size_t)ed[i].tri + 1,
                 ck_incircle(pts[a], pts[b], pts[c], pts[d]) > 0 ? ""
                                                                 : " and the tie rule says inside");
         i++;
