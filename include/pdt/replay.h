@@ -170,8 +170,27 @@ uint32_t pdt_replay_lift_ev(const pdt_replay *r, size_t p);
 pdt_rstate *pdt_rstate_new(const pdt_replay *r);
 void pdt_rstate_free(pdt_rstate *s);
 
-/* Set `s` to the state at cursor k (clamped to count). */
+/* Set `s` to the state at cursor k (clamped to count), the cheapest way:
+ * stepping from where s is, from the nearest checkpoint (pdt_replay_set_mem),
+ * or pdt_replay_seek_direct.  Every way gives the same state.  Not
+ * thread-safe: it may keep a checkpoint in r (a cache; r stays const to its
+ * users). */
 void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k);
+/* The same from the histories alone (no stepping, no checkpoints): cost
+ * linear in the number of objects, independent of k.  For tests. */
+void pdt_replay_seek_direct(const pdt_replay *r, pdt_rstate *s, size_t k);
+
+/* Bytes of one pdt_rstate of r (what a checkpoint costs). */
+size_t pdt_replay_state_bytes(const pdt_replay *r);
+/* Give checkpoints half of `budget` bytes: a copy of the state every K
+ * events (K >= 64, as small as the budget allows), each made on the first
+ * seek near it, so that a seek costs at most K/2 steps once its checkpoint
+ * exists.  A budget too small for two checkpoints leaves none (seeks step or
+ * go the direct way).  Replaces earlier checkpoints. */
+void pdt_replay_set_mem(pdt_replay *r, uint64_t budget);
+/* Checkpoint slots (0: none); *every = K, *made = those made so far
+ * (either may be NULL). */
+size_t pdt_replay_checkpoints(const pdt_replay *r, size_t *every, size_t *made);
 /* Move `s` by one event: dir > 0 forwards, dir < 0 backwards.  Returns 1 if
  * it moved, 0 at either end. */
 int pdt_replay_step(const pdt_replay *r, pdt_rstate *s, int dir);
@@ -217,6 +236,43 @@ typedef struct pdt_cov_cell {
 size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, double y0,
                            double x1, double y1, int cols, int rows,
                            const uint8_t *rank_visible, pdt_cov_cell *cells);
+
+/* ---- run folders and the kept index (index.c) -------------------------------- */
+
+/* Default memory budget of the viewer (pdtview --mem). */
+#define PDT_VIEW_MEM_DEFAULT ((uint64_t)1 << 30)
+
+/* What pdt_replay_open_run did. */
+typedef struct pdt_replay_open_info {
+    uint64_t events;         /* events in the rank files */
+    int indexed;             /* 1: the tables are mapped from a kept index (path) */
+    int built;               /* 1: the index was built at this opening */
+    double build_s;          /* seconds the build took */
+    char path[4096];         /* the index file */
+    char why[160];           /* why an index found was not used ("stale: ...", "damaged: ...") */
+    char write_error[1024];   /* why no index could be written (then: in memory) */
+} pdt_replay_open_info;
+
+/* The replay of run folder `dir` (opened as `run`, which must outlive the
+ * replay: the points stay in it).  use_index 1: through a kept index,
+ * 0: in memory (the merged events decoded, as pdt_run_merged), -1: the
+ * index when holding the run in memory would take more than a quarter of
+ * `budget` bytes (about 100 bytes per event).
+ *
+ * The kept index (the merged events and every table of the replay) is
+ * DIR/.pdtview-index, or, when the folder cannot take a file,
+ * $XDG_CACHE_HOME/pdt (else ~/.cache/pdt)/run-HASH.pdtview-index, keyed by
+ * the folder's real path.  It is checked at every opening (identity of the
+ * run's files: names, sizes, modification times, the manifest's bytes;
+ * checksums of every section; its size) and rebuilt when stale or damaged,
+ * written to a temporary file and renamed.  Then it is memory-mapped: the
+ * replay's own memory is its checkpoints (pdt_replay_set_mem(budget)).
+ * Building streams the merged events into the file (pdt_merge_*) and needs
+ * the tables in memory once (about 60 bytes per event).  When no index can
+ * be written anywhere, the run is held in memory (info->write_error says why).
+ * Returns PDT_OK and *out (pdt_replay_free), or an error; info may be NULL. */
+pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, int use_index,
+                               pdt_replay **out, pdt_replay_open_info *info, pdt_err *err);
 
 /* Searching the event list (for the controls).  Kinds of "selected event": */
 typedef enum pdt_ev_class {

@@ -50,6 +50,8 @@ typedef struct opts {
     uint64_t bench_live; /* --bench-live N: editor re-run figures on N points */
     double font_scale;
     int theme, fullscreen, clean, circles, voronoi;
+    uint64_t mem;      /* --mem BYTES (or $PDTVIEW_MEM): the viewer's memory budget */
+    int index;         /* --index on|off|auto: 1, 0, -1 */
 } opts;
 
 static const char help_text[] =
@@ -58,7 +60,7 @@ static const char help_text[] =
     "               [--script KEYS] [--screenshot FILE.png] [--speed EV_PER_S]\n"
     "               [--record FILE.gif|.mp4|.webm] [--fps F] [--every K]\n"
     "               [--font-scale F] [--theme light|dark|contrast] [--fullscreen]\n"
-    "               [--clean] [--circles] [--voronoi]\n"
+    "               [--clean] [--circles] [--voronoi] [--mem BYTES] [--index on|off|auto]\n"
     "       pdtview --headless RUN (--at N | --phase NAME | --end) -o FILE.png|.svg|.pdf\n"
     "               [--size WxH]\n"
     "       pdtview --headless RUN --frames DIR --every K [--size WxH]\n"
@@ -74,6 +76,9 @@ static const char help_text[] =
     "                event K its event line and lit code line; tab-separated)\n"
     "       pdtview --write-run DIR RUN\n"
     "RUN: a run folder, or synth:srm:COLS:ROWS:RANKS, synth:graham:N\n"
+    "--mem BYTES (or $PDTVIEW_MEM; e.g. 64M, default 1G): memory for the replay; a run\n"
+    "  larger than a quarter of it is opened through a kept index (RUN/.pdtview-index, or\n"
+    "  ~/.cache/pdt when RUN is read-only), built at the first opening; --index forces it.\n"
     "The cursor N counts events applied (0 = start, --end = all).\n"
     "Keys in the window: h or ? (help).  See docs/viewer.md.\n";
 
@@ -89,6 +94,25 @@ static int parse_size(const char *s, int *w, int *h)
     *w = (int)a;
     *h = (int)b;
     return 1;
+}
+
+/* A byte count: digits with an optional K, M or G (powers of 1024).
+ * Returns 0, or -1 if `s` is not one (or is 0). */
+static int parse_bytes(const char *s, uint64_t *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (end == s || errno || *s == '-') return -1;
+    unsigned shift = 0;
+    if (*end == 'K' || *end == 'k') shift = 10;
+    else if (*end == 'M' || *end == 'm') shift = 20;
+    else if (*end == 'G' || *end == 'g') shift = 30;
+    if (shift) end++;
+    if (*end == 'B' || *end == 'b') end++;
+    if (*end || v == 0 || v > (UINT64_MAX >> shift)) return -1;
+    *out = (uint64_t)v << shift;
+    return 0;
 }
 
 /* "R,R,..": rank numbers separated by commas. */
@@ -113,7 +137,7 @@ static int parse_args(int argc, char **argv, opts *o)
     o->h = 1000;
     o->speed = 20;
     o->panels = PDT_PANEL_ALL;
-    const char *size = NULL, *panels = NULL, *theme = NULL;
+    const char *size = NULL, *panels = NULL, *theme = NULL, *mem = NULL, *index = NULL;
     o->font_scale = 1;
     uint64_t at = UINT64_MAX, every = UINT64_MAX, from = UINT64_MAX, to = UINT64_MAX,
              ranks = 1;
@@ -155,6 +179,8 @@ static int parse_args(int argc, char **argv, opts *o)
         {"--clean", NULL, PDT_OPT_FLAG, &o->clean},
         {"--circles", NULL, PDT_OPT_FLAG, &o->circles},
         {"--voronoi", NULL, PDT_OPT_FLAG, &o->voronoi},
+        {"--mem", NULL, PDT_OPT_STR, &mem},
+        {"--index", NULL, PDT_OPT_STR, &index},
         {NULL, NULL, PDT_OPT_FLAG, NULL},
     };
     const char *pos[1];
@@ -209,6 +235,17 @@ static int parse_args(int argc, char **argv, opts *o)
         return pdt_cli_usage(PROG, "--font-scale needs a number 0.4 .. 4, not '%g'", o->font_scale);
     if (theme && pdt_theme_parse(theme, &o->theme) != 0)
         return pdt_cli_usage(PROG, "--theme needs light, dark or contrast, not '%s'", theme);
+    const char *env = getenv("PDTVIEW_MEM");
+    o->mem = PDT_VIEW_MEM_DEFAULT;
+    if (mem && parse_bytes(mem, &o->mem))
+        return pdt_cli_usage(PROG, "--mem %s: not a byte count (e.g. 4096, 64M, 1G)", mem);
+    if (!mem && env && *env && parse_bytes(env, &o->mem))
+        return pdt_cli_usage(PROG, "PDTVIEW_MEM=%s: not a byte count (e.g. 4096, 64M, 1G)", env);
+    o->index = -1;
+    if (index && !strcmp(index, "on")) o->index = 1;
+    else if (index && !strcmp(index, "off")) o->index = 0;
+    else if (index && strcmp(index, "auto"))
+        return pdt_cli_usage(PROG, "--index needs on, off or auto, not '%s'", index);
     if (o->hide && !valid_rank_list(o->hide))
         return pdt_cli_usage(PROG, "--hide needs rank numbers separated by commas, not '%s'", o->hide);
     if (o->headless && !o->out && !o->frames && !o->bench && !o->counts && !o->gif && !o->video)
@@ -251,8 +288,6 @@ static pdt_status load(const char *name, loaded *L, pdt_err *err)
     pdt_status st = pdt_run_open(name, &L->run, err);
     if (st != PDT_OK) return st;
     L->pts = pdt_run_points(L->run, &L->n);
-    st = pdt_run_merged(L->run, &L->recs, &L->m, err);
-    if (st != PDT_OK) return st;
     L->nranks = pdt_run_manifest(L->run)->nranks;
     const char *w = pdt_run_warnings(L->run);
     if (w && *w) fprintf(stderr, "pdtview: %s: %s\n", name, w);
@@ -263,6 +298,18 @@ static void unload(loaded *L)
 {
     if (L->run) pdt_run_close(L->run);
     pdt_synth_free(&L->syn);
+}
+
+/* The replay of the loaded run: a run folder through pdt_replay_open_run
+ * (kept index or memory, by the budget), a synthetic run in memory. */
+static pdt_status open_replay(const loaded *L, const opts *o, pdt_replay **r,
+                              pdt_replay_open_info *info, pdt_err *err)
+{
+    memset(info, 0, sizeof *info);
+    if (L->run) return pdt_replay_open_run(L->run, o->run, o->mem, o->index, r, info, err);
+    pdt_status st = pdt_replay_new(L->pts, L->n, L->recs, L->m, L->nranks, r, err);
+    if (st == PDT_OK) pdt_replay_set_mem(*r, o->mem);
+    return st;
 }
 
 static int headless(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const opts *o, pdt_err *err)
@@ -472,35 +519,43 @@ static int describe(const pdt_replay *r, size_t start)
     return ferror(stdout) ? 1 : 0;
 }
 
-/* Seek(k) == stepping forwards from 0 == stepping backwards from the end. */
+/* Seek(k) == stepping forwards from 0 == stepping backwards from the end ==
+ * the direct seek from the histories.  The seek starts from a pseudo-random
+ * cursor each time, so that it goes through the checkpoints (made on the
+ * way, within the --mem budget) as well as through stepping. */
 static int check(const pdt_replay *r)
 {
     size_t m = pdt_replay_count(r), bad = 0, stride = m > 20000 ? m / 20000 : 1;
-    pdt_rstate *a = pdt_rstate_new(r), *b = pdt_rstate_new(r);
-    if (!a || !b) {
+    pdt_rstate *a = pdt_rstate_new(r), *b = pdt_rstate_new(r), *c = pdt_rstate_new(r);
+    if (!a || !b || !c) {
         pdt_rstate_free(a);
         pdt_rstate_free(b);
+        pdt_rstate_free(c);
         fprintf(stderr, "pdtview: out of memory\n");
         return 1;
     }
-    for (size_t k = 0; k <= m; k++) {
-        if (k % stride == 0 || k == m) {
-            pdt_replay_seek(r, b, k);
-            bad += !pdt_rstate_equal(r, a, b);
+    uint64_t x = 0x9E3779B97F4A7C15ull;
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t i = 0; i <= m; i++) {
+            size_t k = pass == 0 ? i : m - i;
+            if (k % stride == 0 || k == m) {
+                x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+                pdt_replay_seek(r, b, (size_t)(x % (m + 1)));
+                pdt_replay_seek(r, b, k);
+                pdt_replay_seek_direct(r, c, k);
+                bad += !pdt_rstate_equal(r, a, b) || !pdt_rstate_equal(r, a, c);
+            }
+            if (i < m) pdt_replay_step(r, a, pass == 0 ? 1 : -1);
         }
-        pdt_replay_step(r, a, 1);
     }
-    for (size_t k = m + 1; k-- > 0;) {
-        if (k % stride == 0) {
-            pdt_replay_seek(r, b, k);
-            bad += !pdt_rstate_equal(r, a, b);
-        }
-        pdt_replay_step(r, a, -1);
-    }
-    printf("check: %zu events, %zu cursors compared both ways, %zu differ\n", m,
+    size_t every, made, nck = pdt_replay_checkpoints(r, &every, &made);
+    printf("check: %zu events, %zu cursors compared both ways, %zu differ", m,
            2 * (m / stride + 1), bad);
+    if (nck) printf(" (checkpoints every %zu events: %zu of %zu made)", every, made, nck);
+    printf("\n");
     pdt_rstate_free(a);
     pdt_rstate_free(b);
+    pdt_rstate_free(c);
     return bad != 0;
 }
 
@@ -646,15 +701,25 @@ int main(int argc, char **argv)
     if (load(o.run, &L, &err) != PDT_OK) goto out;
     double t1 = now_s(), c1 = cpu_s();
     if (o.write_run) {
+        if (L.run && pdt_run_merged(L.run, &L.recs, &L.m, &err) != PDT_OK) goto out;
         rc = write_run(o.write_run, &L, &err);
         if (!rc && !o.quiet) printf("pdtview: wrote %zu events of %d ranks to %s\n", L.m, L.nranks, o.write_run);
         goto out;
     }
-    if (pdt_replay_new(L.pts, L.n, L.recs, L.m, L.nranks, &r, &err) != PDT_OK) goto out;
-    if (o.bench)
+    pdt_replay_open_info info;
+    if (open_replay(&L, &o, &r, &info, &err) != PDT_OK) goto out;
+    if (o.bench) {
         printf("open %zu events, %zu points, %d ranks: %.3f s (read %.3f s + index %.3f s; "
-               "cpu %.3f s + %.3f s)\n", L.m, L.n, L.nranks, now_s() - t0, t1 - t0, now_s() - t1,
-               c1 - c0, cpu_s() - c1);
+               "cpu %.3f s + %.3f s)\n", pdt_replay_count(r), L.n, L.nranks, now_s() - t0,
+               t1 - t0, now_s() - t1, c1 - c0, cpu_s() - c1);
+        if (info.indexed)
+            printf("kept index %s: %s%s%s\n", info.path,
+                   info.built ? "built at this opening" : "mapped", *info.why ? "; " : "", info.why);
+        else
+            printf("in memory (no kept index)%s%s\n", *info.write_error ? ": " : "", info.write_error);
+    } else if (!o.quiet && info.built && *info.why && strcmp(info.why, "no index yet")) {
+        fprintf(stderr, "pdtview: %s: rebuilt the index (%s)\n", o.run, info.why);
+    }
     if (pdt_replay_skipped(r) && !o.quiet)
         fprintf(stderr, "pdtview: %zu malformed events ignored\n", pdt_replay_skipped(r));
     s = pdt_rstate_new(r);

@@ -1,5 +1,6 @@
 /* pdt — the replay model: index the events once, then answer "state at k". */
 #include "pdt/replay.h"
+#include "replay_int.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -106,49 +107,6 @@ static int km_put(keymap *km, uint64_t hi, uint64_t lo, int32_t v)
 }
 
 /* ---- the replay ------------------------------------------------------------ */
-
-typedef struct slot_change {
-    uint32_t ev;
-    int32_t val, prev;
-} slot_change;
-
-struct pdt_replay {
-    const pdt_point *pts;
-    size_t n;
-    const pdt_rec *recs;
-    size_t m, skipped;
-    int nranks;
-    int32_t *ev_obj;   /* per event: object (see build()) or -1 */
-    uint32_t *ev_ent;  /* per event: entry (history / change index, or flag) */
-
-    pdt_rtri *tris;
-    size_t ntri, cap_tri;
-    pdt_rtri_hist *hist;
-    size_t nhist;
-    pdt_redge *edges;
-    size_t nedge, cap_edge;
-    pdt_rnode *nodes;
-    size_t nnode, cap_node;
-    pdt_rphase *phases;
-    size_t nphase, cap_phase;
-    pdt_rmerge *merges;
-    size_t nmerge, cap_merge;
-    pdt_rmsg *msgs;
-    size_t nmsg, cap_msg;
-    pdt_rhull *hulls;
-    size_t nhull, cap_hull;
-
-    slot_change *ch;    /* every slot change, in event order */
-    size_t nch, cap_ch;
-    uint32_t *slot_ch;  /* changes grouped by slot: slot_ch[slot_start[s] .. slot_start[s+1]) */
-    uint32_t *slot_start;
-
-    uint32_t *lift_ev, *sort_ev, *del_ev;  /* per point: first such event or UINT32_MAX */
-    int64_t *sort_pos;
-    pdt_point *box_lo, *box_hi;  /* per rank */
-    uint8_t *has_box;
-    size_t kind_count[PDT_EV_KIND_COUNT];
-};
 
 #define NONE32 UINT32_MAX
 
@@ -601,6 +559,13 @@ pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, s
 void pdt_replay_free(pdt_replay *r)
 {
     if (!r) return;
+    for (size_t c = 0; c < r->nck; c++) pdt_rstate_free(r->ck[c]);
+    free(r->ck);
+    if (r->map) { /* the tables live in the kept index's mapping */
+        munmap(r->map, r->map_len);
+        free(r);
+        return;
+    }
     free(r->ev_obj);
     free(r->ev_ent);
     free(r->tris);
@@ -700,7 +665,7 @@ pdt_rstate *pdt_rstate_new(const pdt_replay *r)
         pdt_rstate_free(s);
         return NULL;
     }
-    pdt_replay_seek(r, s, 0);
+    pdt_replay_seek_direct(r, s, 0);
     return s;
 }
 
@@ -727,7 +692,7 @@ static uint8_t alive(uint32_t from, uint32_t to, size_t k)
     return from < k && !(to < k);
 }
 
-void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k)
+void pdt_replay_seek_direct(const pdt_replay *r, pdt_rstate *s, size_t k)
 {
     if (k > r->m) k = r->m;
     s->k = k;
@@ -800,6 +765,108 @@ int pdt_replay_step(const pdt_replay *r, pdt_rstate *s, int dir)
         return 1;
     }
     return 0;
+}
+
+/* ---- checkpoints --------------------------------------------------------------- */
+
+/* A seek this many events away or closer steps there instead (a step costs
+ * about what looking at one object costs in pdt_replay_seek_direct). */
+#define STEP_FACTOR 1
+
+size_t pdt_replay_state_bytes(const pdt_replay *r)
+{
+    return sizeof(pdt_rstate) + r->n + r->ntri * sizeof(uint32_t) + r->nedge + r->nmsg +
+           (size_t)r->nranks * PDT_SLOT_PER_RANK * sizeof(int32_t);
+}
+
+/* Objects pdt_replay_seek_direct looks at: its cost, in steps. */
+static size_t direct_cost(const pdt_replay *r)
+{
+    return r->n + r->ntri + r->nedge + r->nmsg + (size_t)r->nranks * PDT_SLOT_PER_RANK;
+}
+
+void pdt_replay_set_mem(pdt_replay *r, uint64_t budget)
+{
+    for (size_t c = 0; c < r->nck; c++) pdt_rstate_free(r->ck[c]);
+    free(r->ck);
+    r->ck = NULL;
+    r->nck = r->ck_every = 0;
+    r->ck_bytes = pdt_replay_state_bytes(r);
+    /* half the budget for checkpoints; one every at least 64 events */
+    uint64_t fit = budget / 2 / r->ck_bytes;
+    if (fit < 2 || r->m < 128) return;
+    size_t every = (r->m + (size_t)fit - 1) / (size_t)fit;
+    if (every < 64) every = 64;
+    size_t n = r->m / every + 1;
+    r->ck = calloc(n, sizeof *r->ck);
+    if (!r->ck) return;  /* no checkpoints: seeks go the direct way */
+    r->nck = n;
+    r->ck_every = every;
+}
+
+size_t pdt_replay_checkpoints(const pdt_replay *r, size_t *every, size_t *made)
+{
+    size_t got = 0;
+    for (size_t c = 0; c < r->nck; c++) got += r->ck[c] != NULL;
+    if (every) *every = r->ck_every;
+    if (made) *made = got;
+    return r->nck;
+}
+
+static void state_copy(const pdt_replay *r, pdt_rstate *to, const pdt_rstate *from)
+{
+    size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
+    to->k = from->k;
+    memcpy(to->pflags, from->pflags, r->n);
+    memcpy(to->tcur, from->tcur, r->ntri * sizeof *to->tcur);
+    memcpy(to->ealive, from->ealive, r->nedge);
+    memcpy(to->mflight, from->mflight, r->nmsg);
+    memcpy(to->slot, from->slot, nslot * sizeof *to->slot);
+}
+
+static size_t dist(size_t a, size_t b) { return a > b ? a - b : b - a; }
+
+static void step_to(const pdt_replay *r, pdt_rstate *s, size_t k)
+{
+    while (s->k < k) pdt_replay_step(r, s, 1);
+    while (s->k > k) pdt_replay_step(r, s, -1);
+}
+
+/* The cheapest of: stepping from where s is; restoring the checkpoint
+ * nearest k and stepping from it; the direct seek (which, when the
+ * checkpoint near k is not made yet, goes to the checkpoint's cursor, keeps a
+ * copy, and steps from it).  Every route gives the same state. */
+void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k)
+{
+    if (k > r->m) k = r->m;
+    size_t direct = direct_cost(r), from_here = dist(s->k, k) * STEP_FACTOR;
+    if (from_here <= direct && (!r->nck || from_here <= r->ck_every / 2)) {
+        step_to(r, s, k);
+        return;
+    }
+    if (!r->nck) {
+        pdt_replay_seek_direct(r, s, k);
+        return;
+    }
+    size_t c = (k + r->ck_every / 2) / r->ck_every;
+    if (c >= r->nck) c = r->nck - 1;
+    size_t ck = c * r->ck_every;
+    if (from_here <= dist(ck, k) * STEP_FACTOR) {
+        step_to(r, s, k);
+        return;
+    }
+    pdt_replay *w = (pdt_replay *)r;  /* the checkpoints are a cache */
+    if (!w->ck[c]) {
+        pdt_rstate *cs = pdt_rstate_new(r);
+        if (!cs) {  /* no room for it: the direct way */
+            pdt_replay_seek_direct(r, s, k);
+            return;
+        }
+        pdt_replay_seek_direct(r, cs, ck);
+        w->ck[c] = cs;
+    }
+    state_copy(r, s, w->ck[c]);
+    step_to(r, s, k);
 }
 
 int pdt_rstate_equal(const pdt_replay *r, const pdt_rstate *a, const pdt_rstate *b)

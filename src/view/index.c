@@ -1,0 +1,547 @@
+/* pdt — the kept index of a run folder: the replay model's tables in a file,
+ * built at the first opening and memory-mapped at the next ones.
+ *
+ * File layout (native byte order; a different build's layout is refused):
+ *   [0, 4096)        header: magic, version, the run's identity, the sizes
+ *                    of the record types, the table sizes, and per section
+ *                    its offset, length and CRC-32C; the header's own CRC
+ *   sections         the merged event records, then every table of the
+ *                    replay (replay_int.h), each at a 64-byte boundary
+ *
+ * The identity of a run is a hash of the name, size and modification time
+ * of every file in the folder (but dot-files) and of the manifest's bytes.
+ * An index whose identity, sizes or checksums do not match is rebuilt. */
+#include "pdt/replay.h"
+#include "replay_int.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#define INDEX_NAME ".pdtview-index"
+#define INDEX_VERSION 1u
+#define HDR_BYTES 4096u
+#define EST_BYTES_PER_EVENT 100u /* what the replay model holds per event in memory */
+
+enum {
+    S_RECS, S_EVOBJ, S_EVENT, S_TRIS, S_HIST, S_EDGES, S_NODES, S_PHASES, S_MERGES, S_MSGS,
+    S_HULLS, S_CH, S_SLOTCH, S_SLOTSTART, S_LIFT, S_SORT, S_DEL, S_SORTPOS, S_BOXLO, S_BOXHI,
+    S_HASBOX, NSEC
+};
+
+typedef struct isec {
+    uint64_t off, bytes;
+    uint32_t crc, pad;
+} isec;
+
+typedef struct ihdr {
+    char magic[8];
+    uint32_t version, hdr_crc;  /* hdr_crc: over the header with this field 0 */
+    uint64_t ident, file_bytes;
+    uint32_t layout[12];        /* sizes of the record types */
+    uint64_t n, m, skipped, nranks;
+    uint64_t count[NSEC];       /* elements per section */
+    uint64_t kind_count[64];
+    isec sec[NSEC];
+} ihdr;
+
+_Static_assert(sizeof(ihdr) <= HDR_BYTES, "index header fits its page");
+_Static_assert(PDT_EV_KIND_COUNT <= 64, "kind counts fit the header");
+
+static const char magic[8] = {'P', 'D', 'T', 'V', 'I', 'D', 'X', '\n'};
+
+static void layout_of(uint32_t out[12])
+{
+    const uint32_t l[12] = {sizeof(pdt_rec), sizeof(pdt_rtri), sizeof(pdt_rtri_hist),
+                            sizeof(pdt_redge), sizeof(pdt_rnode), sizeof(pdt_rphase),
+                            sizeof(pdt_rmerge), sizeof(pdt_rmsg), sizeof(pdt_rhull),
+                            sizeof(slot_change), sizeof(pdt_point), PDT_SLOT_PER_RANK};
+    memcpy(out, l, sizeof l);
+}
+
+/* Where each section lives in r and how big its elements are; counts from r. */
+static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_t count[NSEC])
+{
+    size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
+#define SEC(i, field, cnt)                \
+    ptr[i] = (void **)&r->field;          \
+    elem[i] = sizeof *r->field;           \
+    count[i] = (cnt)
+    SEC(S_RECS, recs, r->m);
+    SEC(S_EVOBJ, ev_obj, r->m);
+    SEC(S_EVENT, ev_ent, r->m);
+    SEC(S_TRIS, tris, r->ntri);
+    SEC(S_HIST, hist, r->nhist);
+    SEC(S_EDGES, edges, r->nedge);
+    SEC(S_NODES, nodes, r->nnode);
+    SEC(S_PHASES, phases, r->nphase);
+    SEC(S_MERGES, merges, r->nmerge);
+    SEC(S_MSGS, msgs, r->nmsg);
+    SEC(S_HULLS, hulls, r->nhull);
+    SEC(S_CH, ch, r->nch);
+    SEC(S_SLOTCH, slot_ch, r->nch);
+    SEC(S_SLOTSTART, slot_start, nslot + 1);
+    SEC(S_LIFT, lift_ev, r->n);
+    SEC(S_SORT, sort_ev, r->n);
+    SEC(S_DEL, del_ev, r->n);
+    SEC(S_SORTPOS, sort_pos, r->n);
+    SEC(S_BOXLO, box_lo, (uint64_t)r->nranks);
+    SEC(S_BOXHI, box_hi, (uint64_t)r->nranks);
+    SEC(S_HASBOX, has_box, (uint64_t)r->nranks);
+#undef SEC
+}
+
+static uint32_t hdr_crc(const ihdr *h)
+{
+    ihdr c = *h;
+    c.hdr_crc = 0;
+    return pdt_crc32c(0, &c, sizeof c);
+}
+
+/* ---- the run's identity and the index's place ---------------------------------- */
+
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001B3ull;
+    return h;
+}
+
+typedef struct fent {
+    char name[256];
+    uint64_t size, mtime_ns;
+} fent;
+
+static int fent_cmp(const void *a, const void *b)
+{
+    return strcmp(((const fent *)a)->name, ((const fent *)b)->name);
+}
+
+/* Identity of the run folder: its files' names, sizes, modification times
+ * and the manifest's bytes.  0 and err set when the folder cannot be listed. */
+static pdt_status run_ident(const char *dir, uint64_t *id, pdt_err *err)
+{
+    DIR *d = opendir(dir);
+    if (!d) return pdt_err_set(err, PDT_ERR_IO, "%s: %s", dir, strerror(errno));
+    fent *f = NULL;
+    size_t nf = 0, cap = 0;
+    struct dirent *de;
+    pdt_status st = PDT_OK;
+    while ((de = readdir(d))) {
+        if (de->d_name[0] == '.' || strlen(de->d_name) >= sizeof f->name) continue;
+        char path[PATH_MAX];
+        struct stat sb;
+        snprintf(path, sizeof path, "%s/%s", dir, de->d_name);
+        if (stat(path, &sb) != 0 || !S_ISREG(sb.st_mode)) continue;
+        if (nf == cap) {
+            fent *g = realloc(f, (cap = cap ? 2 * cap : 16) * sizeof *f);
+            if (!g) {
+                st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+                break;
+            }
+            f = g;
+        }
+        memset(&f[nf], 0, sizeof *f);
+        strcpy(f[nf].name, de->d_name);
+        f[nf].size = (uint64_t)sb.st_size;
+        f[nf].mtime_ns = (uint64_t)sb.st_mtim.tv_sec * 1000000000ull + (uint64_t)sb.st_mtim.tv_nsec;
+        nf++;
+    }
+    closedir(d);
+    if (st == PDT_OK) {
+        qsort(f, nf, sizeof *f, fent_cmp);
+        uint64_t h = fnv(0xCBF29CE484222325ull, magic, sizeof magic);
+        for (size_t i = 0; i < nf; i++) h = fnv(h, &f[i], sizeof f[i]);
+        char path[PATH_MAX];
+        snprintf(path, sizeof path, "%s/manifest", dir);
+        FILE *mf = fopen(path, "rb");
+        if (mf) {
+            char buf[4096];
+            size_t got;
+            while ((got = fread(buf, 1, sizeof buf, mf)) > 0) h = fnv(h, buf, got);
+            fclose(mf);
+        }
+        *id = h;
+    }
+    free(f);
+    return st;
+}
+
+/* The cache folder ($XDG_CACHE_HOME/pdt, else ~/.cache/pdt) into buf; 0 if
+ * there is none (no HOME). */
+static int cache_dir(char *buf, size_t cap)
+{
+    const char *x = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
+    if (x && *x == '/') snprintf(buf, cap, "%s/pdt", x);
+    else if (home && *home) snprintf(buf, cap, "%s/.cache/pdt", home);
+    else return 0;
+    return 1;
+}
+
+/* mkdir -p of a folder we own (0700 like other cache folders). */
+static int make_dirs(const char *path)
+{
+    char tmp[PATH_MAX];
+    snprintf(tmp, sizeof tmp, "%s", path);
+    for (char *p = tmp + 1; *p; p++) {
+        if (*p != '/') continue;
+        *p = 0;
+        if (mkdir(tmp, 0700) != 0 && errno != EEXIST) return 0;
+        *p = '/';
+    }
+    return mkdir(tmp, 0700) == 0 || errno == EEXIST;
+}
+
+/* The index beside the run (where = 0) or in the cache (where = 1), keyed
+ * by the folder's real path.  0 if there is no such place. */
+static int index_path(const char *dir, int where, char *buf, size_t cap)
+{
+    if (where == 0) {
+        return snprintf(buf, cap, "%s/" INDEX_NAME, dir) < (int)cap;
+    }
+    char cdir[PATH_MAX], real[PATH_MAX];
+    if (!cache_dir(cdir, sizeof cdir) || !realpath(dir, real)) return 0;
+    uint64_t h = fnv(0xCBF29CE484222325ull, real, strlen(real));
+    return snprintf(buf, cap, "%s/run-%016llx" INDEX_NAME, cdir, (unsigned long long)h) < (int)cap;
+}
+
+/* ---- loading ------------------------------------------------------------------ */
+
+/* Map the index at `path` onto a new replay over pts.  Returns NULL with a
+ * reason in why when it is missing, stale or damaged.  verify: check every
+ * section's checksum (reading the file through a small buffer). */
+static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, size_t n,
+                        int verify, char *why, size_t wcap)
+{
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0) {
+        snprintf(why, wcap, "%s", errno == ENOENT ? "no index yet" : strerror(errno));
+        return NULL;
+    }
+    struct stat sb;
+    ihdr h;
+    uint32_t lay[12];
+    layout_of(lay);
+    pdt_replay *r = NULL;
+    void *map = MAP_FAILED;
+    if (fstat(fd, &sb) != 0 || (uint64_t)sb.st_size < HDR_BYTES ||
+        pread(fd, &h, sizeof h, 0) != (ssize_t)sizeof h) {
+        snprintf(why, wcap, "damaged: shorter than its header");
+        goto fail;
+    }
+    if (memcmp(h.magic, magic, sizeof magic) || h.version != INDEX_VERSION ||
+        memcmp(h.layout, lay, sizeof lay)) {
+        snprintf(why, wcap, "made by another version of pdtview");
+        goto fail;
+    }
+    if (hdr_crc(&h) != h.hdr_crc) {
+        snprintf(why, wcap, "damaged: header checksum mismatch");
+        goto fail;
+    }
+    if (h.ident != ident) {
+        snprintf(why, wcap, "stale: the run folder changed since it was made");
+        goto fail;
+    }
+    if (h.file_bytes != (uint64_t)sb.st_size) {
+        snprintf(why, wcap, "damaged: %llu bytes, want %llu", (unsigned long long)sb.st_size,
+                 (unsigned long long)h.file_bytes);
+        goto fail;
+    }
+    if (h.n != n || h.nranks == 0 || h.nranks > INT32_MAX) {
+        snprintf(why, wcap, "stale: made for %llu points, the run has %zu", (unsigned long long)h.n, n);
+        goto fail;
+    }
+    for (int i = 0; i < NSEC; i++)
+        if (h.sec[i].off < HDR_BYTES || h.sec[i].off > h.file_bytes ||
+            h.sec[i].bytes > h.file_bytes - h.sec[i].off) {
+            snprintf(why, wcap, "damaged: section %d outside the file", i);
+            goto fail;
+        }
+    if (verify) {
+        enum { CHUNK = 1 << 20 };
+        unsigned char *buf = malloc(CHUNK);
+        if (!buf) {
+            snprintf(why, wcap, "out of memory");
+            goto fail;
+        }
+        for (int i = 0; i < NSEC; i++) {
+            uint32_t crc = 0;
+            for (uint64_t o = 0; o < h.sec[i].bytes;) {
+                size_t want = h.sec[i].bytes - o < CHUNK ? (size_t)(h.sec[i].bytes - o) : CHUNK;
+                ssize_t got = pread(fd, buf, want, (off_t)(h.sec[i].off + o));
+                if (got <= 0) break;
+                crc = pdt_crc32c(crc, buf, (size_t)got);
+                o += (uint64_t)got;
+            }
+            if (crc != h.sec[i].crc) {
+                snprintf(why, wcap, "damaged: checksum mismatch in section %d", i);
+                free(buf);
+                goto fail;
+            }
+        }
+        free(buf);
+    }
+    map = mmap(NULL, h.file_bytes, PROT_READ, MAP_SHARED, fd, 0);
+    if (map == MAP_FAILED) {
+        snprintf(why, wcap, "cannot map it: %s", strerror(errno));
+        goto fail;
+    }
+    r = calloc(1, sizeof *r);
+    if (!r) {
+        snprintf(why, wcap, "out of memory");
+        goto fail;
+    }
+    r->pts = pts;
+    r->n = n;
+    r->m = h.m;
+    r->skipped = h.skipped;
+    r->nranks = (int)h.nranks;
+    for (int k = 0; k < PDT_EV_KIND_COUNT; k++) r->kind_count[k] = h.kind_count[k];
+    r->ntri = h.count[S_TRIS];
+    r->nhist = h.count[S_HIST];
+    r->nedge = h.count[S_EDGES];
+    r->nnode = h.count[S_NODES];
+    r->nphase = h.count[S_PHASES];
+    r->nmerge = h.count[S_MERGES];
+    r->nmsg = h.count[S_MSGS];
+    r->nhull = h.count[S_HULLS];
+    r->nch = h.count[S_CH];
+    void **ptr[NSEC];
+    size_t elem[NSEC];
+    uint64_t count[NSEC];
+    sections(r, ptr, elem, count);
+    for (int i = 0; i < NSEC; i++) {
+        if (count[i] != h.count[i] || count[i] * elem[i] != h.sec[i].bytes) {
+            snprintf(why, wcap, "damaged: section %d has the wrong size", i);
+            free(r);
+            r = NULL;
+            goto fail;
+        }
+        *ptr[i] = (char *)map + h.sec[i].off;
+    }
+    r->map = map;
+    r->map_len = h.file_bytes;
+    close(fd);
+    return r;
+fail:
+    if (map != MAP_FAILED) munmap(map, h.file_bytes);
+    close(fd);
+    return NULL;
+}
+
+/* ---- building ------------------------------------------------------------------ */
+
+static int write_all(int fd, const void *p, size_t len, uint64_t off)
+{
+    const char *b = p;
+    while (len) {
+        ssize_t w = pwrite(fd, b, len > ((size_t)1 << 30) ? (size_t)1 << 30 : len, (off_t)off);
+        if (w <= 0) return 0;
+        b += w;
+        len -= (size_t)w;
+        off += (uint64_t)w;
+    }
+    return 1;
+}
+
+/* Stream the merged records of run into fd at HDR_BYTES (the reader's
+ * merge: one decoded block per rank in memory).  Sets h->sec[S_RECS] and *m. */
+static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, pdt_err *err)
+{
+    enum { BATCH = 8192 };
+    pdt_rec *buf = malloc(BATCH * sizeof *buf);
+    pdt_merge *mg = NULL;
+    if (!buf) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    pdt_status st = pdt_merge_open(run, &mg, err);
+    uint64_t off = HDR_BYTES;
+    uint32_t crc = 0;
+    size_t count = 0, nb = 0;
+    int got = 1;
+    while (st == PDT_OK && got > 0) {
+        got = pdt_merge_next(mg, &buf[nb], err);
+        if (got < 0) st = err->code ? err->code : PDT_ERR_NOMEM;
+        if (got > 0) nb++, count++;
+        if (st == PDT_OK && (nb == BATCH || (got == 0 && nb))) {
+            if (!write_all(fd, buf, nb * sizeof *buf, off))
+                st = pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+            crc = pdt_crc32c(crc, buf, nb * sizeof *buf);
+            off += nb * sizeof *buf;
+            nb = 0;
+        }
+    }
+    pdt_merge_close(mg);
+    free(buf);
+    h->sec[S_RECS] = (isec){HDR_BYTES, (uint64_t)count * sizeof(pdt_rec), crc, 0};
+    *m = count;
+    return st;
+}
+
+/* Write the tables of r after the records, then the header. */
+static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, pdt_err *err)
+{
+    void **ptr[NSEC];
+    size_t elem[NSEC];
+    uint64_t count[NSEC];
+    sections(r, ptr, elem, count);
+    uint64_t off = h->sec[S_RECS].off + h->sec[S_RECS].bytes;
+    for (int i = 0; i < NSEC; i++) {
+        h->count[i] = count[i];
+        if (i == S_RECS) continue;
+        off = (off + 63) & ~(uint64_t)63;
+        size_t bytes = (size_t)count[i] * elem[i];
+        if (bytes && !write_all(fd, *ptr[i], bytes, off))
+            return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+        h->sec[i] = (isec){off, bytes, bytes ? pdt_crc32c(0, *ptr[i], bytes) : 0, 0};
+        off += bytes;
+    }
+    memcpy(h->magic, magic, sizeof magic);
+    h->version = INDEX_VERSION;
+    h->ident = ident;
+    h->file_bytes = off;
+    layout_of(h->layout);
+    h->n = r->n;
+    h->m = r->m;
+    h->skipped = r->skipped;
+    h->nranks = (uint64_t)r->nranks;
+    for (int k = 0; k < PDT_EV_KIND_COUNT; k++) h->kind_count[k] = r->kind_count[k];
+    h->hdr_crc = hdr_crc(h);
+    unsigned char page[HDR_BYTES];
+    memset(page, 0, sizeof page);
+    memcpy(page, h, sizeof *h);
+    if (ftruncate(fd, (off_t)off) != 0 || !write_all(fd, page, sizeof page, 0))
+        return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+    return PDT_OK;
+}
+
+/* Build the index of run at `path` (temporary file + rename). */
+static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks, uint64_t ident,
+                        const char *path, pdt_err *err)
+{
+    char tmp[PATH_MAX + 128];
+    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
+    int fd = open(tmp, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) return pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
+    ihdr *h = calloc(1, sizeof *h);
+    pdt_replay *r = NULL;
+    void *recs = MAP_FAILED;
+    size_t m = 0, recs_len = 0;
+    pdt_status st = h ? write_recs(run, fd, h, &m, err)
+                      : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    if (st == PDT_OK) {
+        /* the records as the replay's input: mapped from the file, so they
+         * take no memory of their own while the tables are built */
+        recs_len = HDR_BYTES + m * sizeof(pdt_rec);
+        recs = mmap(NULL, recs_len, PROT_READ, MAP_SHARED, fd, 0);
+        if (recs == MAP_FAILED) st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
+    }
+    if (st == PDT_OK)
+        st = pdt_replay_new(pts, n, (const pdt_rec *)((char *)recs + HDR_BYTES), m, nranks, &r, err);
+    if (st == PDT_OK) st = write_tables(r, fd, h, ident, err);
+    pdt_replay_free(r);
+    if (recs != MAP_FAILED) munmap(recs, recs_len);
+    if (close(fd) != 0 && st == PDT_OK)
+        st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
+    if (st == PDT_OK && rename(tmp, path) != 0)
+        st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", path, strerror(errno));
+    if (st != PDT_OK) unlink(tmp);
+    free(h);
+    return st;
+}
+
+/* ---- opening a run ---------------------------------------------------------------- */
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* The replay of run in memory, as before the kept index. */
+static pdt_status in_memory(pdt_run *run, const pdt_point *pts, size_t n, int nranks,
+                            pdt_replay **out, pdt_err *err)
+{
+    const pdt_rec *recs;
+    size_t m;
+    pdt_status st = pdt_run_merged(run, &recs, &m, err);
+    if (st != PDT_OK) return st;
+    return pdt_replay_new(pts, n, recs, m, nranks, out, err);
+}
+
+pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, int use_index,
+                               pdt_replay **out, pdt_replay_open_info *info, pdt_err *err)
+{
+    pdt_replay_open_info dummy;
+    if (!info) info = &dummy;
+    memset(info, 0, sizeof *info);
+    *out = NULL;
+    size_t n;
+    const pdt_point *pts = pdt_run_points(run, &n);
+    int nranks = pdt_run_nranks(run);
+    uint64_t events = 0;
+    for (int q = 0; q < nranks; q++) {
+        pdt_rank_info ri;
+        pdt_run_rank_info(run, q, &ri);
+        events += ri.events;
+    }
+    info->events = events;
+    if (use_index < 0) use_index = events * EST_BYTES_PER_EVENT > budget / 4;
+    pdt_status st;
+    if (!use_index) {
+        st = in_memory(run, pts, n, nranks, out, err);
+        if (st == PDT_OK) pdt_replay_set_mem(*out, budget);
+        return st;
+    }
+    uint64_t ident = 0;
+    st = run_ident(dir, &ident, err);
+    if (st != PDT_OK) return st;
+    char path[PATH_MAX];
+    pdt_replay *r = NULL;
+    /* a kept index beside the run, else in the cache */
+    for (int where = 0; where < 2 && !r; where++) {
+        char why[160];
+        if (!index_path(dir, where, path, sizeof path)) continue;
+        r = load(path, ident, pts, n, 1, why, sizeof why);
+        if (!r && where == 0) snprintf(info->why, sizeof info->why, "%s", why);
+        if (!r && where == 1 && strcmp(why, "no index yet"))
+            snprintf(info->why, sizeof info->why, "%s", why);
+    }
+    if (!r) { /* (re)build it: beside the run if the folder takes it, else in the cache */
+        double t0 = now_s();
+        for (int where = 0; where < 2 && !r; where++) {
+            if (!index_path(dir, where, path, sizeof path)) continue;
+            if (where == 1) {
+                char cdir[PATH_MAX];
+                if (!cache_dir(cdir, sizeof cdir) || !make_dirs(cdir)) continue;
+            }
+            pdt_err e2 = {0};
+            if (build(run, pts, n, nranks, ident, path, &e2) != PDT_OK) {
+                snprintf(info->write_error, sizeof info->write_error, "%s", e2.msg);
+                pdt_err_clear(&e2);
+                continue;
+            }
+            char why[160];
+            r = load(path, ident, pts, n, 0, why, sizeof why);
+        }
+        info->built = r != NULL;
+        info->build_s = now_s() - t0;
+    }
+    if (!r) { /* no place to keep an index: the whole run in memory */
+        st = in_memory(run, pts, n, nranks, out, err);
+        if (st == PDT_OK) pdt_replay_set_mem(*out, budget);
+        return st;
+    }
+    info->indexed = 1;
+    snprintf(info->path, sizeof info->path, "%s", path);
+    pdt_replay_set_mem(r, budget);
+    *out = r;
+    return PDT_OK;
+}

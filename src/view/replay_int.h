@@ -1,0 +1,63 @@
+/* pdt — the replay model's insides, shared by replay.c and the kept index
+ * (index.c), which writes these tables to a file and maps them back. */
+#ifndef PDT_REPLAY_INT_H
+#define PDT_REPLAY_INT_H
+
+#include "pdt/replay.h"
+
+typedef struct slot_change {
+    uint32_t ev;
+    int32_t val, prev;
+} slot_change;
+
+struct pdt_replay {
+    const pdt_point *pts;
+    size_t n;
+    const pdt_rec *recs;
+    size_t m, skipped;
+    int nranks;
+    int32_t *ev_obj;   /* per event: object (see build()) or -1 */
+    uint32_t *ev_ent;  /* per event: entry (history / change index, or flag) */
+
+    pdt_rtri *tris;
+    size_t ntri, cap_tri;
+    pdt_rtri_hist *hist;
+    size_t nhist;
+    pdt_redge *edges;
+    size_t nedge, cap_edge;
+    pdt_rnode *nodes;
+    size_t nnode, cap_node;
+    pdt_rphase *phases;
+    size_t nphase, cap_phase;
+    pdt_rmerge *merges;
+    size_t nmerge, cap_merge;
+    pdt_rmsg *msgs;
+    size_t nmsg, cap_msg;
+    pdt_rhull *hulls;
+    size_t nhull, cap_hull;
+
+    slot_change *ch;    /* every slot change, in event order */
+    size_t nch, cap_ch;
+    uint32_t *slot_ch;  /* changes grouped by slot: slot_ch[slot_start[s] .. slot_start[s+1]) */
+    uint32_t *slot_start;
+
+    uint32_t *lift_ev, *sort_ev, *del_ev;  /* per point: first such event or UINT32_MAX */
+    int64_t *sort_pos;
+    pdt_point *box_lo, *box_hi;  /* per rank */
+    uint8_t *has_box;
+    size_t kind_count[PDT_EV_KIND_COUNT];
+
+    /* Kept index: when map is set, every table above points into it (a
+     * read-only mapping of the index file) and pdt_replay_free unmaps it
+     * instead of freeing the tables. */
+    void *map;
+    size_t map_len;
+
+    /* Checkpoints: a copy of the state at every `ck_every`-th cursor, made on
+     * the first seek near it (NULL until then); none when ck_every == 0. */
+    size_t ck_every, nck, ck_bytes;
+    pdt_rstate **ck;
+};
+
+
+#endif

@@ -1,0 +1,116 @@
+#!/bin/bash
+# pdtview's kept index and memory budget (issue 12): a run larger than a
+# quarter of --mem opens through RUN/.pdtview-index (or the cache folder when
+# RUN is read-only); the index is kept, rebuilt when the run changed or the
+# index is damaged, and gives the same replay as the run held in memory.
+# san: yes
+. "$(dirname "$0")/lib.sh"
+V=$BIN/pdtview
+R=$TMP/run
+"$PDT" gen uniform 1500 --seed 7 > "$TMP/u.txt"
+"$PDT" triangulate "$TMP/u.txt" -o "$TMP/u.tri" --trace "$R" || { fail record; summary; exit 1; }
+IDX=$R/.pdtview-index
+inode() { stat -c %i "$1" 2>/dev/null; }
+
+# in memory (the default budget on a small run): no index is written
+mem=$("$V" "$R" --counts --end)
+if [ -n "$mem" ] && [ ! -e "$IDX" ]; then ok small_run_in_memory
+else fail small_run_in_memory "index written for a small run, or no counts: $mem"; fi
+
+# a tiny budget: the index is built beside the run, and the replay is the same
+got=$("$V" "$R" --counts --end --mem 1M 2>"$TMP/e1")
+if [ "$got" = "$mem" ] && [ -s "$IDX" ] && [ ! -s "$TMP/e1" ]; then ok index_built_same_counts
+else fail index_built_same_counts "got '$got' want '$mem'; $(cat "$TMP/e1")"; fi
+ls "$R"/.pdtview-index.tmp* >/dev/null 2>&1 && fail no_temp_left "a temporary index is left" || ok no_temp_left
+
+# what the window shows (event lines, lit code lines) is the same at every event
+"$V" "$R" --describe --index off > "$TMP/d_mem.txt"
+"$V" "$R" --describe --mem 1M > "$TMP/d_idx.txt"
+if [ -s "$TMP/d_mem.txt" ] && cmp -s "$TMP/d_mem.txt" "$TMP/d_idx.txt"; then ok describe_same
+else fail describe_same "$(diff "$TMP/d_mem.txt" "$TMP/d_idx.txt" | head -3)"; fi
+
+# seek == stepping == direct seek, with checkpoints (1M) and without (64K)
+for b in 1M 64K; do
+    out=$("$V" "$R" --check --mem $b)
+    case "$out" in *", 0 differ"*) ok "check_mem_$b" ;; *) fail "check_mem_$b" "$out" ;; esac
+done
+case "$("$V" "$R" --check --mem 1M)" in *"checkpoints every"*) ok checkpoints_made ;;
+    *) fail checkpoints_made "no checkpoints under --mem 1M" ;; esac
+
+# the second opening maps the kept index (same file, not rewritten)
+i1=$(inode "$IDX")
+"$V" "$R" --counts --end --mem 1M >/dev/null 2>"$TMP/e2"
+if [ "$(inode "$IDX")" = "$i1" ] && [ ! -s "$TMP/e2" ]; then ok index_kept
+else fail index_kept "the index was rewritten: $(cat "$TMP/e2")"; fi
+
+# the same picture from the index as from memory
+"$V" --headless "$R" --end -o "$TMP/mem.png" --size 640x400 --quiet --index off
+"$V" --headless "$R" --end -o "$TMP/idx.png" --size 640x400 --quiet --mem 1M
+if [ -s "$TMP/mem.png" ] && cmp -s "$TMP/mem.png" "$TMP/idx.png"; then ok same_picture
+else fail same_picture "the end frame differs through the index"; fi
+
+# stale: a run file changed (size and time) -> rebuilt, never trusted
+"$PDT" gen uniform 1400 --seed 8 > "$TMP/v.txt"
+"$PDT" triangulate "$TMP/v.txt" -o "$TMP/v.tri" --trace "$R" >/dev/null
+want=$("$V" "$R" --counts --end --index off)
+got=$("$V" "$R" --counts --end --mem 1M 2>"$TMP/e3")
+if [ "$got" = "$want" ] && grep -q "rebuilt the index (stale" "$TMP/e3"; then ok stale_rebuilt
+else fail stale_rebuilt "got '$got' want '$want'; $(cat "$TMP/e3")"; fi
+# only the modification time changed
+touch -d '2001-01-01' "$R/rank-0000.trace"
+"$V" "$R" --counts --end --mem 1M >/dev/null 2>"$TMP/e4"
+grep -q "stale" "$TMP/e4" && ok stale_mtime_rebuilt || fail stale_mtime_rebuilt "$(cat "$TMP/e4")"
+
+# damaged: a byte changed in the middle, or cut short -> rebuilt
+size=$(stat -c %s "$IDX")
+printf '\x5a' | dd of="$IDX" bs=1 seek=$((size / 2)) conv=notrunc status=none
+got=$("$V" "$R" --counts --end --mem 1M 2>"$TMP/e5")
+if [ "$got" = "$want" ] && grep -q "damaged: checksum" "$TMP/e5"; then ok damaged_rebuilt
+else fail damaged_rebuilt "got '$got'; $(cat "$TMP/e5")"; fi
+truncate -s $((size / 3)) "$IDX"
+got=$("$V" "$R" --counts --end --mem 1M 2>"$TMP/e6")
+if [ "$got" = "$want" ] && grep -q "damaged" "$TMP/e6" && [ "$(stat -c %s "$IDX")" = "$size" ]; then
+    ok truncated_rebuilt
+else fail truncated_rebuilt "got '$got'; $(cat "$TMP/e6")"; fi
+# an index of another run copied over this one's
+cp "$IDX" "$TMP/idx.bak"
+"$V" synth:srm:8:4:2 --counts --end >/dev/null
+mkdir "$TMP/other" && "$V" --write-run "$TMP/other" synth:srm:8:4:2 --quiet &&
+    "$V" "$TMP/other" --counts --end --mem 1M --index on >/dev/null 2>&1 &&
+    cp "$TMP/other/.pdtview-index" "$IDX"
+got=$("$V" "$R" --counts --end --mem 1M 2>"$TMP/e7")
+if [ "$got" = "$want" ] && grep -q "rebuilt the index" "$TMP/e7"; then ok foreign_index_rebuilt
+else fail foreign_index_rebuilt "got '$got'; $(cat "$TMP/e7")"; fi
+
+# a read-only run folder: the index goes to $XDG_CACHE_HOME/pdt, the folder is untouched
+RO=$TMP/ro
+mkdir -p "$RO/run" "$TMP/cache" "$TMP/rbin"
+cp "$R"/manifest "$R"/points.bin "$R"/rank-*.trace "$RO/run/"
+cp "$V" "$TMP/rbin/pdtview"
+chmod 755 "$TMP" "$RO" "$TMP/rbin"
+chmod 555 "$RO/run"
+chmod 777 "$TMP/cache"
+as_user() {  # root ignores folder permissions: read-only is tested as nobody
+    if [ "$(id -u)" = 0 ]; then
+        setpriv --reuid=65534 --regid=65534 --clear-groups env HOME=/nonexistent XDG_CACHE_HOME="$TMP/cache" "$@"
+    else
+        env XDG_CACHE_HOME="$TMP/cache" "$@"
+    fi
+}
+got=$(as_user "$TMP/rbin/pdtview" "$RO/run" --counts --end --mem 1M 2>"$TMP/e8")
+cached=$(ls "$TMP/cache/pdt/"run-*.pdtview-index 2>/dev/null | head -1)
+if [ "$got" = "$want" ] && [ -n "$cached" ] && [ ! -e "$RO/run/.pdtview-index" ]; then ok readonly_cache
+else fail readonly_cache "got '$got'; cache '$cached'; $(cat "$TMP/e8")"; fi
+i2=$(inode "$cached")
+as_user "$TMP/rbin/pdtview" "$RO/run" --counts --end --mem 1M >/dev/null 2>&1
+[ -n "$i2" ] && [ "$(inode "$cached")" = "$i2" ] && ok readonly_cache_kept || fail readonly_cache_kept
+chmod 755 "$RO/run"
+
+# bad budgets
+for bad in 0 12Q -5 ''; do
+    "$V" "$R" --counts --mem "$bad" >/dev/null 2>"$TMP/eb"; rc=$?
+    if [ $rc -eq 2 ] && grep -q -- "--mem" "$TMP/eb"; then ok "bad_mem_'$bad'"
+    else fail "bad_mem_'$bad'" "exit $rc: $(cat "$TMP/eb")"; fi
+done
+PDTVIEW_MEM=1M "$V" "$R" --check >/dev/null && ok env_budget || fail env_budget
+summary
