@@ -274,6 +274,16 @@ typedef struct pdt_replay_open_info {
 pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, int use_index,
                                pdt_replay **out, pdt_replay_open_info *info, pdt_err *err);
 
+/* The replay of run folder `dir` from its kept index alone, without reading
+ * the run (the index holds the points too): *out = NULL (and PDT_OK, with
+ * info->why) when there is no valid index beside the run or in the cache.
+ * Errors: the folder cannot be listed, out of memory. */
+pdt_status pdt_replay_open_kept(const char *dir, uint64_t budget, pdt_replay **out,
+                                pdt_replay_open_info *info, pdt_err *err);
+/* What the reader said about damage in the run when the kept index was
+ * built ("" if nothing, or for a replay not opened from an index). */
+const char *pdt_replay_run_warnings(const pdt_replay *r);
+
 /* Searching the event list (for the controls).  Kinds of "selected event": */
 typedef enum pdt_ev_class {
     PDT_EVC_ANY = 0,

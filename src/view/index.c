@@ -6,7 +6,9 @@
  *                    of the record types, the table sizes, and per section
  *                    its offset, length and CRC-32C; the header's own CRC
  *   sections         the merged event records, then every table of the
- *                    replay (replay_int.h), each at a 64-byte boundary
+ *                    replay (replay_int.h), the points and the reader's
+ *                    warnings about the run, each at a 64-byte boundary
+ *                    (so that a valid index opens without reading the run)
  *
  * The identity of a run is a hash of the name, size and modification time
  * of every file in the folder (but dot-files) and of the manifest's bytes.
@@ -27,14 +29,14 @@
 #include <unistd.h>
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 1u
+#define INDEX_VERSION 2u
 #define HDR_BYTES 4096u
 #define EST_BYTES_PER_EVENT 100u /* what the replay model holds per event in memory */
 
 enum {
     S_RECS, S_EVOBJ, S_EVENT, S_TRIS, S_HIST, S_EDGES, S_NODES, S_PHASES, S_MERGES, S_MSGS,
     S_HULLS, S_CH, S_SLOTCH, S_SLOTSTART, S_LIFT, S_SORT, S_DEL, S_SORTPOS, S_BOXLO, S_BOXHI,
-    S_HASBOX, NSEC
+    S_HASBOX, S_POINTS, S_WARN, NSEC
 };
 
 typedef struct isec {
@@ -96,6 +98,12 @@ static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_
     SEC(S_BOXLO, box_lo, (uint64_t)r->nranks);
     SEC(S_BOXHI, box_hi, (uint64_t)r->nranks);
     SEC(S_HASBOX, has_box, (uint64_t)r->nranks);
+    ptr[S_POINTS] = (void **)&r->pts;
+    elem[S_POINTS] = sizeof(pdt_point);
+    count[S_POINTS] = r->n;
+    ptr[S_WARN] = (void **)&r->warnings;
+    elem[S_WARN] = 1;
+    count[S_WARN] = r->warnings ? strlen(r->warnings) + 1 : 0;
 #undef SEC
 }
 
@@ -255,7 +263,7 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
                  (unsigned long long)h.file_bytes);
         goto fail;
     }
-    if (h.n != n || h.nranks == 0 || h.nranks > INT32_MAX) {
+    if ((pts && h.n != n) || h.nranks == 0 || h.nranks > INT32_MAX) {
         snprintf(why, wcap, "stale: made for %llu points, the run has %zu", (unsigned long long)h.n, n);
         goto fail;
     }
@@ -299,8 +307,7 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
         snprintf(why, wcap, "out of memory");
         goto fail;
     }
-    r->pts = pts;
-    r->n = n;
+    r->n = h.n;
     r->m = h.m;
     r->skipped = h.skipped;
     r->nranks = (int)h.nranks;
@@ -314,10 +321,12 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
     r->nmsg = h.count[S_MSGS];
     r->nhull = h.count[S_HULLS];
     r->nch = h.count[S_CH];
+    r->warnings = h.count[S_WARN] ? "" : NULL;  /* so that sections() sizes it */
     void **ptr[NSEC];
     size_t elem[NSEC];
     uint64_t count[NSEC];
     sections(r, ptr, elem, count);
+    count[S_WARN] = h.count[S_WARN];
     for (int i = 0; i < NSEC; i++) {
         if (count[i] != h.count[i] || count[i] * elem[i] != h.sec[i].bytes) {
             snprintf(why, wcap, "damaged: section %d has the wrong size", i);
@@ -327,6 +336,13 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
         }
         *ptr[i] = (char *)map + h.sec[i].off;
     }
+    if (h.count[S_WARN] && ((const char *)map)[h.sec[S_WARN].off + h.count[S_WARN] - 1]) {
+        snprintf(why, wcap, "damaged: warnings not terminated");
+        free(r);
+        r = NULL;
+        goto fail;
+    }
+    if (pts) r->pts = pts;  /* the run's own copy (the same points) */
     r->map = map;
     r->map_len = h.file_bytes;
     close(fd);
@@ -444,7 +460,10 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     }
     if (st == PDT_OK)
         st = pdt_replay_new(pts, n, (const pdt_rec *)((char *)recs + HDR_BYTES), m, nranks, &r, err);
-    if (st == PDT_OK) st = write_tables(r, fd, h, ident, err);
+    if (st == PDT_OK) {
+        r->warnings = pdt_run_warnings(run);
+        st = write_tables(r, fd, h, ident, err);
+    }
     pdt_replay_free(r);
     if (recs != MAP_FAILED) munmap(recs, recs_len);
     if (close(fd) != 0 && st == PDT_OK)
@@ -463,6 +482,36 @@ static double now_s(void)
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+pdt_status pdt_replay_open_kept(const char *dir, uint64_t budget, pdt_replay **out,
+                                pdt_replay_open_info *info, pdt_err *err)
+{
+    pdt_replay_open_info dummy;
+    if (!info) info = &dummy;
+    memset(info, 0, sizeof *info);
+    *out = NULL;
+    uint64_t ident = 0;
+    pdt_status st = run_ident(dir, &ident, err);
+    if (st != PDT_OK) return st;
+    char path[PATH_MAX];
+    for (int where = 0; where < 2; where++) {
+        char why[160];
+        if (!index_path(dir, where, path, sizeof path)) continue;
+        pdt_replay *r = load(path, ident, NULL, 0, 1, why, sizeof why);
+        if (!r) {
+            if (where == 0 || strcmp(why, "no index yet"))
+                snprintf(info->why, sizeof info->why, "%s", why);
+            continue;
+        }
+        info->indexed = 1;
+        info->events = r->m;
+        snprintf(info->path, sizeof info->path, "%s", path);
+        pdt_replay_set_mem(r, budget);
+        *out = r;
+        return PDT_OK;
+    }
+    return PDT_OK;
 }
 
 /* The replay of run in memory, as before the kept index. */

@@ -597,6 +597,7 @@ size_t pdt_replay_kind_count(const pdt_replay *r, int kind)
     return kind >= 0 && kind < PDT_EV_KIND_COUNT ? r->kind_count[kind] : 0;
 }
 int pdt_replay_nranks(const pdt_replay *r) { return r->nranks; }
+const char *pdt_replay_run_warnings(const pdt_replay *r) { return r->warnings ? r->warnings : ""; }
 
 const pdt_point *pdt_replay_points(const pdt_replay *r, size_t *n)
 {
@@ -692,9 +693,25 @@ static uint8_t alive(uint32_t from, uint32_t to, size_t k)
     return from < k && !(to < k);
 }
 
+/* Cursor 0: nothing has happened (no history entry is before it). */
+static void seek_zero(const pdt_replay *r, pdt_rstate *s)
+{
+    size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
+    s->k = 0;
+    memset(s->pflags, 0, r->n);
+    memset(s->tcur, 0xff, r->ntri * sizeof *s->tcur);
+    memset(s->ealive, 0, r->nedge);
+    memset(s->mflight, 0, r->nmsg);
+    for (size_t sl = 0; sl < nslot; sl++) s->slot[sl] = -1;
+}
+
 void pdt_replay_seek_direct(const pdt_replay *r, pdt_rstate *s, size_t k)
 {
     if (k > r->m) k = r->m;
+    if (k == 0 && r->map) { /* do not touch every table of a mapped index */
+        seek_zero(r, s);
+        return;
+    }
     s->k = k;
     for (size_t p = 0; p < r->n; p++) s->pflags[p] = point_flags(r, p, k);
     for (size_t t = 0; t < r->ntri; t++) {

@@ -52,6 +52,7 @@ struct pdt_replay {
      * instead of freeing the tables. */
     void *map;
     size_t map_len;
+    const char *warnings;  /* the reader's warnings about the run (kept index), or NULL */
 
     /* Checkpoints: a copy of the state at every `ck_every`-th cursor, made on
      * the first seek near it (NULL until then); none when ck_every == 0. */
