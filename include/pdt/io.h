@@ -61,6 +61,38 @@ pdt_tri_format pdt_tri_format_of(const char *path);
 pdt_status pdt_write_tris(const char *path, pdt_tri_format fmt, const pdt_point *pts, size_t n,
                           const pdt_tri *tris, size_t ntri, pdt_err *err);
 
+/* ---- formatting, for writers that place the bytes themselves ----------------
+ * (the parallel write: every rank formats its block of lines and writes it
+ * at its offset; the plain writer above formats with the same functions). */
+
+/* What a block of lines holds. */
+typedef enum pdt_lines {
+    PDT_LINES_TRI,       /* triangles "a b c" (.tri) */
+    PDT_LINES_ELE,       /* triangles "i a b c", i = first + k (.ele) */
+    PDT_LINES_OFF_TRI,   /* triangles "3 a b c" (.off faces) */
+    PDT_LINES_NODE,      /* points "i x y", i = first + k (.node) */
+    PDT_LINES_OFF_POINT, /* points "x y 0" (.off vertices) */
+    PDT_LINES_XY         /* points "x y" (text) */
+} pdt_lines;
+
+/* The most bytes one line of any kind takes. */
+enum { PDT_LINE_MAX = 64 };
+
+/* Write items[0..n) (pdt_tri for the triangle kinds, pdt_point for the
+ * point kinds) as lines of `kind` at buf, the k-th numbered first + k where
+ * the kind numbers its lines.  Requires room for n * PDT_LINE_MAX bytes.
+ * Returns the bytes written. */
+size_t pdt_format_lines(char *buf, pdt_lines kind, const void *items, size_t n, uint64_t first);
+/* The bytes pdt_format_lines would write for the same arguments. */
+uint64_t pdt_lines_bytes(pdt_lines kind, const void *items, size_t n, uint64_t first);
+/* The header of a triangle file of format fmt for npts points and ntri
+ * triangles (.ele: comment and counts; .off: "OFF" and counts; .tri: none)
+ * at buf (room for 256 bytes).  Returns its bytes. */
+size_t pdt_format_tri_header(char *buf, pdt_tri_format fmt, uint64_t npts, uint64_t ntri);
+/* The header of a .node file of npts points (comment and counts) at buf
+ * (room for 256 bytes).  Returns its bytes. */
+size_t pdt_format_node_header(char *buf, uint64_t npts);
+
 /* Read a canonical .tri file (or a Triangle .ele file by extension). */
 pdt_status pdt_read_tris(const char *path, pdt_tri **tris, size_t *ntri, pdt_err *err);
 

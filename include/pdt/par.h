@@ -93,15 +93,17 @@ typedef struct pdt_comm_file pdt_comm_file;
  * status: if any rank failed, every rank gets PDT_ERR_IO naming the path and
  * *f = NULL.  On success *f is owned by the caller (pdt_comm_file_close). */
 pdt_status pdt_comm_file_open(pdt_comm *c, const char *path, pdt_comm_file **f, pdt_err *err);
-/* Collective: every rank writes its own `bytes` bytes of buf at byte
- * `offset` of the file (ranges must not overlap; bytes may be 0, buf then
- * unused).  MPI_File_write_at_all in chunks, pwrite(2) in serial mode.  All
- * ranks return the same status (PDT_ERR_IO naming the path and the failing
- * rank). */
+/* Not collective: write `bytes` bytes of buf at byte `offset` of the file
+ * (any number of calls per rank, none included; ranges of different ranks
+ * must not overlap).  MPI_File_write_at in chunks, pwrite(2) in the local
+ * backend.  Returns this rank's status; after a failure every later write
+ * fails the same way, and pdt_comm_file_close reports it to every rank. */
 pdt_status pdt_comm_file_write_at(pdt_comm_file *f, uint64_t offset, const void *buf,
                                   size_t bytes, pdt_err *err);
 /* Collective: close and free f (f may be NULL on every rank).  Same status
- * at every rank.  Does not remove the file, even after a failed write. */
+ * at every rank: PDT_ERR_IO if a write or the close failed at any rank (the
+ * failing rank keeps its own message; the others get "PATH: write failed
+ * at rank R").  Does not remove the file, even after a failed write. */
 pdt_status pdt_comm_file_close(pdt_comm_file *f, pdt_err *err);
 
 /* Point to point, blocking.  recv: waits (sleeping between polls) for the
@@ -228,11 +230,12 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_par_input *in, pdt_par_out
                                pdt_par_rank_stats *me, pdt_trace *tr, pdt_err *err);
 
 /* Collective: write the output to `path` (NULL or "-" = standard output,
- * gathered at rank 0) in format `fmt` (.ele also
- * writes the .node beside it, .off and .node need every rank's points in
- * `in`).  The file is written by all ranks at their offsets into a
- * temporary name and renamed by rank 0 once every rank succeeded; on any
- * failure nothing is left.  Same status at every rank (pdt_par_agree). */
+ * a device or a pipe: gathered at rank 0) in format `fmt` (.ele also writes
+ * the .node beside it; .off and .node take each rank's input block `in`,
+ * the triangles its block `out`).  Every rank formats its blocks and writes
+ * them at their offsets of a temporary name; rank 0 renames it once every
+ * rank succeeded; on any failure nothing is left.  Same status at every
+ * rank (pdt_par_agree). */
 pdt_status pdt_par_write(pdt_comm *c, const char *path, pdt_tri_format fmt, const pdt_par_input *in,
                          const pdt_par_output *out, pdt_err *err);
 

@@ -605,13 +605,17 @@ static void sort_run(pdt_tri *t, size_t lo, size_t hi)
 void pdt_tri_canonical(pdt_tri *tris, size_t ntri)
 {
     if (ntri == 0) return;
-    uint32_t maxv = 0;
+    uint32_t minv = UINT32_MAX, maxv = 0;
     for (size_t i = 0; i < ntri; i++) {
         tri_rotate(&tris[i]);
         if (tris[i].v[0] > maxv) maxv = tris[i].v[0];
+        if (tris[i].v[0] < minv) minv = tris[i].v[0];
     }
-    int bits = 32 - __builtin_clz(maxv | 1u), shift = bits > 11 ? bits - 11 : 0;
-    size_t nhi = ((size_t)maxv >> shift) + 1, nlo = (size_t)1 << shift;
+    /* the buckets span [minv, maxv] only: a rank of a parallel run orders the
+     * triangles of one index range */
+    uint32_t span = maxv - minv;
+    int bits = 32 - __builtin_clz(span | 1u), shift = bits > 11 ? bits - 11 : 0;
+    size_t nhi = ((size_t)span >> shift) + 1, nlo = (size_t)1 << shift;
     pdt_tri *tmp = ntri > 64 ? pdt_big_alloc(ntri * sizeof *tmp) : NULL;
     size_t *hc = tmp ? calloc(nhi + 1, sizeof *hc) : NULL;
     size_t *lc = hc ? malloc((nlo + 1) * sizeof *lc) : NULL;
@@ -621,19 +625,20 @@ void pdt_tri_canonical(pdt_tri *tris, size_t ntri)
         qsort(tris, ntri, sizeof *tris, tri_qcmp);
         return;
     }
-    for (size_t i = 0; i < ntri; i++) hc[(tris[i].v[0] >> shift) + 1]++;
+    for (size_t i = 0; i < ntri; i++) hc[((tris[i].v[0] - minv) >> shift) + 1]++;
     for (size_t h = 1; h <= nhi; h++) hc[h] += hc[h - 1];
-    for (size_t i = 0; i < ntri; i++) tmp[hc[tris[i].v[0] >> shift]++] = tris[i];
+    for (size_t i = 0; i < ntri; i++) tmp[hc[(tris[i].v[0] - minv) >> shift]++] = tris[i];
     /* hc[h] is now the end of high bucket h */
     uint32_t lmask = (uint32_t)(nlo - 1);
     size_t start = 0;
     for (size_t h = 0; h < nhi; h++) {
         size_t end = hc[h];
+        if (end == start) continue; /* (no counters to clear for an empty bucket) */
         memset(lc, 0, (nlo + 1) * sizeof *lc);
-        for (size_t i = start; i < end; i++) lc[(tmp[i].v[0] & lmask) + 1]++;
+        for (size_t i = start; i < end; i++) lc[((tmp[i].v[0] - minv) & lmask) + 1]++;
         lc[0] = start;
         for (size_t l = 1; l <= nlo; l++) lc[l] += lc[l - 1];
-        for (size_t i = start; i < end; i++) tris[lc[tmp[i].v[0] & lmask]++] = tmp[i];
+        for (size_t i = start; i < end; i++) tris[lc[(tmp[i].v[0] - minv) & lmask]++] = tmp[i];
         for (size_t i = start; i < end;) { /* runs of one first index */
             size_t j = i + 1;
             while (j < end && tris[j].v[0] == tris[i].v[0]) j++;

@@ -22,13 +22,6 @@ static void wb_flush(wbuf *w)
     w->n = 0;
 }
 
-/* Make room for at least 64 more bytes. */
-static inline char *wb_room(wbuf *w)
-{
-    if (w->n > WBUF - 64) wb_flush(w);
-    return w->b + w->n;
-}
-
 /* "00" "01" ... "99": two digits per division by 100. */
 static const char digits2[201] =
     "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
@@ -76,37 +69,159 @@ static inline char *put_u64(char *p, uint64_t v)
     return p;
 }
 
-static inline char *put_i64(char *p, int64_t v)
+static inline char *put_i32(char *p, int32_t v)
 {
     if (v < 0) {
         *p++ = '-';
-        return put_u64(p, (uint64_t)0 - (uint64_t)v);
+        return put_u32(p, (uint32_t)0 - (uint32_t)v);
     }
-    return put_u64(p, (uint64_t)v);
+    return put_u32(p, (uint32_t)v);
 }
 
-static void wb_str(wbuf *w, const char *s)
+static inline int ndigits64(uint64_t v)
 {
-    size_t len = strlen(s);
-    if (w->n + len > WBUF) wb_flush(w);
-    if (len > WBUF) {
-        if (fwrite(s, 1, len, w->fp) != len) w->bad = 1;
-        return;
+    if (v <= UINT32_MAX) return ndigits32((uint32_t)v);
+    int k = 10;
+    for (v /= 10000000000u; v; v /= 10) k++;
+    return k;
+}
+
+static inline int nchars_i32(int32_t v)
+{
+    return v < 0 ? 1 + ndigits32((uint32_t)0 - (uint32_t)v) : ndigits32((uint32_t)v);
+}
+
+/* ---- formatting (pdt_format_*: the lines of every output format) ---------------- */
+
+size_t pdt_format_lines(char *buf, pdt_lines kind, const void *items, size_t n, uint64_t first)
+{
+    const pdt_tri *t = items;
+    const pdt_point *q = items;
+    char *p = buf;
+    switch (kind) {
+    case PDT_LINES_TRI:
+    case PDT_LINES_ELE:
+    case PDT_LINES_OFF_TRI:
+        for (size_t i = 0; i < n; i++) {
+            if (kind == PDT_LINES_ELE) {
+                p = put_u64(p, first + i);
+                *p++ = ' ';
+            } else if (kind == PDT_LINES_OFF_TRI) {
+                memcpy(p, "3 ", 2);
+                p += 2;
+            }
+            p = put_u32(p, t[i].v[0]);
+            *p++ = ' ';
+            p = put_u32(p, t[i].v[1]);
+            *p++ = ' ';
+            p = put_u32(p, t[i].v[2]);
+            *p++ = '\n';
+        }
+        break;
+    case PDT_LINES_NODE:
+    case PDT_LINES_OFF_POINT:
+    case PDT_LINES_XY:
+        for (size_t i = 0; i < n; i++) {
+            if (kind == PDT_LINES_NODE) {
+                p = put_u64(p, first + i);
+                *p++ = ' ';
+            }
+            p = put_i32(p, q[i].x);
+            *p++ = ' ';
+            p = put_i32(p, q[i].y);
+            if (kind == PDT_LINES_OFF_POINT) {
+                memcpy(p, " 0", 2);
+                p += 2;
+            }
+            *p++ = '\n';
+        }
+        break;
     }
-    memcpy(w->b + w->n, s, len);
-    w->n += len;
+    return (size_t)(p - buf);
+}
+
+uint64_t pdt_lines_bytes(pdt_lines kind, const void *items, size_t n, uint64_t first)
+{
+    const pdt_tri *t = items;
+    const pdt_point *q = items;
+    uint64_t b = 0;
+    switch (kind) {
+    case PDT_LINES_TRI:
+    case PDT_LINES_ELE:
+    case PDT_LINES_OFF_TRI:
+        for (size_t i = 0; i < n; i++)
+            b += (uint64_t)(ndigits32(t[i].v[0]) + ndigits32(t[i].v[1]) + ndigits32(t[i].v[2]));
+        b += 3 * (uint64_t)n; /* two spaces and the newline */
+        if (kind == PDT_LINES_OFF_TRI) b += 2 * (uint64_t)n;
+        if (kind == PDT_LINES_ELE)
+            for (size_t i = 0; i < n; i++) b += (uint64_t)ndigits64(first + i) + 1;
+        break;
+    case PDT_LINES_NODE:
+    case PDT_LINES_OFF_POINT:
+    case PDT_LINES_XY:
+        for (size_t i = 0; i < n; i++) b += (uint64_t)(nchars_i32(q[i].x) + nchars_i32(q[i].y));
+        b += 2 * (uint64_t)n; /* the space and the newline */
+        if (kind == PDT_LINES_OFF_POINT) b += 2 * (uint64_t)n;
+        if (kind == PDT_LINES_NODE)
+            for (size_t i = 0; i < n; i++) b += (uint64_t)ndigits64(first + i) + 1;
+        break;
+    }
+    return b;
 }
 
 /* k integers separated by spaces, then a newline. */
-static void wb_ints(wbuf *w, const int64_t *v, int k)
+static char *put_ints(char *p, const uint64_t *v, int k)
 {
-    char *p = wb_room(w), *s = p;
     for (int i = 0; i < k; i++) {
         if (i) *p++ = ' ';
-        p = put_i64(p, v[i]);
+        p = put_u64(p, v[i]);
     }
     *p++ = '\n';
-    w->n += (size_t)(p - s);
+    return p;
+}
+
+size_t pdt_format_tri_header(char *buf, pdt_tri_format fmt, uint64_t npts, uint64_t ntri)
+{
+    char *p = buf;
+    if (fmt == PDT_FMT_ELE) {
+        static const char c[] = "# pdt: triangles, 0-based indices into the .node file\n";
+        uint64_t h[3] = { ntri, 3, 0 };
+        memcpy(p, c, sizeof c - 1);
+        p = put_ints(p + sizeof c - 1, h, 3);
+    } else if (fmt == PDT_FMT_OFF) {
+        uint64_t h[3] = { npts, ntri, 0 };
+        memcpy(p, "OFF\n", 4);
+        p = put_ints(p + 4, h, 3);
+    }
+    return (size_t)(p - buf);
+}
+
+size_t pdt_format_node_header(char *buf, uint64_t npts)
+{
+    static const char c[] = "# pdt: points, 0-based indices\n";
+    uint64_t h[4] = { npts, 2, 0, 0 };
+    memcpy(buf, c, sizeof c - 1);
+    return (size_t)(put_ints(buf + sizeof c - 1, h, 4) - buf);
+}
+
+/* ---- the plain writer: the same lines through a buffer ------------------------ */
+
+/* items[0..n) as lines of `kind`, a buffer's worth at a time. */
+static void wb_lines(wbuf *w, pdt_lines kind, const void *items, size_t elem, size_t n)
+{
+    const size_t step = WBUF / PDT_LINE_MAX;
+    for (size_t i = 0; i < n; i += step) {
+        size_t k = n - i < step ? n - i : step;
+        if (w->n + k * PDT_LINE_MAX > WBUF) wb_flush(w);
+        w->n += pdt_format_lines(w->b + w->n, kind, (const char *)items + i * elem, k, i);
+    }
+}
+
+static void wb_header(wbuf *w, const char *h, size_t len)
+{
+    if (w->n + len > WBUF) wb_flush(w);
+    memcpy(w->b + w->n, h, len);
+    w->n += len;
 }
 
 static int has_ext(const char *path, const char *ext)
@@ -134,15 +249,10 @@ static pdt_status finish(pdt_outfile *o, wbuf *w, pdt_err *err)
 static void emit_points(wbuf *w, const pdt_point *pts, size_t n, int node)
 {
     if (node) {
-        int64_t h[4] = { (int64_t)n, 2, 0, 0 };
-        wb_str(w, "# pdt: points, 0-based indices\n");
-        wb_ints(w, h, 4);
+        char h[256];
+        wb_header(w, h, pdt_format_node_header(h, n));
     }
-    for (size_t i = 0; i < n; i++) {
-        int64_t v[3] = { (int64_t)i, pts[i].x, pts[i].y };
-        if (node) wb_ints(w, v, 3);
-        else wb_ints(w, v + 1, 2);
-    }
+    wb_lines(w, node ? PDT_LINES_NODE : PDT_LINES_XY, pts, sizeof *pts, n);
 }
 
 pdt_status pdt_write_points(const char *path, const pdt_point *pts, size_t n, pdt_err *err)
@@ -176,36 +286,12 @@ pdt_tri_format pdt_tri_format_of(const char *path)
 static void emit_tris(wbuf *w, pdt_tri_format fmt, const pdt_point *pts, size_t n,
                       const pdt_tri *t, size_t ntri)
 {
-    if (fmt == PDT_FMT_ELE) {
-        int64_t h[3] = { (int64_t)ntri, 3, 0 };
-        wb_str(w, "# pdt: triangles, 0-based indices into the .node file\n");
-        wb_ints(w, h, 3);
-    } else if (fmt == PDT_FMT_OFF) {
-        int64_t h[3] = { (int64_t)n, (int64_t)ntri, 0 };
-        wb_str(w, "OFF\n");
-        wb_ints(w, h, 3);
-        for (size_t i = 0; i < n; i++) {
-            int64_t v[3] = { pts[i].x, pts[i].y, 0 };
-            wb_ints(w, v, 3);
-        }
-    }
-    if (fmt == PDT_FMT_TRI) {
-        for (size_t i = 0; i < ntri; i++) { /* the common case, without the int64 detour */
-            char *p = wb_room(w), *s = p;
-            p = put_u32(p, t[i].v[0]);
-            *p++ = ' ';
-            p = put_u32(p, t[i].v[1]);
-            *p++ = ' ';
-            p = put_u32(p, t[i].v[2]);
-            *p++ = '\n';
-            w->n += (size_t)(p - s);
-        }
-        return;
-    }
-    for (size_t i = 0; i < ntri; i++) {
-        int64_t v[4] = { fmt == PDT_FMT_OFF ? 3 : (int64_t)i, t[i].v[0], t[i].v[1], t[i].v[2] };
-        wb_ints(w, v, 4);
-    }
+    char h[256];
+    wb_header(w, h, pdt_format_tri_header(h, fmt, n, ntri));
+    if (fmt == PDT_FMT_OFF) wb_lines(w, PDT_LINES_OFF_POINT, pts, sizeof *pts, n);
+    wb_lines(w, fmt == PDT_FMT_ELE ? PDT_LINES_ELE : fmt == PDT_FMT_OFF ? PDT_LINES_OFF_TRI
+                                                                         : PDT_LINES_TRI,
+             t, sizeof *t, ntri);
 }
 
 /* "X.ele" -> "X.node" (malloc'd). */

@@ -155,6 +155,7 @@ pdt_status pdt_comm_file_open(pdt_comm *c, const char *path, pdt_comm_file **out
     }
     f->c = c;
     f->path = p;
+    pdt_err_clear(&f->first);
     pdt_status s = c->ops->file_open(c, f, err);
     if (s != PDT_OK) {
         free(p);
@@ -168,14 +169,23 @@ pdt_status pdt_comm_file_open(pdt_comm *c, const char *path, pdt_comm_file **out
 pdt_status pdt_comm_file_write_at(pdt_comm_file *f, uint64_t offset, const void *buf,
                                   size_t bytes, pdt_err *err)
 {
-    return f->c->ops->file_write_at(f, offset, buf, bytes, err);
+    if (f->first.code != PDT_OK) return pdt_err_set(err, f->first.code, "%s", f->first.msg);
+    pdt_status s = f->c->ops->file_write_at(f, offset, buf, bytes, &f->first);
+    if (s != PDT_OK) pdt_err_set(err, s, "%s", f->first.msg);
+    return s;
 }
 
 pdt_status pdt_comm_file_close(pdt_comm_file *f, pdt_err *err)
 {
     if (!f) return PDT_OK;
-    pdt_status s = f->c->ops->file_close(f, err);
+    pdt_comm *c = f->c;
+    pdt_err cerr;
+    pdt_err_clear(&cerr);
+    pdt_status s = c->ops->file_close(f, &cerr);
+    pdt_status mine = f->first.code != PDT_OK ? f->first.code : s;
+    if (mine != PDT_OK) pdt_err_set(err, mine, "%s", f->first.code ? f->first.msg : cerr.msg);
+    mine = pdt_comm_agree(c, mine, f->path, f->first.code ? "write" : "close", err);
     free(f->path);
     free(f);
-    return s;
+    return mine;
 }

@@ -31,7 +31,8 @@ typedef struct pdt_comm_ops {
     pdt_status (*send)(pdt_comm *c, int peer, int tag, const void *buf, size_t bytes,
                        pdt_err *err);
     pdt_status (*recv)(pdt_comm *c, int peer, int tag, void **buf, size_t *bytes, pdt_err *err);
-    /* files: the backend allocates and frees f->be */
+    /* files: the backend allocates and frees f->be; open and close are
+     * collective (the front agrees on their status), write_at is not */
     pdt_status (*file_open)(pdt_comm *c, pdt_comm_file *f, pdt_err *err);
     pdt_status (*file_write_at)(pdt_comm_file *f, uint64_t offset, const void *buf,
                                 size_t bytes, pdt_err *err);
@@ -50,6 +51,7 @@ struct pdt_comm_file {
     pdt_comm *c;
     char *path;
     void *be;
+    pdt_err first; /* this rank's first failed write (code PDT_OK: none) */
 };
 
 /* The chunk size from PDT_COMM_CHUNK (1 GiB if unset or invalid). */

@@ -441,30 +441,26 @@ static pdt_status mpi_file_open(pdt_comm *c, pdt_comm_file *f, pdt_err *err)
     return PDT_OK;
 }
 
+/* Independent writes (MPI_File_write_at, a chunk at a time): every rank's
+ * range is one contiguous run of the file, so a collective write (two-phase
+ * aggregation through a few ranks) would only move the bytes once more. */
 static pdt_status mpi_file_write_at(pdt_comm_file *f, uint64_t offset, const void *buf,
                                     size_t bytes, pdt_err *err)
 {
     pdt_comm *c = f->c;
     MPI_File *fh = f->be;
-    /* write_at_all is collective: every rank calls it as often as the rank
-     * with the most chunks, with 0 bytes once done (or after a failure). */
-    uint64_t rounds = (bytes + c->chunk - 1) / c->chunk;
-    pdt_status s = mpi_allreduce_u64(c, &rounds, 1, PDT_COMM_MAX, err);
-    if (s != PDT_OK) return s;
-    pdt_status mine = PDT_OK;
-    for (uint64_t r = 0; r < rounds; r++) {
-        size_t off = (size_t)r * c->chunk;
-        int len = mine == PDT_OK && off < bytes ? (int)min_size(c->chunk, bytes - off) : 0;
-        const char *p = len ? (const char *)buf + off : (const char *)buf;
+    pdt_status s = PDT_OK;
+    for (size_t off = 0; off < bytes && s == PDT_OK; off += c->chunk) {
+        int len = (int)min_size(c->chunk, bytes - off);
         MPI_Status st;
-        int rc = MPI_File_write_at_all(*fh, (MPI_Offset)(offset + off), p, len, MPI_BYTE, &st);
-        pdt_status w = mpi_io_check(rc, c, f->path, "write", err);
+        int rc = MPI_File_write_at(*fh, (MPI_Offset)(offset + off), (const char *)buf + off, len,
+                                   MPI_BYTE, &st);
+        s = mpi_io_check(rc, c, f->path, "write", err);
         int got = 0;
-        if (w == PDT_OK && len && (MPI_Get_count(&st, MPI_BYTE, &got) != MPI_SUCCESS || got != len))
-            w = pdt_err_set(err, PDT_ERR_IO, "%s: short write at rank %d", f->path, c->rank);
-        if (mine == PDT_OK) mine = w;
+        if (s == PDT_OK && (MPI_Get_count(&st, MPI_BYTE, &got) != MPI_SUCCESS || got != len))
+            s = pdt_err_set(err, PDT_ERR_IO, "%s: short write at rank %d", f->path, c->rank);
     }
-    return pdt_comm_agree(c, mine, f->path, "write", err);
+    return s;
 }
 
 static pdt_status mpi_file_close(pdt_comm_file *f, pdt_err *err)
@@ -472,7 +468,7 @@ static pdt_status mpi_file_close(pdt_comm_file *f, pdt_err *err)
     MPI_File *fh = f->be;
     pdt_status s = mpi_io_check(MPI_File_close(fh), f->c, f->path, "close", err);
     free(fh);
-    return pdt_comm_agree(f->c, s, f->path, "close", err);
+    return s;
 }
 
 static const pdt_comm_ops mpi_ops = {

@@ -8,8 +8,9 @@
  *   merge      for each level: every rank of a pair sends one message (its
  *              pending triangles for that level, and the hull if it holds
  *              one) to the merge rank, which runs pdt_srm_merge.
- *   order      the final triangles are sample-sorted across ranks into the
- *              canonical order: rank q ends with a consecutive block.
+ *   order      the final triangles go to the rank of their smallest index's
+ *              range (ranges balanced by a histogram) and are put in
+ *              canonical order there: rank q ends with a consecutive block.
  *
  * With one rank the sequential pipeline (pdt_triangulate) does all of it. */
 #include <stdlib.h>
@@ -42,6 +43,7 @@ typedef struct drv {
     srm_rec *rec;                  /* partition: this rank's distinct records */
     size_t m;
     uint64_t nrecv;
+    uint64_t n_total;              /* points in the whole input */
     srm_strip *strip;              /* p strip descriptors */
     srm_rank s;
     int s_init;
@@ -331,146 +333,88 @@ static pdt_status merge_tree(drv *d, pdt_err *err)
 
 /* ---- canonical order across ranks ------------------------------------------------ */
 
-static int tri_less(const pdt_tri *a, const pdt_tri *b)
+/* The canonical order sorts by smallest index first, so the output splits
+ * into ranges of smallest index: rank q orders (pdt_tri_canonical, the plain
+ * run's own counting sort) and writes the triangles whose smallest index
+ * lies in its range.  No sample sort, no merge of sorted blocks: one
+ * histogram, one exchange of 12-byte records, one local sort. */
+
+static uint32_t tri_min(const pdt_tri *t)
 {
-    for (int k = 0; k < 3; k++)
-        if (a->v[k] != b->v[k]) return a->v[k] < b->v[k];
-    return 0;
+    uint32_t a = t->v[0], b = t->v[1], c = t->v[2];
+    if (b < a) a = b;
+    return c < a ? c : a;
 }
 
-static int tri_cmp(const void *x, const void *y)
-{
-    const pdt_tri *a = x, *b = y;
-    return tri_less(a, b) ? -1 : tri_less(b, a) ? 1 : 0;
-}
-
-/* Restore the heap order below heap[k]: the block whose next triangle is
- * smallest comes first. */
-static void sift_down(int *heap, int h, int k, const pdt_tri *a, const size_t *pos)
-{
-    for (;;) {
-        int m = k, l = 2 * k + 1, r = l + 1;
-        if (l < h && tri_less(&a[pos[heap[l]]], &a[pos[heap[m]]])) m = l;
-        if (r < h && tri_less(&a[pos[heap[r]]], &a[pos[heap[m]]])) m = r;
-        if (m == k) return;
-        int t = heap[k];
-        heap[k] = heap[m];
-        heap[m] = t;
-        k = m;
-    }
-}
-
-/* Merge p sorted blocks (count[q] bytes each, contiguous) of *all into one
- * sorted array with a binary heap of block cursors: O(T log p). */
-static pdt_status merge_blocks(drv *d, pdt_tri **all, const size_t *count, size_t total)
+/* The ranges: the smallest indices [0, n_total) in buckets of 2^*shift
+ * consecutive indices (at most 256 p, at most 2^16 buckets); the histogram of
+ * every rank's final triangles summed (allreduce); bucket b goes to rank
+ * owner[b], nondecreasing in b, so that every rank gets about T / p
+ * triangles (a bucket is never split). */
+static pdt_status order_ranges(drv *d, const pdt_tri *t, size_t n, int *shift, int **owner,
+                               pdt_err *err)
 {
     int p = d->p;
-    size_t *pos = malloc((size_t)p * sizeof *pos), *end = malloc((size_t)p * sizeof *end);
-    int *heap = malloc((size_t)p * sizeof *heap);
-    pdt_tri *out = malloc((total + 1) * sizeof *out);
-    if (!pos || !end || !heap || !out) {
-        free(pos);
-        free(end);
-        free(heap);
-        free(out);
+    uint64_t top = d->n_total ? d->n_total - 1 : 0;
+    uint64_t want = (uint64_t)256 * (uint64_t)p;
+    if (want > ((uint64_t)1 << 16)) want = (uint64_t)1 << 16;
+    int sh = 0;
+    while ((top >> sh) + 1 > want) sh++;
+    size_t nb = (size_t)(top >> sh) + 1;
+    uint64_t *h = calloc(nb, sizeof *h);
+    int *own = malloc(nb * sizeof *own);
+    if (!h || !own) {
+        free(h);
+        free(own);
         return nomem(d, "order");
     }
-    const pdt_tri *a = *all;
-    size_t off = 0;
-    int h = 0;
-    for (int q = 0; q < p; q++) {
-        pos[q] = off;
-        off += count[q] / sizeof(pdt_tri);
-        end[q] = off;
-        if (pos[q] < end[q]) heap[h++] = q;
-    }
-    for (int i = h / 2 - 1; i >= 0; i--) /* heapify */
-        sift_down(heap, h, i, a, pos);
-    for (size_t o = 0; o < total; o++) {
-        int q = heap[0];
-        out[o] = a[pos[q]++];
-        if (pos[q] == end[q]) heap[0] = heap[--h];
-        sift_down(heap, h, 0, a, pos);
-    }
-    free(pos);
-    free(end);
-    free(heap);
-    free(*all);
-    *all = out;
-    return PDT_OK;
-}
-
-/* p - 1 splitter triangles from evenly spaced samples of every rank's
- * sorted final triangles (allgathered). */
-static pdt_status order_splitters(drv *d, const pdt_tri *t, size_t n, pdt_tri *split,
-                                  size_t *nsplit, pdt_err *err)
-{
-    int p = d->p;
-    size_t S = (size_t)32 * (size_t)p, blk = S + 1;
-    pdt_tri *samp = calloc(blk, sizeof *samp), *all = malloc((size_t)p * blk * sizeof *all);
-    if (!samp || !all) {
-        free(samp);
-        free(all);
-        return nomem(d, "order");
-    }
-    size_t k = n < S ? n : S;
-    samp[0].v[0] = (uint32_t)k; /* block = [count, k samples] */
-    for (size_t i = 0; i < k; i++) samp[1 + i] = t[i * n / k];
-    pdt_status st = pdt_comm_allgather(d->c, samp, blk * sizeof *samp, all, err);
+    for (size_t i = 0; i < n; i++) h[tri_min(&t[i]) >> sh]++;
+    pdt_status st = pdt_comm_allreduce_u64(d->c, h, nb, PDT_COMM_SUM, err);
     if (st == PDT_OK) {
-        note_all(d, TAG_ORDER, blk * sizeof *samp);
-        size_t ns = 0;
-        for (int q = 0; q < p; q++) {
-            const pdt_tri *b = all + (size_t)q * blk;
-            for (size_t i = 0; i < b[0].v[0] && i < S; i++) all[ns++] = b[1 + i];
+        note_all(d, TAG_ORDER, nb * sizeof *h);
+        uint64_t total = 0, before = 0;
+        for (size_t b = 0; b < nb; b++) total += h[b];
+        for (size_t b = 0; b < nb; b++) { /* the rank whose share holds the bucket's middle */
+            uint64_t q = total ? (before + h[b] / 2) * (uint64_t)p / total : 0;
+            own[b] = q < (uint64_t)p ? (int)q : p - 1;
+            before += h[b];
         }
-        qsort(all, ns, sizeof *all, tri_cmp);
-        *nsplit = ns ? (size_t)p - 1 : 0;
-        for (size_t i = 0; i < *nsplit; i++) split[i] = all[(i + 1) * ns / (size_t)p];
+        *shift = sh;
+        *owner = own;
+        own = NULL;
     }
-    free(samp);
-    free(all);
+    free(h);
+    free(own);
     return st;
 }
 
-/* Phase 4: this rank's final triangles in canonical order, then a sample
- * sort across ranks: rank q ends with the q-th block of the canonical output
- * in out (and its place in the whole output). */
+/* Phase 4: the final triangles go to the rank of their smallest index's
+ * range, which puts them in canonical order: rank q ends with the q-th block
+ * of the canonical output in out (and its place in the whole output). */
 static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
 {
     int p = d->p;
-    pdt_tri *t = d->s.fin;
+    const pdt_tri *t = d->s.fin;
     size_t n = d->s.nfin;
-    pdt_tri_canonical(t, n);
     pdt_status st = pdt_comm_quiet_barrier(d->c, err); /* ranks done early sleep */
     if (st != PDT_OK) return st;
     size_t *cnt = calloc((size_t)p, sizeof *cnt), *rcnt = calloc((size_t)p, sizeof *rcnt);
+    size_t *at = calloc((size_t)p, sizeof *at);
     uint64_t *sc = calloc((size_t)p, sizeof *sc), *rc = calloc((size_t)p, sizeof *rc);
-    pdt_tri *split = malloc((size_t)p * sizeof *split), *got = NULL;
-    size_t nsplit = 0;
-    if (!cnt || !rcnt || !sc || !rc || !split) {
+    pdt_tri *send = malloc((n + 1) * sizeof *send), *got = NULL;
+    int *owner = NULL, shift = 0;
+    if (!cnt || !rcnt || !at || !sc || !rc || !send) {
         st = nomem(d, "order");
         goto done;
     }
-    st = order_splitters(d, t, n, split, &nsplit, err);
+    st = order_ranges(d, t, n, &shift, &owner, err);
     if (st != PDT_OK) goto done;
-    /* rank q gets the triangles in [split[q-1], split[q]): a contiguous run
-     * of the sorted local array */
-    size_t lo = 0;
-    for (int q = 0; q < p; q++) {
-        size_t hi = n;
-        if ((size_t)q < nsplit) {
-            size_t a = lo, b = n;
-            while (a < b) {
-                size_t mid = a + (b - a) / 2;
-                if (tri_less(&t[mid], &split[q])) a = mid + 1;
-                else b = mid;
-            }
-            hi = a;
-        }
-        sc[q] = hi - lo;
-        lo = hi;
-    }
+    for (size_t i = 0; i < n; i++) sc[owner[tri_min(&t[i]) >> shift]]++;
+    for (int q = 1; q < p; q++) at[q] = at[q - 1] + (size_t)sc[q - 1];
+    for (size_t i = 0; i < n; i++) send[at[owner[tri_min(&t[i]) >> shift]]++] = t[i];
+    free(d->s.fin); /* every triangle is in send now */
+    d->s.fin = NULL;
+    d->s.nfin = d->s.capfin = 0;
     st = pdt_comm_alltoall(d->c, sc, sizeof *sc, rc, err);
     if (st != PDT_OK) goto done;
     note_all(d, TAG_COUNTS, sizeof *sc);
@@ -485,32 +429,17 @@ static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
         st = nomem(d, "order");
         goto done;
     }
-    st = pdt_comm_alltoallv(d->c, t, cnt, got, rcnt, err);
+    st = pdt_comm_alltoallv(d->c, send, cnt, got, rcnt, err);
     if (st != PDT_OK) goto done;
     note_v(d, TAG_ORDER, cnt, rcnt);
-    free(d->s.fin); /* every triangle went somewhere (itself included) */
-    d->s.fin = NULL;
-    d->s.nfin = d->s.capfin = 0;
-    int blocks = 0;
-    for (int q = 0; q < p; q++) blocks += rcnt[q] != 0;
-    if (blocks > 1) st = merge_blocks(d, &got, rcnt, total);
+    free(send);
+    send = NULL;
+    pdt_tri_canonical(got, total);
+    uint64_t first = 0, all = total;
+    st = pdt_comm_exscan_u64(d->c, total, &first, err); /* place in the whole output */
+    if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, &all, 1, PDT_COMM_SUM, err);
     if (st != PDT_OK) goto done;
-    uint64_t mine = total, first = 0, all = 0;
-    {   /* place in the whole output: prefix sum of the block sizes */
-        uint64_t *cnts = malloc((size_t)p * sizeof *cnts);
-        if (!cnts) {
-            st = nomem(d, "order");
-            goto done;
-        }
-        st = pdt_comm_allgather(d->c, &mine, sizeof mine, cnts, err);
-        if (st == PDT_OK) note_all(d, TAG_ORDER, sizeof mine);
-        for (int q = 0; q < p; q++) {
-            if (q < d->rank) first += cnts[q];
-            all += cnts[q];
-        }
-        free(cnts);
-    }
-    if (st != PDT_OK) goto done;
+    note_all(d, TAG_ORDER, sizeof all);
     out->tris = got;
     out->ntri = total;
     out->first = first;
@@ -519,9 +448,11 @@ static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
 done:
     free(cnt);
     free(rcnt);
+    free(at);
     free(sc);
     free(rc);
-    free(split);
+    free(send);
+    free(owner);
     free(got);
     return st;
 }
@@ -615,6 +546,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_par_input *in, pdt_par_out
     d.rank = pdt_comm_rank(c);
     d.p = pdt_comm_size(c);
     d.tr = tr;
+    d.n_total = in->n_total;
     d.me = me;
     d.err = err;
     pdt_point *lp = NULL;

@@ -1,0 +1,252 @@
+/* pdt — the output of a parallel run (pdt_par_write in pdt/par.h).
+ *
+ * A file is a header and one or two sections (.off: the points, then the
+ * triangles); every rank holds a consecutive block of each section (its
+ * input block of points, its block of the canonical triangles).  Each rank
+ * counts its bytes, a prefix sum gives its offset, and it formats its block
+ * with the plain writer's own printer (pdt_format_lines) a piece at a time
+ * and writes each piece at its place (pdt_comm_file_write_at: MPI-IO).
+ * Everything goes to "DIR/.BASE.tmp.PID" (rank 0's pid), renamed by rank 0
+ * once every rank succeeded (an .ele's .node after the .ele, as in a plain
+ * run), removed otherwise.  Standard output, a device or a pipe cannot be
+ * written at offsets: the blocks are gathered at rank 0 and written there. */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "pdt/io.h"
+#include "pdt/par.h"
+
+/* Bytes formatted at once (then written): 4 MiB of the longest lines. */
+enum { PIECE_LINES = 65536 };
+
+/* One section of a file: this rank's block of lines. */
+typedef struct section {
+    pdt_lines kind;
+    const void *items;
+    size_t elem, n;
+    uint64_t first;   /* number of this block's first line (.ele, .node) */
+} section;
+
+/* One file: its final name, its temporary, its header, its sections. */
+typedef struct outfile {
+    const char *path;
+    char tmp[4096];
+    char head[256];
+    size_t hlen;
+    section sec[2];
+    int nsec;
+} outfile;
+
+/* ---- gathering at rank 0 (standard output, devices, pipes) ---------------------- */
+
+/* Gather every rank's block (elem bytes each, n elements here) at rank 0. */
+static pdt_status gather_all(pdt_comm *c, const void *mine, size_t n, size_t elem,
+                             void **all, uint64_t *total, pdt_err *err)
+{
+    int p = pdt_comm_size(c), r = pdt_comm_rank(c);
+    uint64_t k = n, *ks = malloc((size_t)p * sizeof *ks);
+    size_t *cnt = malloc((size_t)p * sizeof *cnt);
+    *all = NULL;
+    *total = 0;
+    pdt_status st = ks && cnt ? PDT_OK
+                              : pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: write: out of memory", r);
+    if (st == PDT_OK) st = pdt_comm_allgather(c, &k, sizeof k, ks, err);
+    if (st == PDT_OK) {
+        for (int q = 0; q < p; q++) {
+            cnt[q] = (size_t)ks[q] * elem;
+            *total += ks[q];
+        }
+        if (r == 0 && !(*all = malloc((size_t)*total * elem + 1)))
+            st = pdt_err_set(err, PDT_ERR_NOMEM, "rank 0: write: out of memory");
+    }
+    if (st == PDT_OK) st = pdt_comm_gatherv(c, mine, n * elem, *all, cnt, 0, err);
+    free(ks);
+    free(cnt);
+    return st;
+}
+
+static pdt_status write_gathered(pdt_comm *c, const char *path, pdt_tri_format fmt,
+                                 const pdt_par_input *in, const pdt_par_output *out, pdt_err *err)
+{
+    void *pts = NULL, *tris = NULL;
+    uint64_t np = 0, nt = 0;
+    pdt_status st = PDT_OK;
+    if (fmt != PDT_FMT_TRI) st = gather_all(c, in->pts, in->n, sizeof(pdt_point), &pts, &np, err);
+    if (st == PDT_OK) st = gather_all(c, out->tris, out->ntri, sizeof(pdt_tri), &tris, &nt, err);
+    if (st == PDT_OK && pdt_comm_rank(c) == 0)
+        st = pdt_write_tris(path, fmt, pts, (size_t)np, tris, (size_t)nt, err);
+    free(pts);
+    free(tris);
+    return pdt_par_agree(c, st, NULL, err);
+}
+
+/* ---- every rank at its offset ------------------------------------------------ */
+
+/* Test-only: PDT_TEST_FAIL_WRITE=RANK makes RANK fail its share of the
+ * parallel write (after the temporary file exists), as a full disk would. */
+static pdt_status test_fail_write(int rank, const char *path, pdt_err *err)
+{
+    const char *e = getenv("PDT_TEST_FAIL_WRITE");
+    if (e && *e && atoi(e) == rank)
+        return pdt_err_set(err, PDT_ERR_IO, "%s: write error: injected by PDT_TEST_FAIL_WRITE",
+                           path);
+    return PDT_OK;
+}
+
+/* 1 if `path` can be replaced by a renamed temporary (a regular file or no
+ * file yet), 0 for standard output, a device or a pipe. */
+static int renamable(const char *path)
+{
+    struct stat sb;
+    if (!path || strcmp(path, "-") == 0) return 0;
+    return stat(path, &sb) != 0 || S_ISREG(sb.st_mode);
+}
+
+/* "DIR/.BASE.tmp.PID" for path (pid: rank 0's, broadcast by the caller). */
+static void temp_name(char *tmp, size_t size, const char *path, long pid)
+{
+    const char *slash = strrchr(path, '/');
+    int dl = slash ? (int)(slash - path + 1) : 0;
+    snprintf(tmp, size, "%.*s.%s.tmp.%ld", dl, path, slash ? slash + 1 : path, pid);
+}
+
+/* The temporary could not be created: name the user's file and why. */
+static pdt_status cannot_create(const char *path, pdt_err *err)
+{
+    struct stat sb;
+    const char *slash = strrchr(path, '/');
+    char dir[4096];
+    pdt_err_clear(err);
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) : 1, slash ? path : ".");
+    return pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: %s", path,
+                       stat(dir, &sb) != 0 ? "no such folder" : "cannot create a file there");
+}
+
+/* This rank's block of section s, formatted a piece at a time, written from
+ * byte `at` of f.  Returns this rank's status (message in err). */
+static pdt_status write_section(pdt_comm_file *f, const section *s, uint64_t at, char *buf,
+                                pdt_err *err)
+{
+    pdt_status st = PDT_OK;
+    for (size_t i = 0; i < s->n && st == PDT_OK; i += PIECE_LINES) {
+        size_t k = s->n - i < PIECE_LINES ? s->n - i : PIECE_LINES;
+        size_t len = pdt_format_lines(buf, s->kind, (const char *)s->items + i * s->elem, k,
+                                      s->first + i);
+        st = pdt_comm_file_write_at(f, at, buf, len, err);
+        at += len;
+    }
+    return st;
+}
+
+/* Collective: write o's temporary.  Every rank gets the same status; the
+ * temporary may be left behind on failure (the caller removes it). */
+static pdt_status write_file(pdt_comm *c, outfile *o, pdt_err *err)
+{
+    int r = pdt_comm_rank(c);
+    uint64_t len[2] = {0, 0}, off[2] = {0, 0}, tot[2] = {0, 0};
+    for (int k = 0; k < o->nsec; k++) {
+        const section *s = &o->sec[k];
+        len[k] = tot[k] = pdt_lines_bytes(s->kind, s->items, s->n, s->first);
+    }
+    pdt_status st = PDT_OK;
+    for (int k = 0; k < o->nsec && st == PDT_OK; k++)
+        st = pdt_comm_exscan_u64(c, len[k], &off[k], err);
+    if (st == PDT_OK) st = pdt_comm_allreduce_u64(c, tot, 2, PDT_COMM_SUM, err);
+    if (st != PDT_OK) return st;
+    pdt_comm_file *f = NULL;
+    st = pdt_comm_file_open(c, o->tmp, &f, err);
+    if (st != PDT_OK) { /* name the user's file, not our temporary */
+        if (r == 0) cannot_create(o->path, err);
+        return pdt_par_agree(c, r == 0 ? PDT_ERR_IO : PDT_OK, NULL, err);
+    }
+    pdt_err werr;
+    pdt_err_clear(&werr);
+    pdt_status wst = test_fail_write(r, o->path, &werr);
+    char *buf = NULL;
+    if (wst == PDT_OK && !(buf = malloc((size_t)PIECE_LINES * PDT_LINE_MAX)))
+        wst = pdt_err_set(&werr, PDT_ERR_NOMEM, "rank %d: write: out of memory", r);
+    if (wst == PDT_OK && r == 0 && o->hlen)
+        wst = pdt_comm_file_write_at(f, 0, o->head, o->hlen, &werr);
+    uint64_t at = o->hlen;
+    for (int k = 0; k < o->nsec && wst == PDT_OK; k++) {
+        wst = write_section(f, &o->sec[k], at + off[k], buf, &werr);
+        at += tot[k];
+    }
+    free(buf);
+    pdt_err cerr;
+    pdt_err_clear(&cerr);
+    pdt_status cst = pdt_comm_file_close(f, &cerr); /* collective: agrees on the writes */
+    if (wst != PDT_OK) {
+        *err = werr;
+        cst = wst;
+    } else if (cst != PDT_OK) {
+        *err = cerr;
+    }
+    return pdt_par_agree(c, cst, NULL, err);
+}
+
+/* Collective: the files (one, or an .ele and its .node) written in parallel
+ * into their temporaries, then renamed into place by rank 0 in order (the
+ * last first: a plain run commits the .node after the .ele). */
+static pdt_status write_files(pdt_comm *c, outfile *o, int nfile, pdt_err *err)
+{
+    int r = pdt_comm_rank(c);
+    long pid = (long)getpid();
+    pdt_status st = pdt_comm_bcast(c, &pid, sizeof pid, 0, err);
+    if (st != PDT_OK) return st;
+    int made = 0;
+    for (; made < nfile && st == PDT_OK; made++) {
+        temp_name(o[made].tmp, sizeof o[made].tmp, o[made].path, pid);
+        st = write_file(c, &o[made], err);
+    }
+    for (int k = 0; k < nfile && st == PDT_OK && r == 0; k++)
+        if (rename(o[k].tmp, o[k].path) != 0)
+            st = pdt_err_set(err, PDT_ERR_IO, "%s: cannot rename into place: %s", o[k].path,
+                             strerror(errno));
+    if (st != PDT_OK && r == 0)
+        for (int k = 0; k < made; k++) unlink(o[k].tmp); /* (renamed ones are gone already) */
+    return pdt_par_agree(c, st, NULL, err);
+}
+
+/* "X.ele" -> "X.node" into buf. */
+static void node_path(char *buf, size_t size, const char *ele)
+{
+    size_t n = strlen(ele);
+    snprintf(buf, size, "%.*s.node", (int)(n >= 4 ? n - 4 : n), ele);
+}
+
+pdt_status pdt_par_write(pdt_comm *c, const char *path, pdt_tri_format fmt,
+                         const pdt_par_input *in, const pdt_par_output *out, pdt_err *err)
+{
+    if (pdt_comm_size(c) == 1)
+        return pdt_write_tris(path, fmt, in->pts, in->n, out->tris, out->ntri, err);
+    int direct = renamable(path) && strlen(path) < 3000;
+    if (pdt_par_agree(c, direct ? PDT_OK : PDT_ERR_ARG, NULL, err) != PDT_OK) {
+        pdt_err_clear(err);
+        return write_gathered(c, path, fmt, in, out, err);
+    }
+    outfile o[2];
+    memset(o, 0, sizeof o);
+    char npath[4096];
+    const section tris = {fmt == PDT_FMT_ELE   ? PDT_LINES_ELE
+                          : fmt == PDT_FMT_OFF ? PDT_LINES_OFF_TRI
+                                               : PDT_LINES_TRI,
+                          out->tris, sizeof(pdt_tri), out->ntri, out->first};
+    o[0].path = path;
+    o[0].hlen = pdt_format_tri_header(o[0].head, fmt, in->n_total, out->n_total);
+    if (fmt == PDT_FMT_OFF)
+        o[0].sec[o[0].nsec++] = (section){PDT_LINES_OFF_POINT, in->pts, sizeof(pdt_point), in->n,
+                                          in->first};
+    o[0].sec[o[0].nsec++] = tris;
+    if (fmt != PDT_FMT_ELE) return write_files(c, o, 1, err);
+    node_path(npath, sizeof npath, path);
+    o[1].path = npath;
+    o[1].hlen = pdt_format_node_header(o[1].head, in->n_total);
+    o[1].sec[o[1].nsec++] = (section){PDT_LINES_NODE, in->pts, sizeof(pdt_point), in->n,
+                                      in->first};
+    return write_files(c, o, 2, err);
+}
