@@ -3,8 +3,10 @@
  *
  * File layout (native byte order; a different build's layout is refused):
  *   [0, 4096)        header: magic, version, the run's identity, the sizes
- *                    of the record types, the table sizes, and per section
- *                    its offset, length and CRC-32C; the header's own CRC
+ *                    of the record types, the table sizes, per section its
+ *                    offset and length, the place of the chunk checksums
+ *                    (a CRC-32C per 16 MiB of every section: verified by
+ *                    several threads at each opening); the header's own CRC
  *   sections         the merged event records, then every table of the
  *                    replay (replay_int.h), the points and the reader's
  *                    warnings about the run, each at a 64-byte boundary
@@ -20,6 +22,8 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -29,14 +33,17 @@
 #include <unistd.h>
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 2u
+#define INDEX_VERSION 4u
+#define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/16 events, at least this */
+#define ICK_PARTS 16u
+#define CHUNK_BYTES ((uint64_t)16 << 20) /* sections are checksummed in chunks of this */
 #define HDR_BYTES 4096u
 #define EST_BYTES_PER_EVENT 100u /* what the replay model holds per event in memory */
 
 enum {
     S_RECS, S_EVOBJ, S_EVENT, S_TRIS, S_HIST, S_EDGES, S_NODES, S_PHASES, S_MERGES, S_MSGS,
     S_HULLS, S_CH, S_SLOTCH, S_SLOTSTART, S_LIFT, S_SORT, S_DEL, S_SORTPOS, S_BOXLO, S_BOXHI,
-    S_HASBOX, S_POINTS, S_WARN, NSEC
+    S_HASBOX, S_POINTS, S_WARN, S_EVKIND, S_CKPT, NSEC
 };
 
 typedef struct isec {
@@ -53,6 +60,9 @@ typedef struct ihdr {
     uint64_t count[NSEC];       /* elements per section */
     uint64_t kind_count[64];
     isec sec[NSEC];
+    uint64_t ick_every, nick, ick_bytes;  /* the checkpoints (S_CKPT) */
+    isec ctab;                  /* CRC-32C of every CHUNK_BYTES of every section,
+                                 * in section order; ctab.crc covers the table */
 } ihdr;
 
 _Static_assert(sizeof(ihdr) <= HDR_BYTES, "index header fits its page");
@@ -104,6 +114,10 @@ static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_
     ptr[S_WARN] = (void **)&r->warnings;
     elem[S_WARN] = 1;
     count[S_WARN] = r->warnings ? strlen(r->warnings) + 1 : 0;
+    SEC(S_EVKIND, ev_kind, r->m);
+    ptr[S_CKPT] = (void **)&r->ick;
+    elem[S_CKPT] = 1;
+    count[S_CKPT] = (uint64_t)r->nick * r->ick_bytes;
 #undef SEC
 }
 
@@ -112,6 +126,84 @@ static uint32_t hdr_crc(const ihdr *h)
     ihdr c = *h;
     c.hdr_crc = 0;
     return pdt_crc32c(0, &c, sizeof c);
+}
+
+static uint64_t chunks_of(uint64_t bytes) { return (bytes + CHUNK_BYTES - 1) / CHUNK_BYTES; }
+
+/* ---- verifying the chunks, in parallel ----------------------------------------- */
+
+typedef struct verify_job {
+    int fd;
+    const ihdr *h;
+    const uint32_t *tab;        /* chunk checksums */
+    uint64_t nchunk;
+    uint64_t *first;            /* per section: index of its first chunk in tab */
+    atomic_uint_fast64_t next;  /* next chunk to check */
+    atomic_int bad;
+} verify_job;
+
+static void *verify_worker(void *arg)
+{
+    verify_job *j = arg;
+    enum { BUF = 1 << 20 };
+    unsigned char *buf = malloc(BUF);
+    if (!buf) {
+        atomic_store(&j->bad, 1);
+        return NULL;
+    }
+    for (;;) {
+        uint64_t c = atomic_fetch_add(&j->next, 1);
+        if (c >= j->nchunk || atomic_load(&j->bad)) break;
+        int i = 0;
+        while (i + 1 < NSEC && j->first[i + 1] <= c) i++;
+        uint64_t from = (c - j->first[i]) * CHUNK_BYTES, to = from + CHUNK_BYTES;
+        if (to > j->h->sec[i].bytes) to = j->h->sec[i].bytes;
+        uint32_t crc = 0;
+        for (uint64_t o = from; o < to;) {
+            size_t want = to - o < BUF ? (size_t)(to - o) : BUF;
+            ssize_t got = pread(j->fd, buf, want, (off_t)(j->h->sec[i].off + o));
+            if (got <= 0) break;
+            crc = pdt_crc32c(crc, buf, (size_t)got);
+            o += (uint64_t)got;
+        }
+        if (crc != j->tab[c]) atomic_store(&j->bad, 1);
+    }
+    free(buf);
+    return NULL;
+}
+
+/* 1 when every chunk of every section matches its checksum. */
+static int verify_chunks(int fd, const ihdr *h, char *why, size_t wcap)
+{
+    uint64_t first[NSEC + 1], n = 0;
+    for (int i = 0; i < NSEC; i++) first[i] = n, n += chunks_of(h->sec[i].bytes);
+    first[NSEC] = n;
+    if (h->ctab.bytes != n * sizeof(uint32_t)) {
+        snprintf(why, wcap, "damaged: chunk table has the wrong size");
+        return 0;
+    }
+    uint32_t *tab = malloc(n ? n * sizeof *tab : 1);
+    if (!tab || pread(fd, tab, (size_t)h->ctab.bytes, (off_t)h->ctab.off) != (ssize_t)h->ctab.bytes ||
+        pdt_crc32c(0, tab, (size_t)h->ctab.bytes) != h->ctab.crc) {
+        free(tab);
+        snprintf(why, wcap, "damaged: chunk table checksum mismatch");
+        return 0;
+    }
+    verify_job j = {fd, h, tab, n, first, 0, 0};
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    int nt = cpus < 1 ? 1 : cpus > 4 ? 4 : (int)cpus, started = 0;
+    pthread_t th[4];
+    for (int t = 1; t < nt; t++)
+        if (pthread_create(&th[t], NULL, verify_worker, &j) == 0) started |= 1 << t;
+    verify_worker(&j);
+    for (int t = 1; t < nt; t++)
+        if (started & (1 << t)) pthread_join(th[t], NULL);
+    free(tab);
+    if (atomic_load(&j.bad)) {
+        snprintf(why, wcap, "damaged: checksum mismatch");
+        return 0;
+    }
+    return 1;
 }
 
 /* ---- the run's identity and the index's place ---------------------------------- */
@@ -273,30 +365,12 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
             snprintf(why, wcap, "damaged: section %d outside the file", i);
             goto fail;
         }
-    if (verify) {
-        enum { CHUNK = 1 << 20 };
-        unsigned char *buf = malloc(CHUNK);
-        if (!buf) {
-            snprintf(why, wcap, "out of memory");
-            goto fail;
-        }
-        for (int i = 0; i < NSEC; i++) {
-            uint32_t crc = 0;
-            for (uint64_t o = 0; o < h.sec[i].bytes;) {
-                size_t want = h.sec[i].bytes - o < CHUNK ? (size_t)(h.sec[i].bytes - o) : CHUNK;
-                ssize_t got = pread(fd, buf, want, (off_t)(h.sec[i].off + o));
-                if (got <= 0) break;
-                crc = pdt_crc32c(crc, buf, (size_t)got);
-                o += (uint64_t)got;
-            }
-            if (crc != h.sec[i].crc) {
-                snprintf(why, wcap, "damaged: checksum mismatch in section %d", i);
-                free(buf);
-                goto fail;
-            }
-        }
-        free(buf);
+    if (h.ctab.off < HDR_BYTES || h.ctab.off > h.file_bytes ||
+        h.ctab.bytes > h.file_bytes - h.ctab.off) {
+        snprintf(why, wcap, "damaged: chunk table outside the file");
+        goto fail;
     }
+    if (verify && !verify_chunks(fd, &h, why, wcap)) goto fail;
     map = mmap(NULL, h.file_bytes, PROT_READ, MAP_SHARED, fd, 0);
     if (map == MAP_FAILED) {
         snprintf(why, wcap, "cannot map it: %s", strerror(errno));
@@ -322,6 +396,16 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
     r->nhull = h.count[S_HULLS];
     r->nch = h.count[S_CH];
     r->warnings = h.count[S_WARN] ? "" : NULL;  /* so that sections() sizes it */
+    r->ick_every = h.ick_every;
+    r->nick = h.nick;
+    r->ick_bytes = h.ick_bytes;
+    if (r->nick && (r->ick_every == 0 || r->ick_bytes != pdt_rstate_blob_bytes(r) ||
+                    (r->nick - 1) * r->ick_every > r->m)) {
+        snprintf(why, wcap, "damaged: checkpoints do not fit the tables");
+        free(r);
+        r = NULL;
+        goto fail;
+    }
     void **ptr[NSEC];
     size_t elem[NSEC];
     uint64_t count[NSEC];
@@ -378,7 +462,6 @@ static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, pdt_err *
     if (!buf) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     pdt_status st = pdt_merge_open(run, &mg, err);
     uint64_t off = HDR_BYTES;
-    uint32_t crc = 0;
     size_t count = 0, nb = 0;
     int got = 1;
     while (st == PDT_OK && got > 0) {
@@ -388,16 +471,33 @@ static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, pdt_err *
         if (st == PDT_OK && (nb == BATCH || (got == 0 && nb))) {
             if (!write_all(fd, buf, nb * sizeof *buf, off))
                 st = pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-            crc = pdt_crc32c(crc, buf, nb * sizeof *buf);
             off += nb * sizeof *buf;
             nb = 0;
         }
     }
     pdt_merge_close(mg);
     free(buf);
-    h->sec[S_RECS] = (isec){HDR_BYTES, (uint64_t)count * sizeof(pdt_rec), crc, 0};
+    h->sec[S_RECS] = (isec){HDR_BYTES, (uint64_t)count * sizeof(pdt_rec), 0, 0};
     *m = count;
     return st;
+}
+
+/* The state at every r->ick_every-th cursor, stepped forwards from 0,
+ * written at off one after the other (r->nick of r->ick_bytes). */
+static int write_checkpoints(const pdt_replay *r, int fd, uint64_t off)
+{
+    if (!r->nick) return 1;
+    pdt_rstate *s = pdt_rstate_new(r);
+    uint8_t *blob = malloc(r->ick_bytes ? r->ick_bytes : 1);
+    int ok = s && blob;
+    for (size_t c = 0; ok && c < r->nick; c++) {
+        while (s->k < c * r->ick_every) pdt_replay_step(r, s, 1);
+        pdt_rstate_to_blob(r, s, blob);
+        ok = write_all(fd, blob, r->ick_bytes, off + c * r->ick_bytes);
+    }
+    free(blob);
+    pdt_rstate_free(s);
+    return ok;
 }
 
 /* Write the tables of r after the records, then the header. */
@@ -413,11 +513,37 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, p
         if (i == S_RECS) continue;
         off = (off + 63) & ~(uint64_t)63;
         size_t bytes = (size_t)count[i] * elem[i];
-        if (bytes && !write_all(fd, *ptr[i], bytes, off))
+        if (i == S_CKPT) {
+            if (!write_checkpoints(r, fd, off))
+                return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+        } else if (bytes && !write_all(fd, *ptr[i], bytes, off)) {
             return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-        h->sec[i] = (isec){off, bytes, bytes ? pdt_crc32c(0, *ptr[i], bytes) : 0, 0};
+        }
+        h->sec[i] = (isec){off, bytes, 0, 0};
         off += bytes;
     }
+    /* the chunk checksums, read back through a mapping of what was written */
+    uint64_t n = 0;
+    for (int i = 0; i < NSEC; i++) n += chunks_of(h->sec[i].bytes);
+    uint32_t *tab = malloc(n ? n * sizeof *tab : 1);
+    void *map = off ? mmap(NULL, off, PROT_READ, MAP_SHARED, fd, 0) : MAP_FAILED;
+    if (!tab || map == MAP_FAILED) {
+        free(tab);
+        if (map != MAP_FAILED) munmap(map, off);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for the index's checksums");
+    }
+    for (int i = 0, c = 0; i < NSEC; i++)
+        for (uint64_t o = 0; o < h->sec[i].bytes; o += CHUNK_BYTES) {
+            uint64_t len = h->sec[i].bytes - o < CHUNK_BYTES ? h->sec[i].bytes - o : CHUNK_BYTES;
+            tab[c++] = pdt_crc32c(0, (const char *)map + h->sec[i].off + o, (size_t)len);
+        }
+    munmap(map, off);
+    off = (off + 63) & ~(uint64_t)63;
+    h->ctab = (isec){off, n * sizeof *tab, pdt_crc32c(0, tab, (size_t)(n * sizeof *tab)), 0};
+    int wrote = write_all(fd, tab, (size_t)(n * sizeof *tab), off);
+    free(tab);
+    if (!wrote) return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+    off += h->ctab.bytes;
     memcpy(h->magic, magic, sizeof magic);
     h->version = INDEX_VERSION;
     h->ident = ident;
@@ -427,6 +553,9 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, p
     h->m = r->m;
     h->skipped = r->skipped;
     h->nranks = (uint64_t)r->nranks;
+    h->ick_every = r->ick_every;
+    h->nick = r->nick;
+    h->ick_bytes = r->ick_bytes;
     for (int k = 0; k < PDT_EV_KIND_COUNT; k++) h->kind_count[k] = r->kind_count[k];
     h->hdr_crc = hdr_crc(h);
     unsigned char page[HDR_BYTES];
@@ -462,7 +591,12 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         st = pdt_replay_new(pts, n, (const pdt_rec *)((char *)recs + HDR_BYTES), m, nranks, &r, err);
     if (st == PDT_OK) {
         r->warnings = pdt_run_warnings(run);
+        size_t every = r->m / ICK_PARTS;
+        r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
+        r->nick = r->m / r->ick_every + 1;
+        r->ick_bytes = pdt_rstate_blob_bytes(r);
         st = write_tables(r, fd, h, ident, err);
+        r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
     }
     pdt_replay_free(r);
     if (recs != MAP_FAILED) munmap(recs, recs_len);

@@ -430,6 +430,7 @@ static pdt_status build(pdt_replay *r, pdt_err *err)
     for (size_t i = 0; i < r->m; i++) {
         r->ev_obj[i] = -1;
         r->ev_ent[i] = 0;
+        r->ev_kind[i] = r->recs[i].ev.kind;
         if (r->recs[i].rank >= (uint32_t)r->nranks) {
             r->skipped++;
             continue;
@@ -531,6 +532,7 @@ pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, s
     size_t n1 = n ? n : 1, m1 = m ? m : 1, q1 = (size_t)nranks;
     r->ev_obj = malloc(m1 * sizeof *r->ev_obj);
     r->ev_ent = malloc(m1 * sizeof *r->ev_ent);
+    r->ev_kind = malloc(m1 * sizeof *r->ev_kind);
     r->lift_ev = malloc(n1 * sizeof *r->lift_ev);
     r->sort_ev = malloc(n1 * sizeof *r->sort_ev);
     r->del_ev = malloc(n1 * sizeof *r->del_ev);
@@ -538,7 +540,7 @@ pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, s
     r->box_lo = malloc(q1 * sizeof *r->box_lo);
     r->box_hi = malloc(q1 * sizeof *r->box_hi);
     r->has_box = calloc(q1, 1);
-    if (!r->ev_obj || !r->ev_ent || !r->lift_ev || !r->sort_ev || !r->del_ev || !r->sort_pos ||
+    if (!r->ev_obj || !r->ev_ent || !r->ev_kind || !r->lift_ev || !r->sort_ev || !r->del_ev || !r->sort_pos ||
         !r->box_lo || !r->box_hi || !r->has_box) {
         pdt_replay_free(r);
         return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for %zu events", m);
@@ -568,6 +570,7 @@ void pdt_replay_free(pdt_replay *r)
     }
     free(r->ev_obj);
     free(r->ev_ent);
+    free(r->ev_kind);
     free(r->tris);
     free(r->hist);
     free(r->edges);
@@ -738,11 +741,11 @@ void pdt_replay_seek_direct(const pdt_replay *r, pdt_rstate *s, size_t k)
 /* Apply (fwd) or undo (!fwd) event i; s->k is already the new cursor. */
 static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
 {
-    const pdt_event *e = &r->recs[i].ev;
     int32_t obj = r->ev_obj[i];
     if (obj < 0) return;
     uint32_t ent = r->ev_ent[i];
-    switch (e->kind) {
+    int kind = r->ev_kind[i];
+    switch (kind) {
     case PDT_EV_LIFT:
     case PDT_EV_SORT:
     case PDT_EV_DELETE:
@@ -757,7 +760,7 @@ static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
         s->mflight[obj] = alive(r->msgs[obj].send_ev, r->msgs[obj].recv_ev, s->k);
         return;
     default:
-        if (is_tri_kind(e->kind)) {
+        if (is_tri_kind(kind)) {
             s->tcur[obj] = fwd ? ent : (ent > r->tris[obj].h0 ? ent - 1 : NONE32);
             return;
         }
@@ -809,6 +812,7 @@ void pdt_replay_set_mem(pdt_replay *r, uint64_t budget)
     r->ck = NULL;
     r->nck = r->ck_every = 0;
     r->ck_bytes = pdt_replay_state_bytes(r);
+    if (r->nick) return;  /* the index's checkpoints serve */
     /* half the budget for checkpoints; one every at least 64 events */
     uint64_t fit = budget / 2 / r->ck_bytes;
     if (fit < 2 || r->m < 128) return;
@@ -823,6 +827,11 @@ void pdt_replay_set_mem(pdt_replay *r, uint64_t budget)
 
 size_t pdt_replay_checkpoints(const pdt_replay *r, size_t *every, size_t *made)
 {
+    if (r->nick) {
+        if (every) *every = r->ick_every;
+        if (made) *made = r->nick;
+        return r->nick;
+    }
     size_t got = 0;
     for (size_t c = 0; c < r->nck; c++) got += r->ck[c] != NULL;
     if (every) *every = r->ck_every;
@@ -843,6 +852,44 @@ static void state_copy(const pdt_replay *r, pdt_rstate *to, const pdt_rstate *fr
 
 static size_t dist(size_t a, size_t b) { return a > b ? a - b : b - a; }
 
+static size_t up8(size_t x) { return (x + 7) & ~(size_t)7; }
+
+size_t pdt_rstate_blob_bytes(const pdt_replay *r)
+{
+    size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
+    return up8(r->n) + up8(r->ntri * 4) + up8(r->nedge) + up8(r->nmsg) + up8(nslot * 4);
+}
+
+void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, uint8_t *out)
+{
+    size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
+    memset(out, 0, pdt_rstate_blob_bytes(r));
+    memcpy(out, s->pflags, r->n);
+    out += up8(r->n);
+    memcpy(out, s->tcur, r->ntri * 4);
+    out += up8(r->ntri * 4);
+    memcpy(out, s->ealive, r->nedge);
+    out += up8(r->nedge);
+    memcpy(out, s->mflight, r->nmsg);
+    out += up8(r->nmsg);
+    memcpy(out, s->slot, nslot * 4);
+}
+
+void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in, size_t k)
+{
+    size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
+    s->k = k;
+    memcpy(s->pflags, in, r->n);
+    in += up8(r->n);
+    memcpy(s->tcur, in, r->ntri * 4);
+    in += up8(r->ntri * 4);
+    memcpy(s->ealive, in, r->nedge);
+    in += up8(r->nedge);
+    memcpy(s->mflight, in, r->nmsg);
+    in += up8(r->nmsg);
+    memcpy(s->slot, in, nslot * 4);
+}
+
 static void step_to(const pdt_replay *r, pdt_rstate *s, size_t k)
 {
     while (s->k < k) pdt_replay_step(r, s, 1);
@@ -857,6 +904,15 @@ void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k)
 {
     if (k > r->m) k = r->m;
     size_t direct = direct_cost(r), from_here = dist(s->k, k) * STEP_FACTOR;
+    if (r->nick) { /* the index's checkpoints */
+        size_t c = (k + r->ick_every / 2) / r->ick_every;
+        if (c >= r->nick) c = r->nick - 1;
+        size_t ck = c * r->ick_every;
+        if (from_here > dist(ck, k) * STEP_FACTOR + r->ick_bytes / 64)
+            pdt_rstate_from_blob(r, s, r->ick + c * r->ick_bytes, ck);
+        step_to(r, s, k);
+        return;
+    }
     if (from_here <= direct && (!r->nck || from_here <= r->ck_every / 2)) {
         step_to(r, s, k);
         return;

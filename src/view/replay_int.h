@@ -18,6 +18,7 @@ struct pdt_replay {
     int nranks;
     int32_t *ev_obj;   /* per event: object (see build()) or -1 */
     uint32_t *ev_ent;  /* per event: entry (history / change index, or flag) */
+    uint8_t *ev_kind;  /* per event: its kind (stepping reads no records) */
 
     pdt_rtri *tris;
     size_t ntri, cap_tri;
@@ -58,7 +59,18 @@ struct pdt_replay {
      * the first seek near it (NULL until then); none when ck_every == 0. */
     size_t ck_every, nck, ck_bytes;
     pdt_rstate **ck;
+
+    /* Checkpoints kept in the index: the state at every ick_every-th cursor
+     * (pdt_rstate_to_blob), nick of them, ick_bytes each; none: nick == 0.
+     * They take the place of the checkpoints above. */
+    const uint8_t *ick;
+    size_t ick_every, nick, ick_bytes;
 };
+
+/* A state as bytes (the index's checkpoints): pdt_rstate_blob_bytes(r) bytes. */
+size_t pdt_rstate_blob_bytes(const pdt_replay *r);
+void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, uint8_t *out);
+void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in, size_t k);
 
 
 #endif
