@@ -37,6 +37,7 @@
 #include "pdt/predicates.h"
 
 #include "bigmem.h"
+#include "pred_inline.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -58,6 +59,7 @@ typedef struct dt {
     uint32_t freelist; /* a free even edge, chained through onext, or NIL */
     pdt_trace *tr;
     int nomem;
+    int small; /* every coordinate difference < 2^30: the int64 predicates */
 } dt;
 
 static inline uint32_t sym(uint32_t e)
@@ -151,7 +153,8 @@ static void delete_edge(dt *d, uint32_t e)
 
 static inline int ccw(const dt *d, uint32_t a, uint32_t b, uint32_t c)
 {
-    return pdt_orient(d->p[a], d->p[b], d->p[c]) > 0;
+    if (d->small) return pdt_orient_small(d->p[a], d->p[b], d->p[c]) > 0;
+    return pdt_orient_fast(d->p[a], d->p[b], d->p[c]) > 0;
 }
 
 /* x strictly right of edge e (i.e. x, dest e, org e counter-clockwise) */
@@ -168,7 +171,10 @@ static inline int left_of(const dt *d, uint32_t x, uint32_t e)
 /* d strictly inside the circle of counter-clockwise a, b, c, ties by SoS */
 static inline int in_circle(const dt *d, uint32_t a, uint32_t b, uint32_t c, uint32_t q)
 {
-    return pdt_incircle_sos(d->p[a], d->p[b], d->p[c], d->p[q]) > 0;
+    pdt_point pa = d->p[a], pb = d->p[b], pc = d->p[c], pq = d->p[q];
+    int s = d->small ? pdt_incircle0_small(pa, pb, pc, pq) : pdt_incircle0_fast(pa, pb, pc, pq);
+    if (s == 0) s = pdt_incircle_ties(pa, pb, pc, pq);
+    return s > 0;
 }
 
 /* ---- Dwyer's alternating cuts ----
@@ -246,25 +252,61 @@ typedef struct cutter {
     pdt_point *tq;        /* scratch: the upper part of a split (points) */
 } cutter;
 
+/* The frame-1 key of rank t among the keys of q[0, m) (the value with exactly
+ * t keys below it), found from a sample: two sample keys a <= b that bracket
+ * rank t with high probability, one pass that counts the keys below a and
+ * gathers those in [a, b] (a few percent), a selection among those.  When
+ * the bracket misses (rare; any input only costs the fallback), a selection
+ * over all m keys.  The pass is branch-free: the old selection over all keys
+ * mispredicted about every other comparison. */
+static uint64_t frame1_rank(const cutter *c, const pdt_point *q, size_t m, size_t t)
+{
+    uint64_t *k = c->k, *smp = c->ks;
+    if (m < 2048) {
+        for (size_t i = 0; i < m; i++) k[i] = frame_key(q[i], 1);
+        return kth_key(k, m, t);
+    }
+    size_t S = 4;
+    while (S * S < 16 * m && S < 8192) S *= 2; /* ~ 4 sqrt(m), at most 8192 */
+    for (size_t j = 0; j < S; j++) smp[j] = frame_key(q[(2 * j + 1) * m / (2 * S)], 1);
+    size_t r = (size_t)((double)t * (double)S / (double)m), delta = 2;
+    while (delta * delta < 3 * S) delta++; /* ~ 1.7 sqrt(S): over 3 standard deviations */
+    size_t rlo = r > delta ? r - delta : 0, rhi = r + delta < S ? r + delta : S - 1;
+    uint64_t a = kth_key(smp, S, rlo);
+    uint64_t b = kth_key(smp + rlo, S - rlo, rhi - rlo); /* smp[rlo, S) >= a */
+    size_t below = 0, nm = 0;
+    uint64_t w = b - a;
+    for (size_t i = 0; i < m; i++) {
+        uint64_t x = frame_key(q[i], 1);
+        below += x < a;
+        k[nm] = x;
+        nm += x - a <= w;
+    }
+    if (below <= t && t < below + nm) return kth_key(k, nm, t - below);
+    for (size_t i = 0; i < m; i++) k[i] = frame_key(q[i], 1);
+    return kth_key(k, m, t);
+}
+
 /* Split [lo, hi) (in frame-0 order) at the frame-1 median: the mid - lo
  * frame-1 smallest points first; both parts stay in frame-0 order (a stable
- * partition), so frame-0 nodes never need a selection. */
+ * partition, branch-free), so frame-0 nodes never need a selection. */
 static void split_frame1(const cutter *c, uint32_t lo, uint32_t hi, uint32_t mid)
 {
     size_t m = hi - lo;
     uint32_t *id = c->id + lo;
     pdt_point *q = c->q + lo;
-    for (size_t i = 0; i < m; i++) c->ks[i] = c->k[i] = frame_key(q[i], 1);
-    uint64_t piv = kth_key(c->ks, m, mid - lo); /* the smallest key of the upper part */
+    uint64_t piv = frame1_rank(c, q, m, mid - lo); /* the smallest key of the upper part */
     size_t a = 0, b = 0;
     for (size_t i = 0; i < m; i++) {
-        if (c->k[i] < piv) {
-            id[a] = id[i];
-            q[a++] = q[i];
-        } else {
-            c->tp[b] = id[i];
-            c->tq[b++] = q[i];
-        }
+        uint32_t v = id[i];
+        pdt_point p = q[i];
+        size_t lt = frame_key(p, 1) < piv;
+        id[a] = v;
+        q[a] = p;
+        c->tp[b] = v;
+        c->tq[b] = p;
+        a += lt;
+        b += 1 - lt;
     }
     memcpy(id + a, c->tp, b * sizeof *c->tp);
     memcpy(q + a, c->tq, b * sizeof *c->tq);
@@ -408,7 +450,7 @@ static int build(dt *d, uint32_t lo, uint32_t hi, int axis, uint32_t *le, uint32
         uint32_t b = make_edge(d, s2, s3);
         if (b == NIL) return 0;
         splice(d, sym(a), b);
-        int o = pdt_orient(d->p[s1], d->p[s2], d->p[s3]);
+        int o = pdt_orient_fast(d->p[s1], d->p[s2], d->p[s3]);
         if (o > 0) {
             if (connect(d, b, a) == NIL) return 0;
             *le = a;
@@ -451,7 +493,7 @@ static size_t collect(dt *d, const uint32_t *id, const uint32_t *tid, int run)
         uint32_t e2 = sym(d->e[e1].onext); /* lprev(lprev(e)) */
         if (e2 < e || sym(d->e[e2].onext) != e) continue;
         uint32_t a = d->e[e].org, b = d->e[e2].org, c = d->e[e1].org;
-        if (pdt_orient(d->p[a], d->p[b], d->p[c]) <= 0) continue; /* the outer face */
+        if (pdt_orient_fast(d->p[a], d->p[b], d->p[c]) <= 0) continue; /* the outer face */
         PDT_TRACE(tr, 1, PDT_EV_TRI_NEW, run, tid[a], tid[b], tid[c], 0);
         out[nt].v[0] = id[a];
         out[nt].v[1] = id[b];
@@ -484,7 +526,16 @@ static pdt_status kernel(const pdt_point *pts, uint32_t *id, size_t n, pdt_tri *
     /* the cuts, on the points gathered in lexicographic order and moved
      * along with their ids (scratch: 7 words per point, in the edge array
      * before any edge exists) */
-    for (size_t i = 0; i < n; i++) q[i] = pts[id[i]];
+    int32_t minx = INT32_MAX, maxx = INT32_MIN, miny = INT32_MAX, maxy = INT32_MIN;
+    for (size_t i = 0; i < n; i++) {
+        pdt_point v = pts[id[i]];
+        q[i] = v;
+        minx = v.x < minx ? v.x : minx;
+        maxx = v.x > maxx ? v.x : maxx;
+        miny = v.y < miny ? v.y : miny;
+        maxy = v.y > maxy ? v.y : maxy;
+    }
+    d.small = (int64_t)maxx - minx < (INT64_C(1) << 30) && (int64_t)maxy - miny < (INT64_C(1) << 30);
     cutter c = { q, id, (uint64_t *)(void *)d.e, NULL, NULL, NULL };
     c.ks = c.k + n;
     c.tp = (uint32_t *)(void *)(c.ks + n);

@@ -33,15 +33,14 @@
  */
 #include "pdt/predicates.h"
 
+#include "pred_inline.h"
+
 typedef __int128 i128;
 typedef unsigned __int128 u128;
 
 int pdt_orient(pdt_point a, pdt_point b, pdt_point c)
 {
-    int64_t bx = (int64_t)b.x - a.x, by = (int64_t)b.y - a.y;
-    int64_t cx = (int64_t)c.x - a.x, cy = (int64_t)c.y - a.y;
-    i128 l = (i128)bx * cy, r = (i128)by * cx;
-    return (l > r) - (l < r);
+    return pdt_orient_fast(a, b, c);
 }
 
 /* ---- signed 192-bit integers: three 64-bit limbs, two's complement ---- */
@@ -125,34 +124,10 @@ static inline int small30(int64_t v)
     return v > -(INT64_C(1) << 30) && v < (INT64_C(1) << 30);
 }
 
-static inline __attribute__((always_inline)) int incircle(pdt_point a, pdt_point b, pdt_point c,
-                                                         pdt_point d)
+/* Stages 2 and 3 (stage 1, the filter, is pdt_incircle0_fast in pred_inline.h). */
+int pdt_incircle_exact(int64_t adx, int64_t ady, int64_t bdx, int64_t bdy, int64_t cdx,
+                       int64_t cdy)
 {
-    int64_t adx = (int64_t)a.x - d.x, ady = (int64_t)a.y - d.y;
-    int64_t bdx = (int64_t)b.x - d.x, bdy = (int64_t)b.y - d.y;
-    int64_t cdx = (int64_t)c.x - d.x, cdy = (int64_t)c.y - d.y;
-
-    /* Stage 1: floating-point filter (all six differences are exact doubles). */
-    double fadx = (double)adx, fady = (double)ady, fbdx = (double)bdx, fbdy = (double)bdy;
-    double fcdx = (double)cdx, fcdy = (double)cdy;
-    double bdxcdy = fbdx * fcdy, cdxbdy = fcdx * fbdy;
-    double cdxady = fcdx * fady, adxcdy = fadx * fcdy;
-    double adxbdy = fadx * fbdy, bdxady = fbdx * fady;
-    double alift = fadx * fadx + fady * fady;
-    double blift = fbdx * fbdx + fbdy * fbdy;
-    double clift = fcdx * fcdx + fcdy * fcdy;
-    double det = alift * (bdxcdy - cdxbdy) + blift * (cdxady - adxcdy) +
-                 clift * (adxbdy - bdxady);
-    double perm = (__builtin_fabs(bdxcdy) + __builtin_fabs(cdxbdy)) * alift +
-                  (__builtin_fabs(cdxady) + __builtin_fabs(adxcdy)) * blift +
-                  (__builtin_fabs(adxbdy) + __builtin_fabs(bdxady)) * clift;
-    /* Shewchuk's bound is (10 + 96 eps) eps = 1.11022302462515...e-15; we use
-     * a slightly larger constant, which only widens the band that goes exact. */
-    const double errbound = 1.2e-15 * perm;
-    if (det > errbound) return 1;
-    if (-det > errbound) return -1;
-
-    /* Stages 2 and 3: exact. */
     if (small30(adx) && small30(ady) && small30(bdx) && small30(bdy) && small30(cdx) &&
         small30(cdy))
         return incircle_exact128(adx, ady, bdx, bdy, cdx, cdy);
@@ -161,12 +136,11 @@ static inline __attribute__((always_inline)) int incircle(pdt_point a, pdt_point
 
 int pdt_incircle0(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
 {
-    return incircle(a, b, c, d);
+    return pdt_incircle0_fast(a, b, c, d);
 }
 
 /* The tie-breaking part, kept out of line: it runs only on exact zeros. */
-static __attribute__((noinline)) int incircle_ties(pdt_point a, pdt_point b, pdt_point c,
-                                                   pdt_point d)
+int pdt_incircle_ties(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
 {
     /* H(eps) = incircle0 + d_a orient(b,c,d) - d_b orient(a,c,d) + d_c orient(a,b,d)
      *          - d_d orient(a,b,c), the lexicographically smallest point having
@@ -196,8 +170,7 @@ static __attribute__((noinline)) int incircle_ties(pdt_point a, pdt_point b, pdt
 
 int pdt_incircle_sos(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
 {
-    int s = incircle(a, b, c, d);
-    return s != 0 ? s : incircle_ties(a, b, c, d);
+    return pdt_incircle_sos_fast(a, b, c, d);
 }
 
 pdt_lifted pdt_lift(pdt_point p)
