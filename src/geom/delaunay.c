@@ -504,10 +504,13 @@ static size_t collect(dt *d, const uint32_t *id, const uint32_t *tid, int run)
 }
 
 /* T* of the n >= 2 distinct points pts[id[0]], ..., pts[id[n-1]], listed in
- * lexicographic order (id is reordered: leaf order).  Triangles come out as
- * ids; the trace sees ids through tr->gid when there is one. */
-static pdt_status kernel(const pdt_point *pts, uint32_t *id, size_t n, pdt_tri **tris,
-                         size_t *ntri, int run, pdt_trace *tr)
+ * lexicographic order (id is reordered: leaf order).  lexq: NULL, or those
+ * points already in that order (the sort decodes them from its keys, which
+ * saves a random gather; reordered too, still the caller's to free).
+ * Triangles come out as ids; the trace sees ids through tr->gid when there is
+ * one. */
+static pdt_status kernel(const pdt_point *pts, uint32_t *id, pdt_point *lexq, size_t n,
+                         pdt_tri **tris, size_t *ntri, int run, pdt_trace *tr)
 {
     *tris = NULL;
     *ntri = 0;
@@ -516,10 +519,10 @@ static pdt_status kernel(const pdt_point *pts, uint32_t *id, size_t n, pdt_tri *
     d.freelist = NIL;
     d.cap = 6 * n + 12; /* at most 3n undirected edges alive */
     d.e = malloc(d.cap * sizeof *d.e); /* becomes the triangle array */
-    pdt_point *q = pdt_big_alloc(n * sizeof *q);
+    pdt_point *q = lexq ? lexq : pdt_big_alloc(n * sizeof *q);
     if (!d.e || !q) {
         free(d.e);
-        pdt_big_free(q, n * sizeof *q);
+        if (!lexq) pdt_big_free(q, n * sizeof *q);
         return PDT_ERR_NOMEM;
     }
     pdt_big_advise(d.e, d.cap * sizeof *d.e);
@@ -528,7 +531,7 @@ static pdt_status kernel(const pdt_point *pts, uint32_t *id, size_t n, pdt_tri *
      * before any edge exists) */
     int32_t minx = INT32_MAX, maxx = INT32_MIN, miny = INT32_MAX, maxy = INT32_MIN;
     for (size_t i = 0; i < n; i++) {
-        pdt_point v = pts[id[i]];
+        pdt_point v = lexq ? q[i] : pts[id[i]];
         q[i] = v;
         minx = v.x < minx ? v.x : minx;
         maxx = v.x > maxx ? v.x : maxx;
@@ -551,7 +554,7 @@ static pdt_status kernel(const pdt_point *pts, uint32_t *id, size_t n, pdt_tri *
             tmap = malloc(n * sizeof *tmap);
             if (!tmap) {
                 free(d.e);
-                pdt_big_free(q, n * sizeof *q);
+                if (!lexq) pdt_big_free(q, n * sizeof *q);
                 return PDT_ERR_NOMEM;
             }
             for (size_t i = 0; i < n; i++) tmap[i] = tr->gid[id[i]];
@@ -565,7 +568,7 @@ static pdt_status kernel(const pdt_point *pts, uint32_t *id, size_t n, pdt_tri *
     int ok = build(&d, 0, (uint32_t)n, 0, &le, &re);
     size_t nt = ok ? collect(&d, id, tid, run) : 0;
     free(tmap);
-    pdt_big_free(q, n * sizeof *q);
+    if (!lexq) pdt_big_free(q, n * sizeof *q);
     if (!ok) {
         free(d.e);
         return PDT_ERR_NOMEM;
@@ -593,7 +596,7 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
     uint32_t *id = malloc(n * sizeof *id);
     if (!id) return PDT_ERR_NOMEM;
     for (uint32_t i = 0; i < (uint32_t)n; i++) id[i] = i;
-    pdt_status s = kernel(pts, id, n, tris, ntri, run, tr);
+    pdt_status s = kernel(pts, id, NULL, n, tris, ntri, run, tr);
     free(id);
     return s;
 }
@@ -770,7 +773,10 @@ static keyed *lsd_sort(keyed *src, keyed *dst, size_t m, int bits, size_t *cnt)
  * points stay in input order and the first is kept.  (Four passes of 16-bit
  * digits over the whole array, as before, had 65 536 output streams: far
  * past the cache and the TLB at 10^7 points.) */
-pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size_t *nu)
+/* pdt_sort_unique; q: NULL, or room for n points, where the distinct points
+ * are written in order (decoded from the keys: q[i] == pts[order[i]]). */
+static pdt_status sort_unique(const pdt_point *pts, size_t n, uint32_t *order, pdt_point *q,
+                              size_t *nu)
 {
     *nu = 0;
     if (n == 0) return PDT_OK;
@@ -798,6 +804,7 @@ pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size
         a[i].key = by < 64 ? (kx << by) | ky : ky;
         a[i].idx = (uint32_t)i;
     }
+    uint64_t ymask = by ? (~UINT64_C(0) >> (64 - by)) : 0;
     int hb = bits < 11 ? bits : 11, shift = bits - hb;
     size_t nb = (size_t)1 << hb;
     memset(hc, 0, (nb + 1) * sizeof *hc);
@@ -812,7 +819,14 @@ pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size
         size_t end = hc[h];
         keyed *r = lsd_sort(b + start, a + start, end - start, shift, cnt);
         for (size_t i = 0; i < end - start; i++) {
-            if (!have_prev || r[i].key != prev) order[u++] = r[i].idx;
+            if (!have_prev || r[i].key != prev) {
+                if (q) {
+                    uint64_t kx = by ? r[i].key >> by : r[i].key, ky = r[i].key & ymask;
+                    q[u].x = (int32_t)((int64_t)kx + minx);
+                    q[u].y = (int32_t)((int64_t)ky + miny);
+                }
+                order[u++] = r[i].idx;
+            }
             prev = r[i].key;
             have_prev = 1;
         }
@@ -824,6 +838,11 @@ pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size
     free(cnt);
     free(hc);
     return PDT_OK;
+}
+
+pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size_t *nu)
+{
+    return sort_unique(pts, n, order, NULL, nu);
 }
 
 /* ---- the pipeline ---- */
@@ -848,11 +867,16 @@ pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_
     double t0 = now();
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_PARTITION, 0, 0, 0, 0);
     uint32_t *order = malloc((n ? n : 1) * sizeof *order);
-    if (!order) return PDT_ERR_NOMEM;
+    pdt_point *lexq = order ? pdt_big_alloc(n * sizeof *lexq) : NULL;
+    if (!lexq) {
+        free(order);
+        return PDT_ERR_NOMEM;
+    }
     size_t nu;
-    pdt_status s = pdt_sort_unique(pts, n, order, &nu);
+    pdt_status s = sort_unique(pts, n, order, lexq, &nu);
     if (s != PDT_OK) {
         free(order);
+        pdt_big_free(lexq, n * sizeof *lexq);
         return s;
     }
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_PARTITION, 0, 0, 0, 0);
@@ -873,9 +897,10 @@ pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_KERNEL, 0, 0, 0, 0);
     pdt_tri *t = NULL;
     size_t nt = 0;
-    s = nu >= 2 ? kernel(pts, order, nu, &t, &nt, 0, tr) : PDT_OK;
+    s = nu >= 2 ? kernel(pts, order, lexq, nu, &t, &nt, 0, tr) : PDT_OK;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
     free(order);
+    pdt_big_free(lexq, n * sizeof *lexq);
     if (s != PDT_OK) return s;
     double t2 = now();
 
