@@ -41,6 +41,90 @@ void pdt_out_abort(pdt_outfile *o);
 pdt_status pdt_read_points(const char *path, double scale, pdt_point **pts, size_t *n,
                            size_t *collisions, pdt_err *err);
 
+/* ---- a point file read in parts, one per rank (pdt_par_read) -----------------
+ *
+ * The first reader calls pdt_points_head_read; every reader q of p then
+ * loads its part (pdt_points_part_load: whole lines, about size/p bytes,
+ * after the header), parses it knowing the line number of its first byte
+ * (pdt_points_part_parse: the '\n' counts of the parts before it, summed),
+ * and checks it against the whole file (pdt_points_part_check: the point
+ * counts of the parts before it, summed).  The failure to report is the one
+ * of smallest err_key over all parts: it is the failure, and the message,
+ * that pdt_read_points gives for the whole file. */
+
+/* What the first reader learns from the start of the file. */
+typedef struct pdt_points_head {
+    int parts;           /* 1: the file can be read in parts (a regular, non-empty file) */
+    int node;            /* Triangle's .node format */
+    uint64_t size;       /* bytes in the file */
+    uint64_t body;       /* first byte after the byte-order mark and header line */
+    uint64_t body_nl;    /* '\n' bytes before body */
+    int64_t count;       /* .node: points the header announces; -1 without a header */
+    int64_t nattr, nmark;
+    int32_t last_nl;     /* the file ends with '\n' */
+} pdt_points_head;
+
+/* Open `path` and read its start: h->parts = 0 for standard input ("-"), a
+ * pipe, a device or an empty file (read those whole with pdt_read_points).
+ * Errors as pdt_read_points ("FILE: cannot open: ...", a bad .node header
+ * "FILE:LINE: ..."). */
+pdt_status pdt_points_head_read(const char *path, double scale, pdt_points_head *h,
+                                pdt_err *err);
+
+/* One part of a file: its bytes, then its points. */
+typedef struct pdt_points_part {
+    char *buf;              /* bytes [lo, hi) of the file, '\0'-terminated */
+    uint64_t lo, hi;
+    uint64_t nl;            /* '\n' bytes in [lo, hi) */
+    uint64_t line0;         /* line number of byte lo (pdt_points_part_parse) */
+    pdt_point *pts;         /* malloc'd; the caller may take it (set to NULL) */
+    size_t n;
+    void *orig;             /* --scale: the values as written (pdt_points_part_written) */
+    int32_t has_idx0;       /* .node: the first point line's index was read */
+    int64_t idx0;
+    uint64_t err_key;       /* UINT64_MAX: no failure; else smaller = reported first */
+} pdt_points_part;
+
+/* Load part q of p of the file (path as given to pdt_points_head_read):
+ * the lines that start in [size q / p, size (q + 1) / p), none before
+ * h->body.  On failure pt->err_key = 0. */
+pdt_status pdt_points_part_load(const char *path, const pdt_points_head *h, int q, int p,
+                                pdt_points_part *pt, pdt_err *err);
+
+/* Parse the loaded part; line0 = 1 + the '\n' bytes before pt->lo.  A bad
+ * line sets err ("FILE:LINE: what") and pt->err_key.  In a .node file the
+ * indices are checked within the part only. */
+pdt_status pdt_points_part_parse(pdt_points_part *pt, const char *path, const pdt_points_head *h,
+                                 double scale, uint64_t line0, pdt_err *err);
+
+/* The checks that need the parts before this one (.node: first index 0 or
+ * 1, consecutive indices across parts, the point count of the header).
+ * first = points in the parts before, total = points in all parts, base =
+ * the index of the file's first point line (if any part has one), last = 1
+ * for the last part, last_line = the number of the file's last line.  May
+ * replace the part's failure with an earlier one. */
+pdt_status pdt_points_part_check(pdt_points_part *pt, const char *path, const pdt_points_head *h,
+                                 uint64_t first, uint64_t total, int64_t base, int last,
+                                 uint64_t last_line, pdt_err *err);
+
+/* --scale: a point with its two coordinates as written, to count across
+ * parts the points that became equal to a point written differently. */
+typedef struct pdt_points_written {
+    pdt_point p;
+    unsigned char as_written[32];
+} pdt_points_written;
+
+/* The part's points as pdt_points_written records (*w malloc'd, pt->n of them). */
+pdt_status pdt_points_part_written(const pdt_points_part *pt, pdt_points_written **w,
+                                   pdt_err *err);
+
+/* Sort w and count the collisions among them (every record of a key must
+ * be here): as pdt_read_points' *collisions. */
+pdt_status pdt_points_collisions(pdt_points_written *w, size_t n, uint64_t *collisions,
+                                 pdt_err *err);
+
+void pdt_points_part_free(pdt_points_part *pt);
+
 /* Write points as text ("x y" per line) or, for a ".node" path, Triangle's
  * node format.  Atomic. */
 pdt_status pdt_write_points(const char *path, const pdt_point *pts, size_t n, pdt_err *err);

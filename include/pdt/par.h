@@ -215,7 +215,11 @@ pdt_status pdt_par_agree(pdt_comm *c, pdt_status st, int *who, pdt_err *err);
 /* Collective: read the points of `path` ("-" = standard input; ".node" =
  * Triangle's format; else text), scaled by `scale` as pdt_read_points does.
  * Every rank gets its block in *in (pdt_par_input_free); the
- * collision count is the whole input's.  Same status at every rank
+ * collision count is the whole input's.  A regular file is read in parts:
+ * every rank loads and parses about size/P bytes of whole lines (no rank
+ * holds the whole input); standard input, a pipe or a device is read by
+ * rank 0 and scattered.  The failure reported is the one pdt_read_points
+ * gives on the whole file (its first bad line), whatever P.  Same status at every rank
  * (pdt_par_agree): a parse error is reported, at the rank that found it, as
  * "FILE:LINE: what". */
 pdt_status pdt_par_read(pdt_comm *c, const char *path, double scale, pdt_par_input *in,
