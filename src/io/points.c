@@ -147,19 +147,84 @@ static void skip_header(reader *r)
     r->cur = save;
 }
 
+static inline int blank(char ch)
+{
+    return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\v' || ch == '\f';
+}
+
+/* [+-]digits, at most 10 digits, fitting in int32: the byte after it, or
+ * NULL (then the general path reads the token and names what is wrong). */
+static inline const char *fast_int(const char *p, int32_t *v)
+{
+    int neg = *p == '-';
+    if (*p == '-' || *p == '+') p++;
+    const char *s = p;
+    uint64_t acc = 0;
+    unsigned d;
+    while ((d = (unsigned)(unsigned char)*p - '0') <= 9 && p - s < 11) {
+        acc = acc * 10 + d;
+        p++;
+    }
+    if (p == s || p - s > 10 || acc > (uint64_t)INT32_MAX + (uint64_t)neg) return NULL;
+    *v = neg ? (int32_t)(-(int64_t)acc) : (int32_t)acc;
+    return p;
+}
+
+/* The common line of a point text file, "x y" of plain integers separated
+ * by blanks and at most one ',' or ';', nothing after them, read in one
+ * pass (the cursor at its first byte; the text ends with a '\0', as
+ * pdt_io_load and pdt_points_part_load leave it).  Returns 1 (the point
+ * appended, the cursor on the next line) or 0 (nothing moved: the general
+ * path reads the line). */
+static int fast_xy(reader *r)
+{
+    pdt_io_cur *c = &r->cur;
+    pdt_point pt;
+    const char *p = fast_int(c->p, &pt.x), *q;
+    if (!p) return 0;
+    for (q = p; blank(*q); q++) {}
+    if (*q == ',' || *q == ';')
+        for (q++; blank(*q); q++) {}
+    else if (q == p)
+        return 0; /* "12x", "12#", "12" alone */
+    if (!(p = fast_int(q, &pt.y))) return 0;
+    for (q = p; q < c->end && blank(*q); q++) {}
+    if (q < c->end && *q != '\n') return 0; /* more on the line, or "12 13x" */
+    r->pts[r->n++] = pt;
+    if (q < c->end) {
+        c->p = q + 1;
+        c->line++;
+    } else {
+        c->p = q;
+    }
+    return 1;
+}
+
+/* The point lines of a text file from the cursor on (after the header);
+ * on failure r->n counts the points of the lines before the bad one. */
+static pdt_status text_lines(reader *r)
+{
+    while (pdt_io_next_line(&r->cur)) {
+        if (r->scale == 0 && r->n < r->cap && r->n < UINT32_MAX - 1 && fast_xy(r)) continue;
+        size_t before = r->n;
+        pdt_status st = point_xy(r);
+        if (st == PDT_OK)
+            st = pdt_io_end_line(&r->cur, "the coordinates (one point 'x y' per line)", r->err);
+        if (st != PDT_OK) {
+            r->n = before;
+            return st;
+        }
+    }
+    return PDT_OK;
+}
+
 /* One point per line: "x y", "x,y", "x;y" or "x<TAB>y", after an optional
  * header line naming the columns. */
 static pdt_status read_text(reader *r)
 {
     r->cur.fields = 1;
     if (pdt_io_next_line(&r->cur)) skip_header(r);
-    while (pdt_io_next_line(&r->cur)) {
-        pdt_status st = point_xy(r);
-        if (st == PDT_OK)
-            st = pdt_io_end_line(&r->cur, "the coordinates (one point 'x y' per line)", r->err);
-        if (st != PDT_OK) return st;
-    }
-    return PDT_OK;
+    return text_lines(r);
 }
 
 /* A non-negative integer field of a .node/.ele header or entry. */
@@ -585,13 +650,7 @@ pdt_status pdt_points_part_parse(pdt_points_part *pt, const char *path, const pd
     } else if (h->node) {
         st = part_node(&r, h, pt);
     } else {
-        while (st == PDT_OK && pdt_io_next_line(&r.cur)) {
-            size_t before = r.n;
-            st = point_xy(&r);
-            if (st == PDT_OK)
-                st = pdt_io_end_line(&r.cur, "the coordinates (one point 'x y' per line)", err);
-            if (st != PDT_OK) r.n = before;
-        }
+        st = text_lines(&r);
     }
     if (st != PDT_OK && pt->err_key != 0)
         pt->err_key = st == PDT_ERR_PARSE ? (uint64_t)r.cur.line * 4 + 2 : 0;

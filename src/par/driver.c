@@ -195,6 +195,8 @@ static pdt_status partition(drv *d, const pdt_par_input *in, pdt_err *err)
         rcnt[q] = (size_t)rc[q] * sizeof(srm_rec);
         total += (size_t)rc[q];
     }
+    free(tmp); /* the grouping's scratch: not held through the exchange */
+    tmp = NULL;
     got = malloc((total + 1) * sizeof *got);
     if (!got) goto nomem;
     st = pdt_comm_alltoallv(d->c, rec, cnt, got, rcnt, err);
@@ -202,7 +204,6 @@ static pdt_status partition(drv *d, const pdt_par_input *in, pdt_err *err)
     note_v(d, TAG_RECORDS, cnt, rcnt);
     free(rec);
     rec = NULL;
-    free(tmp);
     tmp = malloc((total + 1) * sizeof *tmp);
     if (!tmp) goto nomem;
     /* blocks arrive in rank order, each in index order, and rank q's indices
