@@ -523,6 +523,41 @@ TEST(devices_are_written_not_replaced)
     CHECK(stat("/dev/null", &sb) == 0 && S_ISCHR(sb.st_mode));
 }
 
+/* The text reader's one-pass path for plain "x y" lines and its general
+ * tokenizer agree: every line read as it is (the one-pass path when it
+ * applies) and with a trailing comment (always the general path) gives the
+ * same point or the same message. */
+TEST(text_fast_path_same_as_general)
+{
+    static const char *num[] = {"0", "-0", "+5", "12", "007", "2147483647", "2147483648",
+                                "-2147483648", "-2147483649", "0000000001", "00000000001",
+                                "99999999999", "1.5", "-", "+", "x", "12x", ""};
+    static const char *sep[] = {" ", ",", ";", "\t", " , ", ",,", "", " ;\t"};
+    int n_num = (int)(sizeof num / sizeof *num), n_sep = (int)(sizeof sep / sizeof *sep);
+    int bad = 0;
+    for (int a = 0; a < n_num; a++)
+        for (int b = 0; b < n_num; b++)
+            for (int k = 0; k < n_sep; k++) {
+                char t1[128], t2[128];
+                snprintf(t1, sizeof t1, "1 1\n%s%s%s\n2 2", num[a], sep[k], num[b]);
+                snprintf(t2, sizeof t2, "1 1\n%s%s%s #\n2 2", num[a], sep[k], num[b]);
+                pdt_point *p1 = NULL, *p2 = NULL;
+                size_t n1 = 0, n2 = 0;
+                pdt_err e1, e2;
+                pdt_status s1 = rd("f1.txt", t1, 0, &p1, &n1, NULL, &e1);
+                pdt_status s2 = rd("f1.txt", t2, 0, &p2, &n2, NULL, &e2);
+                int same = s1 == s2 && n1 == n2 && strcmp(e1.msg, e2.msg) == 0;
+                for (size_t i = 0; same && i < n1; i++)
+                    same = p1[i].x == p2[i].x && p1[i].y == p2[i].y;
+                if (!same && bad++ < 5)
+                    printf("#   '%s': status %d '%s' vs %d '%s'\n", t1, (int)s1, e1.msg, (int)s2,
+                           e2.msg);
+                free(p1);
+                free(p2);
+            }
+    CHECK(bad == 0);
+}
+
 int main(void)
 {
     snprintf(dir, sizeof dir, "%s/pdt-io.XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -540,6 +575,7 @@ int main(void)
     RUN(scale_collisions);
     RUN(points_write_roundtrip);
     RUN(numbers_every_digit_count);
+    RUN(text_fast_path_same_as_general);
     RUN(tris_write_formats);
     RUN(tris_read_bad_inputs);
     RUN(atomic_write_leaves_nothing);
