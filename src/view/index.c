@@ -535,7 +535,12 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, p
     for (int i = 0, c = 0; i < NSEC; i++)
         for (uint64_t o = 0; o < h->sec[i].bytes; o += CHUNK_BYTES) {
             uint64_t len = h->sec[i].bytes - o < CHUNK_BYTES ? h->sec[i].bytes - o : CHUNK_BYTES;
-            tab[c++] = pdt_crc32c(0, (const char *)map + h->sec[i].off + o, (size_t)len);
+            const char *at = (const char *)map + h->sec[i].off + o;
+            tab[c++] = pdt_crc32c(0, at, (size_t)len);
+            /* drop the pages just read from this process (they stay in the page cache) */
+            uintptr_t a = ((uintptr_t)at + 4095) & ~(uintptr_t)4095,
+                      b = ((uintptr_t)at + (uintptr_t)len) & ~(uintptr_t)4095;
+            if (b > a) madvise((void *)a, b - a, MADV_DONTNEED);
         }
     munmap(map, off);
     off = (off + 63) & ~(uint64_t)63;
