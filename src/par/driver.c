@@ -353,7 +353,7 @@ static uint32_t tri_min(const pdt_tri *t)
  * owner[b], nondecreasing in b, so that every rank gets about T / p
  * triangles (a bucket is never split). */
 static pdt_status order_ranges(drv *d, const pdt_tri *t, size_t n, int *shift, int **owner,
-                               pdt_err *err)
+                               uint64_t *mine, pdt_err *err)
 {
     int p = d->p;
     uint64_t top = d->n_total ? d->n_total - 1 : 0;
@@ -362,14 +362,16 @@ static pdt_status order_ranges(drv *d, const pdt_tri *t, size_t n, int *shift, i
     int sh = 0;
     while ((top >> sh) + 1 > want) sh++;
     size_t nb = (size_t)(top >> sh) + 1;
-    uint64_t *h = calloc(nb, sizeof *h);
+    uint64_t *h = calloc(nb, sizeof *h), *local = malloc(nb * sizeof *local);
     int *own = malloc(nb * sizeof *own);
-    if (!h || !own) {
+    if (!h || !local || !own) {
         free(h);
+        free(local);
         free(own);
         return nomem(d, "order");
     }
     for (size_t i = 0; i < n; i++) h[tri_min(&t[i]) >> sh]++;
+    memcpy(local, h, nb * sizeof *h);
     pdt_status st = pdt_comm_allreduce_u64(d->c, h, nb, PDT_COMM_SUM, err);
     if (st == PDT_OK) {
         note_all(d, TAG_ORDER, nb * sizeof *h);
@@ -379,14 +381,36 @@ static pdt_status order_ranges(drv *d, const pdt_tri *t, size_t n, int *shift, i
             uint64_t q = total ? (before + h[b] / 2) * (uint64_t)p / total : 0;
             own[b] = q < (uint64_t)p ? (int)q : p - 1;
             before += h[b];
+            mine[own[b]] += local[b]; /* this rank's triangles for that rank */
         }
         *shift = sh;
         *owner = own;
         own = NULL;
     }
     free(h);
+    free(local);
     free(own);
     return st;
+}
+
+/* Group t[0..n) by destination rank in place (American flag sort: every
+ * triangle moves once, no second array): rank q's block is [at[q], end[q])
+ * (at[] is used up). */
+static void group_by_rank(pdt_tri *t, int p, size_t *at, const size_t *end, const int *owner,
+                          int shift)
+{
+    for (int q = 0; q < p; q++)
+        while (at[q] < end[q]) {
+            pdt_tri x = t[at[q]];
+            int dq = owner[tri_min(&x) >> shift];
+            while (dq != q) { /* put x in its place, carry on with the one it displaces */
+                pdt_tri y = t[at[dq]];
+                t[at[dq]++] = x;
+                x = y;
+                dq = owner[tri_min(&x) >> shift];
+            }
+            t[at[q]++] = x;
+        }
 }
 
 /* Phase 4: the final triangles go to the rank of their smallest index's
@@ -395,27 +419,25 @@ static pdt_status order_ranges(drv *d, const pdt_tri *t, size_t n, int *shift, i
 static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
 {
     int p = d->p;
-    const pdt_tri *t = d->s.fin;
+    pdt_tri *t = d->s.fin;
     size_t n = d->s.nfin;
-    pdt_status st = pdt_comm_quiet_barrier(d->c, err); /* ranks done early sleep */
-    if (st != PDT_OK) return st;
+    pdt_status st = PDT_OK;
     size_t *cnt = calloc((size_t)p, sizeof *cnt), *rcnt = calloc((size_t)p, sizeof *rcnt);
-    size_t *at = calloc((size_t)p, sizeof *at);
+    size_t *at = calloc((size_t)p, sizeof *at), *end = calloc((size_t)p, sizeof *end);
     uint64_t *sc = calloc((size_t)p, sizeof *sc), *rc = calloc((size_t)p, sizeof *rc);
-    pdt_tri *send = malloc((n + 1) * sizeof *send), *got = NULL;
+    pdt_tri *got = NULL;
     int *owner = NULL, shift = 0;
-    if (!cnt || !rcnt || !at || !sc || !rc || !send) {
+    if (!cnt || !rcnt || !at || !end || !sc || !rc) {
         st = nomem(d, "order");
         goto done;
     }
-    st = order_ranges(d, t, n, &shift, &owner, err);
+    st = order_ranges(d, t, n, &shift, &owner, sc, err);
     if (st != PDT_OK) goto done;
-    for (size_t i = 0; i < n; i++) sc[owner[tri_min(&t[i]) >> shift]]++;
-    for (int q = 1; q < p; q++) at[q] = at[q - 1] + (size_t)sc[q - 1];
-    for (size_t i = 0; i < n; i++) send[at[owner[tri_min(&t[i]) >> shift]]++] = t[i];
-    free(d->s.fin); /* every triangle is in send now */
-    d->s.fin = NULL;
-    d->s.nfin = d->s.capfin = 0;
+    for (int q = 0; q < p; q++) {
+        at[q] = q ? end[q - 1] : 0;
+        end[q] = at[q] + (size_t)sc[q];
+    }
+    group_by_rank(t, p, at, end, owner, shift);
     st = pdt_comm_alltoall(d->c, sc, sizeof *sc, rc, err);
     if (st != PDT_OK) goto done;
     note_all(d, TAG_COUNTS, sizeof *sc);
@@ -430,11 +452,12 @@ static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
         st = nomem(d, "order");
         goto done;
     }
-    st = pdt_comm_alltoallv(d->c, send, cnt, got, rcnt, err);
+    st = pdt_comm_alltoallv(d->c, t, cnt, got, rcnt, err);
     if (st != PDT_OK) goto done;
     note_v(d, TAG_ORDER, cnt, rcnt);
-    free(send);
-    send = NULL;
+    free(d->s.fin); /* every triangle went somewhere (itself included) */
+    d->s.fin = NULL;
+    d->s.nfin = d->s.capfin = 0;
     pdt_tri_canonical(got, total);
     uint64_t first = 0, all = total;
     st = pdt_comm_exscan_u64(d->c, total, &first, err); /* place in the whole output */
@@ -450,9 +473,9 @@ done:
     free(cnt);
     free(rcnt);
     free(at);
+    free(end);
     free(sc);
     free(rc);
-    free(send);
     free(owner);
     free(got);
     return st;
@@ -574,6 +597,9 @@ pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_par_input *in, pdt_par_out
     lg = NULL;
     double t2 = pdt_comm_wtime(c);
     st = merge_tree(&d, err);
+    /* the merge phase ends when the last merge does: ranks done early sleep
+     * here (counted as merge time, not as order time) */
+    if (st == PDT_OK) st = pdt_comm_quiet_barrier(c, err);
     if (st != PDT_OK) goto done;
     double t3 = pdt_comm_wtime(c);
     me->emitted = d.s.nfin;

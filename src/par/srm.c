@@ -246,6 +246,10 @@ pdt_status pdt_srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid,
     /* classification: final at once, or deferred until a merge level (with
      * no other strip at all, everything is final without a test) */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_CLASSIFY, 0, 0, 0, 0);
+    if (grow((void **)&s->fin, &s->capfin, s->nfin + ntri, sizeof *s->fin)) { /* most are final */
+        free(tris);
+        return nomem(err, s->rank, "classify");
+    }
     int alone = s->nne == 0 || (s->nne == 1 && s->nonempty[0] == s->rank);
     for (size_t i = 0; i < ntri; i++) {
         srm_pt v[3];
