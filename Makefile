@@ -44,7 +44,8 @@
 # program), src/view (replay model, cairo renderer, SDL2 shell: every file
 # but shell.c and pdtview.c goes into libpdtview.a, which needs cairo, and
 # for anim.c giflib (FFmpeg's libraries are opened with dlopen); bin/pdtview
-# adds SDL2 and the option parser src/cli/opts.c).  Unit tests named
+# adds SDL2, the option parser src/cli/opts.c and libpdtpar.a (the editor's
+# live runs on simulated ranks: src/view/live.c).  Unit tests named
 # tests/unit/test_view*.c are compiled with the cairo/SDL flags and linked
 # with libpdtview.a.
 
@@ -125,7 +126,7 @@ build/$(1)/libpdtview.a: $$(patsubst %.c,build/$(1)/%.o,$(VIEWLIB_SRC))
 $(3)/pdt: $$(patsubst %.c,build/$(1)/%.o,$(CLI_SRC) src/par/comm_mpi.c) build/$(1)/libpdtpar.a build/$(1)/libpdt.a
 	$$(CC) $(2) -o $$@ $$^ $(MPI_LIBS) $(OTF2_LIBS) $(LIBS)
 
-$(3)/pdtview: $$(patsubst %.c,build/$(1)/%.o,$(VIEWAPP_SRC) src/cli/opts.c) build/$(1)/libpdtview.a build/$(1)/libpdt.a
+$(3)/pdtview: $$(patsubst %.c,build/$(1)/%.o,$(VIEWAPP_SRC) src/cli/opts.c) build/$(1)/libpdtview.a build/$(1)/libpdtpar.a build/$(1)/libpdt.a
 	$$(CC) $(2) -o $$@ $$^ $(SDL_LIBS) $(CAIRO_LIBS) $(ANIM_LIBS) $(LIBS)
 
 $(3)/tests/%: build/$(1)/tests/unit/%.o $(if $(VIEWLIB_SRC),build/$(1)/libpdtview.a) build/$(1)/libpdtpar.a build/$(1)/libpdt.a

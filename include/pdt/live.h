@@ -6,7 +6,15 @@
  *  - triangulate, 1 rank: the sequential pipeline (pdt_triangulate) between
  *    a "run" phase, then the output phase with one TRI_FINAL per triangle of
  *    T*, exactly as the command's tracing does;
- *  - hull: Graham's scan, Version B (pdt_hull_graham) inside a "run" phase.
+ *  - triangulate, P > 1 ranks: the parallel pipeline of libpdtpar
+ *    (pdt_par_triangulate) on P threads over the local communicator
+ *    (pdt_comm_local_run), each rank with its block of the input as
+ *    pdt_par_read deals it and the events `mpirun -np P pdt triangulate
+ *    --trace` records at that rank (run, read, the triangulation, write);
+ *    times are the shared monotonic clock, and the ranks are merged as the
+ *    reader merges a run folder (a RECV never before its SEND, else by time);
+ *  - hull: Graham's scan, Version B (pdt_hull_graham) inside a "run" phase
+ *    (one rank whatever o->ranks says: `pdt hull` has no parallel mode).
  *
  * The run also says where the tie rule decided: an interior edge of T* whose
  * two triangles have their four points on one circle (exact pdt_incircle0 of
@@ -17,6 +25,9 @@
 
 #include "pdt/common.h"
 #include "pdt/tracefile.h"
+
+/* The most simulated ranks a live run takes. */
+#define PDT_LIVE_MAX_RANKS 64
 
 typedef struct pdt_live_opts {
     int hull;     /* 1: Graham's scan only (pdt hull) */
@@ -36,10 +47,9 @@ typedef struct pdt_live_result {
 } pdt_live_result;
 
 /* Run o's algorithm on pts[0..n) and record it into *res (which the caller
- * frees with pdt_live_free, also after an error).  Requires o->ranks >= 1;
- * ranks > 1 is refused (PDT_ERR_ARG) while the viewer has no in-process
- * communicator.  Returns PDT_OK, or an error (out of memory, too many
- * points) described in err. */
+ * frees with pdt_live_free, also after an error).  Requires 1 <= o->ranks <=
+ * PDT_LIVE_MAX_RANKS (else PDT_ERR_ARG).  Returns PDT_OK, or an error (out of
+ * memory, too many points, a failed rank) described in err. */
 pdt_status pdt_live_run(const pdt_point *pts, size_t n, const pdt_live_opts *o,
                         pdt_live_result *res, pdt_err *err);
 void pdt_live_free(pdt_live_result *res);

@@ -45,6 +45,7 @@ struct pdt_editor {
     double mx0, my0, mx, my;
     double per_px;        /* world units per pixel kept across a change */
     char msg[1100];
+    char title[470];      /* the window title (hook_title) */
 };
 
 /* ---- points and history --------------------------------------------------------- */
@@ -208,7 +209,7 @@ pdt_status pdt_editor_open(const char *path, const pdt_live_opts *o, pdt_editor 
         pdt_editor_free(ed);
         return st;
     }
-    snprintf(ed->msg, sizeof ed->msg, "click: add · drag: move · right click: delete · Ctrl+Z/Y · g snap · n random · F1-F4 presets · x hull");
+    snprintf(ed->msg, sizeof ed->msg, "click: add · drag: move · right click: delete · Ctrl+Z/Y · g snap · n random · F1-F4 presets · x hull · 1-8 ranks · h help");
     *out = ed;
     return PDT_OK;
 }
@@ -542,7 +543,11 @@ static int edit_key(pdt_editor *ed, const pdt_shell_input *in, double w, double 
     }
     if (in->key >= '1' && in->key <= '8') {
         int p = in->key - '0';
-        snprintf(ok, sizeof ok, "%d rank%s", p, p > 1 ? "s" : "");
+        if (ed->mode.hull)
+            snprintf(ok, sizeof ok, "%d rank%s for the triangulation (x); Graham's scan runs on one",
+                     p, p > 1 ? "s" : "");
+        else
+            snprintf(ok, sizeof ok, "%d simulated rank%s", p, p > 1 ? "s" : "");
         {
         pdt_err e = {0};
         frame_begin(ed, w, h, v);
@@ -732,9 +737,10 @@ static void hook_overlay(void *user, cairo_t *cr, double w, double h, const pdt_
     /* the banner: file, mode, message; the cocircular warning */
     double f = L.font;
     char line[512];
+    int ranks = ed->mode.hull ? 1 : ed->mode.ranks;
     snprintf(line, sizeof line, "EDIT %s · %zu points · %s · %d rank%s%s · re-run %.1f ms", ed->path,
-             ed->n, ed->mode.hull ? "hull (Graham)" : "triangulate", ed->mode.ranks,
-             ed->mode.ranks > 1 ? "s" : "", ed->snap ? " · snap" : "", 1e3 * ed->last_run_s);
+             ed->n, ed->mode.hull ? "hull (Graham)" : "triangulate", ranks,
+             ranks > 1 ? "s" : "", ed->snap ? " · snap" : "", 1e3 * ed->last_run_s);
     overlay_text(cr, L.geo.x + 0.6 * f, L.geo.y + L.geo.h - 2.9 * f, 0.85 * f, line, 0.1, 0.1, 0.1);
     overlay_text(cr, L.geo.x + 0.6 * f, L.geo.y + L.geo.h - 1.6 * f, 0.85 * f, ed->msg, 0.1, 0.3, 0.6);
     if (!ed->mode.hull && ed->run.nties) {
@@ -746,11 +752,25 @@ static void hook_overlay(void *user, cairo_t *cr, double w, double h, const pdt_
     cairo_restore(cr);
 }
 
+static const char *hook_title(void *user)
+{
+    pdt_editor *ed = user;
+    snprintf(ed->title, sizeof ed->title, "editing %s · %s", ed->path,
+             ed->mode.hull ? "hull (Graham), 1 rank" : "triangulate");
+    if (!ed->mode.hull) {
+        size_t len = strlen(ed->title);
+        snprintf(ed->title + len, sizeof ed->title - len, ", %d rank%s", ed->mode.ranks,
+                 ed->mode.ranks > 1 ? "s" : "");
+    }
+    return ed->title;
+}
+
 const pdt_shell_hook *pdt_editor_hook(pdt_editor *ed)
 {
     ed->hook.user = ed;
     ed->hook.input = hook_input;
     ed->hook.current = hook_current;
     ed->hook.overlay = hook_overlay;
+    ed->hook.title = hook_title;
     return &ed->hook;
 }

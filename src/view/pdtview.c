@@ -6,6 +6,8 @@
  *   pdtview --headless RUN --gif OUT.gif | --video OUT.mp4|OUT.webm
  *           [--phase P | --from N --to M] [--every K] [--fps F] [--hold S] [--size WxH]
  *   pdtview --edit FILE [--hull] [--ranks P]   the point editor
+ *   pdtview --edit FILE [--hull] [--ranks P] --write-run DIR
+ *                                           its live run as a run folder, no window
  *   pdtview --bench RUN [--size WxH]        open / seek / draw figures
  *   pdtview --write-run DIR RUN             copy a (synthetic) run to a run folder
  *
@@ -67,7 +69,10 @@ static const char help_text[] =
     "       pdtview --headless RUN --gif OUT.gif | --video OUT.mp4|OUT.webm\n"
     "               [--phase P | --from N --to M] [--every K] [--fps F] [--hold S]\n"
     "               [--size WxH]   (an animation: all events, a phase, or N..M)\n"
-    "       pdtview --edit FILE [--ranks P] [--hull] [--size WxH]   (click points in)\n"
+    "       pdtview --edit FILE [--ranks P] [--hull] [--size WxH]   (click points in;\n"
+    "               P simulated ranks run the parallel code; keys 1..8 and x switch)\n"
+    "       pdtview --edit FILE [--ranks P] [--hull] --write-run DIR   (the live run as a\n"
+    "               run folder, no window)\n"
     "       pdtview --bench RUN [--size WxH]\n"
     "       pdtview RUN [--at N|--phase NAME|--end] --counts   (triangles by status)\n"
     "       pdtview RUN --check     (seek equals stepping, both ways, at every cursor)\n"
@@ -601,14 +606,15 @@ static int check(const pdt_replay *r)
 
 /* Write the loaded events to a run folder through the trace writer, in
  * their merged order (so the reader's causal merge finds the same order). */
-static int write_run(const char *dir, const loaded *L, pdt_err *err)
+static int write_run(const char *dir, const loaded *L, const char *command, int level,
+                     pdt_err *err)
 {
     int p = L->nranks;
     pdt_trace_writer **w = calloc((size_t)p, sizeof *w);
     int64_t *off = calloc((size_t)p, sizeof *off);
     pdt_status st = PDT_OK;
     if (!w || !off) st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    for (int q = 0; q < p && st == PDT_OK; q++) st = pdt_tw_open(dir, q, 2, &w[q], err);
+    for (int q = 0; q < p && st == PDT_OK; q++) st = pdt_tw_open(dir, q, level, &w[q], err);
     /* every writer's clock starts at its open: align them on rank 0's */
     if (st == PDT_OK) {
         uint64_t t0 = pdt_tw_now(w[0]);
@@ -632,8 +638,8 @@ static int write_run(const char *dir, const loaded *L, pdt_err *err)
         mf.input_checksum = pdt_points_checksum(L->pts, L->n);
         mf.n = L->n;
         mf.nranks = p;
-        mf.level = 2;
-        snprintf(mf.command, sizeof mf.command, "triangulate");
+        mf.level = level;
+        snprintf(mf.command, sizeof mf.command, "%s", command);
         mf.clock_offset_ns = off;
         mf.wall_start_ns = pdt_wall_ns();
         st = pdt_run_write_meta(dir, &mf, L->pts, L->n, err);
@@ -652,6 +658,21 @@ static int edit(const opts *o)
     if (pdt_editor_open(o->edit, &lo, &ed, &err) != PDT_OK) {
         fprintf(stderr, "pdtview: %s\n", err.msg);
         return 2;
+    }
+    if (o->write_run) { /* the live run as a run folder (tests compare it with mpirun's) */
+        loaded L = {0};
+        const pdt_live_result *res = pdt_editor_run(ed);
+        L.pts = pdt_editor_points(ed, &L.n);
+        L.recs = res->recs;
+        L.m = res->m;
+        L.nranks = res->nranks;
+        int rc = write_run(o->write_run, &L, lo.hull ? "hull" : "triangulate", lo.level, &err);
+        if (rc) fprintf(stderr, "pdtview: %s\n", err.msg);
+        else if (!o->quiet)
+            printf("pdtview: wrote the live run of %s (%zu events, %d rank%s) to %s\n", o->edit,
+                   L.m, L.nranks, L.nranks > 1 ? "s" : "", o->write_run);
+        pdt_editor_free(ed);
+        return rc ? 2 : 0;
     }
     pdt_view v;
     pdt_view_defaults(&v);
@@ -755,7 +776,7 @@ int main(int argc, char **argv)
     double t1 = now_s(), c1 = cpu_s();
     if (o.write_run) {
         if (L.run && pdt_run_merged(L.run, &L.recs, &L.m, &err) != PDT_OK) goto out;
-        rc = write_run(o.write_run, &L, &err);
+        rc = write_run(o.write_run, &L, "triangulate", 2, &err);
         if (!rc && !o.quiet) printf("pdtview: wrote %zu events of %d ranks to %s\n", L.m, L.nranks, o.write_run);
         goto out;
     }

@@ -48,6 +48,7 @@ typedef struct shell {
     int typing;
     char num[24], prompt[96];
     int fullscreen;
+    char title[480];        /* the hook's title last set */
 } shell;
 
 static void set_status(shell *sh)
@@ -501,10 +502,23 @@ static int hook_input(shell *sh, const SDL_Event *e)
     return 1;
 }
 
+/* The hook's window title, when it changed. */
+static void hook_title(shell *sh)
+{
+    const pdt_shell_hook *hk = sh->o->hook;
+    const char *t = hk && hk->title ? hk->title(hk->user) : NULL;
+    if (!t || !strcmp(t, sh->title)) return;
+    snprintf(sh->title, sizeof sh->title, "%s", t);
+    char full[sizeof sh->title + 16];
+    snprintf(full, sizeof full, "pdtview — %s", t);
+    SDL_SetWindowTitle(sh->win, full);
+}
+
 /* Take the hook's replay if it changed. */
 static void hook_current(shell *sh)
 {
     const pdt_shell_hook *hk = sh->o->hook;
+    hook_title(sh);
     if (!hk || !hk->current || !hk->current(hk->user, &sh->r, &sh->s)) return;
     int n = pdt_replay_nranks(sh->r);
     sh->nranks = n < sh->cap_ranks ? n : sh->cap_ranks;

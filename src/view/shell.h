@@ -24,6 +24,8 @@ typedef struct pdt_shell_hook {
     int (*current)(void *user, const pdt_replay **r, pdt_rstate **s);
     /* Draw over the rendered frame (may be NULL). */
     void (*overlay)(void *user, cairo_t *cr, double w, double h, const pdt_view *v);
+    /* The window title now, after "pdtview — " (may be NULL: opts.title). */
+    const char *(*title)(void *user);
 } pdt_shell_hook;
 
 typedef struct pdt_shell_opts {

@@ -9,6 +9,7 @@
 #include "../harness.h"
 #include "../../src/view/edit.h"
 #include "pdt/delaunay.h"
+#include "pdt/gen.h"
 #include "pdt/io.h"
 
 static char dir[] = "/tmp/pdt-edit-XXXXXX";
@@ -35,7 +36,13 @@ static size_t finals_at_end(pdt_editor *ed)
     pdt_rstate *s = pdt_editor_state(ed);
     size_t nt, c = 0;
     pdt_replay_tris(r, &nt);
-    for (size_t t = 0; t < nt; t++) c += pdt_rstate_tri_status(r, s, t) == PDT_TS_FINAL;
+    const pdt_rtri_hist *H = pdt_replay_tri_hist(r);
+    /* as the window draws them: a final triangle a border kernel recomputed
+     * and its merge dropped again stays final (pdt_rstate_tri_entry) */
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t h = pdt_rstate_tri_entry(r, s, t);
+        c += h != UINT32_MAX && H[h].status == PDT_TS_FINAL;
+    }
     return c;
 }
 
@@ -113,10 +120,17 @@ TEST(hull_mode_and_presets)
     pdt_point *pts = NULL;
     CHECK(saved(f, &pts) == 61);
     free(pts);
-    /* more ranks than the live runner has: refused, the mode stays */
+    /* 4 simulated ranks; Graham only runs on one whatever the ranks say */
+    CHECK(pdt_editor_set_mode(ed, 0, 4, &err) == PDT_OK);
+    CHECK(pdt_editor_run(ed)->nranks == 4 && pdt_replay_nranks(pdt_editor_replay(ed)) == 4);
+    CHECK_MSG(finals_at_end(ed) == pdt_editor_run(ed)->ntri, "%zu final of %zu",
+              finals_at_end(ed), pdt_editor_run(ed)->ntri);
+    CHECK(pdt_editor_add(ed, 33, 77, &err) == PDT_OK && pdt_editor_run(ed)->nranks == 4);
+    CHECK(pdt_editor_set_mode(ed, 1, 4, &err) == PDT_OK && pdt_editor_run(ed)->nranks == 1);
+    /* more ranks than a live run takes: refused */
     pdt_err e2 = {0};
-    CHECK(pdt_editor_set_mode(ed, 0, 4, &e2) != PDT_OK || pdt_editor_run(ed)->nranks == 4);
-    CHECK(pdt_replay_nranks(pdt_editor_replay(ed)) >= 1);
+    CHECK(pdt_editor_set_mode(ed, 0, PDT_LIVE_MAX_RANKS + 1, &e2) != PDT_OK &&
+          strstr(e2.msg, "simulated ranks"));
     pdt_editor_free(ed);
     free(f);
 }
@@ -140,12 +154,95 @@ TEST(unparsable_file_is_never_written)
     free(f);
 }
 
+/* Rank q's events in a merged list: q's own order, its seq 0, 1, 2, ...; the
+ * frame `mpirun -np P pdt triangulate --trace` records around the library
+ * (run, read ... write, run); every RECV after its SEND. */
+static int rank_frame_ok(const pdt_live_result *res, int q)
+{
+    uint32_t want = 0;
+    const pdt_event *first[3] = {NULL, NULL, NULL}, *last = NULL;
+    for (size_t k = 0; k < res->m; k++) {
+        if (res->recs[k].rank != (uint32_t)q) continue;
+        if (res->recs[k].seq != want) return 0;
+        if (want < 3) first[want] = &res->recs[k].ev;
+        last = &res->recs[k].ev;
+        want++;
+    }
+    return want > 4 && first[0]->kind == PDT_EV_PHASE_BEGIN && first[0]->sub == PDT_PH_RUN &&
+           first[1]->kind == PDT_EV_PHASE_BEGIN && first[1]->sub == PDT_PH_READ &&
+           first[2]->kind == PDT_EV_PHASE_END && first[2]->sub == PDT_PH_READ &&
+           last->kind == PDT_EV_PHASE_END && last->sub == PDT_PH_RUN;
+}
+
+static int causal(const pdt_live_result *res)
+{
+    int p = res->nranks;
+    uint64_t *sent = calloc((size_t)(p * p), sizeof *sent);
+    int ok = sent != NULL;
+    for (size_t k = 0; ok && k < res->m; k++) {
+        const pdt_event *e = &res->recs[k].ev;
+        uint32_t r = res->recs[k].rank;
+        if (e->kind == PDT_EV_SEND) sent[r * (uint32_t)p + e->a]++;
+        if (e->kind == PDT_EV_RECV) ok = sent[e->a * (uint32_t)p + r] > (uint64_t)e->v;
+    }
+    free(sent);
+    return ok;
+}
+
+/* P simulated ranks run the parallel code: T* is the sequential pipeline's,
+ * triangle for triangle in the canonical order, for P = 2 .. 8 and for
+ * inputs with duplicates and collinear runs; every rank's events are framed
+ * as the command frames them, and the merge is causal. */
+TEST(simulated_ranks_give_the_same_triangles)
+{
+    static const char *const kinds[] = {"uniform", "clusters", "duplicates", "collinear", "grid"};
+    for (size_t i = 0; i < sizeof kinds / sizeof *kinds; i++) {
+        pdt_point *pts = NULL;
+        pdt_err err = {0};
+        size_t n = 150;
+        CHECK(pdt_gen(kinds[i], n, 7, &pts, &err) == PDT_OK);
+        pdt_live_opts one = {0, 1, 1};
+        pdt_live_result r1;
+        CHECK(pdt_live_run(pts, n, &one, &r1, &err) == PDT_OK);
+        for (int p = 2; p <= 8; p++) {
+            pdt_live_opts lo = {0, p, 1};
+            pdt_live_result rp;
+            pdt_status st = pdt_live_run(pts, n, &lo, &rp, &err);
+            CHECK_MSG(st == PDT_OK, "%s on %d ranks: %s", kinds[i], p, err.msg);
+            if (st != PDT_OK) continue;
+            CHECK_MSG(rp.ntri == r1.ntri && !memcmp(rp.tris, r1.tris, r1.ntri * sizeof *r1.tris),
+                      "%s on %d ranks: %zu triangles, sequential %zu", kinds[i], p, rp.ntri,
+                      r1.ntri);
+            CHECK(rp.nranks == p && rp.nties == r1.nties);
+            size_t finals = 0;
+            for (size_t k = 0; k < rp.m; k++) finals += rp.recs[k].ev.kind == PDT_EV_TRI_FINAL;
+            CHECK_MSG(finals == rp.ntri, "%s, %d ranks: %zu TRI_FINAL", kinds[i], p, finals);
+            for (int q = 0; q < p; q++) CHECK_MSG(rank_frame_ok(&rp, q), "%s rank %d", kinds[i], q);
+            CHECK(causal(&rp));
+            pdt_live_free(&rp);
+        }
+        pdt_live_free(&r1);
+        free(pts);
+    }
+    /* fewer points than ranks, and none at all */
+    pdt_point few[3] = {{0, 0}, {5, 0}, {0, 5}};
+    for (size_t n = 0; n <= 3; n++) {
+        pdt_live_opts lo = {0, 6, 1};
+        pdt_live_result rp;
+        pdt_err err = {0};
+        CHECK_MSG(pdt_live_run(few, n, &lo, &rp, &err) == PDT_OK, "%zu points: %s", n, err.msg);
+        CHECK(rp.ntri == (n == 3));
+        pdt_live_free(&rp);
+    }
+}
+
 int main(void)
 {
     if (!mkdtemp(dir)) return 1;
     RUN(add_move_delete_saved_and_rerun);
     RUN(hull_mode_and_presets);
     RUN(unparsable_file_is_never_written);
+    RUN(simulated_ranks_give_the_same_triangles);
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
     if (system(cmd) != 0) return 1;
