@@ -38,6 +38,13 @@ typedef struct pdt_view {
     int voronoi;          /* draw the Voronoi diagram of the final triangles */
     const char *prompt;   /* a line being typed ("go to event: 75"), drawn over the
                            * picture, or NULL */
+    const char *const (*help_more)[2]; /* the help overlay's second column (a layer
+                           * that takes the mouse and the digits: the editor): help_nmore
+                           * rows {keys, what they do} under help_more_title; the
+                           * viewer's rows for click, drag and the digits are then left
+                           * out.  NULL: the viewer's keys only */
+    int help_nmore;
+    const char *help_more_title;
 } pdt_view;
 
 /* Colour themes (pdt_view.theme).  Every theme keeps the colour-blind-safe

@@ -485,6 +485,21 @@ static void frame_end(pdt_editor *ed, double w, double h, pdt_view *v, pdt_statu
     report(ed, st, err, ok);
 }
 
+const char *const pdt_editor_keys[][2] = {
+    {"click", "add a point (integer coordinates)"},
+    {"drag", "move a point (elsewhere: pan)"},
+    {"right click", "delete a point"},
+    {"Ctrl + Z  Y", "undo / redo"},
+    {"g", "grid snap on / off"},
+    {"n", "add 10 random points in the view"},
+    {"F1 … F4", "presets: circle, grid, collinear, duplicates"},
+    {"x", "Graham's scan only / the triangulation"},
+    {"1 … 8", "simulated ranks of the live run"},
+    {"0", "show all ranks"},
+    {"9", "show / hide rank 8"},
+};
+const int pdt_editor_nkeys = (int)(sizeof pdt_editor_keys / sizeof *pdt_editor_keys);
+
 static int edit_key(pdt_editor *ed, const pdt_shell_input *in, double w, double h, pdt_view *v)
 {
     char ok[160];
@@ -677,13 +692,19 @@ static int hook_current(void *user, const pdt_replay **r, pdt_rstate **s)
     return changed;
 }
 
-static void overlay_text(cairo_t *cr, double x, double y, double size, const char *t,
+/* One line on a white band at (x, y), shrunk to fit max_w pixels. */
+static void overlay_text(cairo_t *cr, double x, double y, double size, double max_w, const char *t,
                          double r, double g, double b)
 {
     cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
     cairo_set_font_size(cr, size);
     cairo_text_extents_t te;
     cairo_text_extents(cr, t, &te);
+    if (te.x_advance + 0.6 * size > max_w && te.x_advance > 0) {
+        size *= fmax(0.5, (max_w - 0.6 * size) / te.x_advance);
+        cairo_set_font_size(cr, size);
+        cairo_text_extents(cr, t, &te);
+    }
     cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
     cairo_rectangle(cr, x - 0.3 * size, y - size, te.x_advance + 0.6 * size, 1.35 * size);
     cairo_fill(cr);
@@ -695,6 +716,7 @@ static void overlay_text(cairo_t *cr, double x, double y, double size, const cha
 static void hook_overlay(void *user, cairo_t *cr, double w, double h, const pdt_view *v)
 {
     pdt_editor *ed = user;
+    if (v->help) return; /* the help box is on top */
     pdt_layout L;
     pdt_render_layout_panels(w, h, pdt_replay_nranks(ed->r), v->panels, &L);
     cairo_save(cr);
@@ -741,13 +763,13 @@ static void hook_overlay(void *user, cairo_t *cr, double w, double h, const pdt_
     snprintf(line, sizeof line, "EDIT %s · %zu points · %s · %d rank%s%s · re-run %.1f ms", ed->path,
              ed->n, ed->mode.hull ? "hull (Graham)" : "triangulate", ranks,
              ranks > 1 ? "s" : "", ed->snap ? " · snap" : "", 1e3 * ed->last_run_s);
-    overlay_text(cr, L.geo.x + 0.6 * f, L.geo.y + L.geo.h - 2.9 * f, 0.85 * f, line, 0.1, 0.1, 0.1);
-    overlay_text(cr, L.geo.x + 0.6 * f, L.geo.y + L.geo.h - 1.6 * f, 0.85 * f, ed->msg, 0.1, 0.3, 0.6);
+    overlay_text(cr, L.geo.x + 0.6 * f, L.geo.y + L.geo.h - 2.9 * f, 0.85 * f, L.geo.w - 1.2 * f, line, 0.1, 0.1, 0.1);
+    overlay_text(cr, L.geo.x + 0.6 * f, L.geo.y + L.geo.h - 1.6 * f, 0.85 * f, L.geo.w - 1.2 * f, ed->msg, 0.1, 0.3, 0.6);
     if (!ed->mode.hull && ed->run.nties) {
         snprintf(line, sizeof line, "cocircular: the tie rule chose %zu edge%s (dashed magenta; "
                  "the other diagonal%s would be Delaunay too)", ed->run.nties,
                  ed->run.nties == 1 ? "" : "s", ed->run.nties == 1 ? "" : "s");
-        overlay_text(cr, L.geo.x + 0.6 * f, L.geo.y + 1.2 * f, 0.85 * f, line, 0.7, 0.0, 0.5);
+        overlay_text(cr, L.geo.x + 0.6 * f, L.geo.y + 1.2 * f, 0.85 * f, L.geo.w - 1.2 * f, line, 0.7, 0.0, 0.5);
     }
     cairo_restore(cr);
 }

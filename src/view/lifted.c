@@ -106,6 +106,8 @@ void pdt_draw_lifted(ctx *c)
     const pdt_rtri *Tr = pdt_replay_tris(c->r, &nt);
     const pdt_rtri_hist *Hh = pdt_replay_tri_hist(c->r);
     if (nt <= 20000) {
+        cairo_save(cr);
+        cairo_set_antialias(cr, CAIRO_ANTIALIAS_FAST); /* small faces: as good, much cheaper */
         for (int q = 0; q < c->nranks; q++) {
             if (!shown(c, (uint32_t)q)) continue;
             int any = 0;
@@ -130,6 +132,7 @@ void pdt_draw_lifted(ctx *c)
             cairo_set_line_width(cr, 0.8);
             cairo_stroke(cr);
         }
+        cairo_restore(cr);
     }
     /* the points: lifted ones on the paraboloid (rank colour of their box),
      * others faint on the floor; those below the plane in red */

@@ -385,6 +385,33 @@ void pdt_draw_stack_panel(ctx *c)
     cairo_restore(cr);
 }
 
+/* Is base row `key` one the layer of v->help_more takes over? */
+static int help_taken(const pdt_view *v, const char *key)
+{
+    static const char *const taken[] = {"1 … 9", "0", "click", "drag"};
+    if (!v->help_more) return 0;
+    for (size_t i = 0; i < sizeof taken / sizeof *taken; i++)
+        if (!strcmp(key, taken[i])) return 1;
+    return 0;
+}
+
+/* One column of key rows at (x, y0): title, then {keys, text} rows; kw is
+ * the keys' width. */
+static void help_column(cairo_t *cr, double f, double x, double y0, double kw, const char *title,
+                        const char *sub, const char *const (*rows)[2], int n, const pdt_view *v)
+{
+    text_at(cr, SANS, 1, 1.2 * f, x, y0 + 1.7 * f, title);
+    if (sub) text_at(cr, SANS, 0, 0.85 * f, x + text_wb(cr, SANS, 1, 1.2 * f, title) + f, y0 + 1.7 * f, sub);
+    int i = 0;
+    for (int r = 0; r < n; r++) {
+        if (help_taken(v, rows[r][0]) && rows != v->help_more) continue;
+        double y = y0 + (i + 2.4) * 1.45 * f + 0.4 * f;
+        text_at(cr, MONO, 1, 0.9 * f, x, y, rows[r][0]);
+        text_at(cr, SANS, 0, 0.9 * f, x + kw + 1.5 * f, y, rows[r][1]);
+        i++;
+    }
+}
+
 void pdt_draw_help(ctx *c, double w, double h)
 {
     static const char *const keys[][2] = {
@@ -414,14 +441,27 @@ void pdt_draw_help(ctx *c, double w, double h)
         {"m  r", "mark an event; record mark → current as GIF/video"},
         {"Esc  q", "quit"},
     };
-    int nk = (int)(sizeof keys / sizeof *keys);
+    const pdt_view *v = c->v;
+    int nk = (int)(sizeof keys / sizeof *keys), shown = 0;
+    int nm = v->help_more ? v->help_nmore : 0;
+    for (int i = 0; i < nk; i++) shown += !help_taken(v, keys[i][0]);
+    int rows = shown > nm ? shown : nm;
     cairo_t *cr = c->cr;
-    double f = fmin(c->L.font * 1.05, 0.96 * h / ((nk + 2.6) * 1.45)), kw = 0, dw = 0;
+    /* measured at size 1, then the largest size that fits both ways */
+    double kw = 0, dw = 0, kw2 = 0, dw2 = 0;
     for (int i = 0; i < nk; i++) {
-        kw = fmax(kw, text_wb(cr, MONO, 1, 0.9 * f, keys[i][0]));
-        dw = fmax(dw, text_w(cr, SANS, 0.9 * f, keys[i][1]));
+        if (help_taken(v, keys[i][0])) continue;
+        kw = fmax(kw, text_wb(cr, MONO, 1, 0.9, keys[i][0]));
+        dw = fmax(dw, text_w(cr, SANS, 0.9, keys[i][1]));
     }
-    double bw = fmin(w * 0.96, kw + dw + 3.5 * f), bh = (nk + 2.6) * 1.45 * f;
+    for (int i = 0; i < nm; i++) {
+        kw2 = fmax(kw2, text_wb(cr, MONO, 1, 0.9, v->help_more[i][0]));
+        dw2 = fmax(dw2, text_w(cr, SANS, 0.9, v->help_more[i][1]));
+    }
+    double unit_w = kw + dw + 3.5 + (nm ? kw2 + dw2 + 3.5 : 0);
+    double f = fmin(c->L.font * 1.05, 0.96 * h / ((rows + 2.6) * 1.45));
+    f = fmin(f, 0.96 * w / unit_w);
+    double bw = unit_w * f, bh = (rows + 2.6) * 1.45 * f;
     double bx = (w - bw) / 2, by = (h - bh) / 2;
     cairo_rectangle(cr, 0, 0, w, h);
     cairo_set_source_rgba(cr, 0, 0, 0, 0.35);
@@ -432,13 +472,16 @@ void pdt_draw_help(ctx *c, double w, double h)
     rgb(cr, c->T->ink, 1);
     cairo_set_line_width(cr, 2);
     cairo_stroke(cr);
-    text_at(cr, SANS, 1, 1.2 * f, bx + f, by + 1.7 * f, "Keys");
     char sel[96];
-    snprintf(sel, sizeof sel, "(selected kind: %s)", pdt_ev_class_name(c->v->ev_class));
-    text_at(cr, SANS, 0, 0.85 * f, bx + 5 * f, by + 1.7 * f, sel);
-    for (int i = 0; i < nk; i++) {
-        double y = by + (i + 2.4) * 1.45 * f + 0.4 * f;
-        text_at(cr, MONO, 1, 0.9 * f, bx + f, y, keys[i][0]);
-        text_at(cr, SANS, 0, 0.9 * f, bx + kw + 2.5 * f, y, keys[i][1]);
+    snprintf(sel, sizeof sel, "(selected kind: %s)", pdt_ev_class_name(v->ev_class));
+    help_column(cr, f, bx + f, by, kw * f, "Keys", sel, keys, nk, v);
+    if (nm) {
+        double x2 = bx + (kw + dw + 3.5) * f;
+        cairo_move_to(cr, x2 - 0.75 * f, by + 0.6 * f);
+        cairo_line_to(cr, x2 - 0.75 * f, by + bh - 0.6 * f);
+        cairo_set_line_width(cr, 1);
+        cairo_stroke(cr);
+        help_column(cr, f, x2 + 0.25 * f, by, kw2 * f, v->help_more_title ? v->help_more_title : "More",
+                    NULL, v->help_more, nm, v);
     }
 }

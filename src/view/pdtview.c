@@ -677,6 +677,14 @@ static int edit(const opts *o)
     pdt_view v;
     pdt_view_defaults(&v);
     v.panels = o->panels;
+    v.font_scale = o->font_scale;
+    v.theme = o->theme;
+    v.clean = o->clean;
+    v.circles = o->circles;
+    v.voronoi = o->voronoi;
+    v.help_more = pdt_editor_keys;
+    v.help_nmore = pdt_editor_nkeys;
+    v.help_more_title = "Editor";
     char title[512];
     snprintf(title, sizeof title, "editing %s", o->edit);
     pdt_shell_opts so = {o->w, o->h, title, o->script, o->screenshot, o->speed,
