@@ -738,11 +738,17 @@ static int bench_live(const opts *o)
     }
     double worst = 0;
     for (int i = 0; i < NCLICK; i++) worst = t[i] > worst ? t[i] : worst;
+    double load = -1;
+    FILE *la = fopen("/proc/loadavg", "r");
+    if (la) {
+        if (fscanf(la, "%lf", &load) != 1) load = -1;
+        fclose(la);
+    }
     printf("live edit, %llu points, %s, %d rank%s, frame %dx%d: click to redrawn frame median %.2f ms "
            "wall (%.2f ms CPU), worst %.2f ms; of which save + re-run + index + seek median %.2f ms "
-           "(%d changes)\n", (unsigned long long)o->bench_live, o->hull ? "hull" : "triangulate",
+           "(%d changes; load %.1f)\n", (unsigned long long)o->bench_live, o->hull ? "hull" : "triangulate",
            o->ranks, o->ranks > 1 ? "s" : "", o->w, o->h, 1e3 * median(t, NCLICK),
-           1e3 * median(tc, NCLICK), 1e3 * worst, 1e3 * median(tr, NCLICK), NCLICK);
+           1e3 * median(tc, NCLICK), 1e3 * worst, 1e3 * median(tr, NCLICK), NCLICK, load);
     rc = 0;
 out:
     if (rc) fprintf(stderr, "pdtview: %s\n", err.msg);
