@@ -9,7 +9,7 @@
  *  - triangulate, P > 1 ranks: the parallel pipeline of libpdtpar
  *    (pdt_par_triangulate) on P threads over the local communicator
  *    (pdt_comm_local_run), each rank with its block of the input as
- *    pdt_par_read deals it and the events `mpirun -np P pdt triangulate
+ *    pdt_par_read deals the file pdt_write_points writes for the points and the events `mpirun -np P pdt triangulate
  *    --trace` records at that rank (run, read, the triangulation, write);
  *    times are the shared monotonic clock, and the ranks are merged as the
  *    reader merges a run folder (a RECV never before its SEND, else by time);
@@ -33,6 +33,8 @@ typedef struct pdt_live_opts {
     int hull;     /* 1: Graham's scan only (pdt hull) */
     int ranks;    /* simulated ranks (1 = the sequential pipeline) */
     int level;    /* trace level, 1 or 2 */
+    int node;     /* the points' file is Triangle's .node: its line lengths decide
+                   * the ranks' blocks, as pdt_par_read deals them (0: "x y" text) */
 } pdt_live_opts;
 
 typedef struct pdt_live_result {

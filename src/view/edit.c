@@ -193,6 +193,8 @@ pdt_status pdt_editor_open(const char *path, const pdt_live_opts *o, pdt_editor 
     if (!ed) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     ed->path = strdup(path);
     ed->mode = *o;
+    size_t len = strlen(path);
+    ed->mode.node = len >= 5 && !strcmp(path + len - 5, ".node"); /* the ranks' blocks follow the file */
     ed->drag = -1;
     ed->rng = 0x9E3779B97F4A7C15ull;
     pdt_status st = ed->path ? PDT_OK : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");

@@ -9,6 +9,7 @@
 
 #include "pdt/delaunay.h"
 #include "pdt/hull.h"
+#include "pdt/io.h"
 #include "pdt/par.h"
 #include "pdt/predicates.h"
 #include "pdt/trace.h"
@@ -79,7 +80,27 @@ typedef struct par_job {
     size_t n;
     int level;
     rank_rec *rk;         /* one per rank */
+    uint64_t *first;      /* P + 1: rank q's block is points first[q] .. first[q+1] - 1 */
 } par_job;
+
+/* The blocks pdt_par_read deals from the file pdt_write_points writes for
+ * these points (text "x y" lines, or .node): rank q gets the point lines
+ * that start in [size q / P, size (q + 1) / P) of the file. */
+static void file_blocks(const pdt_point *pts, size_t n, int p, int node, uint64_t *first)
+{
+    char hdr[256];
+    uint64_t head = node ? pdt_format_node_header(hdr, n) : 0, at = head;
+    pdt_lines kind = node ? PDT_LINES_NODE : PDT_LINES_XY;
+    uint64_t size = head + pdt_lines_bytes(kind, pts, n, 0);
+    size_t k = 0; /* point k's line starts at byte `at` */
+    first[0] = 0;
+    for (int q = 1; q < p; q++) {
+        unsigned __int128 bound = (unsigned __int128)size * (unsigned)q / (unsigned)p;
+        for (; k < n && at < bound; k++) at += pdt_lines_bytes(kind, &pts[k], 1, k);
+        first[q] = k;
+    }
+    first[p] = n;
+}
 
 static uint64_t mono_ns(void)
 {
@@ -118,7 +139,8 @@ static pdt_status live_rank(pdt_comm *c, void *arg, pdt_err *err)
     pdt_trace tr = {J->level, r, NULL, stamp_sink, R};
     PDT_TRACE(&tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_RUN, 0, 0, 0, 0);
     PDT_TRACE(&tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_READ, 0, 0, 0, 0);
-    uint64_t n = J->n, lo = n * (uint64_t)r / (uint64_t)p, hi = n * (uint64_t)(r + 1) / (uint64_t)p;
+    (void)p;
+    uint64_t n = J->n, lo = J->first[r], hi = J->first[r + 1];
     pdt_par_input in = {malloc((size_t)(hi - lo) * sizeof(pdt_point) + 1), (size_t)(hi - lo), lo,
                         n, 0};
     pdt_status st = in.pts ? PDT_OK : pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: out of memory", r);
@@ -208,7 +230,13 @@ static pdt_status run_ranks(const pdt_point *pts, size_t n, const pdt_live_opts 
     if (!rk) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     uint64_t t0 = mono_ns();
     for (int q = 0; q < p; q++) rk[q].t0 = t0;
-    par_job J = {pts, n, o->level == 2 ? 2 : 1, rk};
+    uint64_t *first = malloc((size_t)(p + 1) * sizeof *first);
+    if (!first) {
+        free(rk);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    }
+    file_blocks(pts, n, p, o->node, first);
+    par_job J = {pts, n, o->level == 2 ? 2 : 1, rk, first};
     pdt_status st = pdt_comm_local_run(p, live_rank, &J, err);
     if (st == PDT_OK) st = merge_ranks(rk, p, res, err);
     if (st == PDT_OK) st = gather_tris(rk, p, res, err);
@@ -218,6 +246,7 @@ static pdt_status run_ranks(const pdt_point *pts, size_t n, const pdt_live_opts 
         pdt_par_output_free(&rk[q].out);
     }
     free(rk);
+    free(first);
     return st;
 }
 

@@ -652,7 +652,7 @@ static int write_run(const char *dir, const loaded *L, const char *command, int 
 /* --edit FILE: the editor's replay in the window, re-run after every change. */
 static int edit(const opts *o)
 {
-    pdt_live_opts lo = {o->hull, o->ranks ? o->ranks : 1, 1};
+    pdt_live_opts lo = {o->hull, o->ranks ? o->ranks : 1, 1, 0};
     pdt_editor *ed;
     pdt_err err = {0};
     if (pdt_editor_open(o->edit, &lo, &ed, &err) != PDT_OK) {
@@ -705,7 +705,7 @@ static int bench_live(const opts *o)
         return 1;
     }
     snprintf(path, sizeof path, "%s/points.txt", dir);
-    pdt_live_opts lo = {o->hull, o->ranks, 1};
+    pdt_live_opts lo = {o->hull, o->ranks, 1, 0};
     pdt_editor *ed = NULL;
     pdt_err err = {0};
     enum { NCLICK = 101 };

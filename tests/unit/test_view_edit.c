@@ -48,7 +48,7 @@ static size_t finals_at_end(pdt_editor *ed)
 
 TEST(add_move_delete_saved_and_rerun)
 {
-    pdt_live_opts lo = {0, 1, 1};
+    pdt_live_opts lo = {0, 1, 1, 0};
     pdt_editor *ed;
     pdt_err err = {0};
     char *f = strdup(path("a.txt"));
@@ -96,7 +96,7 @@ TEST(add_move_delete_saved_and_rerun)
 
 TEST(hull_mode_and_presets)
 {
-    pdt_live_opts lo = {1, 1, 1};
+    pdt_live_opts lo = {1, 1, 1, 0};
     pdt_editor *ed;
     pdt_err err = {0};
     char *f = strdup(path("b.txt"));
@@ -141,7 +141,7 @@ TEST(unparsable_file_is_never_written)
     FILE *fp = fopen(f, "w");
     fputs("0 0\n1 2\n3 4294967296\n", fp);
     fclose(fp);
-    pdt_live_opts lo = {0, 1, 1};
+    pdt_live_opts lo = {0, 1, 1, 0};
     pdt_editor *ed = NULL;
     pdt_err err = {0};
     CHECK(pdt_editor_open(f, &lo, &ed, &err) != PDT_OK && ed == NULL);
@@ -201,11 +201,11 @@ TEST(simulated_ranks_give_the_same_triangles)
         pdt_err err = {0};
         size_t n = 150;
         CHECK(pdt_gen(kinds[i], n, 7, &pts, &err) == PDT_OK);
-        pdt_live_opts one = {0, 1, 1};
+        pdt_live_opts one = {0, 1, 1, 0};
         pdt_live_result r1;
         CHECK(pdt_live_run(pts, n, &one, &r1, &err) == PDT_OK);
         for (int p = 2; p <= 8; p++) {
-            pdt_live_opts lo = {0, p, 1};
+            pdt_live_opts lo = {0, p, 1, 0};
             pdt_live_result rp;
             pdt_status st = pdt_live_run(pts, n, &lo, &rp, &err);
             CHECK_MSG(st == PDT_OK, "%s on %d ranks: %s", kinds[i], p, err.msg);
@@ -227,7 +227,7 @@ TEST(simulated_ranks_give_the_same_triangles)
     /* fewer points than ranks, and none at all */
     pdt_point few[3] = {{0, 0}, {5, 0}, {0, 5}};
     for (size_t n = 0; n <= 3; n++) {
-        pdt_live_opts lo = {0, 6, 1};
+        pdt_live_opts lo = {0, 6, 1, 0};
         pdt_live_result rp;
         pdt_err err = {0};
         CHECK_MSG(pdt_live_run(few, n, &lo, &rp, &err) == PDT_OK, "%zu points: %s", n, err.msg);
