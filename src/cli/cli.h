@@ -61,6 +61,10 @@ int pdt_cli_parse(const char *cmd, const char *help, int argc, char **argv,
 
 /* Print "pdt CMD: MESSAGE\n(see: pdt CMD --help)" to stderr (CMD a program
  * name starting with "pdt": without the "pdt ") and return PDT_EXIT_USAGE. */
+/* A byte count: digits with an optional K, M or G (powers of 1024), an
+ * optional B ("512M", "1G", "64KB").  Returns 0 and sets *out, or -1 if `s` is
+ * not one (or is 0).  Used by --mem of pdtview and of pdt trace check. */
+int pdt_cli_bytes(const char *s, uint64_t *out);
 int pdt_cli_usage(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /* Print "pdt: " + the error's message to stderr; return the exit status for

@@ -272,33 +272,15 @@ static int cmd_dump(int argc, char **argv)
 
 /* ---- check ------------------------------------------------------------------ */
 
-/* A byte count: digits with an optional K, M or G (powers of 1024).
- * Returns 0, or -1 if `s` is not one (or is 0). */
-static int parse_bytes(const char *s, uint64_t *out)
-{
-    char *end;
-    errno = 0;
-    unsigned long long v = strtoull(s, &end, 10);
-    if (end == s || errno || *s == '-') return -1;
-    unsigned shift = 0;
-    if (*end == 'K' || *end == 'k') shift = 10;
-    else if (*end == 'M' || *end == 'm') shift = 20;
-    else if (*end == 'G' || *end == 'g') shift = 30;
-    if (shift) end++;
-    if (*end == 'B' || *end == 'b') end++;
-    if (*end || v == 0 || v > (UINT64_MAX >> shift)) return -1;
-    *out = (uint64_t)v << shift;
-    return 0;
-}
 
 /* The memory budget: --mem, else $PDT_TRACE_MEM, else the default. */
 static int trace_budget(const char *cmd, const char *opt, uint64_t *budget)
 {
     const char *env = getenv("PDT_TRACE_MEM");
     *budget = PDT_TRACE_MEM_DEFAULT;
-    if (opt && parse_bytes(opt, budget))
+    if (opt && pdt_cli_bytes(opt, budget))
         return pdt_cli_usage(cmd, "--mem %s: not a byte count (e.g. 4096, 64M, 1G)", opt);
-    if (!opt && env && *env && parse_bytes(env, budget))
+    if (!opt && env && *env && pdt_cli_bytes(env, budget))
         return pdt_cli_usage(cmd, "PDT_TRACE_MEM=%s: not a byte count (e.g. 4096, 64M, 1G)", env);
     return PDT_EXIT_OK;
 }

@@ -101,24 +101,6 @@ static int parse_size(const char *s, int *w, int *h)
     return 1;
 }
 
-/* A byte count: digits with an optional K, M or G (powers of 1024).
- * Returns 0, or -1 if `s` is not one (or is 0). */
-static int parse_bytes(const char *s, uint64_t *out)
-{
-    char *end;
-    errno = 0;
-    unsigned long long v = strtoull(s, &end, 10);
-    if (end == s || errno || *s == '-') return -1;
-    unsigned shift = 0;
-    if (*end == 'K' || *end == 'k') shift = 10;
-    else if (*end == 'M' || *end == 'm') shift = 20;
-    else if (*end == 'G' || *end == 'g') shift = 30;
-    if (shift) end++;
-    if (*end == 'B' || *end == 'b') end++;
-    if (*end || v == 0 || v > (UINT64_MAX >> shift)) return -1;
-    *out = (uint64_t)v << shift;
-    return 0;
-}
 
 /* "R,R,..": rank numbers separated by commas. */
 static int valid_rank_list(const char *s)
@@ -242,9 +224,9 @@ static int parse_args(int argc, char **argv, opts *o)
         return pdt_cli_usage(PROG, "--theme needs light, dark or contrast, not '%s'", theme);
     const char *env = getenv("PDTVIEW_MEM");
     o->mem = PDT_VIEW_MEM_DEFAULT;
-    if (mem && parse_bytes(mem, &o->mem))
+    if (mem && pdt_cli_bytes(mem, &o->mem))
         return pdt_cli_usage(PROG, "--mem %s: not a byte count (e.g. 4096, 64M, 1G)", mem);
-    if (!mem && env && *env && parse_bytes(env, &o->mem))
+    if (!mem && env && *env && pdt_cli_bytes(env, &o->mem))
         return pdt_cli_usage(PROG, "PDTVIEW_MEM=%s: not a byte count (e.g. 4096, 64M, 1G)", env);
     o->index = -1;
     if (index && !strcmp(index, "on")) o->index = 1;
