@@ -136,8 +136,8 @@ static pdt_status partition(drv *d, const pdt_par_input *in, pdt_err *err)
     size_t *cnt = calloc((size_t)p, sizeof *cnt), *rcnt = calloc((size_t)p, sizeof *rcnt);
     uint64_t *samp = NULL, *all = NULL, *split = NULL, *sc = NULL, *rc = NULL;
     srm_rec *rec = NULL, *tmp = NULL, *got = NULL;
-    rec = malloc((mine_n + 1) * sizeof *rec);
-    tmp = malloc((mine_n + 1) * sizeof *tmp);
+    rec = srm_big((mine_n + 1) * sizeof *rec);
+    tmp = srm_big((mine_n + 1) * sizeof *tmp);
     if (!cnt || !rcnt || !rec || !tmp) goto nomem;
     for (size_t i = 0; i < mine_n; i++)
         rec[i] = (srm_rec){pdt_key(in->pts[i]), (uint32_t)(in->first + i), 0};
@@ -197,14 +197,14 @@ static pdt_status partition(drv *d, const pdt_par_input *in, pdt_err *err)
     }
     free(tmp); /* the grouping's scratch: not held through the exchange */
     tmp = NULL;
-    got = malloc((total + 1) * sizeof *got);
+    got = srm_big((total + 1) * sizeof *got);
     if (!got) goto nomem;
     st = pdt_comm_alltoallv(d->c, rec, cnt, got, rcnt, err);
     if (st != PDT_OK) goto done;
     note_v(d, TAG_RECORDS, cnt, rcnt);
     free(rec);
     rec = NULL;
-    tmp = malloc((total + 1) * sizeof *tmp);
+    tmp = srm_big((total + 1) * sizeof *tmp);
     if (!tmp) goto nomem;
     /* blocks arrive in rank order, each in index order, and rank q's indices
      * are all below rank q+1's, so a stable sort by key orders equal keys by
@@ -237,8 +237,8 @@ done:
 static pdt_status strips(drv *d, pdt_point **lp, uint32_t **lg, pdt_err *err)
 {
     size_t m = d->m;
-    *lp = malloc((m + 1) * sizeof **lp);
-    *lg = malloc((m + 1) * sizeof **lg);
+    *lp = srm_big((m + 1) * sizeof **lp);
+    *lg = srm_big((m + 1) * sizeof **lg);
     d->strip = malloc((size_t)d->p * sizeof *d->strip);
     if (!*lp || !*lg || !d->strip) return nomem(d, "partition");
     srm_strip mine = {m, 0, 0, 0, 0, 0, 0};
@@ -447,7 +447,7 @@ static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
         rcnt[q] = (size_t)rc[q] * sizeof(pdt_tri);
         total += (size_t)rc[q];
     }
-    got = malloc((total + 1) * sizeof *got);
+    got = srm_big((total + 1) * sizeof *got);
     if (!got) {
         st = nomem(d, "order");
         goto done;

