@@ -15,24 +15,7 @@
 #include "pdt/hull.h"
 #include "pdt/predicates.h"
 #include "pdt/tracefile.h"
-
-typedef struct u32vec {
-    uint32_t *v;
-    size_t n, cap;
-} u32vec;
-
-static int u32_push(u32vec *s, uint32_t x)
-{
-    if (s->n == s->cap) {
-        size_t cap = s->cap ? 2 * s->cap : 16;
-        uint32_t *v = realloc(s->v, cap * sizeof *v);
-        if (!v) return -1;
-        s->v = v;
-        s->cap = cap;
-    }
-    s->v[s->n++] = x;
-    return 0;
-}
+#include "tf_internal.h"
 
 typedef struct fin {   /* a TRI_FINAL, rotated to start at its smallest index */
     pdt_tri t;

@@ -134,27 +134,8 @@ static pdt_status time_span(ox *x)
     return PDT_OK;
 }
 
-/* A stack of the regions a rank is in (phases and merge steps nest). */
-typedef struct rstack {
-    uint32_t *v;
-    size_t n, cap;
-} rstack;
-
-static int rs_push(rstack *s, uint32_t r)
-{
-    if (s->n == s->cap) {
-        size_t cap = s->cap ? 2 * s->cap : 16;
-        uint32_t *v = realloc(s->v, cap * sizeof *v);
-        if (!v) return -1;
-        s->v = v;
-        s->cap = cap;
-    }
-    s->v[s->n++] = r;
-    return 0;
-}
-
 /* One event of rank r into its event writer (unmapped kinds: nothing). */
-static pdt_status put_event(ox *x, OTF2_EvtWriter *w, rstack *open, const pdt_event *e,
+static pdt_status put_event(ox *x, OTF2_EvtWriter *w, u32vec *open, const pdt_event *e,
                             uint64_t t)
 {
     uint32_t p = (uint32_t)pdt_run_nranks(x->run);
@@ -162,7 +143,7 @@ static pdt_status put_event(ox *x, OTF2_EvtWriter *w, rstack *open, const pdt_ev
     case PDT_EV_PHASE_BEGIN:
     case PDT_EV_MERGE_BEGIN: {
         uint32_t reg = region_of(x, e);
-        if (rs_push(open, reg)) return pdt_err_set(x->err, PDT_ERR_NOMEM, "out of memory");
+        if (u32_push(open, reg)) return pdt_err_set(x->err, PDT_ERR_NOMEM, "out of memory");
         x->counts.enters++;
         return ck(x, OTF2_EvtWriter_Enter(w, NULL, t, reg), "enter record");
     }
@@ -204,7 +185,7 @@ static pdt_status put_rank(ox *x, int r)
     if (!w) return pdt_err_set(x->err, PDT_ERR_IO, "OTF2: no event writer for rank %d", r);
     pdt_cursor *c;
     pdt_status st = pdt_cursor_open(x->run, r, &c, x->err);
-    rstack open = {0};
+    u32vec open = {0}; /* the regions a rank is in: phases and merge steps nest */
     uint64_t last = x->t0;
     pdt_event e;
     while (st == PDT_OK && pdt_cursor_next(c, &e, NULL)) {

@@ -3,6 +3,7 @@
 #ifndef PDT_TF_INTERNAL_H
 #define PDT_TF_INTERNAL_H
 
+#include <stdlib.h>
 #include <string.h>
 
 #include "pdt/tracefile.h"
@@ -74,5 +75,26 @@ pdt_status pdt_tf_manifest_parse(const char *path, char *text, pdt_manifest *m, 
 /* Verify points.bin (len bytes at p) and decode it.  *pts malloc'd. */
 pdt_status pdt_tf_points_parse(const char *path, const uint8_t *p, size_t len, pdt_point **pts,
                                size_t *n, pdt_err *err);
+
+/* A growable array of 32-bit values (the check's index lists, the OTF2
+ * export's stack of open regions).  Zero-initialise; free(v) when done. */
+typedef struct u32vec {
+    uint32_t *v;
+    size_t n, cap;
+} u32vec;
+
+/* Append x; 0, or -1 when out of memory (the vector is unchanged). */
+static inline int u32_push(u32vec *s, uint32_t x)
+{
+    if (s->n == s->cap) {
+        size_t cap = s->cap ? 2 * s->cap : 16;
+        uint32_t *v = realloc(s->v, cap * sizeof *v);
+        if (!v) return -1;
+        s->v = v;
+        s->cap = cap;
+    }
+    s->v[s->n++] = x;
+    return 0;
+}
 
 #endif
