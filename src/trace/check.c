@@ -46,6 +46,7 @@ typedef struct chk {
     fin *fin;               /* final triangles not yet spilled (see spill_finals) */
     size_t nfin, capfin;
     size_t maxfin;          /* finals held in memory before a spill (from the budget) */
+    uint64_t budget;        /* the memory budget (bytes) */
     FILE **runs;            /* sorted runs of finals spilled to temporary files */
     size_t nruns, capruns;
     uint64_t totfin;        /* final triangles recorded in all */
@@ -264,6 +265,11 @@ static int cmp_fin(const void *a, const void *b)
  * more than MAX_RUNS runs pile up they are first merged into one, so the
  * number of open files stays bounded too. */
 #define MAX_RUNS 64
+/* What recomputing T* takes per point (the kernel's arrays and the reference
+ * triangles; measured: some 90 bytes per point at 2*10^6 points).  When the
+ * finals still in memory and this do not fit the budget together, the
+ * finals go to disk before T* is recomputed. */
+#define TSTAR_BYTES_PER_POINT 96u
 
 /* A sorted source of finals: a temporary file or the memory buffer. */
 typedef struct fin_src {
@@ -640,7 +646,9 @@ static pdt_status check_rank(chk *c, uint32_t r)
  * after the buffer has been given back (the kernel needs its memory). */
 static pdt_status check_finals(chk *c)
 {
-    if (c->nruns) {  /* out of memory's reach: the rest goes to disk too */
+    uint64_t held = (uint64_t)c->capfin * sizeof *c->fin;  /* the buffer as allocated */
+    if (c->nruns || held + (uint64_t)c->npts * TSTAR_BYTES_PER_POINT > c->budget) {
+        /* out of memory's reach (or T* needs the room): the rest goes to disk too */
         pdt_status st = spill_finals(c);
         if (st != PDT_OK) return st;
         free(c->fin);
@@ -782,6 +790,7 @@ pdt_status pdt_run_check_mem(pdt_run *run, uint64_t budget, char *summary, size_
     c.run = run;
     c.err = err;
     c.pts = pdt_run_points(run, &c.npts);
+    c.budget = budget;
     /* half the budget for the finals' buffer; at least a few, so that a tiny
      * budget spills often instead of failing */
     c.maxfin = (size_t)(budget / 2 / sizeof(fin) < 16 ? 16 : budget / 2 / sizeof(fin));

@@ -13,6 +13,10 @@ out=$("$PDT" trace check "$TMP/run" 2>&1) && [[ "$out" == "ok: "*"= T*"* && "$ou
     ok check_in_memory || fail check_in_memory "$out"
 out=$("$PDT" trace check "$TMP/run" --mem 2K 2>&1) && [[ "$out" == *"= T*"*"sorted on disk in"* ]] &&
     ok check_tiny_mem_spills || fail check_tiny_mem_spills "$out"
+# 300K: the ~5000 finals fit the pass's buffer (half the budget), but not
+# beside what recomputing T* of 2500 points takes: they go to disk first
+out=$("$PDT" trace check "$TMP/run" --mem 300K 2>&1) && [[ "$out" == *"= T*"*"sorted on disk in 1 runs"* ]] &&
+    ok check_finals_leave_room_for_tstar || fail check_finals_leave_room_for_tstar "$out"
 out=$(PDT_TRACE_MEM=1K "$PDT" trace check "$TMP/run" 2>&1) && [[ "$out" == *"sorted on disk in"* ]] &&
     ok check_mem_from_environment || fail check_mem_from_environment "$out"
 TMPDIR=/nonexistent-dir "$PDT" trace check "$TMP/run" --mem 1K >"$TMP/o" 2>&1; rc=$?
