@@ -69,6 +69,15 @@ static int cmp_u64(const void *x, const void *y)
     return (a > b) - (a < b);
 }
 
+size_t pdt_unique_edges(uint64_t *e, size_t n)
+{
+    qsort(e, n, sizeof *e, cmp_u64);
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++)
+        if (!k || e[i] != e[k - 1]) e[k++] = e[i];
+    return k;
+}
+
 static void draw_triangles(ctx *c)
 {
     cairo_t *cr = c->cr;
@@ -170,10 +179,9 @@ static void draw_triangles(ctx *c)
                     edges[ne++] = a < e ? (uint64_t)a << 32 | e : (uint64_t)e << 32 | a;
                 }
             }
-            qsort(edges, ne, sizeof *edges, cmp_u64);
+            ne = pdt_unique_edges(edges, ne);
             size_t seg = 0;
             for (size_t i = 0; i < ne; i++) {
-                if (i && edges[i] == edges[i - 1]) continue;
                 double x0, y0, x1, y1;
                 wpt(c, (uint32_t)(edges[i] >> 32), &x0, &y0);
                 wpt(c, (uint32_t)edges[i], &x1, &y1);

@@ -16,6 +16,13 @@ static void lift_xy(const proj *J, double u, double w, double z, double *sx, dou
     *sy = J->oy - J->s * (z * J->cp + Y * J->sp);
 }
 
+/* A point lifted onto the paraboloid, on the screen. */
+static void lift_pt(const proj *J, const pdt_point *p, double *sx, double *sy)
+{
+    double u = (p->x - J->cx) / J->sc, w = (p->y - J->cy) / J->sc;
+    lift_xy(J, u, w, u * u + w * w, sx, sy);
+}
+
 void pdt_draw_lifted(ctx *c)
 {
     cairo_t *cr = c->cr;
@@ -108,31 +115,45 @@ void pdt_draw_lifted(ctx *c)
     size_t nt;
     const pdt_rtri *Tr = pdt_replay_tris(c->r, &nt);
     const pdt_rtri_hist *Hh = pdt_replay_tri_hist(c->r);
-    if (nt <= 20000) {
+    uint64_t *edges = nt <= 20000 ? malloc((3 * nt + 1) * sizeof *edges) : NULL;
+    if (edges) {
+        /* faces filled as one path per rank; their edges stroked once each
+         * as separate segments (no joins): a fraction of the cost of
+         * stroking the closed triangles */
+        cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
         for (int q = 0; q < c->nranks; q++) {
             if (!shown(c, (uint32_t)q)) continue;
-            int any = 0;
+            size_t ne = 0;
             for (size_t t = 0; t < nt; t++) {
                 uint32_t h = pdt_rstate_tri_entry(c->r, c->s, t);
                 if (Tr[t].maker != (uint32_t)q || h == NONE32 || Hh[h].status == PDT_TS_DISCARDED) continue;
                 if (c->v->clean && Hh[h].status != PDT_TS_FINAL) continue;
                 for (int j = 0; j < 3; j++) {
-                    const pdt_point *pp = &c->P[Tr[t].v[j]];
-                    double u = (pp->x - J.cx) / J.sc, w = (pp->y - J.cy) / J.sc, sx, sy;
-                    lift_xy(&J, u, w, u * u + w * w, &sx, &sy);
+                    double sx, sy;
+                    lift_pt(&J, &c->P[Tr[t].v[j]], &sx, &sy);
                     if (j) cairo_line_to(cr, sx, sy);
                     else cairo_move_to(cr, sx, sy);
+                    uint32_t a = Tr[t].v[j], b = Tr[t].v[(j + 1) % 3];
+                    edges[ne++] = a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a;
                 }
                 cairo_close_path(cr);
-                any = 1;
             }
-            if (!any) continue;
+            if (!ne) continue;
             set_rank(cr, q, 0.22);
-            cairo_fill_preserve(cr);
+            cairo_fill(cr);
+            ne = pdt_unique_edges(edges, ne);
+            for (size_t i = 0; i < ne; i++) {
+                double x0, y0, x1, y1;
+                lift_pt(&J, &c->P[edges[i] >> 32], &x0, &y0);
+                lift_pt(&J, &c->P[(uint32_t)edges[i]], &x1, &y1);
+                cairo_move_to(cr, x0, y0);
+                cairo_line_to(cr, x1, y1);
+            }
             set_rank(cr, q, 0.7);
             cairo_set_line_width(cr, 0.8);
             cairo_stroke(cr);
         }
+        free(edges);
     }
     /* the points: lifted ones on the paraboloid (rank colour of their box),
      * others faint on the floor; those below the plane in red */

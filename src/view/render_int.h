@@ -82,6 +82,9 @@ typedef struct ctx {
 
 /* The parts of the frame, each clipped to its rectangle of c->L. */
 void pdt_draw_geometry(ctx *c);                 /* geometry.c */
+/* Sorts the packed edges e[0..n) (smaller vertex in the high half) and
+ * removes repeats; returns how many distinct edges stay in front. */
+size_t pdt_unique_edges(uint64_t *e, size_t n);
 /* Level of detail (render_lod.c): when the triangles in the geometry area are
  * too many to draw one by one, paint their coverage per cell instead and
  * return 1; else draw nothing and return 0. */
