@@ -23,6 +23,7 @@
 #include <fcntl.h>
 #include <limits.h>
 #include <pthread.h>
+#include <signal.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -571,11 +572,42 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, p
     return PDT_OK;
 }
 
+/* Remove the temporary files (path.tmpPID) that builds of processes no
+ * longer alive left beside path (a crash or a kill while building). */
+static void clean_stale_temps(const char *path)
+{
+    char dir[PATH_MAX];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    const char *base = slash ? slash + 1 : path;
+    if (slash) *slash = 0;
+    else snprintf(dir, sizeof dir, ".");
+    size_t blen = strlen(base);
+    DIR *d = opendir(dir);
+    if (!d) return;
+    struct dirent *de;
+    while ((de = readdir(d))) {
+        const char *nm = de->d_name;
+        if (strncmp(nm, base, blen) || strncmp(nm + blen, ".tmp", 4)) continue;
+        const char *digits = nm + blen + 4;
+        char *end;
+        errno = 0;
+        long pid = strtol(digits, &end, 10);
+        if (!*digits || *end || errno || pid <= 0 || pid == (long)getpid()) continue;
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;  /* alive, or not ours to judge */
+        char victim[PATH_MAX + 256];
+        snprintf(victim, sizeof victim, "%s/%s", dir, nm);
+        unlink(victim);
+    }
+    closedir(d);
+}
+
 /* Build the index of run at `path` (temporary file + rename). */
 static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks, uint64_t ident,
                         const char *path, pdt_err *err)
 {
     char tmp[PATH_MAX + 128];
+    clean_stale_temps(path);
     snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
     int fd = open(tmp, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd < 0) return pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));

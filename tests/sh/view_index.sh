@@ -37,6 +37,17 @@ done
 case "$("$V" "$R" --check --mem 1M)" in *"checkpoints every"*) ok checkpoints_made ;;
     *) fail checkpoints_made "no checkpoints under --mem 1M" ;; esac
 
+# a build that crashed left its temporary file: the next build removes it
+# (its process is gone), and leaves alone the one of a process still alive
+dead=$(sh -c 'echo $$')
+echo junk > "$IDX.tmp$dead"
+echo junk > "$IDX.tmp$$"
+mv "$IDX" "$TMP/idx.keep"
+"$V" "$R" --counts --end --mem 1M >/dev/null 2>&1
+if [ ! -e "$IDX.tmp$dead" ] && [ -e "$IDX.tmp$$" ] && [ -s "$IDX" ]; then ok stale_temp_removed
+else fail stale_temp_removed "$(ls -a "$R")"; fi
+rm -f "$IDX.tmp$$"
+
 # the second opening maps the kept index (same file, not rewritten)
 i1=$(inode "$IDX")
 "$V" "$R" --counts --end --mem 1M >/dev/null 2>"$TMP/e2"
