@@ -280,6 +280,16 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
  * Errors: the folder cannot be listed, out of memory. */
 pdt_status pdt_replay_open_kept(const char *dir, uint64_t budget, pdt_replay **out,
                                 pdt_replay_open_info *info, pdt_err *err);
+/* Verify kept indexes of at least min_bytes bytes lazily: at the opening
+ * only their header and chunk table; each 16 MiB chunk of the tables when a
+ * frame first reads it (its pages stay closed until then; a SIGSEGV handler
+ * opens them, chaining any handler installed before).  When a chunk does not
+ * match its checksum, the index file is removed and on_damage is called with
+ * a message naming it, from the signal handler: it may only make
+ * async-signal-safe calls (write, _exit) and must not return.  Without this
+ * call (or with on_damage NULL), every index is verified whole when opened. */
+void pdt_replay_lazy_verify(void (*on_damage)(const char *msg), uint64_t min_bytes);
+
 /* What the reader said about damage in the run when the kept index was
  * built ("" if nothing, or for a replay not opened from an index). */
 const char *pdt_replay_run_warnings(const pdt_replay *r);

@@ -173,23 +173,34 @@ static void *verify_worker(void *arg)
     return NULL;
 }
 
-/* 1 when every chunk of every section matches its checksum. */
-static int verify_chunks(int fd, const ihdr *h, char *why, size_t wcap)
+/* The chunk checksums of the index (its own checksum verified), malloc'd;
+ * NULL with a reason in why. */
+static uint32_t *read_ctab(int fd, const ihdr *h, char *why, size_t wcap)
 {
-    uint64_t first[NSEC + 1], n = 0;
-    for (int i = 0; i < NSEC; i++) first[i] = n, n += chunks_of(h->sec[i].bytes);
-    first[NSEC] = n;
+    uint64_t n = 0;
+    for (int i = 0; i < NSEC; i++) n += chunks_of(h->sec[i].bytes);
     if (h->ctab.bytes != n * sizeof(uint32_t)) {
         snprintf(why, wcap, "damaged: chunk table has the wrong size");
-        return 0;
+        return NULL;
     }
     uint32_t *tab = malloc(n ? n * sizeof *tab : 1);
     if (!tab || pread(fd, tab, (size_t)h->ctab.bytes, (off_t)h->ctab.off) != (ssize_t)h->ctab.bytes ||
         pdt_crc32c(0, tab, (size_t)h->ctab.bytes) != h->ctab.crc) {
         free(tab);
         snprintf(why, wcap, "damaged: chunk table checksum mismatch");
-        return 0;
+        return NULL;
     }
+    return tab;
+}
+
+/* 1 when every chunk of every section matches its checksum. */
+static int verify_chunks(int fd, const ihdr *h, char *why, size_t wcap)
+{
+    uint64_t first[NSEC + 1], n = 0;
+    for (int i = 0; i < NSEC; i++) first[i] = n, n += chunks_of(h->sec[i].bytes);
+    first[NSEC] = n;
+    uint32_t *tab = read_ctab(fd, h, why, wcap);
+    if (!tab) return 0;
     verify_job j = {fd, h, tab, n, first, 0, 0};
     long cpus = sysconf(_SC_NPROCESSORS_ONLN);
     int nt = cpus < 1 ? 1 : cpus > 4 ? 4 : (int)cpus, started = 0;
@@ -205,6 +216,214 @@ static int verify_chunks(int fd, const ihdr *h, char *why, size_t wcap)
         return 0;
     }
     return 1;
+}
+
+/* ---- verifying a big index lazily: each chunk when it is first read -------------
+ *
+ * Checksumming a whole index of gigabytes at every opening costs seconds; a
+ * frame reads a small part of it.  So a big index (pdt_replay_lazy_verify)
+ * is mapped with no access but its header page: the first read of a page
+ * faults, and the handler (SIGSEGV) checksums the chunks the page belongs
+ * to, through a second, readable mapping of the file, before it opens their
+ * pages to the replay.  Nothing of the index is used unverified.  A mismatch
+ * removes the index and calls the program's damage hook (which must not
+ * return: the replay cannot go on with a damaged table). */
+
+#define LAZY_MAX 8  /* indexes open at once with lazy verification */
+
+typedef struct lazy {
+    char *base;                  /* the replay's mapping */
+    const char *raw;             /* the same file, readable: what is checksummed */
+    size_t len;
+    uint64_t off[NSEC], bytes[NSEC], first[NSEC + 1];
+    uint32_t *tab;               /* the chunk checksums */
+    atomic_uchar *done;          /* per chunk: verified */
+    char path[PATH_MAX];
+    char msg[PATH_MAX + 256];
+} lazy;
+
+static _Atomic(lazy *) lazies[LAZY_MAX];
+static void (*damage_hook)(const char *msg);
+static uint64_t lazy_min_bytes = UINT64_MAX;
+static struct sigaction old_segv;
+static pthread_once_t segv_once = PTHREAD_ONCE_INIT;
+
+void pdt_replay_lazy_verify(void (*on_damage)(const char *msg), uint64_t min_bytes)
+{
+    damage_hook = on_damage;
+    lazy_min_bytes = on_damage ? min_bytes : UINT64_MAX;
+}
+
+/* The file range of chunk c. */
+static void lazy_chunk(const lazy *L, uint64_t c, uint64_t *lo, uint64_t *hi)
+{
+    int i = 0;
+    while (i + 1 < NSEC && L->first[i + 1] <= c) i++;
+    *lo = L->off[i] + (c - L->first[i]) * CHUNK_BYTES;
+    *hi = *lo + CHUNK_BYTES < L->off[i] + L->bytes[i] ? *lo + CHUNK_BYTES : L->off[i] + L->bytes[i];
+}
+
+/* Checksum chunk c (once).  0 on a mismatch. */
+static int lazy_verify(lazy *L, uint64_t c)
+{
+    if (atomic_load(&L->done[c])) return 1;
+    uint64_t lo, hi;
+    lazy_chunk(L, c, &lo, &hi);
+    uint32_t crc = pdt_crc32c(0, L->raw + lo, (size_t)(hi - lo));
+    /* the checksummed pages leave this process (they stay in the page cache) */
+    uint64_t a = (lo + 4095) & ~(uint64_t)4095, b = hi & ~(uint64_t)4095;
+    if (b > a) madvise((void *)(L->raw + a), (size_t)(b - a), MADV_DONTNEED);
+    if (crc != L->tab[c]) return 0;
+    atomic_store(&L->done[c], 1);
+    return 1;
+}
+
+/* Verify every chunk overlapping the file range [lo, hi).  0 on a mismatch. */
+static int lazy_verify_range(lazy *L, uint64_t lo, uint64_t hi)
+{
+    for (int i = 0; i < NSEC; i++) {
+        uint64_t s = L->off[i], e = L->off[i] + L->bytes[i];
+        if (!L->bytes[i] || e <= lo || s >= hi) continue;
+        uint64_t from = (lo > s ? lo : s) - s, to = (hi < e ? hi : e) - s;
+        for (uint64_t c = from / CHUNK_BYTES; c <= (to - 1) / CHUNK_BYTES; c++)
+            if (!lazy_verify(L, L->first[i] + c)) return 0;
+    }
+    return 1;
+}
+
+/* Open the page at file offset pos to the replay: the chunks on it are
+ * verified, then each of them is opened whole (and the chunks sharing its
+ * end pages verified first).  0 on a mismatch or when the pages cannot be
+ * opened. */
+static int lazy_open_page(lazy *L, uint64_t pos)
+{
+    uint64_t p = pos & ~(uint64_t)4095, pe = p + 4096 < L->len ? p + 4096 : L->len;
+    int any = 0;
+    for (int i = 0; i < NSEC; i++) {
+        uint64_t s = L->off[i], e = L->off[i] + L->bytes[i];
+        if (!L->bytes[i] || e <= p || s >= pe) continue;
+        uint64_t from = (p > s ? p : s) - s, to = (pe < e ? pe : e) - s;
+        for (uint64_t c = from / CHUNK_BYTES; c <= (to - 1) / CHUNK_BYTES; c++) {
+            uint64_t lo, hi;
+            lazy_chunk(L, L->first[i] + c, &lo, &hi);
+            uint64_t plo = lo & ~(uint64_t)4095, phi = (hi + 4095) & ~(uint64_t)4095;
+            if (phi > L->len) phi = L->len;
+            if (!lazy_verify(L, L->first[i] + c) || !lazy_verify_range(L, plo, lo) ||
+                !lazy_verify_range(L, hi, phi))
+                return 0;
+            if (mprotect(L->base + plo, (size_t)(phi - plo), PROT_READ) != 0) return -1;
+            any = 1;
+        }
+    }
+    if (!any && mprotect(L->base + p, (size_t)(pe - p), PROT_READ) != 0) return -1;  /* padding */
+    return 1;
+}
+
+/* Append src to dst (async-signal-safe). */
+static char *cat(char *dst, const char *end, const char *src)
+{
+    while (*src && dst < end) *dst++ = *src++;
+    return dst;
+}
+
+static void segv_handler(int sig, siginfo_t *si, void *uc)
+{
+    const char *a = si->si_addr;
+    for (int k = 0; k < LAZY_MAX; k++) {
+        lazy *L = atomic_load(&lazies[k]);
+        if (!L || a < L->base || a >= L->base + L->len) continue;
+        int ok = lazy_open_page(L, (uint64_t)(a - L->base));
+        if (ok == 1) return;
+        char *m = L->msg, *end = L->msg + sizeof L->msg - 1;
+        m = cat(m, end, "the kept index ");
+        m = cat(m, end, L->path);
+        m = cat(m, end, ok == 0 ? " is damaged (a checksum mismatch, found when a part of it was "
+                                  "first read); it was removed: open the run again to rebuild it"
+                                : " cannot be opened to the replay (mprotect failed)");
+        *m = 0;
+        if (ok == 0) unlink(L->path);
+        if (damage_hook) damage_hook(L->msg);
+        abort();
+    }
+    /* not ours: what was there before */
+    if ((old_segv.sa_flags & SA_SIGINFO) && old_segv.sa_sigaction) {
+        old_segv.sa_sigaction(sig, si, uc);
+    } else if (old_segv.sa_handler != SIG_DFL && old_segv.sa_handler != SIG_IGN) {
+        old_segv.sa_handler(sig);
+    } else {
+        signal(SIGSEGV, SIG_DFL);  /* the fault repeats and ends the process as usual */
+    }
+}
+
+static void segv_install(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_sigaction = segv_handler;
+    sa.sa_flags = SA_SIGINFO | SA_NODEFER;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGSEGV, &sa, &old_segv);
+}
+
+/* Make r's mapping (map, len, header h, chunk table tab) lazily verified:
+ * every page but the header's closed until read.  0 if it cannot be
+ * (then the caller verifies the whole index). */
+static lazy *lazy_start(char *map, size_t len, const ihdr *h, uint32_t *tab, int fd,
+                        const char *path)
+{
+    lazy *L = calloc(1, sizeof *L);
+    uint64_t n = 0;
+    for (int i = 0; i < NSEC; i++) L->first[i] = n, n += chunks_of(h->sec[i].bytes);
+    if (!L) return NULL;
+    L->first[NSEC] = n;
+    L->done = calloc(n ? n : 1, 1);
+    void *raw = mmap(NULL, len, PROT_READ, MAP_SHARED, fd, 0);
+    if (!L->done || raw == MAP_FAILED || strlen(path) >= sizeof L->path) {
+        if (raw != MAP_FAILED) munmap(raw, len);
+        free(L->done);
+        free(L);
+        return NULL;
+    }
+    L->base = map;
+    L->raw = raw;
+    L->len = len;
+    L->tab = tab;
+    for (int i = 0; i < NSEC; i++) L->off[i] = h->sec[i].off, L->bytes[i] = h->sec[i].bytes;
+    strcpy(L->path, path);
+    pthread_once(&segv_once, segv_install);
+    int slot = -1;
+    for (int k = 0; k < LAZY_MAX && slot < 0; k++) {
+        lazy *none = NULL;
+        if (atomic_compare_exchange_strong(&lazies[k], &none, L)) slot = k;
+    }
+    if (slot < 0 || mprotect(map + HDR_BYTES, len - HDR_BYTES, PROT_NONE) != 0) {
+        if (slot >= 0) atomic_store(&lazies[slot], NULL);
+        munmap(raw, len);
+        free(L->done);
+        free(L);
+        return NULL;
+    }
+    return L;
+}
+
+/* Forget a lazily verified mapping and unmap it. */
+static void lazy_stop(lazy *L)
+{
+    for (int k = 0; k < LAZY_MAX; k++)
+        if (atomic_load(&lazies[k]) == L) atomic_store(&lazies[k], NULL);
+    munmap((void *)L->raw, L->len);
+    munmap(L->base, L->len);
+    free(L->tab);
+    free(L->done);
+    free(L);
+}
+
+void pdt_index_unmap(pdt_replay *r)
+{
+    if (r->lazy) lazy_stop(r->lazy);
+    else munmap(r->map, r->map_len);
+    r->lazy = NULL;
+    r->map = NULL;
 }
 
 /* ---- the run's identity and the index's place ---------------------------------- */
@@ -318,7 +537,8 @@ static int index_path(const char *dir, int where, char *buf, size_t cap)
 
 /* Map the index at `path` onto a new replay over pts.  Returns NULL with a
  * reason in why when it is missing, stale or damaged.  verify: check every
- * section's checksum (reading the file through a small buffer). */
+ * section's checksum (reading the file through a small buffer), or, for an
+ * index of at least lazy_min_bytes, each chunk when it is first read. */
 static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, size_t n,
                         int verify, char *why, size_t wcap)
 {
@@ -333,6 +553,7 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
     layout_of(lay);
     pdt_replay *r = NULL;
     void *map = MAP_FAILED;
+    lazy *L = NULL;
     if (fstat(fd, &sb) != 0 || (uint64_t)sb.st_size < HDR_BYTES ||
         pread(fd, &h, sizeof h, 0) != (ssize_t)sizeof h) {
         snprintf(why, wcap, "damaged: shorter than its header");
@@ -371,11 +592,21 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
         snprintf(why, wcap, "damaged: chunk table outside the file");
         goto fail;
     }
-    if (verify && !verify_chunks(fd, &h, why, wcap)) goto fail;
+    int lazily = verify && h.file_bytes >= lazy_min_bytes;
+    if (verify && !lazily && !verify_chunks(fd, &h, why, wcap)) goto fail;
     map = mmap(NULL, h.file_bytes, PROT_READ, MAP_SHARED, fd, 0);
     if (map == MAP_FAILED) {
         snprintf(why, wcap, "cannot map it: %s", strerror(errno));
         goto fail;
+    }
+    if (lazily) { /* only the chunk table now; each chunk when first read */
+        uint32_t *tab = read_ctab(fd, &h, why, wcap);
+        if (!tab) goto fail;
+        L = lazy_start(map, h.file_bytes, &h, tab, fd, path);
+        if (!L) {
+            free(tab);
+            if (!verify_chunks(fd, &h, why, wcap)) goto fail;
+        }
     }
     r = calloc(1, sizeof *r);
     if (!r) {
@@ -430,10 +661,12 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
     if (pts) r->pts = pts;  /* the run's own copy (the same points) */
     r->map = map;
     r->map_len = h.file_bytes;
+    r->lazy = L;
     close(fd);
     return r;
 fail:
-    if (map != MAP_FAILED) munmap(map, h.file_bytes);
+    if (L) lazy_stop(L);
+    else if (map != MAP_FAILED) munmap(map, h.file_bytes);
     close(fd);
     return NULL;
 }

@@ -758,6 +758,20 @@ out:
     return rc;
 }
 
+/* A kept index found damaged while it is read (pdt_replay_lazy_verify): say
+ * so and stop.  Called from a signal handler: write and _exit only. */
+static void index_damaged(const char *msg)
+{
+    static const char pre[] = "pdtview: ";
+    if (write(2, pre, sizeof pre - 1) < 0 || write(2, msg, strlen(msg)) < 0 || write(2, "\n", 1) < 0)
+        _exit(1);
+    _exit(1);
+}
+
+/* Kept indexes from this size on are verified chunk by chunk as they are
+ * read ($PDTVIEW_VERIFY=lazy: all of them; =eager: none, whole at opening). */
+#define LAZY_VERIFY_MIN ((uint64_t)64 << 20)
+
 int main(int argc, char **argv)
 {
     opts o;
@@ -765,6 +779,9 @@ int main(int argc, char **argv)
     if (prc >= 0) return prc;
     if (o.bench_live) return bench_live(&o);
     if (o.edit) return edit(&o);
+    const char *verify = getenv("PDTVIEW_VERIFY");
+    if (!verify || strcmp(verify, "eager"))
+        pdt_replay_lazy_verify(index_damaged, verify && !strcmp(verify, "lazy") ? 0 : LAZY_VERIFY_MIN);
     pdt_err err = {0};
     loaded L;
     pdt_replay *r = NULL;

@@ -1,6 +1,7 @@
 /* pdt — the replay model: index the events once, then answer "state at k". */
 #include "pdt/replay.h"
 #include "replay_int.h"
+#include "../geom/bigmem.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -564,7 +565,7 @@ void pdt_replay_free(pdt_replay *r)
     for (size_t c = 0; c < r->nck; c++) pdt_rstate_free(r->ck[c]);
     free(r->ck);
     if (r->map) { /* the tables live in the kept index's mapping */
-        munmap(r->map, r->map_len);
+        pdt_index_unmap(r);
         free(r);
         return;
     }
@@ -669,6 +670,11 @@ pdt_rstate *pdt_rstate_new(const pdt_replay *r)
         pdt_rstate_free(s);
         return NULL;
     }
+    /* a state of a huge run is 10^8 bytes, filled at once: huge pages spare
+     * most of the page faults (costly on virtual machines) */
+    pdt_big_advise(s->pflags, r->n);
+    pdt_big_advise(s->tcur, r->ntri * sizeof *s->tcur);
+    pdt_big_advise(s->ealive, r->nedge);
     pdt_replay_seek_direct(r, s, 0);
     return s;
 }

@@ -53,6 +53,7 @@ struct pdt_replay {
      * instead of freeing the tables. */
     void *map;
     size_t map_len;
+    struct lazy *lazy;     /* the map is verified chunk by chunk as it is read (index.c) */
     const char *warnings;  /* the reader's warnings about the run (kept index), or NULL */
 
     /* Checkpoints: a copy of the state at every `ck_every`-th cursor, made on
@@ -72,5 +73,7 @@ size_t pdt_rstate_blob_bytes(const pdt_replay *r);
 void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, uint8_t *out);
 void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in, size_t k);
 
+/* Unmap a replay's kept index (index.c). */
+void pdt_index_unmap(pdt_replay *r);
 
 #endif
