@@ -126,77 +126,124 @@ void pdt_par_output_free(pdt_par_output *out)
 
 /* ---- partition -------------------------------------------------------------- */
 
-/* Sample sort of this rank's input block by key: d->rec[0..d->m) are the
- * distinct records of this rank's strip, key-sorted. */
-static pdt_status partition(drv *d, const pdt_par_input *in, pdt_err *err)
+/* The p - 1 splitters, exact: split[q-1] is the key of rank q * N / p
+ * (0-based, N records in all, every rank's sorted rec[0..n) together), so
+ * that the keys below it number q N / p but for copies of that key, which
+ * all go with it (a key goes to the rank of the number of splitters <= it).
+ * A distributed search: each round cuts every splitter's key interval into
+ * SEL_WAYS parts, counts the keys up to each cut (binary searches), sums the
+ * counts over the ranks (one allreduce) and keeps the part holding the
+ * splitter; 64-bit keys take at most 8 rounds. */
+enum { SEL_WAYS = 256 };
+
+static uint64_t sel_cut(uint64_t lo, uint64_t hi, uint64_t step, int j)
+{
+    uint64_t off = (uint64_t)(j + 1) * step - 1;
+    return off >= hi - lo ? hi : lo + off;
+}
+
+static pdt_status splitters(drv *d, const srm_rec *rec, size_t n, uint64_t *split, pdt_err *err)
+{
+    int p = d->p, q1 = p - 1, nc = SEL_WAYS - 1;
+    uint64_t ext[2] = {n ? rec[0].key : UINT64_MAX, n ? ~rec[n - 1].key : UINT64_MAX};
+    pdt_status st = pdt_comm_allreduce_u64(d->c, ext, 2, PDT_COMM_MIN, err);
+    if (st != PDT_OK) return st;
+    note_all(d, TAG_SAMPLES, sizeof ext);
+    uint64_t N = d->n_total;
+    uint64_t *lo = malloc((size_t)q1 * sizeof *lo), *hi = malloc((size_t)q1 * sizeof *hi);
+    uint64_t *cnt = malloc((size_t)q1 * (size_t)nc * sizeof *cnt);
+    if (!lo || !hi || !cnt) {
+        free(lo);
+        free(hi);
+        free(cnt);
+        return nomem(d, "partition");
+    }
+    for (int q = 0; q < q1; q++) { /* an empty input: every key to rank 0 */
+        lo[q] = N ? ext[0] : UINT64_MAX;
+        hi[q] = N ? ~ext[1] : UINT64_MAX;
+    }
+    for (;;) {
+        int open = 0;
+        for (int q = 0; q < q1; q++) {
+            uint64_t step = (hi[q] - lo[q]) / SEL_WAYS + 1;
+            for (int j = 0; j < nc; j++) {
+                uint64_t *c = &cnt[(size_t)q * (size_t)nc + (size_t)j];
+                if (lo[q] == hi[q]) *c = 0;
+                else *c = pdt_srm_count_lt(rec, n, sel_cut(lo[q], hi[q], step, j) + 1);
+            }
+            open |= lo[q] != hi[q];
+        }
+        if (!open) break;
+        st = pdt_comm_allreduce_u64(d->c, cnt, (size_t)q1 * (size_t)nc, PDT_COMM_SUM, err);
+        if (st != PDT_OK) break;
+        note_all(d, TAG_SAMPLES, (size_t)q1 * (size_t)nc * sizeof *cnt);
+        for (int q = 0; q < q1; q++) {
+            if (lo[q] == hi[q]) continue;
+            /* the splitter: the smallest key v with more than t keys <= v */
+            uint64_t t = N * (uint64_t)(q + 1) / (uint64_t)p, step = (hi[q] - lo[q]) / SEL_WAYS + 1;
+            int j = 0;
+            while (j < nc && cnt[(size_t)q * (size_t)nc + (size_t)j] <= t) j++;
+            uint64_t nlo = j ? sel_cut(lo[q], hi[q], step, j - 1) + 1 : lo[q];
+            if (j < nc) hi[q] = sel_cut(lo[q], hi[q], step, j);
+            lo[q] = nlo;
+        }
+    }
+    for (int q = 0; q < q1; q++) split[q] = lo[q];
+    free(lo);
+    free(hi);
+    free(cnt);
+    return st;
+}
+
+/* Sample sort of this rank's input block by key, with exact splitters:
+ * d->rec[0..d->m) are the distinct records of this rank's strip,
+ * key-sorted.  in->pts is freed as soon as the records hold it if
+ * in->release_pts. */
+static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
 {
     int p = d->p, r = d->rank;
     pdt_status st = PDT_OK;
-    size_t mine_n = in->n;
+    size_t n = in->n;
     size_t *cnt = calloc((size_t)p, sizeof *cnt), *rcnt = calloc((size_t)p, sizeof *rcnt);
-    uint64_t *samp = NULL, *all = NULL, *split = NULL, *sc = NULL, *rc = NULL;
+    size_t *start = calloc((size_t)p + 1, sizeof *start);
+    uint64_t *split = malloc((size_t)p * sizeof *split), *sc = NULL, *rc = NULL;
     srm_rec *rec = NULL, *tmp = NULL, *got = NULL;
-    rec = srm_big((mine_n + 1) * sizeof *rec);
-    tmp = srm_big((mine_n + 1) * sizeof *tmp);
-    if (!cnt || !rcnt || !rec || !tmp) goto nomem;
-    for (size_t i = 0; i < mine_n; i++)
-        rec[i] = (srm_rec){pdt_key(in->pts[i]), (uint32_t)(in->first + i), 0};
-    /* samples at a regular stride of the input order (no sort needed here),
-     * allgathered: [count, S keys] per rank */
-    size_t S = (size_t)64 * (size_t)p;
-    samp = calloc(S + 1, sizeof *samp);
-    all = malloc((size_t)p * (S + 1) * sizeof *all);
-    split = malloc((size_t)p * sizeof *split);
-    if (!samp || !all || !split) goto nomem;
-    size_t k = mine_n < S ? mine_n : S;
-    samp[0] = k;
-    for (size_t i = 0; i < k; i++) samp[1 + i] = rec[i * mine_n / k].key;
-    st = pdt_comm_allgather(d->c, samp, (S + 1) * sizeof *samp, all, err);
-    if (st != PDT_OK) goto done;
-    note_all(d, TAG_SAMPLES, (S + 1) * sizeof *samp);
-    size_t ns = 0; /* compact in place: the write index never passes the read index */
-    for (int q = 0; q < p; q++) {
-        const uint64_t *b = all + (size_t)q * (S + 1);
-        size_t cnt_q = b[0] < S ? (size_t)b[0] : S;
-        for (size_t i = 0; i < cnt_q; i++) all[ns++] = b[1 + i];
-    }
-    pdt_srm_pick_splitters(all, ns, p, split);
-
-    /* destination of each record; a stable counting pass groups them by
-     * destination (input order, hence index order, kept within a group) */
-    for (int q = 0; q < p; q++) cnt[q] = 0;
-    if (p > 1) {
-        for (size_t i = 0; i < mine_n; i++) {
-            rec[i].pad = (uint32_t)pdt_srm_dest_rank(split, p, rec[i].key);
-            cnt[rec[i].pad]++;
-        }
-        size_t off = 0;
-        for (int q = 0; q < p; q++) {
-            rcnt[q] = off; /* scratch: start of group q */
-            off += cnt[q];
-        }
-        for (size_t i = 0; i < mine_n; i++) tmp[rcnt[rec[i].pad]++] = rec[i];
-        srm_rec *t = rec;
-        rec = tmp;
-        tmp = t;
-    } else {
-        cnt[0] = mine_n;
-    }
+    rec = srm_big((n + 1) * sizeof *rec);
+    tmp = srm_big((n + 1) * sizeof *tmp);
     sc = malloc((size_t)p * sizeof *sc);
     rc = malloc((size_t)p * sizeof *rc);
-    if (!sc || !rc) goto nomem;
-    for (int q = 0; q < p; q++) sc[q] = cnt[q];
+    if (!cnt || !rcnt || !start || !split || !sc || !rc || !rec || !tmp) goto nomem;
+    for (size_t i = 0; i < n; i++)
+        rec[i] = (srm_rec){pdt_key(in->pts[i]), (uint32_t)(in->first + i), 0};
+    if (in->release_pts) {
+        free(in->pts);
+        in->pts = NULL;
+    }
+    /* input order is index order: the stable sort orders equal keys by index */
+    pdt_srm_radix_sort(rec, tmp, n);
+    free(tmp);
+    tmp = NULL;
+    st = splitters(d, rec, n, split, err);
+    if (st != PDT_OK) goto done;
+    /* rank q's records are a consecutive block of the sorted ones */
+    size_t at = 0;
+    for (int q = 0; q < p; q++) {
+        size_t end = q < p - 1 ? pdt_srm_count_lt(rec, n, split[q]) : n;
+        if (end < at) end = at;
+        sc[q] = end - at;
+        at = end;
+    }
     st = pdt_comm_alltoall(d->c, sc, sizeof *sc, rc, err);
     if (st != PDT_OK) goto done;
     note_all(d, TAG_COUNTS, sizeof *sc);
     size_t total = 0;
     for (int q = 0; q < p; q++) {
-        cnt[q] *= sizeof(srm_rec);
+        cnt[q] = (size_t)sc[q] * sizeof(srm_rec);
         rcnt[q] = (size_t)rc[q] * sizeof(srm_rec);
+        start[q] = total;
         total += (size_t)rc[q];
     }
-    free(tmp); /* the grouping's scratch: not held through the exchange */
-    tmp = NULL;
+    start[p] = total;
     got = srm_big((total + 1) * sizeof *got);
     if (!got) goto nomem;
     st = pdt_comm_alltoallv(d->c, rec, cnt, got, rcnt, err);
@@ -206,10 +253,14 @@ static pdt_status partition(drv *d, const pdt_par_input *in, pdt_err *err)
     rec = NULL;
     tmp = srm_big((total + 1) * sizeof *tmp);
     if (!tmp) goto nomem;
-    /* blocks arrive in rank order, each in index order, and rank q's indices
-     * are all below rank q+1's, so a stable sort by key orders equal keys by
-     * index: the first copy is the smallest index */
-    pdt_srm_radix_sort(got, tmp, total);
+    /* blocks arrive in rank order, each key-sorted with equal keys in index
+     * order, and rank q's indices are all below rank q+1's: the stable merge
+     * puts the smallest index first among equal keys */
+    srm_rec *sorted = pdt_srm_merge_runs(got, tmp, start, p);
+    if (sorted == tmp) {
+        tmp = got;
+        got = sorted;
+    }
     d->nrecv = total;
     d->m = pdt_srm_dedupe(got, total);
     d->rec = got;
@@ -220,8 +271,7 @@ nomem:
 done:
     free(cnt);
     free(rcnt);
-    free(samp);
-    free(all);
+    free(start);
     free(split);
     free(sc);
     free(rc);
@@ -550,7 +600,7 @@ static pdt_status sequential(pdt_comm *c, const pdt_par_input *in, pdt_par_outpu
 
 /* ---- the whole run ------------------------------------------------------------ */
 
-pdt_status pdt_par_triangulate(pdt_comm *c, const pdt_par_input *in, pdt_par_output *out,
+pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *out,
                                pdt_par_rank_stats *me, pdt_trace *tr, pdt_err *err)
 {
     memset(out, 0, sizeof *out);

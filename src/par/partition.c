@@ -80,30 +80,43 @@ size_t pdt_srm_dedupe(srm_rec *r, size_t n)
     return k;
 }
 
-static int cmp_u64(const void *a, const void *b)
+size_t pdt_srm_count_lt(const srm_rec *r, size_t n, uint64_t key)
 {
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return x < y ? -1 : x > y;
-}
-
-void pdt_srm_pick_splitters(uint64_t *samples, size_t ns, int p, uint64_t *split)
-{
-    qsort(samples, ns, sizeof *samples, cmp_u64);
-    for (int i = 1; i < p; i++) {
-        /* The i-th p-quantile of the samples; with no samples every record
-         * goes to rank 0 (UINT64_MAX splitters). */
-        split[i - 1] = ns ? samples[(size_t)i * ns / (size_t)p] : UINT64_MAX;
-    }
-}
-
-int pdt_srm_dest_rank(const uint64_t *split, int p, uint64_t key)
-{
-    /* number of splitters <= key (upper bound): equal keys, same rank */
-    int lo = 0, hi = p - 1;
+    size_t lo = 0, hi = n;
     while (lo < hi) {
-        int mid = (lo + hi) / 2;
-        if (split[mid] <= key) lo = mid + 1;
+        size_t mid = lo + (hi - lo) / 2;
+        if (r[mid].key < key) lo = mid + 1;
         else hi = mid;
     }
     return lo;
+}
+
+/* One stable merge of the sorted runs a[0..na) and b[0..nb) into out
+ * (ties: a first). */
+static void merge2(const srm_rec *a, size_t na, const srm_rec *b, size_t nb, srm_rec *out)
+{
+    size_t i = 0, j = 0, k = 0;
+    while (i < na && j < nb) out[k++] = b[j].key < a[i].key ? b[j++] : a[i++];
+    while (i < na) out[k++] = a[i++];
+    while (j < nb) out[k++] = b[j++];
+}
+
+srm_rec *pdt_srm_merge_runs(srm_rec *r, srm_rec *tmp, size_t *start, int k)
+{
+    srm_rec *src = r, *dst = tmp;
+    while (k > 1) { /* merge neighbouring runs pairwise: run order kept on ties */
+        int nk = 0;
+        for (int i = 0; i < k; i += 2) {
+            size_t lo = start[i], mid = start[i + 1], hi = i + 2 <= k ? start[i + 2] : mid;
+            if (i + 1 < k) merge2(src + lo, mid - lo, src + mid, hi - mid, dst + lo);
+            else memcpy(dst + lo, src + lo, (mid - lo) * sizeof *src);
+            start[nk++] = lo;
+        }
+        start[nk] = start[k];
+        k = nk;
+        srm_rec *t = src;
+        src = dst;
+        dst = t;
+    }
+    return src;
 }

@@ -64,10 +64,14 @@ void pdt_srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n);
 /* Remove records with equal keys keeping the first; returns the new count. */
 size_t pdt_srm_dedupe(srm_rec *r, size_t n);
 
-/* p-1 splitter keys from the pooled samples (sorted in place); rank of a
- * key = number of splitters <= key. */
-void pdt_srm_pick_splitters(uint64_t *samples, size_t ns, int p, uint64_t *split);
-int pdt_srm_dest_rank(const uint64_t *split, int p, uint64_t key);
+/* Number of records of the key-sorted r[0..n) whose key is below `key`. */
+size_t pdt_srm_count_lt(const srm_rec *r, size_t n, uint64_t key);
+
+/* Merge the k key-sorted runs r[start[i] .. start[i+1]) (i < k; start has
+ * k + 1 entries and is used up) into one key-sorted array, stably: on equal
+ * keys run i's records come before run i+1's.  tmp: start[k] scratch
+ * records.  Returns the array that holds the result (r or tmp). */
+srm_rec *pdt_srm_merge_runs(srm_rec *r, srm_rec *tmp, size_t *start, int k);
 
 /* Point of a key (inverse of pdt_key). */
 static inline pdt_point srm_key_point(uint64_t key)

@@ -227,11 +227,70 @@ TEST(failing_rank_ends_the_run)
     }
 }
 
+/* The partition of pdt_par_triangulate: the input (job->n points, point i
+ * at job->pt(i)) dealt in consecutive blocks; every rank checks it got
+ * exactly its share of the records when keys are distinct, and the distinct
+ * points of all ranks add up (copies of a key on two ranks would count it
+ * twice). */
+typedef struct part_job {
+    size_t n;
+    int dups;            /* 1: a third of the points are one point */
+    uint64_t distinct;   /* expected distinct points */
+    uint64_t *points;    /* per rank, filled by the ranks */
+} part_job;
+
+static pdt_point part_pt(const part_job *j, size_t i)
+{
+    if (j->dups && i % 3 == 1) return (pdt_point){500, 500};
+    return (pdt_point){(int32_t)((i * 7919) % 1009), (int32_t)i};
+}
+
+static pdt_status rank_partition(pdt_comm *c, void *arg, pdt_err *err)
+{
+    part_job *j = arg;
+    int r = pdt_comm_rank(c), P = pdt_comm_size(c);
+    size_t lo = j->n * (size_t)r / (size_t)P, hi = j->n * (size_t)(r + 1) / (size_t)P;
+    pdt_par_input in = {malloc((hi - lo + 1) * sizeof(pdt_point)), hi - lo, lo, j->n, 0, 1};
+    if (!in.pts) WRONG("out of memory");
+    for (size_t i = lo; i < hi; i++) in.pts[i - lo] = part_pt(j, i);
+    pdt_par_output out;
+    pdt_par_rank_stats me;
+    memset(&me, 0, sizeof me);
+    pdt_status s = pdt_par_triangulate(c, &in, &out, &me, NULL, err);
+    int released = in.pts == NULL;
+    pdt_par_input_free(&in);
+    pdt_par_output_free(&out);
+    if (s != PDT_OK) return s;
+    if (!released) WRONG("rank %d: input points not released", r);
+    j->points[r] = me.points;
+    if (!j->dups && me.received != hi - lo)
+        WRONG("rank %d of %d: %llu records, not %zu", r, P, (unsigned long long)me.received,
+              hi - lo);
+    return PDT_OK;
+}
+
+TEST(partition_exact_shares_p2_to_p7)
+{
+    for (int dups = 0; dups <= 1; dups++)
+        for (int P = 2; P <= 7; P++) {
+            uint64_t pts[8] = {0};
+            part_job j = {3000, dups, dups ? 2001 : 3000, pts};
+            pdt_err err = {0};
+            pdt_status s = pdt_comm_local_run(P, rank_partition, &j, &err);
+            CHECK_MSG(s == PDT_OK, "P=%d dups=%d: %s", P, dups, err.msg);
+            uint64_t sum = 0;
+            for (int q = 0; q < P; q++) sum += pts[q];
+            CHECK_MSG(s != PDT_OK || sum == j.distinct, "P=%d dups=%d: %llu distinct points",
+                      P, dups, (unsigned long long)sum);
+        }
+}
+
 int main(void)
 {
     RUN(every_collective_p1_to_p5);
     RUN(messages_by_tag_p1_to_p5);
     RUN(one_file_written_by_all_ranks);
     RUN(failing_rank_ends_the_run);
+    RUN(partition_exact_shares_p2_to_p7);
     return test_summary();
 }

@@ -127,16 +127,21 @@ TEST(radix_sort_stable_dedupe)
     free(t);
 }
 
-TEST(splitters_equal_keys_one_rank)
+TEST(merge_runs_stable)
 {
-    uint64_t samples[12] = {5, 5, 5, 5, 5, 5, 7, 7, 9, 9, 9, 1};
-    uint64_t split[3];
-    pdt_srm_pick_splitters(samples, 12, 4, split);
-    int d5 = pdt_srm_dest_rank(split, 4, 5);
-    CHECK(pdt_srm_dest_rank(split, 4, 5) == d5);
-    CHECK(pdt_srm_dest_rank(split, 4, 1) <= d5);
-    CHECK(pdt_srm_dest_rank(split, 4, 9) >= pdt_srm_dest_rank(split, 4, 7));
-    CHECK(pdt_srm_dest_rank(split, 1, 5) == 0);
+    /* three sorted runs with shared keys: the merge is sorted and keeps run
+     * order on equal keys (the smallest index first, as the partition needs) */
+    srm_rec r[9] = {{1, 0, 0}, {5, 1, 0}, {9, 2, 0}, {5, 10, 0}, {7, 11, 0},
+                    {1, 20, 0}, {5, 21, 0}, {9, 22, 0}, {9, 23, 0}};
+    srm_rec t[9];
+    size_t start[4] = {0, 3, 5, 9};
+    srm_rec *m = pdt_srm_merge_runs(r, t, start, 3);
+    const uint32_t want[9] = {0, 20, 1, 10, 21, 11, 2, 22, 23};
+    for (int i = 0; i < 9; i++) CHECK_MSG(m[i].idx == want[i], "position %d: %u", i, m[i].idx);
+    CHECK(pdt_srm_count_lt(m, 9, 5) == 2);
+    CHECK(pdt_srm_count_lt(m, 9, 6) == 5);
+    CHECK(pdt_srm_count_lt(m, 9, 0) == 0);
+    CHECK(pdt_srm_count_lt(m, 9, 10) == 9);
 }
 
 TEST(schedule)
@@ -160,7 +165,7 @@ int main(void)
     RUN(touch_is_sound);
     RUN(touch_cocircular_corner);
     RUN(radix_sort_stable_dedupe);
-    RUN(splitters_equal_keys_one_rank);
+    RUN(merge_runs_stable);
     RUN(schedule);
     return test_summary();
 }
