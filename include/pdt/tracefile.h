@@ -3,8 +3,9 @@
  * A run folder holds a manifest (text, "manifest"), the input points (binary,
  * "points.bin") and one binary trace file per rank ("rank-NNNN.trace", four
  * or more digits).  The format is documented in docs/trace-format.md.
- * Writing never involves MPI: the parallel driver gathers what the manifest
- * needs and calls these functions.
+ * Writing never involves MPI: the parallel driver writes points.bin with its
+ * own parallel file API (every rank its block; the checksums combined) and
+ * calls these functions for the rest.
  *
  * What a driver calls (sequential: nranks = 1, rank = 0, offsets {0}):
  *
@@ -17,7 +18,8 @@
  *                   on rank 0's time line.
  *   3. rank 0:      fill a pdt_manifest (format_version = PDT_TRACE_FORMAT_MAJOR,
  *                   program_version = PDT_VERSION, command, command_line,
- *                   input_name, input_checksum = pdt_points_checksum(pts, n),
+ *                   input_name, input_checksum = pdt_points_checksum(pts, n)
+ *                   (or combined from the ranks' blocks: pdt_crc64_combine),
  *                   n, nranks, level, clock_offset_ns, wall_start_ns =
  *                   pdt_wall_ns()) and call pdt_run_write_meta(dir, &m, pts, n).
  *                   Doing this before the run means a killed run still
@@ -38,10 +40,14 @@
 #include "pdt/trace.h"
 
 /* Version of the run-folder format written by this code.  A reader accepts
- * every minor version of its own major version (unknown manifest keys and
- * unknown event kinds are skipped); a different major version is refused. */
-#define PDT_TRACE_FORMAT_MAJOR 1
+ * every minor version of the major versions it knows (unknown manifest keys
+ * and unknown event kinds are skipped); another major version is refused.
+ * Format 2 differs from 1 only in the manifest's input_checksum (CRC-64/XZ,
+ * which ranks can compute in parallel, instead of FNV-1a 64); this reader
+ * reads both (PDT_TRACE_FORMAT_OLDEST). */
+#define PDT_TRACE_FORMAT_MAJOR 2
 #define PDT_TRACE_FORMAT_MINOR 0
+#define PDT_TRACE_FORMAT_OLDEST 1
 
 /* ---- manifest ------------------------------------------------------------ */
 
@@ -50,7 +56,7 @@ typedef struct pdt_manifest {
     char program_version[32];
     char *command_line;      /* malloc'd */
     char *input_name;        /* malloc'd */
-    uint64_t input_checksum; /* of the input points as read */
+    uint64_t input_checksum; /* of the input points as read (input_checksum_kind) */
     uint64_t n;              /* points in the input */
     int nranks;
     int level;               /* trace level */
@@ -58,18 +64,39 @@ typedef struct pdt_manifest {
     int64_t *clock_offset_ns;/* per rank: add to a rank's times to align (malloc'd) */
     uint64_t wall_start_ns;  /* realtime clock at the start (rank 0) */
     int format_minor;        /* minor version (reader: as found in the file) */
+    int input_checksum_kind; /* PDT_CHECKSUM_CRC64 (0: what writers write) or
+                              * PDT_CHECKSUM_FNV1A64 (format 1 runs) */
 } pdt_manifest;
+
+enum { PDT_CHECKSUM_CRC64 = 0, PDT_CHECKSUM_FNV1A64 = 1 };
 
 /* Free the malloc'd members (not m itself); m may be NULL. */
 void pdt_manifest_free(pdt_manifest *m);
 
-/* FNV-1a 64 over the points as little-endian int32 pairs (x, y): the
- * manifest's input_checksum. */
+/* CRC-64/XZ of the points as little-endian int32 pairs (x, y), i.e. of the
+ * data part of points.bin: the manifest's input_checksum (format 2). */
 uint64_t pdt_points_checksum(const pdt_point *pts, size_t n);
+/* FNV-1a 64 of the same bytes: the input_checksum of format 1 manifests. */
+uint64_t pdt_points_fnv1a64(const pdt_point *pts, size_t n);
+/* The 8n bytes of pts[0..n) as points.bin stores them (i32 x, i32 y,
+ * little-endian) into out. */
+void pdt_points_encode(uint8_t *out, const pdt_point *pts, size_t n);
+/* points.bin's header (PDT_POINTS_HEADER_BYTES) for n points whose 8n data
+ * bytes have CRC-32C data_crc. */
+#define PDT_POINTS_HEADER_BYTES 24
+void pdt_points_header(uint8_t *h, uint64_t n, uint32_t data_crc);
 /* CRC-32C (Castagnoli, reflected 0x82F63B78, init and final xor ~0) of n
  * bytes, continuing from `crc` (start with 0): the checksum of trace blocks
  * and points.bin.  pdt_crc32c(0, "123456789", 9) == 0xE3069283. */
 uint32_t pdt_crc32c(uint32_t crc, const void *data, size_t n);
+/* CRC-64/XZ (reflected 0xC96C5795D7870F42, init and final xor ~0) of n bytes,
+ * continuing from `crc` (start with 0).  pdt_crc64(0, "123456789", 9) ==
+ * 0x995DC9BBDF1939FA. */
+uint64_t pdt_crc64(uint64_t crc, const void *data, size_t n);
+/* The CRC of A followed by B, from crc_a = CRC(A), crc_b = CRC(B) and
+ * len_b = |B| in bytes (any length; O(log len_b)). */
+uint32_t pdt_crc32c_combine(uint32_t crc_a, uint32_t crc_b, uint64_t len_b);
+uint64_t pdt_crc64_combine(uint64_t crc_a, uint64_t crc_b, uint64_t len_b);
 /* Realtime clock in nanoseconds since the epoch (for wall_start_ns). */
 uint64_t pdt_wall_ns(void);
 
@@ -105,9 +132,13 @@ pdt_status pdt_tw_close(pdt_trace_writer *w, pdt_err *err);
 void pdt_tw_abort(pdt_trace_writer *w);
 
 /* Rank 0: write the input points (points.bin) and the manifest, each
- * atomically (temporary file + rename).  Creates dir if needed. */
+ * atomically (temporary file + rename).  Creates dir if needed.  (A parallel
+ * driver writes points.bin itself, every rank its block at byte
+ * PDT_POINTS_HEADER_BYTES + 8 * first, and then calls pdt_run_write_manifest.) */
 pdt_status pdt_run_write_meta(const char *dir, const pdt_manifest *m, const pdt_point *pts,
                               size_t n, pdt_err *err);
+/* Write dir/manifest only, atomically (dir must exist). */
+pdt_status pdt_run_write_manifest(const char *dir, const pdt_manifest *m, pdt_err *err);
 
 /* ---- reader ----------------------------------------------------------------- */
 

@@ -78,8 +78,10 @@ static int cmd_info(const char *dir)
     printf("command      %s  (pdt %s)\n", m->command[0] ? m->command : "?",
            m->program_version[0] ? m->program_version : "?");
     if (m->command_line) printf("command line %s\n", m->command_line);
-    printf("input        %s  n=%" PRIu64 "  checksum fnv1a64:%016" PRIx64 "\n",
-           m->input_name ? m->input_name : "?", m->n, m->input_checksum);
+    printf("input        %s  n=%" PRIu64 "  checksum %s:%016" PRIx64 "\n",
+           m->input_name ? m->input_name : "?", m->n,
+           m->input_checksum_kind == PDT_CHECKSUM_FNV1A64 ? "fnv1a64" : "crc64",
+           m->input_checksum);
     if (m->wall_start_ns) {
         time_t s = (time_t)(m->wall_start_ns / 1000000000u);
         struct tm tm;

@@ -54,8 +54,10 @@ pdt_status pdt_cli_trace_close(pdt_cli_trace *t, pdt_err *err);
  * when o->trace_dir is NULL.  Records the beginning of the run. */
 pdt_status pdt_cli_trace_open_ranks(const pdt_run_opts *o, pdt_comm *c, pdt_cli_trace **t,
                                     pdt_err *err);
-/* Collective: the manifest and points.bin of the input read into `in`
- * (every rank's block; written by rank 0).  Nothing if t is NULL. */
+/* Collective: points.bin of the input read into `in` (every rank writes its
+ * block at its offset; the blocks' checksums are combined at rank 0), then
+ * the manifest (rank 0).  The same bytes whatever the number of ranks; on
+ * failure neither file is left.  Nothing if t is NULL. */
 pdt_status pdt_cli_trace_manifest(pdt_cli_trace *t, const pdt_run_opts *o, pdt_comm *c,
                                   const pdt_par_input *in, pdt_err *err);
 

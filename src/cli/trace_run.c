@@ -1,9 +1,14 @@
 /* pdt — tracing of a command run (run_opts.h): the run folder of
  * docs/trace-format.md, one rank file per rank, written through the trace
- * writer; the manifest and points.bin by rank 0. */
+ * writer; points.bin by every rank at its place (no rank holds the whole
+ * input; the checksums of the blocks are combined at rank 0), the manifest
+ * by rank 0. */
+#include <errno.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "pdt/par.h"
 #include "pdt/tracefile.h"
@@ -45,26 +50,35 @@ static pdt_status traceable(const pdt_run_opts *o, pdt_err *err)
     return PDT_OK;
 }
 
-/* The manifest of a run of o->command on n points over p ranks (checksum
- * and points of the whole input: rank 0's job). */
-static pdt_status write_manifest(const pdt_run_opts *o, int p, const int64_t *offsets,
-                                 const pdt_point *pts, size_t n, pdt_err *err)
+/* The manifest of a run of o->command on n points (checksum: the CRC-64 of
+ * their points.bin bytes) over p ranks, into *m (free m->command_line). */
+static pdt_status fill_manifest(const pdt_run_opts *o, int p, const int64_t *offsets,
+                                uint64_t checksum, uint64_t n, pdt_manifest *m, pdt_err *err)
+{
+    memset(m, 0, sizeof *m);
+    m->format_version = PDT_TRACE_FORMAT_MAJOR;
+    strncpy(m->program_version, PDT_VERSION, sizeof m->program_version - 1);
+    strncpy(m->command, o->command, sizeof m->command - 1);
+    m->command_line = join_args(o->argc, o->argv);
+    m->input_name = (char *)(o->input ? o->input : "-");
+    m->input_checksum = checksum;
+    m->input_checksum_kind = PDT_CHECKSUM_CRC64;
+    m->n = n;
+    m->nranks = p;
+    m->level = o->trace_level;
+    m->clock_offset_ns = (int64_t *)offsets;
+    m->wall_start_ns = pdt_wall_ns();
+    return m->command_line ? PDT_OK : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+}
+
+/* A one-process run (pdt hull): points.bin and the manifest, by this process. */
+static pdt_status write_manifest(const pdt_run_opts *o, const pdt_point *pts, size_t n,
+                                 pdt_err *err)
 {
     pdt_manifest m;
-    memset(&m, 0, sizeof m);
-    m.format_version = PDT_TRACE_FORMAT_MAJOR;
-    strncpy(m.program_version, PDT_VERSION, sizeof m.program_version - 1);
-    strncpy(m.command, o->command, sizeof m.command - 1);
-    m.command_line = join_args(o->argc, o->argv);
-    m.input_name = (char *)(o->input ? o->input : "-");
-    m.input_checksum = pdt_points_checksum(pts, n);
-    m.n = n;
-    m.nranks = p;
-    m.level = o->trace_level;
-    m.clock_offset_ns = (int64_t *)offsets;
-    m.wall_start_ns = pdt_wall_ns();
-    pdt_status st = m.command_line ? pdt_run_write_meta(o->trace_dir, &m, pts, n, err)
-                                   : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    int64_t offset0 = 0;
+    pdt_status st = fill_manifest(o, 1, &offset0, pdt_points_checksum(pts, n), n, &m, err);
+    if (st == PDT_OK) st = pdt_run_write_meta(o->trace_dir, &m, pts, n, err);
     free(m.command_line);
     return st;
 }
@@ -84,8 +98,7 @@ pdt_status pdt_cli_trace_open(const pdt_run_opts *o, const pdt_point *pts, size_
         return st;
     }
     /* the manifest first, so that a killed run still leaves a complete folder */
-    int64_t offset0 = 0;
-    st = write_manifest(o, 1, &offset0, pts, n, err);
+    st = write_manifest(o, pts, n, err);
     if (st != PDT_OK) {
         pdt_tw_abort(ct->w);
         free(ct);
@@ -165,33 +178,167 @@ pdt_status pdt_cli_trace_open_ranks(const pdt_run_opts *o, pdt_comm *c, pdt_cli_
     return PDT_OK;
 }
 
+/* ---- points.bin written by every rank ------------------------------------------- */
+
+enum { POINTS_PIECE = 65536 }; /* points encoded and written at once (512 KiB) */
+
+/* What a rank tells rank 0 about its block of points.bin. */
+typedef struct block_sums {
+    uint64_t bytes;  /* 8 * points */
+    uint64_t crc64;  /* CRC-64/XZ of the block's bytes */
+    uint64_t crc32c; /* CRC-32C of the same bytes (in the low 32 bits) */
+} block_sums;
+
+/* Test-only: PDT_TEST_FAIL_TRACE_POINTS=RANK makes RANK fail its block of
+ * points.bin (after the temporary exists), as a full disk would. */
+static pdt_status test_fail_points(int rank, const char *path, pdt_err *err)
+{
+    const char *e = getenv("PDT_TEST_FAIL_TRACE_POINTS");
+    if (e && *e && atoi(e) == rank)
+        return pdt_err_set(err, PDT_ERR_IO, "%s: write error: injected by "
+                           "PDT_TEST_FAIL_TRACE_POINTS", path);
+    return PDT_OK;
+}
+
+/* This rank's block of points.bin: encoded a piece at a time, checksummed,
+ * written at byte 24 + 8 * in->first of f.  Returns this rank's status. */
+static pdt_status write_block(pdt_comm_file *f, const pdt_par_input *in, block_sums *s,
+                              pdt_err *err)
+{
+    s->bytes = 8 * (uint64_t)in->n;
+    s->crc64 = s->crc32c = 0;
+    uint8_t *buf = in->n ? malloc(8 * (size_t)(in->n < POINTS_PIECE ? in->n : POINTS_PIECE))
+                         : NULL;
+    if (in->n && !buf) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    pdt_status st = PDT_OK;
+    uint32_t crc32 = 0;
+    for (size_t i = 0; i < in->n && st == PDT_OK; i += POINTS_PIECE) {
+        size_t k = in->n - i < POINTS_PIECE ? in->n - i : POINTS_PIECE;
+        pdt_points_encode(buf, in->pts + i, k);
+        crc32 = pdt_crc32c(crc32, buf, 8 * k);
+        s->crc64 = pdt_crc64(s->crc64, buf, 8 * k);
+        st = pdt_comm_file_write_at(f, PDT_POINTS_HEADER_BYTES + 8 * (in->first + i), buf, 8 * k,
+                                    err);
+    }
+    s->crc32c = crc32;
+    free(buf);
+    return st;
+}
+
+/* Rank 0: the checksums of the whole data from the blocks' (rank order). */
+static void combine_sums(const block_sums *b, int p, uint32_t *crc32c, uint64_t *crc64)
+{
+    *crc32c = 0;
+    *crc64 = 0;
+    for (int q = 0; q < p; q++) {
+        *crc32c = pdt_crc32c_combine(*crc32c, (uint32_t)b[q].crc32c, b[q].bytes);
+        *crc64 = pdt_crc64_combine(*crc64, b[q].crc64, b[q].bytes);
+    }
+}
+
+/* Collective: write DIR/points.bin's temporary `tmp`, every rank its block
+ * of the input, rank 0 the header; *checksum (rank 0) = the manifest's.
+ * Same status at every rank; the temporary may be left on failure. */
+static pdt_status write_points_tmp(pdt_comm *c, const char *tmp, const pdt_par_input *in,
+                                   uint64_t *checksum, pdt_err *err)
+{
+    int r = pdt_comm_rank(c), p = pdt_comm_size(c);
+    block_sums mine = {0, 0, 0}, *all = r == 0 ? malloc((size_t)p * sizeof *all) : NULL;
+    size_t *cnt = r == 0 ? malloc((size_t)p * sizeof *cnt) : NULL;
+    pdt_status st = r == 0 && (!all || !cnt) ? pdt_err_set(err, PDT_ERR_NOMEM, "out of memory")
+                                             : PDT_OK;
+    pdt_comm_file *f = NULL;
+    if (pdt_par_agree(c, st, NULL, err) == PDT_OK) st = pdt_comm_file_open(c, tmp, &f, err);
+    else st = PDT_ERR_NOMEM;
+    if (st != PDT_OK) {
+        free(all);
+        free(cnt);
+        return st;
+    }
+    for (int q = 0; r == 0 && q < p; q++) cnt[q] = sizeof *all;
+    pdt_err werr;
+    pdt_err_clear(&werr);
+    pdt_status wst = test_fail_points(r, tmp, &werr);
+    if (wst == PDT_OK) wst = write_block(f, in, &mine, &werr);
+    /* the sums travel even after a failed write: the gather is collective */
+    pdt_err gerr;
+    pdt_err_clear(&gerr);
+    st = pdt_comm_gatherv(c, &mine, sizeof mine, all, cnt, 0, &gerr);
+    if (st == PDT_OK && wst == PDT_OK && r == 0) {
+        uint32_t crc32c;
+        uint8_t h[PDT_POINTS_HEADER_BYTES];
+        combine_sums(all, p, &crc32c, checksum);
+        pdt_points_header(h, in->n_total, crc32c);
+        wst = pdt_comm_file_write_at(f, 0, h, sizeof h, &werr);
+    }
+    free(all);
+    free(cnt);
+    pdt_err cerr;
+    pdt_err_clear(&cerr);
+    pdt_status cst = pdt_comm_file_close(f, &cerr); /* collective: agrees on the writes */
+    if (st != PDT_OK) {
+        *err = gerr;
+        cst = st;
+    } else if (wst != PDT_OK) {
+        *err = werr;
+        cst = wst;
+    } else if (cst != PDT_OK) {
+        *err = cerr;
+    }
+    return pdt_par_agree(c, cst, NULL, err);
+}
+
+/* A message about our temporary names the user's file instead. */
+static void name_final(pdt_err *err, const char *tmp, const char *path)
+{
+    size_t k = strlen(tmp);
+    if (strncmp(err->msg, tmp, k) != 0) return;
+    char rest[sizeof err->msg];
+    snprintf(rest, sizeof rest, "%s", err->msg + k);
+    snprintf(err->msg, sizeof err->msg, "%s%s", path, rest);
+}
+
+/* Collective: points.bin written by every rank at its place (a temporary,
+ * renamed by rank 0 once every rank succeeded), then the manifest (rank 0).
+ * Same bytes whatever the number of ranks. */
+static pdt_status write_run_meta(pdt_cli_trace *t, const pdt_run_opts *o, pdt_comm *c,
+                                 const pdt_par_input *in, pdt_err *err)
+{
+    int r = pdt_comm_rank(c);
+    long pid = (long)getpid();
+    pdt_status st = pdt_comm_bcast(c, &pid, sizeof pid, 0, err);
+    if (st != PDT_OK) return st;
+    size_t len = strlen(o->trace_dir) + 64;
+    char *path = malloc(len), *tmp = malloc(len);
+    st = path && tmp ? PDT_OK : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    st = pdt_par_agree(c, st, NULL, err);
+    uint64_t checksum = 0;
+    if (st == PDT_OK) {
+        snprintf(path, len, "%s/points.bin", o->trace_dir);
+        snprintf(tmp, len, "%s/.points.bin.tmp.%ld", o->trace_dir, pid);
+        st = write_points_tmp(c, tmp, in, &checksum, err);
+        if (st != PDT_OK) name_final(err, tmp, path);
+    }
+    if (r == 0 && st == PDT_OK && rename(tmp, path) != 0)
+        st = pdt_err_set(err, PDT_ERR_IO, "%s: cannot rename into place: %s", path,
+                         strerror(errno));
+    if (r == 0 && st != PDT_OK && tmp) unlink(tmp);
+    if (r == 0 && st == PDT_OK) {
+        pdt_manifest m;
+        st = fill_manifest(o, t->nranks, t->offsets, checksum, in->n_total, &m, err);
+        if (st == PDT_OK) st = pdt_run_write_manifest(o->trace_dir, &m, err);
+        free(m.command_line);
+    }
+    free(path);
+    free(tmp);
+    return pdt_par_agree(c, st, NULL, err);
+}
+
 pdt_status pdt_cli_trace_manifest(pdt_cli_trace *t, const pdt_run_opts *o, pdt_comm *c,
                                   const pdt_par_input *in, pdt_err *err)
 {
     if (!t) return PDT_OK;
-    /* the whole input at rank 0 (traced runs are small enough to be replayed) */
-    int p = pdt_comm_size(c), r = pdt_comm_rank(c);
-    pdt_point *all = r == 0 ? malloc((size_t)in->n_total * sizeof *all + 1) : NULL;
-    size_t *cnt = malloc((size_t)p * sizeof *cnt);
-    uint64_t *ks = malloc((size_t)p * sizeof *ks), k = in->n;
-    pdt_status st = (r == 0 && !all) || !cnt || !ks
-                        ? pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: trace: out of memory", r)
-                        : PDT_OK;
-    if (p > 1) {
-        if (st == PDT_OK) st = pdt_comm_allgather(c, &k, sizeof k, ks, err);
-        if (st == PDT_OK) {
-            for (int q = 0; q < p; q++) cnt[q] = (size_t)ks[q] * sizeof(pdt_point);
-            st = pdt_comm_gatherv(c, in->pts, in->n * sizeof(pdt_point), all, cnt, 0, err);
-        }
-    } else if (st == PDT_OK) {
-        memcpy(all, in->pts, in->n * sizeof *all);
-    }
-    if (st == PDT_OK && r == 0)
-        st = write_manifest(o, t->nranks, t->offsets, all, (size_t)in->n_total, err);
-    free(all);
-    free(cnt);
-    free(ks);
-    return pdt_par_agree(c, st, NULL, err);
+    return write_run_meta(t, o, c, in, err);
 }
 
 pdt_trace *pdt_cli_trace_hook(pdt_cli_trace *t)

@@ -75,43 +75,59 @@ static void put_escaped(FILE *fp, const char *s)
     }
 }
 
+void pdt_points_header(uint8_t *h, uint64_t n, uint32_t data_crc)
+{
+    memcpy(h, PTS_MAGIC, 8);
+    tf_put64(h + 8, n);
+    tf_put32(h + 16, data_crc);
+    tf_put32(h + 20, pdt_crc32c(0, h, 20));
+}
+
+static pdt_status make_dir(const char *dir, pdt_err *err)
+{
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST)
+        return pdt_err_set(err, PDT_ERR_IO, "%s: cannot create folder: %s", dir,
+                           strerror(errno));
+    return PDT_OK;
+}
+
 pdt_status pdt_run_write_meta(const char *dir, const pdt_manifest *m, const pdt_point *pts,
                               size_t n, pdt_err *err)
 {
     if (m->nranks < 1)
         return pdt_err_set(err, PDT_ERR_ARG, "manifest needs nranks >= 1");
-    if (mkdir(dir, 0777) != 0 && errno != EEXIST)
-        return pdt_err_set(err, PDT_ERR_IO, "%s: cannot create folder: %s", dir,
-                           strerror(errno));
-    /* points.bin */
-    afile f;
-    pdt_status st = af_open(&f, dir, "points.bin", err);
+    pdt_status st = make_dir(dir, err);
     if (st != PDT_OK) return st;
-    uint8_t h[PTS_HEADER_SIZE];
-    memcpy(h, PTS_MAGIC, 8);
-    tf_put64(h + 8, n);
-    uint8_t chunk[8 * 1024];
+    /* points.bin: the header (with the data's checksum), then the data */
+    afile f;
+    st = af_open(&f, dir, "points.bin", err);
+    if (st != PDT_OK) return st;
+    uint8_t h[PTS_HEADER_SIZE], chunk[8 * 1024];
     uint32_t crc = 0;
-    for (size_t pass = 0; pass < 2; pass++) {  /* pass 0: checksum, pass 1: write */
+    for (int pass = 0; pass < 2; pass++) { /* pass 0: checksum, pass 1: write */
         if (pass == 1) {
-            tf_put32(h + 16, crc);
-            tf_put32(h + 20, pdt_crc32c(0, h, 20));
+            pdt_points_header(h, n, crc);
             fwrite(h, 1, sizeof h, f.fp);
         }
         for (size_t i = 0; i < n;) {
-            size_t k = 0;
-            for (; i < n && k < sizeof chunk; i++, k += 8) {
-                tf_put32(chunk + k, (uint32_t)pts[i].x);
-                tf_put32(chunk + k + 4, (uint32_t)pts[i].y);
-            }
-            if (pass == 0) crc = pdt_crc32c(crc, chunk, k);
-            else fwrite(chunk, 1, k, f.fp);
+            size_t k = n - i < sizeof chunk / 8 ? n - i : sizeof chunk / 8;
+            pdt_points_encode(chunk, pts + i, k);
+            if (pass == 0) crc = pdt_crc32c(crc, chunk, 8 * k);
+            else fwrite(chunk, 1, 8 * k, f.fp);
+            i += k;
         }
     }
     st = af_commit(&f, err);
     if (st != PDT_OK) return st;
+    return pdt_run_write_manifest(dir, m, err);
+}
 
-    /* manifest */
+pdt_status pdt_run_write_manifest(const char *dir, const pdt_manifest *m, pdt_err *err)
+{
+    if (m->nranks < 1)
+        return pdt_err_set(err, PDT_ERR_ARG, "manifest needs nranks >= 1");
+    afile f;
+    pdt_status st;
     st = af_open(&f, dir, "manifest", err);
     if (st != PDT_OK) return st;
     FILE *fp = f.fp;
@@ -125,7 +141,9 @@ pdt_status pdt_run_write_meta(const char *dir, const pdt_manifest *m, const pdt_
     put_escaped(fp, m->command_line);
     fprintf(fp, "\ninput_name = ");
     put_escaped(fp, m->input_name);
-    fprintf(fp, "\ninput_checksum = fnv1a64:%016" PRIx64 "\n", m->input_checksum);
+    fprintf(fp, "\ninput_checksum = %s:%016" PRIx64 "\n",
+            m->input_checksum_kind == PDT_CHECKSUM_FNV1A64 ? "fnv1a64" : "crc64",
+            m->input_checksum);
     fprintf(fp, "n = %" PRIu64 "\n", m->n);
     fprintf(fp, "ranks = %d\n", m->nranks);
     fprintf(fp, "level = %d\n", m->level);
@@ -201,10 +219,11 @@ pdt_status pdt_tf_manifest_parse(const char *path, char *text, pdt_manifest *m, 
             }
             m->format_version = (int)maj;
             m->format_minor = (int)min;
-            if (maj != PDT_TRACE_FORMAT_MAJOR) {
+            if (maj < PDT_TRACE_FORMAT_OLDEST || maj > PDT_TRACE_FORMAT_MAJOR) {
                 st = pdt_err_set(err, PDT_ERR_FORMAT,
-                                 "%s:%d: run folder format %ld.%ld; this pdt reads format %d.x",
-                                 path, line, maj, min, PDT_TRACE_FORMAT_MAJOR);
+                                 "%s:%d: run folder format %ld.%ld; this pdt reads formats "
+                                 "%d.x to %d.x", path, line, maj, min, PDT_TRACE_FORMAT_OLDEST,
+                                 PDT_TRACE_FORMAT_MAJOR);
                 break;
             }
         } else if (!strcmp(k, "program_version")) {
@@ -221,10 +240,19 @@ pdt_status pdt_tf_manifest_parse(const char *path, char *text, pdt_manifest *m, 
             free(*slot);
             *slot = d;
         } else if (!strcmp(k, "input_checksum")) {
-            const char *h = !strncmp(v, "fnv1a64:", 8) ? v + 8 : v;
+            /* the value names its algorithm; no name: format 1's FNV-1a 64 */
+            const char *h = v;
+            m->input_checksum_kind = PDT_CHECKSUM_FNV1A64;
+            if (!strncmp(v, "crc64:", 6)) {
+                h = v + 6;
+                m->input_checksum_kind = PDT_CHECKSUM_CRC64;
+            } else if (!strncmp(v, "fnv1a64:", 8)) {
+                h = v + 8;
+            }
             m->input_checksum = strtoull(h, &end, 16);
-            if (end == h || *end) {
-                st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad checksum '%s'", path, line, v);
+            if (end == h || *end || errno || strspn(h, "0123456789abcdefABCDEF") != strlen(h)) {
+                st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad checksum '%s' (expected "
+                                 "crc64: or fnv1a64: and hex digits)", path, line, v);
                 break;
             }
         } else if (!strcmp(k, "n") || !strcmp(k, "wall_start_ns")) {

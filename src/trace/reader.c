@@ -145,9 +145,11 @@ static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
         return PDT_OK;
     }
     unsigned maj = tf_get16(p + 8), min = tf_get16(p + 10);
-    if (maj != PDT_TRACE_FORMAT_MAJOR)
-        return pdt_err_set(err, PDT_ERR_FORMAT, "%s/%s: trace format %u.%u; this pdt reads %d.x",
-                           run->dir, name, maj, min, PDT_TRACE_FORMAT_MAJOR);
+    if (maj < PDT_TRACE_FORMAT_OLDEST || maj > PDT_TRACE_FORMAT_MAJOR)
+        return pdt_err_set(err, PDT_ERR_FORMAT,
+                           "%s/%s: trace format %u.%u; this pdt reads formats %d.x to %d.x",
+                           run->dir, name, maj, min, PDT_TRACE_FORMAT_OLDEST,
+                           PDT_TRACE_FORMAT_MAJOR);
     uint32_t hsize = tf_get32(p + 12);
     if (hsize < TF_HEADER_SIZE || hsize > rk->size) {
         warnf(run, "%s: bad header size %u: no events for rank %d", name, hsize, r);
@@ -282,6 +284,14 @@ static pdt_status guess_manifest(pdt_run *run, pdt_err *err)
     return PDT_OK;
 }
 
+/* The checksum of the points by the algorithm the manifest names (format 1
+ * runs: FNV-1a 64; format 2: CRC-64/XZ). */
+static uint64_t points_sum(const pdt_manifest *m, const pdt_point *pts, size_t n)
+{
+    return m->input_checksum_kind == PDT_CHECKSUM_FNV1A64 ? pdt_points_fnv1a64(pts, n)
+                                                          : pdt_points_checksum(pts, n);
+}
+
 pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
 {
     *out = NULL;
@@ -330,7 +340,7 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
             } else if (run->npts != run->m.n) {
                 warnf(run, "points.bin: %zu points, manifest says %" PRIu64, run->npts,
                       run->m.n);
-            } else if (pdt_points_checksum(run->pts, run->npts) != run->m.input_checksum) {
+            } else if (points_sum(&run->m, run->pts, run->npts) != run->m.input_checksum) {
                 warnf(run, "points.bin: points do not match the manifest's input_checksum");
             }
         }

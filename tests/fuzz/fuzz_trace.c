@@ -35,7 +35,10 @@ static int fuzz_manifest(const uint8_t *data, size_t size)
     pdt_err err = {0};
     pdt_status st = pdt_tf_manifest_parse("manifest", text, &m, &err);
     if (st == PDT_OK) {
-        FZ_ASSERT(m.format_version == PDT_TRACE_FORMAT_MAJOR);
+        FZ_ASSERT(m.format_version >= PDT_TRACE_FORMAT_OLDEST &&
+                  m.format_version <= PDT_TRACE_FORMAT_MAJOR);
+        FZ_ASSERT(m.input_checksum_kind == PDT_CHECKSUM_CRC64 ||
+                  m.input_checksum_kind == PDT_CHECKSUM_FNV1A64);
         FZ_ASSERT(m.nranks >= 1 && m.clock_offset_ns != NULL);
         FZ_ASSERT(memchr(m.program_version, 0, sizeof m.program_version));
         FZ_ASSERT(memchr(m.command, 0, sizeof m.command));

@@ -147,12 +147,12 @@ if sane missing_rank_file && [ "$RC_CHECK" -eq 1 ] && grep -q "rank-0003.trace: 
 else fail missing_rank_file "check rc $RC_CHECK, view rc $RC_VIEW, rank 0 $DUMPED/$full0: $(head -2 check.out)"; fi
 
 # ---- (d) a manifest from another format version ---------------------------------------------
-rm -rf ver; cp -r run ver; sed -i 's/^format = .*/format = 2.0/' ver/manifest
+rm -rf ver; cp -r run ver; sed -i 's/^format = .*/format = 3.0/' ver/manifest
 run_tools ver 0
-if sane other_major_version && [ "$RC_CHECK" -ne 0 ] && grep -q "manifest:2: run folder format 2.0" check.out &&
-   [ "$RC_VIEW" -ne 0 ] && grep -q "format 2.0" view.out; then ok other_major_version_refused
+if sane other_major_version && [ "$RC_CHECK" -ne 0 ] && grep -q "manifest:2: run folder format 3.0; this pdt reads formats 1.x to 2.x" check.out &&
+   [ "$RC_VIEW" -ne 0 ] && grep -q "format 3.0" view.out; then ok other_major_version_refused
 else fail other_major_version_refused "check rc $RC_CHECK, view rc $RC_VIEW: $(head -2 check.out)"; fi
-sed -i 's/^format = .*/format = 1.9/' ver/manifest
+sed -i 's/^format = .*/format = 2.9/' ver/manifest
 run_tools ver 0
 if sane newer_minor_version && [ "$RC_CHECK" -eq 0 ] && [ "$DUMPED" -eq "$full0" ]; then ok newer_minor_version_read
 else fail newer_minor_version_read "check rc $RC_CHECK: $(head -2 check.out)"; fi

@@ -392,36 +392,36 @@ TEST(damage_manifest_version)
     snprintf(d, sizeof d, "%s/ver", tmpdir);
     uint64_t e = traced_run(d, 0, 1);
     opened o;
-    set_format(d, "format = 2.0");
+    set_format(d, "format = 3.0");
     open_run(d, &o, 0);
     CHECK(o.st == PDT_ERR_FORMAT);
-    CHECK_MSG(strstr(o.err, "manifest:2:") && strstr(o.err, "format 2.0") &&
-              strstr(o.err, "reads format 1"), "%s", o.err);
+    CHECK_MSG(strstr(o.err, "manifest:2:") && strstr(o.err, "format 3.0") &&
+              strstr(o.err, "reads formats 1.x to 2.x"), "%s", o.err);
     set_format(d, "format = 0.9");
     open_run(d, &o, 0);
     CHECK_MSG(o.st == PDT_ERR_FORMAT && strstr(o.err, "format 0.9"), "%s", o.err);
     set_format(d, "format = one");
     open_run(d, &o, 0);
     CHECK_MSG(o.st == PDT_ERR_FORMAT && strstr(o.err, "bad format version 'one'"), "%s", o.err);
-    set_format(d, "format = 1.42");  /* a newer minor version is read */
+    set_format(d, "format = 2.42");  /* a newer minor version is read */
     open_run(d, &o, 1);
     CHECK_MSG(o.st == PDT_OK && o.events == e, "%s", o.err);
-    set_format(d, "format = 1.0");
-    /* the rank file's own header says major version 2 (checksum made valid) */
+    set_format(d, "format = 2.0");
+    /* the rank file's own header says major version 3 (checksum made valid) */
     char p[400];
     snprintf(p, sizeof p, "%s/rank-0000.trace", d);
     size_t n;
     uint8_t *r = slurp(p, &n);
     CHECK(r != NULL);
     if (!r) return;
-    r[8] = 2;
+    r[8] = 3;
     uint32_t crc = pdt_crc32c(0, r, 28);
     for (int i = 0; i < 4; i++) r[28 + i] = (uint8_t)(crc >> (8 * i));
     CHECK(put_file(p, r, n) == 0);
     free(r);
     open_run(d, &o, 0);
     CHECK(o.st == PDT_ERR_FORMAT);
-    CHECK_MSG(strstr(o.err, "rank-0000.trace") && strstr(o.err, "trace format 2.0"), "%s", o.err);
+    CHECK_MSG(strstr(o.err, "rank-0000.trace") && strstr(o.err, "trace format 3.0"), "%s", o.err);
 }
 
 /* Regression: with a rank file lost, the causal merge blamed (and moved

@@ -56,6 +56,63 @@ TEST(crc32c_check_value)
     CHECK(whole == parts);
 }
 
+TEST(crc64_check_value)
+{
+    CHECK(pdt_crc64(0, "123456789", 9) == 0x995DC9BBDF1939FAull);
+    CHECK(pdt_crc64(pdt_crc64(0, "1234", 4), "56789", 5) == 0x995DC9BBDF1939FAull);
+    CHECK(pdt_crc64(0, "", 0) == 0);
+}
+
+/* The CRC of a concatenation from the CRCs of its parts, at every split of
+ * random data into up to 9 parts (empty parts included): what lets every
+ * rank checksum its block of points.bin. */
+TEST(crc_combine_any_split)
+{
+    enum { LEN = 3000 };
+    uint8_t buf[LEN];
+    for (int i = 0; i < LEN; i++) buf[i] = (uint8_t)next_rand();
+    uint32_t whole32 = pdt_crc32c(0, buf, LEN);
+    uint64_t whole64 = pdt_crc64(0, buf, LEN);
+    for (int trial = 0; trial < 200; trial++) {
+        int parts = 1 + (int)(next_rand() % 9);
+        size_t cut[10];
+        cut[0] = 0;
+        cut[parts] = LEN;
+        for (int k = 1; k < parts; k++) cut[k] = (size_t)(next_rand() % (LEN + 1));
+        for (int a = 1; a < parts; a++) /* sort the cuts */
+            for (int b = a; b > 1 && cut[b] < cut[b - 1]; b--) {
+                size_t t = cut[b];
+                cut[b] = cut[b - 1];
+                cut[b - 1] = t;
+            }
+        uint32_t c32 = 0;
+        uint64_t c64 = 0;
+        for (int k = 0; k < parts; k++) {
+            size_t len = cut[k + 1] - cut[k];
+            c32 = pdt_crc32c_combine(c32, pdt_crc32c(0, buf + cut[k], len), len);
+            c64 = pdt_crc64_combine(c64, pdt_crc64(0, buf + cut[k], len), len);
+        }
+        CHECK_MSG(c32 == whole32 && c64 == whole64, "trial %d, %d parts", trial, parts);
+    }
+    /* lengths beyond 32 bits: combining with an empty B of a huge length is
+     * multiplication by x^(8 len); three steps of 2^31 bytes equal one of 3 * 2^31 */
+    uint64_t big = 3ull << 31, a = pdt_crc64(0, buf, 64);
+    uint64_t step = pdt_crc64_combine(pdt_crc64_combine(pdt_crc64_combine(a, 0, 1ull << 31), 0,
+                                                        1ull << 31), 0, 1ull << 31);
+    CHECK(pdt_crc64_combine(a, 0, big) == step);
+}
+
+/* The manifest's checksum is the CRC-64 of points.bin's data bytes. */
+TEST(points_checksum_is_crc64_of_the_bytes)
+{
+    pdt_point pts[3] = {{1, -2}, {-2147483647 - 1, 2147483647}, {0, 7}};
+    uint8_t b[24];
+    pdt_points_encode(b, pts, 3);
+    CHECK(b[4] == 0xfe && b[7] == 0xff && b[11] == 0x80 && b[15] == 0x7f);
+    CHECK(pdt_points_checksum(pts, 3) == pdt_crc64(0, b, 24));
+    CHECK(pdt_points_checksum(pts, 0) == 0);
+}
+
 TEST(codec_extremes)
 {
     /* every kind, extreme field values, times going backwards too */
@@ -331,11 +388,11 @@ TEST(missing_rank_and_bad_version)
     /* a manifest of another major version is an error naming both versions */
     snprintf(path, sizeof path, "%s/manifest", dir);
     FILE *f = fopen(path, "w");
-    fprintf(f, "format = 2.3\nranks = 1\n");
+    fprintf(f, "format = 3.3\nranks = 1\n");
     fclose(f);
     pdt_err_clear(&err);
     CHECK(pdt_run_open(dir, &run, &err) == PDT_ERR_FORMAT);
-    CHECK_MSG(strstr(err.msg, "format 2.3") && strstr(err.msg, "reads format 1.x"), "%s", err.msg);
+    CHECK_MSG(strstr(err.msg, "format 3.3") && strstr(err.msg, "reads formats 1.x to 2.x"), "%s", err.msg);
     /* no manifest at all: the rank files are still readable */
     remove(path);
     pdt_err_clear(&err);
@@ -349,6 +406,95 @@ TEST(missing_rank_and_bad_version)
 
 /* Three ranks exchange messages; rank clocks are skewed by the manifest's
  * offsets so that, by time alone, receives would come before their sends. */
+/* Replace line `key = ...` of dir/manifest by `line`. */
+static void set_manifest_line(const char *dir, const char *key, const char *line)
+{
+    char path[400], text[4096], out[4096];
+    snprintf(path, sizeof path, "%s/manifest", dir);
+    FILE *f = fopen(path, "rb");
+    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
+    if (f) fclose(f);
+    text[n] = 0;
+    size_t o = 0, kl = strlen(key);
+    for (char *s = text, *e; *s; s = e) {
+        e = strchr(s, '\n');
+        e = e ? e + 1 : s + strlen(s);
+        if (!strncmp(s, key, kl) && s[kl] == ' ') o += (size_t)snprintf(out + o, sizeof out - o, "%s\n", line);
+        else o += (size_t)snprintf(out + o, sizeof out - o, "%.*s", (int)(e - s), s);
+    }
+    f = fopen(path, "wb");
+    if (f) {
+        fwrite(out, 1, o, f);
+        fclose(f);
+    }
+}
+
+/* A run folder of format 1 (FNV-1a 64 input checksum, rank files of major
+ * version 1), as pdt wrote them before points.bin was written in parallel,
+ * is read as it was; a wrong FNV is reported; an unknown checksum name is
+ * refused naming the manifest's line. */
+TEST(format_1_runs_are_still_read)
+{
+    char dir[300], path[400];
+    snprintf(dir, sizeof dir, "%s/old", tmpdir);
+    pdt_trace_writer *w;
+    pdt_err err = {0};
+    CHECK(pdt_tw_open(dir, 0, 1, &w, &err) == PDT_OK);
+    PDT_TRACE(pdt_tw_hook(w), 1, PDT_EV_PHASE_BEGIN, PDT_PH_RUN, 0, 0, 0, 0);
+    PDT_TRACE(pdt_tw_hook(w), 1, PDT_EV_PHASE_END, PDT_PH_RUN, 0, 0, 0, 0);
+    CHECK(pdt_tw_close(w, &err) == PDT_OK);
+    int64_t off0 = 0;
+    write_meta(dir, 1, &off0);
+    pdt_point pts[5] = {{0, 0}, {10, 0}, {0, 10}, {-2147483647 - 1, 2147483647}, {3, 4}};
+    char line[128];
+    set_manifest_line(dir, "format", "format = 1.0");
+    snprintf(line, sizeof line, "input_checksum = fnv1a64:%016llx",
+             (unsigned long long)pdt_points_fnv1a64(pts, 5));
+    set_manifest_line(dir, "input_checksum", line);
+    snprintf(path, sizeof path, "%s/rank-0000.trace", dir); /* header: major version 1 */
+    FILE *f = fopen(path, "r+b");
+    uint8_t h[32];
+    CHECK(f && fread(h, 1, 32, f) == 32);
+    h[8] = 1;
+    uint32_t crc = pdt_crc32c(0, h, 28);
+    for (int i = 0; i < 4; i++) h[28 + i] = (uint8_t)(crc >> (8 * i));
+    if (f) {
+        fseek(f, 0, SEEK_SET);
+        fwrite(h, 1, 32, f);
+        fclose(f);
+    }
+    pdt_run *run = NULL;
+    CHECK_MSG(pdt_run_open(dir, &run, &err) == PDT_OK, "%s", err.msg);
+    if (run) {
+        const pdt_manifest *m = pdt_run_manifest(run);
+        size_t n;
+        CHECK(m->format_version == 1 && m->input_checksum_kind == PDT_CHECKSUM_FNV1A64);
+        CHECK(pdt_run_points(run, &n) && n == 5);
+        CHECK_MSG(!*pdt_run_warnings(run), "%s", pdt_run_warnings(run));
+        pdt_run_close(run);
+    }
+    /* format 1's checksum, wrong: the same warning as ever */
+    set_manifest_line(dir, "input_checksum", "input_checksum = fnv1a64:0000000000000001");
+    CHECK(pdt_run_open(dir, &run, &err) == PDT_OK);
+    if (run) {
+        CHECK_MSG(strstr(pdt_run_warnings(run), "input_checksum"), "%s", pdt_run_warnings(run));
+        pdt_run_close(run);
+    }
+    /* no name: format 1's FNV-1a 64 (its readers accepted bare hex) */
+    snprintf(line, sizeof line, "input_checksum = %016llx",
+             (unsigned long long)pdt_points_fnv1a64(pts, 5));
+    set_manifest_line(dir, "input_checksum", line);
+    CHECK(pdt_run_open(dir, &run, &err) == PDT_OK);
+    if (run) {
+        CHECK_MSG(!*pdt_run_warnings(run), "%s", pdt_run_warnings(run));
+        pdt_run_close(run);
+    }
+    set_manifest_line(dir, "input_checksum", "input_checksum = sha1:0123456789abcdef");
+    pdt_err_clear(&err);
+    CHECK(pdt_run_open(dir, &run, &err) == PDT_ERR_FORMAT);
+    CHECK_MSG(strstr(err.msg, "manifest:") && strstr(err.msg, "sha1:0123"), "%s", err.msg);
+}
+
 TEST(merged_order_is_causal)
 {
     char dir[400];
@@ -421,10 +567,14 @@ int main(void)
 {
     make_tmp();
     RUN(crc32c_check_value);
+    RUN(crc64_check_value);
+    RUN(crc_combine_any_split);
+    RUN(points_checksum_is_crc64_of_the_bytes);
     RUN(codec_extremes);
     RUN(writer_reader_round_trip);
     RUN(damage_is_reported_with_offsets);
     RUN(missing_rank_and_bad_version);
+    RUN(format_1_runs_are_still_read);
     RUN(merged_order_is_causal);
     RUN(event_text);
     rm_rf(tmpdir);
