@@ -9,6 +9,12 @@
 #include "pdt/common.h"
 #include "pdt/trace.h"
 
+/* The most points one kernel run takes (2^29 - 1 = 536 870 911): its edge
+ * records are indexed by 32-bit numbers, 8 per point.  pdt_delaunay and
+ * pdt_triangulate return PDT_ERR_ARG above it, before touching the points;
+ * a parallel run needs about n / PDT_KERNEL_MAX_POINTS ranks or more. */
+#define PDT_KERNEL_MAX_POINTS ((size_t)(UINT32_MAX / 8))
+
 /* T*(pts) for n DISTINCT points sorted lexicographically (x, then y).
  * On success *tris is a malloc'd array of *ntri counter-clockwise triangles
  * (indices into pts; order unspecified; the caller frees).  Fewer than 3

@@ -127,6 +127,32 @@ static pdt_trace *io_hook(const run *R)
     return R->p > 1 ? pdt_cli_trace_hook(R->trace) : NULL;
 }
 
+/* The kernel takes at most PDT_KERNEL_MAX_POINTS points per run, and the
+ * partition gives every rank n/P of them (rounded up): a run whose ranks
+ * would hold more is refused before computing, naming the limit and the
+ * number of ranks that would do.  (PDT_TEST_KERNEL_LIMIT=K lowers the limit
+ * for the tests: 2^29 points do not fit a test machine.) */
+static pdt_status check_size(run *R, pdt_err *err)
+{
+    R->phase = "options";
+    uint64_t limit = PDT_KERNEL_MAX_POINTS, n = R->in.n_total, p = (uint64_t)R->p;
+    const char *t = getenv("PDT_TEST_KERNEL_LIMIT");
+    if (t && strtoull(t, NULL, 10) > 0) limit = strtoull(t, NULL, 10);
+    pdt_status st = PDT_OK;
+    if (R->rank == 0 && (n + p - 1) / p > limit) {
+        uint64_t need = (n + limit - 1) / limit;
+        st = pdt_err_set(err, PDT_ERR_ARG,
+                         "%s: %llu points on %d rank%s: more than %llu points per rank, the "
+                         "kernel's limit (its edge records have 32-bit indices); run on at "
+                         "least %llu ranks (mpirun -np %llu ...)",
+                         strcmp(R->o->input, "-") ? R->o->input : "standard input",
+                         (unsigned long long)n, R->p, R->p == 1 ? "" : "s",
+                         (unsigned long long)limit, (unsigned long long)need,
+                         (unsigned long long)need);
+    }
+    return agreed(R, st, err);
+}
+
 static pdt_status read_input(run *R, pdt_err *err)
 {
     pdt_trace *tr = io_hook(R);
@@ -136,6 +162,7 @@ static pdt_status read_input(run *R, pdt_err *err)
     pdt_status st = agreed(R, pdt_par_read(R->c, R->o->input, R->o->scale, &R->in, err), err);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_READ, 0, 0, 0, 0);
     R->me.t_read = pdt_comm_wtime(R->c) - t0;
+    if (st == PDT_OK) st = check_size(R, err);
     if (st == PDT_OK) {
         R->phase = "trace";
         st = agreed(R, pdt_cli_trace_manifest(R->trace, R->o, R->c, &R->in, err), err);
