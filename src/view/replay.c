@@ -1025,6 +1025,8 @@ static int band_range(const double x[3], const double y[3], double lo, double hi
     return any;
 }
 
+#define COV_AHEAD 16  /* triangles ahead whose points are fetched (pdt_replay_coverage) */
+
 size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, double y0,
                            double x1, double y1, int cols, int rows,
                            const uint8_t *rank_visible, pdt_cov_cell *cells)
@@ -1035,6 +1037,13 @@ size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, 
     double sx = cols / (x1 - x0), sy = rows / (y1 - y0);
     size_t binned = 0;
     for (size_t t = 0; t < r->ntri; t++) {
+        /* the corners' points and the history entry of a triangle a few
+         * ahead: random places in tables of 10^8 bytes (a hint only) */
+        if (t + COV_AHEAD < r->ntri) {
+            const pdt_rtri *ahead = &r->tris[t + COV_AHEAD];
+            for (int k = 0; k < 3; k++) __builtin_prefetch(&r->pts[ahead->v[k]]);
+            if (s->tcur[t + COV_AHEAD] != NONE32) __builtin_prefetch(&r->hist[s->tcur[t + COV_AHEAD]]);
+        }
         uint32_t h = pdt_rstate_tri_entry(r, s, t);
         if (h == NONE32) continue;
         const pdt_rtri *tr = &r->tris[t];
