@@ -5,7 +5,7 @@
  *   [0, 4096)        header: magic, version, the run's identity, the sizes
  *                    of the record types, the table sizes, per section its
  *                    offset and length, the place of the chunk checksums
- *                    (a CRC-32C per 16 MiB of every section: verified by
+ *                    (a CRC-32C per 1 MiB of every section: verified by
  *                    several threads at each opening); the header's own CRC
  *   sections         the merged event records, then every table of the
  *                    replay (replay_int.h), the points and the reader's
@@ -34,10 +34,11 @@
 #include <unistd.h>
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 4u
+#define INDEX_VERSION 5u  /* 5: chunks of 1 MiB (were 16) */
 #define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/16 events, at least this */
 #define ICK_PARTS 16u
-#define CHUNK_BYTES ((uint64_t)16 << 20) /* sections are checksummed in chunks of this */
+#define CHUNK_BYTES ((uint64_t)1 << 20) /* sections are checksummed in chunks of this: the
+                                         * least a lazily checked frame reads */
 #define HDR_BYTES 4096u
 #define EST_BYTES_PER_EVENT 100u /* what the replay model holds per event in memory */
 
@@ -224,7 +225,7 @@ static int verify_chunks(int fd, const ihdr *h, char *why, size_t wcap)
  * frame reads a small part of it.  So a big index (pdt_replay_lazy_verify)
  * is mapped with no access but its header page: the first read of a page
  * faults, and the handler (SIGSEGV) checksums the chunks the page belongs
- * to, through a second, readable mapping of the file, before it opens their
+ * to, reading the file (pread), before it opens their
  * pages to the replay.  Nothing of the index is used unverified.  A mismatch
  * removes the index and calls the program's damage hook (which must not
  * return: the replay cannot go on with a damaged table). */
@@ -233,7 +234,7 @@ static int verify_chunks(int fd, const ihdr *h, char *why, size_t wcap)
 
 typedef struct lazy {
     char *base;                  /* the replay's mapping */
-    const char *raw;             /* the same file, readable: what is checksummed */
+    int fd;                      /* the file, read (pread) for the checksums */
     size_t len;
     uint64_t off[NSEC], bytes[NSEC], first[NSEC + 1];
     uint32_t *tab;               /* the chunk checksums */
@@ -269,10 +270,17 @@ static int lazy_verify(lazy *L, uint64_t c)
     if (atomic_load(&L->done[c])) return 1;
     uint64_t lo, hi;
     lazy_chunk(L, c, &lo, &hi);
-    uint32_t crc = pdt_crc32c(0, L->raw + lo, (size_t)(hi - lo));
-    /* the checksummed pages leave this process (they stay in the page cache) */
-    uint64_t a = (lo + 4095) & ~(uint64_t)4095, b = hi & ~(uint64_t)4095;
-    if (b > a) madvise((void *)(L->raw + a), (size_t)(b - a), MADV_DONTNEED);
+    /* read through a small buffer (pread: async-signal-safe, and cheaper
+     * than faulting the pages of a second mapping in) */
+    unsigned char buf[1 << 16];
+    uint32_t crc = 0;
+    for (uint64_t o = lo; o < hi;) {
+        size_t want = hi - o < sizeof buf ? (size_t)(hi - o) : sizeof buf;
+        ssize_t got = pread(L->fd, buf, want, (off_t)o);
+        if (got <= 0) return 0;
+        crc = pdt_crc32c(crc, buf, (size_t)got);
+        o += (uint64_t)got;
+    }
     if (crc != L->tab[c]) return 0;
     atomic_store(&L->done[c], 1);
     return 1;
@@ -291,6 +299,19 @@ static int lazy_verify_range(lazy *L, uint64_t lo, uint64_t hi)
     return 1;
 }
 
+/* Verify chunk c and open its pages to the replay (the chunks sharing its
+ * end pages verified first).  1, 0 on a mismatch, -1 if mprotect failed. */
+static int lazy_open_chunk(lazy *L, uint64_t c)
+{
+    uint64_t lo, hi;
+    lazy_chunk(L, c, &lo, &hi);
+    uint64_t plo = lo & ~(uint64_t)4095, phi = (hi + 4095) & ~(uint64_t)4095;
+    if (phi > L->len) phi = L->len;
+    if (!lazy_verify(L, c) || !lazy_verify_range(L, plo, lo) || !lazy_verify_range(L, hi, phi))
+        return 0;
+    return mprotect(L->base + plo, (size_t)(phi - plo), PROT_READ) == 0 ? 1 : -1;
+}
+
 /* Open the page at file offset pos to the replay: the chunks on it are
  * verified, then each of them is opened whole (and the chunks sharing its
  * end pages verified first).  0 on a mismatch or when the pages cannot be
@@ -304,14 +325,8 @@ static int lazy_open_page(lazy *L, uint64_t pos)
         if (!L->bytes[i] || e <= p || s >= pe) continue;
         uint64_t from = (p > s ? p : s) - s, to = (pe < e ? pe : e) - s;
         for (uint64_t c = from / CHUNK_BYTES; c <= (to - 1) / CHUNK_BYTES; c++) {
-            uint64_t lo, hi;
-            lazy_chunk(L, L->first[i] + c, &lo, &hi);
-            uint64_t plo = lo & ~(uint64_t)4095, phi = (hi + 4095) & ~(uint64_t)4095;
-            if (phi > L->len) phi = L->len;
-            if (!lazy_verify(L, L->first[i] + c) || !lazy_verify_range(L, plo, lo) ||
-                !lazy_verify_range(L, hi, phi))
-                return 0;
-            if (mprotect(L->base + plo, (size_t)(phi - plo), PROT_READ) != 0) return -1;
+            int ok = lazy_open_chunk(L, L->first[i] + c);
+            if (ok != 1) return ok;
             any = 1;
         }
     }
@@ -326,6 +341,22 @@ static char *cat(char *dst, const char *end, const char *src)
     return dst;
 }
 
+/* A chunk did not match (ok 0) or could not be opened (-1): remove the
+ * index, tell the program, stop (async-signal-safe). */
+static _Noreturn void lazy_fail(lazy *L, int ok)
+{
+    char *m = L->msg, *end = L->msg + sizeof L->msg - 1;
+    m = cat(m, end, "the kept index ");
+    m = cat(m, end, L->path);
+    m = cat(m, end, ok == 0 ? " is damaged (a checksum mismatch, found when a part of it was "
+                              "first read); it was removed: open the run again to rebuild it"
+                            : " cannot be opened to the replay (mprotect failed)");
+    *m = 0;
+    if (ok == 0) unlink(L->path);
+    if (damage_hook) damage_hook(L->msg);
+    abort();
+}
+
 static void segv_handler(int sig, siginfo_t *si, void *uc)
 {
     const char *a = si->si_addr;
@@ -334,16 +365,7 @@ static void segv_handler(int sig, siginfo_t *si, void *uc)
         if (!L || a < L->base || a >= L->base + L->len) continue;
         int ok = lazy_open_page(L, (uint64_t)(a - L->base));
         if (ok == 1) return;
-        char *m = L->msg, *end = L->msg + sizeof L->msg - 1;
-        m = cat(m, end, "the kept index ");
-        m = cat(m, end, L->path);
-        m = cat(m, end, ok == 0 ? " is damaged (a checksum mismatch, found when a part of it was "
-                                  "first read); it was removed: open the run again to rebuild it"
-                                : " cannot be opened to the replay (mprotect failed)");
-        *m = 0;
-        if (ok == 0) unlink(L->path);
-        if (damage_hook) damage_hook(L->msg);
-        abort();
+        lazy_fail(L, ok);
     }
     /* not ours: what was there before */
     if ((old_segv.sa_flags & SA_SIGINFO) && old_segv.sa_sigaction) {
@@ -372,20 +394,20 @@ static lazy *lazy_start(char *map, size_t len, const ihdr *h, uint32_t *tab, int
                         const char *path)
 {
     lazy *L = calloc(1, sizeof *L);
+    if (!L) return NULL;
     uint64_t n = 0;
     for (int i = 0; i < NSEC; i++) L->first[i] = n, n += chunks_of(h->sec[i].bytes);
-    if (!L) return NULL;
     L->first[NSEC] = n;
     L->done = calloc(n ? n : 1, 1);
-    void *raw = mmap(NULL, len, PROT_READ, MAP_SHARED, fd, 0);
-    if (!L->done || raw == MAP_FAILED || strlen(path) >= sizeof L->path) {
-        if (raw != MAP_FAILED) munmap(raw, len);
+    L->fd = fcntl(fd, F_DUPFD_CLOEXEC, 0);
+    if (!L->done || L->fd < 0 || strlen(path) >= sizeof L->path) {
+        if (L->fd >= 0) close(L->fd);
         free(L->done);
         free(L);
         return NULL;
     }
     L->base = map;
-    L->raw = raw;
+
     L->len = len;
     L->tab = tab;
     for (int i = 0; i < NSEC; i++) L->off[i] = h->sec[i].off, L->bytes[i] = h->sec[i].bytes;
@@ -398,7 +420,7 @@ static lazy *lazy_start(char *map, size_t len, const ihdr *h, uint32_t *tab, int
     }
     if (slot < 0 || mprotect(map + HDR_BYTES, len - HDR_BYTES, PROT_NONE) != 0) {
         if (slot >= 0) atomic_store(&lazies[slot], NULL);
-        munmap(raw, len);
+        close(L->fd);
         free(L->done);
         free(L);
         return NULL;
@@ -411,7 +433,7 @@ static void lazy_stop(lazy *L)
 {
     for (int k = 0; k < LAZY_MAX; k++)
         if (atomic_load(&lazies[k]) == L) atomic_store(&lazies[k], NULL);
-    munmap((void *)L->raw, L->len);
+    close(L->fd);
     munmap(L->base, L->len);
     free(L->tab);
     free(L->done);

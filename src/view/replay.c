@@ -426,6 +426,8 @@ static pdt_status build(pdt_replay *r, pdt_err *err)
             !grow((void **)&r->edges, &r->cap_edge, cnt[PDT_EV_EDGE_ADD], sizeof *r->edges) ||
             !grow((void **)&r->nodes, &r->cap_node, cnt[PDT_EV_PUSH], sizeof *r->nodes))
             goto out;
+        pdt_big_advise(r->tris, r->cap_tri * sizeof *r->tris);
+        pdt_big_advise(b.tri_count, b.cap_count * sizeof *b.tri_count);
     }
 
     for (size_t i = 0; i < r->m; i++) {
@@ -471,6 +473,7 @@ static pdt_status build(pdt_replay *r, pdt_err *err)
     }
     r->hist = malloc((r->nhist ? r->nhist : 1) * sizeof *r->hist);
     if (!r->hist) goto out;
+    pdt_big_advise(r->hist, r->nhist * sizeof *r->hist);
     for (size_t i = 0; i < r->m; i++) {
         const pdt_event *e = &r->recs[i].ev;
         if (!is_tri_kind(e->kind) || r->ev_obj[i] < 0) continue;
@@ -546,6 +549,15 @@ pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, s
         pdt_replay_free(r);
         return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for %zu events", m);
     }
+    /* tables of a huge run: huge pages spare most page faults (costly on
+     * virtual machines); a hint only */
+    pdt_big_advise(r->ev_obj, m1 * sizeof *r->ev_obj);
+    pdt_big_advise(r->ev_ent, m1 * sizeof *r->ev_ent);
+    pdt_big_advise(r->ev_kind, m1 * sizeof *r->ev_kind);
+    pdt_big_advise(r->lift_ev, n1 * sizeof *r->lift_ev);
+    pdt_big_advise(r->sort_ev, n1 * sizeof *r->sort_ev);
+    pdt_big_advise(r->del_ev, n1 * sizeof *r->del_ev);
+    pdt_big_advise(r->sort_pos, n1 * sizeof *r->sort_pos);
     for (size_t p = 0; p < n; p++) {
         r->lift_ev[p] = r->sort_ev[p] = r->del_ev[p] = NONE32;
         r->sort_pos[p] = -1;
