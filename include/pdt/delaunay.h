@@ -49,6 +49,13 @@ typedef struct pdt_tri_stats {
 pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
                            pdt_tri_stats *stats, pdt_trace *tr);
 
+/* The same pipeline on the caller's points used as working memory (8 bytes
+ * per point less at the peak than pdt_triangulate, which copies them): during
+ * the call pts[] hold other values; on return, success or not, they hold
+ * their values again. */
+pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
+                                   pdt_tri_stats *stats, pdt_trace *tr);
+
 /* Sort-and-dedupe helper used by the pipeline and the parallel driver:
  * writes to order[0..*nu) the input indices of the distinct points in
  * lexicographic order, each the smallest index among its copies. */

@@ -503,42 +503,33 @@ static size_t collect(dt *d, const uint32_t *id, const uint32_t *tid, int run)
     return nt;
 }
 
-/* T* of the n >= 2 distinct points pts[id[0]], ..., pts[id[n-1]], listed in
- * lexicographic order (id is reordered: leaf order).  lexq: NULL, or those
- * points already in that order (the sort decodes them from its keys, which
- * saves a random gather; reordered too, still the caller's to free).
- * Triangles come out as ids; the trace sees ids through tr->gid when there is
- * one. */
-static pdt_status kernel(const pdt_point *pts, uint32_t *id, pdt_point *lexq, size_t n,
-                         pdt_tri **tris, size_t *ntri, int run, pdt_trace *tr)
+/* T* of the n >= 2 distinct points q[0, n), listed in lexicographic order,
+ * on memory the caller provides: id[0, n) names them (q and id are reordered
+ * together: leaf order), e has room for cap >= 6n + 12 edge records, the
+ * cutter's scratch first, the edges then, and the triangles at last (written
+ * over the edges: (pdt_tri *)e, *ntri of them).  Triangles come out as ids;
+ * the trace sees ids through tr->gid when there is one.  Returns
+ * PDT_ERR_NOMEM (q and id still consistent) when an allocation fails. */
+static pdt_status kernel_on(uint32_t *id, pdt_point *q, size_t n, edge *e, size_t cap,
+                            size_t *ntri, int run, pdt_trace *tr)
 {
-    *tris = NULL;
     *ntri = 0;
     dt d;
     memset(&d, 0, sizeof d);
     d.freelist = NIL;
-    d.cap = 6 * n + 12; /* at most 3n undirected edges alive */
-    d.e = malloc(d.cap * sizeof *d.e); /* becomes the triangle array */
-    pdt_point *q = lexq ? lexq : pdt_big_alloc(n * sizeof *q);
-    if (!d.e || !q) {
-        free(d.e);
-        if (!lexq) pdt_big_free(q, n * sizeof *q);
-        return PDT_ERR_NOMEM;
-    }
-    pdt_big_advise(d.e, d.cap * sizeof *d.e);
-    /* the cuts, on the points gathered in lexicographic order and moved
-     * along with their ids (scratch: 7 words per point, in the edge array
-     * before any edge exists) */
+    d.e = e;
+    d.cap = cap; /* at most 3n undirected edges alive */
     int32_t minx = INT32_MAX, maxx = INT32_MIN, miny = INT32_MAX, maxy = INT32_MIN;
     for (size_t i = 0; i < n; i++) {
-        pdt_point v = lexq ? q[i] : pts[id[i]];
-        q[i] = v;
+        pdt_point v = q[i];
         minx = v.x < minx ? v.x : minx;
         maxx = v.x > maxx ? v.x : maxx;
         miny = v.y < miny ? v.y : miny;
         maxy = v.y > maxy ? v.y : maxy;
     }
     d.small = (int64_t)maxx - minx < (INT64_C(1) << 30) && (int64_t)maxy - miny < (INT64_C(1) << 30);
+    /* the cuts, on the points moved along with their ids (scratch: 7 words
+     * per point, in the edge array before any edge exists) */
     cutter c = { q, id, (uint64_t *)(void *)d.e, NULL, NULL, NULL };
     c.ks = c.k + n;
     c.tp = (uint32_t *)(void *)(c.ks + n);
@@ -552,11 +543,7 @@ static pdt_status kernel(const pdt_point *pts, uint32_t *id, pdt_point *lexq, si
     if (tr) {
         if (tr->gid) {
             tmap = malloc(n * sizeof *tmap);
-            if (!tmap) {
-                free(d.e);
-                if (!lexq) pdt_big_free(q, n * sizeof *q);
-                return PDT_ERR_NOMEM;
-            }
+            if (!tmap) return PDT_ERR_NOMEM;
             for (size_t i = 0; i < n; i++) tmap[i] = tr->gid[id[i]];
             tid = tmap;
         }
@@ -566,22 +553,15 @@ static pdt_status kernel(const pdt_point *pts, uint32_t *id, pdt_point *lexq, si
     }
     uint32_t le, re;
     int ok = build(&d, 0, (uint32_t)n, 0, &le, &re);
-    size_t nt = ok ? collect(&d, id, tid, run) : 0;
+    if (ok) *ntri = collect(&d, id, tid, run);
     free(tmap);
-    if (!lexq) pdt_big_free(q, n * sizeof *q);
-    if (!ok) {
-        free(d.e);
-        return PDT_ERR_NOMEM;
-    }
-    if (nt == 0) {
-        free(d.e);
-        return PDT_OK;
-    }
-    pdt_tri *out = (pdt_tri *)(void *)d.e;
-    pdt_tri *shrunk = realloc(out, nt * sizeof *shrunk);
-    *tris = shrunk ? shrunk : out;
-    *ntri = nt;
-    return PDT_OK;
+    return ok ? PDT_OK : PDT_ERR_NOMEM;
+}
+
+/* Edge records for the kernel on n points (the planar bound and a margin). */
+static size_t edge_cap(size_t n)
+{
+    return 6 * n + 12;
 }
 
 pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri, int run,
@@ -593,12 +573,31 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
     if (n > (size_t)(UINT32_MAX / 8)) return PDT_ERR_ARG;
     for (size_t i = 1; i < n; i++) /* the precondition: distinct and sorted */
         if (pdt_key(pts[i - 1]) >= pdt_key(pts[i])) return PDT_ERR_ARG;
+    size_t cap = edge_cap(n);
     uint32_t *id = malloc(n * sizeof *id);
-    if (!id) return PDT_ERR_NOMEM;
+    pdt_point *q = pdt_big_alloc(n * sizeof *q);
+    edge *e = malloc(cap * sizeof *e); /* becomes the triangle array */
+    if (!id || !q || !e) {
+        free(id);
+        pdt_big_free(q, n * sizeof *q);
+        free(e);
+        return PDT_ERR_NOMEM;
+    }
+    pdt_big_advise(e, cap * sizeof *e);
     for (uint32_t i = 0; i < (uint32_t)n; i++) id[i] = i;
-    pdt_status s = kernel(pts, id, NULL, n, tris, ntri, run, tr);
+    memcpy(q, pts, n * sizeof *q);
+    size_t nt = 0;
+    pdt_status s = kernel_on(id, q, n, e, cap, &nt, run, tr);
     free(id);
-    return s;
+    pdt_big_free(q, n * sizeof *q);
+    if (s != PDT_OK || nt == 0) {
+        free(e);
+        return s;
+    }
+    pdt_tri *shrunk = realloc(e, nt * sizeof *shrunk);
+    *tris = shrunk ? shrunk : (pdt_tri *)(void *)e;
+    *ntri = nt;
+    return PDT_OK;
 }
 
 /* ---- canonical order ---- */
@@ -656,7 +655,7 @@ static void sort_run(pdt_tri *t, size_t lo, size_t hi)
  * indices (two triangles per vertex on average) are then sorted by the other
  * two.  A random scatter of all triangles in one pass, as before, missed the
  * cache and the TLB on every triangle at 10^7 points. */
-void pdt_tri_canonical(pdt_tri *tris, size_t ntri)
+static void canonical(pdt_tri *tris, size_t ntri, pdt_tri *scratch)
 {
     if (ntri == 0) return;
     uint32_t minv = UINT32_MAX, maxv = 0;
@@ -670,11 +669,11 @@ void pdt_tri_canonical(pdt_tri *tris, size_t ntri)
     uint32_t span = maxv - minv;
     int bits = 32 - __builtin_clz(span | 1u), shift = bits > 11 ? bits - 11 : 0;
     size_t nhi = ((size_t)span >> shift) + 1, nlo = (size_t)1 << shift;
-    pdt_tri *tmp = ntri > 64 ? pdt_big_alloc(ntri * sizeof *tmp) : NULL;
+    pdt_tri *tmp = ntri <= 64 ? NULL : scratch ? scratch : pdt_big_alloc(ntri * sizeof *tmp);
     size_t *hc = tmp ? calloc(nhi + 1, sizeof *hc) : NULL;
     size_t *lc = hc ? malloc((nlo + 1) * sizeof *lc) : NULL;
     if (!lc) {
-        pdt_big_free(tmp, ntri * sizeof *tmp);
+        if (tmp != scratch) pdt_big_free(tmp, ntri * sizeof *tmp);
         free(hc);
         qsort(tris, ntri, sizeof *tris, tri_qcmp);
         return;
@@ -701,9 +700,14 @@ void pdt_tri_canonical(pdt_tri *tris, size_t ntri)
         }
         start = end;
     }
-    pdt_big_free(tmp, ntri * sizeof *tmp);
+    if (tmp != scratch) pdt_big_free(tmp, ntri * sizeof *tmp);
     free(hc);
     free(lc);
+}
+
+void pdt_tri_canonical(pdt_tri *tris, size_t ntri)
+{
+    canonical(tris, ntri, NULL);
 }
 
 /* ---- sort and dedupe ---- */
@@ -773,23 +777,23 @@ static keyed *lsd_sort(keyed *src, keyed *dst, size_t m, int bits, size_t *cnt)
  * points stay in input order and the first is kept.  (Four passes of 16-bit
  * digits over the whole array, as before, had 65 536 output streams: far
  * past the cache and the TLB at 10^7 points.) */
-/* pdt_sort_unique; q: NULL, or room for n points, where the distinct points
- * are written in order (decoded from the keys: q[i] == pts[order[i]]). */
-static pdt_status sort_unique(const pdt_point *pts, size_t n, uint32_t *order, pdt_point *q,
-                              size_t *nu)
+/* What the sort writes: order[0, nu) the input indices of the distinct
+ * points in order, each the smallest of its copies; q (NULL, or room for n
+ * points): the distinct points in order, decoded from the keys (q[i] ==
+ * pts[order[i]]); dup (NULL, or room for 2n words): a pair (index of a
+ * copy, index kept for it) for each of the ndup copies dropped. */
+typedef struct sorted {
+    uint32_t *order;
+    pdt_point *q;
+    uint32_t *dup;
+    size_t nu, ndup;
+} sorted;
+
+/* The sort on the caller's scratch: a and b room for n records each, cnt
+ * and hc 2049 counters each.  n >= 1. */
+static void sort_core(const pdt_point *pts, size_t n, keyed *a, keyed *b, size_t *cnt,
+                      size_t *hc, sorted *o)
 {
-    *nu = 0;
-    if (n == 0) return PDT_OK;
-    if (n > UINT32_MAX) return PDT_ERR_ARG;
-    keyed *a = pdt_big_alloc(n * sizeof *a), *b = pdt_big_alloc(n * sizeof *b);
-    size_t *cnt = malloc(2049 * sizeof *cnt), *hc = malloc(2049 * sizeof *hc);
-    if (!a || !b || !cnt || !hc) {
-        pdt_big_free(a, n * sizeof *a);
-        pdt_big_free(b, n * sizeof *b);
-        free(cnt);
-        free(hc);
-        return PDT_ERR_NOMEM;
-    }
     int32_t minx = INT32_MAX, maxx = INT32_MIN, miny = INT32_MAX, maxy = INT32_MIN;
     for (size_t i = 0; i < n; i++) {
         if (pts[i].x < minx) minx = pts[i].x;
@@ -812,7 +816,7 @@ static pdt_status sort_unique(const pdt_point *pts, size_t n, uint32_t *order, p
     for (size_t h = 1; h <= nb; h++) hc[h] += hc[h - 1];
     for (size_t i = 0; i < n; i++) b[hc[a[i].key >> shift]++] = a[i];
     /* hc[h] is the end of bucket h, in b */
-    size_t u = 0, start = 0;
+    size_t u = 0, nd = 0, start = 0;
     int have_prev = 0;
     uint64_t prev = 0;
     for (size_t h = 0; h < nb; h++) {
@@ -820,29 +824,45 @@ static pdt_status sort_unique(const pdt_point *pts, size_t n, uint32_t *order, p
         keyed *r = lsd_sort(b + start, a + start, end - start, shift, cnt);
         for (size_t i = 0; i < end - start; i++) {
             if (!have_prev || r[i].key != prev) {
-                if (q) {
+                if (o->q) {
                     uint64_t kx = by ? r[i].key >> by : r[i].key, ky = r[i].key & ymask;
-                    q[u].x = (int32_t)((int64_t)kx + minx);
-                    q[u].y = (int32_t)((int64_t)ky + miny);
+                    o->q[u].x = (int32_t)((int64_t)kx + minx);
+                    o->q[u].y = (int32_t)((int64_t)ky + miny);
                 }
-                order[u++] = r[i].idx;
+                o->order[u++] = r[i].idx;
+            } else if (o->dup) {
+                o->dup[2 * nd] = r[i].idx;
+                o->dup[2 * nd + 1] = o->order[u - 1];
+                nd++;
             }
             prev = r[i].key;
             have_prev = 1;
         }
         start = end;
     }
-    *nu = u;
-    pdt_big_free(a, n * sizeof *a);
-    pdt_big_free(b, n * sizeof *b);
-    free(cnt);
-    free(hc);
-    return PDT_OK;
+    o->nu = u;
+    o->ndup = n - u;
 }
 
 pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size_t *nu)
 {
-    return sort_unique(pts, n, order, NULL, nu);
+    *nu = 0;
+    if (n == 0) return PDT_OK;
+    if (n > UINT32_MAX) return PDT_ERR_ARG;
+    keyed *a = pdt_big_alloc(n * sizeof *a), *b = pdt_big_alloc(n * sizeof *b);
+    size_t *cnt = malloc(2049 * sizeof *cnt), *hc = malloc(2049 * sizeof *hc);
+    pdt_status st = PDT_ERR_NOMEM;
+    if (a && b && cnt && hc) {
+        sorted o = { order, NULL, NULL, 0, 0 };
+        sort_core(pts, n, a, b, cnt, hc, &o);
+        *nu = o.nu;
+        st = PDT_OK;
+    }
+    pdt_big_free(a, n * sizeof *a);
+    pdt_big_free(b, n * sizeof *b);
+    free(cnt);
+    free(hc);
+    return st;
 }
 
 /* ---- the pipeline ---- */
@@ -854,8 +874,29 @@ static double now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
-                           pdt_tri_stats *stats, pdt_trace *tr)
+/* Put pts back as they were: the distinct points from q (== pts[0, nu), in
+ * the kernel's order, id naming them) through a copy in `scratch` (room for
+ * nu points), then each dropped copy from the point kept for it. */
+static void restore_points(pdt_point *pts, size_t nu, const uint32_t *id, const uint32_t *dup,
+                           size_t ndup, pdt_point *scratch)
+{
+    memcpy(scratch, pts, nu * sizeof *pts);
+    for (size_t v = 0; v < nu; v++) pts[id[v]] = scratch[v];
+    for (size_t k = 0; k < ndup; k++) pts[dup[2 * k]] = pts[dup[2 * k + 1]];
+}
+
+/* Memory of the pipeline (n input points, nu distinct): one block R of
+ * edge_cap(n) edge records (72 bytes per point) is the sort's scratch (two
+ * key arrays, the sorted points and the copies dropped: 48 bytes per point),
+ * then the kernel's cut scratch, edges and triangles, then the canonical
+ * order's scratch, and at last (shrunk) the triangles returned; order (4
+ * bytes per point) names the distinct points; the points themselves (8 bytes
+ * per point) are the caller's array, in the kernel's order during the
+ * kernel.  Peak: 84 bytes per point (92 when the kernel had its own copy of
+ * the points and the sort its own scratch); every page of R is touched once
+ * (the fresh-page faults were a sixth of the time at 10^7 points). */
+pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
+                                   pdt_tri_stats *stats, pdt_trace *tr)
 {
     *tris = NULL;
     *ntri = 0;
@@ -863,22 +904,44 @@ pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_
     memset(&st, 0, sizeof st);
     st.n_in = n;
     if (n > (size_t)(UINT32_MAX / 8)) return PDT_ERR_ARG;
+    if (n == 0) {
+        st.collinear = 1;
+        if (stats) *stats = st;
+        return PDT_OK;
+    }
 
     double t0 = now();
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_PARTITION, 0, 0, 0, 0);
-    uint32_t *order = malloc((n ? n : 1) * sizeof *order);
-    pdt_point *lexq = order ? pdt_big_alloc(n * sizeof *lexq) : NULL;
-    if (!lexq) {
+    size_t cap = edge_cap(n);
+    edge *R = malloc(cap * sizeof *R);
+    uint32_t *order = malloc(n * sizeof *order), *dup = NULL;
+    size_t *cnt = malloc(2049 * sizeof *cnt), *hc = malloc(2049 * sizeof *hc);
+    if (!R || !order || !cnt || !hc) {
+        free(R);
         free(order);
+        free(cnt);
+        free(hc);
         return PDT_ERR_NOMEM;
     }
-    size_t nu;
-    pdt_status s = sort_unique(pts, n, order, lexq, &nu);
-    if (s != PDT_OK) {
-        free(order);
-        pdt_big_free(lexq, n * sizeof *lexq);
-        return s;
+    pdt_big_advise(R, cap * sizeof *R);
+    pdt_big_advise(order, n * sizeof *order);
+    keyed *ka = (keyed *)(void *)R, *kb = ka + n;
+    pdt_point *q = (pdt_point *)(void *)(kb + n);
+    sorted so = { order, q, (uint32_t *)(void *)(q + n), 0, 0 };
+    sort_core(pts, n, ka, kb, cnt, hc, &so);
+    free(cnt);
+    free(hc);
+    size_t nu = so.nu;
+    if (so.ndup) {
+        dup = malloc(2 * so.ndup * sizeof *dup);
+        if (!dup) {
+            free(R);
+            free(order);
+            return PDT_ERR_NOMEM;
+        }
+        memcpy(dup, so.dup, 2 * so.ndup * sizeof *dup);
     }
+    memcpy(pts, q, nu * sizeof *pts); /* from here on pts[0, nu) are the kernel's */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_PARTITION, 0, 0, 0, 0);
     st.n_unique = nu;
     st.n_dup = n - nu;
@@ -888,25 +951,39 @@ pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_
         PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_LIFT, 0, 0, 0, 0);
         for (size_t i = 0; i < nu; i++)
             PDT_TRACE(tr, 1, PDT_EV_LIFT, 0, PDT_TRACE_PT(tr, order[i]), 0, 0,
-                      (int64_t)pdt_lift(pts[order[i]]).z);
+                      (int64_t)pdt_lift(pts[i]).z);
         PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_LIFT, 0, 0, 0, 0);
     }
 
-    /* the kernel on the input points through `order`: triangles come out as
-     * input indices, the trace names points as before (tr->gid composed) */
+    /* the kernel on the distinct points, named by their input indices:
+     * triangles come out as input indices, the trace names points as before
+     * (tr->gid composed) */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_KERNEL, 0, 0, 0, 0);
-    pdt_tri *t = NULL;
     size_t nt = 0;
-    s = nu >= 2 ? kernel(pts, order, lexq, nu, &t, &nt, 0, tr) : PDT_OK;
+    pdt_status s = nu >= 2 ? kernel_on(order, pts, nu, R, cap, &nt, 0, tr) : PDT_OK;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
-    free(order);
-    pdt_big_free(lexq, n * sizeof *lexq);
-    if (s != PDT_OK) return s;
     double t2 = now();
 
+    /* the triangles fill R[0, nt) (12 bytes each: at most 24 bytes per point);
+     * the rest of R is scratch for what follows */
+    pdt_tri *t = (pdt_tri *)(void *)R;
+    restore_points(pts, nu, order, dup, so.ndup, (pdt_point *)(void *)(t + nt));
+    free(order);
+    free(dup);
+    if (s != PDT_OK) {
+        free(R);
+        return s;
+    }
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_OUTPUT, 0, 0, 0, 0);
-    pdt_tri_canonical(t, nt);
+    canonical(t, nt, t + nt);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_OUTPUT, 0, 0, 0, 0);
+    if (nt == 0) {
+        free(R);
+        t = NULL;
+    } else {
+        pdt_tri *shrunk = realloc(t, nt * sizeof *shrunk);
+        if (shrunk) t = shrunk;
+    }
     double t3 = now();
 
     st.n_tri = nt;
@@ -920,4 +997,18 @@ pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_
     *tris = t;
     *ntri = nt;
     return PDT_OK;
+}
+
+pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
+                           pdt_tri_stats *stats, pdt_trace *tr)
+{
+    *tris = NULL;
+    *ntri = 0;
+    if (n > (size_t)(UINT32_MAX / 8)) return PDT_ERR_ARG;
+    pdt_point *w = pdt_big_alloc(n * sizeof *w);
+    if (!w) return PDT_ERR_NOMEM;
+    memcpy(w, pts, n * sizeof *w);
+    pdt_status s = pdt_triangulate_inplace(w, n, tris, ntri, stats, tr);
+    pdt_big_free(w, n * sizeof *w);
+    return s;
 }

@@ -1,6 +1,8 @@
 /* pdt — loading a text file and scanning it line by line (see io_internal.h). */
 #include "io_internal.h"
 
+#include "../geom/bigmem.h"
+
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -29,13 +31,15 @@ pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
         if (!is_stdin) close(fd);
         return pdt_err_set(err, PDT_ERR_IO, "%s: is a directory", name);
     }
-    /* Regular files: one allocation of the right size; pipes: grow. */
-    size_t cap = S_ISREG(sb.st_mode) && sb.st_size > 0 ? (size_t)sb.st_size + 1 : 65536;
+    /* Regular files: one allocation of the right size (room for the byte the
+     * read that finds the end asks for, and the '\0'); pipes: grow. */
+    size_t cap = S_ISREG(sb.st_mode) && sb.st_size > 0 ? (size_t)sb.st_size + 2 : 65536;
     char *buf = malloc(cap);
     if (!buf) {
         if (!is_stdin) close(fd);
         return pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory (%zu bytes)", name, cap);
     }
+    pdt_big_advise(buf, cap); /* huge pages: a fresh 4 KiB page costs a fault */
     size_t len = 0;
     for (;;) {
         if (cap - len < 2) {
@@ -48,6 +52,7 @@ pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
             }
             buf = nb;
             cap = ncap;
+            pdt_big_advise(buf, cap);
         }
         ssize_t r = read(fd, buf + len, cap - len - 1);
         if (r < 0) {

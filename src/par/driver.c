@@ -574,7 +574,7 @@ static pdt_status sequential(pdt_comm *c, const pdt_par_input *in, pdt_par_outpu
 {
     pdt_tri_stats ts;
     double c0 = cpu_seconds(), w0 = pdt_comm_wtime(c);
-    pdt_status st = pdt_triangulate(in->pts, in->n, &out->tris, &out->ntri, &ts, tr);
+    pdt_status st = pdt_triangulate_inplace(in->pts, in->n, &out->tris, &out->ntri, &ts, tr);
     if (st != PDT_OK) return pdt_err_set(err, st, "triangulation failed: %s", pdt_status_str(st));
     out->first = 0;
     out->n_total = out->ntri;
