@@ -15,6 +15,7 @@
  * With one rank the sequential pipeline (pdt_triangulate) does all of it. */
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/resource.h>
 #include <time.h>
 #include <unistd.h>
@@ -41,6 +42,8 @@ typedef struct drv {
     uint32_t *seq_send, *seq_recv; /* per-peer message sequence numbers */
     uint64_t bytes_sent, bytes_recv, merge_sent, merge_recv;
     srm_rec *rec;                  /* partition: this rank's distinct records */
+    srm_rec *spare;                /* and a scratch array of the same size */
+    size_t rec_bytes;              /* size of both blocks */
     size_t m;
     uint64_t nrecv;
     uint64_t n_total;              /* points in the whole input */
@@ -208,8 +211,14 @@ static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
     size_t *start = calloc((size_t)p + 1, sizeof *start);
     uint64_t *split = malloc((size_t)p * sizeof *split), *sc = NULL, *rc = NULL;
     srm_rec *rec = NULL, *tmp = NULL, *got = NULL;
-    rec = srm_big((n + 1) * sizeof *rec);
-    tmp = srm_big((n + 1) * sizeof *tmp);
+    /* two blocks serve the whole phase (fresh pages are costly): room for
+     * this rank's input block or its share of the whole plus 1/16, touched
+     * only as far as used */
+    size_t share = (size_t)(d->n_total / (uint64_t)p), cap = n > share ? n : share;
+    cap += cap / 16 + 64;
+    size_t bytes = cap * sizeof(srm_rec);
+    rec = srm_big(bytes);
+    tmp = srm_big(bytes);
     sc = malloc((size_t)p * sizeof *sc);
     rc = malloc((size_t)p * sizeof *rc);
     if (!cnt || !rcnt || !start || !split || !sc || !rc || !rec || !tmp) goto nomem;
@@ -221,8 +230,6 @@ static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
     }
     /* input order is index order: the stable sort orders equal keys by index */
     pdt_srm_radix_sort(rec, tmp, n);
-    free(tmp);
-    tmp = NULL;
     st = splitters(d, rec, n, split, err);
     if (st != PDT_OK) goto done;
     /* rank q's records are a consecutive block of the sorted ones */
@@ -244,15 +251,25 @@ static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
         total += (size_t)rc[q];
     }
     start[p] = total;
-    got = srm_big((total + 1) * sizeof *got);
-    if (!got) goto nomem;
+    size_t need = total >= cap ? total + 1 : 0; /* more than the room (many equal keys) */
+    if (need) {
+        free(tmp);
+        tmp = srm_big(need * sizeof(srm_rec));
+        if (!tmp) goto nomem;
+    }
+    got = tmp;
+    tmp = NULL;
     st = pdt_comm_alltoallv(d->c, rec, cnt, got, rcnt, err);
     if (st != PDT_OK) goto done;
     note_v(d, TAG_RECORDS, cnt, rcnt);
-    free(rec);
+    if (need) { /* the merge's scratch too */
+        free(rec);
+        bytes = need * sizeof(srm_rec);
+        rec = srm_big(bytes);
+        if (!rec) goto nomem;
+    }
+    tmp = rec;
     rec = NULL;
-    tmp = srm_big((total + 1) * sizeof *tmp);
-    if (!tmp) goto nomem;
     /* blocks arrive in rank order, each key-sorted with equal keys in index
      * order, and rank q's indices are all below rank q+1's: the stable merge
      * puts the smallest index first among equal keys */
@@ -264,7 +281,9 @@ static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
     d->nrecv = total;
     d->m = pdt_srm_dedupe(got, total);
     d->rec = got;
-    got = NULL;
+    d->spare = tmp;
+    d->rec_bytes = bytes;
+    got = tmp = NULL;
     goto done;
 nomem:
     st = pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: partition: out of memory", r);
@@ -281,31 +300,49 @@ done:
     return st;
 }
 
+/* Give the pages of p[used, bytes) back to the system (the block stays
+ * allocated; only whole pages inside the range go). */
+static void release_tail(void *p, size_t used, size_t bytes)
+{
+    uintptr_t a = ((uintptr_t)p + used + 4095) & ~(uintptr_t)4095;
+    uintptr_t b = ((uintptr_t)p + bytes) & ~(uintptr_t)4095;
+    if (b > a) madvise((void *)a, b - a, MADV_DONTNEED);
+}
 
 /* The local strip from the partition's records: points, global indices and
- * the strip descriptor, allgathered into d->strip. */
+ * the strip descriptor, allgathered into d->strip.  No fresh memory: the
+ * points are written over the records (8 bytes over 16, front to back),
+ * the indices into the partition's spare array, and the pages beyond what
+ * they use are given back. */
 static pdt_status strips(drv *d, pdt_point **lp, uint32_t **lg, pdt_err *err)
 {
     size_t m = d->m;
-    *lp = srm_big((m + 1) * sizeof **lp);
-    *lg = srm_big((m + 1) * sizeof **lg);
     d->strip = malloc((size_t)d->p * sizeof *d->strip);
-    if (!*lp || !*lg || !d->strip) return nomem(d, "partition");
+    if (!d->strip) return nomem(d, "partition");
     srm_strip mine = {m, 0, 0, 0, 0, 0, 0};
-    for (size_t i = 0; i < m; i++) {
-        (*lp)[i] = srm_key_point(d->rec[i].key);
-        (*lg)[i] = d->rec[i].idx;
-        if (i == 0 || (*lp)[i].y < mine.ymin) mine.ymin = (*lp)[i].y;
-        if (i == 0 || (*lp)[i].y > mine.ymax) mine.ymax = (*lp)[i].y;
-    }
     if (m) {
         mine.first_key = d->rec[0].key;
         mine.last_key = d->rec[m - 1].key;
-        mine.xmin = (*lp)[0].x;
-        mine.xmax = (*lp)[m - 1].x;
     }
-    free(d->rec);
+    pdt_point *pt = (pdt_point *)(void *)d->rec;
+    uint32_t *g = (uint32_t *)(void *)d->spare;
+    for (size_t i = 0; i < m; i++) {
+        srm_rec r = d->rec[i]; /* read whole before pt[i] overwrites its front */
+        pt[i] = srm_key_point(r.key);
+        g[i] = r.idx;
+        if (i == 0 || pt[i].y < mine.ymin) mine.ymin = pt[i].y;
+        if (i == 0 || pt[i].y > mine.ymax) mine.ymax = pt[i].y;
+    }
+    if (m) {
+        mine.xmin = pt[0].x;
+        mine.xmax = pt[m - 1].x;
+    }
+    release_tail(pt, m * sizeof *pt, d->rec_bytes);
+    release_tail(g, m * sizeof *g, d->rec_bytes);
+    *lp = pt;
+    *lg = g;
     d->rec = NULL;
+    d->spare = NULL;
     pdt_status st = pdt_comm_allgather(d->c, &mine, sizeof mine, d->strip, err);
     if (st == PDT_OK) note_all(d, TAG_STRIPS, sizeof mine);
     return st;
@@ -667,6 +704,7 @@ done:
     if (tr) tr->gid = saved_gid;
     if (d.s_init) pdt_srm_free(&d.s);
     free(d.rec);
+    free(d.spare);
     free(lp);
     free(lg);
     free(d.strip);

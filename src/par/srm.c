@@ -88,16 +88,40 @@ static pdt_status nomem(pdt_err *err, int rank, const char *what)
     return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", rank, what);
 }
 
+/* realloc for arrays that may be large: a large new block asks for huge
+ * pages BEFORE the old contents are copied into it (realloc would copy
+ * first, faulting in every 4 KiB page, and advise after). */
+static void *big_realloc(void *p, size_t old_bytes, size_t bytes)
+{
+    if (bytes < ((size_t)2 << 20)) return realloc(p, bytes);
+    void *q = srm_big(bytes);
+    if (!q) return NULL;
+    if (old_bytes) memcpy(q, p, old_bytes < bytes ? old_bytes : bytes);
+    free(p);
+    return q;
+}
+
 static pdt_status grow(void **p, size_t *cap, size_t need, size_t size)
 {
     if (need <= *cap) return PDT_OK;
     size_t c = *cap ? *cap : 64;
     while (c < need) c *= 2;
-    void *q = realloc(*p, c * size);
+    void *q = big_realloc(*p, *cap * size, c * size);
     if (!q) return PDT_ERR_NOMEM;
-    if (c * size >= ((size_t)2 << 20)) pdt_big_advise(q, c * size);
     *p = q;
     *cap = c;
+    return PDT_OK;
+}
+
+/* Exactly `need` places (or more if already there): for an array that is
+ * large and about to take a known number of elements. */
+static pdt_status reserve(void **p, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap) return PDT_OK;
+    void *q = big_realloc(*p, *cap * size, need * size);
+    if (!q) return PDT_ERR_NOMEM;
+    *p = q;
+    *cap = need;
     return PDT_OK;
 }
 
@@ -245,36 +269,47 @@ pdt_status pdt_srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid,
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_HULL, 0, 0, 0, 0);
 
     /* classification: final at once, or deferred until a merge level (with
-     * no other strip at all, everything is final without a test) */
+     * no other strip at all, everything is final without a test).  The
+     * final triangles stay in the kernel's array, renamed to global indices
+     * and moved down over the deferred ones (k <= i): it becomes s->fin, no
+     * second array of the same size */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_CLASSIFY, 0, 0, 0, 0);
-    if (grow((void **)&s->fin, &s->capfin, s->nfin + ntri, sizeof *s->fin)) { /* most are final */
-        free(tris);
-        return nomem(err, s->rank, "classify");
-    }
     int alone = s->nne == 0 || (s->nne == 1 && s->nonempty[0] == s->rank);
+    size_t k = 0;
     for (size_t i = 0; i < ntri; i++) {
         srm_pt v[3];
-        for (int k = 0; k < 3; k++) {
-            uint32_t j = tris[i].v[k];
-            v[k] = (srm_pt){pts[j].x, pts[j].y, gid[j]};
+        for (int e = 0; e < 3; e++) {
+            uint32_t j = tris[i].v[e];
+            v[e] = (srm_pt){pts[j].x, pts[j].y, gid[j]};
         }
         int who;
         int lev = alone ? -1 : send_level(s, s->rank, 0, v[0], v[1], v[2], &who);
         if (lev < 0) {
-            st = add_final(s, v[0], v[1], v[2]);
-            s->cnt.final_at_once++;
+            tris[k++] = (pdt_tri){{v[0].gid, v[1].gid, v[2].gid}};
+            PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, v[0].gid, v[1].gid, v[2].gid, 0);
         } else {
-            st = add_pending(s, v[0], v[1], v[2], lev);
+            if (add_pending(s, v[0], v[1], v[2], lev) != PDT_OK) {
+                free(tris);
+                return nomem(err, s->rank, "classify");
+            }
             s->cnt.deferred++;
             PDT_TRACE(tr, 1, PDT_EV_RA_DEFER, 0, v[0].gid, v[1].gid, v[2].gid, who);
         }
-        if (st != PDT_OK) {
-            free(tris);
-            return nomem(err, s->rank, "classify");
-        }
     }
+    s->cnt.final_at_once = k;
+    pdt_tri *old = s->fin; /* final triangles of before, if any, go after */
+    size_t nold = s->nfin;
+    s->fin = tris;
+    s->nfin = k;
+    s->capfin = ntri;
+    if (nold && grow((void **)&s->fin, &s->capfin, k + nold, sizeof *s->fin)) {
+        free(old);
+        return nomem(err, s->rank, "classify");
+    }
+    if (nold) memcpy(s->fin + k, old, nold * sizeof *old);
+    s->nfin += nold;
+    free(old);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_CLASSIFY, 0, 0, 0, 0);
-    free(tris);
     s->cnt.critical_path += now(s) - t0;
     s->cnt.critical_cpu += cpu_now() - c0;
     return PDT_OK;
@@ -629,7 +664,11 @@ static pdt_status select_kept(merge_job *j)
             break;
         }
     j->tb = malloc((j->ntri + 1) * sizeof *j->tb);
-    if (!j->tb) return nomem(j->err, s->rank, "merge");
+    /* the final array holds the local kernel's triangles with little room
+     * to spare: make room for every kept one at once (doubling it would
+     * copy and fault in twice its size) */
+    if (!j->tb || reserve((void **)&s->fin, &s->capfin, s->nfin + j->ntri, sizeof *s->fin))
+        return nomem(j->err, s->rank, "merge");
     for (size_t i = 0; i < j->ntri; i++) {
         const uint32_t *v = j->tris[i].v;
         gtri g = canon3(j->bg[v[0]], j->bg[v[1]], j->bg[v[2]]);
