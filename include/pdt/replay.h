@@ -281,7 +281,7 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
 pdt_status pdt_replay_open_kept(const char *dir, uint64_t budget, pdt_replay **out,
                                 pdt_replay_open_info *info, pdt_err *err);
 /* Verify kept indexes of at least min_bytes bytes lazily: at the opening
- * only their header and chunk table; each 1 MiB chunk of the tables when a
+ * only their header and chunk table; each 16 MiB chunk of the tables when a
  * frame first reads it (its pages stay closed until then; a SIGSEGV handler
  * opens them, chaining any handler installed before).  When a chunk does not
  * match its checksum, the index file is removed and on_damage is called with

@@ -64,6 +64,6 @@ one_run() {
 
 record "$N1" 1 "$OUT/run-$N1-p1" && one_run "$OUT/run-$N1-p1"
 record "$N8" 8 "$OUT/run-$N8-p8" && one_run "$OUT/run-$N8-p8"
-echo "(first opening: builds RUN/.pdtview-index; later openings map it and check each 1 MiB chunk"
+echo "(first opening: builds RUN/.pdtview-index; later openings map it and check each 16 MiB chunk"
 echo " when first read (an index of 64 MiB or more; 'whole check': all of it at the opening); peak counts the mapped"
 echo " index pages the frame touched, which the kernel can drop; pdtview --bench splits RssAnon/RssFile)"

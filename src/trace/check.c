@@ -16,6 +16,7 @@
 #include "pdt/predicates.h"
 #include "pdt/tracefile.h"
 #include "tf_internal.h"
+#include "../geom/bigmem.h"
 
 typedef struct fin {   /* a TRI_FINAL, rotated to start at its smallest index */
     pdt_tri t;
@@ -529,7 +530,11 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
             return viol(c, r, seq, e, "the triangle is not counter-clockwise");
         int k = v[0] < v[1] ? (v[0] < v[2] ? 0 : 2) : (v[1] < v[2] ? 1 : 2);
         if (c->nfin == c->maxfin && (st = spill_finals(c)) != PDT_OK) return st;
-        if (grow((void **)&c->fin, &c->capfin, c->nfin, sizeof *c->fin)) return nomem(c);
+        if (c->nfin == c->capfin) {
+            if (grow((void **)&c->fin, &c->capfin, c->nfin, sizeof *c->fin)) return nomem(c);
+            /* up to half the budget, filled once: huge pages spare most page faults */
+            pdt_big_advise(c->fin, c->capfin * sizeof *c->fin);
+        }
         c->totfin++;
         fin *f = &c->fin[c->nfin++];
         for (int i = 0; i < 3; i++) f->t.v[i] = v[(k + i) % 3];

@@ -1051,10 +1051,10 @@ size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, 
     for (size_t t = 0; t < r->ntri; t++) {
         /* the corners' points and the history entry of a triangle a few
          * ahead: random places in tables of 10^8 bytes (a hint only) */
-        if (t + COV_AHEAD < r->ntri) {
+        if (t + COV_AHEAD < r->ntri && s->tcur[t + COV_AHEAD] != NONE32) {
             const pdt_rtri *ahead = &r->tris[t + COV_AHEAD];
             for (int k = 0; k < 3; k++) __builtin_prefetch(&r->pts[ahead->v[k]]);
-            if (s->tcur[t + COV_AHEAD] != NONE32) __builtin_prefetch(&r->hist[s->tcur[t + COV_AHEAD]]);
+            __builtin_prefetch(&r->hist[s->tcur[t + COV_AHEAD]]);
         }
         uint32_t h = pdt_rstate_tri_entry(r, s, t);
         if (h == NONE32) continue;
