@@ -49,12 +49,18 @@ typedef struct pdt_tri_stats {
 pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
                            pdt_tri_stats *stats, pdt_trace *tr);
 
+/* What pdt_triangulate_inplace leaves in the caller's points. */
+enum {
+    PDT_PTS_RESTORE = 1, /* their values again (one more pass, a scatter) */
+    PDT_PTS_SPEND = 0    /* unspecified values: the caller only frees them */
+};
+
 /* The same pipeline on the caller's points used as working memory (8 bytes
  * per point less at the peak than pdt_triangulate, which copies them): during
  * the call pts[] hold other values; on return, success or not, they hold
- * their values again. */
-pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
-                                   pdt_tri_stats *stats, pdt_trace *tr);
+ * their values again if keep == PDT_PTS_RESTORE. */
+pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri **tris,
+                                   size_t *ntri, pdt_tri_stats *stats, pdt_trace *tr);
 
 /* Sort-and-dedupe helper used by the pipeline and the parallel driver:
  * writes to order[0..*nu) the input indices of the distinct points in

@@ -229,9 +229,9 @@ pdt_status pdt_par_read(pdt_comm *c, const char *path, double scale, pdt_par_inp
 /* Collective: T* of the whole input (every rank passes its block).  *out is
  * this rank's block of the canonical output (pdt_par_output_free).  me gets
  * this rank's figures (partition .. order).  tr (may be NULL) is this rank's
- * trace hook; events name global input indices.  With P > 1 and
- * in->release_pts set, in->pts is freed (and set to NULL) as soon as the
- * partition has its keys: for a caller that does not need the points after
+ * trace hook; events name global input indices.  With in->release_pts set,
+ * in->pts is freed (and set to NULL) as soon as the partition has its keys
+ * (P = 1: used as the kernel's working memory, then freed): for a caller that does not need the points after
  * (a .tri output), the peak memory of the run is lower by 8 bytes per point.
  * On error ranks that wait for a failed peer may block: the caller reports
  * and calls pdt_comm_abort. */

@@ -570,7 +570,7 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
     *tris = NULL;
     *ntri = 0;
     if (n < 2) return PDT_OK;
-    if (n > (size_t)(UINT32_MAX / 8)) return PDT_ERR_ARG;
+    if (n > PDT_KERNEL_MAX_POINTS) return PDT_ERR_ARG;
     for (size_t i = 1; i < n; i++) /* the precondition: distinct and sorted */
         if (pdt_key(pts[i - 1]) >= pdt_key(pts[i])) return PDT_ERR_ARG;
     size_t cap = edge_cap(n);
@@ -769,6 +769,52 @@ static keyed *lsd_sort(keyed *src, keyed *dst, size_t m, int bits, size_t *cnt)
     return src;
 }
 
+/* lsd_sort for packed records: src[0, m) by their bits [lo, lo + bits),
+ * the bits below lo (the input index) increasing within equal digits, so
+ * the result is in (key, index) order.  Returns src or dst. */
+static uint64_t *lsd_sort64(uint64_t *src, uint64_t *dst, size_t m, int lo, int bits, size_t *cnt)
+{
+    if (m < 2 || bits == 0) return src;
+    if (m <= 32) { /* insertion sort on the whole word: (key, index) */
+        for (size_t i = 1; i < m; i++) {
+            uint64_t v = src[i];
+            size_t j = i;
+            while (j > 0 && src[j - 1] > v) {
+                src[j] = src[j - 1];
+                j--;
+            }
+            src[j] = v;
+        }
+        return src;
+    }
+    uint64_t all_or = 0, all_and = ~UINT64_C(0);
+    for (size_t i = 0; i < m; i++) {
+        all_or |= src[i];
+        all_and &= src[i];
+    }
+    int dmax = bit_length(m) - 1;
+    if (dmax > 11) dmax = 11;
+    if (dmax < 4) dmax = 4;
+    int passes = (bits + dmax - 1) / dmax, d = (bits + passes - 1) / passes;
+    uint64_t mask = (UINT64_C(1) << d) - 1;
+    for (int shift = lo; shift < lo + bits; shift += d) {
+        if ((((all_or ^ all_and) >> shift) & mask) == 0) continue;
+        memset(cnt, 0, ((size_t)mask + 1) * sizeof *cnt);
+        for (size_t i = 0; i < m; i++) cnt[(src[i] >> shift) & mask]++;
+        size_t sum = 0;
+        for (size_t k = 0; k <= mask; k++) {
+            size_t c = cnt[k];
+            cnt[k] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < m; i++) dst[cnt[(src[i] >> shift) & mask]++] = src[i];
+        uint64_t *t = src;
+        src = dst;
+        dst = t;
+    }
+    return src;
+}
+
 /* The points are keyed by (x - min x) * 2^by + (y - min y), which orders
  * them lexicographically with as few bits as the data need (40 for points in
  * [0, 2^20)^2).  One counting pass by the top 11 bits splits them into
@@ -789,6 +835,71 @@ typedef struct sorted {
     size_t nu, ndup;
 } sorted;
 
+/* The key of p: (x - min x) * 2^by + (y - min y). */
+static inline uint64_t point_key(pdt_point p, pdt_point mn, int by)
+{
+    return ((uint64_t)((int64_t)p.x - mn.x) << by) | (uint64_t)((int64_t)p.y - mn.y);
+}
+
+/* Write the point of key k (the inverse of point_key) as the u-th distinct
+ * point, and its input index, to o. */
+static inline void put_distinct(sorted *o, size_t u, uint64_t k, uint32_t idx, pdt_point mn,
+                                int by)
+{
+    if (o->q) {
+        uint64_t ymask = by ? (~UINT64_C(0) >> (64 - by)) : 0;
+        o->q[u].x = (int32_t)((int64_t)(k >> by) + mn.x);
+        o->q[u].y = (int32_t)((int64_t)(k & ymask) + mn.y);
+    }
+    o->order[u] = idx;
+}
+
+/* The sort when a key without its top hb bits and an input index fit one
+ * word (shift + ib <= 64: 10^7 points of [0, 2^20)^2 need 29 + 24): the
+ * counting pass by the top hb bits reads the points themselves and writes
+ * words (low key bits << ib | index) into bucket order, so the records are 8
+ * bytes instead of 16 and there is no key array to write first; each bucket
+ * is then finished in the cache by the bits of its keys below the top. */
+static void sort_packed(const pdt_point *pts, size_t n, uint64_t *a, uint64_t *b, size_t *cnt,
+                        size_t *hc, sorted *o, pdt_point mn, int by, int shift, int hb, int ib)
+{
+    size_t nb = (size_t)1 << hb;
+    uint64_t lmask = shift ? (~UINT64_C(0) >> (64 - shift)) : 0;
+    uint64_t imask = ib ? (~UINT64_C(0) >> (64 - ib)) : 0;
+    memset(hc, 0, (nb + 1) * sizeof *hc);
+    for (size_t i = 0; i < n; i++) hc[(point_key(pts[i], mn, by) >> shift) + 1]++;
+    for (size_t h = 1; h <= nb; h++) hc[h] += hc[h - 1];
+    for (size_t i = 0; i < n; i++) {
+        uint64_t k = point_key(pts[i], mn, by);
+        b[hc[k >> shift]++] = ((k & lmask) << ib) | i;
+    }
+    /* hc[h] is the end of bucket h, in b */
+    size_t u = 0, nd = 0, start = 0;
+    uint64_t prev = 0;
+    int have_prev = 0;
+    for (size_t h = 0; h < nb; h++) {
+        size_t end = hc[h];
+        uint64_t *r = lsd_sort64(b + start, a + start, end - start, ib, shift, cnt);
+        uint64_t top = (uint64_t)h << shift;
+        for (size_t i = 0; i < end - start; i++) {
+            uint64_t k = top | r[i] >> ib;
+            uint32_t idx = (uint32_t)(r[i] & imask);
+            if (!have_prev || k != prev) {
+                put_distinct(o, u++, k, idx, mn, by);
+            } else if (o->dup) {
+                o->dup[2 * nd] = idx;
+                o->dup[2 * nd + 1] = o->order[u - 1];
+                nd++;
+            }
+            prev = k;
+            have_prev = 1;
+        }
+        start = end;
+    }
+    o->nu = u;
+    o->ndup = n - u;
+}
+
 /* The sort on the caller's scratch: a and b room for n records each, cnt
  * and hc 2049 counters each.  n >= 1. */
 static void sort_core(const pdt_point *pts, size_t n, keyed *a, keyed *b, size_t *cnt,
@@ -803,14 +914,20 @@ static void sort_core(const pdt_point *pts, size_t n, keyed *a, keyed *b, size_t
     }
     int by = bit_length((uint64_t)((int64_t)maxy - miny));
     int bits = bit_length((uint64_t)((int64_t)maxx - minx)) + by; /* <= 64 */
-    for (size_t i = 0; i < n; i++) {
-        uint64_t kx = (uint64_t)((int64_t)pts[i].x - minx), ky = (uint64_t)((int64_t)pts[i].y - miny);
-        a[i].key = by < 64 ? (kx << by) | ky : ky;
-        a[i].idx = (uint32_t)i;
-    }
     uint64_t ymask = by ? (~UINT64_C(0) >> (64 - by)) : 0;
     int hb = bits < 11 ? bits : 11, shift = bits - hb;
     size_t nb = (size_t)1 << hb;
+    int ib = bit_length(n - 1); /* bits of an input index */
+    if (shift + ib <= 64) {
+        sort_packed(pts, n, (uint64_t *)(void *)a, (uint64_t *)(void *)b, cnt, hc, o,
+                    (pdt_point){ minx, miny }, by, shift, hb, ib);
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        uint64_t kx = (uint64_t)((int64_t)pts[i].x - minx), ky = (uint64_t)((int64_t)pts[i].y - miny);
+        a[i].key = (kx << by) | ky;
+        a[i].idx = (uint32_t)i;
+    }
     memset(hc, 0, (nb + 1) * sizeof *hc);
     for (size_t i = 0; i < n; i++) hc[(a[i].key >> shift) + 1]++;
     for (size_t h = 1; h <= nb; h++) hc[h] += hc[h - 1];
@@ -895,15 +1012,15 @@ static void restore_points(pdt_point *pts, size_t nu, const uint32_t *id, const 
  * kernel.  Peak: 84 bytes per point (92 when the kernel had its own copy of
  * the points and the sort its own scratch); every page of R is touched once
  * (the fresh-page faults were a sixth of the time at 10^7 points). */
-pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
-                                   pdt_tri_stats *stats, pdt_trace *tr)
+pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri **tris,
+                                   size_t *ntri, pdt_tri_stats *stats, pdt_trace *tr)
 {
     *tris = NULL;
     *ntri = 0;
     pdt_tri_stats st;
     memset(&st, 0, sizeof st);
     st.n_in = n;
-    if (n > (size_t)(UINT32_MAX / 8)) return PDT_ERR_ARG;
+    if (n > PDT_KERNEL_MAX_POINTS) return PDT_ERR_ARG;
     if (n == 0) {
         st.collinear = 1;
         if (stats) *stats = st;
@@ -932,7 +1049,7 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, pdt_tri **tris, siz
     free(cnt);
     free(hc);
     size_t nu = so.nu;
-    if (so.ndup) {
+    if (so.ndup && keep == PDT_PTS_RESTORE) {
         dup = malloc(2 * so.ndup * sizeof *dup);
         if (!dup) {
             free(R);
@@ -967,7 +1084,8 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, pdt_tri **tris, siz
     /* the triangles fill R[0, nt) (12 bytes each: at most 24 bytes per point);
      * the rest of R is scratch for what follows */
     pdt_tri *t = (pdt_tri *)(void *)R;
-    restore_points(pts, nu, order, dup, so.ndup, (pdt_point *)(void *)(t + nt));
+    if (keep == PDT_PTS_RESTORE)
+        restore_points(pts, nu, order, dup, so.ndup, (pdt_point *)(void *)(t + nt));
     free(order);
     free(dup);
     if (s != PDT_OK) {
@@ -1004,11 +1122,11 @@ pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_
 {
     *tris = NULL;
     *ntri = 0;
-    if (n > (size_t)(UINT32_MAX / 8)) return PDT_ERR_ARG;
+    if (n > PDT_KERNEL_MAX_POINTS) return PDT_ERR_ARG;
     pdt_point *w = pdt_big_alloc(n * sizeof *w);
     if (!w) return PDT_ERR_NOMEM;
     memcpy(w, pts, n * sizeof *w);
-    pdt_status s = pdt_triangulate_inplace(w, n, tris, ntri, stats, tr);
+    pdt_status s = pdt_triangulate_inplace(w, n, PDT_PTS_SPEND, tris, ntri, stats, tr);
     pdt_big_free(w, n * sizeof *w);
     return s;
 }

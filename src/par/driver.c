@@ -606,12 +606,18 @@ static double cpu_seconds(void)
 
 /* One rank: the sequential pipeline on the whole input, its figures in the
  * same shape; the trace gets the final triangles as a parallel run does. */
-static pdt_status sequential(pdt_comm *c, const pdt_par_input *in, pdt_par_output *out,
+static pdt_status sequential(pdt_comm *c, pdt_par_input *in, pdt_par_output *out,
                              pdt_par_rank_stats *me, pdt_trace *tr, pdt_err *err)
 {
     pdt_tri_stats ts;
     double c0 = cpu_seconds(), w0 = pdt_comm_wtime(c);
-    pdt_status st = pdt_triangulate_inplace(in->pts, in->n, &out->tris, &out->ntri, &ts, tr);
+    pdt_status st = pdt_triangulate_inplace(in->pts, in->n,
+                                            in->release_pts ? PDT_PTS_SPEND : PDT_PTS_RESTORE,
+                                            &out->tris, &out->ntri, &ts, tr);
+    if (in->release_pts) {
+        free(in->pts);
+        in->pts = NULL;
+    }
     if (st != PDT_OK) return pdt_err_set(err, st, "triangulation failed: %s", pdt_status_str(st));
     out->first = 0;
     out->n_total = out->ntri;

@@ -386,6 +386,41 @@ TEST(high_degree_vertex)
     free(p);
 }
 
+/* pdt_triangulate_inplace works on the caller's points: with PDT_PTS_RESTORE
+ * they hold their values again afterwards (duplicates included), and the
+ * triangles and figures are pdt_triangulate's; with PDT_PTS_SPEND only the
+ * triangles are promised. */
+TEST(inplace_restores_points)
+{
+    static const size_t sizes[] = {0, 1, 2, 3, 5, 17, 100, 4000, 70000};
+    for (size_t si = 0; si < sizeof sizes / sizeof *sizes; si++) {
+        size_t n = sizes[si];
+        for (int range = 3; range <= 3000; range *= 10) { /* many copies, then few */
+            pdt_point *p = malloc((n ? n : 1) * sizeof *p), *w = malloc((n ? n : 1) * sizeof *w);
+            for (size_t i = 0; i < n; i++)
+                p[i] = P((int)(xr() % (uint64_t)range) - range / 2, (int)(xr() % (uint64_t)range));
+            memcpy(w, p, n * sizeof *p);
+            pdt_tri *a = NULL, *b = NULL, *c = NULL;
+            size_t na = 0, nb = 0, nc = 0;
+            pdt_tri_stats sa, sb;
+            CHECK(pdt_triangulate(p, n, &a, &na, &sa, NULL) == PDT_OK);
+            CHECK(pdt_triangulate_inplace(w, n, PDT_PTS_RESTORE, &b, &nb, &sb, NULL) == PDT_OK);
+            CHECK_MSG(n == 0 || memcmp(p, w, n * sizeof *p) == 0, "n=%zu range %d: points not restored",
+                      n, range);
+            CHECK(na == nb && (na == 0 || memcmp(a, b, na * sizeof *a) == 0));
+            CHECK(sa.n_unique == sb.n_unique && sa.n_dup == sb.n_dup && sa.n_hull == sb.n_hull &&
+                  sa.collinear == sb.collinear);
+            CHECK(pdt_triangulate_inplace(w, n, PDT_PTS_SPEND, &c, &nc, NULL, NULL) == PDT_OK);
+            CHECK(na == nc && (na == 0 || memcmp(a, c, na * sizeof *a) == 0));
+            free(a);
+            free(b);
+            free(c);
+            free(p);
+            free(w);
+        }
+    }
+}
+
 int main(void)
 {
     RUN(oracle_every_gen_family);
@@ -405,5 +440,6 @@ int main(void)
     RUN(trace_events);
     RUN(symmetric_parabola_and_circle_large);
     RUN(high_degree_vertex);
+    RUN(inplace_restores_points);
     return test_summary();
 }
