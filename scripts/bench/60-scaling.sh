@@ -12,6 +12,8 @@
 #   SCALING_UNIFORM  uniform points in [0, 2^20)^2   (default 1e5 1e6 4e6 1e7 3e7)
 #   SCALING_OTHER    grid (k x k) and clusters        (default 1e6 1e7)
 #   SCALING_QUICK=1  the same as SCALING_UNIFORM="1e5 1e6" SCALING_OTHER="1e6"
+# This section alone: make bench BENCH_ONLY=scaling (3*10^7 points need about
+# 2.5 GB for pdt (84 bytes per point), more for CGAL, and 0.5 GB of input text in build/bench).
 # Inputs are cached in build/bench/scaling/.  The load average is printed
 # before and after: on a loaded machine the seconds measure the contention.
 set -u
