@@ -1125,7 +1125,7 @@ pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_
     if (n > PDT_KERNEL_MAX_POINTS) return PDT_ERR_ARG;
     pdt_point *w = pdt_big_alloc(n * sizeof *w);
     if (!w) return PDT_ERR_NOMEM;
-    memcpy(w, pts, n * sizeof *w);
+    if (n) memcpy(w, pts, n * sizeof *w); /* (pts may be NULL when n == 0) */
     pdt_status s = pdt_triangulate_inplace(w, n, PDT_PTS_SPEND, tris, ntri, stats, tr);
     pdt_big_free(w, n * sizeof *w);
     return s;
