@@ -434,13 +434,20 @@ static uint32_t tri_min(const pdt_tri *t)
     return c < a ? c : a;
 }
 
+/* The final triangles of a rank: the local phase's and the merges'. */
+typedef struct finals {
+    pdt_tri *t[2];
+    size_t n[2];
+} finals;
+
 /* The ranges: the smallest indices [0, n_total) in buckets of 2^*shift
  * consecutive indices (at most 256 p, at most 2^16 buckets); the histogram of
  * every rank's final triangles summed (allreduce); bucket b goes to rank
  * owner[b], nondecreasing in b, so that every rank gets about T / p
- * triangles (a bucket is never split). */
-static pdt_status order_ranges(drv *d, const pdt_tri *t, size_t n, int *shift, int **owner,
-                               uint64_t *mine, pdt_err *err)
+ * triangles (a bucket is never split).  mine[2 q + k]: how many of f.t[k]
+ * go to rank q. */
+static pdt_status order_ranges(drv *d, const finals *f, int *shift, int **owner, uint64_t *mine,
+                               pdt_err *err)
 {
     int p = d->p;
     uint64_t top = d->n_total ? d->n_total - 1 : 0;
@@ -449,7 +456,7 @@ static pdt_status order_ranges(drv *d, const pdt_tri *t, size_t n, int *shift, i
     int sh = 0;
     while ((top >> sh) + 1 > want) sh++;
     size_t nb = (size_t)(top >> sh) + 1;
-    uint64_t *h = calloc(nb, sizeof *h), *local = malloc(nb * sizeof *local);
+    uint64_t *h = calloc(nb, sizeof *h), *local = calloc(2 * nb, sizeof *local);
     int *own = malloc(nb * sizeof *own);
     if (!h || !local || !own) {
         free(h);
@@ -457,8 +464,9 @@ static pdt_status order_ranges(drv *d, const pdt_tri *t, size_t n, int *shift, i
         free(own);
         return nomem(d, "order");
     }
-    for (size_t i = 0; i < n; i++) h[tri_min(&t[i]) >> sh]++;
-    memcpy(local, h, nb * sizeof *h);
+    for (int k = 0; k < 2; k++)
+        for (size_t i = 0; i < f->n[k]; i++) local[k * nb + (tri_min(&f->t[k][i]) >> sh)]++;
+    for (size_t b = 0; b < nb; b++) h[b] = local[b] + local[nb + b];
     pdt_status st = pdt_comm_allreduce_u64(d->c, h, nb, PDT_COMM_SUM, err);
     if (st == PDT_OK) {
         note_all(d, TAG_ORDER, nb * sizeof *h);
@@ -468,7 +476,8 @@ static pdt_status order_ranges(drv *d, const pdt_tri *t, size_t n, int *shift, i
             uint64_t q = total ? (before + h[b] / 2) * (uint64_t)p / total : 0;
             own[b] = q < (uint64_t)p ? (int)q : p - 1;
             before += h[b];
-            mine[own[b]] += local[b]; /* this rank's triangles for that rank */
+            mine[2 * own[b]] += local[b]; /* this rank's triangles for that rank */
+            mine[2 * own[b] + 1] += local[nb + b];
         }
         *shift = sh;
         *owner = own;
@@ -502,49 +511,58 @@ static void group_by_rank(pdt_tri *t, int p, size_t *at, const size_t *end, cons
 
 /* Phase 4: the final triangles go to the rank of their smallest index's
  * range, which puts them in canonical order: rank q ends with the q-th block
- * of the canonical output in out (and its place in the whole output). */
+ * of the canonical output in out (and its place in the whole output).  The
+ * two arrays of finals go in two exchanges into one array (no copy of the
+ * large one into a buffer with room for the other). */
 static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
 {
     int p = d->p;
-    pdt_tri *t = d->s.fin;
-    size_t n = d->s.nfin;
+    finals f = {{d->s.fin, d->s.more}, {d->s.nfin, d->s.nmore}};
     pdt_status st = PDT_OK;
-    size_t *cnt = calloc((size_t)p, sizeof *cnt), *rcnt = calloc((size_t)p, sizeof *rcnt);
+    size_t *cnt = calloc(2 * (size_t)p, sizeof *cnt), *rcnt = calloc(2 * (size_t)p, sizeof *rcnt);
     size_t *at = calloc((size_t)p, sizeof *at), *end = calloc((size_t)p, sizeof *end);
-    uint64_t *sc = calloc((size_t)p, sizeof *sc), *rc = calloc((size_t)p, sizeof *rc);
+    uint64_t *sc = calloc(2 * (size_t)p, sizeof *sc), *rc = calloc(2 * (size_t)p, sizeof *rc);
     pdt_tri *got = NULL;
     int *owner = NULL, shift = 0;
     if (!cnt || !rcnt || !at || !end || !sc || !rc) {
         st = nomem(d, "order");
         goto done;
     }
-    st = order_ranges(d, t, n, &shift, &owner, sc, err);
+    st = order_ranges(d, &f, &shift, &owner, sc, err);
     if (st != PDT_OK) goto done;
-    for (int q = 0; q < p; q++) {
-        at[q] = q ? end[q - 1] : 0;
-        end[q] = at[q] + (size_t)sc[q];
+    for (int k = 0; k < 2; k++) {
+        for (int q = 0; q < p; q++) {
+            at[q] = q ? end[q - 1] : 0;
+            end[q] = at[q] + (size_t)sc[2 * q + k];
+        }
+        group_by_rank(f.t[k], p, at, end, owner, shift);
     }
-    group_by_rank(t, p, at, end, owner, shift);
-    st = pdt_comm_alltoall(d->c, sc, sizeof *sc, rc, err);
+    st = pdt_comm_alltoall(d->c, sc, 2 * sizeof *sc, rc, err);
     if (st != PDT_OK) goto done;
-    note_all(d, TAG_COUNTS, sizeof *sc);
-    size_t total = 0;
-    for (int q = 0; q < p; q++) {
-        cnt[q] = (size_t)sc[q] * sizeof(pdt_tri);
-        rcnt[q] = (size_t)rc[q] * sizeof(pdt_tri);
-        total += (size_t)rc[q];
-    }
+    note_all(d, TAG_COUNTS, 2 * sizeof *sc);
+    size_t total = 0, part[2] = {0, 0};
+    for (int k = 0; k < 2; k++)
+        for (int q = 0; q < p; q++) {
+            cnt[k * p + q] = (size_t)sc[2 * q + k] * sizeof(pdt_tri);
+            rcnt[k * p + q] = (size_t)rc[2 * q + k] * sizeof(pdt_tri);
+            part[k] += (size_t)rc[2 * q + k];
+        }
+    total = part[0] + part[1];
     got = srm_big((total + 1) * sizeof *got);
     if (!got) {
         st = nomem(d, "order");
         goto done;
     }
-    st = pdt_comm_alltoallv(d->c, t, cnt, got, rcnt, err);
+    for (int k = 0; k < 2 && st == PDT_OK; k++) {
+        st = pdt_comm_alltoallv(d->c, f.t[k], cnt + k * p, got + (k ? part[0] : 0),
+                                rcnt + k * p, err);
+        if (st == PDT_OK) note_v(d, TAG_ORDER, cnt + k * p, rcnt + k * p);
+    }
     if (st != PDT_OK) goto done;
-    note_v(d, TAG_ORDER, cnt, rcnt);
     free(d->s.fin); /* every triangle went somewhere (itself included) */
-    d->s.fin = NULL;
-    d->s.nfin = d->s.capfin = 0;
+    free(d->s.more);
+    d->s.fin = d->s.more = NULL;
+    d->s.nfin = d->s.capfin = d->s.nmore = d->s.capmore = 0;
     pdt_tri_canonical(got, total);
     uint64_t first = 0, all = total;
     st = pdt_comm_exscan_u64(d->c, total, &first, err); /* place in the whole output */
@@ -695,7 +713,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
     if (st == PDT_OK) st = pdt_comm_quiet_barrier(c, err);
     if (st != PDT_OK) goto done;
     double t3 = pdt_comm_wtime(c);
-    me->emitted = d.s.nfin;
+    me->emitted = d.s.nfin + d.s.nmore;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_ORDER, 0, 0, 0, 0);
     st = order(&d, out, err);
     if (st != PDT_OK) goto done;

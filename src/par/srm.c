@@ -113,22 +113,11 @@ static pdt_status grow(void **p, size_t *cap, size_t need, size_t size)
     return PDT_OK;
 }
 
-/* Exactly `need` places (or more if already there): for an array that is
- * large and about to take a known number of elements. */
-static pdt_status reserve(void **p, size_t *cap, size_t need, size_t size)
-{
-    if (need <= *cap) return PDT_OK;
-    void *q = big_realloc(*p, *cap * size, need * size);
-    if (!q) return PDT_ERR_NOMEM;
-    *p = q;
-    *cap = need;
-    return PDT_OK;
-}
-
 static pdt_status add_final(srm_rank *s, srm_pt a, srm_pt b, srm_pt c)
 {
-    if (grow((void **)&s->fin, &s->capfin, s->nfin + 1, sizeof *s->fin)) return PDT_ERR_NOMEM;
-    s->fin[s->nfin++] = (pdt_tri){{a.gid, b.gid, c.gid}};
+    if (grow((void **)&s->more, &s->capmore, s->nmore + 1, sizeof *s->more))
+        return PDT_ERR_NOMEM;
+    s->more[s->nmore++] = (pdt_tri){{a.gid, b.gid, c.gid}};
     PDT_TRACE(s->tr, 1, PDT_EV_TRI_FINAL, 0, a.gid, b.gid, c.gid, 0);
     return PDT_OK;
 }
@@ -203,6 +192,7 @@ void pdt_srm_free(srm_rank *s)
 {
     free(s->nonempty);
     free(s->fin);
+    free(s->more);
     free(s->pend);
     free(s->hull);
     memset(s, 0, sizeof *s);
@@ -297,18 +287,10 @@ pdt_status pdt_srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid,
         }
     }
     s->cnt.final_at_once = k;
-    pdt_tri *old = s->fin; /* final triangles of before, if any, go after */
-    size_t nold = s->nfin;
+    free(s->fin); /* (none: the local phase comes first) */
     s->fin = tris;
     s->nfin = k;
     s->capfin = ntri;
-    if (nold && grow((void **)&s->fin, &s->capfin, k + nold, sizeof *s->fin)) {
-        free(old);
-        return nomem(err, s->rank, "classify");
-    }
-    if (nold) memcpy(s->fin + k, old, nold * sizeof *old);
-    s->nfin += nold;
-    free(old);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_CLASSIFY, 0, 0, 0, 0);
     s->cnt.critical_path += now(s) - t0;
     s->cnt.critical_cpu += cpu_now() - c0;
@@ -664,11 +646,7 @@ static pdt_status select_kept(merge_job *j)
             break;
         }
     j->tb = malloc((j->ntri + 1) * sizeof *j->tb);
-    /* the final array holds the local kernel's triangles with little room
-     * to spare: make room for every kept one at once (doubling it would
-     * copy and fault in twice its size) */
-    if (!j->tb || reserve((void **)&s->fin, &s->capfin, s->nfin + j->ntri, sizeof *s->fin))
-        return nomem(j->err, s->rank, "merge");
+    if (!j->tb) return nomem(j->err, s->rank, "merge");
     for (size_t i = 0; i < j->ntri; i++) {
         const uint32_t *v = j->tris[i].v;
         gtri g = canon3(j->bg[v[0]], j->bg[v[1]], j->bg[v[2]]);

@@ -127,9 +127,12 @@ typedef struct srm_rank {
     const srm_strip *strip;       /* p descriptors (not owned) */
     int *nonempty;                /* ranks with points, in order (x-sorted boxes) */
     int nne;
-    /* output: final triangles as global indices, CCW */
+    /* output: final triangles as global indices, CCW: the local phase's in
+     * fin (the kernel's own array, no room to spare), the merges' in more */
     pdt_tri *fin;
     size_t nfin, capfin;
+    pdt_tri *more;
+    size_t nmore, capmore;
     /* pending triangles held here */
     srm_tri *pend;
     size_t npend, cappend;

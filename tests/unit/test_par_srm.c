@@ -141,7 +141,7 @@ static pdt_status simulate(const srm_rec *u, int p, const size_t *cut, pdt_tri *
     size_t total = 0;
     *bmax = 0;
     for (int r = 0; r < p; r++) {
-        total += rk[r].nfin;
+        total += rk[r].nfin + rk[r].nmore;
         if (rk[r].npend) st = PDT_ERR_CHECK;
         if (rk[r].cnt.border_max > *bmax) *bmax = rk[r].cnt.border_max;
     }
@@ -150,6 +150,8 @@ static pdt_status simulate(const srm_rec *u, int p, const size_t *cut, pdt_tri *
     for (int r = 0; r < p; r++) {
         if (rk[r].nfin) memcpy(t + k, rk[r].fin, rk[r].nfin * sizeof *t);
         k += rk[r].nfin;
+        if (rk[r].nmore) memcpy(t + k, rk[r].more, rk[r].nmore * sizeof *t);
+        k += rk[r].nmore;
         pdt_srm_free(&rk[r]);
     }
     pdt_tri_canonical(t, total);
