@@ -102,24 +102,34 @@ uint32_t pdt_crc32c(uint32_t crc, const void *data, size_t n)
 /* ---- combination: polynomials modulo P in the reflected representation
  * (bit 31, resp. 63, is x^0) ---------------------------------------------------- */
 
-static uint32_t mulmod32(uint32_t a, uint32_t b)
+/* a * b modulo the polynomial poly, both of `width` bits (32 or 64) in the
+ * reflected representation: bit width-1 is x^0. */
+static uint64_t gf2_mulmod(uint64_t a, uint64_t b, uint64_t poly, int width)
 {
-    uint32_t prod = 0;
-    for (uint32_t m = 1u << 31; m; m >>= 1) {
+    uint64_t prod = 0;
+    for (uint64_t m = UINT64_C(1) << (width - 1); m; m >>= 1) {
         if (a & m) prod ^= b;
-        b = b & 1 ? (b >> 1) ^ 0x82F63B78u : b >> 1;
+        b = b & 1 ? (b >> 1) ^ poly : b >> 1;
     }
     return prod;
 }
 
+/* The CRC of A followed by B from crc_a, crc_b and B's length: crc_a times
+ * x^(8 len_b), plus crc_b (the all-ones initial value and final xor cancel
+ * out). */
+static uint64_t gf2_combine(uint64_t crc_a, uint64_t crc_b, uint64_t len_b, uint64_t poly, int width)
+{
+    uint64_t xn = UINT64_C(1) << (width - 1), sq = UINT64_C(1) << (width - 9); /* x^0, x^8 */
+    for (uint64_t n = len_b; n; n >>= 1) {
+        if (n & 1) xn = gf2_mulmod(xn, sq, poly, width);
+        sq = gf2_mulmod(sq, sq, poly, width);
+    }
+    return gf2_mulmod(crc_a, xn, poly, width) ^ crc_b;
+}
+
 uint32_t pdt_crc32c_combine(uint32_t crc_a, uint32_t crc_b, uint64_t len_b)
 {
-    uint32_t xn = 1u << 31, sq = 1u << 23; /* x^0, and x^8: one byte */
-    for (uint64_t n = len_b; n; n >>= 1) {
-        if (n & 1) xn = mulmod32(xn, sq);
-        sq = mulmod32(sq, sq);
-    }
-    return mulmod32(crc_a, xn) ^ crc_b;
+    return (uint32_t)gf2_combine(crc_a, crc_b, len_b, 0x82F63B78u, 32);
 }
 
 static const uint64_t crc64_table[256] = {
@@ -219,24 +229,9 @@ uint64_t pdt_crc64(uint64_t crc, const void *data, size_t n)
     return ~c;
 }
 
-static uint64_t mulmod64(uint64_t a, uint64_t b)
-{
-    uint64_t prod = 0;
-    for (uint64_t m = 1ull << 63; m; m >>= 1) {
-        if (a & m) prod ^= b;
-        b = b & 1 ? (b >> 1) ^ 0xC96C5795D7870F42ull : b >> 1;
-    }
-    return prod;
-}
-
 uint64_t pdt_crc64_combine(uint64_t crc_a, uint64_t crc_b, uint64_t len_b)
 {
-    uint64_t xn = 1ull << 63, sq = 1ull << 55; /* x^0, and x^8: one byte */
-    for (uint64_t n = len_b; n; n >>= 1) {
-        if (n & 1) xn = mulmod64(xn, sq);
-        sq = mulmod64(sq, sq);
-    }
-    return mulmod64(crc_a, xn) ^ crc_b;
+    return gf2_combine(crc_a, crc_b, len_b, 0xC96C5795D7870F42ull, 64);
 }
 
 /* ---- the points checksums ------------------------------------------------------ */
