@@ -49,16 +49,24 @@ typedef struct pdt_tri_stats {
 pdt_status pdt_triangulate(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
                            pdt_tri_stats *stats, pdt_trace *tr);
 
-/* What pdt_triangulate_inplace leaves in the caller's points. */
+/* What pdt_triangulate_inplace leaves in the caller's points, and how it
+ * uses the machine. */
 enum {
     PDT_PTS_RESTORE = 1, /* their values again (one more pass, a scatter) */
-    PDT_PTS_SPEND = 0    /* unspecified values: the caller only frees them */
+    PDT_PTS_SPEND = 0,   /* unspecified values: the caller only frees them */
+    /* (or'd with one of the above) a second thread faults the pipeline's
+     * working memory in ahead of use (docs/geometry.md, "Prefault"): only
+     * for a caller that leaves a core idle (a plain run, never an MPI rank
+     * sharing the machine's cores); costs that core about 2 s of CPU per
+     * GiB of fresh memory on this project's VM, saves the caller about as
+     * much on the critical path.  Same results with or without. */
+    PDT_TRI_PREFAULT = 2
 };
 
 /* The same pipeline on the caller's points used as working memory (8 bytes
  * per point less at the peak than pdt_triangulate, which copies them): during
  * the call pts[] hold other values; on return, success or not, they hold
- * their values again if keep == PDT_PTS_RESTORE. */
+ * their values again if keep has PDT_PTS_RESTORE. */
 pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri **tris,
                                    size_t *ntri, pdt_tri_stats *stats, pdt_trace *tr);
 

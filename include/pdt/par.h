@@ -147,6 +147,9 @@ typedef struct pdt_par_input {
     uint64_t collisions; /* --scale: points that became equal to a point written
                           * differently, over the whole input (every rank) */
     int release_pts;     /* 1: pdt_par_triangulate may free pts (see there) */
+    int idle_core;       /* 1: a one-rank run may use a second thread to fault
+                          * its working memory in (PDT_TRI_PREFAULT); set
+                          * only when a core would otherwise be idle */
 } pdt_par_input;
 
 /* This rank's share of T*: triangles first .. first + ntri - 1 of the

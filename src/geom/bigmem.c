@@ -1,8 +1,11 @@
 /* pdt — large scratch arrays: mmap'd, huge pages asked for (see bigmem.h). */
 #include "bigmem.h"
 
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/mman.h>
 
 enum { BIG = 1 << 20, HUGE_PAGE = 1 << 21 };
@@ -33,4 +36,59 @@ void pdt_big_free(void *p, size_t bytes)
     if (!p) return;
     if (bytes < BIG) free(p);
     else munmap(p, bytes);
+}
+
+/* ---- faulting in ahead of use (bigmem.h) ---- */
+
+enum { PF_MAX = 8, PF_STEP = 1 << 21 };
+
+struct pdt_prefault {
+    pthread_t th;
+    atomic_int stop;
+    int nr;
+    pdt_range r[PF_MAX];
+};
+
+static void *prefault_run(void *arg)
+{
+    pdt_prefault *pf = arg;
+#ifdef MADV_POPULATE_WRITE
+    long pg = 4096;
+    for (int k = 0; k < pf->nr; k++) {
+        /* whole pages inside the range only: a page it shares with another
+         * allocation is left to that allocation's owner */
+        uintptr_t a = ((uintptr_t)pf->r[k].p + (uintptr_t)pg - 1) & ~(uintptr_t)(pg - 1);
+        uintptr_t b = ((uintptr_t)pf->r[k].p + pf->r[k].bytes) & ~(uintptr_t)(pg - 1);
+        while (a < b && !atomic_load_explicit(&pf->stop, memory_order_relaxed)) {
+            uintptr_t e = (a & ~(uintptr_t)(PF_STEP - 1)) + PF_STEP; /* the next 2 MiB boundary */
+            if (e > b) e = b;
+            if (madvise((void *)a, e - a, MADV_POPULATE_WRITE) != 0) return NULL; /* old kernel */
+            a = e;
+        }
+    }
+#endif
+    return NULL;
+}
+
+pdt_prefault *pdt_prefault_start(const pdt_range *r, int nr)
+{
+    if (nr <= 0 || nr > PF_MAX) return NULL;
+    pdt_prefault *pf = malloc(sizeof *pf);
+    if (!pf) return NULL;
+    atomic_init(&pf->stop, 0);
+    pf->nr = nr;
+    memcpy(pf->r, r, (size_t)nr * sizeof *r);
+    if (pthread_create(&pf->th, NULL, prefault_run, pf) != 0) {
+        free(pf);
+        return NULL;
+    }
+    return pf;
+}
+
+void pdt_prefault_stop(pdt_prefault *pf)
+{
+    if (!pf) return;
+    atomic_store(&pf->stop, 1);
+    pthread_join(pf->th, NULL);
+    free(pf);
 }

@@ -984,6 +984,9 @@ pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size
 
 /* ---- the pipeline ---- */
 
+/* Working memory below this is not worth a thread faulting it in. */
+enum { PREFAULT_MIN = 8 << 20 };
+
 static double now(void)
 {
     struct timespec ts;
@@ -1042,6 +1045,17 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
     }
     pdt_big_advise(R, cap * sizeof *R);
     pdt_big_advise(order, n * sizeof *order);
+    pdt_prefault *pf = NULL;
+    if ((keep & PDT_TRI_PREFAULT) && cap * sizeof *R >= PREFAULT_MIN) {
+        /* the sort writes its buckets to R[16n, 24n) bytes at once (left to
+         * it); the helper does what comes next: the index list, the sort's
+         * other records and points, then the rest of R in the order the
+         * kernel's edges grow into it */
+        char *rb = (char *)(void *)R;
+        pdt_range rr[3] = { { order, n * sizeof *order }, { rb, 16 * n },
+                            { rb + 24 * n, cap * sizeof *R - 24 * n } };
+        pf = pdt_prefault_start(rr, 3);
+    }
     keyed *ka = (keyed *)(void *)R, *kb = ka + n;
     pdt_point *q = (pdt_point *)(void *)(kb + n);
     sorted so = { order, q, (uint32_t *)(void *)(q + n), 0, 0 };
@@ -1049,9 +1063,10 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
     free(cnt);
     free(hc);
     size_t nu = so.nu;
-    if (so.ndup && keep == PDT_PTS_RESTORE) {
+    if (so.ndup && (keep & PDT_PTS_RESTORE)) {
         dup = malloc(2 * so.ndup * sizeof *dup);
         if (!dup) {
+            pdt_prefault_stop(pf);
             free(R);
             free(order);
             return PDT_ERR_NOMEM;
@@ -1079,12 +1094,13 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
     size_t nt = 0;
     pdt_status s = nu >= 2 ? kernel_on(order, pts, nu, R, cap, &nt, 0, tr) : PDT_OK;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
+    pdt_prefault_stop(pf); /* (long done, but it must end before R shrinks) */
     double t2 = now();
 
     /* the triangles fill R[0, nt) (12 bytes each: at most 24 bytes per point);
      * the rest of R is scratch for what follows */
     pdt_tri *t = (pdt_tri *)(void *)R;
-    if (keep == PDT_PTS_RESTORE)
+    if ((keep & PDT_PTS_RESTORE))
         restore_points(pts, nu, order, dup, so.ndup, (pdt_point *)(void *)(t + nt));
     free(order);
     free(dup);

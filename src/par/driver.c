@@ -629,9 +629,9 @@ static pdt_status sequential(pdt_comm *c, pdt_par_input *in, pdt_par_output *out
 {
     pdt_tri_stats ts;
     double c0 = cpu_seconds(), w0 = pdt_comm_wtime(c);
-    pdt_status st = pdt_triangulate_inplace(in->pts, in->n,
-                                            in->release_pts ? PDT_PTS_SPEND : PDT_PTS_RESTORE,
-                                            &out->tris, &out->ntri, &ts, tr);
+    int how = (in->release_pts ? PDT_PTS_SPEND : PDT_PTS_RESTORE) |
+              (in->idle_core ? PDT_TRI_PREFAULT : 0);
+    pdt_status st = pdt_triangulate_inplace(in->pts, in->n, how, &out->tris, &out->ntri, &ts, tr);
     if (in->release_pts) {
         free(in->pts);
         in->pts = NULL;

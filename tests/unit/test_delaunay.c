@@ -6,8 +6,11 @@
 #include "pdt/delaunay.h"
 #include "pdt/gen.h"
 #include "pdt/predicates.h"
+#include "../../src/geom/bigmem.h"
 
 #include <string.h>
+#include <sys/mman.h>
+#include <unistd.h>
 #include <time.h>
 
 static pdt_point P(int x, int y)
@@ -421,6 +424,73 @@ TEST(inplace_restores_points)
     }
 }
 
+/* PDT_TRI_PREFAULT (a second thread faults the working memory in) changes
+ * nothing in the results: sizes below and above the threshold at which the
+ * thread starts (8 MiB of edge records: about 116 000 points), with and
+ * without duplicates, restored and spent. */
+TEST(prefault_same_triangles)
+{
+    static const size_t sizes[] = {0, 3, 1000, 200000};
+    for (size_t si = 0; si < sizeof sizes / sizeof *sizes; si++) {
+        size_t n = sizes[si];
+        for (int ri = 0; ri < 2; ri++) {
+            int range = ri ? 3000000 : 300; /* many duplicates, then few */
+            pdt_point *p = malloc((n ? n : 1) * sizeof *p), *w = malloc((n ? n : 1) * sizeof *w);
+            for (size_t i = 0; i < n; i++)
+                p[i] = P((int)(xr() % (uint64_t)range), (int)(xr() % (uint64_t)range));
+            memcpy(w, p, n * sizeof *p);
+            pdt_tri *a = NULL, *b = NULL, *c = NULL;
+            size_t na = 0, nb = 0, nc = 0;
+            pdt_tri_stats sa, sb;
+            CHECK(pdt_triangulate(p, n, &a, &na, &sa, NULL) == PDT_OK);
+            CHECK(pdt_triangulate_inplace(w, n, PDT_PTS_RESTORE | PDT_TRI_PREFAULT, &b, &nb, &sb,
+                                          NULL) == PDT_OK);
+            CHECK_MSG(n == 0 || memcmp(p, w, n * sizeof *p) == 0, "n=%zu: points not restored", n);
+            CHECK(na == nb && (na == 0 || memcmp(a, b, na * sizeof *a) == 0));
+            CHECK(sa.n_unique == sb.n_unique && sa.n_dup == sb.n_dup && sa.n_hull == sb.n_hull);
+            CHECK(pdt_triangulate_inplace(w, n, PDT_PTS_SPEND | PDT_TRI_PREFAULT, &c, &nc, NULL,
+                                          NULL) == PDT_OK);
+            CHECK(na == nc && (na == 0 || memcmp(a, c, na * sizeof *a) == 0));
+            free(a);
+            free(b);
+            free(c);
+            free(p);
+            free(w);
+        }
+    }
+}
+
+/* The prefault thread makes the pages of its ranges resident (mincore) and
+ * leaves their contents alone; stopping it at once is allowed. */
+TEST(prefault_makes_pages_resident)
+{
+    size_t pg = (size_t)sysconf(_SC_PAGESIZE), bytes = 64 * pg;
+    char *m = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    CHECK(m != MAP_FAILED);
+    m[0] = 7; /* page 0 written by us; the others untouched */
+    unsigned char vec[64];
+    CHECK(mincore(m, bytes, vec) == 0);
+    int resident = 0;
+    for (int i = 0; i < 64; i++) resident += vec[i] & 1;
+    CHECK(resident < 64);
+    pdt_range r = { m, bytes };
+    pdt_prefault *pf = pdt_prefault_start(&r, 1);
+    CHECK(pf != NULL);
+    for (int tries = 0; tries < 1000 && resident < 64; tries++) { /* at most ~10 s */
+        struct timespec ts = { 0, 10 * 1000 * 1000 };
+        nanosleep(&ts, NULL);
+        CHECK(mincore(m, bytes, vec) == 0);
+        resident = 0;
+        for (int i = 0; i < 64; i++) resident += vec[i] & 1;
+    }
+    pdt_prefault_stop(pf);
+    CHECK_MSG(resident == 64, "only %d of 64 pages resident after prefaulting", resident);
+    CHECK(m[0] == 7 && m[pg] == 0 && m[bytes - 1] == 0);
+    pdt_prefault_stop(pdt_prefault_start(&r, 1)); /* started and stopped at once */
+    pdt_prefault_stop(NULL);
+    munmap(m, bytes);
+}
+
 int main(void)
 {
     RUN(oracle_every_gen_family);
@@ -441,5 +511,7 @@ int main(void)
     RUN(symmetric_parabola_and_circle_large);
     RUN(high_degree_vertex);
     RUN(inplace_restores_points);
+    RUN(prefault_same_triangles);
+    RUN(prefault_makes_pages_resident);
     return test_summary();
 }
