@@ -251,6 +251,15 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
 pdt_status pdt_par_write(pdt_comm *c, const char *path, pdt_tri_format fmt, const pdt_par_input *in,
                          const pdt_par_output *out, pdt_err *err);
 
+/* Remove the temporaries of a parallel write still in progress at this rank
+ * (none: nothing happens).  Async-signal-safe (unlink only): for a handler
+ * of the signal that ends the job when another rank died. */
+void pdt_par_write_abandon(void);
+
+/* Test-only: create the file named by PDT_TEST_MARK (if set), so that a test
+ * knows a rank has reached one of the test sleeps (PDT_TEST_SLEEP_*). */
+void pdt_par_test_mark(void);
+
 /* Collective: gather every rank's figures at rank 0 into *all (other ranks:
  * *all zeroed).  Free with pdt_par_stats_free. */
 pdt_status pdt_par_stats_collect(pdt_comm *c, const pdt_par_rank_stats *me, uint64_t n_in,

@@ -6,9 +6,11 @@
  * write its block of the output, then the figures.  The library returns
  * statuses; this file alone prints and chooses exit codes (cli.h). */
 #include <malloc.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "pdt/delaunay.h"
@@ -62,6 +64,69 @@ typedef struct run {
     const char *phase;       /* the step running, for messages */
 } run;
 
+/* ---- when the launcher ends the job -------------------------------------------- */
+
+/* mpirun ends every rank with SIGTERM when one rank died (killed, crashed) or
+ * the job was interrupted; its own message names the rank that died, not
+ * what the job was doing.  Rank 0 says which step it was in, and every rank
+ * removes the temporaries of a write in progress.  (Set by the pipeline,
+ * read by the handler: plain values, the step a string constant.) */
+static const char *volatile stop_phase = "start";
+static volatile sig_atomic_t stop_rank, stop_size;
+
+static size_t put_str(char *b, size_t at, const char *s)
+{
+    while (*s && at < 255) b[at++] = *s++;
+    return at;
+}
+
+static size_t put_uint(char *b, size_t at, unsigned v)
+{
+    char d[12];
+    int k = 0;
+    do d[k++] = (char)('0' + v % 10); while ((v /= 10) && k < 11);
+    while (k > 0 && at < 255) b[at++] = d[--k];
+    return at;
+}
+
+static void on_stop(int sig)
+{
+    pdt_par_write_abandon();
+    if (stop_rank == 0) {
+        char b[256];
+        size_t n = put_str(b, 0, "pdt: the job was ended (signal ");
+        n = put_uint(b, n, (unsigned)sig);
+        n = put_str(b, n, ") while rank 0 was in its ");
+        n = put_str(b, n, stop_phase);
+        n = put_str(b, n, " step: another of the ");
+        n = put_uint(b, n, (unsigned)stop_size);
+        n = put_str(b, n, " ranks ended first (the launcher names it) or the job was "
+                          "interrupted; no output written\n");
+        ssize_t w = write(STDERR_FILENO, b, n);
+        (void)w;
+    }
+    _exit(PDT_EXIT_USAGE);
+}
+
+static void catch_stop(const run *R)
+{
+    stop_rank = R->rank;
+    stop_size = R->p;
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGHUP, &sa, NULL);
+}
+
+static void set_phase(run *R, const char *phase)
+{
+    R->phase = phase;
+    stop_phase = phase;
+}
+
 /* Print the failure of a step, at the rank that failed (who): the message
  * alone when it names the user's input or options, else with the rank and
  * the step.  Returns st. */
@@ -94,7 +159,7 @@ static pdt_status check_output(run *R, pdt_err *err)
 {
     const pdt_run_opts *o = R->o;
     pdt_status st = PDT_OK;
-    R->phase = "options";
+    set_phase(R, "options");
     if (R->rank == 0 && o->output && strcmp(o->input, "-") != 0) {
         if (pdt_tri_format_of(o->output) == PDT_FMT_ELE) {
             size_t len = strlen(o->output);
@@ -116,7 +181,7 @@ static pdt_status check_output(run *R, pdt_err *err)
 
 static pdt_status open_trace(run *R, pdt_err *err)
 {
-    R->phase = "trace";
+    set_phase(R, "trace");
     return agreed(R, pdt_cli_trace_open_ranks(R->o, R->c, &R->trace, err), err);
 }
 
@@ -134,7 +199,7 @@ static pdt_trace *io_hook(const run *R)
  * for the tests: 2^29 points do not fit a test machine.) */
 static pdt_status check_size(run *R, pdt_err *err)
 {
-    R->phase = "options";
+    set_phase(R, "options");
     uint64_t limit = PDT_KERNEL_MAX_POINTS, n = R->in.n_total, p = (uint64_t)R->p;
     const char *t = getenv("PDT_TEST_KERNEL_LIMIT");
     if (t && strtoull(t, NULL, 10) > 0) limit = strtoull(t, NULL, 10);
@@ -156,7 +221,7 @@ static pdt_status check_size(run *R, pdt_err *err)
 static pdt_status read_input(run *R, pdt_err *err)
 {
     pdt_trace *tr = io_hook(R);
-    R->phase = "read";
+    set_phase(R, "read");
     double t0 = pdt_comm_wtime(R->c);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_READ, 0, 0, 0, 0);
     pdt_status st = agreed(R, pdt_par_read(R->c, R->o->input, R->o->scale, &R->in, err), err);
@@ -164,7 +229,7 @@ static pdt_status read_input(run *R, pdt_err *err)
     R->me.t_read = pdt_comm_wtime(R->c) - t0;
     if (st == PDT_OK) st = check_size(R, err);
     if (st == PDT_OK) {
-        R->phase = "trace";
+        set_phase(R, "trace");
         st = agreed(R, pdt_cli_trace_manifest(R->trace, R->o, R->c, &R->in, err), err);
     }
     return st;
@@ -174,7 +239,7 @@ static pdt_status read_input(run *R, pdt_err *err)
  * (they may wait for it): it reports and ends the whole job. */
 static pdt_status compute(run *R, pdt_err *err)
 {
-    R->phase = "triangulate";
+    set_phase(R, "triangulate");
     /* a .tri output names points by index only: the points can go once
      * partitioned (the other formats write them; a trace keeps them) */
     R->in.release_pts = pdt_tri_format_of(R->o->output) == PDT_FMT_TRI && !R->trace;
@@ -194,7 +259,7 @@ static pdt_status compute(run *R, pdt_err *err)
 static pdt_status write_output(run *R, pdt_err *err)
 {
     pdt_trace *tr = io_hook(R);
-    R->phase = "write";
+    set_phase(R, "write");
     double t0 = pdt_comm_wtime(R->c);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_WRITE, 0, 0, 0, 0);
     pdt_status st = pdt_par_write(R->c, R->o->output, pdt_tri_format_of(R->o->output), &R->in,
@@ -204,7 +269,7 @@ static pdt_status write_output(run *R, pdt_err *err)
     R->me.written = R->out.ntri;
     st = agreed(R, st, err);
     if (st == PDT_OK) {
-        R->phase = "trace";
+        set_phase(R, "trace");
         pdt_status tst = pdt_cli_trace_close(R->trace, err);
         R->trace = NULL;
         st = agreed(R, tst, err);
@@ -313,7 +378,7 @@ static void json_stats(const run *R, const pdt_par_stats *s, double total)
  * no triangles) and, with --stats, the figures: rank 0, on stderr. */
 static pdt_status report(run *R, pdt_err *err)
 {
-    R->phase = "figures";
+    set_phase(R, "figures");
     R->me.peak_rss_kib = pdt_cli_peak_kib();
     pdt_par_stats s;
     pdt_status st = agreed(R, pdt_par_stats_collect(R->c, &R->me, R->in.n_total, &s, err), err);
@@ -356,6 +421,7 @@ int pdt_cmd_triangulate(int argc, char **argv)
      * on top of it (at 4*10^6 points on 2 ranks: 230 MB per rank, 199 MB
      * with a fixed threshold).  A fixed threshold hands them back. */
     if (R.p > 1) mallopt(M_MMAP_THRESHOLD, 4 << 20);
+    if (R.p > 1 && pdt_comm_is_mpi(R.c)) catch_stop(&R);
     R.t_start = pdt_comm_wtime(R.c);
 
     pdt_status st = check_output(&R, &err);

@@ -102,13 +102,15 @@ static pdt_status nomem(drv *d, const char *phase)
 }
 
 /* Test-only: PDT_TEST_SLEEP_BEFORE_MERGE="RANK:SECONDS" makes RANK sleep
- * before its first merge step (to kill it there in a test). */
+ * before its first merge step (to kill it there in a test); PDT_TEST_MARK=FILE
+ * is created when the sleep begins. */
 static void test_sleep(int rank)
 {
     const char *e = getenv("PDT_TEST_SLEEP_BEFORE_MERGE");
     int r;
     double sec;
     if (e && sscanf(e, "%d:%lf", &r, &sec) == 2 && r == rank && sec > 0) {
+        pdt_par_test_mark();
         struct timespec ts = {(time_t)sec, (long)((sec - (double)(time_t)sec) * 1e9)};
         nanosleep(&ts, NULL);
     }

@@ -11,10 +11,13 @@
  * run), removed otherwise.  Standard output, a device or a pipe cannot be
  * written at offsets: the blocks are gathered at rank 0 and written there. */
 #include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "pdt/io.h"
@@ -85,6 +88,40 @@ static pdt_status write_gathered(pdt_comm *c, const char *path, pdt_tri_format f
 }
 
 /* ---- every rank at its offset ------------------------------------------------ */
+
+/* The temporaries this rank's write has named and not yet seen renamed: what
+ * pdt_par_write_abandon removes (from a signal handler: a fixed array, a
+ * count that is set after the name is complete). */
+static char pending[2][4096];
+static volatile sig_atomic_t npending;
+
+void pdt_par_test_mark(void)
+{
+    const char *m = getenv("PDT_TEST_MARK");
+    if (!m || !*m) return;
+    int fd = open(m, O_WRONLY | O_CREAT, 0644);
+    if (fd >= 0) close(fd);
+}
+
+void pdt_par_write_abandon(void)
+{
+    for (int k = 0; k < npending && k < 2; k++) unlink(pending[k]);
+}
+
+/* Test-only: PDT_TEST_SLEEP_IN_WRITE="RANK:SECONDS" makes RANK sleep once its
+ * temporary is open (to kill a rank in the middle of the write in a test);
+ * PDT_TEST_MARK=FILE is created when the sleep begins. */
+static void test_sleep_in_write(int rank)
+{
+    const char *e = getenv("PDT_TEST_SLEEP_IN_WRITE");
+    int r;
+    double sec;
+    if (e && sscanf(e, "%d:%lf", &r, &sec) == 2 && r == rank && sec > 0) {
+        pdt_par_test_mark();
+        struct timespec ts = {(time_t)sec, (long)((sec - (double)(time_t)sec) * 1e9)};
+        nanosleep(&ts, NULL);
+    }
+}
 
 /* Test-only: PDT_TEST_FAIL_WRITE=RANK makes RANK fail its share of the
  * parallel write (after the temporary file exists), as a full disk would. */
@@ -163,6 +200,7 @@ static pdt_status write_file(pdt_comm *c, outfile *o, pdt_err *err)
         if (r == 0) cannot_create(o->path, err);
         return pdt_par_agree(c, r == 0 ? PDT_ERR_IO : PDT_OK, NULL, err);
     }
+    test_sleep_in_write(r);
     pdt_err werr;
     pdt_err_clear(&werr);
     pdt_status wst = test_fail_write(r, o->path, &werr);
@@ -201,6 +239,10 @@ static pdt_status write_files(pdt_comm *c, outfile *o, int nfile, pdt_err *err)
     int made = 0;
     for (; made < nfile && st == PDT_OK; made++) {
         temp_name(o[made].tmp, sizeof o[made].tmp, o[made].path, pid);
+        if (pdt_comm_is_mpi(c)) { /* (one process per rank: the list is this rank's) */
+            memcpy(pending[made], o[made].tmp, sizeof pending[made]);
+            npending = made + 1;
+        }
         st = write_file(c, &o[made], err);
     }
     for (int k = 0; k < nfile && st == PDT_OK && r == 0; k++)
@@ -209,6 +251,7 @@ static pdt_status write_files(pdt_comm *c, outfile *o, int nfile, pdt_err *err)
                              strerror(errno));
     if (st != PDT_OK && r == 0)
         for (int k = 0; k < made; k++) unlink(o[k].tmp); /* (renamed ones are gone already) */
+    if (pdt_comm_is_mpi(c)) npending = 0;
     return pdt_par_agree(c, st, NULL, err);
 }
 

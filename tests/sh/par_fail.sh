@@ -15,37 +15,49 @@ if ! command -v mpirun > /dev/null; then fail mpirun_available "mpirun not found
 
 "$PDT" gen uniform 3000 --seed 3 -o u.txt
 
-# --- a rank dies: rank 1 sleeps before its merge step (test-only variable),
-# we kill exactly that process
-PDT_TEST_SLEEP_BEFORE_MERGE=1:60 timeout 120 mpirun -np 2 "$PDT" triangulate u.txt -o killed.tri \
-    > kill.out 2> kill.err &
-MPID=$!   # timeout, whose child is mpirun, whose children are the ranks
-victim=
-for _ in $(seq 1 100); do
-    for c in $(for m in $(pgrep -P "$MPID"); do pgrep -P "$m"; done 2> /dev/null); do
-        if tr '\0' '\n' < "/proc/$c/environ" 2> /dev/null | grep -qx 'OMPI_COMM_WORLD_RANK=1'; then
-            victim=$c
-        fi
+# --- a rank dies: rank 1 sleeps at a given place (test-only variable), we kill
+# exactly that process.  Non-zero exit, no output file and no temporary left,
+# and rank 0 (ended by mpirun's SIGTERM) names the step the job was in.
+# kill_rank NAME VAR=RANK:SECONDS STEP
+kill_rank() {
+    local name=$1 hook=$2 step=$3
+    env "$hook" PDT_TEST_MARK="mark-$name" timeout 120 mpirun -np 2 "$PDT" triangulate u.txt -o "$name.tri" \
+        > "log-$name.out" 2> "log-$name.err" &
+    local MPID=$!   # timeout, whose child is mpirun, whose children are the ranks
+    local victim=
+    for _ in $(seq 1 100); do
+        for c in $(for m in $(pgrep -P "$MPID"); do pgrep -P "$m"; done 2> /dev/null); do
+            if tr '\0' '\n' < "/proc/$c/environ" 2> /dev/null | grep -qx 'OMPI_COMM_WORLD_RANK=1'; then
+                victim=$c
+            fi
+        done
+        [ -n "$victim" ] && break
+        sleep 0.1
     done
-    [ -n "$victim" ] && break
-    sleep 0.1
-done
-if [ -z "$victim" ]; then
-    fail rank_killed_mid_run "could not find rank 1 of mpirun $MPID"
-    kill "$MPID" 2> /dev/null
-else
-    sleep 1   # let it reach the sleep before its merge
-    t0=$SECONDS
+    if [ -z "$victim" ]; then
+        fail "$name" "could not find rank 1 of mpirun $MPID"
+        kill "$MPID" 2> /dev/null
+        wait 2> /dev/null
+        return
+    fi
+    # let it reach its sleep (the hook creates the mark file then)
+    for _ in $(seq 1 600); do [ -e "mark-$name" ] && break; sleep 0.1; done
+    sleep 0.2
+    local t0=$SECONDS rc
     kill -KILL "$victim"
     wait "$MPID"; rc=$?
-    left=$(ls -A | grep -c killed)
-    if [ $rc -ne 0 ] && [ $rc -ne 124 ] && [ "$left" -eq 0 ] && [ $((SECONDS - t0)) -lt 30 ]; then
-        ok rank_killed_mid_run
+    local left
+    left=$(ls -A | grep -v '^log-\|^mark-' | grep -c "$name")
+    if [ $rc -ne 0 ] && [ $rc -ne 124 ] && [ "$left" -eq 0 ] && [ $((SECONDS - t0)) -lt 30 ] &&
+        grep -q "while rank 0 was in its $step step" "log-$name.err"; then
+        ok "$name"
     else
-        fail rank_killed_mid_run "rc=$rc files=$(ls -A | grep killed) after $((SECONDS - t0)) s"
+        fail "$name" "rc=$rc files=$(ls -A | grep -v '^log-\|^mark-' | grep "$name") after $((SECONDS - t0)) s: $(cat "log-$name.err")"
     fi
-fi
-wait 2> /dev/null
+    wait 2> /dev/null
+}
+kill_rank rank_killed_mid_run PDT_TEST_SLEEP_BEFORE_MERGE=1:60 triangulate
+kill_rank rank_killed_in_write PDT_TEST_SLEEP_IN_WRITE=1:60 write
 
 # --- bad input: file:line message, exit 2, no output
 printf '0 0\n1 1\n2 x\n' > bad.txt
