@@ -16,11 +16,15 @@
 typedef struct pdt_io_text {
     char *buf;
     size_t len;
+    size_t mapped; /* 0: buf is malloc'd; else the bytes mapped at buf (read only) */
 } pdt_io_text;
 
 /* Read the file `path` ("-" = standard input) into t.  Errors name the file:
  * "FILE: cannot open: REASON", "FILE: is a directory", "FILE: read error: REASON".
- * On success t->buf is malloc'd (free with pdt_io_text_free). */
+ * A regular file of 1 MiB or more is mapped (read only: its page-cache pages
+ * are used as they are, no fresh memory; the file must not shrink while it
+ * is read), anything else is read into a malloc'd buffer.  Free t with
+ * pdt_io_text_free. */
 pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err);
 void pdt_io_text_free(pdt_io_text *t);
 

@@ -540,7 +540,7 @@ pdt_status pdt_points_head_read(const char *path, double scale, pdt_points_head 
         buf = nb;
         if ((st = pread_full(fd, buf, len, 0, path, err)) != PDT_OK) break;
         buf[len] = '\0';
-        pdt_io_text t = {buf, len};
+        pdt_io_text t = {buf, len, 0};
         reader r = {.scale = scale, .err = err};
         pdt_io_cur_init(&r.cur, &t, path);
         r.cur.fields = !h->node;

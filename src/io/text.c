@@ -8,15 +8,42 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 /* ---- loading -------------------------------------------------------------- */
 
+enum { MAP_MIN = 1 << 20 };
+
+/* A regular file of size bytes mapped read only at t->buf, with a zero byte
+ * after it: the file's pages, then one page of anonymous zeros when size is
+ * a multiple of the page size (else the rest of its last page reads as
+ * zeros already).  Returns 0, or -1 (nothing mapped: read it instead). */
+static int map_file(int fd, size_t size, pdt_io_text *t)
+{
+    size_t pg = (size_t)sysconf(_SC_PAGESIZE);
+    size_t fbytes = (size + pg - 1) / pg * pg, total = size / pg * pg + pg;
+    char *a = mmap(NULL, total, PROT_READ, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (a == MAP_FAILED) return -1;
+    /* MAP_POPULATE: the page-cache pages are mapped in one call, not one
+     * fault per 64 KiB as the parser reaches them */
+    if (mmap(a, fbytes, PROT_READ, MAP_PRIVATE | MAP_FIXED | MAP_POPULATE, fd, 0) == MAP_FAILED) {
+        munmap(a, total);
+        return -1;
+    }
+    madvise(a, fbytes, MADV_SEQUENTIAL);
+    t->buf = a;
+    t->len = size;
+    t->mapped = total;
+    return 0;
+}
+
 pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
 {
     t->buf = NULL;
     t->len = 0;
+    t->mapped = 0;
     int is_stdin = strcmp(path, "-") == 0;
     const char *name = is_stdin ? "standard input" : path;
     int fd = is_stdin ? STDIN_FILENO : open(path, O_RDONLY | O_CLOEXEC);
@@ -31,8 +58,16 @@ pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
         if (!is_stdin) close(fd);
         return pdt_err_set(err, PDT_ERR_IO, "%s: is a directory", name);
     }
-    /* Regular files: one allocation of the right size (room for the byte the
-     * read that finds the end asks for, and the '\0'); pipes: grow. */
+    /* Large regular files: mapped (reading them copied the file into as
+     * much fresh memory, whose first touch is dear: 0.2-0.3 s at 10^7
+     * points on this project's VM).  Other regular files: one allocation
+     * of the right size (room for the byte the read that finds the end asks
+     * for, and the '\0'); pipes: grow. */
+    if (S_ISREG(sb.st_mode) && (uint64_t)sb.st_size >= MAP_MIN && (uint64_t)sb.st_size < SIZE_MAX / 2 &&
+        map_file(fd, (size_t)sb.st_size, t) == 0) {
+        if (!is_stdin) close(fd);
+        return PDT_OK;
+    }
     size_t cap = S_ISREG(sb.st_mode) && sb.st_size > 0 ? (size_t)sb.st_size + 2 : 65536;
     char *buf = malloc(cap);
     if (!buf) {
@@ -74,7 +109,9 @@ pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
 
 void pdt_io_text_free(pdt_io_text *t)
 {
-    free(t->buf);
+    if (t->mapped) munmap(t->buf, t->mapped);
+    else free(t->buf);
+    t->mapped = 0;
     t->buf = NULL;
     t->len = 0;
 }
