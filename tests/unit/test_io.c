@@ -163,6 +163,34 @@ TEST(empty_file_is_zero_points)
     free(p);
 }
 
+/* Files of 1 MiB or more are mapped, not read: one whose size is a
+ * multiple of the page size (so no zero byte follows it in its last page)
+ * ends with a point without a newline; another ends with a bad line, which
+ * is still named by its number. */
+TEST(large_file_mapped_exact_pages)
+{
+    size_t lines = (1u << 20) / 4; /* "1 2\n" is 4 bytes: the file is exactly 1 MiB */
+    char *t = malloc(4 * lines + 1);
+    CHECK(t != NULL);
+    for (size_t i = 0; i < lines; i++) memcpy(t + 4 * i, "1 2\n", 4);
+    memcpy(t + 4 * (lines - 1), "3 45", 4); /* last line, no newline */
+    t[4 * lines] = '\0';
+    pdt_point *p = NULL;
+    size_t n = 0;
+    pdt_err err;
+    CHECK(rd("big.txt", t, 0, &p, &n, NULL, &err) == PDT_OK);
+    CHECK(n == lines && p[0].x == 1 && p[0].y == 2 && p[n - 1].x == 3 && p[n - 1].y == 45);
+    free(p);
+    memcpy(t + 4 * (lines - 1), "3 4x", 4);
+    p = NULL;
+    CHECK(rd("big2.txt", t, 0, &p, &n, NULL, &err) == PDT_ERR_PARSE);
+    char want[64];
+    snprintf(want, sizeof want, "big2.txt:%zu:", lines);
+    CHECK_MSG(strstr(err.msg, want) != NULL, "message: %s", err.msg);
+    free(p);
+    free(t);
+}
+
 TEST(text_bad_inputs)
 {
     CHECK(bad("b.txt", "1 2\n3 4294967296\n", 0, "2: coordinate 4294967296 does not fit in 32 bits"));
@@ -579,6 +607,7 @@ int main(void)
     RUN(tris_write_formats);
     RUN(tris_read_bad_inputs);
     RUN(atomic_write_leaves_nothing);
+    RUN(large_file_mapped_exact_pages);
     RUN(devices_are_written_not_replaced);
     clean();
     rmdir(dir);
