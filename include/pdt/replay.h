@@ -107,7 +107,8 @@ typedef struct pdt_rmerge {
 
 /* A message: SEND on src and the matching RECV on dst. */
 typedef struct pdt_rmsg {
-    uint32_t src, dst, tag, bytes;
+    uint32_t src, dst, tag;
+    uint64_t bytes;
     uint32_t send_ev, recv_ev;  /* UINT32_MAX when that side is missing */
 } pdt_rmsg;
 

@@ -35,9 +35,11 @@
  *                 one past last rank of G_R / v = merge rank
  *   MERGE_END     merge level / shipped triangles |R_L|+|R_R| / |B| / kept /
  *                 v = discarded
- *   SEND          message tag / peer rank / bytes / - / v = sequence number of
- *                 the message between this pair of ranks (pairs with RECV)
- *   RECV          message tag / peer rank / bytes / - / v = sequence number
+ *   SEND          message tag / peer rank / bytes (low 32 bits) / bytes (high
+ *                 32 bits: pdt_event_bytes) / v = sequence number of the
+ *                 message between this pair of ranks (pairs with RECV)
+ *   RECV          message tag / peer rank / bytes (low) / bytes (high) / v =
+ *                 sequence number
  *   HULL          - / number of hull vertices / 1 if degenerate / - / -
  *                 (the hull of the current group is on the stack just built)
  *  level 2
@@ -114,6 +116,14 @@ typedef struct pdt_event {
     int64_t v;         /* kind-specific */
     uint64_t t;        /* nanoseconds on the rank's clock; set by the sink */
 } pdt_event;
+
+/* The byte count of a SEND or RECV event: 64-bit, in b (low half) and c
+ * (high half; 0 in traces written before it was used, which is right for
+ * their counts, all below 2^32). */
+static inline uint64_t pdt_event_bytes(const pdt_event *e)
+{
+    return (uint64_t)e->b | (uint64_t)e->c << 32;
+}
 
 typedef struct pdt_trace pdt_trace;
 struct pdt_trace {

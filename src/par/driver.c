@@ -59,7 +59,8 @@ static void note_send(drv *d, int tag, int peer, size_t bytes)
 {
     d->bytes_sent += bytes;
     if (tag >= TAG_MERGE) d->merge_sent += bytes;
-    PDT_TRACE(d->tr, 1, PDT_EV_SEND, tag, peer, bytes, 0, d->seq_send[peer]);
+    PDT_TRACE(d->tr, 1, PDT_EV_SEND, tag, peer, (uint32_t)bytes, (uint32_t)((uint64_t)bytes >> 32),
+              d->seq_send[peer]);
     d->seq_send[peer]++;
 }
 
@@ -67,7 +68,8 @@ static void note_recv(drv *d, int tag, int peer, size_t bytes)
 {
     d->bytes_recv += bytes;
     if (tag >= TAG_MERGE) d->merge_recv += bytes;
-    PDT_TRACE(d->tr, 1, PDT_EV_RECV, tag, peer, bytes, 0, d->seq_recv[peer]);
+    PDT_TRACE(d->tr, 1, PDT_EV_RECV, tag, peer, (uint32_t)bytes, (uint32_t)((uint64_t)bytes >> 32),
+              d->seq_recv[peer]);
     d->seq_recv[peer]++;
 }
 

@@ -25,7 +25,8 @@ typedef struct fin {   /* a TRI_FINAL, rotated to start at its smallest index */
 } fin;
 
 typedef struct msg {   /* a SEND or RECV */
-    uint32_t src, dst, tag, bytes, rank;
+    uint32_t src, dst, tag, rank;
+    uint64_t bytes;
     int64_t seq_no;
     uint64_t seq;      /* event index */
     pdt_event ev;
@@ -602,7 +603,7 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
         m->dst = send ? e->a : r;
         m->tag = e->sub;
         m->seq_no = e->v;
-        m->bytes = e->b;
+        m->bytes = pdt_event_bytes(e);
         m->rank = r;
         m->seq = seq;
         m->ev = *e;
@@ -739,7 +740,7 @@ static pdt_status check_messages(chk *c)
         }
         if (n->bytes != m->bytes)
             return viol(c, n->rank, n->seq, &n->ev, "the send (rank %" PRIu32 " event #%" PRIu64
-                                                    ") has %" PRIu32 " bytes",
+                                                    ") has %" PRIu64 " bytes",
                         m->rank, m->seq, m->bytes);
         i += 2;
     }

@@ -166,11 +166,13 @@ static pdt_status put_event(ox *x, OTF2_EvtWriter *w, u32vec *open, const pdt_ev
         }
         if (e->kind == PDT_EV_SEND) {
             x->counts.sends++;
-            return ck(x, OTF2_EvtWriter_MpiSend(w, NULL, t, e->a, COMM_ALL, e->sub, e->b),
+            return ck(x, OTF2_EvtWriter_MpiSend(w, NULL, t, e->a, COMM_ALL, e->sub,
+                                                 pdt_event_bytes(e)),
                       "send record");
         }
         x->counts.recvs++;
-        return ck(x, OTF2_EvtWriter_MpiRecv(w, NULL, t, e->a, COMM_ALL, e->sub, e->b),
+        return ck(x, OTF2_EvtWriter_MpiRecv(w, NULL, t, e->a, COMM_ALL, e->sub,
+                                             pdt_event_bytes(e)),
                   "recv record");
     default:
         return PDT_OK;

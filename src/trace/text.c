@@ -113,12 +113,12 @@ char *pdt_event_format(const pdt_event *e0, char *buf, size_t cap)
                  " discarded=%" PRId64, e->sub, e->a, e->b, e->c, e->v);
         break;
     case PDT_EV_SEND:
-        snprintf(buf, cap, "send tag=%u to=%" PRIu32 " bytes=%" PRIu32 " seq=%" PRId64, e->sub, e->a,
-                 e->b, e->v);
+        snprintf(buf, cap, "send tag=%u to=%" PRIu32 " bytes=%" PRIu64 " seq=%" PRId64, e->sub, e->a,
+                 pdt_event_bytes(e), e->v);
         break;
     case PDT_EV_RECV:
-        snprintf(buf, cap, "recv tag=%u from=%" PRIu32 " bytes=%" PRIu32 " seq=%" PRId64, e->sub,
-                 e->a, e->b, e->v);
+        snprintf(buf, cap, "recv tag=%u from=%" PRIu32 " bytes=%" PRIu64 " seq=%" PRId64, e->sub,
+                 e->a, pdt_event_bytes(e), e->v);
         break;
     case PDT_EV_HULL:
         snprintf(buf, cap, "hull vertices=%" PRIu32 "%s", e->a, e->b ? " degenerate" : "");

@@ -2,6 +2,7 @@
  * (see pdt/describe.h). */
 #include "pdt/describe.h"
 
+#include <inttypes.h>
 #include <stdio.h>
 
 #define NONE32 UINT32_MAX
@@ -305,10 +306,11 @@ void pdt_replay_describe_state(const pdt_replay *r, const pdt_rstate *s, size_t 
                  e->sub, e->a, e->b, e->c, (long long)e->v);
         break;
     case PDT_EV_SEND:
-        snprintf(o, c, "send %u bytes to rank %u (tag %u)", e->b, e->a, e->sub);
+        snprintf(o, c, "send %" PRIu64 " bytes to rank %u (tag %u)", pdt_event_bytes(e), e->a, e->sub);
         break;
     case PDT_EV_RECV:
-        snprintf(o, c, "receive %u bytes from rank %u (tag %u)", e->b, e->a, e->sub);
+        snprintf(o, c, "receive %" PRIu64 " bytes from rank %u (tag %u)", pdt_event_bytes(e), e->a,
+                 e->sub);
         break;
     case PDT_EV_HULL:
         snprintf(o, c, "hull of %u vertices%s", e->a, e->b ? " (degenerate)" : "");

@@ -332,7 +332,7 @@ static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
         if (!km_get(&b->msg_map, hi, lo, &id) ||
             (send ? r->msgs[id].send_ev : r->msgs[id].recv_ev) != NONE32) {
             if (!grow((void **)&r->msgs, &r->cap_msg, r->nmsg + 1, sizeof *r->msgs)) return 0;
-            r->msgs[r->nmsg] = (pdt_rmsg){src, dst, e->sub, e->b, NONE32, NONE32};
+            r->msgs[r->nmsg] = (pdt_rmsg){src, dst, e->sub, pdt_event_bytes(e), NONE32, NONE32};
             id = (int32_t)r->nmsg++;
             if (!km_put(&b->msg_map, hi, lo, id)) return 0;
         }

@@ -554,6 +554,17 @@ TEST(event_text)
     CHECK(!strcmp(pdt_event_format(&e, buf, sizeof buf), "pop graham pt=17 depth=3 cause=-"));
     pdt_event l = {.kind = PDT_EV_LIFT, .a = 4, .v = 25};
     CHECK(!strcmp(pdt_event_format(&l, buf, sizeof buf), "lift pt=4 z=25"));
+    /* a message of 5 GiB + 7 bytes: the count's high half is in c */
+    uint64_t big = ((uint64_t)5 << 30) + 7;
+    pdt_event snd = {.kind = PDT_EV_SEND, .sub = 3, .a = 1, .b = (uint32_t)big,
+                     .c = (uint32_t)(big >> 32), .v = 2};
+    CHECK(pdt_event_bytes(&snd) == big);
+    CHECK(!strcmp(pdt_event_format(&snd, buf, sizeof buf), "send tag=3 to=1 bytes=5368709127 seq=2"));
+    snd.kind = PDT_EV_RECV;
+    CHECK(!strcmp(pdt_event_format(&snd, buf, sizeof buf),
+                  "recv tag=3 from=1 bytes=5368709127 seq=2"));
+    snd.c = 0; /* as every trace written before: the low half alone */
+    CHECK(pdt_event_bytes(&snd) == 1073741831u);
     CHECK(pdt_event_kind_by_name("tri-final") == PDT_EV_TRI_FINAL);
     CHECK(pdt_event_kind_by_name("nope") == -1);
     for (int k = 0; k < PDT_EV_KIND_COUNT + 2; k++) {
