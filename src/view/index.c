@@ -7,8 +7,10 @@
  *                    offset and length, the place of the chunk checksums
  *                    (a CRC-32C per 16 MiB of every section: verified by
  *                    several threads at each opening); the header's own CRC
- *   sections         the merged event records, then every table of the
- *                    replay (replay_int.h), the points and the reader's
+ *   sections         the merged event records, then the triangle
+ *                    histories and the triangles (streamed here while they
+ *                    are built: pdt_replay_build), then every other table of
+ *                    the replay (replay_int.h), the points and the reader's
  *                    warnings about the run, each at a 64-byte boundary
  *                    (so that a valid index opens without reading the run)
  *
@@ -757,17 +759,58 @@ static int write_checkpoints(const pdt_replay *r, int fd, uint64_t off)
     return ok;
 }
 
-/* Write the tables of r after the records, then the header. */
-static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, pdt_err *err)
+/* The triangles and histories of a replay being built, streamed to the index
+ * file itself (pdt_replay_place): written once, in place, by pwrite (not
+ * through a shared mapping: on this file system page faults on a file being
+ * written back wait for the disk), and never held in memory. */
+typedef struct placer {
+    int fd;
+    uint64_t off;  /* where the next table goes */
+} placer;
+
+static uint64_t place_reserve(void *ctx, uint64_t bytes)
+{
+    placer *pc = ctx;
+    uint64_t at = (pc->off + 63) & ~(uint64_t)63;
+    pc->off = at + bytes;
+    return at;
+}
+
+static int place_put(void *ctx, uint64_t at, const void *p, size_t bytes)
+{
+    return write_all(((placer *)ctx)->fd, p, bytes, at);
+}
+
+static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
+{
+    char *b = p;
+    while (bytes) {
+        ssize_t got = pread(((placer *)ctx)->fd, b, bytes, (off_t)at);
+        if (got <= 0) return 0;
+        b += got;
+        bytes -= (size_t)got;
+        at += (uint64_t)got;
+    }
+    return 1;
+}
+
+/* Write the tables of r after the records and the streamed ones (at pc->off),
+ * then the header. */
+static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
+                               pdt_err *err)
 {
     void **ptr[NSEC];
     size_t elem[NSEC];
     uint64_t count[NSEC];
     sections(r, ptr, elem, count);
-    uint64_t off = h->sec[S_RECS].off + h->sec[S_RECS].bytes;
+    uint64_t off = pc->off;
     for (int i = 0; i < NSEC; i++) {
         h->count[i] = count[i];
         if (i == S_RECS) continue;
+        if (r->streamed && (i == S_TRIS || i == S_HIST)) {
+            h->sec[i] = (isec){i == S_TRIS ? r->tris_at : r->hist_at, count[i] * elem[i], 0, 0};
+            continue;
+        }
         off = (off + 63) & ~(uint64_t)63;
         size_t bytes = (size_t)count[i] * elem[i];
         if (i == S_CKPT) {
@@ -860,7 +903,7 @@ static void clean_stale_temps(const char *path)
 
 /* Build the index of run at `path` (temporary file + rename). */
 static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks, uint64_t ident,
-                        const char *path, pdt_err *err)
+                        const char *path, uint64_t budget, pdt_err *err)
 {
     char tmp[PATH_MAX + 128];
     clean_stale_temps(path);
@@ -880,15 +923,18 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         recs = mmap(NULL, recs_len, PROT_READ, MAP_SHARED, fd, 0);
         if (recs == MAP_FAILED) st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
     }
+    placer pc = {fd, recs_len};
+    pdt_replay_place pl = {place_reserve, place_put, place_get, &pc, budget};
     if (st == PDT_OK)
-        st = pdt_replay_new(pts, n, (const pdt_rec *)((char *)recs + HDR_BYTES), m, nranks, &r, err);
+        st = pdt_replay_build(pts, n, (const pdt_rec *)((char *)recs + HDR_BYTES), m, nranks, &pl,
+                              &r, err);
     if (st == PDT_OK) {
         r->warnings = pdt_run_warnings(run);
         size_t every = r->m / ICK_PARTS;
         r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
         r->nick = r->m / r->ick_every + 1;
         r->ick_bytes = pdt_rstate_blob_bytes(r);
-        st = write_tables(r, fd, h, ident, err);
+        st = write_tables(r, fd, h, ident, &pc, err);
         r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
     }
     pdt_replay_free(r);
@@ -999,7 +1045,7 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
                 if (!cache_dir(cdir, sizeof cdir) || !make_dirs(cdir)) continue;
             }
             pdt_err e2 = {0};
-            if (build(run, pts, n, nranks, ident, path, &e2) != PDT_OK) {
+            if (build(run, pts, n, nranks, ident, path, budget, &e2) != PDT_OK) {
                 snprintf(info->write_error, sizeof info->write_error, "%s", e2.msg);
                 pdt_err_clear(&e2);
                 continue;

@@ -3,6 +3,7 @@
 #include "replay_int.h"
 #include "../geom/bigmem.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -139,15 +140,76 @@ static void sort3(uint32_t v[3], const uint32_t in[3])
     v[2] = c;
 }
 
+/* ---- triangles: their events grouped by triangle, in buckets of bounded size ----
+ *
+ * The first pass writes every triangle event, with its triangle's key (the
+ * corners sorted), into the place of a history entry (the same size), sorted
+ * by a hash of the key into NFINE fine buckets, each in event order.  Then
+ * runs of consecutive fine buckets that fit the working budget are grouped
+ * one after the other with a hash table of their own size (tri_groups): the
+ * events of one triangle are all in one fine bucket, so each run's triangles
+ * are whole, and their history entries are written over the run's records.
+ * A last pass in event order numbers the triangles by their first event
+ * (tri_ids).  Memory: the tables themselves (which may be the caller's, e.g.
+ * a mapping of the index file) and a working set bounded by the budget. */
+
+typedef struct tri_rec {
+    uint32_t s[3];  /* corners, sorted: the triangle's key */
+    uint32_t ev, rank;
+    uint8_t kind, sub;
+    uint16_t pad;
+    int64_t v;
+} tri_rec;
+
+_Static_assert(sizeof(tri_rec) == sizeof(pdt_rtri_hist), "a triangle event fits its history entry");
+
+#define FINE_BITS 8
+#define NFINE ((size_t)1 << FINE_BITS)
+#define GROUP_BYTES_PER_EVENT 128u /* tri_groups' working memory per event, at most */
+
+static uint64_t key_hash(const uint32_t s[3])
+{
+    return mix(((uint64_t)s[0] << 32) | s[1], s[2]);
+}
+
+static size_t fine_of(const uint32_t s[3]) { return (size_t)(key_hash(s) >> (64 - FINE_BITS)); }
+
 /* Build state while indexing: the current slot values of every rank. */
 typedef struct builder {
     pdt_replay *r;
     int32_t *cur;   /* per rank * PDT_SLOT_PER_RANK */
     int32_t *lastst;     /* per rank: the stack touched last (HULL reports it) */
-    keymap tri_map, edge_map, msg_map;
-    uint32_t *tri_count;  /* histories per triangle (pass 1) */
-    size_t cap_count;
+    keymap edge_map, msg_map;
+    size_t *fine_fill;    /* per fine bucket: the next free history entry (pass 1) */
+    size_t *fine_off;     /* per fine bucket: its first history entry; NFINE + 1 */
+    const pdt_replay_place *pl;  /* streamed: the place, and per fine bucket a buffer */
+    tri_rec *fbuf;        /* NFINE * FBUF records */
+    uint32_t *fbn;        /* records in each buffer */
+    int failed;           /* a put or get failed */
 } builder;
+
+#define FBUF 1024u  /* records buffered per fine bucket (streamed) */
+
+/* Write n entries of `elem` bytes from p at entry `at` of the table at `base`
+ * of the place (streamed) or of the array `arr`. */
+static int tput(builder *b, void *arr, uint64_t base, size_t at, const void *p, size_t n, size_t elem)
+{
+    if (!n) return 1;
+    if (!b->pl) {
+        memcpy((char *)arr + at * elem, p, n * elem);
+        return 1;
+    }
+    if (!b->pl->put(b->pl->ctx, base + (uint64_t)at * elem, p, n * elem)) b->failed = 1;
+    return !b->failed;
+}
+
+/* Flush the buffer of fine bucket f (streamed). */
+static int fine_flush(builder *b, size_t f)
+{
+    size_t k = b->fbn[f];
+    b->fbn[f] = 0;
+    return tput(b, NULL, b->r->hist_at, b->fine_fill[f] - k, b->fbuf + f * FBUF, k, sizeof(tri_rec));
+}
 
 static int set_slot(builder *b, uint32_t ev, int rank, int slot, int32_t val)
 {
@@ -347,29 +409,30 @@ static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
             r->skipped++;
             return 1;
         }
-        uint32_t in[3] = {e->a, e->b, e->c}, s[3];
-        sort3(s, in);
-        int32_t id;
-        if (!km_get(&b->tri_map, ((uint64_t)s[0] << 32) | s[1], s[2], &id)) {
-            if (!grow((void **)&r->tris, &r->cap_tri, r->ntri + 1, sizeof *r->tris) ||
-                !grow((void **)&b->tri_count, &b->cap_count, r->ntri + 1, sizeof *b->tri_count))
-                return 0;
-            r->tris[r->ntri] = (pdt_rtri){{e->a, e->b, e->c}, rec->rank, 0, 0};
-            b->tri_count[r->ntri] = 0;
-            id = (int32_t)r->ntri++;
-            if (!km_put(&b->tri_map, ((uint64_t)s[0] << 32) | s[1], s[2], id)) return 0;
+        tri_rec t;
+        uint32_t in[3] = {e->a, e->b, e->c};
+        sort3(t.s, in);
+        t.ev = i;
+        t.rank = rec->rank;
+        t.kind = e->kind;
+        t.sub = e->sub;
+        t.pad = 0;
+        t.v = e->v;
+        size_t f = fine_of(t.s);
+        if (!b->pl) {
+            memcpy(&r->hist[b->fine_fill[f]++], &t, sizeof t);
+            return 1;
         }
-        if (e->kind == PDT_EV_TRI_NEW && b->tri_count[id] == 0) r->tris[id].maker = rec->rank;
-        b->tri_count[id]++;
-        r->ev_obj[i] = id;
-        return 1;
+        b->fbuf[f * FBUF + b->fbn[f]++] = t;
+        b->fine_fill[f]++;
+        return b->fbn[f] < FBUF || fine_flush(b, f);
     }
 }
 
-/* The index pass is bound by cache misses in the triangle and edge maps
- * (random slots in tables of 10^8 bytes).  The events are all known in
- * advance, so the slot an event a few places ahead will probe is fetched
- * while the current one is handled.  A hint only: nothing depends on it. */
+/* The index pass is bound by cache misses in the edge map (random slots in
+ * a table of 10^8 bytes at level 2).  The events are all known in advance,
+ * so the slot an event a few places ahead will probe is fetched while the
+ * current one is handled.  A hint only: nothing depends on it. */
 #define PREFETCH_AHEAD 12
 
 /* The slot that looking up event i will probe first, or NULL.  (The caller
@@ -379,58 +442,235 @@ static const void *probe_addr(const builder *b, size_t i)
 {
     const pdt_rec *rec = &b->r->recs[i];
     const pdt_event *e = &rec->ev;
-    const keymap *km;
-    uint64_t hi, lo;
-    if (e->kind == PDT_EV_EDGE_ADD || e->kind == PDT_EV_EDGE_DEL) {
-        uint32_t x = e->a < e->b ? e->a : e->b, y = e->a < e->b ? e->b : e->a;
-        km = &b->edge_map;
-        hi = rec->rank;
-        lo = ((uint64_t)x << 32) | y;
-    } else if (is_tri_kind(e->kind)) {
-        uint32_t in[3] = {e->a, e->b, e->c}, s[3];
-        sort3(s, in);
-        km = &b->tri_map;
-        hi = ((uint64_t)s[0] << 32) | s[1];
-        lo = s[2];
-    } else {
-        return NULL;
-    }
-    return km->cap ? &km->e[(size_t)mix(hi, lo) & (km->cap - 1)] : NULL;
+    if (e->kind != PDT_EV_EDGE_ADD && e->kind != PDT_EV_EDGE_DEL) return NULL;
+    uint32_t x = e->a < e->b ? e->a : e->b, y = e->a < e->b ? e->b : e->a;
+    const keymap *km = &b->edge_map;
+    return km->cap ? &km->e[(size_t)mix(rec->rank, ((uint64_t)x << 32) | y) & (km->cap - 1)] : NULL;
 }
 
-static pdt_status build(pdt_replay *r, pdt_err *err)
+/* One slot of tri_groups' hash table: a key and its group, UINT32_MAX = empty. */
+typedef struct gslot {
+    uint32_t s[3], g;
+} gslot;
+
+/* The history entry of the triangle event in t (the status it sets). */
+static pdt_rtri_hist hist_of(const pdt_replay *r, const tri_rec *t)
+{
+    pdt_rtri_hist h = {t->ev, t->rank, tri_status_of(t->kind), t->sub, t->v, NONE32};
+    if (t->kind == PDT_EV_TRI_NEW && t->sub == 1) /* border kernel: which merge step? */
+        for (size_t g = 0; g < r->nmerge; g++)
+            if (r->merges[g].rank == t->rank && r->merges[g].begin_ev < t->ev &&
+                r->merges[g].end_ev != NONE32 && t->ev < r->merges[g].end_ev)
+                h.until = r->merges[g].end_ev;
+    return h;
+}
+
+/* Group the triangle events (hist[], in fine buckets) by triangle, a run
+ * of fine buckets at a time: each triangle's entries become consecutive, in
+ * event order; ev_ent[ev] is the event's entry; ev_obj[ev] is -1 - (entries
+ * of its triangle) for a triangle's first event, else that first event.
+ * Working memory: about budget bytes (0: no limit). */
+static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
+{
+    pdt_replay *r = b->r;
+    *ntri = 0;
+    size_t cap = budget ? (size_t)(budget / GROUP_BYTES_PER_EVENT) : SIZE_MAX;
+    if (cap < 1024) cap = 1024;
+    size_t most = 0;  /* the largest run */
+    for (size_t f = 0; f < NFINE;) {
+        size_t g = f + 1;
+        while (g < NFINE && b->fine_off[g + 1] - b->fine_off[f] <= cap) g++;
+        if (b->fine_off[g] - b->fine_off[f] > most) most = b->fine_off[g] - b->fine_off[f];
+        f = g;
+    }
+    if (!most) return 1;
+    size_t hcap = 1024;
+    while (hcap / 4 * 3 < most) hcap *= 2;
+    tri_rec *buf = malloc(most * sizeof *buf);
+    gslot *slot = malloc(hcap * sizeof *slot);
+    uint32_t *gid = malloc(most * sizeof *gid), *gfirst = malloc(most * sizeof *gfirst);
+    uint32_t *gn = malloc(most * sizeof *gn), *gfill = malloc(most * sizeof *gfill);
+    pdt_rtri_hist *out = b->pl ? malloc(most * sizeof *out) : NULL;  /* streamed: the run's entries */
+    int ok = buf && slot && gid && gfirst && gn && gfill && (out || !b->pl);
+    if (ok) {
+        pdt_big_advise(buf, most * sizeof *buf);
+        pdt_big_advise(slot, hcap * sizeof *slot);
+    }
+    for (size_t f = 0; ok && f < NFINE;) {
+        size_t g = f + 1;
+        while (g < NFINE && b->fine_off[g + 1] - b->fine_off[f] <= cap) g++;
+        size_t base = b->fine_off[f], nb = b->fine_off[g] - base;
+        f = g;
+        if (!nb) continue;
+        if (!b->pl) memcpy(buf, &r->hist[base], nb * sizeof *buf);
+        else if (!b->pl->get(b->pl->ctx, r->hist_at + base * sizeof *buf, buf, nb * sizeof *buf)) {
+            ok = 0;
+            break;
+        }
+        size_t hc = 1024;
+        while (hc / 4 * 3 < nb) hc *= 2;
+        size_t mask = hc - 1;
+        for (size_t k = 0; k < hc; k++) slot[k].g = NONE32;
+        uint32_t ng = 0;
+        for (size_t j = 0; j < nb; j++) {
+            if (j + PREFETCH_AHEAD < nb)
+                __builtin_prefetch(&slot[(size_t)key_hash(buf[j + PREFETCH_AHEAD].s) & mask]);
+            const uint32_t *s = buf[j].s;
+            size_t k = (size_t)key_hash(s) & mask;
+            while (slot[k].g != NONE32 &&
+                   (slot[k].s[0] != s[0] || slot[k].s[1] != s[1] || slot[k].s[2] != s[2]))
+                k = (k + 1) & mask;
+            if (slot[k].g == NONE32) {
+                slot[k] = (gslot){{s[0], s[1], s[2]}, ng};
+                gfirst[ng] = buf[j].ev;
+                gn[ng++] = 0;
+            }
+            gid[j] = slot[k].g;
+            gn[gid[j]]++;
+        }
+        size_t h = base;
+        for (uint32_t q = 0; q < ng; q++) gfill[q] = (uint32_t)h, h += gn[q];
+        pdt_rtri_hist *to = b->pl ? out - base : r->hist;
+        for (size_t j = 0; j < nb; j++) {
+            uint32_t q = gid[j], ev = buf[j].ev, at = gfill[q]++;
+            to[at] = hist_of(r, &buf[j]);
+            r->ev_ent[ev] = at;
+            r->ev_obj[ev] = ev == gfirst[q] ? -1 - (int32_t)gn[q] : (int32_t)gfirst[q];
+        }
+        if (b->pl && !tput(b, NULL, r->hist_at, base, out, nb, sizeof *out)) ok = 0;
+        *ntri += ng;
+    }
+    free(out);
+    free(buf);
+    free(slot);
+    free(gid);
+    free(gfirst);
+    free(gn);
+    free(gfill);
+    return ok;
+}
+
+/* A streamed build reads the records (a mapping of the index file) from
+ * start to end a few times: the pages behind the pass are let go every
+ * DROP_EVERY records (they stay in the page cache), so the process does not
+ * hold all of them at once. */
+#define DROP_EVERY ((size_t)1 << 20)
+
+static void drop_recs(const builder *b, size_t upto)
+{
+    if (!b->pl || !upto || upto % DROP_EVERY) return;
+    uintptr_t lo = ((uintptr_t)(b->r->recs + upto - DROP_EVERY) + 4095) & ~(uintptr_t)4095,
+              hi = (uintptr_t)(b->r->recs + upto) & ~(uintptr_t)4095;
+    if (hi > lo) madvise((void *)lo, hi - lo, MADV_DONTNEED);
+}
+
+/* Number the triangles by their first event (after tri_groups): the
+ * triangle table (in r->tris, or streamed to tris_at), and ev_obj[ev] = the
+ * triangle of every triangle event. */
+static int tri_ids(builder *b)
+{
+    pdt_replay *r = b->r;
+    enum { TBUF = 4096 };
+    pdt_rtri tb[TBUF], *to = b->pl ? tb : r->tris;
+    size_t nb = 0;
+    r->ntri = 0;
+    for (size_t i = 0; i < r->m; i++) {
+        drop_recs(b, i);
+        if (i + PREFETCH_AHEAD < r->m) {
+            int32_t a = r->ev_obj[i + PREFETCH_AHEAD];
+            if (a >= 0 && is_tri_kind(r->ev_kind[i + PREFETCH_AHEAD])) __builtin_prefetch(&r->ev_obj[a]);
+        }
+        if (!is_tri_kind(r->ev_kind[i])) continue;
+        int32_t o = r->ev_obj[i];
+        if (o == -1) continue;  /* skipped */
+        if (o >= 0) {
+            r->ev_obj[i] = r->ev_obj[o];
+            continue;
+        }
+        const pdt_rec *rec = &r->recs[i];
+        to[b->pl ? nb++ : r->ntri] = (pdt_rtri){{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank,
+                                               r->ev_ent[i], (uint32_t)(-1 - o)};
+        r->ev_obj[i] = (int32_t)r->ntri++;
+        if (nb == TBUF) {
+            if (!tput(b, NULL, r->tris_at, r->ntri - nb, tb, nb, sizeof *tb)) return 0;
+            nb = 0;
+        }
+    }
+    return tput(b, NULL, r->tris_at, r->ntri - nb, tb, nb, sizeof *tb);
+}
+
+/* A big table of `bytes` (malloc'd, asking for huge pages), or NULL. */
+static void *big_table(size_t bytes)
+{
+    void *p = malloc(bytes ? bytes : 1);
+    if (p) pdt_big_advise(p, bytes);
+    return p;
+}
+
+/* What a streamed build of m events and n points holds in memory besides
+ * tri_groups' working set: the per-event and per-point tables, the run's
+ * points, and some room for the small tables. */
+static uint64_t held_bytes(size_t m, size_t n)
+{
+    return (uint64_t)m * 9 + (uint64_t)n * 28 + ((uint64_t)16 << 20);
+}
+
+static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
 {
     builder b;
     memset(&b, 0, sizeof b);
     b.r = r;
+    b.pl = pl;
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
     b.cur = malloc((nslot ? nslot : 1) * sizeof *b.cur);
     b.lastst = calloc((size_t)r->nranks + 1, sizeof *b.lastst);
+    b.fine_fill = calloc(NFINE, sizeof *b.fine_fill);
+    b.fine_off = calloc(NFINE + 1, sizeof *b.fine_off);
     uint8_t *lifted_any = calloc((size_t)r->nranks + 1, 1);
     pdt_status st = PDT_ERR_NOMEM;
-    if (!b.cur || !b.lastst || !lifted_any) goto out;
+    if (!b.cur || !b.lastst || !lifted_any || !b.fine_fill || !b.fine_off) goto out;
     for (size_t s = 0; s < nslot; s++) b.cur[s] = -1;
     for (int q = 0; q < r->nranks; q++) b.lastst[q] = -1;
-    /* size the tables once: counts of the events that create objects */
+    /* size the tables once: counts of the events that create objects, and
+     * of the triangle events per fine bucket */
     {
         size_t cnt[PDT_EV_KIND_COUNT] = {0};
-        for (size_t i = 0; i < r->m; i++)
-            if (r->recs[i].ev.kind < PDT_EV_KIND_COUNT) cnt[r->recs[i].ev.kind]++;
-        size_t ntri_ev = cnt[PDT_EV_TRI_NEW] + cnt[PDT_EV_TRI_FINAL] + cnt[PDT_EV_RA_DEFER] +
-                         cnt[PDT_EV_SHIP] + cnt[PDT_EV_DISCARD];
-        size_t guess_tri = cnt[PDT_EV_TRI_NEW] ? cnt[PDT_EV_TRI_NEW] : ntri_ev;
-        if (!km_alloc(&b.tri_map, guess_tri) || !km_alloc(&b.edge_map, cnt[PDT_EV_EDGE_ADD]) ||
+        for (size_t i = 0; i < r->m; i++) {
+            drop_recs(&b, i);
+            const pdt_rec *rec = &r->recs[i];
+            const pdt_event *e = &rec->ev;
+            if (e->kind < PDT_EV_KIND_COUNT) cnt[e->kind]++;
+            if (!is_tri_kind(e->kind) || rec->rank >= (uint32_t)r->nranks || e->a >= r->n ||
+                e->b >= r->n || e->c >= r->n)
+                continue;
+            uint32_t in[3] = {e->a, e->b, e->c}, s[3];
+            sort3(s, in);
+            b.fine_off[fine_of(s) + 1]++;
+        }
+        for (size_t f = 0; f < NFINE; f++) b.fine_off[f + 1] += b.fine_off[f];
+        memcpy(b.fine_fill, b.fine_off, NFINE * sizeof *b.fine_fill);
+        r->nhist = b.fine_off[NFINE];
+        if (pl) {
+            r->streamed = 1;
+            r->hist_at = pl->reserve(pl->ctx, (uint64_t)r->nhist * sizeof *r->hist);
+            b.fbuf = malloc(NFINE * FBUF * sizeof *b.fbuf);
+            b.fbn = calloc(NFINE, sizeof *b.fbn);
+            if (r->hist_at == UINT64_MAX || !b.fbuf || !b.fbn) goto out;
+        } else {
+            r->hist = big_table(r->nhist * sizeof *r->hist);
+            r->tris = big_table(r->nhist * sizeof *r->tris); /* at most one per event */
+            r->cap_tri = r->nhist;
+            if (!r->hist || !r->tris) goto out;
+        }
+        if (!km_alloc(&b.edge_map, cnt[PDT_EV_EDGE_ADD]) ||
             !km_alloc(&b.msg_map, cnt[PDT_EV_SEND]) ||
-            !grow((void **)&r->tris, &r->cap_tri, guess_tri, sizeof *r->tris) ||
-            !grow((void **)&b.tri_count, &b.cap_count, guess_tri, sizeof *b.tri_count) ||
             !grow((void **)&r->edges, &r->cap_edge, cnt[PDT_EV_EDGE_ADD], sizeof *r->edges) ||
             !grow((void **)&r->nodes, &r->cap_node, cnt[PDT_EV_PUSH], sizeof *r->nodes))
             goto out;
-        pdt_big_advise(r->tris, r->cap_tri * sizeof *r->tris);
-        pdt_big_advise(b.tri_count, b.cap_count * sizeof *b.tri_count);
     }
 
     for (size_t i = 0; i < r->m; i++) {
+        drop_recs(&b, i);
         r->ev_obj[i] = -1;
         r->ev_ent[i] = 0;
         r->ev_kind[i] = r->recs[i].ev.kind;
@@ -464,30 +704,21 @@ static pdt_status build(pdt_replay *r, pdt_err *err)
         }
         km_free(&last_end);
     }
-    /* Triangle histories: counts -> offsets -> entries in event order. */
-    r->nhist = 0;
-    for (size_t t = 0; t < r->ntri; t++) {
-        r->tris[t].h0 = (uint32_t)r->nhist;
-        r->tris[t].hn = 0;
-        r->nhist += b.tri_count[t];
+    /* Triangle histories: grouped by triangle, then the triangles numbered. */
+    for (size_t f = 0; pl && f < NFINE; f++)
+        if (!fine_flush(&b, f)) goto out;
+    free(b.fbuf);
+    b.fbuf = NULL;
+    size_t ntri;
+    uint64_t work = 0; /* tri_groups' share of the budget: what the replay does not hold */
+    if (pl) {
+        uint64_t held = held_bytes(r->m, r->n);
+        work = pl->budget > held + pl->budget / 4 ? pl->budget - held : pl->budget / 4;
     }
-    r->hist = malloc((r->nhist ? r->nhist : 1) * sizeof *r->hist);
-    if (!r->hist) goto out;
-    pdt_big_advise(r->hist, r->nhist * sizeof *r->hist);
-    for (size_t i = 0; i < r->m; i++) {
-        const pdt_event *e = &r->recs[i].ev;
-        if (!is_tri_kind(e->kind) || r->ev_obj[i] < 0) continue;
-        pdt_rtri *t = &r->tris[r->ev_obj[i]];
-        uint32_t h = t->h0 + t->hn++;
-        r->hist[h] = (pdt_rtri_hist){(uint32_t)i, r->recs[i].rank, tri_status_of(e->kind),
-                                     (uint8_t)e->sub, e->v, NONE32};
-        if (e->kind == PDT_EV_TRI_NEW && e->sub == 1) /* border kernel: which merge step? */
-            for (size_t g = 0; g < r->nmerge; g++)
-                if (r->merges[g].rank == r->recs[i].rank && r->merges[g].begin_ev < i &&
-                    r->merges[g].end_ev != NONE32 && i < r->merges[g].end_ev)
-                    r->hist[h].until = r->merges[g].end_ev;
-        r->ev_ent[i] = h;
-    }
+    if (!tri_groups(&b, work, &ntri)) goto out;
+    if (pl && (r->tris_at = pl->reserve(pl->ctx, (uint64_t)ntri * sizeof *r->tris)) == UINT64_MAX)
+        goto out;
+    if (!tri_ids(&b)) goto out;
     /* Slot changes grouped by slot (counting sort keeps event order). */
     r->slot_start = calloc(nslot + 1, sizeof *r->slot_start);
     r->slot_ch = malloc((r->nch ? r->nch : 1) * sizeof *r->slot_ch);
@@ -506,16 +737,25 @@ out:
     free(b.cur);
     free(b.lastst);
     free(lifted_any);
-    free(b.tri_count);
-    km_free(&b.tri_map);
+    free(b.fine_fill);
+    free(b.fine_off);
+    free(b.fbuf);
+    free(b.fbn);
     km_free(&b.edge_map);
     km_free(&b.msg_map);
-    if (st != PDT_OK) pdt_err_set(err, st, "out of memory indexing %zu events", r->m);
+    if (st != PDT_OK && b.failed) pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+    else if (st != PDT_OK) pdt_err_set(err, st, "out of memory indexing %zu events", r->m);
     return st;
 }
 
 pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, size_t m,
                           int nranks, pdt_replay **out, pdt_err *err)
+{
+    return pdt_replay_build(pts, n, recs, m, nranks, NULL, out, err);
+}
+
+pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs, size_t m,
+                            int nranks, const pdt_replay_place *pl, pdt_replay **out, pdt_err *err)
 {
     *out = NULL;
     if (m >= NONE32 || n >= NONE32)
@@ -533,14 +773,14 @@ pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, s
     r->recs = recs;
     r->m = m;
     r->nranks = nranks;
-    size_t n1 = n ? n : 1, m1 = m ? m : 1, q1 = (size_t)nranks;
-    r->ev_obj = malloc(m1 * sizeof *r->ev_obj);
-    r->ev_ent = malloc(m1 * sizeof *r->ev_ent);
-    r->ev_kind = malloc(m1 * sizeof *r->ev_kind);
-    r->lift_ev = malloc(n1 * sizeof *r->lift_ev);
-    r->sort_ev = malloc(n1 * sizeof *r->sort_ev);
-    r->del_ev = malloc(n1 * sizeof *r->del_ev);
-    r->sort_pos = malloc(n1 * sizeof *r->sort_pos);
+    size_t q1 = (size_t)nranks;
+    r->ev_obj = big_table(m * sizeof *r->ev_obj);
+    r->ev_ent = big_table(m * sizeof *r->ev_ent);
+    r->ev_kind = big_table(m * sizeof *r->ev_kind);
+    r->lift_ev = big_table(n * sizeof *r->lift_ev);
+    r->sort_ev = big_table(n * sizeof *r->sort_ev);
+    r->del_ev = big_table(n * sizeof *r->del_ev);
+    r->sort_pos = big_table(n * sizeof *r->sort_pos);
     r->box_lo = malloc(q1 * sizeof *r->box_lo);
     r->box_hi = malloc(q1 * sizeof *r->box_hi);
     r->has_box = calloc(q1, 1);
@@ -549,20 +789,11 @@ pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, s
         pdt_replay_free(r);
         return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for %zu events", m);
     }
-    /* tables of a huge run: huge pages spare most page faults (costly on
-     * virtual machines); a hint only */
-    pdt_big_advise(r->ev_obj, m1 * sizeof *r->ev_obj);
-    pdt_big_advise(r->ev_ent, m1 * sizeof *r->ev_ent);
-    pdt_big_advise(r->ev_kind, m1 * sizeof *r->ev_kind);
-    pdt_big_advise(r->lift_ev, n1 * sizeof *r->lift_ev);
-    pdt_big_advise(r->sort_ev, n1 * sizeof *r->sort_ev);
-    pdt_big_advise(r->del_ev, n1 * sizeof *r->del_ev);
-    pdt_big_advise(r->sort_pos, n1 * sizeof *r->sort_pos);
     for (size_t p = 0; p < n; p++) {
         r->lift_ev[p] = r->sort_ev[p] = r->del_ev[p] = NONE32;
         r->sort_pos[p] = -1;
     }
-    pdt_status st = build(r, err);
+    pdt_status st = build(r, pl, err);
     if (st != PDT_OK) {
         pdt_replay_free(r);
         return st;
@@ -586,6 +817,10 @@ void pdt_replay_free(pdt_replay *r)
     free(r->ev_kind);
     free(r->tris);
     free(r->hist);
+    free(r->lift_ev);
+    free(r->sort_ev);
+    free(r->del_ev);
+    free(r->sort_pos);
     free(r->edges);
     free(r->nodes);
     free(r->phases);
@@ -595,10 +830,6 @@ void pdt_replay_free(pdt_replay *r)
     free(r->ch);
     free(r->slot_ch);
     free(r->slot_start);
-    free(r->lift_ev);
-    free(r->sort_ev);
-    free(r->del_ev);
-    free(r->sort_pos);
     free(r->box_lo);
     free(r->box_hi);
     free(r->has_box);
@@ -729,7 +960,7 @@ static void seek_zero(const pdt_replay *r, pdt_rstate *s)
 void pdt_replay_seek_direct(const pdt_replay *r, pdt_rstate *s, size_t k)
 {
     if (k > r->m) k = r->m;
-    if (k == 0 && r->map) { /* do not touch every table of a mapped index */
+    if (k == 0 && (r->map || r->streamed)) { /* do not touch every table of a mapped index */
         seek_zero(r, s);
         return;
     }

@@ -53,6 +53,11 @@ struct pdt_replay {
      * instead of freeing the tables. */
     void *map;
     size_t map_len;
+    /* Streamed (pdt_replay_build with a place): tris and hist are NULL, the
+     * tables are at tris_at and hist_at of the place; the replay steps (the
+     * index's checkpoints) but draws nothing. */
+    int streamed;
+    uint64_t tris_at, hist_at;
     struct lazy *lazy;     /* the map is verified chunk by chunk as it is read (index.c) */
     const char *warnings;  /* the reader's warnings about the run (kept index), or NULL */
 
@@ -67,6 +72,24 @@ struct pdt_replay {
     const uint8_t *ick;
     size_t ick_every, nick, ick_bytes;
 };
+
+/* Where pdt_replay_build streams the triangles and their histories (the
+ * biggest tables) instead of holding them: reserve(ctx, bytes) gives a place
+ * for a table (e.g. a file offset; UINT64_MAX: none), put and get write and
+ * read bytes there (1 on success).  budget: the working memory of grouping
+ * the triangle events by triangle (0: no limit). */
+typedef struct pdt_replay_place {
+    uint64_t (*reserve)(void *ctx, uint64_t bytes);
+    int (*put)(void *ctx, uint64_t at, const void *p, size_t bytes);
+    int (*get)(void *ctx, uint64_t at, void *p, size_t bytes);
+    void *ctx;
+    uint64_t budget;
+} pdt_replay_place;
+
+/* pdt_replay_new, with the triangles and histories streamed to pl (NULL:
+ * held in memory, no budget: pdt_replay_new). */
+pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs, size_t m,
+                            int nranks, const pdt_replay_place *pl, pdt_replay **out, pdt_err *err);
 
 /* A state as bytes (the index's checkpoints): pdt_rstate_blob_bytes(r) bytes. */
 size_t pdt_rstate_blob_bytes(const pdt_replay *r);

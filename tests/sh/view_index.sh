@@ -136,6 +136,30 @@ as_user "$TMP/rbin/pdtview" "$RO/run" --counts --end --mem 1M >/dev/null 2>&1
 [ -n "$i2" ] && [ "$(inode "$cached")" = "$i2" ] && ok readonly_cache_kept || fail readonly_cache_kept
 chmod 755 "$RO/run"
 
+# a run of 3 ranks (candidates deferred, shipped, discarded): the index built
+# under a tiny budget (the triangle events grouped in several runs, streamed
+# to the file) shows the same pictures and the same events as memory (the
+# plain build records it: mpirun with the sanitized one is not what is tested)
+R3=$TMP/run3
+"$PDT" gen uniform 3000 --seed 11 > "$TMP/u3.txt"
+if mpirun -np 3 "$ROOT/bin/pdt" triangulate "$TMP/u3.txt" -o "$TMP/u3.tri" --trace "$R3" >/dev/null 2>&1; then
+    same3=1
+    for at in "--at 9000" "--at 20000" "--end"; do
+        "$V" --headless "$R3" $at -o "$TMP/m3.png" --size 640x400 --quiet --index off
+        "$V" --headless "$R3" $at -o "$TMP/i3.png" --size 640x400 --quiet --mem 256K
+        cmp -s "$TMP/m3.png" "$TMP/i3.png" || same3=0
+    done
+    "$V" "$R3" --describe --index off > "$TMP/d3m.txt"
+    "$V" "$R3" --describe --mem 256K > "$TMP/d3i.txt"
+    if [ $same3 = 1 ] && [ -s "$R3/.pdtview-index" ] && [ -s "$TMP/d3m.txt" ] && cmp -s "$TMP/d3m.txt" "$TMP/d3i.txt"
+    then ok ranks3_tiny_budget_same
+    else fail ranks3_tiny_budget_same "pictures same: $same3; $(diff "$TMP/d3m.txt" "$TMP/d3i.txt" | head -3)"; fi
+    case "$("$V" "$R3" --check --mem 256K)" in *", 0 differ"*) ok ranks3_check ;;
+        *) fail ranks3_check "$("$V" "$R3" --check --mem 256K)" ;; esac
+else
+    fail ranks3_record "mpirun -np 3 failed"
+fi
+
 # bad budgets
 for bad in 0 12Q -5 ''; do
     "$V" "$R" --counts --mem "$bad" >/dev/null 2>"$TMP/eb"; rc=$?
