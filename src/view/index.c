@@ -140,7 +140,8 @@ static uint64_t chunks_of(uint64_t bytes) { return (bytes + CHUNK_BYTES - 1) / C
 typedef struct verify_job {
     int fd;
     const ihdr *h;
-    const uint32_t *tab;        /* chunk checksums */
+    uint32_t *tab;              /* chunk checksums */
+    int compute;                /* 1: fill tab in (building), 0: compare with it */
     uint64_t nchunk;
     uint64_t *first;            /* per section: index of its first chunk in tab */
     atomic_uint_fast64_t next;  /* next chunk to check */
@@ -167,14 +168,31 @@ static void *verify_worker(void *arg)
         for (uint64_t o = from; o < to;) {
             size_t want = to - o < BUF ? (size_t)(to - o) : BUF;
             ssize_t got = pread(j->fd, buf, want, (off_t)(j->h->sec[i].off + o));
-            if (got <= 0) break;
+            if (got <= 0) {
+                if (j->compute) atomic_store(&j->bad, 1);  /* (verifying: a mismatch below) */
+                break;
+            }
             crc = pdt_crc32c(crc, buf, (size_t)got);
             o += (uint64_t)got;
         }
-        if (crc != j->tab[c]) atomic_store(&j->bad, 1);
+        if (j->compute) j->tab[c] = crc;
+        else if (crc != j->tab[c]) atomic_store(&j->bad, 1);
     }
     free(buf);
     return NULL;
+}
+
+/* Run job j on up to four threads (this one among them). */
+static void run_job(verify_job *j)
+{
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    int nt = cpus < 1 ? 1 : cpus > 4 ? 4 : (int)cpus, started = 0;
+    pthread_t th[4];
+    for (int t = 1; t < nt; t++)
+        if (pthread_create(&th[t], NULL, verify_worker, j) == 0) started |= 1 << t;
+    verify_worker(j);
+    for (int t = 1; t < nt; t++)
+        if (started & (1 << t)) pthread_join(th[t], NULL);
 }
 
 /* The chunk checksums of the index (its own checksum verified), malloc'd;
@@ -205,15 +223,8 @@ static int verify_chunks(int fd, const ihdr *h, char *why, size_t wcap)
     first[NSEC] = n;
     uint32_t *tab = read_ctab(fd, h, why, wcap);
     if (!tab) return 0;
-    verify_job j = {fd, h, tab, n, first, 0, 0};
-    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-    int nt = cpus < 1 ? 1 : cpus > 4 ? 4 : (int)cpus, started = 0;
-    pthread_t th[4];
-    for (int t = 1; t < nt; t++)
-        if (pthread_create(&th[t], NULL, verify_worker, &j) == 0) started |= 1 << t;
-    verify_worker(&j);
-    for (int t = 1; t < nt; t++)
-        if (started & (1 << t)) pthread_join(th[t], NULL);
+    verify_job j = {fd, h, tab, 0, n, first, 0, 0};
+    run_job(&j);
     free(tab);
     if (atomic_load(&j.bad)) {
         snprintf(why, wcap, "damaged: checksum mismatch");
@@ -822,27 +833,18 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
         h->sec[i] = (isec){off, bytes, 0, 0};
         off += bytes;
     }
-    /* the chunk checksums, read back through a mapping of what was written */
-    uint64_t n = 0;
-    for (int i = 0; i < NSEC; i++) n += chunks_of(h->sec[i].bytes);
+    /* the chunk checksums, read back (pread, by up to four threads) */
+    uint64_t first[NSEC + 1], n = 0;
+    for (int i = 0; i < NSEC; i++) first[i] = n, n += chunks_of(h->sec[i].bytes);
+    first[NSEC] = n;
     uint32_t *tab = malloc(n ? n * sizeof *tab : 1);
-    void *map = off ? mmap(NULL, off, PROT_READ, MAP_SHARED, fd, 0) : MAP_FAILED;
-    if (!tab || map == MAP_FAILED) {
+    if (!tab) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for the index's checksums");
+    verify_job j = {fd, h, tab, 1, n, first, 0, 0};
+    run_job(&j);
+    if (atomic_load(&j.bad)) {
         free(tab);
-        if (map != MAP_FAILED) munmap(map, off);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for the index's checksums");
+        return pdt_err_set(err, PDT_ERR_IO, "reading the index back for its checksums failed");
     }
-    for (int i = 0, c = 0; i < NSEC; i++)
-        for (uint64_t o = 0; o < h->sec[i].bytes; o += CHUNK_BYTES) {
-            uint64_t len = h->sec[i].bytes - o < CHUNK_BYTES ? h->sec[i].bytes - o : CHUNK_BYTES;
-            const char *at = (const char *)map + h->sec[i].off + o;
-            tab[c++] = pdt_crc32c(0, at, (size_t)len);
-            /* drop the pages just read from this process (they stay in the page cache) */
-            uintptr_t a = ((uintptr_t)at + 4095) & ~(uintptr_t)4095,
-                      b = ((uintptr_t)at + (uintptr_t)len) & ~(uintptr_t)4095;
-            if (b > a) madvise((void *)a, b - a, MADV_DONTNEED);
-        }
-    munmap(map, off);
     off = (off + 63) & ~(uint64_t)63;
     h->ctab = (isec){off, n * sizeof *tab, pdt_crc32c(0, tab, (size_t)(n * sizeof *tab)), 0};
     int wrote = write_all(fd, tab, (size_t)(n * sizeof *tab), off);

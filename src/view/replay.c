@@ -166,6 +166,10 @@ _Static_assert(sizeof(tri_rec) == sizeof(pdt_rtri_hist), "a triangle event fits 
 #define FINE_BITS 8
 #define NFINE ((size_t)1 << FINE_BITS)
 #define GROUP_BYTES_PER_EVENT 128u /* tri_groups' working memory per event, at most */
+/* Events per run, at most (unless one fine bucket holds more): a working set
+ * of some 60 MiB, reused from run to run (fresh pages are dear on virtual
+ * machines, and a smaller hash table misses the caches less). */
+#define GROUP_RUN_MAX ((size_t)1 << 19)
 
 static uint64_t key_hash(const uint32_t s[3])
 {
@@ -476,6 +480,7 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
     *ntri = 0;
     size_t cap = budget ? (size_t)(budget / GROUP_BYTES_PER_EVENT) : SIZE_MAX;
     if (cap < 1024) cap = 1024;
+    if (b->pl && cap > GROUP_RUN_MAX) cap = GROUP_RUN_MAX;
     size_t most = 0;  /* the largest run */
     for (size_t f = 0; f < NFINE;) {
         size_t g = f + 1;
@@ -504,6 +509,7 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
         if (!nb) continue;
         if (!b->pl) memcpy(buf, &r->hist[base], nb * sizeof *buf);
         else if (!b->pl->get(b->pl->ctx, r->hist_at + base * sizeof *buf, buf, nb * sizeof *buf)) {
+            b->failed = 1;
             ok = 0;
             break;
         }
@@ -743,7 +749,7 @@ out:
     free(b.fbn);
     km_free(&b.edge_map);
     km_free(&b.msg_map);
-    if (st != PDT_OK && b.failed) pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+    if (st != PDT_OK && b.failed) pdt_err_set(err, PDT_ERR_IO, "the index file: %s", strerror(errno));
     else if (st != PDT_OK) pdt_err_set(err, st, "out of memory indexing %zu events", r->m);
     return st;
 }
