@@ -26,10 +26,29 @@
 pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri, int run,
                         pdt_trace *tr);
 
+/* Bytes of working memory pdt_delaunay_on needs for n points: its 6n + 12
+ * edge records of 12 bytes (72 bytes per point). */
+#define PDT_DELAUNAY_WORK(n) ((size_t)72 * (size_t)(n) + 144)
+
+/* pdt_delaunay on the caller's memory, with no copy of the points: pts[0, n)
+ * (distinct, sorted lexicographically) are working memory during the call
+ * and hold their values again on return, success or not; id: n words of
+ * scratch; work: work_bytes >= PDT_DELAUNAY_WORK(n) bytes, 8-byte aligned.
+ * On success the *ntri triangles (counter-clockwise, indices into pts) are
+ * ((pdt_tri *)work)[0, *ntri) and the rest of work holds no data.  Allocates
+ * nothing (but a map of n words when tracing with tr->gid).  Traces and
+ * errors as pdt_delaunay (PDT_ERR_ARG also for too small a work). */
+pdt_status pdt_delaunay_on(pdt_point *pts, size_t n, uint32_t *id, void *work, size_t work_bytes,
+                           size_t *ntri, int run, pdt_trace *tr);
+
 /* Rotate every triangle so that it starts at its smallest index (keeping the
  * counter-clockwise order) and sort the array lexicographically: the
  * canonical output order, identical for every algorithm and every rank count. */
 void pdt_tri_canonical(pdt_tri *tris, size_t ntri);
+
+/* pdt_tri_canonical with the caller's scratch: room for ntri triangles, not
+ * overlapping tris (NULL: allocated and freed inside). */
+void pdt_tri_canonical_on(pdt_tri *tris, size_t ntri, pdt_tri *scratch);
 
 /* Figures reported by the pipeline. */
 typedef struct pdt_tri_stats {

@@ -600,6 +600,28 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
     return PDT_OK;
 }
 
+/* The kernel on the caller's memory, with no copy of the points: they are
+ * the kernel's (leaf-order) array during the call and are put back from
+ * id afterwards, through scratch in work beyond the triangles (8 bytes per
+ * point; the triangles take at most 24 of the 72). */
+pdt_status pdt_delaunay_on(pdt_point *pts, size_t n, uint32_t *id, void *work, size_t work_bytes,
+                           size_t *ntri, int run, pdt_trace *tr)
+{
+    *ntri = 0;
+    if (n < 2) return PDT_OK;
+    if (n > PDT_KERNEL_MAX_POINTS || work_bytes < PDT_DELAUNAY_WORK(n)) return PDT_ERR_ARG;
+    for (size_t i = 1; i < n; i++) /* the precondition: distinct and sorted */
+        if (pdt_key(pts[i - 1]) >= pdt_key(pts[i])) return PDT_ERR_ARG;
+    for (uint32_t i = 0; i < (uint32_t)n; i++) id[i] = i;
+    size_t nt = 0;
+    pdt_status s = kernel_on(id, pts, n, (edge *)work, edge_cap(n), &nt, run, tr);
+    pdt_point *tmp = (pdt_point *)(void *)((pdt_tri *)work + (s == PDT_OK ? nt : 0));
+    memcpy(tmp, pts, n * sizeof *tmp);
+    for (size_t v = 0; v < n; v++) pts[id[v]] = tmp[v];
+    if (s == PDT_OK) *ntri = nt;
+    return s;
+}
+
 /* ---- canonical order ---- */
 
 static int tri_cmp(const pdt_tri *a, const pdt_tri *b)
@@ -708,6 +730,11 @@ static void canonical(pdt_tri *tris, size_t ntri, pdt_tri *scratch)
 void pdt_tri_canonical(pdt_tri *tris, size_t ntri)
 {
     canonical(tris, ntri, NULL);
+}
+
+void pdt_tri_canonical_on(pdt_tri *tris, size_t ntri, pdt_tri *scratch)
+{
+    canonical(tris, ntri, scratch);
 }
 
 /* ---- sort and dedupe ---- */

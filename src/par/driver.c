@@ -15,7 +15,6 @@
  * With one rank the sequential pipeline (pdt_triangulate) does all of it. */
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <sys/resource.h>
 #include <time.h>
 #include <unistd.h>
@@ -41,9 +40,9 @@ typedef struct drv {
     pdt_trace *tr;
     uint32_t *seq_send, *seq_recv; /* per-peer message sequence numbers */
     uint64_t bytes_sent, bytes_recv, merge_sent, merge_recv;
-    srm_rec *rec;                  /* partition: this rank's distinct records */
-    srm_rec *spare;                /* and a scratch array of the same size */
-    size_t rec_bytes;              /* size of both blocks */
+    unsigned char *blk;            /* this rank's one block (see block_bytes) */
+    size_t blk_cap, blk_bytes;     /* room for blk_cap points; its size */
+    srm_rec *rec;                  /* partition: this rank's distinct records, in blk */
     size_t m;
     uint64_t nrecv;
     uint64_t n_total;              /* points in the whole input */
@@ -202,9 +201,40 @@ static pdt_status splitters(drv *d, const srm_rec *rec, size_t n, uint64_t *spli
     return st;
 }
 
+/* This rank's one block, for up to M points (fresh pages are costly on
+ * this kind of machine, reused ones cheap, so every phase from the
+ * partition to the order works in it):
+ *   [0, PDT_DELAUNAY_WORK(M))  the partition's two record arrays (32 bytes
+ *                              per point), then the kernel's edges (72), the
+ *                              final triangles at its front, the order's
+ *                              receive buffer and canonical scratch;
+ *   then the strip's points (8 bytes each), global indices (4) and the
+ *   kernel's scratch ids (4), M + 1 of each. */
+static size_t block_bytes(size_t M)
+{
+    return PDT_DELAUNAY_WORK(M) + (M + 1) * (sizeof(pdt_point) + 2 * sizeof(uint32_t));
+}
+
+static pdt_point *block_pts(const drv *d)
+{
+    return (pdt_point *)(void *)(d->blk + PDT_DELAUNAY_WORK(d->blk_cap));
+}
+
+static uint32_t *block_gid(const drv *d)
+{
+    return (uint32_t *)(void *)(block_pts(d) + d->blk_cap + 1);
+}
+
+static uint32_t *block_id(const drv *d)
+{
+    return block_gid(d) + d->blk_cap + 1;
+}
+
 /* Sample sort of this rank's input block by key, with exact splitters:
  * d->rec[0..d->m) are the distinct records of this rank's strip,
- * key-sorted.  in->pts is freed as soon as the records hold it if
+ * key-sorted, in d->blk (room for this rank's input block or its share of
+ * the whole plus 1/16, touched only as far as used; a larger one when more
+ * records arrive).  in->pts is freed as soon as the records hold it if
  * in->release_pts. */
 static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
 {
@@ -214,18 +244,13 @@ static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
     size_t *cnt = calloc((size_t)p, sizeof *cnt), *rcnt = calloc((size_t)p, sizeof *rcnt);
     size_t *start = calloc((size_t)p + 1, sizeof *start);
     uint64_t *split = malloc((size_t)p * sizeof *split), *sc = NULL, *rc = NULL;
-    srm_rec *rec = NULL, *tmp = NULL, *got = NULL;
-    /* two blocks serve the whole phase (fresh pages are costly): room for
-     * this rank's input block or its share of the whole plus 1/16, touched
-     * only as far as used */
     size_t share = (size_t)(d->n_total / (uint64_t)p), cap = n > share ? n : share;
     cap += cap / 16 + 64;
-    size_t bytes = cap * sizeof(srm_rec);
-    rec = srm_big(bytes);
-    tmp = srm_big(bytes);
+    unsigned char *blk = srm_big(block_bytes(cap)), *more = NULL;
+    srm_rec *rec = (srm_rec *)(void *)blk, *tmp = rec + cap, *got = NULL, *scratch = NULL;
     sc = malloc((size_t)p * sizeof *sc);
     rc = malloc((size_t)p * sizeof *rc);
-    if (!cnt || !rcnt || !start || !split || !sc || !rc || !rec || !tmp) goto nomem;
+    if (!cnt || !rcnt || !start || !split || !sc || !rc || !blk) goto nomem;
     for (size_t i = 0; i < n; i++)
         rec[i] = (srm_rec){pdt_key(in->pts[i]), (uint32_t)(in->first + i), 0};
     if (in->release_pts) {
@@ -255,39 +280,36 @@ static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
         total += (size_t)rc[q];
     }
     start[p] = total;
-    size_t need = total >= cap ? total + 1 : 0; /* more than the room (many equal keys) */
-    if (need) {
-        free(tmp);
-        tmp = srm_big(need * sizeof(srm_rec));
-        if (!tmp) goto nomem;
+    if (total < cap) { /* received over the sorted input's scratch; merged back */
+        got = tmp;
+        scratch = rec;
+    } else { /* more than the room (many equal keys): a larger block */
+        size_t M = total + 1;
+        more = srm_big(block_bytes(M));
+        if (!more) goto nomem;
+        got = (srm_rec *)(void *)more;
+        scratch = got + M;
+        cap = M;
     }
-    got = tmp;
-    tmp = NULL;
     st = pdt_comm_alltoallv(d->c, rec, cnt, got, rcnt, err);
     if (st != PDT_OK) goto done;
     note_v(d, TAG_RECORDS, cnt, rcnt);
-    if (need) { /* the merge's scratch too */
-        free(rec);
-        bytes = need * sizeof(srm_rec);
-        rec = srm_big(bytes);
-        if (!rec) goto nomem;
+    if (more) {
+        free(blk);
+        blk = more;
+        more = NULL;
     }
-    tmp = rec;
-    rec = NULL;
     /* blocks arrive in rank order, each key-sorted with equal keys in index
      * order, and rank q's indices are all below rank q+1's: the stable merge
      * puts the smallest index first among equal keys */
-    srm_rec *sorted = pdt_srm_merge_runs(got, tmp, start, p);
-    if (sorted == tmp) {
-        tmp = got;
-        got = sorted;
-    }
+    srm_rec *sorted = pdt_srm_merge_runs(got, scratch, start, p);
     d->nrecv = total;
-    d->m = pdt_srm_dedupe(got, total);
-    d->rec = got;
-    d->spare = tmp;
-    d->rec_bytes = bytes;
-    got = tmp = NULL;
+    d->m = pdt_srm_dedupe(sorted, total);
+    d->rec = sorted;
+    d->blk = blk;
+    d->blk_cap = cap;
+    d->blk_bytes = block_bytes(cap);
+    blk = NULL;
     goto done;
 nomem:
     st = pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: partition: out of memory", r);
@@ -298,27 +320,15 @@ done:
     free(split);
     free(sc);
     free(rc);
-    free(rec);
-    free(tmp);
-    free(got);
+    free(blk);
+    free(more);
     return st;
 }
 
-/* Give the pages of p[used, bytes) back to the system (the block stays
- * allocated; only whole pages inside the range go). */
-static void release_tail(void *p, size_t used, size_t bytes)
-{
-    uintptr_t a = ((uintptr_t)p + used + 4095) & ~(uintptr_t)4095;
-    uintptr_t b = ((uintptr_t)p + bytes) & ~(uintptr_t)4095;
-    if (b > a) madvise((void *)a, b - a, MADV_DONTNEED);
-}
-
-/* The local strip from the partition's records: points, global indices and
- * the strip descriptor, allgathered into d->strip.  No fresh memory: the
- * points are written over the records (8 bytes over 16, front to back),
- * the indices into the partition's spare array, and the pages beyond what
- * they use are given back. */
-static pdt_status strips(drv *d, pdt_point **lp, uint32_t **lg, pdt_err *err)
+/* The local strip from the partition's records: points and global indices
+ * (in the block, beyond the kernel's part) and the strip descriptor,
+ * allgathered into d->strip. */
+static pdt_status strips(drv *d, pdt_err *err)
 {
     size_t m = d->m;
     d->strip = malloc((size_t)d->p * sizeof *d->strip);
@@ -328,12 +338,11 @@ static pdt_status strips(drv *d, pdt_point **lp, uint32_t **lg, pdt_err *err)
         mine.first_key = d->rec[0].key;
         mine.last_key = d->rec[m - 1].key;
     }
-    pdt_point *pt = (pdt_point *)(void *)d->rec;
-    uint32_t *g = (uint32_t *)(void *)d->spare;
+    pdt_point *pt = block_pts(d);
+    uint32_t *g = block_gid(d);
     for (size_t i = 0; i < m; i++) {
-        srm_rec r = d->rec[i]; /* read whole before pt[i] overwrites its front */
-        pt[i] = srm_key_point(r.key);
-        g[i] = r.idx;
+        pt[i] = srm_key_point(d->rec[i].key);
+        g[i] = d->rec[i].idx;
         if (i == 0 || pt[i].y < mine.ymin) mine.ymin = pt[i].y;
         if (i == 0 || pt[i].y > mine.ymax) mine.ymax = pt[i].y;
     }
@@ -341,26 +350,26 @@ static pdt_status strips(drv *d, pdt_point **lp, uint32_t **lg, pdt_err *err)
         mine.xmin = pt[0].x;
         mine.xmax = pt[m - 1].x;
     }
-    release_tail(pt, m * sizeof *pt, d->rec_bytes);
-    release_tail(g, m * sizeof *g, d->rec_bytes);
-    *lp = pt;
-    *lg = g;
     d->rec = NULL;
-    d->spare = NULL;
     pdt_status st = pdt_comm_allgather(d->c, &mine, sizeof mine, d->strip, err);
     if (st == PDT_OK) note_all(d, TAG_STRIPS, sizeof mine);
     return st;
 }
 
-/* Phases 1 and 2 on this rank's strip. */
-static pdt_status local(drv *d, const pdt_point *lp, const uint32_t *lg, pdt_err *err)
+/* Phases 1 and 2 on this rank's strip, in its block (which the SRM state
+ * owns from here on, as the array of final triangles). */
+static pdt_status local(drv *d, pdt_err *err)
 {
     pdt_status st = pdt_srm_init(&d->s, d->rank, d->p, d->strip, d->tr, err);
     if (st != PDT_OK) return st;
     d->s_init = 1;
     d->s.clock = wclock;
     d->s.clock_user = d->c;
-    return pdt_srm_local(&d->s, lp, lg, d->m, err);
+    pdt_point *pts = block_pts(d);
+    uint32_t *gid = block_gid(d), *id = block_id(d);
+    void *blk = d->blk;
+    d->blk = NULL;
+    return pdt_srm_local(&d->s, blk, pts, gid, id, d->m, err);
 }
 
 /* ---- merge --------------------------------------------------------------------- */
@@ -513,11 +522,53 @@ static void group_by_rank(pdt_tri *t, int p, size_t *at, const size_t *end, cons
         }
 }
 
+/* Where the order phase receives and sorts: in the rank's block when the
+ * local finals (its front), the received triangles and the canonical
+ * order's scratch fit in it (pages already touched), else in a new array
+ * (the block then serves as the scratch if it can). */
+typedef struct order_room {
+    unsigned char *blk; /* the block (s.fin), and its size */
+    size_t bytes;
+    pdt_tri *got;       /* receive buffer */
+    int in_blk;         /* got lies in the block */
+} order_room;
+
+static pdt_status order_room_get(drv *d, order_room *o, size_t total)
+{
+    o->blk = (unsigned char *)d->s.fin;
+    o->bytes = o->blk ? d->blk_bytes : 0; /* the strip's points are no longer needed */
+    size_t front = d->s.nfin * sizeof(pdt_tri), need = 2 * (total + 1) * sizeof(pdt_tri);
+    o->in_blk = o->blk && front + need <= o->bytes;
+    o->got = o->in_blk ? (pdt_tri *)(void *)(o->blk + front) : srm_big((total + 1) * sizeof *o->got);
+    return o->got ? PDT_OK : nomem(d, "order");
+}
+
+/* After the exchange (the local finals were sent): the received triangles
+ * in canonical order, in an array of their own (the block, moved to its
+ * front and shrunk, or the new one). */
+static pdt_tri *order_room_sort(drv *d, order_room *o, size_t total)
+{
+    d->s.fin = NULL;
+    d->s.nfin = d->s.capfin = 0;
+    pdt_tri *t = o->got;
+    if (o->in_blk) {
+        t = (pdt_tri *)(void *)o->blk;
+        memmove(t, o->got, total * sizeof *t);
+        pdt_tri_canonical_on(t, total, t + total);
+        pdt_tri *shrunk = realloc(t, (total + 1) * sizeof *t);
+        return shrunk ? shrunk : t;
+    }
+    int scratch = o->blk && total * sizeof(pdt_tri) <= o->bytes;
+    pdt_tri_canonical_on(t, total, scratch ? (pdt_tri *)(void *)o->blk : NULL);
+    free(o->blk);
+    return t;
+}
+
 /* Phase 4: the final triangles go to the rank of their smallest index's
  * range, which puts them in canonical order: rank q ends with the q-th block
  * of the canonical output in out (and its place in the whole output).  The
- * two arrays of finals go in two exchanges into one array (no copy of the
- * large one into a buffer with room for the other). */
+ * two arrays of finals go in two exchanges into one array, in the rank's
+ * block behind its own finals when there is room. */
 static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
 {
     int p = d->p;
@@ -526,7 +577,8 @@ static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
     size_t *cnt = calloc(2 * (size_t)p, sizeof *cnt), *rcnt = calloc(2 * (size_t)p, sizeof *rcnt);
     size_t *at = calloc((size_t)p, sizeof *at), *end = calloc((size_t)p, sizeof *end);
     uint64_t *sc = calloc(2 * (size_t)p, sizeof *sc), *rc = calloc(2 * (size_t)p, sizeof *rc);
-    pdt_tri *got = NULL;
+    order_room room = {0};
+    pdt_tri *tris = NULL;
     int *owner = NULL, shift = 0;
     if (!cnt || !rcnt || !at || !end || !sc || !rc) {
         st = nomem(d, "order");
@@ -552,33 +604,31 @@ static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
             part[k] += (size_t)rc[2 * q + k];
         }
     total = part[0] + part[1];
-    got = srm_big((total + 1) * sizeof *got);
-    if (!got) {
-        st = nomem(d, "order");
-        goto done;
-    }
+    st = order_room_get(d, &room, total);
+    if (st != PDT_OK) goto done;
     for (int k = 0; k < 2 && st == PDT_OK; k++) {
-        st = pdt_comm_alltoallv(d->c, f.t[k], cnt + k * p, got + (k ? part[0] : 0),
+        st = pdt_comm_alltoallv(d->c, f.t[k], cnt + k * p, room.got + (k ? part[0] : 0),
                                 rcnt + k * p, err);
         if (st == PDT_OK) note_v(d, TAG_ORDER, cnt + k * p, rcnt + k * p);
     }
     if (st != PDT_OK) goto done;
-    free(d->s.fin); /* every triangle went somewhere (itself included) */
-    free(d->s.more);
-    d->s.fin = d->s.more = NULL;
-    d->s.nfin = d->s.capfin = d->s.nmore = d->s.capmore = 0;
-    pdt_tri_canonical(got, total);
+    free(d->s.more); /* every triangle went somewhere (itself included) */
+    d->s.more = NULL;
+    d->s.nmore = d->s.capmore = 0;
+    tris = order_room_sort(d, &room, total);
+    room.got = NULL;
     uint64_t first = 0, all = total;
     st = pdt_comm_exscan_u64(d->c, total, &first, err); /* place in the whole output */
     if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, &all, 1, PDT_COMM_SUM, err);
     if (st != PDT_OK) goto done;
     note_all(d, TAG_ORDER, sizeof all);
-    out->tris = got;
+    out->tris = tris;
     out->ntri = total;
     out->first = first;
     out->n_total = all;
-    got = NULL;
+    tris = NULL;
 done:
+    if (room.got && !room.in_blk) free(room.got);
     free(cnt);
     free(rcnt);
     free(at);
@@ -586,7 +636,7 @@ done:
     free(sc);
     free(rc);
     free(owner);
-    free(got);
+    free(tris);
     return st;
 }
 
@@ -688,8 +738,6 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
     d.n_total = in->n_total;
     d.me = me;
     d.err = err;
-    pdt_point *lp = NULL;
-    uint32_t *lg = NULL;
     pdt_status st = PDT_OK;
     d.seq_send = calloc((size_t)d.p, sizeof *d.seq_send);
     d.seq_recv = calloc((size_t)d.p, sizeof *d.seq_recv);
@@ -700,16 +748,12 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
     double t0 = pdt_comm_wtime(c);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_PARTITION, 0, 0, 0, 0);
     st = partition(&d, in, err);
-    if (st == PDT_OK) st = strips(&d, &lp, &lg, err);
+    if (st == PDT_OK) st = strips(&d, err);
     if (st != PDT_OK) goto done;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_PARTITION, 0, 0, 0, 0);
     double t1 = pdt_comm_wtime(c);
-    st = local(&d, lp, lg, err);
+    st = local(&d, err);
     if (st != PDT_OK) goto done;
-    free(lp);
-    free(lg);
-    lp = NULL;
-    lg = NULL;
     double t2 = pdt_comm_wtime(c);
     st = merge_tree(&d, err);
     /* the merge phase ends when the last merge does: ranks done early sleep
@@ -731,10 +775,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
 done:
     if (tr) tr->gid = saved_gid;
     if (d.s_init) pdt_srm_free(&d.s);
-    free(d.rec);
-    free(d.spare);
-    free(lp);
-    free(lg);
+    free(d.blk);
     free(d.strip);
     free(d.seq_send);
     free(d.seq_recv);

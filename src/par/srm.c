@@ -200,11 +200,16 @@ void pdt_srm_free(srm_rank *s)
 
 /* ---- Phases 1 and 2 ----------------------------------------------------------- */
 
-pdt_status pdt_srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid, size_t m,
-                     pdt_err *err)
+pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_t *gid,
+                         uint32_t *id, size_t m, pdt_err *err)
 {
     pdt_trace *tr = s->tr;
     double t0 = now(s), c0 = cpu_now();
+    pdt_tri *tris = block;
+    free(s->fin); /* (none: the local phase comes first) */
+    s->fin = tris; /* the block is this rank's from here on */
+    s->nfin = 0;
+    s->capfin = PDT_DELAUNAY_WORK(m) / sizeof *tris;
     /* lift-up */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_LIFT, 0, 0, 0, 0);
     if (PDT_TRACING(tr, 1))
@@ -215,54 +220,43 @@ pdt_status pdt_srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid,
         }
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_LIFT, 0, 0, 0, 0);
 
-    /* local kernel */
+    /* local kernel, in the block, on the strip's own points (no copy) */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_KERNEL, 0, 0, 0, 0);
-    pdt_tri *tris = NULL;
     size_t ntri = 0;
     const uint32_t *saved = tr ? tr->gid : NULL;
     if (tr) tr->gid = gid;
-    pdt_status st = pdt_delaunay(pts, m, &tris, &ntri, 0, tr);
+    pdt_status st = pdt_delaunay_on(pts, m, id, block, PDT_DELAUNAY_WORK(m), &ntri, 0, tr);
     if (tr) tr->gid = saved;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
-    if (st != PDT_OK) {
-        free(tris);
+    if (st != PDT_OK)
         return pdt_err_set(err, st, "rank %d: local kernel failed (%s)", s->rank,
                            pdt_status_str(st));
-    }
     s->cnt.local_tris = ntri;
 
-    /* strip hull: monotone chain (Graham's scan with the origin at infinity) */
+    /* strip hull: monotone chain (Graham's scan with the origin at infinity),
+     * its stack in the kernel's id scratch */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_HULL, 0, 0, 0, 0);
-    uint32_t *h = srm_big((m + 1) * sizeof *h);
-    s->hull = srm_big((m + 1) * sizeof *s->hull);
-    if (!h || !s->hull) {
-        free(h);
-        free(tris);
-        return nomem(err, s->rank, "hull");
-    }
+    uint32_t *h = id;
     size_t nh = 0;
     int deg = 0;
     if (tr) tr->gid = gid;
     st = pdt_hull_chain(pts, m, h, &nh, &deg, PDT_STACK_LOWER, PDT_STACK_UPPER, tr);
     if (tr) tr->gid = saved;
-    if (st != PDT_OK) {
-        free(h);
-        free(tris);
-        return pdt_err_set(err, st, "rank %d: strip hull failed", s->rank);
-    }
+    if (st != PDT_OK) return pdt_err_set(err, st, "rank %d: strip hull failed", s->rank);
+    s->hull = malloc((nh + 1) * sizeof *s->hull);
+    if (!s->hull) return nomem(err, s->rank, "hull");
     for (size_t i = 0; i < nh; i++) s->hull[i] = (srm_pt){pts[h[i]].x, pts[h[i]].y, gid[h[i]]};
     s->nhull = nh;
     s->hull_degenerate = deg;
     s->holds_hull = 1;
-    free(h);
     PDT_TRACE(tr, 1, PDT_EV_HULL, 0, nh, deg, 0, 0);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_HULL, 0, 0, 0, 0);
 
     /* classification: final at once, or deferred until a merge level (with
      * no other strip at all, everything is final without a test).  The
      * final triangles stay in the kernel's array, renamed to global indices
-     * and moved down over the deferred ones (k <= i): it becomes s->fin, no
-     * second array of the same size */
+     * and moved down over the deferred ones (k <= i): s->fin, no second
+     * array */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_CLASSIFY, 0, 0, 0, 0);
     int alone = s->nne == 0 || (s->nne == 1 && s->nonempty[0] == s->rank);
     size_t k = 0;
@@ -278,19 +272,14 @@ pdt_status pdt_srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid,
             tris[k++] = (pdt_tri){{v[0].gid, v[1].gid, v[2].gid}};
             PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, v[0].gid, v[1].gid, v[2].gid, 0);
         } else {
-            if (add_pending(s, v[0], v[1], v[2], lev) != PDT_OK) {
-                free(tris);
+            if (add_pending(s, v[0], v[1], v[2], lev) != PDT_OK)
                 return nomem(err, s->rank, "classify");
-            }
             s->cnt.deferred++;
             PDT_TRACE(tr, 1, PDT_EV_RA_DEFER, 0, v[0].gid, v[1].gid, v[2].gid, who);
         }
     }
     s->cnt.final_at_once = k;
-    free(s->fin); /* (none: the local phase comes first) */
-    s->fin = tris;
     s->nfin = k;
-    s->capfin = ntri;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_CLASSIFY, 0, 0, 0, 0);
     s->cnt.critical_path += now(s) - t0;
     s->cnt.critical_cpu += cpu_now() - c0;

@@ -153,9 +153,15 @@ void pdt_srm_free(srm_rank *s);
 
 /* Phases 1 and 2 on the local strip: pts[0..m) distinct and lex-sorted,
  * gid[i] the global index of pts[i].  Lift-up (traced), kernel (run 0),
- * strip hull (traced pushes and pops), classification. */
-pdt_status pdt_srm_local(srm_rank *s, const pdt_point *pts, const uint32_t *gid, size_t m,
-                     pdt_err *err);
+ * strip hull (traced pushes and pops), classification.  Memory: block, a
+ * malloc'd array of at least PDT_DELAUNAY_WORK(m) bytes, becomes s->fin
+ * (owned by s from the call on, success or not: the kernel's edges, then the
+ * final triangles at its front, capfin triangles of room); pts (given back
+ * unchanged), gid and id (m + 1 words of scratch) lie beyond its first
+ * PDT_DELAUNAY_WORK(m) bytes (in the same block or elsewhere).  Nothing
+ * else of size m is allocated. */
+pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_t *gid,
+                         uint32_t *id, size_t m, pdt_err *err);
 
 /* Merge schedule.  The pair merged at `level` that contains rank r:
  * G_L = [gl, gr), G_R = [gr, ge); returns 0 if r's group has no partner at

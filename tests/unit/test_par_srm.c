@@ -117,15 +117,18 @@ static pdt_status simulate(const srm_rec *u, int p, const size_t *cut, pdt_tri *
     for (int r = 0; r < p && st == PDT_OK; r++) {
         size_t lo = cut[r], hi = cut[r + 1];
         pdt_point *pts = malloc((hi - lo + 1) * sizeof *pts);
-        uint32_t *gid = malloc((hi - lo + 1) * sizeof *gid);
+        uint32_t *gid = malloc((hi - lo + 1) * sizeof *gid), *id = malloc((hi - lo + 1) * sizeof *id);
+        void *block = malloc(PDT_DELAUNAY_WORK(hi - lo));
         for (size_t i = lo; i < hi; i++) {
             pts[i - lo] = srm_key_point(u[i].key);
             gid[i - lo] = u[i].idx;
         }
         st = pdt_srm_init(&rk[r], r, p, strip, NULL, &err);
-        if (st == PDT_OK) st = pdt_srm_local(&rk[r], pts, gid, hi - lo, &err);
+        if (st == PDT_OK) st = pdt_srm_local(&rk[r], block, pts, gid, id, hi - lo, &err);
+        else free(block);
         free(pts);
         free(gid);
+        free(id);
     }
     int L = pdt_srm_ceil_log2(p);
     for (int level = 0; level < L && st == PDT_OK; level++)

@@ -1,0 +1,124 @@
+/* Unit tests of the pieces the parallel local phase runs on one block of
+ * memory: the kernel on the caller's memory (pdt_delaunay_on) against
+ * pdt_delaunay, and the canonical order with the caller's scratch.
+ *
+ * The code under test comes from libpdt.a and libpdtpar.a. */
+#include "../harness.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "pdt/delaunay.h"
+#include "pdt/gen.h"
+
+static uint64_t rng_state = 0x2545f4914f6cdd1dull;
+static uint64_t rnd(void)
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return rng_state;
+}
+
+static int cmp_key(const void *a, const void *b)
+{
+    uint64_t x = pdt_key(*(const pdt_point *)a), y = pdt_key(*(const pdt_point *)b);
+    return x < y ? -1 : x > y;
+}
+
+/* pts sorted and made distinct in place; returns the new count */
+static size_t sort_distinct(pdt_point *p, size_t n)
+{
+    qsort(p, n, sizeof *p, cmp_key);
+    size_t u = 0;
+    for (size_t i = 0; i < n; i++)
+        if (u == 0 || pdt_key(p[i]) != pdt_key(p[u - 1])) p[u++] = p[i];
+    return u;
+}
+
+/* The same triangles as pdt_delaunay, the points given back unchanged, in
+ * exactly the work the contract names; too small a work is refused before
+ * anything is touched. */
+TEST(delaunay_on_equals_delaunay)
+{
+    int runs = 0;
+    for (const char *const *k = pdt_gen_kinds(); *k; k++) {
+        static const size_t ns[] = {0, 1, 2, 3, 4, 9, 100, 2500};
+        for (size_t ni = 0; ni < sizeof ns / sizeof *ns; ni++) {
+            pdt_point *pts = NULL;
+            pdt_err err;
+            pdt_err_clear(&err);
+            if (pdt_gen(*k, ns[ni], 7 + ni, &pts, &err) != PDT_OK) {
+                CHECK_MSG(0, "gen %s: %s", *k, err.msg);
+                continue;
+            }
+            size_t n = sort_distinct(pts, ns[ni]);
+            pdt_point *orig = malloc((n + 1) * sizeof *orig);
+            if (n) memcpy(orig, pts, n * sizeof *pts);
+            pdt_tri *ref = NULL;
+            size_t nref = 0;
+            CHECK(pdt_delaunay(pts, n, &ref, &nref, 0, NULL) == PDT_OK);
+            pdt_tri_canonical(ref, nref);
+            size_t wb = PDT_DELAUNAY_WORK(n);
+            void *work = malloc(wb);
+            uint32_t *id = malloc((n + 1) * sizeof *id);
+            memset(work, 0xa5, wb);
+            size_t nt = 99;
+            if (n >= 2) { /* too small: refused, points untouched */
+                CHECK(pdt_delaunay_on(pts, n, id, work, wb - 1, &nt, 0, NULL) == PDT_ERR_ARG);
+                CHECK(nt == 0);
+            }
+            CHECK(pdt_delaunay_on(pts, n, id, work, wb, &nt, 0, NULL) == PDT_OK);
+            CHECK_MSG(n == 0 || memcmp(pts, orig, n * sizeof *pts) == 0, "%s n=%zu: points changed",
+                      *k, n);
+            pdt_tri *t = work;
+            pdt_tri_canonical(t, nt);
+            CHECK_MSG(nt == nref && (nt == 0 || memcmp(t, ref, nt * sizeof *t) == 0),
+                      "%s n=%zu: %zu triangles, expected %zu", *k, n, nt, nref);
+            runs++;
+            free(work);
+            free(id);
+            free(ref);
+            free(orig);
+            free(pts);
+        }
+    }
+    /* not sorted: refused, points untouched */
+    pdt_point uns[3] = {{5, 0}, {0, 0}, {1, 7}}, keep[3];
+    memcpy(keep, uns, sizeof uns);
+    uint32_t id[3];
+    void *work = malloc(PDT_DELAUNAY_WORK(3));
+    size_t nt = 5;
+    CHECK(pdt_delaunay_on(uns, 3, id, work, PDT_DELAUNAY_WORK(3), &nt, 0, NULL) == PDT_ERR_ARG);
+    CHECK(nt == 0 && memcmp(uns, keep, sizeof uns) == 0);
+    free(work);
+    printf("# %d kernel runs on the caller's memory\n", runs);
+}
+
+/* The canonical order with the caller's scratch is pdt_tri_canonical's. */
+TEST(canonical_on_scratch)
+{
+    static const size_t ns[] = {0, 1, 64, 65, 5000, 100000};
+    for (size_t ni = 0; ni < sizeof ns / sizeof *ns; ni++) {
+        size_t n = ns[ni];
+        pdt_tri *a = malloc((n + 1) * sizeof *a), *b = malloc((n + 1) * sizeof *b);
+        pdt_tri *scratch = malloc((n + 1) * sizeof *scratch);
+        uint32_t base = (uint32_t)(rnd() % 1000000);
+        for (size_t i = 0; i < n; i++)
+            for (int k = 0; k < 3; k++) a[i].v[k] = base + (uint32_t)(rnd() % (2 * n + 3));
+        if (n) memcpy(b, a, n * sizeof *a);
+        pdt_tri_canonical(a, n);
+        pdt_tri_canonical_on(b, n, scratch);
+        CHECK_MSG(n == 0 || memcmp(a, b, n * sizeof *a) == 0, "n=%zu differs", n);
+        free(a);
+        free(b);
+        free(scratch);
+    }
+}
+
+int main(void)
+{
+    RUN(delaunay_on_equals_delaunay);
+    RUN(canonical_on_scratch);
+    return test_summary();
+}
