@@ -18,17 +18,12 @@
 #include "pdt/hull.h"
 #include "pdt/predicates.h"
 
-#define MSG_MAGIC 0x4d525350u /* "PSRM" */
-
-/* Message: this header (native byte order: a homogeneous cluster is
- * assumed) and `payload` bytes of LEB128 varints: the point table in
- * increasing gid order (gid delta, zigzag x, zigzag y), then the triangles and
- * the hull as positions in that table.  About 8 bytes per point and 5 per
- * triangle for coordinates below 2^20, instead of 12 and 12. */
-typedef struct msg_head {
-    uint32_t magic, level, npts, ntri, nhull, flags, payload, reserved;
-    double cp, cp_cpu;
-} msg_head;
+/* Message: a header (srm_msg_head, srm.h) and `payload` bytes of LEB128
+ * varints: the point table in increasing gid order (gid delta, zigzag x,
+ * zigzag y), then the triangles and the hull as positions in that table.
+ * About 8 bytes per point and 5 per triangle for coordinates below 2^20,
+ * instead of 12 and 12. */
+typedef srm_msg_head msg_head;
 
 static size_t put_varint(unsigned char *b, uint64_t v)
 {
@@ -259,15 +254,27 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
      * array */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_CLASSIFY, 0, 0, 0, 0);
     int alone = s->nne == 0 || (s->nne == 1 && s->nonempty[0] == s->rank);
+    srm_slab slab; /* most triangles are settled by the cheap slab test */
+    pdt_srm_slab_of(&slab, s->strip, s->p, s->rank);
     size_t k = 0;
+    enum { AHEAD = 16 }; /* the kernel's triangles are in its (leaf) order, the
+                          * points in lexicographic order: fetch ahead */
     for (size_t i = 0; i < ntri; i++) {
+        if (i + AHEAD < ntri)
+            for (int e = 0; e < 3; e++) {
+                uint32_t j = tris[i + AHEAD].v[e];
+                __builtin_prefetch(&pts[j]);
+                __builtin_prefetch(&gid[j]);
+            }
         srm_pt v[3];
         for (int e = 0; e < 3; e++) {
             uint32_t j = tris[i].v[e];
             v[e] = (srm_pt){pts[j].x, pts[j].y, gid[j]};
         }
         int who;
-        int lev = alone ? -1 : send_level(s, s->rank, 0, v[0], v[1], v[2], &who);
+        int lev = alone || srm_disk_in_slab(&slab, v[0], v[1], v[2])
+                      ? -1
+                      : send_level(s, s->rank, 0, v[0], v[1], v[2], &who);
         if (lev < 0) {
             tris[k++] = (pdt_tri){{v[0].gid, v[1].gid, v[2].gid}};
             PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, v[0].gid, v[1].gid, v[2].gid, 0);
@@ -355,15 +362,15 @@ pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err
     s->npend = keep;
     s->cnt.shipped += nt;
     for (size_t i = 0; i < nh; i++) w += put_varint(w, find_gid(tab, np, s->hull[i].gid));
-    msg_head hd = {MSG_MAGIC,
+    msg_head hd = {SRM_MSG_MAGIC,
                    (uint32_t)level,
-                   (uint32_t)np,
-                   (uint32_t)nt,
-                   (uint32_t)nh,
                    (send_hull ? MSG_HAS_HULL : 0u) |
                        (send_hull && s->hull_degenerate ? MSG_HULL_DEGENERATE : 0u),
-                   (uint32_t)(w - b - sizeof(msg_head)),
                    0,
+                   (uint64_t)np,
+                   (uint64_t)nt,
+                   (uint64_t)nh,
+                   (uint64_t)(w - b - sizeof(msg_head)),
                    s->cnt.critical_path,
                    s->cnt.critical_cpu};
     memcpy(b, &hd, sizeof hd);
@@ -400,12 +407,14 @@ static pdt_status decode(const void *buf, size_t len, int level, int from, msg_v
         return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: too short", from);
     memcpy(&v->h, buf, sizeof v->h);
     const msg_head *h = &v->h;
-    if (h->magic != MSG_MAGIC || h->level != (uint32_t)level ||
-        (size_t)h->payload != len - sizeof(msg_head))
+    if (h->magic != SRM_MSG_MAGIC || h->level != (uint32_t)level ||
+        h->payload != (uint64_t)(len - sizeof(msg_head)))
         return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: bad header", from);
-    size_t ni = 3 * (size_t)h->ntri + h->nhull;
-    if (h->npts > h->payload || ni > h->payload)
+    /* every count is at most the payload (a varint takes a byte at least) */
+    if (h->npts > h->payload || h->ntri > h->payload / 3 ||
+        h->nhull > h->payload - 3 * h->ntri)
         return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: bad counts", from);
+    size_t ni = 3 * (size_t)h->ntri + (size_t)h->nhull;
     v->pts = malloc(((size_t)h->npts + 1) * sizeof *v->pts);
     v->tri = malloc((ni + 1) * sizeof *v->tri);
     if (!v->pts || !v->tri) {

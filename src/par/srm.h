@@ -109,11 +109,58 @@ int pdt_srm_disk_touch(const srm_disk *d, const srm_strip *box);
 /* An x-range certainly containing the disk (for a search by x). */
 void pdt_srm_disk_xrange(const srm_disk *d, double *lo, double *hi);
 
+/* The open slab xl < x < xr around a strip that holds no point of a foreign
+ * strip, so no foreign box meets it (xl = -inf, xr = +inf on a side with no
+ * other points). */
+typedef struct srm_slab {
+    double xl, xr;
+} srm_slab;
+
+/* The slab of rank h: from the nearest non-empty strip on each side (strips
+ * are lexicographic blocks, so boxes on the left end at x <= xl). */
+void pdt_srm_slab_of(srm_slab *sl, const srm_strip *strip, int p, int h);
+
+/* A cheap pre-test, no division and no square root: 1 only if the closed
+ * circumdisk of (a, b, c) (not collinear) certainly lies inside the open
+ * slab, so that it misses every foreign box; 0 says nothing.  The disk lies
+ * within 2R of a (R its radius) and 4R^2 = l1 l2 l3 / D^2 (l: squared side
+ * lengths, D = twice the signed area, exact in int64 for differences below
+ * 2^29), so a.x - 2R > xl and a.x + 2R < xr when g^2 D^2 > l1 l2 l3, g the
+ * distance from a.x to the nearer side.  Both sides are products of positive
+ * numbers, each computed with a relative error below 8 eps (eps = 2^-53);
+ * the factor 1 + 2^-40 on the right makes the computed comparison imply the
+ * exact one (sound: never 1 for a disk that meets the slab's outside). */
+static inline int srm_disk_in_slab(const srm_slab *sl, srm_pt a, srm_pt b, srm_pt c)
+{
+    int64_t bx = (int64_t)b.x - a.x, by = (int64_t)b.y - a.y;
+    int64_t cx = (int64_t)c.x - a.x, cy = (int64_t)c.y - a.y;
+    const int64_t lim = (int64_t)1 << 29;
+    if ((uint64_t)(bx + lim) >= (uint64_t)(2 * lim) || (uint64_t)(by + lim) >= (uint64_t)(2 * lim) ||
+        (uint64_t)(cx + lim) >= (uint64_t)(2 * lim) || (uint64_t)(cy + lim) >= (uint64_t)(2 * lim))
+        return 0;
+    double gl = (double)a.x - sl->xl, gr = sl->xr - (double)a.x, g = gl < gr ? gl : gr;
+    if (!(g > 0)) return 0;
+    int64_t D = bx * cy - by * cx, dx = cx - bx, dy = cy - by;
+    double l1 = (double)(bx * bx + by * by), l2 = (double)(cx * cx + cy * cy),
+           l3 = (double)(dx * dx + dy * dy), dd = (double)D;
+    return (g * g) * (dd * dd) > (l1 * l2) * l3 * (1.0 + 0x1p-40);
+}
+
 /* Exact: 1 if the closed half-plane right of u->v (the restricted area of
  * the hull edge u->v) meets the closed box. */
 int pdt_srm_edge_touch(srm_pt u, srm_pt v, const srm_strip *box);
 
 /* ---- srm.c: the per-rank state machine --------------------------------- */
+
+/* The header of a merge message (native byte order: a homogeneous cluster
+ * is assumed); every count and the payload's size in 64 bits. */
+#define SRM_MSG_MAGIC 0x4d525350u /* "PSRM" */
+typedef struct srm_msg_head {
+    uint32_t magic, level, flags, reserved;
+    uint64_t npts, ntri, nhull; /* point table, shipped triangles, hull vertices */
+    uint64_t payload;           /* bytes after the header */
+    double cp, cp_cpu;          /* the sender's critical path (wall, CPU) */
+} srm_msg_head;
 
 typedef struct srm_counts {
     uint64_t local_tris, final_at_once, deferred, shipped, merges, border_max, kept, discarded,

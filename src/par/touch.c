@@ -120,3 +120,19 @@ int pdt_srm_edge_touch(srm_pt u, srm_pt v, const srm_strip *box)
             if (orient128(u.x, u.y, v.x, v.y, xs[i], ys[j]) <= 0) return 1;
     return 0;
 }
+
+void pdt_srm_slab_of(srm_slab *sl, const srm_strip *strip, int p, int h)
+{
+    sl->xl = -INFINITY;
+    sl->xr = INFINITY;
+    for (int q = h - 1; q >= 0; q--)
+        if (strip[q].count) {
+            sl->xl = strip[q].xmax;
+            break;
+        }
+    for (int q = h + 1; q < p; q++)
+        if (strip[q].count) {
+            sl->xr = strip[q].xmin;
+            break;
+        }
+}

@@ -5,6 +5,7 @@
  * The code under test comes from libpdtpar.a (src/par without MPI). */
 #include "../harness.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "../../src/par/srm.h"
@@ -102,6 +103,77 @@ TEST(touch_cocircular_corner)
     CHECK(!pdt_srm_edge_touch(u, v, &above));
 }
 
+/* Exact: does the closed circumdisk of (a, b, c) lie inside the open slab
+ * xl < x < xr?  |coordinates| < 2^15 so that everything fits in int128. */
+static int exact_in_slab(srm_pt a, srm_pt b, srm_pt c, int64_t xl, int64_t xr, int open_l,
+                         int open_r)
+{
+    __int128 bxx = b.x - a.x, byy = b.y - a.y, cxx = c.x - a.x, cyy = c.y - a.y;
+    __int128 D = 2 * (bxx * cyy - byy * cxx);
+    __int128 b2 = bxx * bxx + byy * byy, c2 = cxx * cxx + cyy * cyy;
+    __int128 nx = cyy * b2 - byy * c2, ny = bxx * c2 - cxx * b2;
+    if (D < 0) {
+        D = -D;
+        nx = -nx;
+        ny = -ny;
+    }
+    /* centre u = a + (nx, ny) / D, rho^2 = (nx^2 + ny^2) / D^2; inside iff
+     * u.x - rho > xl and u.x + rho < xr, i.e. (u.x - xl)^2 > rho^2 with
+     * u.x > xl, and the same on the right */
+    __int128 rho2 = nx * nx + ny * ny, l = nx - (xl - a.x) * D, r = (xr - a.x) * D - nx;
+    return (open_l || (l > 0 && l * l > rho2)) && (open_r || (r > 0 && r * r > rho2));
+}
+
+TEST(slab_pretest_is_sound)
+{
+    int wrong = 0, yes = 0, easy = 0, easy_yes = 0, checked = 0;
+    for (int it = 0; it < 300000; it++) {
+        int32_t R = it % 3 == 0 ? 30 : it % 3 == 1 ? 500 : 1 << 13;
+        srm_pt p[3];
+        for (int k = 0; k < 3; k++) p[k] = (srm_pt){rndi(-R, R), rndi(-R, R), (uint32_t)k};
+        __int128 o = (__int128)(p[1].x - p[0].x) * (p[2].y - p[0].y) -
+                     (__int128)(p[1].y - p[0].y) * (p[2].x - p[0].x);
+        if (o == 0) continue;
+        int64_t xl = rndi(-3 * R, R), xr = xl + rndi(0, 4 * R);
+        srm_slab sl = {(double)xl, (double)xr};
+        if (it % 7 == 0) sl.xl = -INFINITY; /* one side open */
+        if (it % 11 == 0) sl.xr = INFINITY;
+        int ap = srm_disk_in_slab(&sl, p[0], p[1], p[2]);
+        int ex = exact_in_slab(p[0], p[1], p[2], xl, xr, it % 7 == 0, it % 11 == 0);
+        checked++;
+        yes += ap;
+        if (ap && !ex) wrong++;
+        /* a small fat triangle deep inside a wide slab: must be settled */
+        srm_pt q[3] = {{0, 0, 0}, {rndi(5, 20), rndi(-3, 3), 1}, {rndi(-3, 3), rndi(5, 20), 2}};
+        srm_slab wide = {-1000.0, 1000.0};
+        easy++;
+        easy_yes += srm_disk_in_slab(&wide, q[0], q[1], q[2]);
+    }
+    /* far outside the int64 range of the pre-test: says nothing */
+    srm_pt big[3] = {{-(1 << 30), 0, 0}, {1 << 30, 0, 1}, {0, 1 << 30, 2}};
+    srm_slab all = {-INFINITY, INFINITY};
+    CHECK(!srm_disk_in_slab(&all, big[0], big[1], big[2]));
+    CHECK_MSG(wrong == 0, "%d of %d unsound answers", wrong, checked);
+    CHECK_MSG(yes > checked / 20, "only %d of %d settled", yes, checked);
+    CHECK_MSG(easy_yes == easy, "%d of %d easy triangles settled", easy_yes, easy);
+}
+
+/* The slab of a rank: from the nearest non-empty strips on either side. */
+TEST(slab_of_strips)
+{
+    srm_strip st[5] = {{3, 0, 0, -50, -10, 0, 9}, {0, 0, 0, 0, 0, 0, 0}, {4, 0, 0, -10, 20, 5, 6},
+                       {0, 0, 0, 0, 0, 0, 0}, {2, 0, 0, 40, 41, 0, 1}};
+    srm_slab sl;
+    pdt_srm_slab_of(&sl, st, 5, 2);
+    CHECK(sl.xl == -10.0 && sl.xr == 40.0);
+    pdt_srm_slab_of(&sl, st, 5, 0);
+    CHECK(isinf(sl.xl) && sl.xl < 0 && sl.xr == -10.0);
+    pdt_srm_slab_of(&sl, st, 5, 4);
+    CHECK(sl.xl == 20.0 && isinf(sl.xr) && sl.xr > 0);
+    pdt_srm_slab_of(&sl, st, 1, 0);
+    CHECK(isinf(sl.xl) && isinf(sl.xr));
+}
+
 /* ---- partition helpers and schedule ------------------------------------------ */
 
 TEST(radix_sort_stable_dedupe)
@@ -164,6 +236,8 @@ int main(void)
 {
     RUN(touch_is_sound);
     RUN(touch_cocircular_corner);
+    RUN(slab_pretest_is_sound);
+    RUN(slab_of_strips);
     RUN(radix_sort_stable_dedupe);
     RUN(merge_runs_stable);
     RUN(schedule);

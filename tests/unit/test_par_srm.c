@@ -291,10 +291,93 @@ TEST(srm_gen_families)
     printf("# %d simulated runs on the generators\n", runs);
 }
 
+/* Merge messages: every count and the payload size are 64-bit fields, and
+ * a header whose counts or size disagree with the bytes is refused, also
+ * when they differ only above bit 32 (where a 32-bit field would wrap and
+ * match). */
+TEST(merge_message_header)
+{
+    size_t n;
+    pdt_point *pts = family(0, 200, &n);
+    srm_rec *u = malloc((n + 1) * sizeof *u), *tmp = malloc((n + 1) * sizeof *tmp);
+    for (size_t i = 0; i < n; i++) u[i] = (srm_rec){pdt_key(pts[i]), (uint32_t)i, 0};
+    pdt_srm_radix_sort(u, tmp, n);
+    size_t m = pdt_srm_dedupe(u, n), cut[3] = {0, m / 2, m};
+    srm_strip strip[2];
+    memset(strip, 0, sizeof strip);
+    srm_rank rk[2];
+    pdt_err err;
+    pdt_err_clear(&err);
+    for (int r = 0; r < 2; r++) {
+        size_t lo = cut[r], hi = cut[r + 1];
+        strip[r] = (srm_strip){hi - lo, u[lo].key, u[hi - 1].key, srm_key_point(u[lo].key).x,
+                               srm_key_point(u[hi - 1].key).x, INT32_MAX, INT32_MIN};
+        for (size_t i = lo; i < hi; i++) {
+            pdt_point q = srm_key_point(u[i].key);
+            if (q.y < strip[r].ymin) strip[r].ymin = q.y;
+            if (q.y > strip[r].ymax) strip[r].ymax = q.y;
+        }
+    }
+    for (int r = 0; r < 2; r++) {
+        size_t lo = cut[r], hi = cut[r + 1];
+        pdt_point *lp = malloc((hi - lo + 1) * sizeof *lp);
+        uint32_t *gid = malloc((hi - lo + 1) * sizeof *gid), *id = malloc((hi - lo + 1) * sizeof *id);
+        for (size_t i = lo; i < hi; i++) {
+            lp[i - lo] = srm_key_point(u[i].key);
+            gid[i - lo] = u[i].idx;
+        }
+        CHECK(pdt_srm_init(&rk[r], r, 2, strip, NULL, &err) == PDT_OK);
+        CHECK(pdt_srm_local(&rk[r], malloc(PDT_DELAUNAY_WORK(hi - lo)), lp, gid, id, hi - lo,
+                            &err) == PDT_OK);
+        free(lp);
+        free(gid);
+        free(id);
+    }
+    void *msg[2];
+    size_t len[2];
+    for (int r = 0; r < 2; r++) CHECK(pdt_srm_pack(&rk[r], 0, &msg[r], &len[r], &err) == PDT_OK);
+    srm_msg_head h;
+    memcpy(&h, msg[0], sizeof h);
+    CHECK(sizeof h.payload == 8 && sizeof h.npts == 8 && sizeof h.ntri == 8 && sizeof h.nhull == 8);
+    CHECK(h.magic == SRM_MSG_MAGIC && h.payload == len[0] - sizeof h && h.ntri > 0 && h.nhull > 0);
+    /* damaged headers, each refused with the sender named */
+    const uint64_t wrap = (uint64_t)1 << 32;
+    for (int k = 0; k < 5; k++) {
+        srm_msg_head bad = h;
+        if (k == 0) bad.payload += wrap;
+        if (k == 1) bad.ntri += wrap;
+        if (k == 2) bad.npts += wrap;
+        if (k == 3) bad.nhull += wrap;
+        if (k == 4) bad.ntri = UINT64_MAX / 2; /* 3 * ntri would wrap in 64 bits */
+        unsigned char *c = malloc(len[0]);
+        memcpy(c, msg[0], len[0]);
+        memcpy(c, &bad, sizeof bad);
+        void *mm[2] = {c, msg[1]};
+        pdt_err_clear(&err);
+        CHECK_MSG(pdt_srm_merge(&rk[1], 0, mm, len, &err) == PDT_ERR_CORRUPT, "damage %d", k);
+        CHECK_MSG(strstr(err.msg, "from rank 0") != NULL, "damage %d: %s", k, err.msg);
+        CHECK_MSG(strstr(err.msg, k == 0 ? "bad header" : "bad counts") != NULL, "damage %d: %s", k,
+                  err.msg);
+        free(c);
+    }
+    /* the undamaged messages merge: every triangle final, none pending */
+    pdt_err_clear(&err);
+    CHECK(pdt_srm_merge(&rk[1], 0, msg, len, &err) == PDT_OK);
+    CHECK(rk[0].npend == 0 && rk[1].npend == 0 && rk[1].holds_hull);
+    for (int r = 0; r < 2; r++) {
+        free(msg[r]);
+        pdt_srm_free(&rk[r]);
+    }
+    free(u);
+    free(tmp);
+    free(pts);
+}
+
 int main(void)
 {
     RUN(srm_equals_sequential);
     RUN(srm_gen_families);
+    RUN(merge_message_header);
     (void)cmp_tri;
     return test_summary();
 }
