@@ -256,6 +256,11 @@ pdt_status pdt_par_write(pdt_comm *c, const char *path, pdt_tri_format fmt, cons
  * of the signal that ends the job when another rank died. */
 void pdt_par_write_abandon(void);
 
+/* The phase of pdt_par_triangulate this process is in: "partition",
+ * "local", "merge" or "order", NULL outside it.  Async-signal-safe (an
+ * atomic load of a string constant). */
+const char *pdt_par_phase(void);
+
 /* Test-only: create the file named by PDT_TEST_MARK (if set), so that a test
  * knows a rank has reached one of the test sleeps (PDT_TEST_SLEEP_*). */
 void pdt_par_test_mark(void);

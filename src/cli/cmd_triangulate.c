@@ -98,7 +98,14 @@ static void on_stop(int sig)
         n = put_uint(b, n, (unsigned)sig);
         n = put_str(b, n, ") while rank 0 was in its ");
         n = put_str(b, n, stop_phase);
-        n = put_str(b, n, " step: another of the ");
+        n = put_str(b, n, " step");
+        const char *ph = pdt_par_phase();
+        if (ph) {
+            n = put_str(b, n, " (");
+            n = put_str(b, n, ph);
+            n = put_str(b, n, " phase)");
+        }
+        n = put_str(b, n, ": another of the ");
         n = put_uint(b, n, (unsigned)stop_size);
         n = put_str(b, n, " ranks ended first (the launcher names it) or the job was "
                           "interrupted; no output written\n");

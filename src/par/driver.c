@@ -13,6 +13,7 @@
  *              canonical order there: rank q ends with a consecutive block.
  *
  * With one rank the sequential pipeline (pdt_triangulate) does all of it. */
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
@@ -713,6 +714,20 @@ static pdt_status sequential(pdt_comm *c, pdt_par_input *in, pdt_par_output *out
     return PDT_OK;
 }
 
+/* The phase of pdt_par_triangulate this process is in (NULL outside it), for
+ * a message when the job is ended from outside (pdt_par_phase). */
+static _Atomic(const char *) cur_phase;
+
+const char *pdt_par_phase(void)
+{
+    return atomic_load_explicit(&cur_phase, memory_order_relaxed);
+}
+
+static void enter(const char *phase)
+{
+    atomic_store_explicit(&cur_phase, phase, memory_order_relaxed);
+}
+
 /* ---- the whole run ------------------------------------------------------------ */
 
 pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *out,
@@ -746,15 +761,18 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
         goto done;
     }
     double t0 = pdt_comm_wtime(c);
+    enter("partition");
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_PARTITION, 0, 0, 0, 0);
     st = partition(&d, in, err);
     if (st == PDT_OK) st = strips(&d, err);
     if (st != PDT_OK) goto done;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_PARTITION, 0, 0, 0, 0);
     double t1 = pdt_comm_wtime(c);
+    enter("local");
     st = local(&d, err);
     if (st != PDT_OK) goto done;
     double t2 = pdt_comm_wtime(c);
+    enter("merge");
     st = merge_tree(&d, err);
     /* the merge phase ends when the last merge does: ranks done early sleep
      * here (counted as merge time, not as order time) */
@@ -762,6 +780,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
     if (st != PDT_OK) goto done;
     double t3 = pdt_comm_wtime(c);
     me->emitted = d.s.nfin + d.s.nmore;
+    enter("order");
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_ORDER, 0, 0, 0, 0);
     st = order(&d, out, err);
     if (st != PDT_OK) goto done;
@@ -773,6 +792,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
     me->t_order = t4 - t3;
     figures(&d);
 done:
+    enter(NULL);
     if (tr) tr->gid = saved_gid;
     if (d.s_init) pdt_srm_free(&d.s);
     free(d.blk);

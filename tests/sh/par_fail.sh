@@ -18,7 +18,7 @@ if ! command -v mpirun > /dev/null; then fail mpirun_available "mpirun not found
 # --- a rank dies: rank 1 sleeps at a given place (test-only variable), we kill
 # exactly that process.  Non-zero exit, no output file and no temporary left,
 # and rank 0 (ended by mpirun's SIGTERM) names the step the job was in.
-# kill_rank NAME VAR=RANK:SECONDS STEP
+# kill_rank NAME VAR=RANK:SECONDS "STEP" (as rank 0 names it)
 kill_rank() {
     local name=$1 hook=$2 step=$3
     env "$hook" PDT_TEST_MARK="mark-$name" timeout 120 mpirun -np 2 "$PDT" triangulate u.txt -o "$name.tri" \
@@ -49,15 +49,15 @@ kill_rank() {
     local left
     left=$(ls -A | grep -v '^log-\|^mark-' | grep -c "$name")
     if [ $rc -ne 0 ] && [ $rc -ne 124 ] && [ "$left" -eq 0 ] && [ $((SECONDS - t0)) -lt 30 ] &&
-        grep -q "while rank 0 was in its $step step" "log-$name.err"; then
+        grep -qF "while rank 0 was in its $step:" "log-$name.err"; then
         ok "$name"
     else
         fail "$name" "rc=$rc files=$(ls -A | grep -v '^log-\|^mark-' | grep "$name") after $((SECONDS - t0)) s: $(cat "log-$name.err")"
     fi
     wait 2> /dev/null
 }
-kill_rank rank_killed_mid_run PDT_TEST_SLEEP_BEFORE_MERGE=1:60 triangulate
-kill_rank rank_killed_in_write PDT_TEST_SLEEP_IN_WRITE=1:60 write
+kill_rank rank_killed_mid_run PDT_TEST_SLEEP_BEFORE_MERGE=1:60 "triangulate step (merge phase)"
+kill_rank rank_killed_in_write PDT_TEST_SLEEP_IN_WRITE=1:60 "write step"
 
 # --- bad input: file:line message, exit 2, no output
 printf '0 0\n1 1\n2 x\n' > bad.txt
