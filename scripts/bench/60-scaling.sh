@@ -3,7 +3,9 @@
 # grows (issue 11).  For each input, `pdt triangulate --stats -o OUT.tri`
 # gives the seconds of every phase (read, sort, kernel, canonical, write);
 # the table shows them as seconds and as nanoseconds per input point, the
-# peak resident memory in bytes per point (/usr/bin/time), and CGAL's
+# peak resident memory in bytes per point and the process's CPU seconds
+# (user + system, both threads: a plain run faults its working memory in on
+# a second thread, PDT_TRI_PREFAULT in docs/geometry.md) (/usr/bin/time), and CGAL's
 # Delaunay_triangulation_2 range insert on the same file in the same run
 # (tools/cgal_dt.cpp, exact predicates, spatial sort included) with the ratio
 # (pdt sort + kernel) / (CGAL insert).  Medians of SCALING_RUNS runs (default 1).
@@ -62,15 +64,16 @@ for spec in "${inputs[@]}"; do
     [ -s "$in" ] || "$PDT" gen "$kind" "$n" --seed 1 -o "$in" || exit 1
     echo "measuring $kind $n ..."
     for ((r = 1; r <= RUNS; r++)); do
-        "$TIME" -f '%M' -o "$W/time.out" "$PDT" triangulate "$in" -o "$W/out.tri" --stats \
+        "$TIME" -f '%M %U %S' -o "$W/time.out" "$PDT" triangulate "$in" -o "$W/out.tri" --stats \
             2> "$W/run.err" > /dev/null || { echo "  pdt failed: $(tail -2 "$W/run.err")"; exit 1; }
         stats=$(grep '^{' "$W/run.err" | tail -1)
-        kib=$(tail -1 "$W/time.out")
+        kib=$(tail -1 "$W/time.out" | awk '{print $1}')
+        cpu=$(tail -1 "$W/time.out" | awk '{print $2 + $3}')
         cg=-
         if [ $HAVE_CGAL = 1 ]; then
             cg=$("$B/cgal_dt" "$in" | python3 -c 'import json,sys; print(json.load(sys.stdin)["build"])') || cg=-
         fi
-        printf '%s\t%s\t%s\t%s\t%s\n' "$kind" "$n" "$kib" "$cg" "$stats" >> "$RES"
+        printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$kind" "$n" "$kib" "$cpu" "$cg" "$stats" >> "$RES"
     done
 done
 rm -f "$W/out.tri" "$W/time.out" "$W/run.err"
@@ -81,12 +84,12 @@ import json, statistics, sys
 from collections import OrderedDict
 rows = OrderedDict()
 for line in open(sys.argv[1]):
-    kind, n, kib, cg, st = line.rstrip("\n").split("\t", 4)
-    rows.setdefault((kind, int(n)), []).append((int(kib), None if cg == "-" else float(cg), json.loads(st)))
+    kind, n, kib, cpu, cg, st = line.rstrip("\n").split("\t", 5)
+    rows.setdefault((kind, int(n)), []).append((int(kib), None if cg == "-" else float(cg), json.loads(st), float(cpu)))
 ph = ["read", "sort", "kernel", "canonical", "write", "total"]
 print()
 print(f"pdt triangulate IN -o OUT.tri --stats, per phase (medians of {sys.argv[2]} run(s)); CGAL insert in the same run")
-hdr = f"{'input':<9} {'n':>10} " + " ".join(f"{p:>9}" for p in ph) + f" {'CGAL':>8} {'(s+k)/CGAL':>10} {'peak B/pt':>9}"
+hdr = f"{'input':<9} {'n':>10} " + " ".join(f"{p:>9}" for p in ph) + f" {'cpu s':>7} {'CGAL':>8} {'(s+k)/CGAL':>10} {'peak B/pt':>9}"
 print(hdr)
 print("-" * len(hdr))
 for (kind, n), r in rows.items():
@@ -95,12 +98,14 @@ for (kind, n), r in rows.items():
     cgs = [x[1] for x in r if x[1] is not None]
     cg = statistics.median(cgs) if cgs else None
     ratio = (sec["sort"] + sec["kernel"]) / cg if cg else None
-    print(f"{kind:<9} {n:>10} " + " ".join(f"{sec[p]:>9.3f}" for p in ph) +
+    cpu = statistics.median(x[3] for x in r)
+    print(f"{kind:<9} {n:>10} " + " ".join(f"{sec[p]:>9.3f}" for p in ph) + f" {cpu:>7.2f}" +
           (f" {cg:>8.3f} {ratio:>10.2f}" if cg else f" {'-':>8} {'-':>10}") + f" {kib * 1024 / n:>9.1f}")
-    print(f"{'  ns/pt':<20} " + " ".join(f"{sec[p] * 1e9 / n:>9.1f}" for p in ph) +
+    print(f"{'  ns/pt':<20} " + " ".join(f"{sec[p] * 1e9 / n:>9.1f}" for p in ph) + f" {'':>7}" +
           (f" {cg * 1e9 / n:>8.1f}" if cg else f" {'-':>8}"))
 print()
-print("seconds per phase from --stats (read: text parse; write: the .tri file); ns/pt: the same per")
-print("input point; CGAL: Delaunay_triangulation_2::insert of the range (s, then ns/pt); (s+k)/CGAL:")
+print("seconds per phase from --stats (wall; read: text parse; write: the .tri file); ns/pt: the same per")
+print("input point; cpu s: the process's user + system seconds (both threads: the prefault thread's")
+print("included); CGAL: Delaunay_triangulation_2::insert of the range (s, then ns/pt); (s+k)/CGAL:")
 print("pdt sort + kernel over CGAL's insert (below 1: pdt faster); peak: max RSS / n (time -f %M).")
 PY

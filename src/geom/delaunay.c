@@ -1074,14 +1074,15 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
     pdt_big_advise(order, n * sizeof *order);
     pdt_prefault *pf = NULL;
     if ((keep & PDT_TRI_PREFAULT) && cap * sizeof *R >= PREFAULT_MIN) {
-        /* the sort writes its buckets to R[16n, 24n) bytes at once (left to
-         * it); the helper does what comes next: the index list, the sort's
-         * other records and points, then the rest of R in the order the
-         * kernel's edges grow into it */
+        /* in the order the sort and the kernel need them: the buckets the
+         * sort's counting pass writes (R[16n, 24n) bytes: the helper starts
+         * there while the sort scans the points twice, then both fault it),
+         * the index list, the sort's other records and points, then the
+         * rest of R, where the kernel's edges grow */
         char *rb = (char *)(void *)R;
-        pdt_range rr[3] = { { order, n * sizeof *order }, { rb, 16 * n },
+        pdt_range rr[4] = { { rb + 16 * n, 8 * n }, { order, n * sizeof *order }, { rb, 16 * n },
                             { rb + 24 * n, cap * sizeof *R - 24 * n } };
-        pf = pdt_prefault_start(rr, 3);
+        pf = pdt_prefault_start(rr, 4);
     }
     keyed *ka = (keyed *)(void *)R, *kb = ka + n;
     pdt_point *q = (pdt_point *)(void *)(kb + n);
