@@ -1041,7 +1041,9 @@ static void restore_points(pdt_point *pts, size_t nu, const uint32_t *id, const 
  * per point) are the caller's array, in the kernel's order during the
  * kernel.  Peak: 84 bytes per point (92 when the kernel had its own copy of
  * the points and the sort its own scratch); every page of R is touched once
- * (the fresh-page faults were a sixth of the time at 10^7 points). */
+ * (the fresh-page faults were a sixth of the time at 10^7 points).  With
+ * PDT_TRI_PREFAULT a second thread faults R and order in ahead of use (on
+ * an idle core: docs/geometry.md, "Fresh memory"). */
 pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri **tris,
                                    size_t *ntri, pdt_tri_stats *stats, pdt_trace *tr)
 {
