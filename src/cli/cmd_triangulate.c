@@ -69,7 +69,9 @@ typedef struct run {
 /* mpirun ends every rank with SIGTERM when one rank died (killed, crashed) or
  * the job was interrupted; its own message names the rank that died, not
  * what the job was doing.  Rank 0 says which step it was in, and every rank
- * removes the temporaries of a write in progress.  (Set by the pipeline,
+ * removes the temporaries of a write in progress.  Once the steps are over
+ * (done, or failed and reported) the handler is silent: mpirun also ends
+ * the ranks still finishing when one has exited with a failure status.  (Set by the pipeline,
  * read by the handler: plain values, the step a string constant.) */
 static const char *volatile stop_phase = "start";
 static volatile sig_atomic_t stop_rank, stop_size;
@@ -92,7 +94,7 @@ static size_t put_uint(char *b, size_t at, unsigned v)
 static void on_stop(int sig)
 {
     pdt_par_write_abandon();
-    if (stop_rank == 0) {
+    if (stop_rank == 0 && stop_phase) {
         char b[256];
         size_t n = put_str(b, 0, "pdt: the job was ended (signal ");
         n = put_uint(b, n, (unsigned)sig);
@@ -437,6 +439,7 @@ int pdt_cmd_triangulate(int argc, char **argv)
     if (st == PDT_OK) st = compute(&R, &err);
     if (st == PDT_OK) st = write_output(&R, &err);
     if (st == PDT_OK) st = report(&R, &err);
+    stop_phase = NULL;
 
     if (R.trace) pdt_cli_trace_close(R.trace, NULL);
     pdt_par_input_free(&R.in);
