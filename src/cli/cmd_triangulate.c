@@ -252,10 +252,13 @@ static pdt_status compute(run *R, pdt_err *err)
     /* a .tri output names points by index only: the points can go once
      * partitioned (the other formats write them; a trace keeps them) */
     R->in.release_pts = pdt_tri_format_of(R->o->output) == PDT_FMT_TRI && !R->trace;
-    /* a plain run leaves the second core idle: a thread may fault the
-     * kernel's memory in ahead of it ($PDT_PREFAULT=0 turns that off) */
+    /* one rank in all (a plain run, or mpirun -np 1) on a machine of two
+     * CPUs or more leaves a core idle: a thread may fault the kernel's
+     * memory in ahead of it, on another CPU than the rank's if mpirun bound
+     * the rank to one ($PDT_PREFAULT=0 turns that off) */
     const char *pf = getenv("PDT_PREFAULT");
-    R->in.idle_core = R->p == 1 && !pdt_comm_is_mpi(R->c) && !(pf && strcmp(pf, "0") == 0);
+    R->in.idle_core = R->p == 1 && sysconf(_SC_NPROCESSORS_ONLN) > 1 &&
+                      !(pf && strcmp(pf, "0") == 0);
     pdt_status st = pdt_par_triangulate(R->c, &R->in, &R->out, &R->me,
                                         pdt_cli_trace_hook(R->trace), err);
     if (st != PDT_OK && R->p > 1) {

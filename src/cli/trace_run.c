@@ -10,6 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "pdt/io.h"
 #include "pdt/par.h"
 #include "pdt/tracefile.h"
 #include "run_opts.h"
@@ -248,7 +249,7 @@ static pdt_status write_points_tmp(pdt_comm *c, const char *tmp, const pdt_par_i
     pdt_status st = r == 0 && (!all || !cnt) ? pdt_err_set(err, PDT_ERR_NOMEM, "out of memory")
                                              : PDT_OK;
     pdt_comm_file *f = NULL;
-    if (pdt_par_agree(c, st, NULL, err) == PDT_OK) st = pdt_comm_file_open(c, tmp, &f, err);
+    if (pdt_par_agree(c, st, NULL, err) == PDT_OK) st = pdt_comm_file_open(c, tmp, PDT_POINTS_HEADER_BYTES + 8 * in->n_total, &f, err);
     else st = PDT_ERR_NOMEM;
     if (st != PDT_OK) {
         free(all);
@@ -319,7 +320,7 @@ static pdt_status write_run_meta(pdt_cli_trace *t, const pdt_run_opts *o, pdt_co
         st = write_points_tmp(c, tmp, in, &checksum, err);
         if (st != PDT_OK) name_final(err, tmp, path);
     }
-    if (r == 0 && st == PDT_OK && rename(tmp, path) != 0)
+    if (r == 0 && st == PDT_OK && pdt_replace_file(tmp, path) != 0)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: cannot rename into place: %s", path,
                          strerror(errno));
     if (r == 0 && st != PDT_OK && tmp) unlink(tmp);

@@ -2,11 +2,13 @@
 #include "bigmem.h"
 
 #include <pthread.h>
+#include <sched.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <unistd.h>
 
 enum { BIG = 1 << 20, HUGE_PAGE = 1 << 21 };
 
@@ -70,6 +72,20 @@ static void *prefault_run(void *arg)
     return NULL;
 }
 
+/* A process bound to one CPU (mpirun binds a job's only rank to a core)
+ * would run the helper on that CPU, taking turns with the main thread: the
+ * helper goes to the other CPUs online instead. */
+static void helper_cpus(pthread_t th)
+{
+    cpu_set_t mine, other;
+    if (sched_getaffinity(0, sizeof mine, &mine) != 0 || CPU_COUNT(&mine) != 1) return;
+    long online = sysconf(_SC_NPROCESSORS_ONLN);
+    CPU_ZERO(&other);
+    for (long c = 0; c < online && c < CPU_SETSIZE; c++)
+        if (!CPU_ISSET((size_t)c, &mine)) CPU_SET((size_t)c, &other);
+    if (CPU_COUNT(&other) > 0) (void)pthread_setaffinity_np(th, sizeof other, &other);
+}
+
 pdt_prefault *pdt_prefault_start(const pdt_range *r, int nr)
 {
     if (nr <= 0 || nr > PF_MAX) return NULL;
@@ -82,6 +98,7 @@ pdt_prefault *pdt_prefault_start(const pdt_range *r, int nr)
         free(pf);
         return NULL;
     }
+    helper_cpus(pf->th);
     return pf;
 }
 

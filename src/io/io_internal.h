@@ -16,7 +16,8 @@
 typedef struct pdt_io_text {
     char *buf;
     size_t len;
-    size_t mapped; /* 0: buf is malloc'd; else the bytes mapped at buf (read only) */
+    size_t mapped; /* 0: buf is malloc'd; else the bytes mapped (read only) */
+    void *map_base; /* where the mapping starts (NULL: at buf) */
 } pdt_io_text;
 
 /* Read the file `path` ("-" = standard input) into t.  Errors name the file:
@@ -27,6 +28,12 @@ typedef struct pdt_io_text {
  * pdt_io_text_free. */
 pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err);
 void pdt_io_text_free(pdt_io_text *t);
+/* Bytes [lo, hi) of a regular file mapped read only, hi a line start or the
+ * file's end, when hi - lo is 1 MiB or more: t->buf points at byte lo, a
+ * zero byte follows at t->buf[hi - lo] (the page holding it is the only one
+ * copied), t->len = hi - lo.  Returns 0, or -1 (nothing mapped: read the
+ * bytes instead).  Free with pdt_io_text_free. */
+int pdt_io_map_part(int fd, uint64_t lo, uint64_t hi, pdt_io_text *t);
 
 /* A line cursor over a loaded text. */
 typedef struct pdt_io_cur {

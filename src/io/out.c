@@ -3,10 +3,26 @@
 #include "pdt/io.h"
 
 #include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+int pdt_replace_file(const char *tmp, const char *path)
+{
+    struct stat sb;
+    if (lstat(path, &sb) == 0 && S_ISREG(sb.st_mode)) {
+        if (renameat2(AT_FDCWD, tmp, AT_FDCWD, path, RENAME_EXCHANGE) == 0) {
+            (void)unlink(tmp); /* the old file, now under the temporary's name */
+            return 0;
+        }
+        if (errno != EINVAL && errno != ENOSYS && errno != ENOENT) return -1;
+        /* (a file system without exchanges, or the target just went away) */
+    }
+    return rename(tmp, path);
+}
 
 pdt_status pdt_out_open(pdt_outfile *o, const char *path, pdt_err *err)
 {
@@ -96,7 +112,7 @@ pdt_status pdt_out_commit(pdt_outfile *o, pdt_err *err)
         e = errno;
     }
     o->fp = NULL;
-    if (!bad && o->tmp && rename(o->tmp, o->path) != 0) {
+    if (!bad && o->tmp && pdt_replace_file(o->tmp, o->path) != 0) {
         bad = 1;
         e = errno;
     }

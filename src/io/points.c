@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -540,7 +541,7 @@ pdt_status pdt_points_head_read(const char *path, double scale, pdt_points_head 
         buf = nb;
         if ((st = pread_full(fd, buf, len, 0, path, err)) != PDT_OK) break;
         buf[len] = '\0';
-        pdt_io_text t = {buf, len, 0};
+        pdt_io_text t = {buf, len, 0, NULL};
         reader r = {.scale = scale, .err = err};
         pdt_io_cur_init(&r.cur, &t, path);
         r.cur.fields = !h->node;
@@ -610,6 +611,19 @@ pdt_status pdt_points_part_load(const char *path, const pdt_points_head *h, int 
         if (hi < lo) hi = lo;
         pt->lo = lo;
         pt->hi = hi;
+    }
+    pdt_io_text map;
+    if (st == PDT_OK && pdt_io_map_part(fd, lo, hi, &map) == 0) {
+        /* the file's page-cache pages as they are: no fresh memory */
+        close(fd);
+        pt->buf = map.buf;
+        pt->map = map.map_base;
+        pt->maplen = map.mapped;
+        pt->nl = count_nl(pt->buf, (size_t)(hi - lo));
+        pt->err_key = UINT64_MAX;
+        return PDT_OK;
+    }
+    if (st == PDT_OK) {
         if (!(pt->buf = malloc((size_t)(hi - lo) + 1)))
             st = pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory (%llu bytes)", path,
                              (unsigned long long)(hi - lo));
@@ -790,7 +804,8 @@ pdt_status pdt_points_collisions(pdt_points_written *w, size_t n, uint64_t *coll
 
 void pdt_points_part_free(pdt_points_part *pt)
 {
-    free(pt->buf);
+    if (pt->maplen) munmap(pt->map, pt->maplen);
+    else free(pt->buf);
     free(pt->pts);
     free(pt->orig);
     memset(pt, 0, sizeof *pt);

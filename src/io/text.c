@@ -44,6 +44,7 @@ pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
     t->buf = NULL;
     t->len = 0;
     t->mapped = 0;
+    t->map_base = NULL;
     int is_stdin = strcmp(path, "-") == 0;
     const char *name = is_stdin ? "standard input" : path;
     int fd = is_stdin ? STDIN_FILENO : open(path, O_RDONLY | O_CLOEXEC);
@@ -107,10 +108,46 @@ pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
     return PDT_OK;
 }
 
+int pdt_io_map_part(int fd, uint64_t lo, uint64_t hi, pdt_io_text *t)
+{
+    size_t pg = (size_t)sysconf(_SC_PAGESIZE);
+    struct stat sb;
+    if (hi < lo || hi - lo < MAP_MIN || hi - lo >= SIZE_MAX / 2) return -1;
+    if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode) || (uint64_t)sb.st_size < hi) return -1;
+    uint64_t lo_al = lo / pg * pg;
+    size_t span = (size_t)(hi - lo_al), fbytes = (span + pg - 1) / pg * pg;
+    size_t total = span / pg * pg + pg; /* room for the zero byte at span */
+    char *a = mmap(NULL, total, PROT_READ, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (a == MAP_FAILED) return -1;
+    if (mmap(a, fbytes, PROT_READ, MAP_PRIVATE | MAP_FIXED | MAP_POPULATE, fd, (off_t)lo_al) ==
+        MAP_FAILED) {
+        munmap(a, total);
+        return -1;
+    }
+    madvise(a, fbytes, MADV_SEQUENTIAL);
+    /* byte hi: past the file's end (zero), in the anonymous page (zero), or
+     * the next part's first byte, in a page made private to hold the zero */
+    char *z = a + span, *zp = a + span / pg * pg;
+    if (*z != '\0') {
+        if (mprotect(zp, pg, PROT_READ | PROT_WRITE) != 0) {
+            munmap(a, total);
+            return -1;
+        }
+        *z = '\0';
+        mprotect(zp, pg, PROT_READ);
+    }
+    t->buf = a + (lo - lo_al);
+    t->len = (size_t)(hi - lo);
+    t->mapped = total;
+    t->map_base = a;
+    return 0;
+}
+
 void pdt_io_text_free(pdt_io_text *t)
 {
-    if (t->mapped) munmap(t->buf, t->mapped);
+    if (t->mapped) munmap(t->map_base ? t->map_base : t->buf, t->mapped);
     else free(t->buf);
+    t->map_base = NULL;
     t->mapped = 0;
     t->buf = NULL;
     t->len = 0;

@@ -142,7 +142,8 @@ pdt_status pdt_comm_agree(pdt_comm *c, pdt_status mine, const char *path, const 
     return PDT_OK;
 }
 
-pdt_status pdt_comm_file_open(pdt_comm *c, const char *path, pdt_comm_file **out, pdt_err *err)
+pdt_status pdt_comm_file_open(pdt_comm *c, const char *path, uint64_t size, pdt_comm_file **out,
+                              pdt_err *err)
 {
     *out = NULL;
     pdt_comm_file *f = calloc(1, sizeof *f);
@@ -155,6 +156,7 @@ pdt_status pdt_comm_file_open(pdt_comm *c, const char *path, pdt_comm_file **out
     }
     f->c = c;
     f->path = p;
+    f->size = size;
     pdt_err_clear(&f->first);
     pdt_status s = c->ops->file_open(c, f, err);
     if (s != PDT_OK) {

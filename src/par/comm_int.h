@@ -50,6 +50,7 @@ struct pdt_comm {
 struct pdt_comm_file {
     pdt_comm *c;
     char *path;
+    uint64_t size;  /* the file's final size, set at the open */
     void *be;
     pdt_err first; /* this rank's first failed write (code PDT_OK: none) */
 };

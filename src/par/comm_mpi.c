@@ -443,7 +443,8 @@ static pdt_status mpi_file_open(pdt_comm *c, pdt_comm_file *f, pdt_err *err)
     pdt_status o = mpi_io_check(rc, c, f->path, "create", err);
     if (s == PDT_OK) s = o;
     if (rc == MPI_SUCCESS) { /* the open is collective: it succeeded at every rank */
-        pdt_status t = mpi_io_check(MPI_File_set_size(h, 0), c, f->path, "truncate", err);
+        pdt_status t = mpi_io_check(MPI_File_set_size(h, (MPI_Offset)f->size), c, f->path,
+                                    "truncate", err);
         if (s == PDT_OK) s = t;
     }
     s = pdt_comm_agree(c, s, f->path, "create", err);

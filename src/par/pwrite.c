@@ -195,7 +195,7 @@ static pdt_status write_file(pdt_comm *c, outfile *o, pdt_err *err)
     if (st == PDT_OK) st = pdt_comm_allreduce_u64(c, tot, 2, PDT_COMM_SUM, err);
     if (st != PDT_OK) return st;
     pdt_comm_file *f = NULL;
-    st = pdt_comm_file_open(c, o->tmp, &f, err);
+    st = pdt_comm_file_open(c, o->tmp, o->hlen + tot[0] + tot[1], &f, err);
     if (st != PDT_OK) { /* name the user's file, not our temporary */
         if (r == 0) cannot_create(o->path, err);
         return pdt_par_agree(c, r == 0 ? PDT_ERR_IO : PDT_OK, NULL, err);
@@ -246,7 +246,7 @@ static pdt_status write_files(pdt_comm *c, outfile *o, int nfile, pdt_err *err)
         st = write_file(c, &o[made], err);
     }
     for (int k = 0; k < nfile && st == PDT_OK && r == 0; k++)
-        if (rename(o[k].tmp, o[k].path) != 0)
+        if (pdt_replace_file(o[k].tmp, o[k].path) != 0)
             st = pdt_err_set(err, PDT_ERR_IO, "%s: cannot rename into place: %s", o[k].path,
                              strerror(errno));
     if (st != PDT_OK && r == 0)

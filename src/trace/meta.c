@@ -1,5 +1,6 @@
 /* pdt — the run folder's manifest (text) and points.bin (binary). */
 #include "tf_internal.h"
+#include "pdt/io.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -55,7 +56,7 @@ static pdt_status af_commit(afile *f, pdt_err *err)
     int bad = ferror(f->fp);
     if (fclose(f->fp) != 0 || bad)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: write failed: %s", f->tmp, strerror(errno));
-    else if (rename(f->tmp, f->path) != 0)
+    else if (pdt_replace_file(f->tmp, f->path) != 0)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: cannot rename into place: %s", f->path,
                          strerror(errno));
     if (st != PDT_OK) remove(f->tmp);

@@ -147,7 +147,8 @@ static pdt_status rank_file(pdt_comm *c, void *arg, pdt_err *err)
     uint64_t off;
     pdt_comm_file *f;
     pdt_status s = pdt_comm_exscan_u64(c, (uint64_t)r + 1, &off, err);
-    if (s == PDT_OK) s = pdt_comm_file_open(c, arg, &f, err);
+    int p = pdt_comm_size(c);
+    if (s == PDT_OK) s = pdt_comm_file_open(c, arg, (uint64_t)p * (uint64_t)(p + 1) / 2, &f, err);
     if (s != PDT_OK) return s;
     s = pdt_comm_file_write_at(f, off, line, (size_t)r + 1, err);
     pdt_status s2 = pdt_comm_file_close(f, err);
