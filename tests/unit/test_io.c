@@ -541,6 +541,57 @@ TEST(atomic_write_leaves_nothing)
     }
 }
 
+/* pdt_replace_file: the new bytes under the target's name, the temporary's
+ * name gone, an existing target replaced (by an exchange), a missing one
+ * created, and a symbolic link replaced itself, as rename(2) does. */
+static void put_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    if (f) {
+        fputs(text, f);
+        fclose(f);
+    }
+}
+
+static int file_is(const char *path, const char *text)
+{
+    char got[64] = "";
+    FILE *f = fopen(path, "rb");
+    size_t n = f ? fread(got, 1, sizeof got - 1, f) : 0;
+    if (f) fclose(f);
+    return f && n == strlen(text) && memcmp(got, text, n) == 0;
+}
+
+TEST(replace_file_exchanges_names)
+{
+    char rdir[] = "/tmp/pdt-replace-XXXXXX";
+    CHECK(mkdtemp(rdir) != NULL);
+    char tmp[128], dst[128], other[128];
+    snprintf(tmp, sizeof tmp, "%s/.out.tmp", rdir);
+    snprintf(dst, sizeof dst, "%s/out.tri", rdir);
+    snprintf(other, sizeof other, "%s/other", rdir);
+    put_text(tmp, "first\n");
+    CHECK(pdt_replace_file(tmp, dst) == 0); /* no target yet */
+    CHECK(file_is(dst, "first\n") && access(tmp, F_OK) != 0);
+    put_text(tmp, "second, longer\n");
+    CHECK(pdt_replace_file(tmp, dst) == 0); /* over an existing file */
+    CHECK(file_is(dst, "second, longer\n"));
+    CHECK_MSG(access(tmp, F_OK) != 0, "the old file is left under the temporary's name");
+    put_text(other, "kept\n");
+    unlink(dst);
+    CHECK(symlink(other, dst) == 0);
+    put_text(tmp, "third\n");
+    CHECK(pdt_replace_file(tmp, dst) == 0); /* the link itself is replaced */
+    struct stat sb;
+    CHECK(lstat(dst, &sb) == 0 && S_ISREG(sb.st_mode));
+    CHECK(file_is(dst, "third\n") && file_is(other, "kept\n"));
+    CHECK(pdt_replace_file(tmp, dst) != 0); /* no temporary: an error, target kept */
+    CHECK(file_is(dst, "third\n"));
+    unlink(dst);
+    unlink(other);
+    rmdir(rdir);
+}
+
 TEST(devices_are_written_not_replaced)
 {
     pdt_err err;
@@ -609,6 +660,7 @@ int main(void)
     RUN(atomic_write_leaves_nothing);
     RUN(large_file_mapped_exact_pages);
     RUN(devices_are_written_not_replaced);
+    RUN(replace_file_exchanges_names);
     clean();
     rmdir(dir);
     return test_summary();

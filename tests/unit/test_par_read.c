@@ -199,6 +199,44 @@ static size_t bad_line(char *b, unsigned k, int x, int y)
     }
 }
 
+/* Parts of 1 MiB or more are mapped, not read: the parts' bytes and their
+ * closing zero byte (over the next part's first byte, in a copied page),
+ * a file whose size is a multiple of the page size ending without '\n',
+ * and a bad line deep in a mapped part, all as the plain read sees them. */
+TEST(large_parts_mapped)
+{
+    size_t cap = (size_t)6 << 20, len = 0;
+    char *buf = malloc(cap + 64);
+    for (int v = 0; len < cap - 64; v++)
+        len += (size_t)sprintf(buf + len, "%d %d\n", v % 100003 - 50000, (v * 7919) % 65521);
+    size_t pg = (size_t)sysconf(_SC_PAGESIZE);
+    size_t whole = len / pg * pg; /* cut at a page boundary, last line without '\n' */
+    while (buf[whole - 1] == '\n' || buf[whole - 1] == ' ') whole--, buf[whole] = '7';
+    buf[whole] = '\0';
+    while (whole % pg) buf[whole++] = '1';
+    buf[whole] = '\0';
+    CHECK(same_as_plain(".txt", buf, whole, 0, "large, page multiple") == 0);
+    /* the mapped path is the one taken: a part of at least 1 MiB */
+    snprintf(file, sizeof file, "/tmp/pdt-par-read-%ld-map.txt", (long)getpid());
+    put(buf, whole);
+    pdt_points_head h;
+    pdt_err err;
+    pdt_err_clear(&err);
+    CHECK(pdt_points_head_read(file, 0, &h, &err) == PDT_OK);
+    for (int q = 0; q < 3; q++) {
+        pdt_points_part pt;
+        CHECK(pdt_points_part_load(file, &h, q, 3, &pt, &err) == PDT_OK);
+        CHECK_MSG(pt.maplen > 0, "part %d of 3 not mapped", q);
+        CHECK(pt.buf[pt.hi - pt.lo] == '\0');
+        CHECK(memcmp(pt.buf, buf + pt.lo, (size_t)(pt.hi - pt.lo)) == 0);
+        pdt_points_part_free(&pt);
+    }
+    unlink(file);
+    memcpy(buf + whole / 2 + 40, "\n12 x3\n", 8); /* a bad line in the middle */
+    CHECK(same_as_plain(".txt", buf, whole, 0, "large, bad line") == 0);
+    free(buf);
+}
+
 /* Random text files: mostly good lines in every spelling, some bad ones. */
 TEST(random_text_files)
 {
@@ -264,6 +302,7 @@ int main(void)
     RUN(text_errors);
     RUN(node_files);
     RUN(node_errors);
+    RUN(large_parts_mapped);
     RUN(random_text_files);
     RUN(random_node_files);
     return test_summary();
