@@ -58,6 +58,7 @@ typedef struct pdt_tri_stats {
     size_t n_tri;       /* triangles */
     size_t n_hull;      /* hull vertices (collinear boundary points included) */
     int collinear;      /* 1 if all distinct points are collinear (or n_unique < 3) */
+    int prefaulted;     /* 1 if a second thread faulted the memory in (PDT_TRI_PREFAULT) */
     double t_sort, t_kernel, t_canon; /* seconds */
 } pdt_tri_stats;
 

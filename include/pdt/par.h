@@ -42,6 +42,8 @@ void pdt_comm_abort(pdt_comm *c, int code);
 int pdt_comm_rank(const pdt_comm *c);
 int pdt_comm_size(const pdt_comm *c);
 int pdt_comm_is_mpi(const pdt_comm *c);
+/* How many ranks of the job run on this rank's machine (this one included). */
+int pdt_comm_node_size(const pdt_comm *c);
 /* Name of the host this rank runs on (owned by c). */
 const char *pdt_comm_host(const pdt_comm *c);
 /* Wall clock in seconds (MPI_Wtime, or CLOCK_MONOTONIC in serial mode). */
@@ -151,9 +153,10 @@ typedef struct pdt_par_input {
     uint64_t collisions; /* --scale: points that became equal to a point written
                           * differently, over the whole input (every rank) */
     int release_pts;     /* 1: pdt_par_triangulate may free pts (see there) */
-    int idle_core;       /* 1: a one-rank run may use a second thread to fault
-                          * its working memory in (PDT_TRI_PREFAULT); set
-                          * only when a core would otherwise be idle */
+    int prefault;        /* 1: a second thread may fault this rank's working
+                          * memory in ahead of use (PDT_TRI_PREFAULT with one
+                          * rank, the partition's block with more): for
+                          * ranks not sharing a CPU with another rank */
 } pdt_par_input;
 
 /* This rank's share of T*: triangles first .. first + ntri - 1 of the
@@ -188,6 +191,8 @@ typedef struct pdt_par_rank_stats {
     uint64_t n_dup;         /* duplicates dropped in this rank's strip */
     uint64_t hull;          /* vertices of the hull this rank holds */
     int32_t holds_final_hull, hull_degenerate;
+    int32_t prefault;       /* 1: a second thread faulted memory in ahead */
+    int32_t reserved;
     /* seconds per phase of the pipeline */
     double t_read, t_partition, t_local, t_merge, t_order, t_write;
     double critical_path;   /* seconds: longest chain of dependent compute ending here */

@@ -252,13 +252,17 @@ static pdt_status compute(run *R, pdt_err *err)
     /* a .tri output names points by index only: the points can go once
      * partitioned (the other formats write them; a trace keeps them) */
     R->in.release_pts = pdt_tri_format_of(R->o->output) == PDT_FMT_TRI && !R->trace;
-    /* one rank in all (a plain run, or mpirun -np 1) on a machine of two
-     * CPUs or more leaves a core idle: a thread may fault the kernel's
-     * memory in ahead of it, on another CPU than the rank's if mpirun bound
-     * the rank to one ($PDT_PREFAULT=0 turns that off) */
+    /* a thread may fault a rank's working memory in ahead of it when the
+     * machine has a CPU for every rank of the job on it, and one more for a
+     * lone rank (mpirun binds a rank to one CPU: the thread is moved to
+     * another).  On this project's VM first touches of memory wait for the
+     * host; a second thread hides that wait even when both CPUs compute
+     * ($PDT_PREFAULT=0 turns it off) */
     const char *pf = getenv("PDT_PREFAULT");
-    R->in.idle_core = R->p == 1 && sysconf(_SC_NPROCESSORS_ONLN) > 1 &&
-                      !(pf && strcmp(pf, "0") == 0);
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    int node = pdt_comm_node_size(R->c);
+    R->in.prefault = !(pf && strcmp(pf, "0") == 0) &&
+                     (R->p == 1 ? cpus > 1 : (long)node <= cpus);
     pdt_status st = pdt_par_triangulate(R->c, &R->in, &R->out, &R->me,
                                         pdt_cli_trace_hook(R->trace), err);
     if (st != PDT_OK && R->p > 1) {
@@ -309,7 +313,7 @@ static void json_rank(int q, const pdt_par_rank_stats *r)
             "\"merges\": %llu, \"border_max\": %llu, \"kept\": %llu, \"discarded\": %llu, "
             "\"final_by_merge\": %llu, \"emitted\": %llu, \"written\": %llu, "
             "\"bytes_sent\": %llu, \"bytes_received\": %llu, \"merge_bytes_sent\": %llu, "
-            "\"merge_bytes_received\": %llu, \"critical_path_s\": %.6f}",
+            "\"merge_bytes_received\": %llu, \"critical_path_s\": %.6f, \"prefault\": %s}",
             (long long)r->peak_rss_kib, (unsigned long long)r->points,
             (unsigned long long)r->local_tris, (unsigned long long)r->final_at_once,
             (unsigned long long)r->deferred, (unsigned long long)r->shipped,
@@ -318,7 +322,8 @@ static void json_rank(int q, const pdt_par_rank_stats *r)
             (unsigned long long)r->final_merge, (unsigned long long)r->emitted,
             (unsigned long long)r->written, (unsigned long long)r->bytes_sent,
             (unsigned long long)r->bytes_recv, (unsigned long long)r->merge_bytes_sent,
-            (unsigned long long)r->merge_bytes_recv, r->critical_path);
+            (unsigned long long)r->merge_bytes_recv, r->critical_path,
+            r->prefault ? "true" : "false");
 }
 
 /* The communication figures of an MPI run and per_rank[] again (what make

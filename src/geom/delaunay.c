@@ -1085,6 +1085,7 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
         pdt_range rr[4] = { { rb + 16 * n, 8 * n }, { order, n * sizeof *order }, { rb, 16 * n },
                             { rb + 24 * n, cap * sizeof *R - 24 * n } };
         pf = pdt_prefault_start(rr, 4);
+        st.prefaulted = pf != NULL;
     }
     keyed *ka = (keyed *)(void *)R, *kb = ka + n;
     pdt_point *q = (pdt_point *)(void *)(kb + n);

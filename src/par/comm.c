@@ -45,6 +45,7 @@ pdt_status pdt_comm_finalize(pdt_comm *c, pdt_err *err)
 int pdt_comm_rank(const pdt_comm *c) { return c->rank; }
 int pdt_comm_size(const pdt_comm *c) { return c->size; }
 int pdt_comm_is_mpi(const pdt_comm *c) { return c->ops->is_mpi; }
+int pdt_comm_node_size(const pdt_comm *c) { return c->node_size; }
 const char *pdt_comm_host(const pdt_comm *c) { return c->host; }
 double pdt_comm_wtime(const pdt_comm *c) { return c->ops->wtime(c); }
 

@@ -42,6 +42,7 @@ typedef struct pdt_comm_ops {
 struct pdt_comm {
     const pdt_comm_ops *ops;
     int rank, size;
+    int node_size;  /* ranks of the job on this machine (threads of the local backend: all) */
     size_t chunk;   /* largest single message, bytes (<= INT_MAX) */
     char host[256];
     void *be;       /* the backend's state */

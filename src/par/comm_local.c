@@ -451,6 +451,7 @@ static pdt_comm *rank_new(local_world *w, int rank)
     c->be = b;
     c->rank = rank;
     c->size = w->P;
+    c->node_size = w->P; /* the ranks are threads of this process */
     c->chunk = pdt_comm_chunk_from_env();
     if (gethostname(c->host, sizeof c->host - 1) != 0) strcpy(c->host, "?");
     return c;

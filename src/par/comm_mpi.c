@@ -75,6 +75,7 @@ pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out,
     c->ops = &mpi_ops;
     c->be = m;
     c->size = 1;
+    c->node_size = 1;
     c->chunk = pdt_comm_chunk_from_env();
     if (gethostname(c->host, sizeof c->host - 1) != 0) strcpy(c->host, "?");
     one_node_defaults();
@@ -94,6 +95,13 @@ pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out,
     if (s == PDT_OK) s = mpi_check(MPI_Comm_rank(m->comm, &c->rank), "MPI_Comm_rank", c, err);
     if (s == PDT_OK) s = mpi_check(MPI_Comm_size(m->comm, &c->size), "MPI_Comm_size", c, err);
     if (s == PDT_OK) s = mpi_check(MPI_Comm_dup(m->comm, &m->xcomm), "MPI_Comm_dup", c, err);
+    MPI_Comm node = MPI_COMM_NULL;
+    c->node_size = c->size;
+    if (s == PDT_OK)
+        s = mpi_check(MPI_Comm_split_type(m->comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node),
+                      "MPI_Comm_split_type", c, err);
+    if (s == PDT_OK) s = mpi_check(MPI_Comm_size(node, &c->node_size), "MPI_Comm_size", c, err);
+    if (node != MPI_COMM_NULL) MPI_Comm_free(&node);
     /* Every rank must cut transfers the same way: rank 0's chunk size wins. */
     unsigned long long chunk = c->chunk;
     if (s == PDT_OK)

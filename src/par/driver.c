@@ -50,6 +50,7 @@ typedef struct drv {
     srm_strip *strip;              /* p strip descriptors */
     srm_rank s;
     int s_init;
+    pdt_prefault *pf;              /* faulting the block in ahead (see partition) */
     pdt_par_rank_stats *me;
     pdt_err *err;
 } drv;
@@ -358,8 +359,9 @@ static pdt_status strips(drv *d, pdt_err *err)
 }
 
 /* Phases 1 and 2 on this rank's strip, in its block (which the SRM state
- * owns from here on, as the array of final triangles). */
-static pdt_status local(drv *d, pdt_err *err)
+ * owns from here on, as the array of final triangles); with `prefault` a
+ * second thread faults the kernel's part of the block in ahead of it. */
+static pdt_status local(drv *d, int prefault, pdt_err *err)
 {
     pdt_status st = pdt_srm_init(&d->s, d->rank, d->p, d->strip, d->tr, err);
     if (st != PDT_OK) return st;
@@ -368,9 +370,18 @@ static pdt_status local(drv *d, pdt_err *err)
     d->s.clock_user = d->c;
     pdt_point *pts = block_pts(d);
     uint32_t *gid = block_gid(d), *id = block_id(d);
-    void *blk = d->blk;
+    unsigned char *blk = d->blk;
     d->blk = NULL;
-    return pdt_srm_local(&d->s, blk, pts, gid, id, d->m, err);
+    if (prefault) { /* the kernel's edges grow past the partition's records */
+        size_t front = 2 * d->blk_cap * sizeof(srm_rec), work = PDT_DELAUNAY_WORK(d->blk_cap);
+        pdt_range edges = {blk + front, work > front ? work - front : 0};
+        d->pf = pdt_prefault_start(&edges, 1);
+        d->me->prefault = d->pf != NULL;
+    }
+    st = pdt_srm_local(&d->s, blk, pts, gid, id, d->m, err);
+    pdt_prefault_stop(d->pf); /* every page of the block has been touched */
+    d->pf = NULL;
+    return st;
 }
 
 /* ---- merge --------------------------------------------------------------------- */
@@ -685,7 +696,7 @@ static pdt_status sequential(pdt_comm *c, pdt_par_input *in, pdt_par_output *out
     pdt_tri_stats ts;
     double c0 = cpu_seconds(), w0 = pdt_comm_wtime(c);
     int how = (in->release_pts ? PDT_PTS_SPEND : PDT_PTS_RESTORE) |
-              (in->idle_core ? PDT_TRI_PREFAULT : 0);
+              (in->prefault ? PDT_TRI_PREFAULT : 0);
     pdt_status st = pdt_triangulate_inplace(in->pts, in->n, how, &out->tris, &out->ntri, &ts, tr);
     if (in->release_pts) {
         free(in->pts);
@@ -705,6 +716,7 @@ static pdt_status sequential(pdt_comm *c, pdt_par_input *in, pdt_par_output *out
     me->local_tris = me->final_at_once = me->emitted = ts.n_tri;
     me->hull = ts.n_hull;
     me->holds_final_hull = 1;
+    me->prefault = ts.prefaulted;
     me->hull_degenerate = ts.collinear;
     me->t_partition = ts.t_sort;
     me->t_local = ts.t_kernel;
@@ -769,7 +781,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_PARTITION, 0, 0, 0, 0);
     double t1 = pdt_comm_wtime(c);
     enter("local");
-    st = local(&d, err);
+    st = local(&d, in->prefault, err);
     if (st != PDT_OK) goto done;
     double t2 = pdt_comm_wtime(c);
     enter("merge");
@@ -794,6 +806,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
 done:
     enter(NULL);
     if (tr) tr->gid = saved_gid;
+    pdt_prefault_stop(d.pf);
     if (d.s_init) pdt_srm_free(&d.s);
     free(d.blk);
     free(d.strip);

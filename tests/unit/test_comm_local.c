@@ -23,6 +23,8 @@ static pdt_status rank_collectives(pdt_comm *c, void *arg, pdt_err *err)
     int r = pdt_comm_rank(c), P = pdt_comm_size(c);
     pdt_status s;
     if (pdt_comm_is_mpi(c)) WRONG("local rank says MPI");
+    if (pdt_comm_node_size(c) != P)
+        WRONG("rank %d: %d ranks on the machine, want all %d", r, pdt_comm_node_size(c), P);
     if ((s = pdt_comm_barrier(c, err)) != PDT_OK) return s;
     if ((s = pdt_comm_quiet_barrier(c, err)) != PDT_OK) return s;
 
