@@ -13,7 +13,9 @@
 #              largest over the ranks (from `--stats` per_rank[].seconds;
 #              older builds without it: rank 0's read and write, and
 #              partition_s, local_s, merge_s, gather_s as "order");
-# then, per size, the merge traffic at the largest P (merge-step bytes / input
+# then, for each P of PS from 2 to the number of cores, the "ceiling": P
+# plain runs at once, each on n/P of the points (the best P processes can do
+# here, with no communication, merge or order at all); then, per size, the merge traffic at the largest P (merge-step bytes / input
 # bytes, 8 per point) and peak memory: the largest rank's peak RSS at P = 2
 # against the plain run's.  Load (uptime) is printed before and after: on a
 # busy machine the wall figures mean little (the phases and bytes still do).
@@ -53,6 +55,31 @@ run() {
     done
 }
 
+# ceiling LABEL K IN: RUNS times, K plain runs at once, each on a consecutive
+# K-th of the input's lines (same kind of points, n/K of them): the wall
+# until all are done, in $W/LABEL.runs ("wall -").  What K processes on this
+# machine can do with no communication, merge or order at all: the best a
+# K-rank run could reach here.
+ceiling() {
+    local label=$1 k=$2 in=$3 lines
+    lines=$(wc -l < "$in")
+    for i in $(seq 0 $((k - 1))); do
+        sed -n "$((lines * i / k + 1)),$((lines * (i + 1) / k))p" "$in" > "$W/piece$i.txt"
+    done
+    : > "$W/$label.runs"
+    for r in $(seq 1 "$RUNS"); do
+        local t0 t1
+        t0=$(date +%s.%N)
+        for i in $(seq 0 $((k - 1))); do
+            nice -n "$NICE" "$PDT" triangulate "$W/piece$i.txt" -o "$W/piece$i.tri" 2> /dev/null &
+        done
+        wait
+        t1=$(date +%s.%N)
+        echo "$(awk "BEGIN { print $t1 - $t0 }") -" >> "$W/$label.runs"
+    done
+    rm -f "$W"/piece*.txt "$W"/piece*.tri
+}
+
 echo "pdt Table 1 — wall time against the plain run, uniform points, median of $RUNS runs"
 echo "machine: $CORES cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
 echo "uptime before: $(uptime)"
@@ -62,6 +89,7 @@ for n in $SIZES; do
     [ -s "$in" ] || "$PDT" gen uniform "$n" --seed 1 -o "$in"
     run "seq-$n" "$PDT" triangulate "$in"
     for p in $PS; do run "p$p-$n" mpirun -np "$p" "$PDT" triangulate "$in"; done
+    for p in $PS; do [ "$p" -gt 1 ] && [ "$p" -le "$CORES" ] && ceiling "ceil$p-$n" "$p" "$in"; done
     [ "${KEEP:-0}" = 1 ] || rm -f "$in"
 done
 

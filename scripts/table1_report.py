@@ -71,6 +71,15 @@ def main():
             cols = " | ".join(f"{med([x[k] for x, _ in ph]):.3f}" for k in PHASES)
             mark = "* P > cores" if int(p) > cores else ""
             print(f"| {int(n):,} | mpirun -np {p} | {wall:.3f} | {seq_wall / wall:.2f} | {cols} | {mark} |")
+        for p in ps:
+            try:
+                walls = [float(line.split()[0]) for line in open(f"{w}/ceil{p}-{n}.runs")]
+            except OSError:
+                continue
+            wall = med(walls)
+            blank = " | ".join("" for _ in PHASES)
+            print(f"| {int(n):,} | ceiling: {p} plain runs on n/{p} at once | {wall:.3f} | "
+                  f"{seq_wall / wall:.2f} | {blank} | ‡ |")
         big = max(ps, key=int)
         j = load(w, f"p{big}-{n}")[0][1]["parallel"]
         rel = 100 * j["merge_bytes_rel_input"]
@@ -87,6 +96,9 @@ def main():
     print("wall = the whole command (MPI start-up, read, compute, write); speedup = plain wall / wall.")
     print("Phases: seconds, the largest over the ranks, median over the runs.  † plain run:")
     print("everything between read and write (sort, kernel, canonical order).")
+    print("‡ ceiling: P plain runs started together, each on a consecutive n/P of the input's")
+    print("lines; wall until the last ends.  What P processes can do on this machine with no")
+    print("communication, merge or canonical order at all: the speedup a P-rank run could reach.")
     if not all_native:
         print("(This build's --stats has no per_rank[].seconds: read and write are rank 0's,")
         print(" \"order\" is the gather to rank 0.)")

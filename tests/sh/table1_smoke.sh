@@ -12,6 +12,9 @@ fi
 ok table1_runs
 check table1_header grep -q '| n | run | wall s | speedup | read s | partition s | local s | merge s | order s | write s |' "$out"
 check table1_rows test "$(grep -cE '^\| 3,000 \| (plain|mpirun -np [12]) \|' "$out")" -eq 3
+if [ "$(getconf _NPROCESSORS_ONLN)" -ge 2 ]; then
+    check table1_ceiling_row grep -qE '^\| 3,000 \| ceiling: 2 plain runs on n/2 at once \| [0-9.]+ \| [0-9.]+ \|' "$out"
+fi
 check table1_merge_and_memory grep -qE 'merge traffic at P = 2: .*% of the input; peak memory, largest rank at P = 2' "$out"
 check table1_uptime grep -q '^uptime after:' "$out"
 if python3 "$ROOT/scripts/projection.py" "$TMP/t1/p2-3000.1.json" > "$TMP/proj.txt" 2>&1; then
