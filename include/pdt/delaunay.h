@@ -50,6 +50,12 @@ void pdt_tri_canonical(pdt_tri *tris, size_t ntri);
  * overlapping tris (NULL: allocated and freed inside). */
 void pdt_tri_canonical_on(pdt_tri *tris, size_t ntri, pdt_tri *scratch);
 
+/* The same from in[0, ntri) into out[0, ntri): out may be in or overlap it
+ * (in is read whole first, and its triangles are rotated in place); scratch
+ * (room for ntri) overlaps neither.  A receive buffer is ordered into the
+ * front of its block without a copy first. */
+void pdt_tri_canonical_to(pdt_tri *in, pdt_tri *out, size_t ntri, pdt_tri *scratch);
+
 /* Figures reported by the pipeline. */
 typedef struct pdt_tri_stats {
     size_t n_in;        /* points read */

@@ -677,14 +677,17 @@ static void sort_run(pdt_tri *t, size_t lo, size_t hi)
  * indices (two triangles per vertex on average) are then sorted by the other
  * two.  A random scatter of all triangles in one pass, as before, missed the
  * cache and the TLB on every triangle at 10^7 points. */
-static void canonical(pdt_tri *tris, size_t ntri, pdt_tri *scratch)
+/* The canonical order of in[0, ntri), written to out[0, ntri) (out may be
+ * in, or overlap it: in is read whole before out is written); scratch: room
+ * for ntri triangles overlapping neither (NULL: allocated here). */
+static void canonical(pdt_tri *in, pdt_tri *out, size_t ntri, pdt_tri *scratch)
 {
     if (ntri == 0) return;
     uint32_t minv = UINT32_MAX, maxv = 0;
     for (size_t i = 0; i < ntri; i++) {
-        tri_rotate(&tris[i]);
-        if (tris[i].v[0] > maxv) maxv = tris[i].v[0];
-        if (tris[i].v[0] < minv) minv = tris[i].v[0];
+        tri_rotate(&in[i]);
+        if (in[i].v[0] > maxv) maxv = in[i].v[0];
+        if (in[i].v[0] < minv) minv = in[i].v[0];
     }
     /* the buckets span [minv, maxv] only: a rank of a parallel run orders the
      * triangles of one index range */
@@ -697,12 +700,13 @@ static void canonical(pdt_tri *tris, size_t ntri, pdt_tri *scratch)
     if (!lc) {
         if (tmp != scratch) pdt_big_free(tmp, ntri * sizeof *tmp);
         free(hc);
-        qsort(tris, ntri, sizeof *tris, tri_qcmp);
+        qsort(in, ntri, sizeof *in, tri_qcmp);
+        if (out != in) memmove(out, in, ntri * sizeof *out);
         return;
     }
-    for (size_t i = 0; i < ntri; i++) hc[((tris[i].v[0] - minv) >> shift) + 1]++;
+    for (size_t i = 0; i < ntri; i++) hc[((in[i].v[0] - minv) >> shift) + 1]++;
     for (size_t h = 1; h <= nhi; h++) hc[h] += hc[h - 1];
-    for (size_t i = 0; i < ntri; i++) tmp[hc[(tris[i].v[0] - minv) >> shift]++] = tris[i];
+    for (size_t i = 0; i < ntri; i++) tmp[hc[(in[i].v[0] - minv) >> shift]++] = in[i];
     /* hc[h] is now the end of high bucket h */
     uint32_t lmask = (uint32_t)(nlo - 1);
     size_t start = 0;
@@ -713,11 +717,11 @@ static void canonical(pdt_tri *tris, size_t ntri, pdt_tri *scratch)
         for (size_t i = start; i < end; i++) lc[((tmp[i].v[0] - minv) & lmask) + 1]++;
         lc[0] = start;
         for (size_t l = 1; l <= nlo; l++) lc[l] += lc[l - 1];
-        for (size_t i = start; i < end; i++) tris[lc[(tmp[i].v[0] - minv) & lmask]++] = tmp[i];
+        for (size_t i = start; i < end; i++) out[lc[(tmp[i].v[0] - minv) & lmask]++] = tmp[i];
         for (size_t i = start; i < end;) { /* runs of one first index */
             size_t j = i + 1;
-            while (j < end && tris[j].v[0] == tris[i].v[0]) j++;
-            if (j - i > 1) sort_run(tris, i, j);
+            while (j < end && out[j].v[0] == out[i].v[0]) j++;
+            if (j - i > 1) sort_run(out, i, j);
             i = j;
         }
         start = end;
@@ -729,12 +733,17 @@ static void canonical(pdt_tri *tris, size_t ntri, pdt_tri *scratch)
 
 void pdt_tri_canonical(pdt_tri *tris, size_t ntri)
 {
-    canonical(tris, ntri, NULL);
+    canonical(tris, tris, ntri, NULL);
 }
 
 void pdt_tri_canonical_on(pdt_tri *tris, size_t ntri, pdt_tri *scratch)
 {
-    canonical(tris, ntri, scratch);
+    canonical(tris, tris, ntri, scratch);
+}
+
+void pdt_tri_canonical_to(pdt_tri *in, pdt_tri *out, size_t ntri, pdt_tri *scratch)
+{
+    canonical(in, out, ntri, scratch);
 }
 
 /* ---- sort and dedupe ---- */
@@ -1140,7 +1149,7 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
         return s;
     }
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_OUTPUT, 0, 0, 0, 0);
-    canonical(t, nt, t + nt);
+    canonical(t, t, nt, t + nt);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_OUTPUT, 0, 0, 0, 0);
     if (nt == 0) {
         free(R);

@@ -563,10 +563,9 @@ static pdt_tri *order_room_sort(drv *d, order_room *o, size_t total)
     d->s.fin = NULL;
     d->s.nfin = d->s.capfin = 0;
     pdt_tri *t = o->got;
-    if (o->in_blk) {
+    if (o->in_blk) { /* from behind the (sent) local finals to the front */
         t = (pdt_tri *)(void *)o->blk;
-        memmove(t, o->got, total * sizeof *t);
-        pdt_tri_canonical_on(t, total, t + total);
+        pdt_tri_canonical_to(o->got, t, total, o->got + total);
         pdt_tri *shrunk = realloc(t, (total + 1) * sizeof *t);
         return shrunk ? shrunk : t;
     }

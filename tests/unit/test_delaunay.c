@@ -298,6 +298,31 @@ TEST(canonical_order)
     CHECK(t[3].v[0] == 2 && t[3].v[1] == 9 && t[3].v[2] == 5);
 }
 
+/* pdt_tri_canonical_to: from a buffer behind the front of a block into its
+ * front (overlapping when the buffer is longer than the gap), scratch
+ * behind the buffer, as the parallel order phase calls it; the same as
+ * pdt_tri_canonical in place, for small (insertion) and large (radix) counts
+ * and a narrow index range (one rank's share). */
+TEST(canonical_to_front_of_block)
+{
+    size_t sizes[] = {1, 50, 64, 65, 3000, 200000};
+    for (size_t k = 0; k < sizeof sizes / sizeof *sizes; k++) {
+        size_t n = sizes[k], gap = n / 3 + 1;
+        pdt_tri *blk = malloc((gap + 2 * n) * sizeof *blk), *ref = malloc(n * sizeof *ref);
+        uint32_t lo = (uint32_t)(k * 1000003u), span = (uint32_t)(n / 2 + 3);
+        for (size_t i = 0; i < n; i++) {
+            for (int e = 0; e < 3; e++) ref[i].v[e] = lo + (uint32_t)(rand() % (int)span);
+            if (i % 7 == 3 && i) ref[i] = ref[i - 1]; /* runs of equal triangles */
+        }
+        memcpy(blk + gap, ref, n * sizeof *ref);
+        pdt_tri_canonical(ref, n);
+        pdt_tri_canonical_to(blk + gap, blk, n, blk + gap + n);
+        CHECK_MSG(memcmp(blk, ref, n * sizeof *ref) == 0, "n = %zu: order differs", n);
+        free(blk);
+        free(ref);
+    }
+}
+
 TEST(trace_events)
 {
     pdt_point *p;
@@ -507,6 +532,7 @@ int main(void)
     RUN(sort_unique_keeps_smallest_index);
     RUN(kernel_rejects_unsorted_or_duplicate_points);
     RUN(canonical_order);
+    RUN(canonical_to_front_of_block);
     RUN(trace_events);
     RUN(symmetric_parabola_and_circle_large);
     RUN(high_degree_vertex);
