@@ -140,17 +140,39 @@ size_t pdt_format_lines(char *buf, pdt_lines kind, const void *items, size_t n, 
     return (size_t)(p - buf);
 }
 
+/* The decimal digits of v[0, n) added up: a sum of comparisons, which the
+ * compiler turns into vector instructions (ndigits32's table look-up cannot
+ * be), in blocks whose sums fit 32 bits.  A parallel run counts its bytes
+ * before it writes: 3 indices a triangle, 6*10^7 at 10^7 points. */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("tree-vectorize", "vect-cost-model=dynamic")))
+#endif
+static uint64_t digits_sum(const uint32_t *v, size_t n)
+{
+    uint64_t total = 0;
+    for (size_t i = 0; i < n;) {
+        size_t end = n - i > (1u << 20) ? i + (1u << 20) : n;
+        uint32_t s = 0;
+        for (; i < end; i++) {
+            uint32_t x = v[i];
+            s += 1u + (x >= 10u) + (x >= 100u) + (x >= 1000u) + (x >= 10000u) + (x >= 100000u) +
+                 (x >= 1000000u) + (x >= 10000000u) + (x >= 100000000u) + (x >= 1000000000u);
+        }
+        total += s;
+    }
+    return total;
+}
+
 uint64_t pdt_lines_bytes(pdt_lines kind, const void *items, size_t n, uint64_t first)
 {
-    const pdt_tri *t = items;
     const pdt_point *q = items;
     uint64_t b = 0;
     switch (kind) {
     case PDT_LINES_TRI:
     case PDT_LINES_ELE:
     case PDT_LINES_OFF_TRI:
-        for (size_t i = 0; i < n; i++)
-            b += (uint64_t)(ndigits32(t[i].v[0]) + ndigits32(t[i].v[1]) + ndigits32(t[i].v[2]));
+        _Static_assert(sizeof(pdt_tri) == 3 * sizeof(uint32_t), "pdt_tri is three packed words");
+        b += digits_sum((const uint32_t *)items, 3 * n);
         b += 3 * (uint64_t)n; /* two spaces and the newline */
         if (kind == PDT_LINES_OFF_TRI) b += 2 * (uint64_t)n;
         if (kind == PDT_LINES_ELE)
