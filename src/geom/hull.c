@@ -3,6 +3,7 @@
 #include "pdt/hull.h"
 
 #include "pdt/predicates.h"
+#include "pred_inline.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -198,6 +199,26 @@ pdt_status pdt_hull_graham(const pdt_point *pts, size_t n, uint32_t *out, size_t
 
 /* ---- monotone chain ---- */
 
+/* One chain of the monotone chain, untraced: the same pops and pushes as
+ * the traced loop, without a call per step (a strip of 5*10^6 points makes
+ * 10^7 of each).  dir 1: left to right, -1: right to left. */
+static pdt_status chain_untraced(const pdt_point *pts, size_t n, pdt_stack *s, int dir)
+{
+    for (size_t k = 0; k < n; k++) {
+        size_t i = dir > 0 ? k : n - 1 - k;
+        while (s->n >= 2 &&
+               pdt_orient_fast(pts[s->item[s->n - 2]], pts[s->item[s->n - 1]], pts[i]) < 0)
+            s->n--;
+        if (s->n < s->cap) {
+            s->item[s->n++] = (uint32_t)i;
+        } else {
+            pdt_status st = pdt_stack_push(s, (uint32_t)i); /* (grows it) */
+            if (st != PDT_OK) return st;
+        }
+    }
+    return PDT_OK;
+}
+
 pdt_status pdt_hull_chain(const pdt_point *pts, size_t n, uint32_t *out, size_t *nout,
                           int *degenerate, int lower_id, int upper_id, pdt_trace *tr)
 {
@@ -209,27 +230,35 @@ pdt_status pdt_hull_chain(const pdt_point *pts, size_t n, uint32_t *out, size_t 
         *nout = n;
         return PDT_OK;
     }
+    /* the stacks hold a chain of the points seen so far: a few dozen on most
+     * inputs, all n on a line (they grow as needed) */
+    size_t cap = n < 4096 ? n : 4096;
     pdt_stack lo, up;
-    pdt_status st = pdt_stack_init(&lo, n, lower_id, tr);
+    pdt_status st = pdt_stack_init(&lo, cap, lower_id, tr);
     if (st != PDT_OK) return st;
-    st = pdt_stack_init(&up, n, upper_id, tr);
+    st = pdt_stack_init(&up, cap, upper_id, tr);
     if (st != PDT_OK) {
         pdt_stack_free(&lo);
         return st;
     }
-    /* lower hull, left to right; pop only on a strict right turn */
-    for (size_t i = 0; i < n && st == PDT_OK; i++) {
-        while (lo.n >= 2 &&
-               pdt_orient(pts[lo.item[lo.n - 2]], pts[lo.item[lo.n - 1]], pts[i]) < 0)
-            pdt_stack_pop(&lo, (uint32_t)i);
-        st = pdt_stack_push(&lo, (uint32_t)i);
-    }
-    /* upper hull, right to left */
-    for (size_t i = n; i-- > 0 && st == PDT_OK;) {
-        while (up.n >= 2 &&
-               pdt_orient(pts[up.item[up.n - 2]], pts[up.item[up.n - 1]], pts[i]) < 0)
-            pdt_stack_pop(&up, (uint32_t)i);
-        st = pdt_stack_push(&up, (uint32_t)i);
+    /* lower hull left to right, upper hull right to left; pop only on a
+     * strict right turn */
+    if (PDT_TRACING(tr, 1)) {
+        for (size_t i = 0; i < n && st == PDT_OK; i++) {
+            while (lo.n >= 2 &&
+                   pdt_orient(pts[lo.item[lo.n - 2]], pts[lo.item[lo.n - 1]], pts[i]) < 0)
+                pdt_stack_pop(&lo, (uint32_t)i);
+            st = pdt_stack_push(&lo, (uint32_t)i);
+        }
+        for (size_t i = n; i-- > 0 && st == PDT_OK;) {
+            while (up.n >= 2 &&
+                   pdt_orient(pts[up.item[up.n - 2]], pts[up.item[up.n - 1]], pts[i]) < 0)
+                pdt_stack_pop(&up, (uint32_t)i);
+            st = pdt_stack_push(&up, (uint32_t)i);
+        }
+    } else {
+        st = chain_untraced(pts, n, &lo, 1);
+        if (st == PDT_OK) st = chain_untraced(pts, n, &up, -1);
     }
     if (st == PDT_OK) {
         if (lo.n + up.n - 2 > n) { /* every point on both chains: collinear */

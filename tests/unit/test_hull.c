@@ -277,6 +277,14 @@ TEST(chain_random_vs_brute_force)
                 if (pdt_orient(p[out[k]], p[out[(k + 1) % m]], p[out[(k + 2) % m]]) < 0) bad++;
             }
         }
+        /* untraced (no calls per step): the same hull */
+        uint32_t out2[41];
+        size_t m2;
+        int deg2;
+        if (pdt_hull_chain(p, (size_t)n, out2, &m2, &deg2, PDT_STACK_LOWER, PDT_STACK_UPPER,
+                           NULL) != PDT_OK ||
+            m2 != m || deg2 != deg || memcmp(out, out2, m * sizeof *out) != 0)
+            bad++;
         /* pushes - pops = final stack sizes; every event on the two stacks */
         long pushes = 0, pops = 0;
         for (size_t i = 0; i < buf.n; i++) {
@@ -291,9 +299,40 @@ TEST(chain_random_vs_brute_force)
     CHECK_MSG(bad == 0, "%d failures", bad);
 }
 
+/* Stacks longer than their first allocation (4096): 10 000 points on a line
+ * (degenerate: all of them), then with one point above (all on the hull,
+ * the line's points as the lower chain), traced and untraced alike. */
+TEST(chain_long_stacks_grow)
+{
+    enum { N = 10000 };
+    pdt_point *p = malloc((N + 1) * sizeof *p);
+    uint32_t *out = malloc((N + 2) * sizeof *out), *out2 = malloc((N + 2) * sizeof *out2);
+    for (int i = 0; i < N; i++) p[i] = (pdt_point){i, 2 * i};
+    size_t m, m2;
+    int deg, deg2;
+    CHECK(pdt_hull_chain(p, N, out, &m, &deg, PDT_STACK_LOWER, PDT_STACK_UPPER, NULL) == PDT_OK);
+    CHECK(deg == 1 && m == N);
+    for (int i = 0; i < N; i++) p[i] = (pdt_point){i, 0};
+    p[N] = (pdt_point){N, 5}; /* lex-sorted: last */
+    pdt_trace tr;
+    pdt_trace_buf buf;
+    pdt_trace_buf_init(&tr, &buf, 1, 0);
+    CHECK(pdt_hull_chain(p, N + 1, out, &m, &deg, PDT_STACK_LOWER, PDT_STACK_UPPER, &tr) ==
+          PDT_OK);
+    CHECK(pdt_hull_chain(p, N + 1, out2, &m2, &deg2, PDT_STACK_LOWER, PDT_STACK_UPPER, NULL) ==
+          PDT_OK);
+    CHECK_MSG(deg == 0 && m == N + 1, "deg %d, %zu on the hull", deg, m);
+    CHECK(deg2 == deg && m2 == m && memcmp(out, out2, m * sizeof *out) == 0);
+    pdt_trace_buf_free(&buf);
+    free(p);
+    free(out);
+    free(out2);
+}
+
 int main(void)
 {
     RUN(graham_square_with_side_points);
+    RUN(chain_long_stacks_grow);
     RUN(graham_trace_small_example);
     RUN(graham_angular_ties_and_coincident);
     RUN(graham_degenerate);
