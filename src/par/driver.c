@@ -447,17 +447,12 @@ static pdt_status merge_tree(drv *d, pdt_err *err)
 /* ---- canonical order across ranks ------------------------------------------------ */
 
 /* The canonical order sorts by smallest index first, so the output splits
- * into ranges of smallest index: rank q orders (pdt_tri_canonical, the plain
- * run's own counting sort) and writes the triangles whose smallest index
- * lies in its range.  No sample sort, no merge of sorted blocks: one
- * histogram, one exchange of 12-byte records, one local sort. */
-
-static uint32_t tri_min(const pdt_tri *t)
-{
-    uint32_t a = t->v[0], b = t->v[1], c = t->v[2];
-    if (b < a) a = b;
-    return c < a ? c : a;
-}
+ * into ranges of smallest index: rank q writes the triangles whose smallest
+ * index lies in its range.  Every rank puts its own final triangles in
+ * canonical order first (the plain run's counting sort), so the part for
+ * each rank is one consecutive run of each array: no grouping pass; one
+ * histogram of smallest indices (read off the sorted arrays), one exchange
+ * of 12-byte records, and each rank merges the sorted runs it got. */
 
 /* The final triangles of a rank: the local phase's and the merges'. */
 typedef struct finals {
@@ -465,14 +460,26 @@ typedef struct finals {
     size_t n[2];
 } finals;
 
-/* The ranges: the smallest indices [0, n_total) in buckets of 2^*shift
+/* First i with t[i].v[0] >= key in t[0, n) (canonical: v[0] is the smallest
+ * index, nondecreasing). */
+static size_t first_at_least(const pdt_tri *t, size_t n, uint64_t key)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (t[mid].v[0] < key) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
+/* The ranges: the smallest indices [0, n_total) in buckets of 2^sh
  * consecutive indices (at most 256 p, at most 2^16 buckets); the histogram of
  * every rank's final triangles summed (allreduce); bucket b goes to rank
- * owner[b], nondecreasing in b, so that every rank gets about T / p
+ * owner(b), nondecreasing in b, so that every rank gets about T / p
  * triangles (a bucket is never split).  mine[2 q + k]: how many of f.t[k]
- * go to rank q. */
-static pdt_status order_ranges(drv *d, const finals *f, int *shift, int **owner, uint64_t *mine,
-                               pdt_err *err)
+ * (sorted) go to rank q, a consecutive run of it. */
+static pdt_status order_ranges(drv *d, const finals *f, uint64_t *mine, pdt_err *err)
 {
     int p = d->p;
     uint64_t top = d->n_total ? d->n_total - 1 : 0;
@@ -482,15 +489,19 @@ static pdt_status order_ranges(drv *d, const finals *f, int *shift, int **owner,
     while ((top >> sh) + 1 > want) sh++;
     size_t nb = (size_t)(top >> sh) + 1;
     uint64_t *h = calloc(nb, sizeof *h), *local = calloc(2 * nb, sizeof *local);
-    int *own = malloc(nb * sizeof *own);
-    if (!h || !local || !own) {
+    if (!h || !local) {
         free(h);
         free(local);
-        free(own);
         return nomem(d, "order");
     }
-    for (int k = 0; k < 2; k++)
-        for (size_t i = 0; i < f->n[k]; i++) local[k * nb + (tri_min(&f->t[k][i]) >> sh)]++;
+    for (int k = 0; k < 2; k++) {
+        size_t at = 0;
+        for (size_t b = 0; b < nb; b++) {
+            size_t end = first_at_least(f->t[k] + at, f->n[k] - at, (uint64_t)(b + 1) << sh) + at;
+            local[k * nb + b] = end - at;
+            at = end;
+        }
+    }
     for (size_t b = 0; b < nb; b++) h[b] = local[b] + local[nb + b];
     pdt_status st = pdt_comm_allreduce_u64(d->c, h, nb, PDT_COMM_SUM, err);
     if (st == PDT_OK) {
@@ -499,155 +510,176 @@ static pdt_status order_ranges(drv *d, const finals *f, int *shift, int **owner,
         for (size_t b = 0; b < nb; b++) total += h[b];
         for (size_t b = 0; b < nb; b++) { /* the rank whose share holds the bucket's middle */
             uint64_t q = total ? (before + h[b] / 2) * (uint64_t)p / total : 0;
-            own[b] = q < (uint64_t)p ? (int)q : p - 1;
+            int own = q < (uint64_t)p ? (int)q : p - 1;
             before += h[b];
-            mine[2 * own[b]] += local[b]; /* this rank's triangles for that rank */
-            mine[2 * own[b] + 1] += local[nb + b];
+            mine[2 * own] += local[b]; /* this rank's triangles for that rank */
+            mine[2 * own + 1] += local[nb + b];
         }
-        *shift = sh;
-        *owner = own;
-        own = NULL;
     }
     free(h);
     free(local);
-    free(own);
     return st;
 }
 
-/* Group t[0..n) by destination rank in place (American flag sort: every
- * triangle moves once, no second array): rank q's block is [at[q], end[q])
- * (at[] is used up). */
-static void group_by_rank(pdt_tri *t, int p, size_t *at, const size_t *end, const int *owner,
-                          int shift)
+/* One sorted run of received triangles [at, end) and the heap of runs of the
+ * merge below, by their first triangle. */
+typedef struct run {
+    const pdt_tri *at, *end;
+} run;
+
+static int tri_before(const pdt_tri *a, const pdt_tri *b)
 {
-    for (int q = 0; q < p; q++)
-        while (at[q] < end[q]) {
-            pdt_tri x = t[at[q]];
-            int dq = owner[tri_min(&x) >> shift];
-            while (dq != q) { /* put x in its place, carry on with the one it displaces */
-                pdt_tri y = t[at[dq]];
-                t[at[dq]++] = x;
-                x = y;
-                dq = owner[tri_min(&x) >> shift];
-            }
-            t[at[q]++] = x;
-        }
+    if (a->v[0] != b->v[0]) return a->v[0] < b->v[0];
+    if (a->v[1] != b->v[1]) return a->v[1] < b->v[1];
+    return a->v[2] < b->v[2];
 }
 
-/* Where the order phase receives and sorts: in the rank's block when the
- * local finals (its front), the received triangles and the canonical
- * order's scratch fit in it (pages already touched), else in a new array
- * (the block then serves as the scratch if it can). */
+static void heap_down(run *h, size_t n, size_t i)
+{
+    for (;;) {
+        size_t l = 2 * i + 1, m = i;
+        if (l < n && tri_before(h[l].at, h[m].at)) m = l;
+        if (l + 1 < n && tri_before(h[l + 1].at, h[m].at)) m = l + 1;
+        if (m == i) return;
+        run t = h[i];
+        h[i] = h[m];
+        h[m] = t;
+        i = m;
+    }
+}
+
+/* Merge the nonempty runs of h[0, n) (sorted, no triangle twice) into out,
+ * which overlaps none of them (one pass: a heap of the runs' heads). */
+static void merge_runs(run *h, size_t n, pdt_tri *out)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++)
+        if (h[i].at < h[i].end) h[k++] = h[i];
+    n = k;
+    for (size_t i = n / 2; i-- > 0;) heap_down(h, n, i);
+    while (n > 1) {
+        *out++ = *h[0].at++;
+        if (h[0].at == h[0].end) h[0] = h[--n];
+        heap_down(h, n, 0);
+    }
+    if (n == 1) {
+        size_t left = (size_t)(h[0].end - h[0].at);
+        memcpy(out, h[0].at, left * sizeof *out);
+    }
+}
+
+/* Where the order phase receives and merges: in the rank's block when the
+ * received triangles fit at its end and the output at its front without
+ * overlapping (the local finals at the front have been sent by then), else
+ * in new arrays. */
 typedef struct order_room {
-    unsigned char *blk; /* the block (s.fin), and its size */
-    size_t bytes;
-    pdt_tri *got;       /* receive buffer */
-    int in_blk;         /* got lies in the block */
+    pdt_tri *blk;      /* the block (s.fin), room for cap triangles */
+    size_t cap;
+    pdt_tri *got, *out;
+    int got_own, out_own; /* got / out is an array of its own */
 } order_room;
 
 static pdt_status order_room_get(drv *d, order_room *o, size_t total)
 {
-    o->blk = (unsigned char *)d->s.fin;
-    o->bytes = o->blk ? d->blk_bytes : 0; /* the strip's points are no longer needed */
-    size_t front = d->s.nfin * sizeof(pdt_tri), need = 2 * (total + 1) * sizeof(pdt_tri);
-    o->in_blk = o->blk && front + need <= o->bytes;
-    o->got = o->in_blk ? (pdt_tri *)(void *)(o->blk + front) : srm_big((total + 1) * sizeof *o->got);
-    return o->got ? PDT_OK : nomem(d, "order");
+    o->blk = d->s.fin;
+    o->cap = o->blk ? d->blk_bytes / sizeof(pdt_tri) : 0; /* the strip's points are not needed */
+    if (o->blk && 2 * total + 2 <= o->cap && d->s.nfin + total <= o->cap) {
+        o->out = o->blk;
+        o->got = o->blk + (o->cap - total);
+        return PDT_OK;
+    }
+    o->got = srm_big((total + 1) * sizeof *o->got);
+    o->got_own = 1;
+    if (o->blk && total <= o->cap) {
+        o->out = o->blk;
+    } else {
+        o->out = srm_big((total + 1) * sizeof *o->out);
+        o->out_own = 1;
+    }
+    return o->got && o->out ? PDT_OK : nomem(d, "order");
 }
 
-/* After the exchange (the local finals were sent): the received triangles
- * in canonical order, in an array of their own (the block, moved to its
- * front and shrunk, or the new one). */
-static pdt_tri *order_room_sort(drv *d, order_room *o, size_t total)
+/* This rank's finals in canonical order, each array on its own (the block's
+ * room behind the local finals as the counting sort's scratch). */
+static void order_local(drv *d, finals *f)
 {
-    d->s.fin = NULL;
-    d->s.nfin = d->s.capfin = 0;
-    pdt_tri *t = o->got;
-    if (o->in_blk) { /* from behind the (sent) local finals to the front */
-        t = (pdt_tri *)(void *)o->blk;
-        pdt_tri_canonical_to(o->got, t, total, o->got + total);
-        pdt_tri *shrunk = realloc(t, (total + 1) * sizeof *t);
-        return shrunk ? shrunk : t;
-    }
-    int scratch = o->blk && total * sizeof(pdt_tri) <= o->bytes;
-    pdt_tri_canonical_on(t, total, scratch ? (pdt_tri *)(void *)o->blk : NULL);
-    free(o->blk);
-    return t;
+    pdt_tri *blk = d->s.fin;
+    size_t cap = blk ? d->blk_bytes / sizeof(pdt_tri) : 0;
+    pdt_tri *scratch = blk && 2 * f->n[0] <= cap ? blk + f->n[0] : NULL;
+    pdt_tri_canonical_on(f->t[0], f->n[0], scratch);
+    pdt_tri_canonical_on(f->t[1], f->n[1], scratch && f->n[1] <= f->n[0] ? scratch : NULL);
 }
 
 /* Phase 4: the final triangles go to the rank of their smallest index's
  * range, which puts them in canonical order: rank q ends with the q-th block
- * of the canonical output in out (and its place in the whole output).  The
- * two arrays of finals go in two exchanges into one array, in the rank's
- * block behind its own finals when there is room. */
+ * of the canonical output in out (and its place in the whole output). */
 static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
 {
     int p = d->p;
     finals f = {{d->s.fin, d->s.more}, {d->s.nfin, d->s.nmore}};
     pdt_status st = PDT_OK;
     size_t *cnt = calloc(2 * (size_t)p, sizeof *cnt), *rcnt = calloc(2 * (size_t)p, sizeof *rcnt);
-    size_t *at = calloc((size_t)p, sizeof *at), *end = calloc((size_t)p, sizeof *end);
     uint64_t *sc = calloc(2 * (size_t)p, sizeof *sc), *rc = calloc(2 * (size_t)p, sizeof *rc);
+    run *runs = calloc(2 * (size_t)p, sizeof *runs);
     order_room room = {0};
-    pdt_tri *tris = NULL;
-    int *owner = NULL, shift = 0;
-    if (!cnt || !rcnt || !at || !end || !sc || !rc) {
+    if (!cnt || !rcnt || !sc || !rc || !runs) {
         st = nomem(d, "order");
         goto done;
     }
-    st = order_ranges(d, &f, &shift, &owner, sc, err);
-    if (st != PDT_OK) goto done;
-    for (int k = 0; k < 2; k++) {
-        for (int q = 0; q < p; q++) {
-            at[q] = q ? end[q - 1] : 0;
-            end[q] = at[q] + (size_t)sc[2 * q + k];
-        }
-        group_by_rank(f.t[k], p, at, end, owner, shift);
-    }
-    st = pdt_comm_alltoall(d->c, sc, 2 * sizeof *sc, rc, err);
+    order_local(d, &f);
+    st = order_ranges(d, &f, sc, err);
+    if (st == PDT_OK) st = pdt_comm_alltoall(d->c, sc, 2 * sizeof *sc, rc, err);
     if (st != PDT_OK) goto done;
     note_all(d, TAG_COUNTS, 2 * sizeof *sc);
-    size_t total = 0, part[2] = {0, 0};
+    size_t total = 0;
     for (int k = 0; k < 2; k++)
         for (int q = 0; q < p; q++) {
             cnt[k * p + q] = (size_t)sc[2 * q + k] * sizeof(pdt_tri);
             rcnt[k * p + q] = (size_t)rc[2 * q + k] * sizeof(pdt_tri);
-            part[k] += (size_t)rc[2 * q + k];
+            total += (size_t)rc[2 * q + k];
         }
-    total = part[0] + part[1];
     st = order_room_get(d, &room, total);
     if (st != PDT_OK) goto done;
+    pdt_tri *at = room.got;
     for (int k = 0; k < 2 && st == PDT_OK; k++) {
-        st = pdt_comm_alltoallv(d->c, f.t[k], cnt + k * p, room.got + (k ? part[0] : 0),
-                                rcnt + k * p, err);
+        st = pdt_comm_alltoallv(d->c, f.t[k], cnt + k * p, at, rcnt + k * p, err);
         if (st == PDT_OK) note_v(d, TAG_ORDER, cnt + k * p, rcnt + k * p);
+        for (int q = 0; q < p; q++) { /* the sorted run from rank q */
+            runs[k * p + q] = (run){at, at + rc[2 * q + k]};
+            at += rc[2 * q + k];
+        }
     }
     if (st != PDT_OK) goto done;
+    merge_runs(runs, 2 * (size_t)p, room.out);
     free(d->s.more); /* every triangle went somewhere (itself included) */
     d->s.more = NULL;
     d->s.nmore = d->s.capmore = 0;
-    tris = order_room_sort(d, &room, total);
-    room.got = NULL;
+    d->s.fin = NULL; /* the block is room.blk */
+    d->s.nfin = d->s.capfin = 0;
+    if (room.out == room.blk) {
+        pdt_tri *shrunk = realloc(room.out, (total + 1) * sizeof *room.out);
+        room.out = shrunk ? shrunk : room.out;
+    } else {
+        free(room.blk);
+    }
+    room.blk = NULL;
     uint64_t first = 0, all = total;
     st = pdt_comm_exscan_u64(d->c, total, &first, err); /* place in the whole output */
     if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, &all, 1, PDT_COMM_SUM, err);
-    if (st != PDT_OK) goto done;
-    note_all(d, TAG_ORDER, sizeof all);
-    out->tris = tris;
+    out->tris = room.out;
     out->ntri = total;
     out->first = first;
     out->n_total = all;
-    tris = NULL;
+    room.out = NULL;
+    if (st == PDT_OK) note_all(d, TAG_ORDER, sizeof all);
 done:
-    if (room.got && !room.in_blk) free(room.got);
+    if (room.got_own) free(room.got);
+    if (room.out_own) free(room.out);
     free(cnt);
     free(rcnt);
-    free(at);
-    free(end);
     free(sc);
     free(rc);
-    free(owner);
-    free(tris);
+    free(runs);
     return st;
 }
 
