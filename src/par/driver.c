@@ -43,7 +43,6 @@ typedef struct drv {
     uint64_t bytes_sent, bytes_recv, merge_sent, merge_recv;
     unsigned char *blk;            /* this rank's one block (see block_bytes) */
     size_t blk_cap, blk_bytes;     /* room for blk_cap points; its size */
-    srm_rec *rec;                  /* partition: this rank's distinct records, in blk */
     size_t m;
     uint64_t nrecv;
     uint64_t n_total;              /* points in the whole input */
@@ -233,10 +232,10 @@ static uint32_t *block_id(const drv *d)
 }
 
 /* Sample sort of this rank's input block by key, with exact splitters:
- * d->rec[0..d->m) are the distinct records of this rank's strip,
- * key-sorted, in d->blk (room for this rank's input block or its share of
- * the whole plus 1/16, touched only as far as used; a larger one when more
- * records arrive).  in->pts is freed as soon as the records hold it if
+ * the strip's d->m distinct points in lexicographic order and their global
+ * indices end in d->blk (block_pts, block_gid; room for this rank's input
+ * block or its share of the whole plus 1/16, touched only as far as used; a
+ * larger one when more records arrive).  in->pts is freed as soon as the records hold it if
  * in->release_pts. */
 static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
 {
@@ -303,15 +302,14 @@ static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
     }
     /* blocks arrive in rank order, each key-sorted with equal keys in index
      * order, and rank q's indices are all below rank q+1's: the stable merge
-     * puts the smallest index first among equal keys */
-    srm_rec *sorted = pdt_srm_merge_runs(got, scratch, start, p);
-    d->nrecv = total;
-    d->m = pdt_srm_dedupe(sorted, total);
-    d->rec = sorted;
+     * puts the smallest index first among equal keys, and its last pass
+     * writes the strip's points and global indices, duplicates dropped */
     d->blk = blk;
     d->blk_cap = cap;
     d->blk_bytes = block_bytes(cap);
     blk = NULL;
+    d->nrecv = total;
+    d->m = pdt_srm_runs_to_strip(got, scratch, start, p, block_pts(d), block_gid(d));
     goto done;
 nomem:
     st = pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: partition: out of memory", r);
@@ -327,32 +325,26 @@ done:
     return st;
 }
 
-/* The local strip from the partition's records: points and global indices
- * (in the block, beyond the kernel's part) and the strip descriptor,
- * allgathered into d->strip. */
+/* The strip descriptor of this rank's points (in the block, from the
+ * partition), allgathered into d->strip. */
 static pdt_status strips(drv *d, pdt_err *err)
 {
     size_t m = d->m;
     d->strip = malloc((size_t)d->p * sizeof *d->strip);
     if (!d->strip) return nomem(d, "partition");
     srm_strip mine = {m, 0, 0, 0, 0, 0, 0};
+    const pdt_point *pt = block_pts(d);
     if (m) {
-        mine.first_key = d->rec[0].key;
-        mine.last_key = d->rec[m - 1].key;
-    }
-    pdt_point *pt = block_pts(d);
-    uint32_t *g = block_gid(d);
-    for (size_t i = 0; i < m; i++) {
-        pt[i] = srm_key_point(d->rec[i].key);
-        g[i] = d->rec[i].idx;
-        if (i == 0 || pt[i].y < mine.ymin) mine.ymin = pt[i].y;
-        if (i == 0 || pt[i].y > mine.ymax) mine.ymax = pt[i].y;
-    }
-    if (m) {
+        mine.first_key = pdt_key(pt[0]);
+        mine.last_key = pdt_key(pt[m - 1]);
         mine.xmin = pt[0].x;
         mine.xmax = pt[m - 1].x;
+        mine.ymin = mine.ymax = pt[0].y;
     }
-    d->rec = NULL;
+    for (size_t i = 1; i < m; i++) {
+        if (pt[i].y < mine.ymin) mine.ymin = pt[i].y;
+        if (pt[i].y > mine.ymax) mine.ymax = pt[i].y;
+    }
     pdt_status st = pdt_comm_allgather(d->c, &mine, sizeof mine, d->strip, err);
     if (st == PDT_OK) note_all(d, TAG_STRIPS, sizeof mine);
     return st;

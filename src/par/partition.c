@@ -168,22 +168,58 @@ static void merge2(const srm_rec *a, size_t na, const srm_rec *b, size_t nb, srm
     while (j < nb) out[k++] = b[j++];
 }
 
+/* One round of merge_runs: neighbouring runs merged pairwise from src into
+ * dst (run order kept on ties); returns the new number of runs. */
+static int merge_round(const srm_rec *src, srm_rec *dst, size_t *start, int k)
+{
+    int nk = 0;
+    for (int i = 0; i < k; i += 2) {
+        size_t lo = start[i], mid = start[i + 1], hi = i + 2 <= k ? start[i + 2] : mid;
+        if (i + 1 < k) merge2(src + lo, mid - lo, src + mid, hi - mid, dst + lo);
+        else memcpy(dst + lo, src + lo, (mid - lo) * sizeof *src);
+        start[nk++] = lo;
+    }
+    start[nk] = start[k];
+    return nk;
+}
+
 srm_rec *pdt_srm_merge_runs(srm_rec *r, srm_rec *tmp, size_t *start, int k)
 {
     srm_rec *src = r, *dst = tmp;
-    while (k > 1) { /* merge neighbouring runs pairwise: run order kept on ties */
-        int nk = 0;
-        for (int i = 0; i < k; i += 2) {
-            size_t lo = start[i], mid = start[i + 1], hi = i + 2 <= k ? start[i + 2] : mid;
-            if (i + 1 < k) merge2(src + lo, mid - lo, src + mid, hi - mid, dst + lo);
-            else memcpy(dst + lo, src + lo, (mid - lo) * sizeof *src);
-            start[nk++] = lo;
-        }
-        start[nk] = start[k];
-        k = nk;
+    while (k > 1) {
+        k = merge_round(src, dst, start, k);
         srm_rec *t = src;
         src = dst;
         dst = t;
     }
     return src;
+}
+
+/* The strip's point i: the record's point and global index, if its key is
+ * not the one before (the first of equal keys is kept). */
+static inline void emit(const srm_rec *x, pdt_point *pt, uint32_t *g, size_t *m)
+{
+    if (*m && pdt_key(pt[*m - 1]) == x->key) return;
+    pt[*m] = srm_key_point(x->key);
+    g[*m] = x->idx;
+    (*m)++;
+}
+
+size_t pdt_srm_runs_to_strip(srm_rec *r, srm_rec *tmp, size_t *start, int k, pdt_point *pt,
+                             uint32_t *g)
+{
+    srm_rec *src = r, *dst = tmp;
+    while (k > 2) {
+        k = merge_round(src, dst, start, k);
+        srm_rec *t = src;
+        src = dst;
+        dst = t;
+    }
+    size_t na = k >= 1 ? start[1] - start[0] : 0, nb = k == 2 ? start[2] - start[1] : 0;
+    const srm_rec *a = src + (k >= 1 ? start[0] : 0), *b = a + na;
+    size_t i = 0, j = 0, m = 0;
+    while (i < na && j < nb) emit(b[j].key < a[i].key ? &b[j++] : &a[i++], pt, g, &m);
+    while (i < na) emit(&a[i++], pt, g, &m);
+    while (j < nb) emit(&b[j++], pt, g, &m);
+    return m;
 }

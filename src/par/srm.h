@@ -73,6 +73,14 @@ size_t pdt_srm_count_lt(const srm_rec *r, size_t n, uint64_t key);
  * records.  Returns the array that holds the result (r or tmp). */
 srm_rec *pdt_srm_merge_runs(srm_rec *r, srm_rec *tmp, size_t *start, int k);
 
+/* The same merge (k >= 1 runs) with the duplicates removed (the first of
+ * equal keys kept, as pdt_srm_dedupe does), written as the strip's points
+ * pt[i] and their global indices g[i] (records' idx) in one last pass, not
+ * into records (r, tmp and start are used up; pt and g overlap neither).
+ * Returns the number of distinct points. */
+size_t pdt_srm_runs_to_strip(srm_rec *r, srm_rec *tmp, size_t *start, int k, pdt_point *pt,
+                             uint32_t *g);
+
 /* Point of a key (inverse of pdt_key). */
 static inline pdt_point srm_key_point(uint64_t key)
 {

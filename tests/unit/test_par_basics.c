@@ -176,6 +176,50 @@ TEST(slab_of_strips)
 
 /* ---- partition helpers and schedule ------------------------------------------ */
 
+/* pdt_srm_runs_to_strip: k = 1..7 key-sorted runs with keys repeated within
+ * and across runs: the same points and indices as pdt_srm_merge_runs, then
+ * pdt_srm_dedupe, then each record's point. */
+TEST(runs_to_strip_same_as_merge_dedupe)
+{
+    enum { N = 3000 };
+    srm_rec *r = malloc(N * sizeof *r), *t = malloc(N * sizeof *t), *r2 = malloc(N * sizeof *r2);
+    pdt_point *pt = malloc(N * sizeof *pt);
+    uint32_t *g = malloc(N * sizeof *g);
+    int bad = 0;
+    for (int k = 1; k <= 7; k++)
+        for (int it = 0; it < 20; it++) {
+            size_t start[9], n = 0;
+            for (int q = 0; q < k; q++) {
+                start[q] = n;
+                size_t len = rnd() % (N / 8);
+                for (size_t i = 0; i < len; i++) {
+                    pdt_point p = {rndi(-20, 20), rndi(-3, 3)};
+                    r[n + i] = (srm_rec){pdt_key(p), (uint32_t)(n + i), 0};
+                }
+                pdt_srm_radix_sort(r + n, t, len);
+                n += len;
+            }
+            start[k] = n;
+            size_t s2[9];
+            memcpy(s2, start, sizeof s2);
+            memcpy(r2, r, n * sizeof *r);
+            size_t m = pdt_srm_runs_to_strip(r, t, start, k, pt, g);
+            srm_rec *want = pdt_srm_merge_runs(r2, t, s2, k);
+            size_t mw = pdt_srm_dedupe(want, n);
+            if (m != mw) bad++;
+            for (size_t i = 0; i < m && i < mw; i++) {
+                pdt_point w = srm_key_point(want[i].key);
+                if (pt[i].x != w.x || pt[i].y != w.y || g[i] != want[i].idx) bad++;
+            }
+        }
+    CHECK_MSG(bad == 0, "%d differences", bad);
+    free(r);
+    free(t);
+    free(r2);
+    free(pt);
+    free(g);
+}
+
 TEST(radix_sort_stable_dedupe)
 {
     size_t n = 50000;
@@ -239,6 +283,7 @@ int main(void)
     RUN(slab_pretest_is_sound);
     RUN(slab_of_strips);
     RUN(radix_sort_stable_dedupe);
+    RUN(runs_to_strip_same_as_merge_dedupe);
     RUN(merge_runs_stable);
     RUN(schedule);
     return test_summary();
