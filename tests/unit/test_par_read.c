@@ -208,7 +208,7 @@ TEST(large_parts_mapped)
     size_t cap = (size_t)6 << 20, len = 0;
     char *buf = malloc(cap + 64);
     for (int v = 0; len < cap - 64; v++)
-        len += (size_t)sprintf(buf + len, "%d %d\n", v % 100003 - 50000, (v * 7919) % 65521);
+        len += (size_t)sprintf(buf + len, "%d %d\n", v % 100003 - 50000, (int)(((long)v * 7919) % 65521));
     size_t pg = (size_t)sysconf(_SC_PAGESIZE);
     size_t whole = len / pg * pg; /* cut at a page boundary, last line without '\n' */
     while (buf[whole - 1] == '\n' || buf[whole - 1] == ' ') whole--, buf[whole] = '7';
