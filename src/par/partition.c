@@ -183,16 +183,23 @@ static int merge_round(const srm_rec *src, srm_rec *dst, size_t *start, int k)
     return nk;
 }
 
-srm_rec *pdt_srm_merge_runs(srm_rec *r, srm_rec *tmp, size_t *start, int k)
+/* Merge rounds until at most `keep` runs are left; returns the array that
+ * holds them (r or tmp), *k their number. */
+static srm_rec *merge_down_to(srm_rec *r, srm_rec *tmp, size_t *start, int *k, int keep)
 {
     srm_rec *src = r, *dst = tmp;
-    while (k > 1) {
-        k = merge_round(src, dst, start, k);
+    while (*k > keep) {
+        *k = merge_round(src, dst, start, *k);
         srm_rec *t = src;
         src = dst;
         dst = t;
     }
     return src;
+}
+
+srm_rec *pdt_srm_merge_runs(srm_rec *r, srm_rec *tmp, size_t *start, int k)
+{
+    return merge_down_to(r, tmp, start, &k, 1);
 }
 
 /* The strip's point i: the record's point and global index, if its key is
@@ -208,13 +215,7 @@ static inline void emit(const srm_rec *x, pdt_point *pt, uint32_t *g, size_t *m)
 size_t pdt_srm_runs_to_strip(srm_rec *r, srm_rec *tmp, size_t *start, int k, pdt_point *pt,
                              uint32_t *g)
 {
-    srm_rec *src = r, *dst = tmp;
-    while (k > 2) {
-        k = merge_round(src, dst, start, k);
-        srm_rec *t = src;
-        src = dst;
-        dst = t;
-    }
+    const srm_rec *src = merge_down_to(r, tmp, start, &k, 2);
     size_t na = k >= 1 ? start[1] - start[0] : 0, nb = k == 2 ? start[2] - start[1] : 0;
     const srm_rec *a = src + (k >= 1 ? start[0] : 0), *b = a + na;
     size_t i = 0, j = 0, m = 0;
