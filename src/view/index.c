@@ -36,9 +36,10 @@
 #include <unistd.h>
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 4u
+#define INDEX_VERSION 5u
 #define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/16 events, at least this */
 #define ICK_PARTS 16u
+_Static_assert(ICK_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint's place");
 #define CHUNK_BYTES ((uint64_t)16 << 20) /* sections are checksummed in chunks of this: the
                                           * least a lazily checked frame reads (1 MiB made
                                           * lazily checked seeks 5x slower: not understood) */
@@ -65,7 +66,9 @@ typedef struct ihdr {
     uint64_t count[NSEC];       /* elements per section */
     uint64_t kind_count[64];
     isec sec[NSEC];
-    uint64_t ick_every, nick, ick_bytes;  /* the checkpoints (S_CKPT) */
+    uint64_t ick_every, nick;   /* the checkpoints (S_CKPT): checkpoint c at ick_off[c] */
+    uint64_t ick_off[PDT_ICK_MAX + 1], ick_born[PDT_ICK_MAX];  /* of the section, holding
+                                 * the triangles born before its cursor: ick_born[c] */
     isec ctab;                  /* CRC-32C of every CHUNK_BYTES of every section,
                                  * in section order; ctab.crc covers the table */
 } ihdr;
@@ -122,7 +125,7 @@ static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_
     SEC(S_EVKIND, ev_kind, r->m);
     ptr[S_CKPT] = (void **)&r->ick;
     elem[S_CKPT] = 1;
-    count[S_CKPT] = (uint64_t)r->nick * r->ick_bytes;
+    count[S_CKPT] = r->nick ? r->ick_off[r->nick] : 0;
 #undef SEC
 }
 
@@ -666,9 +669,19 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
     r->warnings = h.count[S_WARN] ? "" : NULL;  /* so that sections() sizes it */
     r->ick_every = h.ick_every;
     r->nick = h.nick;
-    r->ick_bytes = h.ick_bytes;
-    if (r->nick && (r->ick_every == 0 || r->ick_bytes != pdt_rstate_blob_bytes(r) ||
-                    (r->nick - 1) * r->ick_every > r->m)) {
+    int ck_ok = r->nick <= PDT_ICK_MAX &&
+                (!r->nick || (r->ick_every && (r->nick - 1) * r->ick_every <= r->m));
+    for (size_t c = 0; ck_ok && c <= r->nick; c++) {
+        r->ick_off[c] = h.ick_off[c];
+        if (c == 0) {
+            ck_ok = h.ick_off[0] == 0;
+            continue;
+        }
+        r->ick_born[c - 1] = h.ick_born[c - 1];
+        ck_ok = h.ick_born[c - 1] <= r->ntri &&
+                h.ick_off[c] == h.ick_off[c - 1] + pdt_rstate_blob_bytes(r, h.ick_born[c - 1]);
+    }
+    if (!ck_ok) {
         snprintf(why, wcap, "damaged: checkpoints do not fit the tables");
         free(r);
         r = NULL;
@@ -753,17 +766,22 @@ static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, pdt_err *
 }
 
 /* The state at every r->ick_every-th cursor, stepped forwards from 0,
- * written at off one after the other (r->nick of r->ick_bytes). */
-static int write_checkpoints(const pdt_replay *r, int fd, uint64_t off)
+ * written at off one after the other (r->nick of them), each holding the
+ * triangles born before its cursor; sets r->ick_off and r->ick_born. */
+static int write_checkpoints(pdt_replay *r, int fd, uint64_t off)
 {
+    r->ick_off[0] = 0;
     if (!r->nick) return 1;
     pdt_rstate *s = pdt_rstate_new(r);
-    uint8_t *blob = malloc(r->ick_bytes ? r->ick_bytes : 1);
+    uint8_t *blob = malloc(pdt_rstate_blob_bytes(r, r->ntri));
     int ok = s && blob;
     for (size_t c = 0; ok && c < r->nick; c++) {
         while (s->k < c * r->ick_every) pdt_replay_step(r, s, 1);
-        pdt_rstate_to_blob(r, s, blob);
-        ok = write_all(fd, blob, r->ick_bytes, off + c * r->ick_bytes);
+        size_t born = pdt_rstate_born(r, s), bytes = pdt_rstate_blob_bytes(r, born);
+        pdt_rstate_to_blob(r, s, born, blob);
+        ok = write_all(fd, blob, bytes, off + r->ick_off[c]);
+        r->ick_born[c] = born;
+        r->ick_off[c + 1] = r->ick_off[c] + bytes;
     }
     free(blob);
     pdt_rstate_free(s);
@@ -818,16 +836,22 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     for (int i = 0; i < NSEC; i++) {
         h->count[i] = count[i];
         if (i == S_RECS) continue;
+        if (i == S_CKPT) { /* their sizes are known once they are made */
+            off = (off + 63) & ~(uint64_t)63;
+            if (!write_checkpoints(r, fd, off))
+                return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+            h->count[i] = r->nick ? r->ick_off[r->nick] : 0;
+            h->sec[i] = (isec){off, h->count[i], 0, 0};
+            off += h->count[i];
+            continue;
+        }
         if (r->streamed && (i == S_TRIS || i == S_HIST)) {
             h->sec[i] = (isec){i == S_TRIS ? r->tris_at : r->hist_at, count[i] * elem[i], 0, 0};
             continue;
         }
         off = (off + 63) & ~(uint64_t)63;
         size_t bytes = (size_t)count[i] * elem[i];
-        if (i == S_CKPT) {
-            if (!write_checkpoints(r, fd, off))
-                return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-        } else if (bytes && !write_all(fd, *ptr[i], bytes, off)) {
+        if (bytes && !write_all(fd, *ptr[i], bytes, off)) {
             return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
         }
         h->sec[i] = (isec){off, bytes, 0, 0};
@@ -862,7 +886,8 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     h->nranks = (uint64_t)r->nranks;
     h->ick_every = r->ick_every;
     h->nick = r->nick;
-    h->ick_bytes = r->ick_bytes;
+    memcpy(h->ick_off, r->ick_off, sizeof h->ick_off);
+    memcpy(h->ick_born, r->ick_born, sizeof h->ick_born);
     for (int k = 0; k < PDT_EV_KIND_COUNT; k++) h->kind_count[k] = r->kind_count[k];
     h->hdr_crc = hdr_crc(h);
     unsigned char page[HDR_BYTES];
@@ -935,7 +960,6 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         size_t every = r->m / ICK_PARTS;
         r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
         r->nick = r->m / r->ick_every + 1;
-        r->ick_bytes = pdt_rstate_blob_bytes(r);
         st = write_tables(r, fd, h, ident, &pc, err);
         r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
     }

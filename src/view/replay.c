@@ -1109,20 +1109,27 @@ static size_t dist(size_t a, size_t b) { return a > b ? a - b : b - a; }
 
 static size_t up8(size_t x) { return (x + 7) & ~(size_t)7; }
 
-size_t pdt_rstate_blob_bytes(const pdt_replay *r)
+size_t pdt_rstate_blob_bytes(const pdt_replay *r, size_t born)
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
-    return up8(r->n) + up8(r->ntri * 4) + up8(r->nedge) + up8(r->nmsg) + up8(nslot * 4);
+    return up8(r->n) + up8(born * 4) + up8(r->nedge) + up8(r->nmsg) + up8(nslot * 4);
 }
 
-void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, uint8_t *out)
+size_t pdt_rstate_born(const pdt_replay *r, const pdt_rstate *s)
+{
+    size_t t = r->ntri;
+    while (t > 0 && s->tcur[t - 1] == NONE32) t--;
+    return t;
+}
+
+void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, size_t born, uint8_t *out)
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
-    memset(out, 0, pdt_rstate_blob_bytes(r));
+    memset(out, 0, pdt_rstate_blob_bytes(r, born));
     memcpy(out, s->pflags, r->n);
     out += up8(r->n);
-    memcpy(out, s->tcur, r->ntri * 4);
-    out += up8(r->ntri * 4);
+    memcpy(out, s->tcur, born * 4);
+    out += up8(born * 4);
     memcpy(out, s->ealive, r->nedge);
     out += up8(r->nedge);
     memcpy(out, s->mflight, r->nmsg);
@@ -1130,14 +1137,16 @@ void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, uint8_t *out)
     memcpy(out, s->slot, nslot * 4);
 }
 
-void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in, size_t k)
+void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in, size_t born,
+                          size_t k)
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
     s->k = k;
     memcpy(s->pflags, in, r->n);
     in += up8(r->n);
-    memcpy(s->tcur, in, r->ntri * 4);
-    in += up8(r->ntri * 4);
+    memcpy(s->tcur, in, born * 4);
+    memset(s->tcur + born, 0xff, (r->ntri - born) * sizeof *s->tcur);
+    in += up8(born * 4);
     memcpy(s->ealive, in, r->nedge);
     in += up8(r->nedge);
     memcpy(s->mflight, in, r->nmsg);
@@ -1163,8 +1172,9 @@ void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k)
         size_t c = (k + r->ick_every / 2) / r->ick_every;
         if (c >= r->nick) c = r->nick - 1;
         size_t ck = c * r->ick_every;
-        if (from_here > dist(ck, k) * STEP_FACTOR + r->ick_bytes / 64)
-            pdt_rstate_from_blob(r, s, r->ick + c * r->ick_bytes, ck);
+        size_t bytes = (size_t)(r->ick_off[c + 1] - r->ick_off[c]);
+        if (from_here > dist(ck, k) * STEP_FACTOR + bytes / 64)
+            pdt_rstate_from_blob(r, s, r->ick + r->ick_off[c], r->ick_born[c], ck);
         step_to(r, s, k);
         return;
     }
