@@ -736,8 +736,12 @@ static int write_all(int fd, const void *p, size_t len, uint64_t off)
 }
 
 /* Stream the merged records of run into fd at HDR_BYTES (the reader's
- * merge: one decoded block per rank in memory).  Sets h->sec[S_RECS] and *m. */
-static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, pdt_err *err)
+ * merge: one decoded block per rank in memory).  Sets h->sec[S_RECS] and *m,
+ * and counts what the replay's build would count in a first pass over them
+ * (pdt_replay_place): fine[PDT_REPLAY_NFINE] and kinds[PDT_EV_KIND_COUNT],
+ * for a run of n points and nranks ranks. */
+static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, size_t n, int nranks,
+                             uint64_t *fine, uint64_t *kinds, pdt_err *err)
 {
     enum { BATCH = 8192 };
     pdt_rec *buf = malloc(BATCH * sizeof *buf);
@@ -750,7 +754,13 @@ static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, pdt_err *
     while (st == PDT_OK && got > 0) {
         got = pdt_merge_next(mg, &buf[nb], err);
         if (got < 0) st = err->code ? err->code : PDT_ERR_NOMEM;
-        if (got > 0) nb++, count++;
+        if (got > 0) {
+            const pdt_rec *rec = &buf[nb];
+            if (rec->ev.kind < PDT_EV_KIND_COUNT) kinds[rec->ev.kind]++;
+            size_t f = pdt_replay_fine_of(rec, n, nranks);
+            if (f < PDT_REPLAY_NFINE) fine[f]++;
+            nb++, count++;
+        }
         if (st == PDT_OK && (nb == BATCH || (got == 0 && nb))) {
             if (!write_all(fd, buf, nb * sizeof *buf, off))
                 st = pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
@@ -941,7 +951,8 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     pdt_replay *r = NULL;
     void *recs = MAP_FAILED;
     size_t m = 0, recs_len = 0;
-    pdt_status st = h ? write_recs(run, fd, h, &m, err)
+    uint64_t fine[PDT_REPLAY_NFINE] = {0}, kinds[PDT_EV_KIND_COUNT] = {0};
+    pdt_status st = h ? write_recs(run, fd, h, &m, n, nranks, fine, kinds, err)
                       : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     if (st == PDT_OK) {
         /* the records as the replay's input: mapped from the file, so they
@@ -951,7 +962,7 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         if (recs == MAP_FAILED) st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
     }
     placer pc = {fd, recs_len};
-    pdt_replay_place pl = {place_reserve, place_put, place_get, &pc, budget};
+    pdt_replay_place pl = {place_reserve, place_put, place_get, &pc, budget, fine, kinds};
     if (st == PDT_OK)
         st = pdt_replay_build(pts, n, (const pdt_rec *)((char *)recs + HDR_BYTES), m, nranks, &pl,
                               &r, err);

@@ -8,7 +8,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <sys/mman.h>
+#include <unistd.h>
 
 /* ---- a small growable array ----------------------------------------------- */
 
@@ -165,6 +168,7 @@ _Static_assert(sizeof(tri_rec) == sizeof(pdt_rtri_hist), "a triangle event fits 
 
 #define FINE_BITS 8
 #define NFINE ((size_t)1 << FINE_BITS)
+_Static_assert(NFINE == PDT_REPLAY_NFINE, "replay_int.h says how many fine buckets");
 #define GROUP_BYTES_PER_EVENT 128u /* tri_groups' working memory per event, at most */
 /* Events per run, at most (unless one fine bucket holds more): a working set
  * of some 60 MiB, reused from run to run (fresh pages are dear on virtual
@@ -177,6 +181,17 @@ static uint64_t key_hash(const uint32_t s[3])
 }
 
 static size_t fine_of(const uint32_t s[3]) { return (size_t)(key_hash(s) >> (64 - FINE_BITS)); }
+
+size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks)
+{
+    const pdt_event *e = &rec->ev;
+    if (!is_tri_kind(e->kind) || rec->rank >= (uint32_t)nranks || e->a >= n || e->b >= n ||
+        e->c >= n)
+        return NFINE;
+    uint32_t in[3] = {e->a, e->b, e->c}, s[3];
+    sort3(s, in);
+    return fine_of(s);
+}
 
 /* Build state while indexing: the current slot values of every rank. */
 typedef struct builder {
@@ -469,27 +484,25 @@ static pdt_rtri_hist hist_of(const pdt_replay *r, const tri_rec *t)
     return h;
 }
 
-/* Group the triangle events (hist[], in fine buckets) by triangle, a run
- * of fine buckets at a time: each triangle's entries become consecutive, in
- * event order; ev_ent[ev] is the event's entry; ev_obj[ev] is -1 - (entries
- * of its triangle) for a triangle's first event, else that first event.
- * Working memory: about budget bytes (0: no limit). */
-static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
+/* One thread's share of tri_groups: runs of fine buckets (run[] holds
+ * their bounds) taken in turn from *next; each thread its own buffers of
+ * `most` events (the largest run). */
+typedef struct group_job {
+    builder *b;
+    const size_t *run;      /* bucket bounds: run k is [run[k], run[k + 1]) */
+    size_t nrun, most;
+    _Atomic size_t next;    /* next run to take */
+    _Atomic int failed;     /* out of memory, or (io) a read or write of the place failed */
+    _Atomic int io;
+    _Atomic size_t ntri;    /* triangles found */
+} group_job;
+
+static void *group_worker(void *arg)
 {
+    group_job *J = arg;
+    builder *b = J->b;
     pdt_replay *r = b->r;
-    *ntri = 0;
-    size_t cap = budget ? (size_t)(budget / GROUP_BYTES_PER_EVENT) : SIZE_MAX;
-    if (cap < 1024) cap = 1024;
-    if (b->pl && cap > GROUP_RUN_MAX) cap = GROUP_RUN_MAX;
-    size_t most = 0;  /* the largest run */
-    for (size_t f = 0; f < NFINE;) {
-        size_t g = f + 1;
-        while (g < NFINE && b->fine_off[g + 1] - b->fine_off[f] <= cap) g++;
-        if (b->fine_off[g] - b->fine_off[f] > most) most = b->fine_off[g] - b->fine_off[f];
-        f = g;
-    }
-    if (!most) return 1;
-    size_t hcap = 1024;
+    size_t most = J->most, hcap = 1024;
     while (hcap / 4 * 3 < most) hcap *= 2;
     tri_rec *buf = malloc(most * sizeof *buf);
     gslot *slot = malloc(hcap * sizeof *slot);
@@ -501,37 +514,37 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
         pdt_big_advise(buf, most * sizeof *buf);
         pdt_big_advise(slot, hcap * sizeof *slot);
     }
-    for (size_t f = 0; ok && f < NFINE;) {
-        size_t g = f + 1;
-        while (g < NFINE && b->fine_off[g + 1] - b->fine_off[f] <= cap) g++;
-        size_t base = b->fine_off[f], nb = b->fine_off[g] - base;
-        f = g;
+    size_t found = 0;
+    while (ok && !J->failed) {
+        size_t k = J->next++;
+        if (k >= J->nrun) break;
+        size_t base = b->fine_off[J->run[k]], nb = b->fine_off[J->run[k + 1]] - base;
         if (!nb) continue;
         if (!b->pl) memcpy(buf, &r->hist[base], nb * sizeof *buf);
         else if (!b->pl->get(b->pl->ctx, r->hist_at + base * sizeof *buf, buf, nb * sizeof *buf)) {
-            b->failed = 1;
+            J->io = 1;
             ok = 0;
             break;
         }
         size_t hc = 1024;
         while (hc / 4 * 3 < nb) hc *= 2;
         size_t mask = hc - 1;
-        for (size_t k = 0; k < hc; k++) slot[k].g = NONE32;
+        for (size_t q = 0; q < hc; q++) slot[q].g = NONE32;
         uint32_t ng = 0;
         for (size_t j = 0; j < nb; j++) {
             if (j + PREFETCH_AHEAD < nb)
                 __builtin_prefetch(&slot[(size_t)key_hash(buf[j + PREFETCH_AHEAD].s) & mask]);
             const uint32_t *s = buf[j].s;
-            size_t k = (size_t)key_hash(s) & mask;
-            while (slot[k].g != NONE32 &&
-                   (slot[k].s[0] != s[0] || slot[k].s[1] != s[1] || slot[k].s[2] != s[2]))
-                k = (k + 1) & mask;
-            if (slot[k].g == NONE32) {
-                slot[k] = (gslot){{s[0], s[1], s[2]}, ng};
+            size_t q = (size_t)key_hash(s) & mask;
+            while (slot[q].g != NONE32 &&
+                   (slot[q].s[0] != s[0] || slot[q].s[1] != s[1] || slot[q].s[2] != s[2]))
+                q = (q + 1) & mask;
+            if (slot[q].g == NONE32) {
+                slot[q] = (gslot){{s[0], s[1], s[2]}, ng};
                 gfirst[ng] = buf[j].ev;
                 gn[ng++] = 0;
             }
-            gid[j] = slot[k].g;
+            gid[j] = slot[q].g;
             gn[gid[j]]++;
         }
         size_t h = base;
@@ -540,12 +553,17 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
         for (size_t j = 0; j < nb; j++) {
             uint32_t q = gid[j], ev = buf[j].ev, at = gfill[q]++;
             to[at] = hist_of(r, &buf[j]);
-            r->ev_ent[ev] = at;
+            r->ev_ent[ev] = at;  /* (threads write distinct events) */
             r->ev_obj[ev] = ev == gfirst[q] ? -1 - (int32_t)gn[q] : (int32_t)gfirst[q];
         }
-        if (b->pl && !tput(b, NULL, r->hist_at, base, out, nb, sizeof *out)) ok = 0;
-        *ntri += ng;
+        if (b->pl && !b->pl->put(b->pl->ctx, r->hist_at + base * sizeof *out, out, nb * sizeof *out)) {
+            J->io = 1;
+            ok = 0;
+        }
+        found += ng;
     }
+    if (!ok) J->failed = 1;
+    J->ntri += found;
     free(out);
     free(buf);
     free(slot);
@@ -553,7 +571,51 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
     free(gfirst);
     free(gn);
     free(gfill);
-    return ok;
+    return NULL;
+}
+
+/* Threads that group triangle events at once (each with its own share of
+ * the working budget): the runs are independent, and the grouping is bound
+ * by cache misses and copying, which a second core halves. */
+#define GROUP_THREADS 2
+
+/* Group the triangle events (hist[], in fine buckets) by triangle, a run
+ * of fine buckets at a time: each triangle's entries become consecutive, in
+ * event order; ev_ent[ev] is the event's entry; ev_obj[ev] is -1 - (entries
+ * of its triangle) for a triangle's first event, else that first event.
+ * Working memory: about budget bytes (0: no limit), over GROUP_THREADS
+ * threads when the runs are several. */
+static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
+{
+    *ntri = 0;
+    size_t cap = budget ? (size_t)(budget / GROUP_BYTES_PER_EVENT / GROUP_THREADS) : SIZE_MAX;
+    if (cap < 1024) cap = 1024;
+    if (b->pl && cap > GROUP_RUN_MAX) cap = GROUP_RUN_MAX;
+    size_t run[NFINE + 1], nrun = 0, most = 0;  /* the runs' bounds; the largest run */
+    run[0] = 0;
+    for (size_t f = 0; f < NFINE;) {
+        size_t g = f + 1;
+        while (g < NFINE && b->fine_off[g + 1] - b->fine_off[f] <= cap) g++;
+        if (b->fine_off[g] - b->fine_off[f] > most) most = b->fine_off[g] - b->fine_off[f];
+        run[++nrun] = g;
+        f = g;
+    }
+    if (!most) return 1;
+    group_job J = {.b = b, .run = run, .nrun = nrun, .most = most};
+    pthread_t th[GROUP_THREADS];
+    int started = 0;
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    for (int t = 1; t < GROUP_THREADS && t < cpus && (size_t)t < nrun; t++)
+        if (pthread_create(&th[t], NULL, group_worker, &J) == 0) started |= 1 << t;
+    group_worker(&J);
+    for (int t = 1; t < GROUP_THREADS; t++)
+        if (started & (1 << t)) pthread_join(th[t], NULL);
+    if (J.failed) {
+        if (J.io) b->failed = 1;
+        return 0;
+    }
+    *ntri = J.ntri;
+    return 1;
 }
 
 /* A streamed build reads the records (a mapping of the index file) from
@@ -641,17 +703,16 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
      * of the triangle events per fine bucket */
     {
         size_t cnt[PDT_EV_KIND_COUNT] = {0};
-        for (size_t i = 0; i < r->m; i++) {
+        if (pl && pl->fine_count) { /* counted by the caller as it wrote the records */
+            for (size_t f = 0; f < NFINE; f++) b.fine_off[f + 1] = (size_t)pl->fine_count[f];
+            for (int k = 0; k < PDT_EV_KIND_COUNT; k++) cnt[k] = (size_t)pl->kind_count[k];
+        }
+        for (size_t i = 0; !(pl && pl->fine_count) && i < r->m; i++) {
             drop_recs(&b, i);
             const pdt_rec *rec = &r->recs[i];
-            const pdt_event *e = &rec->ev;
-            if (e->kind < PDT_EV_KIND_COUNT) cnt[e->kind]++;
-            if (!is_tri_kind(e->kind) || rec->rank >= (uint32_t)r->nranks || e->a >= r->n ||
-                e->b >= r->n || e->c >= r->n)
-                continue;
-            uint32_t in[3] = {e->a, e->b, e->c}, s[3];
-            sort3(s, in);
-            b.fine_off[fine_of(s) + 1]++;
+            if (rec->ev.kind < PDT_EV_KIND_COUNT) cnt[rec->ev.kind]++;
+            size_t f = pdt_replay_fine_of(rec, r->n, r->nranks);
+            if (f < NFINE) b.fine_off[f + 1]++;
         }
         for (size_t f = 0; f < NFINE; f++) b.fine_off[f + 1] += b.fine_off[f];
         memcpy(b.fine_fill, b.fine_off, NFINE * sizeof *b.fine_fill);

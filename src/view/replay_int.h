@@ -91,7 +91,21 @@ typedef struct pdt_replay_place {
     int (*get)(void *ctx, uint64_t at, void *p, size_t bytes);
     void *ctx;
     uint64_t budget;
+    /* NULL, or the counts the build's first pass would make, made by the
+     * caller as it wrote the records (the pass is then skipped): per fine
+     * bucket the triangle events (pdt_replay_fine_of), PDT_REPLAY_NFINE of
+     * them, and the events of every kind (PDT_EV_KIND_COUNT; kinds beyond
+     * it not counted). */
+    const uint64_t *fine_count, *kind_count;
 } pdt_replay_place;
+
+/* The triangle events of a build are grouped in this many buckets by a hash
+ * of their triangle: pdt_replay_fine_of gives the bucket of record rec of a
+ * run of n points and nranks ranks, or PDT_REPLAY_NFINE when the build does
+ * not group it (not a triangle event, or naming a point or rank beyond the
+ * run's). */
+#define PDT_REPLAY_NFINE 256
+size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks);
 
 /* pdt_replay_new, with the triangles and histories streamed to pl (NULL:
  * held in memory, no budget: pdt_replay_new). */
