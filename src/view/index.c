@@ -138,6 +138,56 @@ static uint32_t hdr_crc(const ihdr *h)
 
 static uint64_t chunks_of(uint64_t bytes) { return (bytes + CHUNK_BYTES - 1) / CHUNK_BYTES; }
 
+/* ---- chunk checksums of data written in order ------------------------------------ */
+
+/* The CRC-32C of every CHUNK_BYTES of a section, made as the section is
+ * written from its start to its end (so that the build does not read it
+ * back): crc[k] for chunk k, grown as needed. */
+typedef struct crcacc {
+    uint32_t *crc;
+    size_t n, cap;
+    uint64_t pos;   /* bytes fed */
+    uint32_t cur;   /* of the chunk being fed */
+    int nomem;
+} crcacc;
+
+static void crc_feed(crcacc *a, const void *data, size_t len)
+{
+    const char *p = data;
+    while (len) {
+        uint64_t room = CHUNK_BYTES - a->pos % CHUNK_BYTES;
+        size_t take = len < room ? len : (size_t)room;
+        a->cur = pdt_crc32c(a->cur, p, take);
+        a->pos += take;
+        p += take;
+        len -= take;
+        if (a->pos % CHUNK_BYTES == 0) {
+            if (a->n == a->cap) {
+                size_t nc = a->cap ? 2 * a->cap : 64;
+                uint32_t *g = realloc(a->crc, nc * sizeof *g);
+                if (!g) {
+                    a->nomem = 1;
+                    return;
+                }
+                a->crc = g;
+                a->cap = nc;
+            }
+            a->crc[a->n++] = a->cur;
+            a->cur = 0;
+        }
+    }
+}
+
+/* Copy the section's chunk checksums (the last chunk's too) to tab.  0 if
+ * memory ran out or the bytes fed are not `bytes`. */
+static int crc_done(const crcacc *a, uint64_t bytes, uint32_t *tab)
+{
+    if (a->nomem || a->pos != bytes) return 0;
+    if (a->n) memcpy(tab, a->crc, a->n * sizeof *tab);
+    if (a->pos % CHUNK_BYTES) tab[a->n] = a->cur;
+    return 1;
+}
+
 /* ---- verifying the chunks, in parallel ----------------------------------------- */
 
 typedef struct verify_job {
@@ -145,6 +195,7 @@ typedef struct verify_job {
     const ihdr *h;
     uint32_t *tab;              /* chunk checksums */
     int compute;                /* 1: fill tab in (building), 0: compare with it */
+    const uint8_t *todo;        /* compute: NULL, or per chunk 1 if it is to be read */
     uint64_t nchunk;
     uint64_t *first;            /* per section: index of its first chunk in tab */
     atomic_uint_fast64_t next;  /* next chunk to check */
@@ -163,6 +214,7 @@ static void *verify_worker(void *arg)
     for (;;) {
         uint64_t c = atomic_fetch_add(&j->next, 1);
         if (c >= j->nchunk || atomic_load(&j->bad)) break;
+        if (j->todo && !j->todo[c]) continue;
         int i = 0;
         while (i + 1 < NSEC && j->first[i + 1] <= c) i++;
         uint64_t from = (c - j->first[i]) * CHUNK_BYTES, to = from + CHUNK_BYTES;
@@ -226,7 +278,7 @@ static int verify_chunks(int fd, const ihdr *h, char *why, size_t wcap)
     first[NSEC] = n;
     uint32_t *tab = read_ctab(fd, h, why, wcap);
     if (!tab) return 0;
-    verify_job j = {fd, h, tab, 0, n, first, 0, 0};
+    verify_job j = {fd, h, tab, 0, NULL, n, first, 0, 0};
     run_job(&j);
     free(tab);
     if (atomic_load(&j.bad)) {
@@ -741,7 +793,7 @@ static int write_all(int fd, const void *p, size_t len, uint64_t off)
  * (pdt_replay_place): fine[PDT_REPLAY_NFINE] and kinds[PDT_EV_KIND_COUNT],
  * for a run of n points and nranks ranks. */
 static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, size_t n, int nranks,
-                             uint64_t *fine, uint64_t *kinds, pdt_err *err)
+                             uint64_t *fine, uint64_t *kinds, crcacc *crc, pdt_err *err)
 {
     enum { BATCH = 8192 };
     pdt_rec *buf = malloc(BATCH * sizeof *buf);
@@ -764,6 +816,7 @@ static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, size_t n,
         if (st == PDT_OK && (nb == BATCH || (got == 0 && nb))) {
             if (!write_all(fd, buf, nb * sizeof *buf, off))
                 st = pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+            crc_feed(crc, buf, nb * sizeof *buf);
             off += nb * sizeof *buf;
             nb = 0;
         }
@@ -778,7 +831,7 @@ static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, size_t n,
 /* The state at every r->ick_every-th cursor, stepped forwards from 0,
  * written at off one after the other (r->nick of them), each holding the
  * triangles born before its cursor; sets r->ick_off and r->ick_born. */
-static int write_checkpoints(pdt_replay *r, int fd, uint64_t off)
+static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
 {
     r->ick_off[0] = 0;
     if (!r->nick) return 1;
@@ -790,6 +843,7 @@ static int write_checkpoints(pdt_replay *r, int fd, uint64_t off)
         size_t born = pdt_rstate_born(r, s), bytes = pdt_rstate_blob_bytes(r, born);
         pdt_rstate_to_blob(r, s, born, blob);
         ok = write_all(fd, blob, bytes, off + r->ick_off[c]);
+        crc_feed(crc, blob, bytes);
         r->ick_born[c] = born;
         r->ick_off[c + 1] = r->ick_off[c] + bytes;
     }
@@ -836,8 +890,9 @@ static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
 /* Write the tables of r after the records and the streamed ones (at pc->off),
  * then the header. */
 static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
-                               pdt_err *err)
+                               crcacc *recs_crc, pdt_err *err)
 {
+    crcacc ck_crc = {0};
     void **ptr[NSEC];
     size_t elem[NSEC];
     uint64_t count[NSEC];
@@ -848,8 +903,10 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
         if (i == S_RECS) continue;
         if (i == S_CKPT) { /* their sizes are known once they are made */
             off = (off + 63) & ~(uint64_t)63;
-            if (!write_checkpoints(r, fd, off))
+            if (!write_checkpoints(r, fd, off, &ck_crc)) {
+                free(ck_crc.crc);
                 return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+            }
             h->count[i] = r->nick ? r->ick_off[r->nick] : 0;
             h->sec[i] = (isec){off, h->count[i], 0, 0};
             off += h->count[i];
@@ -862,19 +919,47 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
         off = (off + 63) & ~(uint64_t)63;
         size_t bytes = (size_t)count[i] * elem[i];
         if (bytes && !write_all(fd, *ptr[i], bytes, off)) {
+            free(ck_crc.crc);
             return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
         }
         h->sec[i] = (isec){off, bytes, 0, 0};
         off += bytes;
     }
-    /* the chunk checksums, read back (pread, by up to four threads) */
+    /* the chunk checksums: of the tables in memory from memory, of the
+     * records and checkpoints as they were written, of the streamed
+     * triangles and histories read back (pread, by up to four threads) */
     uint64_t first[NSEC + 1], n = 0;
     for (int i = 0; i < NSEC; i++) first[i] = n, n += chunks_of(h->sec[i].bytes);
     first[NSEC] = n;
     uint32_t *tab = malloc(n ? n * sizeof *tab : 1);
-    if (!tab) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for the index's checksums");
-    verify_job j = {fd, h, tab, 1, n, first, 0, 0};
+    uint8_t *todo = calloc(n ? n : 1, 1);
+    int have = tab && todo;
+    for (int i = 0; have && i < NSEC; i++) {
+        uint64_t nc = chunks_of(h->sec[i].bytes);
+        if (i == S_RECS) {
+            have = crc_done(recs_crc, h->sec[i].bytes, tab + first[i]);
+        } else if (i == S_CKPT) {
+            have = crc_done(&ck_crc, h->sec[i].bytes, tab + first[i]);
+        } else if (r->streamed && (i == S_TRIS || i == S_HIST)) {
+            memset(todo + first[i], 1, nc);
+        } else {
+            const char *p = *ptr[i];
+            for (uint64_t c = 0; c < nc; c++) {
+                uint64_t lo = c * CHUNK_BYTES, hi = lo + CHUNK_BYTES;
+                if (hi > h->sec[i].bytes) hi = h->sec[i].bytes;
+                tab[first[i] + c] = pdt_crc32c(0, p + lo, (size_t)(hi - lo));
+            }
+        }
+    }
+    free(ck_crc.crc);
+    if (!have) {
+        free(tab);
+        free(todo);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for the index's checksums");
+    }
+    verify_job j = {fd, h, tab, 1, todo, n, first, 0, 0};
     run_job(&j);
+    free(todo);
     if (atomic_load(&j.bad)) {
         free(tab);
         return pdt_err_set(err, PDT_ERR_IO, "reading the index back for its checksums failed");
@@ -952,7 +1037,8 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     void *recs = MAP_FAILED;
     size_t m = 0, recs_len = 0;
     uint64_t fine[PDT_REPLAY_NFINE] = {0}, kinds[PDT_EV_KIND_COUNT] = {0};
-    pdt_status st = h ? write_recs(run, fd, h, &m, n, nranks, fine, kinds, err)
+    crcacc recs_crc = {0};
+    pdt_status st = h ? write_recs(run, fd, h, &m, n, nranks, fine, kinds, &recs_crc, err)
                       : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     if (st == PDT_OK) {
         /* the records as the replay's input: mapped from the file, so they
@@ -971,7 +1057,7 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         size_t every = r->m / ICK_PARTS;
         r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
         r->nick = r->m / r->ick_every + 1;
-        st = write_tables(r, fd, h, ident, &pc, err);
+        st = write_tables(r, fd, h, ident, &pc, &recs_crc, err);
         r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
     }
     pdt_replay_free(r);
@@ -982,6 +1068,7 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", path, strerror(errno));
     if (st != PDT_OK) unlink(tmp);
     free(h);
+    free(recs_crc.crc);
     return st;
 }
 
