@@ -36,7 +36,7 @@
 #include <unistd.h>
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 5u
+#define INDEX_VERSION 6u
 #define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/16 events, at least this */
 #define ICK_PARTS 16u
 _Static_assert(ICK_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint's place");

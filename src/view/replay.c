@@ -115,6 +115,15 @@ static int km_put(keymap *km, uint64_t hi, uint64_t lo, int32_t v)
 
 #define NONE32 UINT32_MAX
 
+/* ev_ent of a triangle's first event carries this bit (when there are fewer
+ * than 2^31 history entries, as in every run so far): stepping back over
+ * it leaves the triangle with no entry, and no step has to read the
+ * triangle table (random places in 20 bytes per triangle: on a kept index,
+ * the first step back into a part of it paid for checking 16 MiB of it). */
+#define FIRST_ENTRY 0x80000000u
+
+static int first_flagged(const pdt_replay *r) { return r->nhist < FIRST_ENTRY; }
+
 static int is_tri_kind(int k)
 {
     return k == PDT_EV_TRI_NEW || k == PDT_EV_TRI_FINAL || k == PDT_EV_RA_DEFER ||
@@ -634,7 +643,8 @@ static void drop_recs(const builder *b, size_t upto)
 
 /* Number the triangles by their first event (after tri_groups): the
  * triangle table (in r->tris, or streamed to tris_at), and ev_obj[ev] = the
- * triangle of every triangle event. */
+ * triangle of every triangle event; the entry of a triangle's first event
+ * is marked (FIRST_ENTRY). */
 static int tri_ids(builder *b)
 {
     pdt_replay *r = b->r;
@@ -658,6 +668,7 @@ static int tri_ids(builder *b)
         const pdt_rec *rec = &r->recs[i];
         to[b->pl ? nb++ : r->ntri] = (pdt_rtri){{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank,
                                                r->ev_ent[i], (uint32_t)(-1 - o)};
+        if (first_flagged(r)) r->ev_ent[i] |= FIRST_ENTRY;
         r->ev_obj[i] = (int32_t)r->ntri++;
         if (nb == TBUF) {
             if (!tput(b, NULL, r->tris_at, r->ntri - nb, tb, nb, sizeof *tb)) return 0;
@@ -1077,7 +1088,10 @@ static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
         return;
     default:
         if (is_tri_kind(kind)) {
-            s->tcur[obj] = fwd ? ent : (ent > r->tris[obj].h0 ? ent - 1 : NONE32);
+            if (first_flagged(r))
+                s->tcur[obj] = fwd ? ent & ~FIRST_ENTRY : ent & FIRST_ENTRY ? NONE32 : ent - 1;
+            else
+                s->tcur[obj] = fwd ? ent : (ent > r->tris[obj].h0 ? ent - 1 : NONE32);
             return;
         }
         /* a slot change */

@@ -20,7 +20,8 @@ struct pdt_replay {
     size_t m, skipped;
     int nranks;
     int32_t *ev_obj;   /* per event: object (see build()) or -1 */
-    uint32_t *ev_ent;  /* per event: entry (history / change index, or flag) */
+    uint32_t *ev_ent;  /* per event: entry (history / change index, or flag; a
+                        * triangle's first event: | FIRST_ENTRY, replay.c) */
     uint8_t *ev_kind;  /* per event: its kind (stepping reads no records) */
 
     pdt_rtri *tris;
