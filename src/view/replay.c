@@ -560,6 +560,10 @@ static void *group_worker(void *arg)
         for (uint32_t q = 0; q < ng; q++) gfill[q] = (uint32_t)h, h += gn[q];
         pdt_rtri_hist *to = b->pl ? out - base : r->hist;
         for (size_t j = 0; j < nb; j++) {
+            if (j + PREFETCH_AHEAD < nb) { /* random places in two tables of 4 bytes per event */
+                __builtin_prefetch(&r->ev_ent[buf[j + PREFETCH_AHEAD].ev], 1);
+                __builtin_prefetch(&r->ev_obj[buf[j + PREFETCH_AHEAD].ev], 1);
+            }
             uint32_t q = gid[j], ev = buf[j].ev, at = gfill[q]++;
             to[at] = hist_of(r, &buf[j]);
             r->ev_ent[ev] = at;  /* (threads write distinct events) */
