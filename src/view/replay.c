@@ -463,13 +463,22 @@ static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
  * current one is handled.  A hint only: nothing depends on it. */
 #define PREFETCH_AHEAD 12
 
-/* The slot that looking up event i will probe first, or NULL.  (The caller
- * prefetches it: GCC drops a __builtin_prefetch inside a helper function,
- * which it deems free of side effects.) */
-static const void *probe_addr(const builder *b, size_t i)
+/* The slot that looking up event i will probe first, or NULL; for a lift,
+ * sort or deletion, the point's entry of its first such event, and (*also)
+ * for a lift its coordinates (random places in tables of 4 and 8 bytes per
+ * point).  (The caller prefetches them: GCC drops a __builtin_prefetch
+ * inside a helper function, which it deems free of side effects.) */
+static const void *probe_addr(const builder *b, size_t i, const void **also)
 {
     const pdt_rec *rec = &b->r->recs[i];
     const pdt_event *e = &rec->ev;
+    const pdt_replay *r = b->r;
+    *also = NULL;
+    if ((e->kind == PDT_EV_LIFT || e->kind == PDT_EV_SORT || e->kind == PDT_EV_DELETE) && e->a < r->n) {
+        if (e->kind == PDT_EV_LIFT) *also = &r->pts[e->a];
+        return e->kind == PDT_EV_LIFT ? &r->lift_ev[e->a]
+               : e->kind == PDT_EV_SORT ? &r->sort_ev[e->a] : &r->del_ev[e->a];
+    }
     if (e->kind != PDT_EV_EDGE_ADD && e->kind != PDT_EV_EDGE_DEL) return NULL;
     uint32_t x = e->a < e->b ? e->a : e->b, y = e->a < e->b ? e->b : e->a;
     const keymap *km = &b->edge_map;
@@ -761,8 +770,9 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             continue;
         }
         if (i + PREFETCH_AHEAD < r->m) {
-            const void *p = probe_addr(&b, i + PREFETCH_AHEAD);
+            const void *also, *p = probe_addr(&b, i + PREFETCH_AHEAD, &also);
             if (p) __builtin_prefetch(p);
+            if (also) __builtin_prefetch(also);
         }
         if (r->recs[i].ev.kind < PDT_EV_KIND_COUNT) r->kind_count[r->recs[i].ev.kind]++;
         if (!index_event(&b, (uint32_t)i, lifted_any)) goto out;
