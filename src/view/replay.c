@@ -216,7 +216,15 @@ typedef struct builder {
     int failed;           /* a put or get failed */
 } builder;
 
-#define FBUF 1024u  /* records buffered per fine bucket (streamed) */
+#define FBUF 256u  /* records buffered per fine bucket (streamed) */
+
+/* A big table of `bytes` (malloc'd, asking for huge pages), or NULL. */
+static void *big_table(size_t bytes)
+{
+    void *p = malloc(bytes ? bytes : 1);
+    if (p) pdt_big_advise(p, bytes);
+    return p;
+}
 
 /* Write n entries of `elem` bytes from p at entry `at` of the table at `base`
  * of the place (streamed) or of the array `arr`. */
@@ -691,13 +699,6 @@ static int tri_ids(builder *b)
     return tput(b, NULL, r->tris_at, r->ntri - nb, tb, nb, sizeof *tb);
 }
 
-/* A big table of `bytes` (malloc'd, asking for huge pages), or NULL. */
-static void *big_table(size_t bytes)
-{
-    void *p = malloc(bytes ? bytes : 1);
-    if (p) pdt_big_advise(p, bytes);
-    return p;
-}
 
 /* What a streamed build of m events and n points holds in memory besides
  * tri_groups' working set: the per-event and per-point tables, the run's
@@ -744,7 +745,7 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         if (pl) {
             r->streamed = 1;
             r->hist_at = pl->reserve(pl->ctx, (uint64_t)r->nhist * sizeof *r->hist);
-            b.fbuf = malloc(NFINE * FBUF * sizeof *b.fbuf);
+            b.fbuf = big_table(NFINE * FBUF * sizeof *b.fbuf);
             b.fbn = calloc(NFINE, sizeof *b.fbn);
             if (r->hist_at == UINT64_MAX || !b.fbuf || !b.fbn) goto out;
         } else {
