@@ -754,6 +754,14 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
     return PDT_OK;
 }
 
+#define CHECK_AHEAD 16
+
+static int is_tri_event(int kind)
+{
+    return kind == PDT_EV_TRI_NEW || kind == PDT_EV_TRI_FINAL || kind == PDT_EV_RA_DEFER ||
+           kind == PDT_EV_SHIP || kind == PDT_EV_DISCARD;
+}
+
 static pdt_status check_rank(chk *c, uint32_t r)
 {
     rank_state *rs = calloc(1, sizeof *rs);
@@ -762,11 +770,27 @@ static pdt_status check_rank(chk *c, uint32_t r)
     rs->open_merge = -1;
     rs->last_stack = -1;
     pdt_status st = pdt_cursor_open(c->run, (int)r, &cur, c->err);
-    pdt_event e;
-    uint64_t seq;
-    while (st == PDT_OK && pdt_cursor_next(cur, &e, &seq)) {
+    /* events are read CHECK_AHEAD ahead of the one checked, and the points a
+     * lift or a triangle will read are fetched meanwhile (random places in
+     * 8 bytes per point: cache misses were a third of the check's time) */
+    pdt_event ring[CHECK_AHEAD];
+    uint64_t seqs[CHECK_AHEAD];
+    size_t got = 0, done = 0;
+    while (st == PDT_OK) {
+        while (got < done + CHECK_AHEAD &&
+               pdt_cursor_next(cur, &ring[got % CHECK_AHEAD], &seqs[got % CHECK_AHEAD])) {
+            const pdt_event *a = &ring[got % CHECK_AHEAD];
+            if (a->kind == PDT_EV_LIFT || is_tri_event(a->kind)) {
+                if (a->a < c->npts) __builtin_prefetch(&c->pts[a->a]);
+                if (a->kind != PDT_EV_LIFT && a->b < c->npts) __builtin_prefetch(&c->pts[a->b]);
+                if (a->kind != PDT_EV_LIFT && a->c < c->npts) __builtin_prefetch(&c->pts[a->c]);
+            }
+            got++;
+        }
+        if (done == got) break;
         c->events++;
-        st = check_event(c, rs, r, seq, &e);
+        st = check_event(c, rs, r, seqs[done % CHECK_AHEAD], &ring[done % CHECK_AHEAD]);
+        done++;
     }
     if (st == PDT_OK && rs->phases.n) {
         uint32_t ph = rs->phases.v[rs->phases.n - 1];
