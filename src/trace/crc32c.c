@@ -73,7 +73,7 @@ static uint32_t crc_soft(uint32_t c, const uint8_t *p, size_t n)
 }
 
 #if defined(__x86_64__) && defined(__GNUC__)
-__attribute__((target("sse4.2"))) static uint32_t crc_hw(uint32_t c, const uint8_t *p, size_t n)
+__attribute__((target("sse4.2"))) static uint32_t crc_hw1(uint32_t c, const uint8_t *p, size_t n)
 {
     uint64_t c64 = c;
     while (n >= 8) {
@@ -86,6 +86,48 @@ __attribute__((target("sse4.2"))) static uint32_t crc_hw(uint32_t c, const uint8
     uint32_t c32 = (uint32_t)c64;
     while (n--) c32 = __builtin_ia32_crc32qi(c32, *p++);
     return c32;
+}
+
+static uint64_t gf2_mulmod(uint64_t a, uint64_t b, uint64_t poly, int width);
+
+/* The crc32 instruction takes 3 cycles and can start every cycle: three
+ * independent lanes of LANE bytes each run at once, and the registers of
+ * the second and third are shifted over the bytes after them (multiplied by
+ * x^(8 LANE) modulo the polynomial) and added (the register is linear in
+ * the bytes).  About three times one lane's speed on long buffers (index
+ * chunks of 16 MiB, trace blocks of 50 KB). */
+#define LANE 4096u
+
+__attribute__((target("sse4.2"))) static uint32_t crc_hw(uint32_t c, const uint8_t *p, size_t n)
+{
+    static uint32_t x_lane, x_2lane;  /* x^(8 LANE), x^(16 LANE) mod P, reflected */
+    if (n < 3 * LANE) return crc_hw1(c, p, n);
+    if (!x_2lane) { /* (a benign race: every thread computes the same values) */
+        uint64_t xn = UINT64_C(1) << 31, sq = UINT64_C(1) << 23; /* x^0, x^8 */
+        for (uint64_t k = LANE; k; k >>= 1) {
+            if (k & 1) xn = gf2_mulmod(xn, sq, 0x82F63B78u, 32);
+            sq = gf2_mulmod(sq, sq, 0x82F63B78u, 32);
+        }
+        x_lane = (uint32_t)xn;
+        x_2lane = (uint32_t)gf2_mulmod(xn, xn, 0x82F63B78u, 32);
+    }
+    while (n >= 3 * LANE) {
+        uint64_t a = c, b = 0, d = 0;
+        for (size_t i = 0; i < LANE; i += 8) {
+            uint64_t w0, w1, w2;
+            memcpy(&w0, p + i, 8);
+            memcpy(&w1, p + LANE + i, 8);
+            memcpy(&w2, p + 2 * LANE + i, 8);
+            a = __builtin_ia32_crc32di(a, w0);
+            b = __builtin_ia32_crc32di(b, w1);
+            d = __builtin_ia32_crc32di(d, w2);
+        }
+        c = (uint32_t)(gf2_mulmod(a, x_2lane, 0x82F63B78u, 32) ^
+                       gf2_mulmod(b, x_lane, 0x82F63B78u, 32) ^ d);
+        p += 3 * LANE;
+        n -= 3 * LANE;
+    }
+    return crc_hw1(c, p, n);
 }
 #endif
 
