@@ -12,7 +12,10 @@
  *                    are built: pdt_replay_build), then every other table of
  *                    the replay (replay_int.h), the points and the reader's
  *                    warnings about the run, each at a 64-byte boundary
- *                    (so that a valid index opens without reading the run)
+ *                    (so that a valid index opens without reading the run),
+ *                    and last the checkpoints, one after the other, each
+ *                    holding the triangles born before its cursor (their
+ *                    places and those counts are in the header)
  *
  * The identity of a run is a hash of the name, size and modification time
  * of every file in the folder (but dot-files) and of the manifest's bytes.
@@ -1064,6 +1067,10 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     if (recs != MAP_FAILED) munmap(recs, recs_len);
     if (close(fd) != 0 && st == PDT_OK)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
+    /* the stale index goes first: a rename over an existing file makes ext4
+     * write the new one back to disk inside the call (its auto_da_alloc
+     * rule), gigabytes for a big run */
+    if (st == PDT_OK) unlink(path);
     if (st == PDT_OK && rename(tmp, path) != 0)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", path, strerror(errno));
     if (st != PDT_OK) unlink(tmp);

@@ -80,7 +80,7 @@ TEST(crc32c_long_buffers_three_lanes)
     if (!buf) return;
     uint32_t x = 12345;
     for (size_t i = 0; i < N; i++) buf[i] = (uint8_t)((x = x * 1103515245u + 12345u) >> 24);
-    const size_t lens[] = {12287, 12288, 12289, 12295, 24576, 24583, 36863, 36864, N - 1};
+    const size_t lens[] = {12287, 12288, 12289, 12295, 24576, 24583, 36863, 36864, N - 3};
     int bad = 0;
     for (size_t l = 0; l < sizeof lens / sizeof *lens; l++)
         for (size_t off = 0; off < 3; off++) {
