@@ -12,7 +12,10 @@
  *                    are built: pdt_replay_build), then every other table of
  *                    the replay (replay_int.h), the points and the reader's
  *                    warnings about the run, each at a 64-byte boundary
- *                    (so that a valid index opens without reading the run)
+ *                    (so that a valid index opens without reading the run),
+ *                    and last the checkpoints, one after the other, each
+ *                    holding the triangles born before its cursor (their
+ *                    places and those counts are in the header)
  *
  * The identity of a run is a hash of the name, size and modification time
  * of every file in the folder (but dot-files) and of the manifest's bytes.
@@ -36,9 +39,10 @@
 #include <unistd.h>
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 4u
+#define INDEX_VERSION 6u
 #define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/16 events, at least this */
 #define ICK_PARTS 16u
+_Static_assert(ICK_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint's place");
 #define CHUNK_BYTES ((uint64_t)16 << 20) /* sections are checksummed in chunks of this: the
                                           * least a lazily checked frame reads (1 MiB made
                                           * lazily checked seeks 5x slower: not understood) */
@@ -65,7 +69,9 @@ typedef struct ihdr {
     uint64_t count[NSEC];       /* elements per section */
     uint64_t kind_count[64];
     isec sec[NSEC];
-    uint64_t ick_every, nick, ick_bytes;  /* the checkpoints (S_CKPT) */
+    uint64_t ick_every, nick;   /* the checkpoints (S_CKPT): checkpoint c at ick_off[c] */
+    uint64_t ick_off[PDT_ICK_MAX + 1], ick_born[PDT_ICK_MAX];  /* of the section, holding
+                                 * the triangles born before its cursor: ick_born[c] */
     isec ctab;                  /* CRC-32C of every CHUNK_BYTES of every section,
                                  * in section order; ctab.crc covers the table */
 } ihdr;
@@ -122,7 +128,7 @@ static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_
     SEC(S_EVKIND, ev_kind, r->m);
     ptr[S_CKPT] = (void **)&r->ick;
     elem[S_CKPT] = 1;
-    count[S_CKPT] = (uint64_t)r->nick * r->ick_bytes;
+    count[S_CKPT] = r->nick ? r->ick_off[r->nick] : 0;
 #undef SEC
 }
 
@@ -135,6 +141,56 @@ static uint32_t hdr_crc(const ihdr *h)
 
 static uint64_t chunks_of(uint64_t bytes) { return (bytes + CHUNK_BYTES - 1) / CHUNK_BYTES; }
 
+/* ---- chunk checksums of data written in order ------------------------------------ */
+
+/* The CRC-32C of every CHUNK_BYTES of a section, made as the section is
+ * written from its start to its end (so that the build does not read it
+ * back): crc[k] for chunk k, grown as needed. */
+typedef struct crcacc {
+    uint32_t *crc;
+    size_t n, cap;
+    uint64_t pos;   /* bytes fed */
+    uint32_t cur;   /* of the chunk being fed */
+    int nomem;
+} crcacc;
+
+static void crc_feed(crcacc *a, const void *data, size_t len)
+{
+    const char *p = data;
+    while (len) {
+        uint64_t room = CHUNK_BYTES - a->pos % CHUNK_BYTES;
+        size_t take = len < room ? len : (size_t)room;
+        a->cur = pdt_crc32c(a->cur, p, take);
+        a->pos += take;
+        p += take;
+        len -= take;
+        if (a->pos % CHUNK_BYTES == 0) {
+            if (a->n == a->cap) {
+                size_t nc = a->cap ? 2 * a->cap : 64;
+                uint32_t *g = realloc(a->crc, nc * sizeof *g);
+                if (!g) {
+                    a->nomem = 1;
+                    return;
+                }
+                a->crc = g;
+                a->cap = nc;
+            }
+            a->crc[a->n++] = a->cur;
+            a->cur = 0;
+        }
+    }
+}
+
+/* Copy the section's chunk checksums (the last chunk's too) to tab.  0 if
+ * memory ran out or the bytes fed are not `bytes`. */
+static int crc_done(const crcacc *a, uint64_t bytes, uint32_t *tab)
+{
+    if (a->nomem || a->pos != bytes) return 0;
+    if (a->n) memcpy(tab, a->crc, a->n * sizeof *tab);
+    if (a->pos % CHUNK_BYTES) tab[a->n] = a->cur;
+    return 1;
+}
+
 /* ---- verifying the chunks, in parallel ----------------------------------------- */
 
 typedef struct verify_job {
@@ -142,6 +198,7 @@ typedef struct verify_job {
     const ihdr *h;
     uint32_t *tab;              /* chunk checksums */
     int compute;                /* 1: fill tab in (building), 0: compare with it */
+    const uint8_t *todo;        /* compute: NULL, or per chunk 1 if it is to be read */
     uint64_t nchunk;
     uint64_t *first;            /* per section: index of its first chunk in tab */
     atomic_uint_fast64_t next;  /* next chunk to check */
@@ -160,6 +217,7 @@ static void *verify_worker(void *arg)
     for (;;) {
         uint64_t c = atomic_fetch_add(&j->next, 1);
         if (c >= j->nchunk || atomic_load(&j->bad)) break;
+        if (j->todo && !j->todo[c]) continue;
         int i = 0;
         while (i + 1 < NSEC && j->first[i + 1] <= c) i++;
         uint64_t from = (c - j->first[i]) * CHUNK_BYTES, to = from + CHUNK_BYTES;
@@ -223,7 +281,7 @@ static int verify_chunks(int fd, const ihdr *h, char *why, size_t wcap)
     first[NSEC] = n;
     uint32_t *tab = read_ctab(fd, h, why, wcap);
     if (!tab) return 0;
-    verify_job j = {fd, h, tab, 0, n, first, 0, 0};
+    verify_job j = {fd, h, tab, 0, NULL, n, first, 0, 0};
     run_job(&j);
     free(tab);
     if (atomic_load(&j.bad)) {
@@ -666,9 +724,19 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
     r->warnings = h.count[S_WARN] ? "" : NULL;  /* so that sections() sizes it */
     r->ick_every = h.ick_every;
     r->nick = h.nick;
-    r->ick_bytes = h.ick_bytes;
-    if (r->nick && (r->ick_every == 0 || r->ick_bytes != pdt_rstate_blob_bytes(r) ||
-                    (r->nick - 1) * r->ick_every > r->m)) {
+    int ck_ok = r->nick <= PDT_ICK_MAX &&
+                (!r->nick || (r->ick_every && (r->nick - 1) * r->ick_every <= r->m));
+    for (size_t c = 0; ck_ok && c <= r->nick; c++) {
+        r->ick_off[c] = h.ick_off[c];
+        if (c == 0) {
+            ck_ok = h.ick_off[0] == 0;
+            continue;
+        }
+        r->ick_born[c - 1] = h.ick_born[c - 1];
+        ck_ok = h.ick_born[c - 1] <= r->ntri &&
+                h.ick_off[c] == h.ick_off[c - 1] + pdt_rstate_blob_bytes(r, h.ick_born[c - 1]);
+    }
+    if (!ck_ok) {
         snprintf(why, wcap, "damaged: checkpoints do not fit the tables");
         free(r);
         r = NULL;
@@ -723,8 +791,12 @@ static int write_all(int fd, const void *p, size_t len, uint64_t off)
 }
 
 /* Stream the merged records of run into fd at HDR_BYTES (the reader's
- * merge: one decoded block per rank in memory).  Sets h->sec[S_RECS] and *m. */
-static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, pdt_err *err)
+ * merge: one decoded block per rank in memory).  Sets h->sec[S_RECS] and *m,
+ * and counts what the replay's build would count in a first pass over them
+ * (pdt_replay_place): fine[PDT_REPLAY_NFINE] and kinds[PDT_EV_KIND_COUNT],
+ * for a run of n points and nranks ranks. */
+static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, size_t n, int nranks,
+                             uint64_t *fine, uint64_t *kinds, crcacc *crc, pdt_err *err)
 {
     enum { BATCH = 8192 };
     pdt_rec *buf = malloc(BATCH * sizeof *buf);
@@ -737,10 +809,17 @@ static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, pdt_err *
     while (st == PDT_OK && got > 0) {
         got = pdt_merge_next(mg, &buf[nb], err);
         if (got < 0) st = err->code ? err->code : PDT_ERR_NOMEM;
-        if (got > 0) nb++, count++;
+        if (got > 0) {
+            const pdt_rec *rec = &buf[nb];
+            if (rec->ev.kind < PDT_EV_KIND_COUNT) kinds[rec->ev.kind]++;
+            size_t f = pdt_replay_fine_of(rec, n, nranks);
+            if (f < PDT_REPLAY_NFINE) fine[f]++;
+            nb++, count++;
+        }
         if (st == PDT_OK && (nb == BATCH || (got == 0 && nb))) {
             if (!write_all(fd, buf, nb * sizeof *buf, off))
                 st = pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+            crc_feed(crc, buf, nb * sizeof *buf);
             off += nb * sizeof *buf;
             nb = 0;
         }
@@ -753,17 +832,23 @@ static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, pdt_err *
 }
 
 /* The state at every r->ick_every-th cursor, stepped forwards from 0,
- * written at off one after the other (r->nick of r->ick_bytes). */
-static int write_checkpoints(const pdt_replay *r, int fd, uint64_t off)
+ * written at off one after the other (r->nick of them), each holding the
+ * triangles born before its cursor; sets r->ick_off and r->ick_born. */
+static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
 {
+    r->ick_off[0] = 0;
     if (!r->nick) return 1;
     pdt_rstate *s = pdt_rstate_new(r);
-    uint8_t *blob = malloc(r->ick_bytes ? r->ick_bytes : 1);
+    uint8_t *blob = malloc(pdt_rstate_blob_bytes(r, r->ntri));
     int ok = s && blob;
     for (size_t c = 0; ok && c < r->nick; c++) {
         while (s->k < c * r->ick_every) pdt_replay_step(r, s, 1);
-        pdt_rstate_to_blob(r, s, blob);
-        ok = write_all(fd, blob, r->ick_bytes, off + c * r->ick_bytes);
+        size_t born = pdt_rstate_born(r, s), bytes = pdt_rstate_blob_bytes(r, born);
+        pdt_rstate_to_blob(r, s, born, blob);
+        ok = write_all(fd, blob, bytes, off + r->ick_off[c]);
+        crc_feed(crc, blob, bytes);
+        r->ick_born[c] = born;
+        r->ick_off[c + 1] = r->ick_off[c] + bytes;
     }
     free(blob);
     pdt_rstate_free(s);
@@ -808,8 +893,9 @@ static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
 /* Write the tables of r after the records and the streamed ones (at pc->off),
  * then the header. */
 static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
-                               pdt_err *err)
+                               crcacc *recs_crc, pdt_err *err)
 {
+    crcacc ck_crc = {0};
     void **ptr[NSEC];
     size_t elem[NSEC];
     uint64_t count[NSEC];
@@ -818,29 +904,65 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     for (int i = 0; i < NSEC; i++) {
         h->count[i] = count[i];
         if (i == S_RECS) continue;
+        if (i == S_CKPT) { /* their sizes are known once they are made */
+            off = (off + 63) & ~(uint64_t)63;
+            if (!write_checkpoints(r, fd, off, &ck_crc)) {
+                free(ck_crc.crc);
+                return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+            }
+            h->count[i] = r->nick ? r->ick_off[r->nick] : 0;
+            h->sec[i] = (isec){off, h->count[i], 0, 0};
+            off += h->count[i];
+            continue;
+        }
         if (r->streamed && (i == S_TRIS || i == S_HIST)) {
             h->sec[i] = (isec){i == S_TRIS ? r->tris_at : r->hist_at, count[i] * elem[i], 0, 0};
             continue;
         }
         off = (off + 63) & ~(uint64_t)63;
         size_t bytes = (size_t)count[i] * elem[i];
-        if (i == S_CKPT) {
-            if (!write_checkpoints(r, fd, off))
-                return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-        } else if (bytes && !write_all(fd, *ptr[i], bytes, off)) {
+        if (bytes && !write_all(fd, *ptr[i], bytes, off)) {
+            free(ck_crc.crc);
             return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
         }
         h->sec[i] = (isec){off, bytes, 0, 0};
         off += bytes;
     }
-    /* the chunk checksums, read back (pread, by up to four threads) */
+    /* the chunk checksums: of the tables in memory from memory, of the
+     * records and checkpoints as they were written, of the streamed
+     * triangles and histories read back (pread, by up to four threads) */
     uint64_t first[NSEC + 1], n = 0;
     for (int i = 0; i < NSEC; i++) first[i] = n, n += chunks_of(h->sec[i].bytes);
     first[NSEC] = n;
     uint32_t *tab = malloc(n ? n * sizeof *tab : 1);
-    if (!tab) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for the index's checksums");
-    verify_job j = {fd, h, tab, 1, n, first, 0, 0};
+    uint8_t *todo = calloc(n ? n : 1, 1);
+    int have = tab && todo;
+    for (int i = 0; have && i < NSEC; i++) {
+        uint64_t nc = chunks_of(h->sec[i].bytes);
+        if (i == S_RECS) {
+            have = crc_done(recs_crc, h->sec[i].bytes, tab + first[i]);
+        } else if (i == S_CKPT) {
+            have = crc_done(&ck_crc, h->sec[i].bytes, tab + first[i]);
+        } else if (r->streamed && (i == S_TRIS || i == S_HIST)) {
+            memset(todo + first[i], 1, nc);
+        } else {
+            const char *p = *ptr[i];
+            for (uint64_t c = 0; c < nc; c++) {
+                uint64_t lo = c * CHUNK_BYTES, hi = lo + CHUNK_BYTES;
+                if (hi > h->sec[i].bytes) hi = h->sec[i].bytes;
+                tab[first[i] + c] = pdt_crc32c(0, p + lo, (size_t)(hi - lo));
+            }
+        }
+    }
+    free(ck_crc.crc);
+    if (!have) {
+        free(tab);
+        free(todo);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for the index's checksums");
+    }
+    verify_job j = {fd, h, tab, 1, todo, n, first, 0, 0};
     run_job(&j);
+    free(todo);
     if (atomic_load(&j.bad)) {
         free(tab);
         return pdt_err_set(err, PDT_ERR_IO, "reading the index back for its checksums failed");
@@ -862,7 +984,8 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     h->nranks = (uint64_t)r->nranks;
     h->ick_every = r->ick_every;
     h->nick = r->nick;
-    h->ick_bytes = r->ick_bytes;
+    memcpy(h->ick_off, r->ick_off, sizeof h->ick_off);
+    memcpy(h->ick_born, r->ick_born, sizeof h->ick_born);
     for (int k = 0; k < PDT_EV_KIND_COUNT; k++) h->kind_count[k] = r->kind_count[k];
     h->hdr_crc = hdr_crc(h);
     unsigned char page[HDR_BYTES];
@@ -916,7 +1039,9 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     pdt_replay *r = NULL;
     void *recs = MAP_FAILED;
     size_t m = 0, recs_len = 0;
-    pdt_status st = h ? write_recs(run, fd, h, &m, err)
+    uint64_t fine[PDT_REPLAY_NFINE] = {0}, kinds[PDT_EV_KIND_COUNT] = {0};
+    crcacc recs_crc = {0};
+    pdt_status st = h ? write_recs(run, fd, h, &m, n, nranks, fine, kinds, &recs_crc, err)
                       : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     if (st == PDT_OK) {
         /* the records as the replay's input: mapped from the file, so they
@@ -926,7 +1051,7 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         if (recs == MAP_FAILED) st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
     }
     placer pc = {fd, recs_len};
-    pdt_replay_place pl = {place_reserve, place_put, place_get, &pc, budget};
+    pdt_replay_place pl = {place_reserve, place_put, place_get, &pc, budget, fine, kinds};
     if (st == PDT_OK)
         st = pdt_replay_build(pts, n, (const pdt_rec *)((char *)recs + HDR_BYTES), m, nranks, &pl,
                               &r, err);
@@ -935,18 +1060,22 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         size_t every = r->m / ICK_PARTS;
         r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
         r->nick = r->m / r->ick_every + 1;
-        r->ick_bytes = pdt_rstate_blob_bytes(r);
-        st = write_tables(r, fd, h, ident, &pc, err);
+        st = write_tables(r, fd, h, ident, &pc, &recs_crc, err);
         r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
     }
     pdt_replay_free(r);
     if (recs != MAP_FAILED) munmap(recs, recs_len);
     if (close(fd) != 0 && st == PDT_OK)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
+    /* the stale index goes first: a rename over an existing file makes ext4
+     * write the new one back to disk inside the call (its auto_da_alloc
+     * rule), gigabytes for a big run */
+    if (st == PDT_OK) unlink(path);
     if (st == PDT_OK && rename(tmp, path) != 0)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", path, strerror(errno));
     if (st != PDT_OK) unlink(tmp);
     free(h);
+    free(recs_crc.crc);
     return st;
 }
 

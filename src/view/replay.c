@@ -8,7 +8,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <sys/mman.h>
+#include <unistd.h>
 
 /* ---- a small growable array ----------------------------------------------- */
 
@@ -112,6 +115,15 @@ static int km_put(keymap *km, uint64_t hi, uint64_t lo, int32_t v)
 
 #define NONE32 UINT32_MAX
 
+/* ev_ent of a triangle's first event carries this bit (when there are fewer
+ * than 2^31 history entries, as in every run so far): stepping back over
+ * it leaves the triangle with no entry, and no step has to read the
+ * triangle table (random places in 20 bytes per triangle: on a kept index,
+ * the first step back into a part of it paid for checking 16 MiB of it). */
+#define FIRST_ENTRY 0x80000000u
+
+static int first_flagged(const pdt_replay *r) { return r->nhist < FIRST_ENTRY; }
+
 static int is_tri_kind(int k)
 {
     return k == PDT_EV_TRI_NEW || k == PDT_EV_TRI_FINAL || k == PDT_EV_RA_DEFER ||
@@ -165,6 +177,7 @@ _Static_assert(sizeof(tri_rec) == sizeof(pdt_rtri_hist), "a triangle event fits 
 
 #define FINE_BITS 8
 #define NFINE ((size_t)1 << FINE_BITS)
+_Static_assert(NFINE == PDT_REPLAY_NFINE, "replay_int.h says how many fine buckets");
 #define GROUP_BYTES_PER_EVENT 128u /* tri_groups' working memory per event, at most */
 /* Events per run, at most (unless one fine bucket holds more): a working set
  * of some 60 MiB, reused from run to run (fresh pages are dear on virtual
@@ -177,6 +190,17 @@ static uint64_t key_hash(const uint32_t s[3])
 }
 
 static size_t fine_of(const uint32_t s[3]) { return (size_t)(key_hash(s) >> (64 - FINE_BITS)); }
+
+size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks)
+{
+    const pdt_event *e = &rec->ev;
+    if (!is_tri_kind(e->kind) || rec->rank >= (uint32_t)nranks || e->a >= n || e->b >= n ||
+        e->c >= n)
+        return NFINE;
+    uint32_t in[3] = {e->a, e->b, e->c}, s[3];
+    sort3(s, in);
+    return fine_of(s);
+}
 
 /* Build state while indexing: the current slot values of every rank. */
 typedef struct builder {
@@ -192,7 +216,15 @@ typedef struct builder {
     int failed;           /* a put or get failed */
 } builder;
 
-#define FBUF 1024u  /* records buffered per fine bucket (streamed) */
+#define FBUF 256u  /* records buffered per fine bucket (streamed) */
+
+/* A big table of `bytes` (malloc'd, asking for huge pages), or NULL. */
+static void *big_table(size_t bytes)
+{
+    void *p = malloc(bytes ? bytes : 1);
+    if (p) pdt_big_advise(p, bytes);
+    return p;
+}
 
 /* Write n entries of `elem` bytes from p at entry `at` of the table at `base`
  * of the place (streamed) or of the array `arr`. */
@@ -439,13 +471,22 @@ static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
  * current one is handled.  A hint only: nothing depends on it. */
 #define PREFETCH_AHEAD 12
 
-/* The slot that looking up event i will probe first, or NULL.  (The caller
- * prefetches it: GCC drops a __builtin_prefetch inside a helper function,
- * which it deems free of side effects.) */
-static const void *probe_addr(const builder *b, size_t i)
+/* The slot that looking up event i will probe first, or NULL; for a lift,
+ * sort or deletion, the point's entry of its first such event, and (*also)
+ * for a lift its coordinates (random places in tables of 4 and 8 bytes per
+ * point).  (The caller prefetches them: GCC drops a __builtin_prefetch
+ * inside a helper function, which it deems free of side effects.) */
+static const void *probe_addr(const builder *b, size_t i, const void **also)
 {
     const pdt_rec *rec = &b->r->recs[i];
     const pdt_event *e = &rec->ev;
+    const pdt_replay *r = b->r;
+    *also = NULL;
+    if ((e->kind == PDT_EV_LIFT || e->kind == PDT_EV_SORT || e->kind == PDT_EV_DELETE) && e->a < r->n) {
+        if (e->kind == PDT_EV_LIFT) *also = &r->pts[e->a];
+        return e->kind == PDT_EV_LIFT ? &r->lift_ev[e->a]
+               : e->kind == PDT_EV_SORT ? &r->sort_ev[e->a] : &r->del_ev[e->a];
+    }
     if (e->kind != PDT_EV_EDGE_ADD && e->kind != PDT_EV_EDGE_DEL) return NULL;
     uint32_t x = e->a < e->b ? e->a : e->b, y = e->a < e->b ? e->b : e->a;
     const keymap *km = &b->edge_map;
@@ -469,27 +510,25 @@ static pdt_rtri_hist hist_of(const pdt_replay *r, const tri_rec *t)
     return h;
 }
 
-/* Group the triangle events (hist[], in fine buckets) by triangle, a run
- * of fine buckets at a time: each triangle's entries become consecutive, in
- * event order; ev_ent[ev] is the event's entry; ev_obj[ev] is -1 - (entries
- * of its triangle) for a triangle's first event, else that first event.
- * Working memory: about budget bytes (0: no limit). */
-static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
+/* One thread's share of tri_groups: runs of fine buckets (run[] holds
+ * their bounds) taken in turn from *next; each thread its own buffers of
+ * `most` events (the largest run). */
+typedef struct group_job {
+    builder *b;
+    const size_t *run;      /* bucket bounds: run k is [run[k], run[k + 1]) */
+    size_t nrun, most;
+    _Atomic size_t next;    /* next run to take */
+    _Atomic int failed;     /* out of memory, or (io) a read or write of the place failed */
+    _Atomic int io;
+    _Atomic size_t ntri;    /* triangles found */
+} group_job;
+
+static void *group_worker(void *arg)
 {
+    group_job *J = arg;
+    builder *b = J->b;
     pdt_replay *r = b->r;
-    *ntri = 0;
-    size_t cap = budget ? (size_t)(budget / GROUP_BYTES_PER_EVENT) : SIZE_MAX;
-    if (cap < 1024) cap = 1024;
-    if (b->pl && cap > GROUP_RUN_MAX) cap = GROUP_RUN_MAX;
-    size_t most = 0;  /* the largest run */
-    for (size_t f = 0; f < NFINE;) {
-        size_t g = f + 1;
-        while (g < NFINE && b->fine_off[g + 1] - b->fine_off[f] <= cap) g++;
-        if (b->fine_off[g] - b->fine_off[f] > most) most = b->fine_off[g] - b->fine_off[f];
-        f = g;
-    }
-    if (!most) return 1;
-    size_t hcap = 1024;
+    size_t most = J->most, hcap = 1024;
     while (hcap / 4 * 3 < most) hcap *= 2;
     tri_rec *buf = malloc(most * sizeof *buf);
     gslot *slot = malloc(hcap * sizeof *slot);
@@ -501,51 +540,60 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
         pdt_big_advise(buf, most * sizeof *buf);
         pdt_big_advise(slot, hcap * sizeof *slot);
     }
-    for (size_t f = 0; ok && f < NFINE;) {
-        size_t g = f + 1;
-        while (g < NFINE && b->fine_off[g + 1] - b->fine_off[f] <= cap) g++;
-        size_t base = b->fine_off[f], nb = b->fine_off[g] - base;
-        f = g;
+    size_t found = 0;
+    while (ok && !J->failed) {
+        size_t k = J->next++;
+        if (k >= J->nrun) break;
+        size_t base = b->fine_off[J->run[k]], nb = b->fine_off[J->run[k + 1]] - base;
         if (!nb) continue;
         if (!b->pl) memcpy(buf, &r->hist[base], nb * sizeof *buf);
         else if (!b->pl->get(b->pl->ctx, r->hist_at + base * sizeof *buf, buf, nb * sizeof *buf)) {
-            b->failed = 1;
+            J->io = 1;
             ok = 0;
             break;
         }
         size_t hc = 1024;
         while (hc / 4 * 3 < nb) hc *= 2;
         size_t mask = hc - 1;
-        for (size_t k = 0; k < hc; k++) slot[k].g = NONE32;
+        for (size_t q = 0; q < hc; q++) slot[q].g = NONE32;
         uint32_t ng = 0;
         for (size_t j = 0; j < nb; j++) {
             if (j + PREFETCH_AHEAD < nb)
                 __builtin_prefetch(&slot[(size_t)key_hash(buf[j + PREFETCH_AHEAD].s) & mask]);
             const uint32_t *s = buf[j].s;
-            size_t k = (size_t)key_hash(s) & mask;
-            while (slot[k].g != NONE32 &&
-                   (slot[k].s[0] != s[0] || slot[k].s[1] != s[1] || slot[k].s[2] != s[2]))
-                k = (k + 1) & mask;
-            if (slot[k].g == NONE32) {
-                slot[k] = (gslot){{s[0], s[1], s[2]}, ng};
+            size_t q = (size_t)key_hash(s) & mask;
+            while (slot[q].g != NONE32 &&
+                   (slot[q].s[0] != s[0] || slot[q].s[1] != s[1] || slot[q].s[2] != s[2]))
+                q = (q + 1) & mask;
+            if (slot[q].g == NONE32) {
+                slot[q] = (gslot){{s[0], s[1], s[2]}, ng};
                 gfirst[ng] = buf[j].ev;
                 gn[ng++] = 0;
             }
-            gid[j] = slot[k].g;
+            gid[j] = slot[q].g;
             gn[gid[j]]++;
         }
         size_t h = base;
         for (uint32_t q = 0; q < ng; q++) gfill[q] = (uint32_t)h, h += gn[q];
         pdt_rtri_hist *to = b->pl ? out - base : r->hist;
         for (size_t j = 0; j < nb; j++) {
+            if (j + PREFETCH_AHEAD < nb) { /* random places in two tables of 4 bytes per event */
+                __builtin_prefetch(&r->ev_ent[buf[j + PREFETCH_AHEAD].ev], 1);
+                __builtin_prefetch(&r->ev_obj[buf[j + PREFETCH_AHEAD].ev], 1);
+            }
             uint32_t q = gid[j], ev = buf[j].ev, at = gfill[q]++;
             to[at] = hist_of(r, &buf[j]);
-            r->ev_ent[ev] = at;
+            r->ev_ent[ev] = at;  /* (threads write distinct events) */
             r->ev_obj[ev] = ev == gfirst[q] ? -1 - (int32_t)gn[q] : (int32_t)gfirst[q];
         }
-        if (b->pl && !tput(b, NULL, r->hist_at, base, out, nb, sizeof *out)) ok = 0;
-        *ntri += ng;
+        if (b->pl && !b->pl->put(b->pl->ctx, r->hist_at + base * sizeof *out, out, nb * sizeof *out)) {
+            J->io = 1;
+            ok = 0;
+        }
+        found += ng;
     }
+    if (!ok) J->failed = 1;
+    J->ntri += found;
     free(out);
     free(buf);
     free(slot);
@@ -553,7 +601,51 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
     free(gfirst);
     free(gn);
     free(gfill);
-    return ok;
+    return NULL;
+}
+
+/* Threads that group triangle events at once (each with its own share of
+ * the working budget): the runs are independent, and the grouping is bound
+ * by cache misses and copying, which a second core halves. */
+#define GROUP_THREADS 2
+
+/* Group the triangle events (hist[], in fine buckets) by triangle, a run
+ * of fine buckets at a time: each triangle's entries become consecutive, in
+ * event order; ev_ent[ev] is the event's entry; ev_obj[ev] is -1 - (entries
+ * of its triangle) for a triangle's first event, else that first event.
+ * Working memory: about budget bytes (0: no limit), over GROUP_THREADS
+ * threads when the runs are several. */
+static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
+{
+    *ntri = 0;
+    size_t cap = budget ? (size_t)(budget / GROUP_BYTES_PER_EVENT / GROUP_THREADS) : SIZE_MAX;
+    if (cap < 1024) cap = 1024;
+    if (b->pl && cap > GROUP_RUN_MAX) cap = GROUP_RUN_MAX;
+    size_t run[NFINE + 1], nrun = 0, most = 0;  /* the runs' bounds; the largest run */
+    run[0] = 0;
+    for (size_t f = 0; f < NFINE;) {
+        size_t g = f + 1;
+        while (g < NFINE && b->fine_off[g + 1] - b->fine_off[f] <= cap) g++;
+        if (b->fine_off[g] - b->fine_off[f] > most) most = b->fine_off[g] - b->fine_off[f];
+        run[++nrun] = g;
+        f = g;
+    }
+    if (!most) return 1;
+    group_job J = {.b = b, .run = run, .nrun = nrun, .most = most};
+    pthread_t th[GROUP_THREADS];
+    int started = 0;
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    for (int t = 1; t < GROUP_THREADS && t < cpus && (size_t)t < nrun; t++)
+        if (pthread_create(&th[t], NULL, group_worker, &J) == 0) started |= 1 << t;
+    group_worker(&J);
+    for (int t = 1; t < GROUP_THREADS; t++)
+        if (started & (1 << t)) pthread_join(th[t], NULL);
+    if (J.failed) {
+        if (J.io) b->failed = 1;
+        return 0;
+    }
+    *ntri = J.ntri;
+    return 1;
 }
 
 /* A streamed build reads the records (a mapping of the index file) from
@@ -572,7 +664,8 @@ static void drop_recs(const builder *b, size_t upto)
 
 /* Number the triangles by their first event (after tri_groups): the
  * triangle table (in r->tris, or streamed to tris_at), and ev_obj[ev] = the
- * triangle of every triangle event. */
+ * triangle of every triangle event; the entry of a triangle's first event
+ * is marked (FIRST_ENTRY). */
 static int tri_ids(builder *b)
 {
     pdt_replay *r = b->r;
@@ -596,6 +689,7 @@ static int tri_ids(builder *b)
         const pdt_rec *rec = &r->recs[i];
         to[b->pl ? nb++ : r->ntri] = (pdt_rtri){{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank,
                                                r->ev_ent[i], (uint32_t)(-1 - o)};
+        if (first_flagged(r)) r->ev_ent[i] |= FIRST_ENTRY;
         r->ev_obj[i] = (int32_t)r->ntri++;
         if (nb == TBUF) {
             if (!tput(b, NULL, r->tris_at, r->ntri - nb, tb, nb, sizeof *tb)) return 0;
@@ -605,13 +699,6 @@ static int tri_ids(builder *b)
     return tput(b, NULL, r->tris_at, r->ntri - nb, tb, nb, sizeof *tb);
 }
 
-/* A big table of `bytes` (malloc'd, asking for huge pages), or NULL. */
-static void *big_table(size_t bytes)
-{
-    void *p = malloc(bytes ? bytes : 1);
-    if (p) pdt_big_advise(p, bytes);
-    return p;
-}
 
 /* What a streamed build of m events and n points holds in memory besides
  * tri_groups' working set: the per-event and per-point tables, the run's
@@ -641,17 +728,16 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
      * of the triangle events per fine bucket */
     {
         size_t cnt[PDT_EV_KIND_COUNT] = {0};
-        for (size_t i = 0; i < r->m; i++) {
+        if (pl && pl->fine_count) { /* counted by the caller as it wrote the records */
+            for (size_t f = 0; f < NFINE; f++) b.fine_off[f + 1] = (size_t)pl->fine_count[f];
+            for (int k = 0; k < PDT_EV_KIND_COUNT; k++) cnt[k] = (size_t)pl->kind_count[k];
+        }
+        for (size_t i = 0; !(pl && pl->fine_count) && i < r->m; i++) {
             drop_recs(&b, i);
             const pdt_rec *rec = &r->recs[i];
-            const pdt_event *e = &rec->ev;
-            if (e->kind < PDT_EV_KIND_COUNT) cnt[e->kind]++;
-            if (!is_tri_kind(e->kind) || rec->rank >= (uint32_t)r->nranks || e->a >= r->n ||
-                e->b >= r->n || e->c >= r->n)
-                continue;
-            uint32_t in[3] = {e->a, e->b, e->c}, s[3];
-            sort3(s, in);
-            b.fine_off[fine_of(s) + 1]++;
+            if (rec->ev.kind < PDT_EV_KIND_COUNT) cnt[rec->ev.kind]++;
+            size_t f = pdt_replay_fine_of(rec, r->n, r->nranks);
+            if (f < NFINE) b.fine_off[f + 1]++;
         }
         for (size_t f = 0; f < NFINE; f++) b.fine_off[f + 1] += b.fine_off[f];
         memcpy(b.fine_fill, b.fine_off, NFINE * sizeof *b.fine_fill);
@@ -659,7 +745,7 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         if (pl) {
             r->streamed = 1;
             r->hist_at = pl->reserve(pl->ctx, (uint64_t)r->nhist * sizeof *r->hist);
-            b.fbuf = malloc(NFINE * FBUF * sizeof *b.fbuf);
+            b.fbuf = big_table(NFINE * FBUF * sizeof *b.fbuf);
             b.fbn = calloc(NFINE, sizeof *b.fbn);
             if (r->hist_at == UINT64_MAX || !b.fbuf || !b.fbn) goto out;
         } else {
@@ -685,8 +771,9 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             continue;
         }
         if (i + PREFETCH_AHEAD < r->m) {
-            const void *p = probe_addr(&b, i + PREFETCH_AHEAD);
+            const void *also, *p = probe_addr(&b, i + PREFETCH_AHEAD, &also);
             if (p) __builtin_prefetch(p);
+            if (also) __builtin_prefetch(also);
         }
         if (r->recs[i].ev.kind < PDT_EV_KIND_COUNT) r->kind_count[r->recs[i].ev.kind]++;
         if (!index_event(&b, (uint32_t)i, lifted_any)) goto out;
@@ -1016,7 +1103,10 @@ static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
         return;
     default:
         if (is_tri_kind(kind)) {
-            s->tcur[obj] = fwd ? ent : (ent > r->tris[obj].h0 ? ent - 1 : NONE32);
+            if (first_flagged(r))
+                s->tcur[obj] = fwd ? ent & ~FIRST_ENTRY : ent & FIRST_ENTRY ? NONE32 : ent - 1;
+            else
+                s->tcur[obj] = fwd ? ent : (ent > r->tris[obj].h0 ? ent - 1 : NONE32);
             return;
         }
         /* a slot change */
@@ -1109,20 +1199,27 @@ static size_t dist(size_t a, size_t b) { return a > b ? a - b : b - a; }
 
 static size_t up8(size_t x) { return (x + 7) & ~(size_t)7; }
 
-size_t pdt_rstate_blob_bytes(const pdt_replay *r)
+size_t pdt_rstate_blob_bytes(const pdt_replay *r, size_t born)
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
-    return up8(r->n) + up8(r->ntri * 4) + up8(r->nedge) + up8(r->nmsg) + up8(nslot * 4);
+    return up8(r->n) + up8(born * 4) + up8(r->nedge) + up8(r->nmsg) + up8(nslot * 4);
 }
 
-void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, uint8_t *out)
+size_t pdt_rstate_born(const pdt_replay *r, const pdt_rstate *s)
+{
+    size_t t = r->ntri;
+    while (t > 0 && s->tcur[t - 1] == NONE32) t--;
+    return t;
+}
+
+void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, size_t born, uint8_t *out)
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
-    memset(out, 0, pdt_rstate_blob_bytes(r));
+    memset(out, 0, pdt_rstate_blob_bytes(r, born));
     memcpy(out, s->pflags, r->n);
     out += up8(r->n);
-    memcpy(out, s->tcur, r->ntri * 4);
-    out += up8(r->ntri * 4);
+    memcpy(out, s->tcur, born * 4);
+    out += up8(born * 4);
     memcpy(out, s->ealive, r->nedge);
     out += up8(r->nedge);
     memcpy(out, s->mflight, r->nmsg);
@@ -1130,14 +1227,16 @@ void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, uint8_t *out)
     memcpy(out, s->slot, nslot * 4);
 }
 
-void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in, size_t k)
+void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in, size_t born,
+                          size_t k)
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
     s->k = k;
     memcpy(s->pflags, in, r->n);
     in += up8(r->n);
-    memcpy(s->tcur, in, r->ntri * 4);
-    in += up8(r->ntri * 4);
+    memcpy(s->tcur, in, born * 4);
+    memset(s->tcur + born, 0xff, (r->ntri - born) * sizeof *s->tcur);
+    in += up8(born * 4);
     memcpy(s->ealive, in, r->nedge);
     in += up8(r->nedge);
     memcpy(s->mflight, in, r->nmsg);
@@ -1163,8 +1262,9 @@ void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k)
         size_t c = (k + r->ick_every / 2) / r->ick_every;
         if (c >= r->nick) c = r->nick - 1;
         size_t ck = c * r->ick_every;
-        if (from_here > dist(ck, k) * STEP_FACTOR + r->ick_bytes / 64)
-            pdt_rstate_from_blob(r, s, r->ick + c * r->ick_bytes, ck);
+        size_t bytes = (size_t)(r->ick_off[c + 1] - r->ick_off[c]);
+        if (from_here > dist(ck, k) * STEP_FACTOR + bytes / 64)
+            pdt_rstate_from_blob(r, s, r->ick + r->ick_off[c], r->ick_born[c], ck);
         step_to(r, s, k);
         return;
     }

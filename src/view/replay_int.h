@@ -5,6 +5,9 @@
 
 #include "pdt/replay.h"
 
+/* Checkpoints a kept index holds, at most (index.c makes 17 at most). */
+#define PDT_ICK_MAX 24
+
 typedef struct slot_change {
     uint32_t ev;
     int32_t val, prev;
@@ -17,7 +20,8 @@ struct pdt_replay {
     size_t m, skipped;
     int nranks;
     int32_t *ev_obj;   /* per event: object (see build()) or -1 */
-    uint32_t *ev_ent;  /* per event: entry (history / change index, or flag) */
+    uint32_t *ev_ent;  /* per event: entry (history / change index, or flag; a
+                        * triangle's first event: | FIRST_ENTRY, replay.c) */
     uint8_t *ev_kind;  /* per event: its kind (stepping reads no records) */
 
     pdt_rtri *tris;
@@ -67,10 +71,14 @@ struct pdt_replay {
     pdt_rstate **ck;
 
     /* Checkpoints kept in the index: the state at every ick_every-th cursor
-     * (pdt_rstate_to_blob), nick of them, ick_bytes each; none: nick == 0.
-     * They take the place of the checkpoints above. */
+     * (pdt_rstate_to_blob), nick of them (at most PDT_ICK_MAX), checkpoint c
+     * at ick + ick_off[c] (ick_off[nick]: their bytes), holding the triangles
+     * born before its cursor, ick_born[c] of them; none: nick == 0.  They
+     * take the place of the checkpoints above. */
     const uint8_t *ick;
-    size_t ick_every, nick, ick_bytes;
+    size_t ick_every, nick;
+    uint64_t ick_off[PDT_ICK_MAX + 1];
+    uint64_t ick_born[PDT_ICK_MAX];
 };
 
 /* Where pdt_replay_build streams the triangles and their histories (the
@@ -84,17 +92,40 @@ typedef struct pdt_replay_place {
     int (*get)(void *ctx, uint64_t at, void *p, size_t bytes);
     void *ctx;
     uint64_t budget;
+    /* NULL, or the counts the build's first pass would make, made by the
+     * caller as it wrote the records (the pass is then skipped): per fine
+     * bucket the triangle events (pdt_replay_fine_of), PDT_REPLAY_NFINE of
+     * them, and the events of every kind (PDT_EV_KIND_COUNT; kinds beyond
+     * it not counted). */
+    const uint64_t *fine_count, *kind_count;
 } pdt_replay_place;
+
+/* The triangle events of a build are grouped in this many buckets by a hash
+ * of their triangle: pdt_replay_fine_of gives the bucket of record rec of a
+ * run of n points and nranks ranks, or PDT_REPLAY_NFINE when the build does
+ * not group it (not a triangle event, or naming a point or rank beyond the
+ * run's). */
+#define PDT_REPLAY_NFINE 256
+size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks);
 
 /* pdt_replay_new, with the triangles and histories streamed to pl (NULL:
  * held in memory, no budget: pdt_replay_new). */
 pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs, size_t m,
                             int nranks, const pdt_replay_place *pl, pdt_replay **out, pdt_err *err);
 
-/* A state as bytes (the index's checkpoints): pdt_rstate_blob_bytes(r) bytes. */
-size_t pdt_rstate_blob_bytes(const pdt_replay *r);
-void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, uint8_t *out);
-void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in, size_t k);
+/* A state as bytes (the index's checkpoints): pdt_rstate_blob_bytes(r, born)
+ * bytes, holding the current entries of triangles 0 .. born-1 only (every
+ * later one must have none: born >= pdt_rstate_born(r, s)).  The triangles
+ * are numbered by their first event, so a checkpoint at cursor k needs only
+ * those born before k: the checkpoints of a run take about half the bytes
+ * of whole states. */
+size_t pdt_rstate_blob_bytes(const pdt_replay *r, size_t born);
+/* 1 + the last triangle that has a current entry in s (0: none has). */
+size_t pdt_rstate_born(const pdt_replay *r, const pdt_rstate *s);
+void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, size_t born, uint8_t *out);
+/* s = the state of the blob at `in` (made with `born`) at cursor k. */
+void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in, size_t born,
+                          size_t k);
 
 /* Unmap a replay's kept index (index.c). */
 void pdt_index_unmap(pdt_replay *r);

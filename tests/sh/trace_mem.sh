@@ -11,6 +11,12 @@ source "$(dirname "$0")/lib.sh"
 
 out=$("$PDT" trace check "$TMP/run" 2>&1) && [[ "$out" == "ok: "*"= T*"* && "$out" != *"on disk"* ]] &&
     ok check_in_memory || fail check_in_memory "$out"
+# the ~5000 finals are sorted in memory by buckets of their smallest corner
+# (4096 or more: sort_fins' bucket pass, then an introsort per bucket); a
+# wrong order would not match T*
+nfin=$(echo "$out" | grep -o '[0-9]* final triangles' | cut -d' ' -f1)
+[ "${nfin:-0}" -ge 4096 ] && ok check_sorts_finals_in_buckets ||
+    fail check_sorts_finals_in_buckets "only '${nfin:-}' finals: the bucket pass is not run"
 out=$("$PDT" trace check "$TMP/run" --mem 2K 2>&1) && [[ "$out" == *"= T*"*"sorted on disk in"* ]] &&
     ok check_tiny_mem_spills || fail check_tiny_mem_spills "$out"
 # 300K: the ~5000 finals fit the pass's buffer (half the budget), but not
