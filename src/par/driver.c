@@ -49,7 +49,6 @@ typedef struct drv {
     srm_strip *strip;              /* p strip descriptors */
     srm_rank s;
     int s_init;
-    pdt_prefault *pf;              /* faulting the block in ahead (see partition) */
     pdt_par_rank_stats *me;
     pdt_err *err;
 } drv;
@@ -235,8 +234,8 @@ static uint32_t *block_id(const drv *d)
  * the strip's d->m distinct points in lexicographic order and their global
  * indices end in d->blk (block_pts, block_gid; room for this rank's input
  * block or its share of the whole plus 1/16, touched only as far as used; a
- * larger one when more records arrive).  in->pts is freed as soon as the records hold it if
- * in->release_pts. */
+ * larger one when more records arrive).  in->pts is freed as soon as the
+ * records hold it if in->release_pts. */
 static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
 {
     int p = d->p, r = d->rank;
@@ -364,15 +363,15 @@ static pdt_status local(drv *d, int prefault, pdt_err *err)
     uint32_t *gid = block_gid(d), *id = block_id(d);
     unsigned char *blk = d->blk;
     d->blk = NULL;
+    pdt_prefault *pf = NULL;
     if (prefault) { /* the kernel's edges grow past the partition's records */
         size_t front = 2 * d->blk_cap * sizeof(srm_rec), work = PDT_DELAUNAY_WORK(d->blk_cap);
         pdt_range edges = {blk + front, work > front ? work - front : 0};
-        d->pf = pdt_prefault_start(&edges, 1);
-        d->me->prefault = d->pf != NULL;
+        pf = pdt_prefault_start(&edges, 1);
+        d->me->prefault = pf != NULL;
     }
     st = pdt_srm_local(&d->s, blk, pts, gid, id, d->m, err);
-    pdt_prefault_stop(d->pf); /* every page of the block has been touched */
-    d->pf = NULL;
+    pdt_prefault_stop(pf); /* every page of the block has been touched */
     return st;
 }
 
@@ -829,7 +828,6 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
 done:
     enter(NULL);
     if (tr) tr->gid = saved_gid;
-    pdt_prefault_stop(d.pf);
     if (d.s_init) pdt_srm_free(&d.s);
     free(d.blk);
     free(d.strip);
