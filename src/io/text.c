@@ -16,29 +16,6 @@
 
 enum { MAP_MIN = 1 << 20 };
 
-/* A regular file of size bytes mapped read only at t->buf, with a zero byte
- * after it: the file's pages, then one page of anonymous zeros when size is
- * a multiple of the page size (else the rest of its last page reads as
- * zeros already).  Returns 0, or -1 (nothing mapped: read it instead). */
-static int map_file(int fd, size_t size, pdt_io_text *t)
-{
-    size_t pg = (size_t)sysconf(_SC_PAGESIZE);
-    size_t fbytes = (size + pg - 1) / pg * pg, total = size / pg * pg + pg;
-    char *a = mmap(NULL, total, PROT_READ, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (a == MAP_FAILED) return -1;
-    /* MAP_POPULATE: the page-cache pages are mapped in one call, not one
-     * fault per 64 KiB as the parser reaches them */
-    if (mmap(a, fbytes, PROT_READ, MAP_PRIVATE | MAP_FIXED | MAP_POPULATE, fd, 0) == MAP_FAILED) {
-        munmap(a, total);
-        return -1;
-    }
-    madvise(a, fbytes, MADV_SEQUENTIAL);
-    t->buf = a;
-    t->len = size;
-    t->mapped = total;
-    return 0;
-}
-
 pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
 {
     t->buf = NULL;
@@ -65,7 +42,7 @@ pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
      * of the right size (room for the byte the read that finds the end asks
      * for, and the '\0'); pipes: grow. */
     if (S_ISREG(sb.st_mode) && (uint64_t)sb.st_size >= MAP_MIN && (uint64_t)sb.st_size < SIZE_MAX / 2 &&
-        map_file(fd, (size_t)sb.st_size, t) == 0) {
+        pdt_io_map_part(fd, 0, (uint64_t)sb.st_size, t) == 0) {
         if (!is_stdin) close(fd);
         return PDT_OK;
     }
@@ -108,6 +85,10 @@ pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
     return PDT_OK;
 }
 
+/* (Also the whole file: lo = 0, hi = its size; the byte after its end is a
+ * zero already, in its last page or in the anonymous page after it.)  The
+ * page-cache pages are mapped in one call (MAP_POPULATE), not one fault per
+ * 64 KiB as the parser reaches them. */
 int pdt_io_map_part(int fd, uint64_t lo, uint64_t hi, pdt_io_text *t)
 {
     size_t pg = (size_t)sysconf(_SC_PAGESIZE);
