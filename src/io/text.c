@@ -41,8 +41,7 @@ pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
      * points on this project's VM).  Other regular files: one allocation
      * of the right size (room for the byte the read that finds the end asks
      * for, and the '\0'); pipes: grow. */
-    if (S_ISREG(sb.st_mode) && (uint64_t)sb.st_size >= MAP_MIN && (uint64_t)sb.st_size < SIZE_MAX / 2 &&
-        pdt_io_map_part(fd, 0, (uint64_t)sb.st_size, t) == 0) {
+    if (S_ISREG(sb.st_mode) && pdt_io_map_part(fd, 0, (uint64_t)sb.st_size, t) == 0) {
         if (!is_stdin) close(fd);
         return PDT_OK;
     }
