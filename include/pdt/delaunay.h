@@ -101,4 +101,12 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
  * lexicographic order, each the smallest index among its copies. */
 pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size_t *nu);
 
+/* The same on the caller's scratch, work: PDT_SORT_WORK(n) bytes, 8-byte
+ * aligned (overlapping none of pts, order, q); q, if not NULL, gets the
+ * distinct points themselves (q[i] == pts[order[i]]).  PDT_ERR_ARG if n is
+ * above 2^32 - 1. */
+#define PDT_SORT_WORK(n) ((size_t)32 * (size_t)(n) + 2 * 2049 * sizeof(size_t))
+pdt_status pdt_sort_unique_on(const pdt_point *pts, size_t n, void *work, uint32_t *order,
+                              pdt_point *q, size_t *nu);
+
 #endif

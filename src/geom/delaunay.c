@@ -997,6 +997,20 @@ static void sort_core(const pdt_point *pts, size_t n, keyed *a, keyed *b, size_t
     o->ndup = n - u;
 }
 
+pdt_status pdt_sort_unique_on(const pdt_point *pts, size_t n, void *work, uint32_t *order,
+                              pdt_point *q, size_t *nu)
+{
+    *nu = 0;
+    if (n == 0) return PDT_OK;
+    if (n > UINT32_MAX) return PDT_ERR_ARG;
+    keyed *a = work, *b = a + n;
+    size_t *cnt = (size_t *)(void *)(b + n), *hc = cnt + 2049;
+    sorted o = { order, q, NULL, 0, 0 };
+    sort_core(pts, n, a, b, cnt, hc, &o);
+    *nu = o.nu;
+    return PDT_OK;
+}
+
 pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size_t *nu)
 {
     *nu = 0;

@@ -45,6 +45,7 @@ typedef struct drv {
     size_t blk_cap, blk_bytes;     /* room for blk_cap points; its size */
     size_t m;
     uint64_t nrecv;
+    uint64_t local_dups;           /* copies dropped before the exchange */
     uint64_t n_total;              /* points in the whole input */
     srm_strip *strip;              /* p strip descriptors */
     srm_rank s;
@@ -230,6 +231,27 @@ static uint32_t *block_id(const drv *d)
     return block_gid(d) + d->blk_cap + 1;
 }
 
+/* This rank's input block sorted by the plain run's sort (pdt_sort_unique_on:
+ * one counting pass by the top bits into buckets, each finished in the
+ * cache; the first of equal points kept, and input order is index order) on
+ * the block's front, the distinct points and their positions written where
+ * the strip's points and indices go later: rec[0, *nu), key-sorted, the
+ * records of the distinct points with their global indices.  A block too
+ * small for the sort's counters (a tiny input) gets scratch of its own. */
+static pdt_status sort_block(drv *d, const pdt_par_input *in, srm_rec *rec, size_t *nu)
+{
+    size_t n = in->n, need = PDT_SORT_WORK(n);
+    void *work = need <= PDT_DELAUNAY_WORK(d->blk_cap) ? (void *)d->blk : malloc(need);
+    pdt_point *q = block_pts(d);
+    uint32_t *pos = block_gid(d);
+    pdt_status st = work ? pdt_sort_unique_on(in->pts, n, work, pos, q, nu) : PDT_ERR_NOMEM;
+    if (work != d->blk) free(work);
+    if (st != PDT_OK) return nomem(d, "partition");
+    for (size_t i = 0; i < *nu; i++)
+        rec[i] = (srm_rec){pdt_key(q[i]), (uint32_t)(in->first + pos[i]), 0};
+    return PDT_OK;
+}
+
 /* Sample sort of this rank's input block by key, with exact splitters:
  * the strip's d->m distinct points in lexicographic order and their global
  * indices end in d->blk (block_pts, block_gid; room for this rank's input
@@ -251,14 +273,18 @@ static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
     sc = malloc((size_t)p * sizeof *sc);
     rc = malloc((size_t)p * sizeof *rc);
     if (!cnt || !rcnt || !start || !split || !sc || !rc || !blk) goto nomem;
-    for (size_t i = 0; i < n; i++)
-        rec[i] = (srm_rec){pdt_key(in->pts[i]), (uint32_t)(in->first + i), 0};
+    d->blk = blk;
+    d->blk_cap = cap;
+    size_t nu = 0;
+    st = sort_block(d, in, rec, &nu);
+    d->blk = NULL;
+    if (st != PDT_OK) goto done;
+    d->local_dups = n - nu;
+    n = nu;
     if (in->release_pts) {
         free(in->pts);
         in->pts = NULL;
     }
-    /* input order is index order: the stable sort orders equal keys by index */
-    pdt_srm_radix_sort(rec, tmp, n);
     st = splitters(d, rec, n, split, err);
     if (st != PDT_OK) goto done;
     /* rank q's records are a consecutive block of the sorted ones */
@@ -681,8 +707,8 @@ static void figures(drv *d)
     pdt_par_rank_stats *me = d->me;
     const srm_rank *s = &d->s;
     me->points = d->m;
-    me->received = d->nrecv;
-    me->n_dup = d->nrecv - d->m;
+    me->received = d->nrecv + d->local_dups;
+    me->n_dup = me->received - d->m;
     me->local_tris = s->cnt.local_tris;
     me->final_at_once = s->cnt.final_at_once;
     me->deferred = s->cnt.deferred;

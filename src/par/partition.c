@@ -7,42 +7,34 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Stable bottom-up merge sort using tmp: the path when no counters can be
- * had (rare). */
-static void merge_sort(srm_rec *r, srm_rec *tmp, size_t n)
+/* Stable LSD radix sort on the 64-bit key, 11 bits per pass over the bits
+ * the records' coordinates actually span (see below). */
+void pdt_srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n)
 {
-    srm_rec *src = r, *dst = tmp;
-    for (size_t w = 1; w < n; w *= 2) {
-        for (size_t lo = 0; lo < n; lo += 2 * w) {
-            size_t mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
-            size_t i = lo, j = mid, k = lo;
-            while (i < mid && j < hi) dst[k++] = src[j].key < src[i].key ? src[j++] : src[i++];
-            while (i < mid) dst[k++] = src[i++];
-            while (j < hi) dst[k++] = src[j++];
+    if (n < 2) return;
+    enum { DBITS = 11, DB = 1 << DBITS, MAXPASS = (64 + DBITS - 1) / DBITS };
+    size_t *hist = calloc((size_t)MAXPASS * DB, sizeof *hist);
+    if (!hist) { /* fall back to insertion-free merge sort: rare path */
+        /* Stable bottom-up merge sort using tmp. */
+        srm_rec *src = r, *dst = tmp;
+        for (size_t w = 1; w < n; w *= 2) {
+            for (size_t lo = 0; lo < n; lo += 2 * w) {
+                size_t mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
+                size_t i = lo, j = mid, k = lo;
+                while (i < mid && j < hi) dst[k++] = src[j].key < src[i].key ? src[j++] : src[i++];
+                while (i < mid) dst[k++] = src[i++];
+                while (j < hi) dst[k++] = src[j++];
+            }
+            srm_rec *t = src;
+            src = dst;
+            dst = t;
         }
-        srm_rec *t = src;
-        src = dst;
-        dst = t;
+        if (src != r) memcpy(r, src, n * sizeof *r);
+        return;
     }
-    if (src != r) memcpy(r, src, n * sizeof *r);
-}
-
-/* The compact key of a record: (x - xlo) << ybits | (y - ylo) orders like the
- * key and needs only the bits the coordinates span (40 for points in
- * [0, 2^20)^2). */
-typedef struct compact {
-    uint32_t xlo, ylo;
-    int ybits, bits;
-} compact;
-
-static inline uint64_t ckey(const compact *c, uint64_t key)
-{
-    return ((uint64_t)((uint32_t)(key >> 32) - c->xlo) << c->ybits) |
-           (uint64_t)((uint32_t)key - c->ylo);
-}
-
-static compact compact_of(const srm_rec *r, size_t n)
-{
+    /* compact keys: (x - xmin) << ybits | (y - ymin) orders like the key
+     * and needs only the bits the coordinates span (40 for points in
+     * [0, 2^20)^2), so 11-bit digits (2048 counters, in L1) take 4 passes */
     uint32_t xlo = UINT32_MAX, xhi = 0, ylo = UINT32_MAX, yhi = 0;
     for (size_t i = 0; i < n; i++) {
         uint32_t x = (uint32_t)(r[i].key >> 32), y = (uint32_t)r[i].key;
@@ -51,91 +43,32 @@ static compact compact_of(const srm_rec *r, size_t n)
         ylo = y < ylo ? y : ylo;
         yhi = y > yhi ? y : yhi;
     }
-    compact c = {xlo, ylo, 0, 0};
-    int xbits = 0;
-    while (c.ybits < 32 && ((uint64_t)(yhi - ylo) >> c.ybits)) c.ybits++;
+    int ybits = 0, xbits = 0;
+    while (ybits < 32 && ((uint64_t)(yhi - ylo) >> ybits)) ybits++;
     while (xbits < 32 && ((uint64_t)(xhi - xlo) >> xbits)) xbits++;
-    c.bits = xbits + c.ybits;
-    return c;
-}
-
-/* Stable LSD passes over one bucket src[0, m) (in the cache) by the compact
- * key's bits [0, bits), digits of at most 11 bits, those on which every key
- * agrees skipped; the result ends in src or dst: returns which. */
-static srm_rec *bucket_lsd(const compact *c, srm_rec *src, srm_rec *dst, size_t m, int bits,
-                           size_t *cnt)
-{
-    if (m < 2 || bits == 0) return src;
-    if (m <= 32) { /* stable insertion sort */
-        for (size_t i = 1; i < m; i++) {
-            srm_rec v = src[i];
-            size_t j = i;
-            while (j > 0 && src[j - 1].key > v.key) {
-                src[j] = src[j - 1];
-                j--;
-            }
-            src[j] = v;
-        }
-        return src;
+    int passes = (xbits + ybits + DBITS - 1) / DBITS;
+#define CKEY(k) (((uint64_t)((uint32_t)((k) >> 32) - xlo) << ybits) | (uint64_t)((uint32_t)(k) - ylo))
+    for (size_t i = 0; i < n; i++) {
+        uint64_t ck = CKEY(r[i].key);
+        for (int p = 0; p < passes; p++) hist[(size_t)p * DB + ((ck >> (p * DBITS)) & (DB - 1))]++;
     }
-    uint64_t all_or = 0, all_and = ~UINT64_C(0);
-    for (size_t i = 0; i < m; i++) {
-        uint64_t k = ckey(c, src[i].key);
-        all_or |= k;
-        all_and &= k;
-    }
-    int passes = (bits + 10) / 11, d = (bits + passes - 1) / passes;
-    uint64_t mask = (UINT64_C(1) << d) - 1;
-    for (int shift = 0; shift < bits; shift += d) {
-        if ((((all_or ^ all_and) >> shift) & mask) == 0) continue;
-        memset(cnt, 0, ((size_t)mask + 1) * sizeof *cnt);
-        for (size_t i = 0; i < m; i++) cnt[(ckey(c, src[i].key) >> shift) & mask]++;
+    srm_rec *src = r, *dst = tmp;
+    for (int p = 0; p < passes; p++) {
+        size_t *h = hist + (size_t)p * DB;
         size_t sum = 0;
-        for (size_t k = 0; k <= mask; k++) {
-            size_t v = cnt[k];
-            cnt[k] = sum;
-            sum += v;
+        for (size_t d = 0; d < DB; d++) {
+            size_t c = h[d];
+            h[d] = sum;
+            sum += c;
         }
-        for (size_t i = 0; i < m; i++) dst[cnt[(ckey(c, src[i].key) >> shift) & mask]++] = src[i];
+        for (size_t i = 0; i < n; i++) dst[h[(CKEY(src[i].key) >> (p * DBITS)) & (DB - 1)]++] = src[i];
         srm_rec *t = src;
         src = dst;
         dst = t;
     }
-    return src;
-}
-
-/* Stable radix sort on the key: one counting pass by the compact key's top
- * 11 bits puts the records in about 2048 buckets (in tmp), each small enough
- * for the cache at a few million records, then LSD passes finish each bucket
- * there and it goes back to r.  (Four LSD passes over the whole array, as
- * before, scattered each record four times into 2048 streams far past the
- * cache and the TLB.) */
-void pdt_srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n)
-{
-    if (n < 2) return;
-    enum { HB = 11, DB = 1 << HB };
-    size_t *hc = calloc(DB + 1, sizeof *hc), *cnt = malloc(DB * sizeof *cnt);
-    if (!hc || !cnt) {
-        free(hc);
-        free(cnt);
-        merge_sort(r, tmp, n);
-        return;
-    }
-    compact c = compact_of(r, n);
-    int hb = c.bits < HB ? c.bits : HB, shift = c.bits - hb;
-    size_t nb = (size_t)1 << hb;
-    for (size_t i = 0; i < n; i++) hc[(ckey(&c, r[i].key) >> shift) + 1]++;
-    for (size_t h = 1; h <= nb; h++) hc[h] += hc[h - 1];
-    for (size_t i = 0; i < n; i++) tmp[hc[ckey(&c, r[i].key) >> shift]++] = r[i];
-    /* hc[h] is now the end of bucket h, in tmp */
-    for (size_t h = 0, start = 0; h < nb; h++) {
-        size_t end = hc[h];
-        srm_rec *done = bucket_lsd(&c, tmp + start, r + start, end - start, shift, cnt);
-        if (done != r + start) memcpy(r + start, done, (end - start) * sizeof *r);
-        start = end;
-    }
-    free(hc);
-    free(cnt);
+#undef CKEY
+    if (src != r) memcpy(r, src, n * sizeof *r);
+    free(hist);
 }
 
 size_t pdt_srm_dedupe(srm_rec *r, size_t n)

@@ -58,7 +58,9 @@ typedef struct srm_rec {
     uint32_t pad;
 } srm_rec;
 
-/* Stable LSD radix sort of r[0..n) by key (tmp: n scratch records). */
+/* Stable LSD radix sort of r[0..n) by key (tmp: n scratch records).  (The
+ * driver's partition sorts its block with pdt_sort_unique_on; the unit tests
+ * that build partitions by hand use this.) */
 void pdt_srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n);
 
 /* Remove records with equal keys keeping the first; returns the new count. */
