@@ -351,7 +351,7 @@ static const char *const srm_code[] = {
     "8    B = border set; lift(B); T_B = DT(B)",
     "9    keep crossing or shipped; discard rest",
     "10   H = merge hulls; reclassify kept",
-    "11 gather, sort, write",
+    "11 sort, send by index range, merge, write",
 };
 
 static const struct {
