@@ -1003,6 +1003,7 @@ pdt_status pdt_sort_unique_on(const pdt_point *pts, size_t n, void *work, uint32
     *nu = 0;
     if (n == 0) return PDT_OK;
     if (n > UINT32_MAX) return PDT_ERR_ARG;
+    _Static_assert(sizeof(keyed) == 16, "PDT_SORT_WORK counts 16 bytes a record");
     keyed *a = work, *b = a + n;
     size_t *cnt = (size_t *)(void *)(b + n), *hc = cnt + 2049;
     sorted o = { order, q, NULL, 0, 0 };
@@ -1016,19 +1017,11 @@ pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size
     *nu = 0;
     if (n == 0) return PDT_OK;
     if (n > UINT32_MAX) return PDT_ERR_ARG;
-    keyed *a = pdt_big_alloc(n * sizeof *a), *b = pdt_big_alloc(n * sizeof *b);
-    size_t *cnt = malloc(2049 * sizeof *cnt), *hc = malloc(2049 * sizeof *hc);
-    pdt_status st = PDT_ERR_NOMEM;
-    if (a && b && cnt && hc) {
-        sorted o = { order, NULL, NULL, 0, 0 };
-        sort_core(pts, n, a, b, cnt, hc, &o);
-        *nu = o.nu;
-        st = PDT_OK;
-    }
-    pdt_big_free(a, n * sizeof *a);
-    pdt_big_free(b, n * sizeof *b);
-    free(cnt);
-    free(hc);
+    size_t bytes = PDT_SORT_WORK(n);
+    void *work = pdt_big_alloc(bytes);
+    if (!work) return PDT_ERR_NOMEM;
+    pdt_status st = pdt_sort_unique_on(pts, n, work, order, NULL, nu);
+    pdt_big_free(work, bytes);
     return st;
 }
 

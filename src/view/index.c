@@ -20,6 +20,7 @@
  * The identity of a run is a hash of the name, size and modification time
  * of every file in the folder (but dot-files) and of the manifest's bytes.
  * An index whose identity, sizes or checksums do not match is rebuilt. */
+#include "pdt/io.h"
 #include "pdt/replay.h"
 #include "replay_int.h"
 
@@ -1067,11 +1068,9 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     if (recs != MAP_FAILED) munmap(recs, recs_len);
     if (close(fd) != 0 && st == PDT_OK)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
-    /* the stale index goes first: a rename over an existing file makes ext4
-     * write the new one back to disk inside the call (its auto_da_alloc
-     * rule), gigabytes for a big run */
-    if (st == PDT_OK) unlink(path);
-    if (st == PDT_OK && rename(tmp, path) != 0)
+    /* into place over a stale index without ext4 writing the new one back
+     * inside the call (pdt_replace_file: gigabytes for a big run) */
+    if (st == PDT_OK && pdt_replace_file(tmp, path) != 0)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", path, strerror(errno));
     if (st != PDT_OK) unlink(tmp);
     free(h);
