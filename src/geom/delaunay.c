@@ -195,7 +195,9 @@ static inline uint64_t frame_key(pdt_point p, int axis)
 /* The value of rank k among the distinct keys v[0, n) (v is reordered).
  * Quickselect with the median of three pseudo-random elements as pivot: the
  * expected time is O(n) for every input (the expectation is over the
- * generator, which is seeded from n, so runs are reproducible). */
+ * generator, which is seeded from n, so runs are reproducible).  The split
+ * is branch-free (Lomuto with an unconditional swap): on keys in random
+ * order a branching split mispredicts about every other comparison. */
 static uint64_t kth_key(uint64_t *v, size_t n, size_t k)
 {
     uint64_t rs = n * UINT64_C(0x9e3779b97f4a7c15) + 1;
@@ -209,24 +211,25 @@ static uint64_t kth_key(uint64_t *v, size_t n, size_t k)
             r[q] = lo + (size_t)(rs % w);
         }
         uint64_t a = v[r[0]], b = v[r[1]], c = v[r[2]];
-        uint64_t piv = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
-        /* three-way split: [lo, lt) < piv, [lt, gt) == piv, [gt, hi) > piv */
-        size_t lt = lo, i = lo, gt = hi;
-        while (i < gt) {
+        size_t m = a < b ? (b < c ? r[1] : (a < c ? r[2] : r[0]))
+                         : (a < c ? r[0] : (b < c ? r[2] : r[1]));
+        uint64_t piv = v[m];
+        v[m] = v[lo];
+        v[lo] = piv;
+        /* [lo + 1, lt) < piv, [lt, i) > piv (the keys are distinct) */
+        size_t lt = lo + 1;
+        for (size_t i = lo + 1; i < hi; i++) {
             uint64_t x = v[i];
-            if (x < piv) {
-                v[i++] = v[lt];
-                v[lt++] = x;
-            } else if (x > piv) {
-                v[i] = v[--gt];
-                v[gt] = x;
-            } else {
-                i++;
-            }
+            v[i] = v[lt];
+            v[lt] = x;
+            lt += x < piv;
         }
-        if (k < lt) hi = lt;
-        else if (k >= gt) lo = gt;
-        else return piv;
+        size_t p = lt - 1; /* piv's place */
+        v[lo] = v[p];
+        v[p] = piv;
+        if (k == p) return piv;
+        if (k < p) hi = p;
+        else lo = p + 1;
     }
     if (hi - lo == 2 && v[lo] > v[lo + 1]) {
         uint64_t t = v[lo];
@@ -476,29 +479,62 @@ static int build(dt *d, uint32_t lo, uint32_t hi, int axis, uint32_t *le, uint32
     return merge(d, ldo, ldi, rdi, rdo, le, re);
 }
 
-/* Collect the counter-clockwise triangles: walk each left face with lprev
- * (org and onext only) and report it at its smallest edge, so every face is
- * seen once, in the order of its smallest edge.  Triangle k is written over
- * edge record k: k <= the current edge, and only larger edges are read from
- * then on.  Vertices are written as id[v].  Returns the number of triangles. */
+/* Collect the counter-clockwise triangles: the left face of every directed
+ * edge e is (org e, dest e, dest lnext e), reported at its smallest edge, so
+ * every face is seen once, in the order of its smallest edge; the outer face
+ * (clockwise around the hull) fails the orientation test.  lnext(e) =
+ * oprev(sym e) lies in the record beside e's, and the record of sym(lnext e)
+ * holds both dest(lnext e) and lnext(lnext e): one record out of place per
+ * edge, fetched PF_AHEAD edge pairs ahead (the walk was bound by those
+ * misses).  Edges go by pairs (e, sym e), both records read before a
+ * triangle is written: triangle k is written over edge record k, and k <=
+ * the current pair's first edge.  Vertices are written as id[v].  Returns
+ * the number of triangles. */
+enum { PF_AHEAD = 16 };
+
 static size_t collect(dt *d, const uint32_t *id, const uint32_t *tid, int run)
 {
     pdt_trace *tr = d->tr;
+    const edge *r = d->e;
     pdt_tri *out = (pdt_tri *)(void *)d->e; /* 12 bytes each, like an edge */
-    size_t nt = 0;
-    for (uint32_t e = 0; e < (uint32_t)d->used; e++) {
-        if (d->e[e].org == NIL) continue;
-        uint32_t e1 = sym(d->e[e].onext);  /* lprev(e) */
-        if (e1 < e) continue;
-        uint32_t e2 = sym(d->e[e1].onext); /* lprev(lprev(e)) */
-        if (e2 < e || sym(d->e[e2].onext) != e) continue;
-        uint32_t a = d->e[e].org, b = d->e[e2].org, c = d->e[e1].org;
-        if (pdt_orient_fast(d->p[a], d->p[b], d->p[c]) <= 0) continue; /* the outer face */
-        PDT_TRACE(tr, 1, PDT_EV_TRI_NEW, run, tid[a], tid[b], tid[c], 0);
-        out[nt].v[0] = id[a];
-        out[nt].v[1] = id[b];
-        out[nt].v[2] = id[c];
-        nt++;
+    size_t nt = 0, used = d->used;
+    for (size_t e = 0; e < used; e += 2) {
+        if (e + 2 * PF_AHEAD < used) {
+            __builtin_prefetch(&r[r[e + 2 * PF_AHEAD + 1].oprev ^ 1u]);
+            __builtin_prefetch(&r[r[e + 2 * PF_AHEAD].oprev ^ 1u]);
+        }
+        edge f = r[e], g = r[e + 1]; /* e and sym e */
+        if (f.org == NIL) continue;  /* a deleted edge (both halves) */
+        uint32_t tri[2][3];
+        int k = 0;
+        /* the left face of e: lnext e = g.oprev; of sym e: lnext = f.oprev */
+        uint32_t l0 = g.oprev, l1 = f.oprev;
+        if (l0 > e) {
+            edge h = r[l0 ^ 1u]; /* org: dest(lnext e); oprev: lnext(lnext e) */
+            if (h.oprev > e && pdt_orient_fast(d->p[f.org], d->p[g.org], d->p[h.org]) > 0) {
+                tri[k][0] = f.org;
+                tri[k][1] = g.org;
+                tri[k][2] = h.org;
+                k++;
+            }
+        }
+        if (l1 > e + 1) {
+            edge h = r[l1 ^ 1u];
+            if (h.oprev > e + 1 && pdt_orient_fast(d->p[g.org], d->p[f.org], d->p[h.org]) > 0) {
+                tri[k][0] = g.org;
+                tri[k][1] = f.org;
+                tri[k][2] = h.org;
+                k++;
+            }
+        }
+        for (int j = 0; j < k; j++) {
+            uint32_t a = tri[j][0], b = tri[j][1], c = tri[j][2];
+            PDT_TRACE(tr, 1, PDT_EV_TRI_NEW, run, tid[a], tid[b], tid[c], 0);
+            out[nt].v[0] = id[a];
+            out[nt].v[1] = id[b];
+            out[nt].v[2] = id[c];
+            nt++;
+        }
     }
     return nt;
 }
