@@ -41,6 +41,18 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
 pdt_status pdt_delaunay_on(pdt_point *pts, size_t n, uint32_t *id, void *work, size_t work_bytes,
                            size_t *ntri, int run, pdt_trace *tr);
 
+/* pdt_delaunay_on, and the convex hull as a by-product of the triangulation
+ * (its outer face, walked before the triangles are written): *hull
+ * (malloc'd, the caller frees) gets the indices of the hull vertices,
+ * collinear boundary points included, counter-clockwise from pts[0] (the
+ * lexicographically smallest) -- the same list as pdt_hull_chain's for a
+ * set that is not degenerate.  When the points are all collinear, n < 3, or
+ * on an error: *hull = NULL, *nhull = 0 (pdt_hull_chain says what a
+ * degenerate hull is).  hull may be NULL (pdt_delaunay_on). */
+pdt_status pdt_delaunay_hull_on(pdt_point *pts, size_t n, uint32_t *id, void *work,
+                                size_t work_bytes, size_t *ntri, uint32_t **hull, size_t *nhull,
+                                int run, pdt_trace *tr);
+
 /* Rotate every triangle so that it starts at its smallest index (keeping the
  * counter-clockwise order) and sort the array lexicographically: the
  * canonical output order, identical for every algorithm and every rank count. */

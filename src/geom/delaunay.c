@@ -546,8 +546,32 @@ static size_t collect(dt *d, const uint32_t *id, const uint32_t *tid, int run)
  * over the edges: (pdt_tri *)e, *ntri of them).  Triangles come out as ids;
  * the trace sees ids through tr->gid when there is one.  Returns
  * PDT_ERR_NOMEM (q and id still consistent) when an allocation fails. */
+/* The convex hull from the triangulation's outer face, before the triangles
+ * are written over the edges: the walk e <- rprev e from le (the
+ * counter-clockwise hull edge out of the lexicographically smallest point)
+ * goes around the hull counter-clockwise; every boundary point is a vertex
+ * of the outer face, the collinear ones included.  *hull (malloc'd) names
+ * them as id[v]; on a line the walk goes out and back (more than n steps)
+ * and nothing is given.  Returns 0 when out of memory. */
+static int outer_hull(const dt *d, uint32_t le, size_t n, const uint32_t *id, uint32_t **hull,
+                      size_t *nhull)
+{
+    size_t k = 0;
+    uint32_t e = le;
+    do {
+        if (++k > n) return 1; /* collinear */
+        e = rprev(d, e);
+    } while (e != le);
+    uint32_t *h = malloc(k * sizeof *h);
+    if (!h) return 0;
+    for (size_t i = 0; i < k; i++, e = rprev(d, e)) h[i] = id[org(d, e)];
+    *hull = h;
+    *nhull = k;
+    return 1;
+}
+
 static pdt_status kernel_on(uint32_t *id, pdt_point *q, size_t n, edge *e, size_t cap,
-                            size_t *ntri, int run, pdt_trace *tr)
+                            size_t *ntri, int run, pdt_trace *tr, uint32_t **hull, size_t *nhull)
 {
     *ntri = 0;
     dt d;
@@ -589,6 +613,7 @@ static pdt_status kernel_on(uint32_t *id, pdt_point *q, size_t n, edge *e, size_
     }
     uint32_t le, re;
     int ok = build(&d, 0, (uint32_t)n, 0, &le, &re);
+    if (ok && hull && n >= 3) ok = outer_hull(&d, le, n, id, hull, nhull);
     if (ok) *ntri = collect(&d, id, tid, run);
     free(tmap);
     return ok ? PDT_OK : PDT_ERR_NOMEM;
@@ -623,7 +648,7 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
     for (uint32_t i = 0; i < (uint32_t)n; i++) id[i] = i;
     memcpy(q, pts, n * sizeof *q);
     size_t nt = 0;
-    pdt_status s = kernel_on(id, q, n, e, cap, &nt, run, tr);
+    pdt_status s = kernel_on(id, q, n, e, cap, &nt, run, tr, NULL, NULL);
     free(id);
     pdt_big_free(q, n * sizeof *q);
     if (s != PDT_OK || nt == 0) {
@@ -640,22 +665,38 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
  * the kernel's (leaf-order) array during the call and are put back from
  * id afterwards, through scratch in work beyond the triangles (8 bytes per
  * point; the triangles take at most 24 of the 72). */
-pdt_status pdt_delaunay_on(pdt_point *pts, size_t n, uint32_t *id, void *work, size_t work_bytes,
-                           size_t *ntri, int run, pdt_trace *tr)
+pdt_status pdt_delaunay_hull_on(pdt_point *pts, size_t n, uint32_t *id, void *work,
+                                size_t work_bytes, size_t *ntri, uint32_t **hull, size_t *nhull,
+                                int run, pdt_trace *tr)
 {
     *ntri = 0;
+    if (hull) {
+        *hull = NULL;
+        *nhull = 0;
+    }
     if (n < 2) return PDT_OK;
     if (n > PDT_KERNEL_MAX_POINTS || work_bytes < PDT_DELAUNAY_WORK(n)) return PDT_ERR_ARG;
     for (size_t i = 1; i < n; i++) /* the precondition: distinct and sorted */
         if (pdt_key(pts[i - 1]) >= pdt_key(pts[i])) return PDT_ERR_ARG;
     for (uint32_t i = 0; i < (uint32_t)n; i++) id[i] = i;
     size_t nt = 0;
-    pdt_status s = kernel_on(id, pts, n, (edge *)work, edge_cap(n), &nt, run, tr);
+    pdt_status s = kernel_on(id, pts, n, (edge *)work, edge_cap(n), &nt, run, tr, hull, nhull);
     pdt_point *tmp = (pdt_point *)(void *)((pdt_tri *)work + (s == PDT_OK ? nt : 0));
     memcpy(tmp, pts, n * sizeof *tmp);
     for (size_t v = 0; v < n; v++) pts[id[v]] = tmp[v];
     if (s == PDT_OK) *ntri = nt;
+    if (hull && (s != PDT_OK || nt == 0)) { /* (none on a line) */
+        free(*hull);
+        *hull = NULL;
+        *nhull = 0;
+    }
     return s;
+}
+
+pdt_status pdt_delaunay_on(pdt_point *pts, size_t n, uint32_t *id, void *work, size_t work_bytes,
+                           size_t *ntri, int run, pdt_trace *tr)
+{
+    return pdt_delaunay_hull_on(pts, n, id, work, work_bytes, ntri, NULL, NULL, run, tr);
 }
 
 /* ---- canonical order ---- */
@@ -1175,7 +1216,7 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
      * (tr->gid composed) */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_KERNEL, 0, 0, 0, 0);
     size_t nt = 0;
-    pdt_status s = nu >= 2 ? kernel_on(order, pts, nu, R, cap, &nt, 0, tr) : PDT_OK;
+    pdt_status s = nu >= 2 ? kernel_on(order, pts, nu, R, cap, &nt, 0, tr, NULL, NULL) : PDT_OK;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
     pdt_prefault_stop(pf); /* (long done, but it must end before R shrinks) */
     double t2 = now();

@@ -215,12 +215,18 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
         }
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_LIFT, 0, 0, 0, 0);
 
-    /* local kernel, in the block, on the strip's own points (no copy) */
+    /* local kernel, in the block, on the strip's own points (no copy); when
+     * not tracing, the strip hull comes with it (the triangulation's outer
+     * face) */
+    int traced = PDT_TRACING(tr, 1);
+    uint32_t *kh = NULL;
+    size_t nkh = 0;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_KERNEL, 0, 0, 0, 0);
     size_t ntri = 0;
     const uint32_t *saved = tr ? tr->gid : NULL;
     if (tr) tr->gid = gid;
-    pdt_status st = pdt_delaunay_on(pts, m, id, block, PDT_DELAUNAY_WORK(m), &ntri, 0, tr);
+    pdt_status st = pdt_delaunay_hull_on(pts, m, id, block, PDT_DELAUNAY_WORK(m), &ntri,
+                                         traced ? NULL : &kh, &nkh, 0, tr);
     if (tr) tr->gid = saved;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
     if (st != PDT_OK)
@@ -229,18 +235,25 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
     s->cnt.local_tris = ntri;
 
     /* strip hull: monotone chain (Graham's scan with the origin at infinity),
-     * its stack in the kernel's id scratch */
+     * its stack in the kernel's id scratch -- traced, or when the kernel gave
+     * none (a degenerate strip: the chain says how) */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_HULL, 0, 0, 0, 0);
-    uint32_t *h = id;
-    size_t nh = 0;
+    uint32_t *h = kh ? kh : id;
+    size_t nh = nkh;
     int deg = 0;
-    if (tr) tr->gid = gid;
-    st = pdt_hull_chain(pts, m, h, &nh, &deg, PDT_STACK_LOWER, PDT_STACK_UPPER, tr);
-    if (tr) tr->gid = saved;
-    if (st != PDT_OK) return pdt_err_set(err, st, "rank %d: strip hull failed", s->rank);
+    if (!kh) {
+        if (tr) tr->gid = gid;
+        st = pdt_hull_chain(pts, m, h, &nh, &deg, PDT_STACK_LOWER, PDT_STACK_UPPER, tr);
+        if (tr) tr->gid = saved;
+        if (st != PDT_OK) return pdt_err_set(err, st, "rank %d: strip hull failed", s->rank);
+    }
     s->hull = malloc((nh + 1) * sizeof *s->hull);
-    if (!s->hull) return nomem(err, s->rank, "hull");
+    if (!s->hull) {
+        free(kh);
+        return nomem(err, s->rank, "hull");
+    }
     for (size_t i = 0; i < nh; i++) s->hull[i] = (srm_pt){pts[h[i]].x, pts[h[i]].y, gid[h[i]]};
+    free(kh);
     s->nhull = nh;
     s->hull_degenerate = deg;
     s->holds_hull = 1;

@@ -10,6 +10,7 @@
 
 #include "pdt/delaunay.h"
 #include "pdt/gen.h"
+#include "pdt/hull.h"
 
 static uint64_t rng_state = 0x2545f4914f6cdd1dull;
 static uint64_t rnd(void)
@@ -95,6 +96,52 @@ TEST(delaunay_on_equals_delaunay)
     printf("# %d kernel runs on the caller's memory\n", runs);
 }
 
+/* The hull the kernel gives with its triangles (its outer face) is the
+ * monotone chain's, vertex for vertex (collinear boundary points kept,
+ * counter-clockwise from the smallest point), on every family the
+ * generator has -- grids, circles and columns put many points on the hull's
+ * edges -- and none when the chain calls the set degenerate. */
+TEST(kernel_hull_is_chain_hull)
+{
+    int runs = 0, degenerate = 0;
+    for (const char *const *k = pdt_gen_kinds(); *k; k++) {
+        static const size_t ns[] = {0, 1, 2, 3, 4, 5, 9, 16, 100, 2500, 20000};
+        for (size_t ni = 0; ni < sizeof ns / sizeof *ns; ni++) {
+            pdt_point *pts = NULL;
+            pdt_err err;
+            pdt_err_clear(&err);
+            if (pdt_gen(*k, ns[ni], 11 + ni, &pts, &err) != PDT_OK) {
+                CHECK_MSG(0, "gen %s: %s", *k, err.msg);
+                continue;
+            }
+            size_t n = sort_distinct(pts, ns[ni]);
+            uint32_t *ch = malloc((n + 1) * sizeof *ch), *id = malloc((n + 1) * sizeof *id);
+            size_t nch = 0, nt = 0, nkh = 99;
+            int deg = 0;
+            CHECK(pdt_hull_chain(pts, n, ch, &nch, &deg, 0, 1, NULL) == PDT_OK);
+            void *work = malloc(PDT_DELAUNAY_WORK(n));
+            uint32_t *kh = (uint32_t *)(void *)&nkh; /* must be replaced */
+            CHECK(pdt_delaunay_hull_on(pts, n, id, work, PDT_DELAUNAY_WORK(n), &nt, &kh, &nkh, 0,
+                                       NULL) == PDT_OK);
+            if (deg) {
+                CHECK_MSG(kh == NULL && nkh == 0, "%s n=%zu: a hull for a degenerate set", *k, n);
+                degenerate++;
+            } else {
+                CHECK_MSG(kh && nkh == nch && memcmp(kh, ch, nch * sizeof *ch) == 0,
+                          "%s n=%zu: kernel hull of %zu vertices, chain %zu", *k, n, nkh, nch);
+            }
+            runs++;
+            free(kh);
+            free(work);
+            free(id);
+            free(ch);
+            free(pts);
+        }
+    }
+    printf("# %d sets, %d of them degenerate\n", runs, degenerate);
+    CHECK(degenerate > 0 && degenerate < runs);
+}
+
 /* The canonical order with the caller's scratch is pdt_tri_canonical's. */
 TEST(canonical_on_scratch)
 {
@@ -119,6 +166,7 @@ TEST(canonical_on_scratch)
 int main(void)
 {
     RUN(delaunay_on_equals_delaunay);
+    RUN(kernel_hull_is_chain_hull);
     RUN(canonical_on_scratch);
     return test_summary();
 }
