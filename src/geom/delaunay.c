@@ -354,25 +354,24 @@ static void cut_order(const cutter *c, uint32_t lo, uint32_t hi, int axis)
  * and the clockwise hull edge out of the frame-largest one. */
 static void frame_extremes(const dt *d, uint32_t e0, int axis, uint32_t *le, uint32_t *re)
 {
-    /* edges e_0 = e0, e_i+1 = rprev(e_i); the edge into org(e_i) is e_i-1 */
-    uint32_t e = e0, prev = NIL, lo_e = NIL, hi_in = NIL;
-    uint64_t klo = 0, khi = 0;
-    int hi_at_start = 0;
-    do {
+    /* edges e_0 = e0, e_i+1 = rprev(e_i); the edge into org(e_i) is e_i-1.
+     * The smallest and the largest so far are kept with conditional moves
+     * (a branch on them mispredicted often on short hulls). */
+    uint64_t k0 = frame_key(d->p[org(d, e0)], axis);
+    uint64_t klo = k0, khi = k0;
+    uint32_t lo_e = e0, hi_in = NIL; /* NIL: the largest is org(e0) */
+    uint32_t prev = e0, e = rprev(d, e0);
+    while (e != e0) {
         uint64_t k = frame_key(d->p[org(d, e)], axis);
-        if (lo_e == NIL || k < klo) {
-            klo = k;
-            lo_e = e;
-        }
-        if (prev == NIL || k > khi) {
-            khi = k;
-            hi_in = prev;
-            hi_at_start = prev == NIL;
-        }
+        int lt = k < klo, gt = k > khi;
+        klo = lt ? k : klo;
+        lo_e = lt ? e : lo_e;
+        khi = gt ? k : khi;
+        hi_in = gt ? prev : hi_in;
         prev = e;
         e = rprev(d, e);
-    } while (e != e0);
-    if (hi_at_start) hi_in = prev; /* the last edge walked leads into org(e0) */
+    }
+    if (hi_in == NIL) hi_in = prev; /* the last edge walked leads into org(e0) */
     *le = lo_e;
     *re = sym(hi_in);
 }
@@ -486,16 +485,20 @@ static int build(dt *d, uint32_t lo, uint32_t hi, int axis, uint32_t *le, uint32
  * oprev(sym e) lies in the record beside e's, and the record of sym(lnext e)
  * holds both dest(lnext e) and lnext(lnext e): one record out of place per
  * edge, fetched PF_AHEAD edge pairs ahead (the walk was bound by those
- * misses).  Edges go by pairs (e, sym e), both records read before a
- * triangle is written: triangle k is written over edge record k, and k <=
- * the current pair's first edge.  Vertices are written as id[v].  Returns
- * the number of triangles. */
+ * misses).  Branch-free: both faces of a pair are tested and written, and
+ * the count moves on only for the reported ones (whether a face is reported
+ * is random: a branch on it mispredicted about once a face).  Edges go by
+ * pairs (e, sym e), every record read before a triangle is written:
+ * triangle k is written over edge record k, and k <= the current pair's
+ * second edge.  Vertices are written as id[v].  Returns the number of
+ * triangles. */
 enum { PF_AHEAD = 16 };
 
 static size_t collect(dt *d, const uint32_t *id, const uint32_t *tid, int run)
 {
     pdt_trace *tr = d->tr;
     const edge *r = d->e;
+    const pdt_point *p = d->p;
     pdt_tri *out = (pdt_tri *)(void *)d->e; /* 12 bytes each, like an edge */
     size_t nt = 0, used = d->used;
     for (size_t e = 0; e < used; e += 2) {
@@ -505,47 +508,26 @@ static size_t collect(dt *d, const uint32_t *id, const uint32_t *tid, int run)
         }
         edge f = r[e], g = r[e + 1]; /* e and sym e */
         if (f.org == NIL) continue;  /* a deleted edge (both halves) */
-        uint32_t tri[2][3];
-        int k = 0;
-        /* the left face of e: lnext e = g.oprev; of sym e: lnext = f.oprev */
-        uint32_t l0 = g.oprev, l1 = f.oprev;
-        if (l0 > e) {
-            edge h = r[l0 ^ 1u]; /* org: dest(lnext e); oprev: lnext(lnext e) */
-            if (h.oprev > e && pdt_orient_fast(d->p[f.org], d->p[g.org], d->p[h.org]) > 0) {
-                tri[k][0] = f.org;
-                tri[k][1] = g.org;
-                tri[k][2] = h.org;
-                k++;
-            }
-        }
-        if (l1 > e + 1) {
-            edge h = r[l1 ^ 1u];
-            if (h.oprev > e + 1 && pdt_orient_fast(d->p[g.org], d->p[f.org], d->p[h.org]) > 0) {
-                tri[k][0] = g.org;
-                tri[k][1] = f.org;
-                tri[k][2] = h.org;
-                k++;
-            }
-        }
-        for (int j = 0; j < k; j++) {
-            uint32_t a = tri[j][0], b = tri[j][1], c = tri[j][2];
-            PDT_TRACE(tr, 1, PDT_EV_TRI_NEW, run, tid[a], tid[b], tid[c], 0);
-            out[nt].v[0] = id[a];
-            out[nt].v[1] = id[b];
-            out[nt].v[2] = id[c];
-            nt++;
-        }
+        /* the left face of e: lnext e = g.oprev; of sym e: lnext = f.oprev;
+         * h: the record of sym(lnext), org = dest(lnext), oprev = lnext(lnext) */
+        edge h0 = r[g.oprev ^ 1u], h1 = r[f.oprev ^ 1u];
+        pdt_point pf = p[f.org], pg = p[g.org];
+        int c0 = (g.oprev > e) & (h0.oprev > e) & (pdt_orient_fast(pf, pg, p[h0.org]) > 0);
+        int c1 = (f.oprev > e + 1) & (h1.oprev > e + 1) &
+                 (pdt_orient_fast(pg, pf, p[h1.org]) > 0);
+        uint32_t fi = id[f.org], gi = id[g.org];
+        out[nt] = (pdt_tri){{fi, gi, id[h0.org]}};
+        if (PDT_TRACING(tr, 1) && c0)
+            PDT_TRACE(tr, 1, PDT_EV_TRI_NEW, run, tid[f.org], tid[g.org], tid[h0.org], 0);
+        nt += (size_t)c0;
+        out[nt] = (pdt_tri){{gi, fi, id[h1.org]}};
+        if (PDT_TRACING(tr, 1) && c1)
+            PDT_TRACE(tr, 1, PDT_EV_TRI_NEW, run, tid[g.org], tid[f.org], tid[h1.org], 0);
+        nt += (size_t)c1;
     }
     return nt;
 }
 
-/* T* of the n >= 2 distinct points q[0, n), listed in lexicographic order,
- * on memory the caller provides: id[0, n) names them (q and id are reordered
- * together: leaf order), e has room for cap >= 6n + 12 edge records, the
- * cutter's scratch first, the edges then, and the triangles at last (written
- * over the edges: (pdt_tri *)e, *ntri of them).  Triangles come out as ids;
- * the trace sees ids through tr->gid when there is one.  Returns
- * PDT_ERR_NOMEM (q and id still consistent) when an allocation fails. */
 /* The convex hull from the triangulation's outer face, before the triangles
  * are written over the edges: the walk e <- rprev e from le (the
  * counter-clockwise hull edge out of the lexicographically smallest point)
@@ -713,18 +695,24 @@ static int tri_qcmp(const void *a, const void *b)
     return tri_cmp(a, b);
 }
 
+/* Rotate t to start at its smallest index, branch-free (which corner is
+ * the smallest is random: a branch on it mispredicted every other
+ * triangle). */
 static void tri_rotate(pdt_tri *t)
 {
     uint32_t a = t->v[0], b = t->v[1], c = t->v[2];
-    if (b < a && b < c) {
-        t->v[0] = b;
-        t->v[1] = c;
-        t->v[2] = a;
-    } else if (c < a && c < b) {
-        t->v[0] = c;
-        t->v[1] = a;
-        t->v[2] = b;
-    }
+    uint32_t w[5] = {a, b, c, a, b};
+    unsigned r = (unsigned)((b < a) & (b < c)) + 2u * (unsigned)((c < a) & (c < b));
+    t->v[0] = w[r];
+    t->v[1] = w[r + 1];
+    t->v[2] = w[r + 2];
+}
+
+/* a before b in the canonical order */
+static inline int tri_less(const pdt_tri *a, const pdt_tri *b)
+{
+    uint64_t ka = (uint64_t)a->v[0] << 32 | a->v[1], kb = (uint64_t)b->v[0] << 32 | b->v[1];
+    return ka < kb || (ka == kb && a->v[2] < b->v[2]);
 }
 
 /* Sort tris[lo, hi), all with the same first index, by (v[1], v[2]):
@@ -744,6 +732,37 @@ static void sort_run(pdt_tri *t, size_t lo, size_t hi)
             j--;
         }
         t[j] = v;
+    }
+}
+
+/* t[lo, hi) is in order by first index: put each run of one first index in
+ * order by the other two.  One insertion pass over the whole range (a
+ * triangle moves only within its run; runs are two triangles long on
+ * average, so a check per triangle and few moves, where finding each run's
+ * end first mispredicted once a run); when the moves pass 8 per triangle (a
+ * vertex of huge degree), the rest goes run by run with sort_run. */
+static void order_first_runs(pdt_tri *t, size_t lo, size_t hi)
+{
+    size_t budget = 8 * (hi - lo) + 64;
+    for (size_t i = lo + 1; i < hi; i++) {
+        if (!tri_less(&t[i], &t[i - 1])) continue;
+        pdt_tri v = t[i];
+        size_t j = i;
+        do {
+            t[j] = t[j - 1];
+            j--;
+        } while (j > lo && tri_less(&v, &t[j - 1]));
+        t[j] = v;
+        if (i - j >= budget) {
+            for (size_t a = lo; a < hi;) {
+                size_t b = a + 1;
+                while (b < hi && t[b].v[0] == t[a].v[0]) b++;
+                if (b - a > 1) sort_run(t, a, b);
+                a = b;
+            }
+            return;
+        }
+        budget -= i - j;
     }
 }
 
@@ -795,12 +814,7 @@ static void canonical(pdt_tri *in, pdt_tri *out, size_t ntri, pdt_tri *scratch)
         lc[0] = start;
         for (size_t l = 1; l <= nlo; l++) lc[l] += lc[l - 1];
         for (size_t i = start; i < end; i++) out[lc[(tmp[i].v[0] - minv) & lmask]++] = tmp[i];
-        for (size_t i = start; i < end;) { /* runs of one first index */
-            size_t j = i + 1;
-            while (j < end && out[j].v[0] == out[i].v[0]) j++;
-            if (j - i > 1) sort_run(out, i, j);
-            i = j;
-        }
+        order_first_runs(out, start, end);
         start = end;
     }
     if (tmp != scratch) pdt_big_free(tmp, ntri * sizeof *tmp);
