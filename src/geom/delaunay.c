@@ -101,18 +101,19 @@ static inline uint32_t rprev(const dt *d, uint32_t e)
  * sized for the planar bound up front, so that never happens in practice). */
 static uint32_t make_edge(dt *d, uint32_t a, uint32_t b)
 {
-    uint32_t e;
-    if (d->freelist != NIL) {
-        e = d->freelist;
-        d->freelist = d->e[e].onext;
-    } else {
-        if (d->used + 2 > d->cap) {
-            d->nomem = 1;
-            return NIL;
-        }
-        e = (uint32_t)d->used;
-        d->used += 2;
+    /* a free edge if there is one, else the next new one; chosen with
+     * conditional moves (whether the list is empty changes often) */
+    uint32_t fl = d->freelist;
+    int reuse = fl != NIL;
+    if (d->used + 2 > d->cap && !reuse) {
+        d->nomem = 1;
+        return NIL;
     }
+    uint32_t keep = 0u - (uint32_t)reuse; /* all ones to reuse (masks: gcc branched) */
+    uint32_t e = (fl & keep) | ((uint32_t)d->used & ~keep);
+    uint32_t next = d->e[e].onext; /* (a record below cap either way) */
+    d->freelist = (next & keep) | (NIL & ~keep);
+    d->used += 2u & ~keep;
     d->e[e] = (edge){ a, e, e };
     d->e[e ^ 1] = (edge){ b, e ^ 1, e ^ 1 };
     PDT_TRACE(d->tr, 2, PDT_EV_EDGE_ADD, 0, PDT_TRACE_PT(d->tr, a), PDT_TRACE_PT(d->tr, b), 0, 0);
@@ -208,12 +209,15 @@ static uint64_t kth_key(uint64_t *v, size_t n, size_t k)
             rs ^= rs << 13;
             rs ^= rs >> 7;
             rs ^= rs << 17;
-            r[q] = lo + (size_t)(rs % w);
+            r[q] = lo + (size_t)(((unsigned __int128)rs * w) >> 64); /* in [0, w): no division */
         }
+        /* the median of the three, by conditional moves */
         uint64_t a = v[r[0]], b = v[r[1]], c = v[r[2]];
-        size_t m = a < b ? (b < c ? r[1] : (a < c ? r[2] : r[0]))
-                         : (a < c ? r[0] : (b < c ? r[2] : r[1]));
-        uint64_t piv = v[m];
+        uint64_t mn = a < b ? a : b, mx = a < b ? b : a;
+        uint64_t piv = mx < c ? mx : c;
+        piv = piv < mn ? mn : piv;
+        size_t m = piv == a ? r[0] : r[1];
+        m = piv == c ? r[2] : m;
         v[m] = v[lo];
         v[lo] = piv;
         /* [lo + 1, lt) < piv, [lt, i) > piv (the keys are distinct) */
