@@ -637,6 +637,61 @@ TEST(text_fast_path_same_as_general)
     CHECK(bad == 0);
 }
 
+/* Numbers of every length from 1 to 10 digits (leading zeros too), signed
+ * or not, with every separator, each line read as strtoll reads it: the
+ * branch-free digit reader (8 bytes at a time, up to 7 digits) and the
+ * byte loop (longer numbers, and the text's last bytes) agree with it
+ * wherever a number starts and ends. */
+TEST(text_numbers_every_length)
+{
+    enum { LINES = 4000 };
+    static const char *sep[] = {" ", ",", ";", "\t", " , ", "  "};
+    char *text = malloc(LINES * 40 + 1);
+    int32_t (*want)[2] = malloc(LINES * sizeof *want);
+    uint64_t s = 12345;
+    size_t o = 0;
+    for (int i = 0; i < LINES; i++) {
+        char num[2][24];
+        for (int k = 0; k < 2; k++) {
+            s = s * 6364136223846793005u + 1442695040888963407u;
+            int digits = 1 + (int)((s >> 33) % 10), sign = (int)((s >> 45) % 3);
+            char *q = num[k];
+            if (sign == 1) *q++ = '-';
+            if (sign == 2) *q++ = '+';
+            uint64_t t = s;
+            for (int d = 0; d < digits; d++) {
+                t = t * 6364136223846793005u + 1442695040888963407u;
+                *q++ = (char)('0' + (t >> 40) % 10);
+            }
+            *q = 0;
+            long long v = strtoll(num[k], NULL, 10);
+            if (v > INT32_MAX || v < INT32_MIN) { /* keep it in range: drop the first digit */
+                memmove(num[k] + (sign != 0), num[k] + (sign != 0) + 1, strlen(num[k]));
+                v = strtoll(num[k], NULL, 10);
+            }
+            want[i][k] = (int32_t)v;
+        }
+        o += (size_t)sprintf(text + o, "%s%s%s\n", num[0], sep[i % 6], num[1]);
+    }
+    text[o - 1] = 0; /* the last line without its newline */
+    pdt_point *p = NULL;
+    size_t n = 0;
+    pdt_err e;
+    CHECK(rd("len.txt", text, 0, &p, &n, NULL, &e) == PDT_OK);
+    CHECK_MSG(n == LINES, "%zu points: %s", n, e.msg);
+    int bad = 0;
+    for (size_t i = 0; i < n && i < LINES; i++)
+        if (p[i].x != want[i][0] || p[i].y != want[i][1]) {
+            if (bad++ < 5)
+                printf("#   line %zu: read %d %d, want %d %d\n", i + 1, p[i].x, p[i].y, want[i][0],
+                       want[i][1]);
+        }
+    CHECK(bad == 0);
+    free(p);
+    free(want);
+    free(text);
+}
+
 int main(void)
 {
     snprintf(dir, sizeof dir, "%s/pdt-io.XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -655,6 +710,7 @@ int main(void)
     RUN(points_write_roundtrip);
     RUN(numbers_every_digit_count);
     RUN(text_fast_path_same_as_general);
+    RUN(text_numbers_every_length);
     RUN(tris_write_formats);
     RUN(tris_read_bad_inputs);
     RUN(atomic_write_leaves_nothing);
