@@ -83,7 +83,7 @@ LIBS        := -lm -pthread
 # Debian packages the build, the tests and the demo need.
 DEB_BUILD := build-essential pkg-config libopenmpi-dev openmpi-bin libsdl2-dev libcairo2-dev fonts-dejavu-core \
              libgif-dev libavcodec-dev libavformat-dev libswscale-dev libavutil-dev libopen-trace-format2-dev
-DEB_TEST  := otf2-tools mandoc bash-completion qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps slurmctld slurmd slurm-client munge ffmpeg
+DEB_TEST  := time otf2-tools mandoc bash-completion qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps slurmctld slurmd slurm-client munge ffmpeg
 DEB_BENCH := hyperfine libcgal-dev g++ nodejs npm valgrind time
 DEB_FUZZ  := clang libclang-rt-dev
 

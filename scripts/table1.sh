@@ -15,7 +15,11 @@
 #              partition_s, local_s, merge_s, gather_s as "order");
 # then, for each P of PS from 2 to the number of cores, the "ceiling": P
 # plain runs at once, each on n/P of the points (the best P processes can do
-# here, with no communication, merge or order at all); then, per size, the merge traffic at the largest P (merge-step bytes / input
+# here, with no communication, merge or order at all), the runs of a size in
+# rounds (plain, each P, each ceiling, then again), with each command's system
+# CPU seconds ("sys": on this project's VMs memory new to the machine costs
+# about 2 s per GiB of system time, 0.3 s when it was in use just before, and
+# the wall follows); then, per size, the merge traffic at the largest P (merge-step bytes / input
 # bytes, 8 per point) and peak memory: the largest rank's peak RSS at P = 2
 # against the plain run's.  Load (uptime) is printed before and after: on a
 # busy machine the wall figures mean little (the phases and bytes still do).
@@ -41,55 +45,69 @@ command -v mpirun > /dev/null || { echo "table1: mpirun not found" >&2; exit 1; 
 command -v python3 > /dev/null || { echo "table1: python3 not found" >&2; exit 1; }
 [ -x "$PDT" ] || { echo "table1: $PDT not built (make)" >&2; exit 1; }
 
-# run LABEL CMD... : RUNS times; appends "wall_seconds stats_json_file" lines to $W/LABEL.runs
-run() {
-    local label=$1; shift
-    : > "$W/$label.runs"
-    for i in $(seq 1 "$RUNS"); do
-        local t0 t1
-        t0=$(date +%s.%N)
-        nice -n "$NICE" "$@" -o "$W/out.tri" --stats 2> "$W/$label.$i.json" > /dev/null || {
-            echo "table1: $label run $i failed:" >&2; tail -3 "$W/$label.$i.json" >&2; exit 1; }
-        t1=$(date +%s.%N)
-        echo "$(awk "BEGIN { print $t1 - $t0 }") $W/$label.$i.json" >> "$W/$label.runs"
+# run_once LABEL I CMD... : run I of LABEL; appends "wall_seconds stats_json_file
+# system_seconds" to $W/LABEL.runs (system seconds of the whole command, its
+# children included: on this project's VMs memory new to the machine makes
+# them jump, 0.3 s -> 2 s at 10^7 points, and the wall with them)
+run_once() {
+    local label=$1 i=$2; shift 2
+    local t0 t1
+    t0=$(date +%s.%N)
+    /usr/bin/time -f "%S" -o "$W/$label.$i.sys" nice -n "$NICE" "$@" -o "$W/out.tri" --stats \
+        2> "$W/$label.$i.json" > /dev/null || {
+        echo "table1: $label run $i failed:" >&2; tail -3 "$W/$label.$i.json" >&2; exit 1; }
+    t1=$(date +%s.%N)
+    echo "$(awk "BEGIN { print $t1 - $t0 }") $W/$label.$i.json $(tail -1 "$W/$label.$i.sys")" >> "$W/$label.runs"
+}
+
+# pieces K IN: K consecutive K-ths of the input's lines (same kind of points,
+# n/K of them) in $W/pieceK-I.txt, for the ceiling
+pieces() {
+    local k=$1 in=$2 lines
+    lines=$(wc -l < "$in")
+    for i in $(seq 0 $((k - 1))); do
+        sed -n "$((lines * i / k + 1)),$((lines * (i + 1) / k))p" "$in" > "$W/piece$k-$i.txt"
     done
 }
 
-# ceiling LABEL K IN: RUNS times, K plain runs at once, each on a consecutive
-# K-th of the input's lines (same kind of points, n/K of them): the wall
-# until all are done, in $W/LABEL.runs ("wall -").  What K processes on this
-# machine can do with no communication, merge or order at all: the best a
-# K-rank run could reach here.
-ceiling() {
-    local label=$1 k=$2 in=$3 lines
-    lines=$(wc -l < "$in")
-    for i in $(seq 0 $((k - 1))); do
-        sed -n "$((lines * i / k + 1)),$((lines * (i + 1) / k))p" "$in" > "$W/piece$i.txt"
-    done
-    : > "$W/$label.runs"
-    for r in $(seq 1 "$RUNS"); do
-        local t0 t1
-        t0=$(date +%s.%N)
-        for i in $(seq 0 $((k - 1))); do
-            nice -n "$NICE" "$PDT" triangulate "$W/piece$i.txt" -o "$W/piece$i.tri" 2> /dev/null &
+# ceiling_once LABEL K: K plain runs at once, one per piece: the wall until all
+# are done, in $W/LABEL.runs ("wall - system_seconds").  What K processes on
+# this machine can do with no communication, merge or order at all: the best
+# a K-rank run could reach here.
+ceiling_once() {
+    local label=$1 k=$2
+    local t0 t1
+    t0=$(date +%s.%N)
+    /usr/bin/time -f "%S" -o "$W/$label.sys" bash -c '
+        for i in $(seq 0 $(($2 - 1))); do
+            nice -n "$3" "$4" triangulate "$1/piece$2-$i.txt" -o "$1/piece$2-$i.tri" 2> /dev/null &
         done
-        wait
-        t1=$(date +%s.%N)
-        echo "$(awk "BEGIN { print $t1 - $t0 }") -" >> "$W/$label.runs"
-    done
-    rm -f "$W"/piece*.txt "$W"/piece*.tri
+        wait' _ "$W" "$k" "$NICE" "$PDT"
+    t1=$(date +%s.%N)
+    echo "$(awk "BEGIN { print $t1 - $t0 }") - $(tail -1 "$W/$label.sys")" >> "$W/$label.runs"
 }
 
 echo "pdt Table 1 — wall time against the plain run, uniform points, median of $RUNS runs"
 echo "machine: $CORES cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
 echo "uptime before: $(uptime)"
 echo
+# The runs of one size go in rounds (plain, each P, each ceiling, then again),
+# so that a change in the machine's state in the middle touches every row.
 for n in $SIZES; do
     in=$W/uniform-$n.txt
     [ -s "$in" ] || "$PDT" gen uniform "$n" --seed 1 -o "$in"
-    run "seq-$n" "$PDT" triangulate "$in"
-    for p in $PS; do run "p$p-$n" mpirun -np "$p" "$PDT" triangulate "$in"; done
-    for p in $PS; do [ "$p" -gt 1 ] && [ "$p" -le "$CORES" ] && ceiling "ceil$p-$n" "$p" "$in"; done
+    ceil_ps=""
+    for p in $PS; do [ "$p" -gt 1 ] && [ "$p" -le "$CORES" ] && ceil_ps="$ceil_ps $p"; done
+    for p in $ceil_ps; do pieces "$p" "$in"; done
+    : > "$W/seq-$n.runs"
+    for p in $PS; do : > "$W/p$p-$n.runs"; done
+    for p in $ceil_ps; do : > "$W/ceil$p-$n.runs"; done
+    for i in $(seq 1 "$RUNS"); do
+        run_once "seq-$n" "$i" "$PDT" triangulate "$in"
+        for p in $PS; do run_once "p$p-$n" "$i" mpirun -np "$p" "$PDT" triangulate "$in"; done
+        for p in $ceil_ps; do ceiling_once "ceil$p-$n" "$p"; done
+    done
+    rm -f "$W"/piece*.txt "$W"/piece*.tri
     [ "${KEEP:-0}" = 1 ] || rm -f "$in"
 done
 

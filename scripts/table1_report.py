@@ -2,8 +2,9 @@
 """pdt — the figures of `make table1` (scripts/table1.sh) from its runs.
 
 Usage: table1_report.py DIR CORES "SIZES" "PS"
-DIR holds LABEL.runs files (lines "wall_seconds stats.json"), LABEL = seq-N
-(the plain run) or pP-N (mpirun -np P)."""
+DIR holds LABEL.runs files (lines "wall_seconds stats.json [system_seconds]"),
+LABEL = seq-N (the plain run), pP-N (mpirun -np P) or ceilP-N (the ceiling,
+"wall_seconds - [system_seconds]")."""
 import json
 import statistics
 import sys
@@ -14,10 +15,20 @@ PHASES = ("read", "partition", "local", "merge", "order", "write")
 def load(w, label):
     rows = []
     for line in open(f"{w}/{label}.runs"):
-        wall, path = line.split()
+        wall, path = line.split()[:2]
         text = open(path).read()
         rows.append((float(wall), json.loads(text[text.index("{"):])))
     return rows
+
+
+def sys_col(w, label):
+    """The median system seconds of LABEL's runs ("" when not recorded)."""
+    vals = []
+    for line in open(f"{w}/{label}.runs"):
+        f = line.split()
+        if len(f) >= 3:
+            vals.append(float(f[2]))
+    return f"{statistics.median(vals):.2f}" if vals else ""
 
 
 def rank_phases(j):
@@ -49,7 +60,7 @@ def peak_kib(j):
 def main():
     w, cores, sizes, ps = sys.argv[1], int(sys.argv[2]), sys.argv[3].split(), sys.argv[4].split()
     med = statistics.median
-    hdr = ("n", "run", "wall s", "speedup") + tuple(f"{k} s" for k in PHASES) + ("",)
+    hdr = ("n", "run", "wall s", "speedup") + tuple(f"{k} s" for k in PHASES) + ("sys s", "")
     print("| " + " | ".join(hdr) + " |")
     print("|" + "|".join("---" for _ in hdr) + "|")
     all_native = True
@@ -62,7 +73,7 @@ def main():
         seq_write = med([x.get("write", 0.0) for x in s])
         seq_peak = med([j.get("peak_rss_kib", 0) for _, j in seq])
         print(f"| {int(n):,} | plain | {seq_wall:.3f} | 1.00 | {seq_read:.3f} | | "
-              f"{seq_wall - seq_read - seq_write:.3f}† | | | {seq_write:.3f} | |")
+              f"{seq_wall - seq_read - seq_write:.3f}† | | | {seq_write:.3f} | {sys_col(w, f'seq-{n}')} | |")
         for p in ps:
             runs = load(w, f"p{p}-{n}")
             wall = med([wall for wall, _ in runs])
@@ -70,16 +81,18 @@ def main():
             all_native = all_native and all(nat for _, nat in ph)
             cols = " | ".join(f"{med([x[k] for x, _ in ph]):.3f}" for k in PHASES)
             mark = "* P > cores" if int(p) > cores else ""
-            print(f"| {int(n):,} | mpirun -np {p} | {wall:.3f} | {seq_wall / wall:.2f} | {cols} | {mark} |")
+            print(f"| {int(n):,} | mpirun -np {p} | {wall:.3f} | {seq_wall / wall:.2f} | {cols} | "
+                  f"{sys_col(w, f'p{p}-{n}')} | {mark} |")
         for p in ps:
             try:
                 walls = [float(line.split()[0]) for line in open(f"{w}/ceil{p}-{n}.runs")]
             except OSError:
                 continue
+            sysc = sys_col(w, f"ceil{p}-{n}")
             wall = med(walls)
             blank = " | ".join("" for _ in PHASES)
             print(f"| {int(n):,} | ceiling: {p} plain runs on n/{p} at once | {wall:.3f} | "
-                  f"{seq_wall / wall:.2f} | {blank} | ‡ |")
+                  f"{seq_wall / wall:.2f} | {blank} | {sysc} | ‡ |")
         big = max(ps, key=int)
         j = load(w, f"p{big}-{n}")[0][1]["parallel"]
         rel = 100 * j["merge_bytes_rel_input"]
@@ -94,6 +107,9 @@ def main():
         print(line)
     print()
     print("wall = the whole command (MPI start-up, read, compute, write); speedup = plain wall / wall.")
+    print("sys = the command's system CPU seconds (all its processes), median: memory new to the")
+    print("VM costs the system seconds (about 2 s per GiB here against 0.3 s), and the wall with it;")
+    print("the runs go in rounds (plain, each P, each ceiling, again) so that every row meets it alike.")
     print("Phases: seconds, the largest over the ranks, median over the runs.  † plain run:")
     print("everything between read and write (sort, kernel, canonical order).")
     print("‡ ceiling: P plain runs started together, each on a consecutive n/P of the input's")

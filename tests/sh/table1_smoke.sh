@@ -10,7 +10,7 @@ if ! TABLE1_DIR=$TMP/t1 SIZES=3000 PS="1 2" RUNS=1 timeout 300 "$ROOT/scripts/ta
     fail table1_runs "$(tail -5 "$out")"; summary; exit
 fi
 ok table1_runs
-check table1_header grep -q '| n | run | wall s | speedup | read s | partition s | local s | merge s | order s | write s |' "$out"
+check table1_header grep -q '| n | run | wall s | speedup | read s | partition s | local s | merge s | order s | write s | sys s |' "$out"
 check table1_rows test "$(grep -cE '^\| 3,000 \| (plain|mpirun -np [12]) \|' "$out")" -eq 3
 if [ "$(getconf _NPROCESSORS_ONLN)" -ge 2 ]; then
     check table1_ceiling_row grep -qE '^\| 3,000 \| ceiling: 2 plain runs on n/2 at once \| [0-9.]+ \| [0-9.]+ \|' "$out"
