@@ -49,6 +49,19 @@ int pdt_replace_file(const char *tmp, const char *path);
 pdt_status pdt_read_points(const char *path, double scale, pdt_point **pts, size_t *n,
                            size_t *collisions, pdt_err *err);
 
+/* Flags of pdt_read_points_ex and pdt_points_part_parse. */
+enum {
+    /* a second thread faults the point array in ahead of the parser (on a
+     * machine where memory new to a process is dear on first touch and a
+     * core is idle: docs/geometry.md, "Fresh memory"); arrays under 8 MiB
+     * are left alone.  Same points either way. */
+    PDT_READ_PREFAULT = 1
+};
+
+/* pdt_read_points with flags (PDT_READ_PREFAULT or 0). */
+pdt_status pdt_read_points_ex(const char *path, double scale, int flags, pdt_point **pts,
+                              size_t *n, size_t *collisions, pdt_err *err);
+
 /* ---- a point file read in parts, one per rank (pdt_par_read) -----------------
  *
  * The first reader calls pdt_points_head_read; every reader q of p then
@@ -101,11 +114,12 @@ typedef struct pdt_points_part {
 pdt_status pdt_points_part_load(const char *path, const pdt_points_head *h, int q, int p,
                                 pdt_points_part *pt, pdt_err *err);
 
-/* Parse the loaded part; line0 = 1 + the '\n' bytes before pt->lo.  A bad
+/* Parse the loaded part; line0 = 1 + the '\n' bytes before pt->lo; flags as
+ * pdt_read_points_ex's.  A bad
  * line sets err ("FILE:LINE: what") and pt->err_key.  In a .node file the
  * indices are checked within the part only. */
 pdt_status pdt_points_part_parse(pdt_points_part *pt, const char *path, const pdt_points_head *h,
-                                 double scale, uint64_t line0, pdt_err *err);
+                                 double scale, uint64_t line0, int flags, pdt_err *err);
 
 /* The checks that need the parts before this one (.node: first index 0 or
  * 1, consecutive indices across parts, the point count of the header).

@@ -234,9 +234,10 @@ pdt_status pdt_par_agree(pdt_comm *c, pdt_status st, int *who, pdt_err *err);
  * rank 0 and scattered.  The failure reported is the one pdt_read_points
  * gives on the whole file (its first bad line), whatever P.  Same status at every rank
  * (pdt_par_agree): a parse error is reported, at the rank that found it, as
- * "FILE:LINE: what". */
-pdt_status pdt_par_read(pdt_comm *c, const char *path, double scale, pdt_par_input *in,
-                        pdt_err *err);
+ * "FILE:LINE: what".  prefault: a thread faults each rank's point array in
+ * ahead of its parser (PDT_READ_PREFAULT). */
+pdt_status pdt_par_read(pdt_comm *c, const char *path, double scale, int prefault,
+                        pdt_par_input *in, pdt_err *err);
 
 /* Collective: T* of the whole input (every rank passes its block).  *out is
  * this rank's block of the canonical output (pdt_par_output_free).  me gets

@@ -227,13 +227,29 @@ static pdt_status check_size(run *R, pdt_err *err)
     return agreed(R, st, err);
 }
 
+/* Whether a thread may fault a rank's memory in ahead of it (the point
+ * array while it reads, the working memory while it computes): when the
+ * machine has a CPU for every rank of the job on it, and one more for a lone
+ * rank (mpirun binds a rank to one CPU: the thread is moved to another).
+ * On this project's VM first touches of memory wait for the host; a second
+ * thread hides that wait even when both CPUs compute ($PDT_PREFAULT=0 turns
+ * it off). */
+static int prefault_wanted(const run *R)
+{
+    const char *pf = getenv("PDT_PREFAULT");
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    int node = pdt_comm_node_size(R->c);
+    return !(pf && strcmp(pf, "0") == 0) && (R->p == 1 ? cpus > 1 : (long)node <= cpus);
+}
+
 static pdt_status read_input(run *R, pdt_err *err)
 {
     pdt_trace *tr = io_hook(R);
     set_phase(R, "read");
     double t0 = pdt_comm_wtime(R->c);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_READ, 0, 0, 0, 0);
-    pdt_status st = agreed(R, pdt_par_read(R->c, R->o->input, R->o->scale, &R->in, err), err);
+    pdt_status st = agreed(
+        R, pdt_par_read(R->c, R->o->input, R->o->scale, prefault_wanted(R), &R->in, err), err);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_READ, 0, 0, 0, 0);
     R->me.t_read = pdt_comm_wtime(R->c) - t0;
     if (st == PDT_OK) st = check_size(R, err);
@@ -252,17 +268,7 @@ static pdt_status compute(run *R, pdt_err *err)
     /* a .tri output names points by index only: the points can go once
      * partitioned (the other formats write them; a trace keeps them) */
     R->in.release_pts = pdt_tri_format_of(R->o->output) == PDT_FMT_TRI && !R->trace;
-    /* a thread may fault a rank's working memory in ahead of it when the
-     * machine has a CPU for every rank of the job on it, and one more for a
-     * lone rank (mpirun binds a rank to one CPU: the thread is moved to
-     * another).  On this project's VM first touches of memory wait for the
-     * host; a second thread hides that wait even when both CPUs compute
-     * ($PDT_PREFAULT=0 turns it off) */
-    const char *pf = getenv("PDT_PREFAULT");
-    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-    int node = pdt_comm_node_size(R->c);
-    R->in.prefault = !(pf && strcmp(pf, "0") == 0) &&
-                     (R->p == 1 ? cpus > 1 : (long)node <= cpus);
+    R->in.prefault = prefault_wanted(R);
     pdt_status st = pdt_par_triangulate(R->c, &R->in, &R->out, &R->me,
                                         pdt_cli_trace_hook(R->trace), err);
     if (st != PDT_OK && R->p > 1) {

@@ -450,8 +450,27 @@ static uint64_t count_nl(const char *b, size_t len)
     return k;
 }
 
+/* Arrays below this are not worth a thread faulting them in. */
+enum { PREFAULT_MIN = 8 << 20 };
+
+/* With PDT_READ_PREFAULT, a thread that faults r's point array in ahead of
+ * the parser (NULL: none). */
+static pdt_prefault *prefault_points(const reader *r, int flags)
+{
+    size_t bytes = r->cap * sizeof *r->pts;
+    if (!(flags & PDT_READ_PREFAULT) || bytes < PREFAULT_MIN) return NULL;
+    pdt_range all = {r->pts, bytes};
+    return pdt_prefault_start(&all, 1);
+}
+
 pdt_status pdt_read_points(const char *path, double scale, pdt_point **pts, size_t *n,
                            size_t *collisions, pdt_err *err)
+{
+    return pdt_read_points_ex(path, scale, 0, pts, n, collisions, err);
+}
+
+pdt_status pdt_read_points_ex(const char *path, double scale, int flags, pdt_point **pts,
+                              size_t *n, size_t *collisions, pdt_err *err)
 {
     *pts = NULL;
     *n = 0;
@@ -476,8 +495,10 @@ pdt_status pdt_read_points(const char *path, double scale, pdt_point **pts, size
         return pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory", name);
     }
     pdt_big_advise(r.pts, r.cap * sizeof *r.pts);
+    pdt_prefault *pf = prefault_points(&r, flags);
     pdt_io_cur_init(&r.cur, &t, name);
     st = has_ext(path, ".node") ? read_node(&r) : read_text(&r);
+    pdt_prefault_stop(pf);
     if (st == PDT_OK && scale > 0 && collisions) st = count_collisions(&r, collisions);
     pdt_io_text_free(&t);
     free(r.orig);
@@ -703,7 +724,7 @@ static pdt_status part_node(reader *r, const pdt_points_head *h, pdt_points_part
 }
 
 pdt_status pdt_points_part_parse(pdt_points_part *pt, const char *path, const pdt_points_head *h,
-                                 double scale, uint64_t line0, pdt_err *err)
+                                 double scale, uint64_t line0, int flags, pdt_err *err)
 {
     reader r = {.scale = scale, .err = err};
     size_t len = (size_t)(pt->hi - pt->lo);
@@ -715,6 +736,7 @@ pdt_status pdt_points_part_parse(pdt_points_part *pt, const char *path, const pd
     if (r.pts) pdt_big_advise(r.pts, r.cap * sizeof *r.pts);
     if (scale > 0) r.orig = malloc(2 * r.cap * sizeof *r.orig);
     pdt_status st = PDT_OK;
+    pdt_prefault *pf = r.pts ? prefault_points(&r, flags) : NULL;
     if (!r.pts || (scale > 0 && !r.orig)) {
         st = pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory", path);
         pt->err_key = 0;
@@ -725,6 +747,7 @@ pdt_status pdt_points_part_parse(pdt_points_part *pt, const char *path, const pd
     } else {
         st = text_lines(&r);
     }
+    pdt_prefault_stop(pf);
     if (st != PDT_OK && pt->err_key != 0)
         pt->err_key = st == PDT_ERR_PARSE ? (uint64_t)r.cur.line * 4 + 2 : 0;
     pt->pts = r.pts;

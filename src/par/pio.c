@@ -69,13 +69,13 @@ static pdt_status scatter_blocks(pdt_comm *c, pdt_par_input *in, pdt_err *err)
 
 /* Standard input, a pipe or a device: rank 0 reads it whole and scatters
  * the blocks. */
-static pdt_status read_whole(pdt_comm *c, const char *path, double scale, pdt_par_input *in,
-                             pdt_err *err)
+static pdt_status read_whole(pdt_comm *c, const char *path, double scale, int flags,
+                             pdt_par_input *in, pdt_err *err)
 {
     int r = pdt_comm_rank(c);
     pdt_status st = PDT_OK;
     size_t n = 0, coll = 0;
-    if (r == 0) st = pdt_read_points(path, scale, &in->pts, &n, &coll, err);
+    if (r == 0) st = pdt_read_points_ex(path, scale, flags, &in->pts, &n, &coll, err);
     st = pdt_par_agree(c, st, NULL, err);
     if (st != PDT_OK) return st;
     uint64_t hdr[2] = {n, coll};
@@ -173,7 +173,7 @@ static pdt_status collisions_across(pdt_comm *c, const pdt_points_part *pt, uint
 /* A regular file: every rank loads and parses its own part (pdt/io.h),
  * the line numbers from a prefix sum of the '\n' counts, the point indices
  * from a prefix sum of the point counts. */
-static pdt_status read_parts(pdt_comm *c, const char *path, double scale,
+static pdt_status read_parts(pdt_comm *c, const char *path, double scale, int flags,
                              const pdt_points_head *h, pdt_par_input *in, pdt_err *err)
 {
     int p = pdt_comm_size(c), r = pdt_comm_rank(c);
@@ -189,7 +189,7 @@ static pdt_status read_parts(pdt_comm *c, const char *path, double scale,
     if (cst != PDT_OK) goto done;
     if (st == PDT_OK)
         st = pdt_points_part_parse(&pt, path, h, scale,
-                                   1 + nl_before + (r == 0 ? h->body_nl : 0), err);
+                                   1 + nl_before + (r == 0 ? h->body_nl : 0), flags, err);
     part_info me = {pt.n, nl_mine, (uint64_t)pt.has_idx0, pt.idx0};
     part_info dummy[1];
     cst = pdt_comm_allgather(c, &me, sizeof me, all ? all : dummy, err);
@@ -226,9 +226,10 @@ done:
     pdt_points_part_free(&pt);
     return st;
 }
-pdt_status pdt_par_read(pdt_comm *c, const char *path, double scale, pdt_par_input *in,
-                        pdt_err *err)
+pdt_status pdt_par_read(pdt_comm *c, const char *path, double scale, int prefault,
+                        pdt_par_input *in, pdt_err *err)
 {
+    int flags = prefault ? PDT_READ_PREFAULT : 0;
     memset(in, 0, sizeof *in);
     pdt_points_head h;
     memset(&h, 0, sizeof h);
@@ -239,7 +240,8 @@ pdt_status pdt_par_read(pdt_comm *c, const char *path, double scale, pdt_par_inp
         if (st == PDT_OK) st = pdt_comm_bcast(c, &h, sizeof h, 0, err);
     }
     if (st == PDT_OK)
-        st = h.parts ? read_parts(c, path, scale, &h, in, err) : read_whole(c, path, scale, in, err);
+        st = h.parts ? read_parts(c, path, scale, flags, &h, in, err)
+                     : read_whole(c, path, scale, flags, in, err);
     if (st != PDT_OK) pdt_par_input_free(in);
     return st;
 }

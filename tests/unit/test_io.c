@@ -692,6 +692,42 @@ TEST(text_numbers_every_length)
     free(text);
 }
 
+/* A thread faulting the point array in ahead of the parser
+ * (PDT_READ_PREFAULT; arrays of 8 MiB or more, so 1.1 M points here) gives
+ * the same points, the same count and the same message for a bad last line. */
+TEST(read_prefault_same_points)
+{
+    enum { N = 1100000 };
+    char *text = malloc((size_t)N * 16 + 32);
+    size_t o = 0;
+    uint64_t s = 99;
+    for (int i = 0; i < N; i++) {
+        s = s * 6364136223846793005u + 1442695040888963407u;
+        o += (size_t)sprintf(text + o, "%u %d\n", (unsigned)(s >> 44), -(int)((s >> 20) & 0xfffff));
+    }
+    text[o] = 0;
+    pdt_point *a = NULL, *b = NULL;
+    size_t na = 0, nb = 0;
+    pdt_err ea, eb;
+    CHECK(rd("pf.txt", text, 0, &a, &na, NULL, &ea) == PDT_OK);
+    pdt_err_clear(&eb);
+    CHECK(pdt_read_points_ex(path("pf.txt"), 0, PDT_READ_PREFAULT, &b, &nb, NULL, &eb) == PDT_OK);
+    CHECK(na == N && nb == N && a && b && memcmp(a, b, (size_t)N * sizeof *a) == 0);
+    free(a);
+    free(b);
+    strcpy(text + o, "1 x\n");
+    a = b = NULL;
+    pdt_status sa = rd("pf.txt", text, 0, &a, &na, NULL, &ea);
+    pdt_err_clear(&eb);
+    pdt_status sb = pdt_read_points_ex(path("pf.txt"), 0, PDT_READ_PREFAULT, &b, &nb, NULL, &eb);
+    CHECK_MSG(sa == PDT_ERR_PARSE && sb == sa && strcmp(ea.msg, eb.msg) == 0, "'%s' / '%s'",
+              ea.msg, eb.msg);
+    CHECK(strstr(eb.msg, ":1100001:") != NULL);
+    free(a);
+    free(b);
+    free(text);
+}
+
 int main(void)
 {
     snprintf(dir, sizeof dir, "%s/pdt-io.XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -711,6 +747,7 @@ int main(void)
     RUN(numbers_every_digit_count);
     RUN(text_fast_path_same_as_general);
     RUN(text_numbers_every_length);
+    RUN(read_prefault_same_points);
     RUN(tris_write_formats);
     RUN(tris_read_bad_inputs);
     RUN(atomic_write_leaves_nothing);

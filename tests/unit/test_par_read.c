@@ -33,7 +33,7 @@ static pdt_status rank_read(pdt_comm *c, void *arg, pdt_err *err)
     job *j = arg;
     rank_out *o = &j->out[pdt_comm_rank(c)];
     pdt_err_clear(&o->err);
-    o->st = pdt_par_read(c, j->path, j->scale, &o->in, &o->err);
+    o->st = pdt_par_read(c, j->path, j->scale, 0, &o->in, &o->err);
     (void)err;
     return PDT_OK; /* each rank's result is checked by the test */
 }
