@@ -565,14 +565,47 @@ static void heap_down(run *h, size_t n, size_t i)
     }
 }
 
+/* The order of a triangle among the finals: its first two indices (no two
+ * triangles of a triangulation share them: the edge v0 -> v1 has one
+ * triangle on its left). */
+static inline uint64_t tri_key(const pdt_tri *t)
+{
+    return (uint64_t)t->v[0] << 32 | t->v[1];
+}
+
+/* Up to four runs (two ranks' local and merge finals): the smallest of the
+ * four heads by conditional moves, an exhausted run's key past every key
+ * (which run's head is next is random: the heap's comparisons mispredicted
+ * about once a triangle). */
+static void merge_four(run *h, size_t n, pdt_tri *out)
+{
+    uint64_t key[4];
+    size_t left = 0;
+    for (size_t i = 0; i < 4; i++) {
+        key[i] = i < n ? tri_key(h[i].at) : UINT64_MAX;
+        left += i < n ? (size_t)(h[i].end - h[i].at) : 0;
+    }
+    for (; left > 0; left--) {
+        size_t a = key[1] < key[0], b = 2 + (key[3] < key[2]);
+        size_t m = key[b] < key[a] ? b : a;
+        *out++ = *h[m].at++;
+        key[m] = h[m].at < h[m].end ? tri_key(h[m].at) : UINT64_MAX;
+    }
+}
+
 /* Merge the nonempty runs of h[0, n) (sorted, no triangle twice) into out,
- * which overlaps none of them (one pass: a heap of the runs' heads). */
+ * which overlaps none of them (one pass: the four-way choice above, or a
+ * heap of the runs' heads when there are more). */
 static void merge_runs(run *h, size_t n, pdt_tri *out)
 {
     size_t k = 0;
     for (size_t i = 0; i < n; i++)
         if (h[i].at < h[i].end) h[k++] = h[i];
     n = k;
+    if (n <= 4) {
+        merge_four(h, n, out);
+        return;
+    }
     for (size_t i = n / 2; i-- > 0;) heap_down(h, n, i);
     while (n > 1) {
         *out++ = *h[0].at++;
