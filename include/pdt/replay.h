@@ -148,7 +148,12 @@ size_t pdt_replay_skipped(const pdt_replay *r);     /* events ignored as malform
 size_t pdt_replay_kind_count(const pdt_replay *r, int kind); /* events of a pdt_event_kind */
 int pdt_replay_nranks(const pdt_replay *r);
 const pdt_point *pdt_replay_points(const pdt_replay *r, size_t *n);
-const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i);  /* NULL if i >= count */
+/* Event i of the merged order, NULL if i >= count.  A replay opened from a
+ * kept index decodes it on demand into a small cache: the pointer holds for
+ * the next 7 calls at least (copy the record to keep it longer). */
+const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i);
+/* The rank of event i, without decoding it; UINT32_MAX if i >= count. */
+uint32_t pdt_replay_rank_of(const pdt_replay *r, size_t i);
 const pdt_rtri *pdt_replay_tris(const pdt_replay *r, size_t *n);
 const pdt_rtri_hist *pdt_replay_tri_hist(const pdt_replay *r);
 const pdt_redge *pdt_replay_edges(const pdt_replay *r, size_t *n);

@@ -7,7 +7,10 @@
  *                    offset and length, the place of the chunk checksums
  *                    (a CRC-32C per 16 MiB of every section: verified by
  *                    several threads at each opening); the header's own CRC
- *   sections         the merged event records, then the triangle
+ *   sections         the events: a copy of every rank file's encoded
+ *                    blocks (12-13 bytes an event, decoded on demand:
+ *                    evsrc.c) and the merged order as segments of
+ *                    consecutive events of one rank; then the triangle
  *                    histories and the triangles (streamed here while they
  *                    are built: pdt_replay_build), then every other table of
  *                    the replay (replay_int.h), the points and the reader's
@@ -40,7 +43,7 @@
 #include <unistd.h>
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 6u
+#define INDEX_VERSION 7u
 #define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/16 events, at least this */
 #define ICK_PARTS 16u
 _Static_assert(ICK_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint's place");
@@ -51,9 +54,9 @@ _Static_assert(ICK_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint'
 #define EST_BYTES_PER_EVENT 100u /* what the replay model holds per event in memory */
 
 enum {
-    S_RECS, S_EVOBJ, S_EVENT, S_TRIS, S_HIST, S_EDGES, S_NODES, S_PHASES, S_MERGES, S_MSGS,
-    S_HULLS, S_CH, S_SLOTCH, S_SLOTSTART, S_LIFT, S_SORT, S_DEL, S_SORTPOS, S_BOXLO, S_BOXHI,
-    S_HASBOX, S_POINTS, S_WARN, S_EVKIND, S_CKPT, NSEC
+    S_BLOCKS, S_SEGS, S_EVOBJ, S_EVENT, S_TRIS, S_HIST, S_EDGES, S_NODES, S_PHASES, S_MERGES,
+    S_MSGS, S_HULLS, S_CH, S_SLOTCH, S_SLOTSTART, S_LIFT, S_SORT, S_DEL, S_SORTPOS, S_BOXLO,
+    S_BOXHI, S_HASBOX, S_POINTS, S_WARN, S_EVKIND, S_BLKTAB, S_RANKBLK, S_CKPT, NSEC
 };
 
 typedef struct isec {
@@ -84,14 +87,15 @@ static const char magic[8] = {'P', 'D', 'T', 'V', 'I', 'D', 'X', '\n'};
 
 static void layout_of(uint32_t out[12])
 {
-    const uint32_t l[12] = {sizeof(pdt_rec), sizeof(pdt_rtri), sizeof(pdt_rtri_hist),
+    const uint32_t l[12] = {sizeof(pdt_block_ref) << 8 | sizeof(pdt_evseg), sizeof(pdt_rtri), sizeof(pdt_rtri_hist),
                             sizeof(pdt_redge), sizeof(pdt_rnode), sizeof(pdt_rphase),
                             sizeof(pdt_rmerge), sizeof(pdt_rmsg), sizeof(pdt_rhull),
                             sizeof(slot_change), sizeof(pdt_point), PDT_SLOT_PER_RANK};
     memcpy(out, l, sizeof l);
 }
 
-/* Where each section lives in r and how big its elements are; counts from r. */
+/* Where each section lives in r (and its event source r->src) and how big
+ * its elements are; counts from r. */
 static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_t count[NSEC])
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
@@ -99,7 +103,10 @@ static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_
     ptr[i] = (void **)&r->field;          \
     elem[i] = sizeof *r->field;           \
     count[i] = (cnt)
-    SEC(S_RECS, recs, r->m);
+    SEC(S_BLOCKS, src->bytes, r->src->nbytes);
+    SEC(S_SEGS, src->seg, r->src->nseg);
+    SEC(S_BLKTAB, src->blk, r->src->nblk);
+    SEC(S_RANKBLK, src->rank_blk, (uint64_t)r->nranks + 1);
     SEC(S_EVOBJ, ev_obj, r->m);
     SEC(S_EVENT, ev_ent, r->m);
     SEC(S_TRIS, tris, r->ntri);
@@ -704,10 +711,18 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
         }
     }
     r = calloc(1, sizeof *r);
-    if (!r) {
+    if (r) r->src = calloc(1, sizeof *r->src);
+    if (!r || !r->src) {
+        free(r);
+        r = NULL;
         snprintf(why, wcap, "out of memory");
         goto fail;
     }
+    r->src->nbytes = h.count[S_BLOCKS];
+    r->src->nseg = h.count[S_SEGS];
+    r->src->nblk = h.count[S_BLKTAB];
+    r->src->m = h.m;
+    r->src->nranks = (int)h.nranks;
     r->n = h.n;
     r->m = h.m;
     r->skipped = h.skipped;
@@ -739,6 +754,7 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
     }
     if (!ck_ok) {
         snprintf(why, wcap, "damaged: checkpoints do not fit the tables");
+        free(r->src);
         free(r);
         r = NULL;
         goto fail;
@@ -751,6 +767,7 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
     for (int i = 0; i < NSEC; i++) {
         if (count[i] != h.count[i] || count[i] * elem[i] != h.sec[i].bytes) {
             snprintf(why, wcap, "damaged: section %d has the wrong size", i);
+            free(r->src);
             free(r);
             r = NULL;
             goto fail;
@@ -759,6 +776,7 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
     }
     if (h.count[S_WARN] && ((const char *)map)[h.sec[S_WARN].off + h.count[S_WARN] - 1]) {
         snprintf(why, wcap, "damaged: warnings not terminated");
+        free(r->src);
         free(r);
         r = NULL;
         goto fail;
@@ -791,43 +809,120 @@ static int write_all(int fd, const void *p, size_t len, uint64_t off)
     return 1;
 }
 
-/* Stream the merged records of run into fd at HDR_BYTES (the reader's
- * merge: one decoded block per rank in memory).  Sets h->sec[S_RECS] and *m,
- * and counts what the replay's build would count in a first pass over them
- * (pdt_replay_place): fine[PDT_REPLAY_NFINE] and kinds[PDT_EV_KIND_COUNT],
- * for a run of n points and nranks ranks. */
-static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, size_t n, int nranks,
-                             uint64_t *fine, uint64_t *kinds, crcacc *crc, pdt_err *err)
+/* The events of a build: the rank files' blocks copied into the index
+ * (S_BLOCKS) and the merged order as segments (S_SEGS), with the tables
+ * that find a block (held here until write_tables writes them). */
+typedef struct evcopy {
+    pdt_evsrc src;           /* over the file's mapping, once both are written */
+    pdt_block_ref *blk;      /* src.blk */
+    uint64_t *rank_blk;      /* src.rank_blk */
+    crcacc blocks_crc, segs_crc;
+    uint64_t segs_off;
+} evcopy;
+
+/* Copy every rank's intact blocks (headers and payloads, as in its file)
+ * into fd at HDR_BYTES: S_BLOCKS, and the table of their payloads. */
+static pdt_status write_blocks(pdt_run *run, int fd, ihdr *h, evcopy *ec, pdt_err *err)
+{
+    int nranks = pdt_run_nranks(run);
+    size_t nblk = 0;
+    for (int q = 0; q < nranks; q++) {
+        const pdt_block_ref *b;
+        const uint8_t *file;
+        int64_t shift;
+        nblk += pdt_run_rank_blocks(run, q, &b, &file, &shift);
+    }
+    ec->blk = malloc((nblk ? nblk : 1) * sizeof *ec->blk);
+    ec->rank_blk = malloc(((size_t)nranks + 1) * sizeof *ec->rank_blk);
+    if (!ec->blk || !ec->rank_blk) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    uint64_t pos = 0; /* in the section */
+    size_t k = 0;
+    for (int q = 0; q < nranks; q++) {
+        const pdt_block_ref *b;
+        const uint8_t *file;
+        int64_t shift;
+        size_t nb = pdt_run_rank_blocks(run, q, &b, &file, &shift);
+        ec->rank_blk[q] = k;
+        if (!nb) continue;
+        uint64_t from = b[0].off, to = b[nb - 1].off + PDT_BLOCK_HEADER_BYTES + b[nb - 1].len;
+        for (size_t j = 0; j < nb; j++, k++)
+            ec->blk[k] = (pdt_block_ref){pos + (b[j].off - from) + PDT_BLOCK_HEADER_BYTES,
+                                         b[j].first, b[j].base_t + (uint64_t)shift, b[j].len,
+                                         b[j].count};
+        /* the file's bytes in steps, their mapped pages given back behind */
+        const uint64_t STEP = (uint64_t)8 << 20;
+        for (uint64_t o = from; o < to; o += STEP) {
+            size_t len = (size_t)(to - o < STEP ? to - o : STEP);
+            if (!write_all(fd, file + o, len, HDR_BYTES + pos + (o - from)))
+                return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+            crc_feed(&ec->blocks_crc, file + o, len);
+            uintptr_t lo = ((uintptr_t)(file + o) + 4095) & ~(uintptr_t)4095,
+                      hi = (uintptr_t)(file + o + len) & ~(uintptr_t)4095;
+            if (hi > lo) madvise((void *)lo, hi - lo, MADV_DONTNEED);
+        }
+        pos += to - from;
+    }
+    ec->rank_blk[nranks] = k;
+    h->sec[S_BLOCKS] = (isec){HDR_BYTES, pos, 0, 0};
+    h->count[S_BLOCKS] = pos;
+    ec->src.nbytes = pos;
+    ec->src.nblk = nblk;
+    ec->src.nranks = nranks;
+    return PDT_OK;
+}
+
+/* Stream the merged order of run (the reader's merge: one decoded block per
+ * rank in memory) into fd after the blocks as segments (S_SEGS).  Sets *m,
+ * and counts what the replay's build would count in a first pass over the
+ * events (pdt_replay_place): fine[PDT_REPLAY_NFINE] and
+ * kinds[PDT_EV_KIND_COUNT], for a run of n points and nranks ranks. */
+static pdt_status write_segs(pdt_run *run, int fd, ihdr *h, evcopy *ec, size_t *m, size_t n,
+                             int nranks, uint64_t *fine, uint64_t *kinds, pdt_err *err)
 {
     enum { BATCH = 8192 };
-    pdt_rec *buf = malloc(BATCH * sizeof *buf);
+    pdt_evseg *buf = malloc(BATCH * sizeof *buf);
     pdt_merge *mg = NULL;
     if (!buf) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     pdt_status st = pdt_merge_open(run, &mg, err);
-    uint64_t off = HDR_BYTES;
-    size_t count = 0, nb = 0;
+    uint64_t at = (HDR_BYTES + h->sec[S_BLOCKS].bytes + 63) & ~(uint64_t)63, off = at;
+    size_t count = 0, nb = 0, nseg = 0;
+    pdt_evseg cur = {0, UINT32_MAX, 0};
     int got = 1;
-    while (st == PDT_OK && got > 0) {
-        got = pdt_merge_next(mg, &buf[nb], err);
+    while (st == PDT_OK && got >= 0) {
+        pdt_rec rec;
+        got = pdt_merge_next(mg, &rec, err);
         if (got < 0) st = err->code ? err->code : PDT_ERR_NOMEM;
+        if (got > 0 && count >= UINT32_MAX - 1)
+            st = pdt_err_set(err, PDT_ERR_ARG, "too many events (%zu)", count);
+        if (st != PDT_OK) break;
         if (got > 0) {
-            const pdt_rec *rec = &buf[nb];
-            if (rec->ev.kind < PDT_EV_KIND_COUNT) kinds[rec->ev.kind]++;
-            size_t f = pdt_replay_fine_of(rec, n, nranks);
+            if (rec.ev.kind < PDT_EV_KIND_COUNT) kinds[rec.ev.kind]++;
+            size_t f = pdt_replay_fine_of(&rec, n, nranks);
             if (f < PDT_REPLAY_NFINE) fine[f]++;
-            nb++, count++;
+            int same = rec.rank == cur.rank && rec.seq - cur.seq0 == count - cur.start;
+            if (!same && cur.rank != UINT32_MAX) buf[nb++] = cur;
+            if (!same) cur = (pdt_evseg){(uint32_t)count, rec.rank, rec.seq};
+            count++;
+        } else if (cur.rank != UINT32_MAX) {
+            buf[nb++] = cur; /* the last one */
         }
-        if (st == PDT_OK && (nb == BATCH || (got == 0 && nb))) {
+        if (nb == BATCH || (got == 0 && nb)) {
             if (!write_all(fd, buf, nb * sizeof *buf, off))
                 st = pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-            crc_feed(crc, buf, nb * sizeof *buf);
+            crc_feed(&ec->segs_crc, buf, nb * sizeof *buf);
             off += nb * sizeof *buf;
+            nseg += nb;
             nb = 0;
         }
+        if (got == 0) break;
     }
     pdt_merge_close(mg);
     free(buf);
-    h->sec[S_RECS] = (isec){HDR_BYTES, (uint64_t)count * sizeof(pdt_rec), 0, 0};
+    h->sec[S_SEGS] = (isec){at, (uint64_t)nseg * sizeof(pdt_evseg), 0, 0};
+    h->count[S_SEGS] = nseg;
+    ec->segs_off = at;
+    ec->src.nseg = nseg;
+    ec->src.m = count;
     *m = count;
     return st;
 }
@@ -894,7 +989,7 @@ static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
 /* Write the tables of r after the records and the streamed ones (at pc->off),
  * then the header. */
 static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
-                               crcacc *recs_crc, pdt_err *err)
+                               evcopy *ec, pdt_err *err)
 {
     crcacc ck_crc = {0};
     void **ptr[NSEC];
@@ -904,7 +999,7 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     uint64_t off = pc->off;
     for (int i = 0; i < NSEC; i++) {
         h->count[i] = count[i];
-        if (i == S_RECS) continue;
+        if (i == S_BLOCKS || i == S_SEGS) continue; /* written first (write_blocks, write_segs) */
         if (i == S_CKPT) { /* their sizes are known once they are made */
             off = (off + 63) & ~(uint64_t)63;
             if (!write_checkpoints(r, fd, off, &ck_crc)) {
@@ -940,8 +1035,9 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     int have = tab && todo;
     for (int i = 0; have && i < NSEC; i++) {
         uint64_t nc = chunks_of(h->sec[i].bytes);
-        if (i == S_RECS) {
-            have = crc_done(recs_crc, h->sec[i].bytes, tab + first[i]);
+        if (i == S_BLOCKS || i == S_SEGS) {
+            have = crc_done(i == S_BLOCKS ? &ec->blocks_crc : &ec->segs_crc, h->sec[i].bytes,
+                            tab + first[i]);
         } else if (i == S_CKPT) {
             have = crc_done(&ck_crc, h->sec[i].bytes, tab + first[i]);
         } else if (r->streamed && (i == S_TRIS || i == S_HIST)) {
@@ -1037,35 +1133,43 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     int fd = open(tmp, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd < 0) return pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
     ihdr *h = calloc(1, sizeof *h);
+    evcopy ec;
+    memset(&ec, 0, sizeof ec);
     pdt_replay *r = NULL;
-    void *recs = MAP_FAILED;
-    size_t m = 0, recs_len = 0;
+    void *map = MAP_FAILED;
+    size_t m = 0, map_len = 0;
     uint64_t fine[PDT_REPLAY_NFINE] = {0}, kinds[PDT_EV_KIND_COUNT] = {0};
-    crcacc recs_crc = {0};
-    pdt_status st = h ? write_recs(run, fd, h, &m, n, nranks, fine, kinds, &recs_crc, err)
+    pdt_status st = h ? write_blocks(run, fd, h, &ec, err)
                       : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    if (st == PDT_OK) st = write_segs(run, fd, h, &ec, &m, n, nranks, fine, kinds, err);
     if (st == PDT_OK) {
-        /* the records as the replay's input: mapped from the file, so they
-         * take no memory of their own while the tables are built */
-        recs_len = HDR_BYTES + m * sizeof(pdt_rec);
-        recs = mmap(NULL, recs_len, PROT_READ, MAP_SHARED, fd, 0);
-        if (recs == MAP_FAILED) st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
+        /* the events as the replay's input: decoded from the blocks just
+         * written, mapped from the file (no memory of their own) */
+        map_len = ec.segs_off + h->sec[S_SEGS].bytes;
+        map = mmap(NULL, map_len, PROT_READ, MAP_SHARED, fd, 0);
+        if (map == MAP_FAILED) st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
     }
-    placer pc = {fd, recs_len};
-    pdt_replay_place pl = {place_reserve, place_put, place_get, &pc, budget, fine, kinds};
-    if (st == PDT_OK)
-        st = pdt_replay_build(pts, n, (const pdt_rec *)((char *)recs + HDR_BYTES), m, nranks, &pl,
-                              &r, err);
+    placer pc = {fd, map_len};
+    if (st == PDT_OK) {
+        ec.src.bytes = (const uint8_t *)map + HDR_BYTES;
+        ec.src.blk = ec.blk;
+        ec.src.rank_blk = ec.rank_blk;
+        ec.src.seg = (const pdt_evseg *)(void *)((const char *)map + ec.segs_off);
+        ec.src.drop_behind = 1;
+    }
+    pdt_replay_place pl = {place_reserve, place_put, place_get, &pc, budget, fine, kinds, &ec.src};
+    if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
     if (st == PDT_OK) {
         r->warnings = pdt_run_warnings(run);
         size_t every = r->m / ICK_PARTS;
         r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
         r->nick = r->m / r->ick_every + 1;
-        st = write_tables(r, fd, h, ident, &pc, &recs_crc, err);
+        st = write_tables(r, fd, h, ident, &pc, &ec, err);
         r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
     }
     pdt_replay_free(r);
-    if (recs != MAP_FAILED) munmap(recs, recs_len);
+    pdt_evsrc_clear(&ec.src);
+    if (map != MAP_FAILED) munmap(map, map_len);
     if (close(fd) != 0 && st == PDT_OK)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
     /* into place over a stale index without ext4 writing the new one back
@@ -1074,7 +1178,10 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", path, strerror(errno));
     if (st != PDT_OK) unlink(tmp);
     free(h);
-    free(recs_crc.crc);
+    free(ec.blk);
+    free(ec.rank_blk);
+    free(ec.blocks_crc.crc);
+    free(ec.segs_crc.crc);
     return st;
 }
 

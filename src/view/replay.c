@@ -124,6 +124,13 @@ static int km_put(keymap *km, uint64_t hi, uint64_t lo, int32_t v)
 
 static int first_flagged(const pdt_replay *r) { return r->nhist < FIRST_ENTRY; }
 
+/* Event i (< m): from the array, or decoded (a kept index: the pointer
+ * holds for PDT_EVSRC_KEEP - 1 more calls). */
+static inline const pdt_rec *rec_at(const pdt_replay *r, size_t i)
+{
+    return r->recs ? &r->recs[i] : pdt_evsrc_get(r->src, i);
+}
+
 static int is_tri_kind(int k)
 {
     return k == PDT_EV_TRI_NEW || k == PDT_EV_TRI_FINAL || k == PDT_EV_RA_DEFER ||
@@ -284,7 +291,7 @@ static void box_add(pdt_replay *r, uint32_t rank, pdt_point p)
 static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
 {
     pdt_replay *r = b->r;
-    const pdt_rec *rec = &r->recs[i];
+    const pdt_rec *rec = rec_at(r, i);
     const pdt_event *e = &rec->ev;
     int rank = (int)rec->rank;
     int32_t *cur = b->cur + (size_t)rank * PDT_SLOT_PER_RANK;
@@ -478,7 +485,7 @@ static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
  * inside a helper function, which it deems free of side effects.) */
 static const void *probe_addr(const builder *b, size_t i, const void **also)
 {
-    const pdt_rec *rec = &b->r->recs[i];
+    const pdt_rec *rec = rec_at(b->r, i);
     const pdt_event *e = &rec->ev;
     const pdt_replay *r = b->r;
     *also = NULL;
@@ -656,7 +663,7 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
 
 static void drop_recs(const builder *b, size_t upto)
 {
-    if (!b->pl || !upto || upto % DROP_EVERY) return;
+    if (!b->pl || !b->r->recs || !upto || upto % DROP_EVERY) return;
     uintptr_t lo = ((uintptr_t)(b->r->recs + upto - DROP_EVERY) + 4095) & ~(uintptr_t)4095,
               hi = (uintptr_t)(b->r->recs + upto) & ~(uintptr_t)4095;
     if (hi > lo) madvise((void *)lo, hi - lo, MADV_DONTNEED);
@@ -686,7 +693,7 @@ static int tri_ids(builder *b)
             r->ev_obj[i] = r->ev_obj[o];
             continue;
         }
-        const pdt_rec *rec = &r->recs[i];
+        const pdt_rec *rec = rec_at(r, i);
         to[b->pl ? nb++ : r->ntri] = (pdt_rtri){{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank,
                                                r->ev_ent[i], (uint32_t)(-1 - o)};
         if (first_flagged(r)) r->ev_ent[i] |= FIRST_ENTRY;
@@ -734,7 +741,7 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         }
         for (size_t i = 0; !(pl && pl->fine_count) && i < r->m; i++) {
             drop_recs(&b, i);
-            const pdt_rec *rec = &r->recs[i];
+            const pdt_rec *rec = rec_at(r, i);
             if (rec->ev.kind < PDT_EV_KIND_COUNT) cnt[rec->ev.kind]++;
             size_t f = pdt_replay_fine_of(rec, r->n, r->nranks);
             if (f < NFINE) b.fine_off[f + 1]++;
@@ -765,8 +772,9 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         drop_recs(&b, i);
         r->ev_obj[i] = -1;
         r->ev_ent[i] = 0;
-        r->ev_kind[i] = r->recs[i].ev.kind;
-        if (r->recs[i].rank >= (uint32_t)r->nranks) {
+        const pdt_rec *rec = rec_at(r, i);
+        r->ev_kind[i] = rec->ev.kind;
+        if (rec->rank >= (uint32_t)r->nranks) {
             r->skipped++;
             continue;
         }
@@ -775,7 +783,7 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             if (p) __builtin_prefetch(p);
             if (also) __builtin_prefetch(also);
         }
-        if (r->recs[i].ev.kind < PDT_EV_KIND_COUNT) r->kind_count[r->recs[i].ev.kind]++;
+        if (r->ev_kind[i] < PDT_EV_KIND_COUNT) r->kind_count[r->ev_kind[i]]++;
         if (!index_event(&b, (uint32_t)i, lifted_any)) goto out;
     }
     /* Phases that open a cluster of overlapping same phases (any rank). */
@@ -853,6 +861,8 @@ pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs,
     *out = NULL;
     if (m >= NONE32 || n >= NONE32)
         return pdt_err_set(err, PDT_ERR_ARG, "too many events or points (%zu, %zu)", m, n);
+    if (!recs && m && (!pl || !pl->src || nranks <= 0))
+        return pdt_err_set(err, PDT_ERR_ARG, "no events to build a replay of");
     if (nranks <= 0) {
         uint32_t mx = 0;
         for (size_t i = 0; i < m; i++)
@@ -864,6 +874,7 @@ pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs,
     r->pts = pts;
     r->n = n;
     r->recs = recs;
+    r->src = recs || !pl ? NULL : pl->src;
     r->m = m;
     r->nranks = nranks;
     size_t q1 = (size_t)nranks;
@@ -900,6 +911,10 @@ void pdt_replay_free(pdt_replay *r)
     if (!r) return;
     for (size_t c = 0; c < r->nck; c++) pdt_rstate_free(r->ck[c]);
     free(r->ck);
+    if (r->src && r->map) { /* a kept index's: the replay owns it (a build's is its caller's) */
+        pdt_evsrc_clear(r->src);
+        free(r->src);
+    }
     if (r->map) { /* the tables live in the kept index's mapping */
         pdt_index_unmap(r);
         free(r);
@@ -945,7 +960,13 @@ const pdt_point *pdt_replay_points(const pdt_replay *r, size_t *n)
     return r->pts;
 }
 
-const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i) { return i < r->m ? &r->recs[i] : NULL; }
+const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i) { return i < r->m ? rec_at(r, i) : NULL; }
+
+uint32_t pdt_replay_rank_of(const pdt_replay *r, size_t i)
+{
+    if (i >= r->m) return UINT32_MAX;
+    return r->recs ? r->recs[i].rank : pdt_evsrc_rank(r->src, i);
+}
 
 #define TABLE(fn, type, arr, cnt)                                \
     const type *fn(const pdt_replay *r, size_t *n)               \
@@ -1448,13 +1469,13 @@ size_t pdt_replay_find(const pdt_replay *r, size_t k, int dir, int c, const uint
     if (k > r->m) k = r->m;
     if (dir > 0) {
         for (size_t i = k; i < r->m; i++)
-            if (pdt_ev_in_class(r->recs[i].ev.kind, c) &&
-                (!rank_visible || rank_visible[r->recs[i].rank]))
+            if (pdt_ev_in_class(r->ev_kind[i], c) &&
+                (!rank_visible || rank_visible[pdt_replay_rank_of(r, i)]))
                 return i + 1;
     } else {
         for (size_t i = k >= 2 ? k - 1 : 0; i-- > 0;)
-            if (pdt_ev_in_class(r->recs[i].ev.kind, c) &&
-                (!rank_visible || rank_visible[r->recs[i].rank]))
+            if (pdt_ev_in_class(r->ev_kind[i], c) &&
+                (!rank_visible || rank_visible[pdt_replay_rank_of(r, i)]))
                 return i + 1;
         if (k >= 1) return 0;
     }
@@ -1486,8 +1507,8 @@ size_t pdt_replay_find_phase_name(const pdt_replay *r, const char *name)
     base[len] = 0;
     if (colon) level = strtol(colon + 1, NULL, 10);
     for (size_t i = 0; i < r->m; i++) {
-        const pdt_event *e = &r->recs[i].ev;
-        if (e->kind != PDT_EV_PHASE_BEGIN) continue;
+        if (r->ev_kind[i] != PDT_EV_PHASE_BEGIN) continue;
+        const pdt_event *e = &rec_at(r, i)->ev;
         const char *nm = pdt_phase_name(e->sub);
         if (nm && !strcmp(nm, base) && (level < 0 || (long)e->a == level)) return i + 1;
     }

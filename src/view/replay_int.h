@@ -8,6 +8,49 @@
 /* Checkpoints a kept index holds, at most (index.c makes 17 at most). */
 #define PDT_ICK_MAX 24
 
+/* ---- the merged events of a kept index, decoded on demand (evsrc.c) ----------
+ *
+ * A kept index holds no decoded events: it holds a copy of the rank files'
+ * encoded blocks (their payloads, one after the other, rank by rank), a
+ * table of those blocks, and the merged order as segments, each a stretch
+ * of consecutive merged events that are consecutive events of one rank.
+ * An event is decoded when asked for, with its block, into a small cache. */
+
+/* The merged events [start, next segment's start) are events seq0, seq0 + 1,
+ * ... of rank `rank`. */
+typedef struct pdt_evseg {
+    uint32_t start, rank, seq0;
+} pdt_evseg;
+
+typedef struct pdt_evsrc {
+    const uint8_t *bytes;        /* the payloads */
+    uint64_t nbytes;
+    const pdt_block_ref *blk;    /* every rank's blocks, rank by rank; off: in bytes,
+                                  * base_t: the aligned time base (shift added) */
+    size_t nblk;
+    const uint64_t *rank_blk;    /* nranks + 1: rank q's blocks are
+                                  * blk[rank_blk[q] .. rank_blk[q + 1]) */
+    const pdt_evseg *seg;
+    size_t nseg, m;
+    int nranks;
+    /* the decoded blocks (a cache; owned) */
+    struct evslot *slot;
+    size_t nslot, hot, last_seg;
+    uint64_t tick;
+    int drop_behind;             /* give back the mapped payload pages behind a forward
+                                  * pass (madvise; the build's one-way passes) */
+    uint64_t released;
+} pdt_evsrc;
+
+/* Event i (< m) of the merged order, decoded: a pointer into the cache,
+ * valid at least until PDT_EVSRC_KEEP - 1 more calls. */
+#define PDT_EVSRC_KEEP 8
+const pdt_rec *pdt_evsrc_get(pdt_evsrc *s, size_t i);
+/* The rank of event i (no decoding). */
+uint32_t pdt_evsrc_rank(pdt_evsrc *s, size_t i);
+/* Free the cache (the tables are not s's). */
+void pdt_evsrc_clear(pdt_evsrc *s);
+
 typedef struct slot_change {
     uint32_t ev;
     int32_t val, prev;
@@ -16,7 +59,8 @@ typedef struct slot_change {
 struct pdt_replay {
     const pdt_point *pts;
     size_t n;
-    const pdt_rec *recs;
+    const pdt_rec *recs;  /* the merged events, or NULL: decoded on demand from src */
+    pdt_evsrc *src;       /* (kept index) */
     size_t m, skipped;
     int nranks;
     int32_t *ev_obj;   /* per event: object (see build()) or -1 */
@@ -98,6 +142,9 @@ typedef struct pdt_replay_place {
      * them, and the events of every kind (PDT_EV_KIND_COUNT; kinds beyond
      * it not counted). */
     const uint64_t *fine_count, *kind_count;
+    /* The events, when the build is given no array of them (recs NULL):
+     * decoded from here, in two forward passes. */
+    pdt_evsrc *src;
 } pdt_replay_place;
 
 /* The triangle events of a build are grouped in this many buckets by a hash
@@ -109,7 +156,8 @@ typedef struct pdt_replay_place {
 size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks);
 
 /* pdt_replay_new, with the triangles and histories streamed to pl (NULL:
- * held in memory, no budget: pdt_replay_new). */
+ * held in memory, no budget: pdt_replay_new); recs NULL: the events are
+ * pl->src's (nranks must then be given). */
 pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs, size_t m,
                             int nranks, const pdt_replay_place *pl, pdt_replay **out, pdt_err *err);
 

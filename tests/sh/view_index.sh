@@ -23,6 +23,14 @@ if [ "$got" = "$mem" ] && [ -s "$IDX" ] && [ ! -s "$TMP/e1" ]; then ok index_bui
 else fail index_built_same_counts "got '$got' want '$mem'; $(cat "$TMP/e1")"; fi
 ls "$R"/.pdtview-index.tmp* >/dev/null 2>&1 && fail no_temp_left "a temporary index is left" || ok no_temp_left
 
+# the index holds the rank file's encoded blocks (a copy from its first block
+# on, at byte 4096), not decoded events (40 bytes each)
+rsz=$(stat -c %s "$R/rank-0000.trace")
+if cmp -s <(tail -c +33 "$R/rank-0000.trace" | head -c $((rsz - 100))) \
+          <(tail -c +4097 "$IDX" | head -c $((rsz - 100)))
+then ok index_holds_encoded_blocks
+else fail index_holds_encoded_blocks "the rank file's blocks are not at byte 4096 of the index"; fi
+
 # what the window shows (event lines, lit code lines) is the same at every event
 "$V" "$R" --describe --index off > "$TMP/d_mem.txt"
 "$V" "$R" --describe --mem 1M > "$TMP/d_idx.txt"
