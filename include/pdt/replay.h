@@ -59,17 +59,19 @@ typedef struct pdt_rtri {
     uint32_t h0, hn;    /* its history entries: hist[h0 .. h0+hn) */
 } pdt_rtri;
 
-/* One change of a triangle's status. */
+/* One change of a triangle's status (12 bytes: a kept index holds one per
+ * triangle event).  The event itself (pdt_replay_rec(r, ev)) says the rest:
+ * the rank that reported it, and v (RA_DEFER: touched rank; SHIP:
+ * destination; DISCARD: witness). */
 typedef struct pdt_rtri_hist {
     uint32_t ev;        /* event index */
-    uint32_t rank;      /* rank that reported it */
-    uint8_t status;     /* pdt_tri_status after the event */
-    uint8_t run;        /* TRI_NEW: 0 local kernel, 1 border kernel */
-    int64_t v;          /* RA_DEFER: touched rank; SHIP: destination; DISCARD: witness */
     uint32_t until;     /* TRI_NEW of a border kernel: the MERGE_END of its merge step.
                          * A candidate still in this state after that event was
                          * neither kept nor shipped: the merge dropped it without
                          * an event (pdt_rstate_tri_visible).  Else UINT32_MAX. */
+    uint8_t status;     /* pdt_tri_status after the event */
+    uint8_t run;        /* TRI_NEW: 0 local kernel, 1 border kernel (the event's sub) */
+    uint8_t pad[2];
 } pdt_rtri_hist;
 
 /* A kernel edge (level 2) between its EDGE_ADD and EDGE_DEL. */

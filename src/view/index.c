@@ -954,10 +954,14 @@ static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
 /* The triangles and histories of a replay being built, streamed to the index
  * file itself (pdt_replay_place): written once, in place, by pwrite (not
  * through a shared mapping: on this file system page faults on a file being
- * written back wait for the disk), and never held in memory. */
+ * written back wait for the disk), and never held in memory.  The triangle
+ * events the build groups go to a spill of their own, an unnamed file
+ * beside the index (O_TMPFILE), dropped (closed) once they are grouped: its
+ * pages leave the page cache with it, mostly before they were written back. */
 typedef struct placer {
     int fd;
     uint64_t off;  /* where the next table goes */
+    int sfd;       /* the spill */
 } placer;
 
 static uint64_t place_reserve(void *ctx, uint64_t bytes)
@@ -973,17 +977,50 @@ static int place_put(void *ctx, uint64_t at, const void *p, size_t bytes)
     return write_all(((placer *)ctx)->fd, p, bytes, at);
 }
 
-static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
+static int read_all(int fd, uint64_t at, void *p, size_t bytes)
 {
     char *b = p;
     while (bytes) {
-        ssize_t got = pread(((placer *)ctx)->fd, b, bytes, (off_t)at);
+        ssize_t got = pread(fd, b, bytes, (off_t)at);
         if (got <= 0) return 0;
         b += got;
         bytes -= (size_t)got;
         at += (uint64_t)got;
     }
     return 1;
+}
+
+static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
+{
+    return read_all(((placer *)ctx)->fd, at, p, bytes);
+}
+
+static int spill_put(void *ctx, uint64_t at, const void *p, size_t bytes)
+{
+    return write_all(((placer *)ctx)->sfd, p, bytes, at);
+}
+
+static int spill_get(void *ctx, uint64_t at, void *p, size_t bytes)
+{
+    return read_all(((placer *)ctx)->sfd, at, p, bytes);
+}
+
+/* An unnamed scratch file in the folder of `path` (O_TMPFILE; where the file
+ * system has none, a named one removed at once), or -1. */
+static int open_spill(const char *path)
+{
+    char dir[PATH_MAX + 128];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    if (slash) *slash = 0;
+    else snprintf(dir, sizeof dir, ".");
+    int fd = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    if (fd >= 0) return fd;
+    char name[PATH_MAX + 160];
+    snprintf(name, sizeof name, "%s.spill", path);
+    fd = open(name, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd >= 0) unlink(name);
+    return fd;
 }
 
 /* Write the tables of r after the records and the streamed ones (at pc->off),
@@ -1149,7 +1186,9 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         map = mmap(NULL, map_len, PROT_READ, MAP_SHARED, fd, 0);
         if (map == MAP_FAILED) st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
     }
-    placer pc = {fd, map_len};
+    placer pc = {fd, map_len, -1};
+    if (st == PDT_OK && (pc.sfd = open_spill(tmp)) < 0)
+        st = pdt_err_set(err, PDT_ERR_IO, "%s: a scratch file beside it: %s", tmp, strerror(errno));
     if (st == PDT_OK) {
         ec.src.bytes = (const uint8_t *)map + HDR_BYTES;
         ec.src.blk = ec.blk;
@@ -1157,8 +1196,10 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         ec.src.seg = (const pdt_evseg *)(void *)((const char *)map + ec.segs_off);
         ec.src.drop_behind = 1;
     }
-    pdt_replay_place pl = {place_reserve, place_put, place_get, &pc, budget, fine, kinds, &ec.src};
+    pdt_replay_place pl = {place_reserve, place_put,  place_get, spill_put, spill_get,
+                           &pc,           budget,     fine,      kinds,     &ec.src};
     if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
+    if (pc.sfd >= 0) close(pc.sfd);  /* the spill, grouped: gone */
     if (st == PDT_OK) {
         r->warnings = pdt_run_warnings(run);
         size_t every = r->m / ICK_PARTS;

@@ -161,26 +161,25 @@ static void sort3(uint32_t v[3], const uint32_t in[3])
 
 /* ---- triangles: their events grouped by triangle, in buckets of bounded size ----
  *
- * The first pass writes every triangle event, with its triangle's key (the
- * corners sorted), into the place of a history entry (the same size), sorted
- * by a hash of the key into NFINE fine buckets, each in event order.  Then
- * runs of consecutive fine buckets that fit the working budget are grouped
- * one after the other with a hash table of their own size (tri_groups): the
- * events of one triangle are all in one fine bucket, so each run's triangles
- * are whole, and their history entries are written over the run's records.
- * A last pass in event order numbers the triangles by their first event
- * (tri_ids).  Memory: the tables themselves (which may be the caller's, e.g.
- * a mapping of the index file) and a working set bounded by the budget. */
+ * The first pass writes every triangle event as its triangle's key (the
+ * corners sorted) and its event index into a spill (memory, or the place's
+ * spill file), sorted by a hash of the key into NFINE fine buckets, each in
+ * event order; what its history entry needs besides (its sub field, and for
+ * a border kernel's candidate the merge step open on its rank) waits in
+ * ev_ent and ev_obj, which the grouping overwrites.  Then runs of
+ * consecutive fine buckets that fit the working budget are grouped one
+ * after the other with a hash table of their own size (tri_groups): the
+ * events of one triangle are all in one fine bucket, so each run's
+ * triangles are whole, and their history entries take the run's place in
+ * the history table.  A last pass in event order numbers the triangles by
+ * their first event (tri_ids).  Memory: the tables themselves (which may be
+ * the caller's, e.g. a mapping of the index file) and a working set bounded
+ * by the budget. */
 
 typedef struct tri_rec {
     uint32_t s[3];  /* corners, sorted: the triangle's key */
-    uint32_t ev, rank;
-    uint8_t kind, sub;
-    uint16_t pad;
-    int64_t v;
+    uint32_t ev;
 } tri_rec;
-
-_Static_assert(sizeof(tri_rec) == sizeof(pdt_rtri_hist), "a triangle event fits its history entry");
 
 #define FINE_BITS 8
 #define NFINE ((size_t)1 << FINE_BITS)
@@ -219,6 +218,7 @@ typedef struct builder {
     size_t *fine_off;     /* per fine bucket: its first history entry; NFINE + 1 */
     const pdt_replay_place *pl;  /* streamed: the place, and per fine bucket a buffer */
     tri_rec *fbuf;        /* NFINE * FBUF records */
+    tri_rec *spill;       /* not streamed: the triangle events by fine bucket */
     uint32_t *fbn;        /* records in each buffer */
     int failed;           /* a put or get failed */
 } builder;
@@ -246,12 +246,16 @@ static int tput(builder *b, void *arr, uint64_t base, size_t at, const void *p, 
     return !b->failed;
 }
 
-/* Flush the buffer of fine bucket f (streamed). */
+/* Flush the buffer of fine bucket f (streamed) to the spill. */
 static int fine_flush(builder *b, size_t f)
 {
     size_t k = b->fbn[f];
     b->fbn[f] = 0;
-    return tput(b, NULL, b->r->hist_at, b->fine_fill[f] - k, b->fbuf + f * FBUF, k, sizeof(tri_rec));
+    if (!k) return 1;
+    if (!b->pl->sput(b->pl->ctx, (uint64_t)(b->fine_fill[f] - k) * sizeof(tri_rec),
+                     b->fbuf + f * FBUF, k * sizeof(tri_rec)))
+        b->failed = 1;
+    return !b->failed;
 }
 
 static int set_slot(builder *b, uint32_t ev, int rank, int slot, int32_t val)
@@ -456,14 +460,12 @@ static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
         uint32_t in[3] = {e->a, e->b, e->c};
         sort3(t.s, in);
         t.ev = i;
-        t.rank = rec->rank;
-        t.kind = e->kind;
-        t.sub = e->sub;
-        t.pad = 0;
-        t.v = e->v;
+        /* for hist_of, until the grouping writes these two */
+        r->ev_ent[i] = e->sub;
+        r->ev_obj[i] = e->kind == PDT_EV_TRI_NEW && e->sub == 1 ? cur[PDT_SLOT_MERGE] : -1;
         size_t f = fine_of(t.s);
         if (!b->pl) {
-            memcpy(&r->hist[b->fine_fill[f]++], &t, sizeof t);
+            b->spill[b->fine_fill[f]++] = t;
             return 1;
         }
         b->fbuf[f * FBUF + b->fbn[f]++] = t;
@@ -505,15 +507,19 @@ typedef struct gslot {
     uint32_t s[3], g;
 } gslot;
 
-/* The history entry of the triangle event in t (the status it sets). */
-static pdt_rtri_hist hist_of(const pdt_replay *r, const tri_rec *t)
+/* The history entry of triangle event ev (the status it sets), from what
+ * the first pass left in ev_ent (its sub field) and ev_obj (a border
+ * kernel's candidate: the merge step open on its rank, else -1).  That step
+ * is the one whose MERGE_END the candidate waits for: a merge step that ends
+ * was its rank's open one from its MERGE_BEGIN to its MERGE_END. */
+static pdt_rtri_hist hist_of(const pdt_replay *r, uint32_t ev)
 {
-    pdt_rtri_hist h = {t->ev, t->rank, tri_status_of(t->kind), t->sub, t->v, NONE32};
-    if (t->kind == PDT_EV_TRI_NEW && t->sub == 1) /* border kernel: which merge step? */
-        for (size_t g = 0; g < r->nmerge; g++)
-            if (r->merges[g].rank == t->rank && r->merges[g].begin_ev < t->ev &&
-                r->merges[g].end_ev != NONE32 && t->ev < r->merges[g].end_ev)
-                h.until = r->merges[g].end_ev;
+    int kind = r->ev_kind[ev];
+    uint8_t sub = (uint8_t)r->ev_ent[ev];
+    int32_t g = r->ev_obj[ev];
+    pdt_rtri_hist h = {ev, NONE32, tri_status_of(kind), sub, {0, 0}};
+    if (kind == PDT_EV_TRI_NEW && sub == 1 && g >= 0 && (size_t)g < r->nmerge)
+        h.until = r->merges[g].end_ev;  /* (NONE32: it never ended) */
     return h;
 }
 
@@ -553,8 +559,8 @@ static void *group_worker(void *arg)
         if (k >= J->nrun) break;
         size_t base = b->fine_off[J->run[k]], nb = b->fine_off[J->run[k + 1]] - base;
         if (!nb) continue;
-        if (!b->pl) memcpy(buf, &r->hist[base], nb * sizeof *buf);
-        else if (!b->pl->get(b->pl->ctx, r->hist_at + base * sizeof *buf, buf, nb * sizeof *buf)) {
+        if (!b->pl) memcpy(buf, &b->spill[base], nb * sizeof *buf);
+        else if (!b->pl->sget(b->pl->ctx, base * sizeof *buf, buf, nb * sizeof *buf)) {
             J->io = 1;
             ok = 0;
             break;
@@ -582,14 +588,15 @@ static void *group_worker(void *arg)
         }
         size_t h = base;
         for (uint32_t q = 0; q < ng; q++) gfill[q] = (uint32_t)h, h += gn[q];
-        pdt_rtri_hist *to = b->pl ? out - base : r->hist;
+        pdt_rtri_hist *to = b->pl ? out : r->hist + base;
         for (size_t j = 0; j < nb; j++) {
-            if (j + PREFETCH_AHEAD < nb) { /* random places in two tables of 4 bytes per event */
+            if (j + PREFETCH_AHEAD < nb) { /* random places in three tables of 4, 4, 1 bytes per event */
                 __builtin_prefetch(&r->ev_ent[buf[j + PREFETCH_AHEAD].ev], 1);
                 __builtin_prefetch(&r->ev_obj[buf[j + PREFETCH_AHEAD].ev], 1);
+                __builtin_prefetch(&r->ev_kind[buf[j + PREFETCH_AHEAD].ev]);
             }
             uint32_t q = gid[j], ev = buf[j].ev, at = gfill[q]++;
-            to[at] = hist_of(r, &buf[j]);
+            to[at - base] = hist_of(r, ev);
             r->ev_ent[ev] = at;  /* (threads write distinct events) */
             r->ev_obj[ev] = ev == gfirst[q] ? -1 - (int32_t)gn[q] : (int32_t)gfirst[q];
         }
@@ -759,7 +766,8 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             r->hist = big_table(r->nhist * sizeof *r->hist);
             r->tris = big_table(r->nhist * sizeof *r->tris); /* at most one per event */
             r->cap_tri = r->nhist;
-            if (!r->hist || !r->tris) goto out;
+            b.spill = big_table(r->nhist * sizeof *b.spill);
+            if (!r->hist || !r->tris || !b.spill) goto out;
         }
         if (!km_alloc(&b.edge_map, cnt[PDT_EV_EDGE_ADD]) ||
             !km_alloc(&b.msg_map, cnt[PDT_EV_SEND]) ||
@@ -817,6 +825,8 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         work = pl->budget > held + pl->budget / 4 ? pl->budget - held : pl->budget / 4;
     }
     if (!tri_groups(&b, work, &ntri)) goto out;
+    free(b.spill);
+    b.spill = NULL;
     if (pl && (r->tris_at = pl->reserve(pl->ctx, (uint64_t)ntri * sizeof *r->tris)) == UINT64_MAX)
         goto out;
     if (!tri_ids(&b)) goto out;
@@ -842,6 +852,7 @@ out:
     free(b.fine_off);
     free(b.fbuf);
     free(b.fbn);
+    free(b.spill);
     km_free(&b.edge_map);
     km_free(&b.msg_map);
     if (st != PDT_OK && b.failed) pdt_err_set(err, PDT_ERR_IO, "the index file: %s", strerror(errno));

@@ -134,6 +134,10 @@ typedef struct pdt_replay_place {
     uint64_t (*reserve)(void *ctx, uint64_t bytes);
     int (*put)(void *ctx, uint64_t at, const void *p, size_t bytes);
     int (*get)(void *ctx, uint64_t at, void *p, size_t bytes);
+    /* scratch of 16 bytes per triangle event, written once and read once
+     * while the build groups them (at: from 0): e.g. a temporary file */
+    int (*sput)(void *ctx, uint64_t at, const void *p, size_t bytes);
+    int (*sget)(void *ctx, uint64_t at, void *p, size_t bytes);
     void *ctx;
     uint64_t budget;
     /* NULL, or the counts the build's first pass would make, made by the
