@@ -45,7 +45,7 @@
 #define INDEX_NAME ".pdtview-index"
 #define INDEX_VERSION 7u
 #define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/16 events, at least this */
-#define ICK_PARTS 16u
+#define ICK_PARTS 8u
 _Static_assert(ICK_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint's place");
 #define CHUNK_BYTES ((uint64_t)16 << 20) /* sections are checksummed in chunks of this: the
                                           * least a lazily checked frame reads (1 MiB made
