@@ -871,60 +871,89 @@ static pdt_status write_blocks(pdt_run *run, int fd, ihdr *h, evcopy *ec, pdt_er
     return PDT_OK;
 }
 
-/* Stream the merged order of run (the reader's merge: one decoded block per
- * rank in memory) into fd after the blocks as segments (S_SEGS).  Sets *m,
- * and counts what the replay's build would count in a first pass over the
- * events (pdt_replay_place): fine[PDT_REPLAY_NFINE] and
- * kinds[PDT_EV_KIND_COUNT], for a run of n points and nranks ranks. */
-static pdt_status write_segs(pdt_run *run, int fd, ihdr *h, evcopy *ec, size_t *m, size_t n,
-                             int nranks, uint64_t *fine, uint64_t *kinds, pdt_err *err)
+/* The merged order of run, streamed to the build (pass 1) by the reader's
+ * merge (one decoded block per rank in memory), and written as it goes
+ * into fd after the blocks as segments (S_SEGS).  At its end the blocks and
+ * segments are mapped, and ec->src decodes the events from there. */
+typedef struct evstream {
+    pdt_merge *mg;
+    int fd;
+    ihdr *h;
+    evcopy *ec;
+    uint64_t at, off;     /* S_SEGS: where it starts, where the next batch goes */
+    pdt_evseg cur, *buf;  /* the segment being made; a batch of finished ones */
+    size_t nb, count, nseg;
+    void *map;            /* at the end: [0, the end of S_SEGS) of the file */
+    size_t map_len;
+    uint64_t *place_off;  /* the placer's start: after S_SEGS */
+    int done;
+} evstream;
+
+enum { SEG_BATCH = 8192 };
+
+static int seg_flush(evstream *es, pdt_err *err)
 {
-    enum { BATCH = 8192 };
-    pdt_evseg *buf = malloc(BATCH * sizeof *buf);
-    pdt_merge *mg = NULL;
-    if (!buf) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    pdt_status st = pdt_merge_open(run, &mg, err);
-    uint64_t at = (HDR_BYTES + h->sec[S_BLOCKS].bytes + 63) & ~(uint64_t)63, off = at;
-    size_t count = 0, nb = 0, nseg = 0;
-    pdt_evseg cur = {0, UINT32_MAX, 0};
-    int got = 1;
-    while (st == PDT_OK && got >= 0) {
-        pdt_rec rec;
-        got = pdt_merge_next(mg, &rec, err);
-        if (got < 0) st = err->code ? err->code : PDT_ERR_NOMEM;
-        if (got > 0 && count >= UINT32_MAX - 1)
-            st = pdt_err_set(err, PDT_ERR_ARG, "too many events (%zu)", count);
-        if (st != PDT_OK) break;
-        if (got > 0) {
-            if (rec.ev.kind < PDT_EV_KIND_COUNT) kinds[rec.ev.kind]++;
-            size_t f = pdt_replay_fine_of(&rec, n, nranks);
-            if (f < PDT_REPLAY_NFINE) fine[f]++;
-            int same = rec.rank == cur.rank && rec.seq - cur.seq0 == count - cur.start;
-            if (!same && cur.rank != UINT32_MAX) buf[nb++] = cur;
-            if (!same) cur = (pdt_evseg){(uint32_t)count, rec.rank, rec.seq};
-            count++;
-        } else if (cur.rank != UINT32_MAX) {
-            buf[nb++] = cur; /* the last one */
-        }
-        if (nb == BATCH || (got == 0 && nb)) {
-            if (!write_all(fd, buf, nb * sizeof *buf, off))
-                st = pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-            crc_feed(&ec->segs_crc, buf, nb * sizeof *buf);
-            off += nb * sizeof *buf;
-            nseg += nb;
-            nb = 0;
-        }
-        if (got == 0) break;
+    if (!es->nb) return 1;
+    if (!write_all(es->fd, es->buf, es->nb * sizeof *es->buf, es->off)) {
+        pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+        return 0;
     }
-    pdt_merge_close(mg);
-    free(buf);
-    h->sec[S_SEGS] = (isec){at, (uint64_t)nseg * sizeof(pdt_evseg), 0, 0};
-    h->count[S_SEGS] = nseg;
-    ec->segs_off = at;
-    ec->src.nseg = nseg;
-    ec->src.m = count;
-    *m = count;
-    return st;
+    crc_feed(&es->ec->segs_crc, es->buf, es->nb * sizeof *es->buf);
+    es->off += es->nb * sizeof *es->buf;
+    es->nseg += es->nb;
+    es->nb = 0;
+    return 1;
+}
+
+/* The last segment out, the section's place, the mapping for ec->src. */
+static int stream_finish(evstream *es, pdt_err *err)
+{
+    if (es->cur.rank != UINT32_MAX) es->buf[es->nb++] = es->cur;
+    if (!seg_flush(es, err)) return 0;
+    es->h->sec[S_SEGS] = (isec){es->at, (uint64_t)es->nseg * sizeof(pdt_evseg), 0, 0};
+    es->h->count[S_SEGS] = es->nseg;
+    es->map_len = (size_t)es->off;
+    es->map = mmap(NULL, es->map_len, PROT_READ, MAP_SHARED, es->fd, 0);
+    if (es->map == MAP_FAILED) {
+        es->map = NULL;
+        pdt_err_set(err, PDT_ERR_IO, "mapping the index: %s", strerror(errno));
+        return 0;
+    }
+    pdt_evsrc *src = &es->ec->src;
+    src->bytes = (const uint8_t *)es->map + HDR_BYTES;
+    src->blk = es->ec->blk;
+    src->rank_blk = es->ec->rank_blk;
+    src->seg = (const pdt_evseg *)(void *)((const char *)es->map + es->at);
+    src->nseg = es->nseg;
+    src->m = es->count;
+    src->drop_behind = 1;
+    *es->place_off = es->off;
+    return 1;
+}
+
+static int stream_next(void *ctx, pdt_rec *out, size_t max, pdt_err *err)
+{
+    evstream *es = *(evstream **)ctx;
+    size_t j = 0;
+    while (!es->done && j < max) {
+        int got = pdt_merge_next(es->mg, &out[j], err);
+        if (got < 0) return -1;
+        if (got == 0) {
+            es->done = 1;
+            if (!stream_finish(es, err)) return -1;
+            break;
+        }
+        const pdt_rec *rec = &out[j++];
+        if (rec->rank != es->cur.rank || rec->seq - es->cur.seq0 != es->count - es->cur.start) {
+            if (es->cur.rank != UINT32_MAX) {
+                es->buf[es->nb++] = es->cur;
+                if (es->nb == SEG_BATCH && !seg_flush(es, err)) return -1;
+            }
+            es->cur = (pdt_evseg){(uint32_t)es->count, rec->rank, rec->seq};
+        }
+        es->count++;
+    }
+    return (int)j;
 }
 
 /* The state at every r->ick_every-th cursor, stepped forwards from 0,
@@ -959,6 +988,7 @@ static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
  * beside the index (O_TMPFILE), dropped (closed) once they are grouped: its
  * pages leave the page cache with it, mostly before they were written back. */
 typedef struct placer {
+    struct evstream *es; /* (first: the stream's context is the placer's) */
     int fd;
     uint64_t off;  /* where the next table goes */
     int sfd;       /* the spill */
@@ -1173,31 +1203,32 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     evcopy ec;
     memset(&ec, 0, sizeof ec);
     pdt_replay *r = NULL;
-    void *map = MAP_FAILED;
-    size_t m = 0, map_len = 0;
-    uint64_t fine[PDT_REPLAY_NFINE] = {0}, kinds[PDT_EV_KIND_COUNT] = {0};
-    pdt_status st = h ? write_blocks(run, fd, h, &ec, err)
-                      : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    if (st == PDT_OK) st = write_segs(run, fd, h, &ec, &m, n, nranks, fine, kinds, err);
-    if (st == PDT_OK) {
-        /* the events as the replay's input: decoded from the blocks just
-         * written, mapped from the file (no memory of their own) */
-        map_len = ec.segs_off + h->sec[S_SEGS].bytes;
-        map = mmap(NULL, map_len, PROT_READ, MAP_SHARED, fd, 0);
-        if (map == MAP_FAILED) st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
+    uint64_t events = 0;
+    for (int q = 0; q < nranks; q++) {
+        pdt_rank_info ri;
+        pdt_run_rank_info(run, q, &ri);
+        events += ri.events;
     }
-    placer pc = {fd, map_len, -1};
-    if (st == PDT_OK && (pc.sfd = open_spill(tmp)) < 0)
-        st = pdt_err_set(err, PDT_ERR_IO, "%s: a scratch file beside it: %s", tmp, strerror(errno));
+    size_t m = (size_t)events;
+    evstream es;
+    memset(&es, 0, sizeof es);
+    es.cur.rank = UINT32_MAX;
+    es.buf = malloc(SEG_BATCH * sizeof *es.buf);
+    placer pc = {&es, fd, 0, -1};
+    pdt_status st = h && es.buf ? write_blocks(run, fd, h, &ec, err)
+                                : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    if (st == PDT_OK) st = pdt_merge_open(run, &es.mg, err);
     if (st == PDT_OK) {
-        ec.src.bytes = (const uint8_t *)map + HDR_BYTES;
-        ec.src.blk = ec.blk;
-        ec.src.rank_blk = ec.rank_blk;
-        ec.src.seg = (const pdt_evseg *)(void *)((const char *)map + ec.segs_off);
-        ec.src.drop_behind = 1;
+        es.fd = fd;
+        es.h = h;
+        es.ec = &ec;
+        es.at = es.off = (HDR_BYTES + h->sec[S_BLOCKS].bytes + 63) & ~(uint64_t)63;
+        es.place_off = &pc.off;
+        if ((pc.sfd = open_spill(tmp)) < 0)
+            st = pdt_err_set(err, PDT_ERR_IO, "%s: a scratch file beside it: %s", tmp, strerror(errno));
     }
-    pdt_replay_place pl = {place_reserve, place_put,  place_get, spill_put, spill_get,
-                           &pc,           budget,     fine,      kinds,     &ec.src};
+    pdt_replay_place pl = {place_reserve, place_put, place_get, spill_put, spill_get,
+                           &pc,           budget,    stream_next, &ec.src};
     if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
     if (pc.sfd >= 0) close(pc.sfd);  /* the spill, grouped: gone */
     if (st == PDT_OK) {
@@ -1210,7 +1241,9 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     }
     pdt_replay_free(r);
     pdt_evsrc_clear(&ec.src);
-    if (map != MAP_FAILED) munmap(map, map_len);
+    pdt_merge_close(es.mg);
+    free(es.buf);
+    if (es.map) munmap(es.map, es.map_len);
     if (close(fd) != 0 && st == PDT_OK)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
     /* into place over a stale index without ext4 writing the new one back

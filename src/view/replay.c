@@ -219,11 +219,32 @@ typedef struct builder {
     const pdt_replay_place *pl;  /* streamed: the place, and per fine bucket a buffer */
     tri_rec *fbuf;        /* NFINE * FBUF records */
     tri_rec *spill;       /* not streamed: the triangle events by fine bucket */
+    /* streamed: the spill is written a buffer (a chunk) at a time, where it
+     * ends; chunk k of fine bucket f is chunk[ck_start[f] + k] after pass 1 */
+    struct spill_chunk *chunk;
+    size_t nchunk, cap_chunk, *ck_start;
+    uint64_t spill_end;   /* bytes */
+    int stream_failed;    /* the place's stream of events failed (err set by it) */
+    pdt_rec *win;         /* streamed: events win_lo .. win_lo + win_n - 1 of the stream */
+    size_t win_lo, win_n;
     uint32_t *fbn;        /* records in each buffer */
     int failed;           /* a put or get failed */
 } builder;
 
-#define FBUF 256u  /* records buffered per fine bucket (streamed) */
+#define FBUF 1024u  /* records buffered per fine bucket (streamed): a chunk of the spill */
+
+#define WIN 8192u  /* events of the stream at hand (streamed) */
+
+/* The index pass is bound by cache misses in the edge map (random slots in
+ * a table of 10^8 bytes at level 2).  The events are all known in advance,
+ * so the slot an event a few places ahead will probe is fetched while the
+ * current one is handled.  A hint only: nothing depends on it. */
+#define PREFETCH_AHEAD 12
+
+typedef struct spill_chunk {
+    uint64_t off;      /* in the spill */
+    uint32_t f, n;     /* fine bucket, records */
+} spill_chunk;
 
 /* A big table of `bytes` (malloc'd, asking for huge pages), or NULL. */
 static void *big_table(size_t bytes)
@@ -246,16 +267,62 @@ static int tput(builder *b, void *arr, uint64_t base, size_t at, const void *p, 
     return !b->failed;
 }
 
-/* Flush the buffer of fine bucket f (streamed) to the spill. */
+/* Flush the buffer of fine bucket f (streamed) to the end of the spill, a
+ * chunk of it. */
 static int fine_flush(builder *b, size_t f)
 {
     size_t k = b->fbn[f];
     b->fbn[f] = 0;
     if (!k) return 1;
-    if (!b->pl->sput(b->pl->ctx, (uint64_t)(b->fine_fill[f] - k) * sizeof(tri_rec),
-                     b->fbuf + f * FBUF, k * sizeof(tri_rec)))
+    if (!grow((void **)&b->chunk, &b->cap_chunk, b->nchunk + 1, sizeof *b->chunk)) return 0;
+    if (!b->pl->sput(b->pl->ctx, b->spill_end, b->fbuf + f * FBUF, k * sizeof(tri_rec))) {
         b->failed = 1;
-    return !b->failed;
+        return 0;
+    }
+    b->chunk[b->nchunk++] = (spill_chunk){b->spill_end, (uint32_t)f, (uint32_t)k};
+    b->spill_end += k * sizeof(tri_rec);
+    return 1;
+}
+
+/* Streamed pass 1: have events i .. i + PREFETCH_AHEAD (or to the end) in
+ * the window.  0 when the stream failed or ended early (err set). */
+static int win_fill(builder *b, size_t i, pdt_err *err)
+{
+    size_t end = b->win_lo + b->win_n;
+    if (i + PREFETCH_AHEAD < end || end == b->r->m) return 1;
+    size_t keep = end - i;
+    memmove(b->win, b->win + (i - b->win_lo), keep * sizeof *b->win);
+    b->win_lo = i;
+    size_t want = WIN - keep;
+    if (want > b->r->m - end) want = b->r->m - end;
+    int got = b->pl->next(b->pl->ctx, b->win + keep, want, err);
+    if (got < 0 || (got == 0 && keep == 0)) {
+        if (got == 0) pdt_err_set(err, PDT_ERR_FORMAT, "the run has fewer events than counted");
+        b->stream_failed = 1;
+        return 0;
+    }
+    b->win_n = keep + (size_t)got;
+    return 1;
+}
+
+/* After pass 1 (streamed): the chunks ordered by fine bucket, each
+ * bucket's in the order written (its events' order). */
+static int chunks_by_bucket(builder *b)
+{
+    b->ck_start = calloc(NFINE + 1, sizeof *b->ck_start);
+    spill_chunk *sorted = malloc((b->nchunk ? b->nchunk : 1) * sizeof *sorted);
+    size_t fill[NFINE];
+    if (!b->ck_start || !sorted) {
+        free(sorted);
+        return 0;
+    }
+    for (size_t c = 0; c < b->nchunk; c++) b->ck_start[b->chunk[c].f + 1]++;
+    for (size_t f = 0; f < NFINE; f++) b->ck_start[f + 1] += b->ck_start[f];
+    memcpy(fill, b->ck_start, sizeof fill);
+    for (size_t c = 0; c < b->nchunk; c++) sorted[fill[b->chunk[c].f]++] = b->chunk[c];
+    free(b->chunk);
+    b->chunk = sorted;
+    return 1;
 }
 
 static int set_slot(builder *b, uint32_t ev, int rank, int slot, int32_t val)
@@ -292,10 +359,9 @@ static void box_add(pdt_replay *r, uint32_t rank, pdt_point p)
 }
 
 /* Pass 1: every object but triangle histories, which need counts first. */
-static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
+static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lifted_any)
 {
     pdt_replay *r = b->r;
-    const pdt_rec *rec = rec_at(r, i);
     const pdt_event *e = &rec->ev;
     int rank = (int)rec->rank;
     int32_t *cur = b->cur + (size_t)rank * PDT_SLOT_PER_RANK;
@@ -468,26 +534,22 @@ static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
             b->spill[b->fine_fill[f]++] = t;
             return 1;
         }
+        /* (streamed: fine_fill counts the bucket's events) */
         b->fbuf[f * FBUF + b->fbn[f]++] = t;
         b->fine_fill[f]++;
         return b->fbn[f] < FBUF || fine_flush(b, f);
     }
 }
 
-/* The index pass is bound by cache misses in the edge map (random slots in
- * a table of 10^8 bytes at level 2).  The events are all known in advance,
- * so the slot an event a few places ahead will probe is fetched while the
- * current one is handled.  A hint only: nothing depends on it. */
-#define PREFETCH_AHEAD 12
+/* (PREFETCH_AHEAD: see probe_addr) */
 
 /* The slot that looking up event i will probe first, or NULL; for a lift,
  * sort or deletion, the point's entry of its first such event, and (*also)
  * for a lift its coordinates (random places in tables of 4 and 8 bytes per
  * point).  (The caller prefetches them: GCC drops a __builtin_prefetch
  * inside a helper function, which it deems free of side effects.) */
-static const void *probe_addr(const builder *b, size_t i, const void **also)
+static const void *probe_addr(const builder *b, const pdt_rec *rec, const void **also)
 {
-    const pdt_rec *rec = rec_at(b->r, i);
     const pdt_event *e = &rec->ev;
     const pdt_replay *r = b->r;
     *also = NULL;
@@ -560,11 +622,18 @@ static void *group_worker(void *arg)
         size_t base = b->fine_off[J->run[k]], nb = b->fine_off[J->run[k + 1]] - base;
         if (!nb) continue;
         if (!b->pl) memcpy(buf, &b->spill[base], nb * sizeof *buf);
-        else if (!b->pl->sget(b->pl->ctx, base * sizeof *buf, buf, nb * sizeof *buf)) {
-            J->io = 1;
-            ok = 0;
-            break;
+        for (size_t c = b->pl ? b->ck_start[J->run[k]] : 0, got = 0;
+             b->pl && c < b->ck_start[J->run[k + 1]]; c++) { /* the run's chunks, bucket by bucket */
+            const spill_chunk *ck = &b->chunk[c];
+            if (got + ck->n > nb ||
+                !b->pl->sget(b->pl->ctx, ck->off, buf + got, ck->n * sizeof *buf)) {
+                J->io = 1;
+                ok = 0;
+                break;
+            }
+            got += ck->n;
         }
+        if (!ok) break;
         size_t hc = 1024;
         while (hc / 4 * 3 < nb) hc *= 2;
         size_t mask = hc - 1;
@@ -738,16 +807,13 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
     if (!b.cur || !b.lastst || !lifted_any || !b.fine_fill || !b.fine_off) goto out;
     for (size_t s = 0; s < nslot; s++) b.cur[s] = -1;
     for (int q = 0; q < r->nranks; q++) b.lastst[q] = -1;
-    /* size the tables once: counts of the events that create objects, and
-     * of the triangle events per fine bucket */
+    /* in memory, size the tables once: counts of the events that create
+     * objects, and of the triangle events per fine bucket (streamed: the
+     * events come once, the fine buckets are spilled in chunks, counted as
+     * they come, and the small tables grow) */
     {
         size_t cnt[PDT_EV_KIND_COUNT] = {0};
-        if (pl && pl->fine_count) { /* counted by the caller as it wrote the records */
-            for (size_t f = 0; f < NFINE; f++) b.fine_off[f + 1] = (size_t)pl->fine_count[f];
-            for (int k = 0; k < PDT_EV_KIND_COUNT; k++) cnt[k] = (size_t)pl->kind_count[k];
-        }
-        for (size_t i = 0; !(pl && pl->fine_count) && i < r->m; i++) {
-            drop_recs(&b, i);
+        for (size_t i = 0; !pl && i < r->m; i++) {
             const pdt_rec *rec = rec_at(r, i);
             if (rec->ev.kind < PDT_EV_KIND_COUNT) cnt[rec->ev.kind]++;
             size_t f = pdt_replay_fine_of(rec, r->n, r->nranks);
@@ -758,10 +824,10 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         r->nhist = b.fine_off[NFINE];
         if (pl) {
             r->streamed = 1;
-            r->hist_at = pl->reserve(pl->ctx, (uint64_t)r->nhist * sizeof *r->hist);
             b.fbuf = big_table(NFINE * FBUF * sizeof *b.fbuf);
             b.fbn = calloc(NFINE, sizeof *b.fbn);
-            if (r->hist_at == UINT64_MAX || !b.fbuf || !b.fbn) goto out;
+            b.win = malloc(WIN * sizeof *b.win);
+            if (!b.fbuf || !b.fbn || !b.win) goto out;
         } else {
             r->hist = big_table(r->nhist * sizeof *r->hist);
             r->tris = big_table(r->nhist * sizeof *r->tris); /* at most one per event */
@@ -778,21 +844,34 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
 
     for (size_t i = 0; i < r->m; i++) {
         drop_recs(&b, i);
+        if (pl && !win_fill(&b, i, err)) goto out;
         r->ev_obj[i] = -1;
         r->ev_ent[i] = 0;
-        const pdt_rec *rec = rec_at(r, i);
+        const pdt_rec *rec = pl ? &b.win[i - b.win_lo] : rec_at(r, i);
         r->ev_kind[i] = rec->ev.kind;
         if (rec->rank >= (uint32_t)r->nranks) {
             r->skipped++;
             continue;
         }
-        if (i + PREFETCH_AHEAD < r->m) {
-            const void *also, *p = probe_addr(&b, i + PREFETCH_AHEAD, &also);
+        if (pl ? i + PREFETCH_AHEAD < b.win_lo + b.win_n : i + PREFETCH_AHEAD < r->m) {
+            const pdt_rec *ahead = pl ? &b.win[i + PREFETCH_AHEAD - b.win_lo] : rec_at(r, i + PREFETCH_AHEAD);
+            const void *also, *p = probe_addr(&b, ahead, &also);
             if (p) __builtin_prefetch(p);
             if (also) __builtin_prefetch(also);
         }
         if (r->ev_kind[i] < PDT_EV_KIND_COUNT) r->kind_count[r->ev_kind[i]]++;
-        if (!index_event(&b, (uint32_t)i, lifted_any)) goto out;
+        if (!index_event(&b, (uint32_t)i, rec, lifted_any)) goto out;
+    }
+    if (pl) { /* the stream's end (it finishes its part: pl->src is ready) */
+        pdt_rec extra;
+        int more = pl->next(pl->ctx, &extra, 1, err);
+        if (more != 0) {
+            if (more > 0) pdt_err_set(err, PDT_ERR_FORMAT, "the run has more events than counted");
+            b.stream_failed = 1;
+            goto out;
+        }
+        free(b.win);
+        b.win = NULL;
     }
     /* Phases that open a cluster of overlapping same phases (any rank). */
     {
@@ -814,8 +893,15 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         km_free(&last_end);
     }
     /* Triangle histories: grouped by triangle, then the triangles numbered. */
-    for (size_t f = 0; pl && f < NFINE; f++)
-        if (!fine_flush(&b, f)) goto out;
+    if (pl) { /* the last chunks; the buckets' places in the history table */
+        for (size_t f = 0; f < NFINE; f++)
+            if (!fine_flush(&b, f)) goto out;
+        if (!chunks_by_bucket(&b)) goto out;
+        for (size_t f = 0; f < NFINE; f++) b.fine_off[f + 1] = b.fine_off[f] + b.fine_fill[f];
+        r->nhist = b.fine_off[NFINE];
+        if ((r->hist_at = pl->reserve(pl->ctx, (uint64_t)r->nhist * sizeof *r->hist)) == UINT64_MAX)
+            goto out;
+    }
     free(b.fbuf);
     b.fbuf = NULL;
     size_t ntri;
@@ -853,9 +939,13 @@ out:
     free(b.fbuf);
     free(b.fbn);
     free(b.spill);
+    free(b.chunk);
+    free(b.ck_start);
+    free(b.win);
     km_free(&b.edge_map);
     km_free(&b.msg_map);
-    if (st != PDT_OK && b.failed) pdt_err_set(err, PDT_ERR_IO, "the index file: %s", strerror(errno));
+    if (st != PDT_OK && b.stream_failed) st = err->code ? err->code : PDT_ERR_IO;
+    else if (st != PDT_OK && b.failed) pdt_err_set(err, PDT_ERR_IO, "the index file: %s", strerror(errno));
     else if (st != PDT_OK) pdt_err_set(err, st, "out of memory indexing %zu events", r->m);
     return st;
 }

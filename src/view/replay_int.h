@@ -140,14 +140,11 @@ typedef struct pdt_replay_place {
     int (*sget)(void *ctx, uint64_t at, void *p, size_t bytes);
     void *ctx;
     uint64_t budget;
-    /* NULL, or the counts the build's first pass would make, made by the
-     * caller as it wrote the records (the pass is then skipped): per fine
-     * bucket the triangle events (pdt_replay_fine_of), PDT_REPLAY_NFINE of
-     * them, and the events of every kind (PDT_EV_KIND_COUNT; kinds beyond
-     * it not counted). */
-    const uint64_t *fine_count, *kind_count;
-    /* The events, when the build is given no array of them (recs NULL):
-     * decoded from here, in two forward passes. */
+    /* The events (the build is given no array of them: recs NULL), in
+     * order, once: up to max of them into out; returns how many, 0 at the
+     * end, -1 on an error (err set).  When it has given them all, src must be
+     * ready: the second pass (numbering the triangles) decodes them there. */
+    int (*next)(void *ctx, pdt_rec *out, size_t max, pdt_err *err);
     pdt_evsrc *src;
 } pdt_replay_place;
 
