@@ -121,9 +121,9 @@ static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_
     SEC(S_SLOTCH, slot_ch, r->nch);
     SEC(S_SLOTSTART, slot_start, nslot + 1);
     SEC(S_LIFT, lift_ev, r->n);
-    SEC(S_SORT, sort_ev, r->n);
-    SEC(S_DEL, del_ev, r->n);
-    SEC(S_SORTPOS, sort_pos, r->n);
+    SEC(S_SORT, sort_ev, r->sort_ev ? r->n : 0);  /* (none: NULL, see load) */
+    SEC(S_DEL, del_ev, r->sort_ev ? r->n : 0);
+    SEC(S_SORTPOS, sort_pos, r->sort_ev ? r->n : 0);
     SEC(S_BOXLO, box_lo, (uint64_t)r->nranks);
     SEC(S_BOXHI, box_hi, (uint64_t)r->nranks);
     SEC(S_HASBOX, has_box, (uint64_t)r->nranks);
@@ -764,6 +764,7 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
     uint64_t count[NSEC];
     sections(r, ptr, elem, count);
     count[S_WARN] = h.count[S_WARN];
+    if (h.count[S_SORT]) count[S_SORT] = count[S_DEL] = count[S_SORTPOS] = r->n;  /* Graham's */
     for (int i = 0; i < NSEC; i++) {
         if (count[i] != h.count[i] || count[i] * elem[i] != h.sec[i].bytes) {
             snprintf(why, wcap, "damaged: section %d has the wrong size", i);
@@ -773,6 +774,10 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
             goto fail;
         }
         *ptr[i] = (char *)map + h.sec[i].off;
+    }
+    if (!h.count[S_SORT]) { /* a run without Graham's sort */
+        r->sort_ev = r->del_ev = NULL;
+        r->sort_pos = NULL;
     }
     if (h.count[S_WARN] && ((const char *)map)[h.sec[S_WARN].off + h.count[S_WARN] - 1]) {
         snprintf(why, wcap, "damaged: warnings not terminated");

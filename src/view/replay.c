@@ -358,6 +358,31 @@ static void box_add(pdt_replay *r, uint32_t rank, pdt_point p)
     if (p.y > r->box_hi[rank].y) r->box_hi[rank].y = p.y;
 }
 
+/* The per-point tables of Graham's sort (sort_ev, del_ev, sort_pos), made
+ * at the first SORT or DELETE event: a run without any (every
+ * triangulation) has none, in memory or in its kept index.  0 when out of
+ * memory. */
+static int graham_tables(pdt_replay *r)
+{
+    size_t n = r->n;
+    r->sort_ev = big_table(n * sizeof *r->sort_ev);
+    r->del_ev = big_table(n * sizeof *r->del_ev);
+    r->sort_pos = big_table(n * sizeof *r->sort_pos);
+    if (!r->sort_ev || !r->del_ev || !r->sort_pos) {
+        free(r->sort_ev);
+        free(r->del_ev);
+        free(r->sort_pos);
+        r->sort_ev = r->del_ev = NULL;
+        r->sort_pos = NULL;
+        return 0;
+    }
+    for (size_t p = 0; p < n; p++) {
+        r->sort_ev[p] = r->del_ev[p] = NONE32;
+        r->sort_pos[p] = -1;
+    }
+    return 1;
+}
+
 /* Pass 1: every object but triangle histories, which need counts first. */
 static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lifted_any)
 {
@@ -447,6 +472,7 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
             r->skipped++;
             return 1;
         }
+        if (e->kind != PDT_EV_LIFT && !r->sort_ev && !graham_tables(r)) return 0;
         uint32_t *first = e->kind == PDT_EV_LIFT ? r->lift_ev
                           : e->kind == PDT_EV_SORT ? r->sort_ev : r->del_ev;
         r->ev_obj[i] = (int32_t)e->a;
@@ -553,7 +579,8 @@ static const void *probe_addr(const builder *b, const pdt_rec *rec, const void *
     const pdt_event *e = &rec->ev;
     const pdt_replay *r = b->r;
     *also = NULL;
-    if ((e->kind == PDT_EV_LIFT || e->kind == PDT_EV_SORT || e->kind == PDT_EV_DELETE) && e->a < r->n) {
+    if ((e->kind == PDT_EV_LIFT || (r->sort_ev && (e->kind == PDT_EV_SORT || e->kind == PDT_EV_DELETE))) &&
+        e->a < r->n) {
         if (e->kind == PDT_EV_LIFT) *also = &r->pts[e->a];
         return e->kind == PDT_EV_LIFT ? &r->lift_ev[e->a]
                : e->kind == PDT_EV_SORT ? &r->sort_ev[e->a] : &r->del_ev[e->a];
@@ -983,20 +1010,16 @@ pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs,
     r->ev_ent = big_table(m * sizeof *r->ev_ent);
     r->ev_kind = big_table(m * sizeof *r->ev_kind);
     r->lift_ev = big_table(n * sizeof *r->lift_ev);
-    r->sort_ev = big_table(n * sizeof *r->sort_ev);
-    r->del_ev = big_table(n * sizeof *r->del_ev);
-    r->sort_pos = big_table(n * sizeof *r->sort_pos);
     r->box_lo = malloc(q1 * sizeof *r->box_lo);
     r->box_hi = malloc(q1 * sizeof *r->box_hi);
     r->has_box = calloc(q1, 1);
-    if (!r->ev_obj || !r->ev_ent || !r->ev_kind || !r->lift_ev || !r->sort_ev || !r->del_ev || !r->sort_pos ||
+    if (!r->ev_obj || !r->ev_ent || !r->ev_kind || !r->lift_ev ||
         !r->box_lo || !r->box_hi || !r->has_box) {
         pdt_replay_free(r);
         return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for %zu events", m);
     }
     for (size_t p = 0; p < n; p++) {
-        r->lift_ev[p] = r->sort_ev[p] = r->del_ev[p] = NONE32;
-        r->sort_pos[p] = -1;
+        r->lift_ev[p] = NONE32;
     }
     pdt_status st = build(r, pl, err);
     if (st != PDT_OK) {
@@ -1086,7 +1109,10 @@ TABLE(pdt_replay_hulls, pdt_rhull, hulls, nhull)
 
 const pdt_rtri_hist *pdt_replay_tri_hist(const pdt_replay *r) { return r->hist; }
 
-int64_t pdt_replay_sort_pos(const pdt_replay *r, size_t p) { return p < r->n ? r->sort_pos[p] : -1; }
+int64_t pdt_replay_sort_pos(const pdt_replay *r, size_t p)
+{
+    return p < r->n && r->sort_pos ? r->sort_pos[p] : -1;
+}
 
 uint32_t pdt_replay_lift_ev(const pdt_replay *r, size_t p) { return p < r->n ? r->lift_ev[p] : NONE32; }
 
@@ -1151,8 +1177,8 @@ void pdt_rstate_free(pdt_rstate *s)
 static uint8_t point_flags(const pdt_replay *r, size_t p, size_t k)
 {
     return (uint8_t)((r->lift_ev[p] < k ? PDT_PF_LIFTED : 0) |
-                     (r->sort_ev[p] < k ? PDT_PF_SORTED : 0) |
-                     (r->del_ev[p] < k ? PDT_PF_DELETED : 0));
+                     (r->sort_ev && r->sort_ev[p] < k ? PDT_PF_SORTED : 0) |
+                     (r->del_ev && r->del_ev[p] < k ? PDT_PF_DELETED : 0));
 }
 
 static uint8_t alive(uint32_t from, uint32_t to, size_t k)

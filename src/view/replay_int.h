@@ -91,7 +91,8 @@ struct pdt_replay {
     uint32_t *slot_start;
 
     uint32_t *lift_ev, *sort_ev, *del_ev;  /* per point: first such event or UINT32_MAX */
-    int64_t *sort_pos;
+    int64_t *sort_pos;  /* sort_ev, del_ev, sort_pos: NULL when the run has no SORT
+                         * and no DELETE event (then all none) */
     pdt_point *box_lo, *box_hi;  /* per rank */
     uint8_t *has_box;
     size_t kind_count[PDT_EV_KIND_COUNT];

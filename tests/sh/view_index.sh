@@ -168,6 +168,19 @@ else
     fail ranks3_record "mpirun -np 3 failed"
 fi
 
+# a hull run (Graham's sort: the per-point sort tables, which a triangulation's
+# index leaves out) gives the same event lines and seeks through the index
+RH=$TMP/runh
+"$PDT" gen uniform 2000 --seed 5 > "$TMP/uh.txt"
+"$PDT" hull "$TMP/uh.txt" -o "$TMP/uh.out" --trace "$RH" >/dev/null 2>&1 || fail hull_record
+"$V" "$RH" --describe --index off > "$TMP/dhm.txt"
+"$V" "$RH" --describe --mem 64K > "$TMP/dhi.txt"
+if [ -s "$RH/.pdtview-index" ] && [ -s "$TMP/dhm.txt" ] && cmp -s "$TMP/dhm.txt" "$TMP/dhi.txt"
+then ok hull_run_same_events
+else fail hull_run_same_events "$(diff "$TMP/dhm.txt" "$TMP/dhi.txt" | head -3)"; fi
+case "$("$V" "$RH" --check --mem 64K)" in *", 0 differ"*) ok hull_run_check ;;
+    *) fail hull_run_check "$("$V" "$RH" --check --mem 64K)" ;; esac
+
 # bad budgets
 for bad in 0 12Q -5 ''; do
     "$V" "$R" --counts --mem "$bad" >/dev/null 2>"$TMP/eb"; rc=$?
