@@ -1,10 +1,12 @@
 /* pdt — the merged events of a kept index, decoded on demand.
  *
- * The index keeps the rank files' encoded blocks (12-13 bytes per event)
- * instead of decoded records (40 bytes per event): an event is found by its
- * segment of the merged order (which rank, which event of it), then by that
- * rank's block (binary search), and decoded with its block into a cache of
- * a few blocks, least recently used first out.  A forward pass over the
+ * The index refers to the rank files' encoded blocks (12-13 bytes per
+ * event, in the run folder) instead of holding decoded records (40 bytes per
+ * event): an event is found by its segment of the merged order (which rank,
+ * which event of it), then by that rank's block (binary search), and decoded
+ * with its block, from the mapped rank file, into a cache of a few blocks,
+ * least recently used first out; a kept index's source checks each block's
+ * checksum as it decodes it (the run folder is not the index's to trust).  A forward pass over the
  * events decodes every block once; the event line, a seek, a search decode
  * one or a few blocks (some 50 microseconds each). */
 #include "pdt/tracefile.h"
@@ -35,8 +37,28 @@ void pdt_evsrc_clear(pdt_evsrc *s)
 {
     for (size_t k = 0; k < s->nslot; k++) free(s->slot[k].rec);
     free(s->slot);
+    free(s->released);
     s->slot = NULL;
+    s->released = NULL;
     s->nslot = 0;
+}
+
+/* Block b of rank q lies inside its file. */
+static int block_inside(const pdt_evsrc *s, size_t b, uint32_t q)
+{
+    const pdt_block_ref *bk = &s->blk[b];
+    return s->file[q] && bk->off >= PDT_BLOCK_HEADER_BYTES && bk->off <= s->file_len[q] &&
+           bk->len <= s->file_len[q] - bk->off;
+}
+
+int pdt_evsrc_block_ok(const pdt_evsrc *s, size_t b, uint32_t q)
+{
+    if (!block_inside(s, b, q)) return 0;
+    const pdt_block_ref *bk = &s->blk[b];
+    const uint8_t *h = s->file[q] + bk->off - PDT_BLOCK_HEADER_BYTES;
+    uint32_t crc = pdt_crc32c(pdt_crc32c(0, h, 28), h + PDT_BLOCK_HEADER_BYTES, bk->len);
+    uint32_t want = (uint32_t)h[28] | (uint32_t)h[29] << 8 | (uint32_t)h[30] << 16 | (uint32_t)h[31] << 24;
+    return crc == want;
 }
 
 /* The segment holding merged event i (i < m). */
@@ -62,18 +84,20 @@ uint32_t pdt_evsrc_rank(pdt_evsrc *s, size_t i)
     return i < s->m && s->nseg ? seg_of(s, i)->rank : UINT32_MAX;
 }
 
-/* Give back the mapped payload pages a forward pass left behind. */
-static void drop_behind(pdt_evsrc *s, uint64_t off)
+/* Give back the mapped pages of rank q's file a forward pass left behind. */
+static void drop_behind(pdt_evsrc *s, uint32_t q, uint64_t off)
 {
-    if (off < s->released) {
-        s->released = off & ~(uint64_t)4095;
+    if (!s->released && !(s->released = calloc((size_t)s->nranks, sizeof *s->released))) return;
+    uint64_t *rel = &s->released[q];
+    if (off < *rel) {
+        *rel = off & ~(uint64_t)4095;
         return;
     }
-    if (off - s->released < RELEASE_STEP) return;
-    uintptr_t lo = ((uintptr_t)(s->bytes + s->released) + 4095) & ~(uintptr_t)4095,
-              hi = (uintptr_t)(s->bytes + off) & ~(uintptr_t)4095;
+    if (off - *rel < RELEASE_STEP) return;
+    uintptr_t lo = ((uintptr_t)(s->file[q] + *rel) + 4095) & ~(uintptr_t)4095,
+              hi = (uintptr_t)(s->file[q] + off) & ~(uintptr_t)4095;
     if (hi > lo) madvise((void *)lo, hi - lo, MADV_DONTNEED);
-    s->released = off;
+    *rel = off;
 }
 
 /* Decode block b (of rank q) into a slot: the least recently used one. */
@@ -90,7 +114,11 @@ static evslot *load(pdt_evsrc *s, size_t b, uint32_t q)
     for (size_t k = 1; k < s->nslot; k++)
         if (s->slot[k].used < v->used) v = &s->slot[k];
     const pdt_block_ref *bk = &s->blk[b];
-    if (bk->off > s->nbytes || bk->len > s->nbytes - bk->off) return NULL;
+    if (!block_inside(s, b, q)) return NULL;
+    if (s->verify && !pdt_evsrc_block_ok(s, b, q)) {
+        if (s->damaged) s->damaged(s->damaged_ctx, q);
+        return NULL;
+    }
     if (bk->count > v->cap) {
         pdt_rec *g = realloc(v->rec, bk->count * sizeof *g);
         if (!g) return NULL;
@@ -103,12 +131,12 @@ static evslot *load(pdt_evsrc *s, size_t b, uint32_t q)
     _Static_assert(sizeof(pdt_rec) >= sizeof(pdt_event), "a record holds its event");
     pdt_event *ev = (pdt_event *)(void *)v->rec;
     v->blk = SIZE_MAX;
-    if (pdt_block_decode(s->bytes + bk->off, bk->len, bk->count, bk->base_t, ev) != 0) return NULL;
+    if (pdt_block_decode(s->file[q] + bk->off, bk->len, bk->count, bk->base_t, ev) != 0) return NULL;
     for (size_t j = bk->count; j-- > 0;) {
         pdt_event e = ev[j];
         v->rec[j] = (pdt_rec){e, q, (uint32_t)(bk->first + j)};
     }
-    if (s->drop_behind) drop_behind(s, bk->off);
+    if (s->drop_behind) drop_behind(s, q, bk->off);
     v->blk = b;
     v->rank = q;
     v->first = bk->first;

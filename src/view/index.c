@@ -7,10 +7,11 @@
  *                    offset and length, the place of the chunk checksums
  *                    (a CRC-32C per 16 MiB of every section: verified by
  *                    several threads at each opening); the header's own CRC
- *   sections         the events: a copy of every rank file's encoded
- *                    blocks (12-13 bytes an event, decoded on demand:
- *                    evsrc.c) and the merged order as segments of
- *                    consecutive events of one rank; then the triangle
+ *   sections         the events: the merged order as segments of
+ *                    consecutive events of one rank (the events themselves
+ *                    stay in the rank files: the table of their encoded
+ *                    blocks is a section below; decoded on demand, each
+ *                    block's checksum checked: evsrc.c); then the triangle
  *                    histories and the triangles (streamed here while they
  *                    are built: pdt_replay_build), then every other table of
  *                    the replay (replay_int.h), the points and the reader's
@@ -54,7 +55,7 @@ _Static_assert(ICK_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint'
 #define EST_BYTES_PER_EVENT 100u /* what the replay model holds per event in memory */
 
 enum {
-    S_BLOCKS, S_SEGS, S_EVOBJ, S_EVENT, S_TRIS, S_HIST, S_EDGES, S_NODES, S_PHASES, S_MERGES,
+    S_SEGS, S_EVOBJ, S_EVENT, S_TRIS, S_HIST, S_EDGES, S_NODES, S_PHASES, S_MERGES,
     S_MSGS, S_HULLS, S_CH, S_SLOTCH, S_SLOTSTART, S_LIFT, S_SORT, S_DEL, S_SORTPOS, S_BOXLO,
     S_BOXHI, S_HASBOX, S_POINTS, S_WARN, S_EVKIND, S_BLKTAB, S_RANKBLK, S_CKPT, NSEC
 };
@@ -103,7 +104,6 @@ static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_
     ptr[i] = (void **)&r->field;          \
     elem[i] = sizeof *r->field;           \
     count[i] = (cnt)
-    SEC(S_BLOCKS, src->bytes, r->src->nbytes);
     SEC(S_SEGS, src->seg, r->src->nseg);
     SEC(S_BLKTAB, src->blk, r->src->nblk);
     SEC(S_RANKBLK, src->rank_blk, (uint64_t)r->nranks + 1);
@@ -520,8 +520,11 @@ static void lazy_stop(lazy *L)
     free(L);
 }
 
+static void unmap_ranks(pdt_replay *r);
+
 void pdt_index_unmap(pdt_replay *r)
 {
+    unmap_ranks(r);
     if (r->lazy) lazy_stop(r->lazy);
     else munmap(r->map, r->map_len);
     r->lazy = NULL;
@@ -641,8 +644,90 @@ static int index_path(const char *dir, int where, char *buf, size_t cap)
  * reason in why when it is missing, stale or damaged.  verify: check every
  * section's checksum (reading the file through a small buffer), or, for an
  * index of at least lazy_min_bytes, each chunk when it is first read. */
-static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, size_t n,
-                        int verify, char *why, size_t wcap)
+/* A rank file's block did not match its checksum when it was decoded (a
+ * lazily verified index's source): the run folder changed behind the index
+ * (its files' sizes and times are the same).  Remove the index, tell the
+ * program, stop: the replay cannot go on without its events. */
+static void run_damaged(void *ctx, uint32_t rank)
+{
+    lazy *L = ctx;
+    char *m = L->msg, *end = L->msg + sizeof L->msg - 1, num[16];
+    snprintf(num, sizeof num, "%04u", rank);
+    m = cat(m, end, "the kept index ");
+    m = cat(m, end, L->path);
+    m = cat(m, end, " refers to rank-");
+    m = cat(m, end, num);
+    m = cat(m, end, ".trace, which no longer matches it (a block's checksum); the index was removed: "
+                    "open the run again to rebuild it");
+    *m = 0;
+    unlink(L->path);
+    if (damage_hook) damage_hook(L->msg);
+    abort();
+}
+
+/* Map the rank files of run folder `dir` that the index's block table
+ * refers to (into r->src), and unless the index is verified lazily (L),
+ * check every block's checksum now.  0 with a reason in why. */
+static int map_ranks(pdt_replay *r, const char *dir, lazy *L, char *why, size_t wcap)
+{
+    pdt_evsrc *src = r->src;
+    size_t q1 = (size_t)r->nranks;
+    src->file = calloc(q1, sizeof *src->file);
+    src->file_len = calloc(q1, sizeof *src->file_len);
+    if (!src->file || !src->file_len) {
+        snprintf(why, wcap, "out of memory");
+        return 0;
+    }
+    for (size_t q = 0; q < q1; q++) {
+        if (src->rank_blk[q] > src->rank_blk[q + 1] || src->rank_blk[q + 1] > src->nblk) {
+            snprintf(why, wcap, "damaged: block table of rank %zu", q);
+            return 0;
+        }
+        if (src->rank_blk[q] == src->rank_blk[q + 1]) continue;
+        char p[PATH_MAX + 32];
+        snprintf(p, sizeof p, "%s/rank-%04zu.trace", dir, q);
+        int fd = open(p, O_RDONLY | O_CLOEXEC);
+        struct stat sb;
+        void *m = MAP_FAILED;
+        if (fd >= 0 && fstat(fd, &sb) == 0 && sb.st_size > 0)
+            m = mmap(NULL, (size_t)sb.st_size, PROT_READ, MAP_SHARED, fd, 0);
+        if (fd >= 0) close(fd);
+        if (m == MAP_FAILED) {
+            snprintf(why, wcap, "stale: rank-%04zu.trace cannot be read", q);
+            return 0;
+        }
+        src->file[q] = m;
+        src->file_len[q] = (uint64_t)sb.st_size;
+        for (size_t b = src->rank_blk[q]; !L && b < src->rank_blk[q + 1]; b++)
+            if (!pdt_evsrc_block_ok(src, b, (uint32_t)q)) {
+                snprintf(why, wcap, "stale: rank-%04zu.trace does not match it (a block's checksum)", q);
+                return 0;
+            }
+    }
+    if (L) {
+        src->verify = 1;
+        src->damaged = run_damaged;
+        src->damaged_ctx = L;
+    }
+    return 1;
+}
+
+/* Unmap the rank files and free r->src (a kept index's). */
+static void unmap_ranks(pdt_replay *r)
+{
+    pdt_evsrc *src = r->src;
+    if (!src) return;
+    for (size_t q = 0; src->file && q < (size_t)r->nranks; q++)
+        if (src->file[q]) munmap((void *)src->file[q], (size_t)src->file_len[q]);
+    pdt_evsrc_clear(src);
+    free(src->file);
+    free(src->file_len);
+    free(src);
+    r->src = NULL;
+}
+
+static pdt_replay *load(const char *path, const char *dir, uint64_t ident, const pdt_point *pts,
+                        size_t n, int verify, char *why, size_t wcap)
 {
     int fd = open(path, O_RDONLY | O_CLOEXEC);
     if (fd < 0) {
@@ -718,7 +803,6 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
         snprintf(why, wcap, "out of memory");
         goto fail;
     }
-    r->src->nbytes = h.count[S_BLOCKS];
     r->src->nseg = h.count[S_SEGS];
     r->src->nblk = h.count[S_BLKTAB];
     r->src->m = h.m;
@@ -786,6 +870,12 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
         r = NULL;
         goto fail;
     }
+    if (!map_ranks(r, dir, L, why, wcap)) {
+        unmap_ranks(r);
+        free(r);
+        r = NULL;
+        goto fail;
+    }
     if (pts) r->pts = pts;  /* the run's own copy (the same points) */
     r->map = map;
     r->map_len = h.file_bytes;
@@ -814,20 +904,20 @@ static int write_all(int fd, const void *p, size_t len, uint64_t off)
     return 1;
 }
 
-/* The events of a build: the rank files' blocks copied into the index
- * (S_BLOCKS) and the merged order as segments (S_SEGS), with the tables
- * that find a block (held here until write_tables writes them). */
+/* The events of a build: the merged order as segments (S_SEGS), and the
+ * tables that find a block of a rank file (held here until write_tables
+ * writes them). */
 typedef struct evcopy {
-    pdt_evsrc src;           /* over the file's mapping, once both are written */
+    pdt_evsrc src;           /* over the reader's mappings and S_SEGS, once written */
     pdt_block_ref *blk;      /* src.blk */
     uint64_t *rank_blk;      /* src.rank_blk */
-    crcacc blocks_crc, segs_crc;
-    uint64_t segs_off;
+    crcacc segs_crc;
 } evcopy;
 
-/* Copy every rank's intact blocks (headers and payloads, as in its file)
- * into fd at HDR_BYTES: S_BLOCKS, and the table of their payloads. */
-static pdt_status write_blocks(pdt_run *run, int fd, ihdr *h, evcopy *ec, pdt_err *err)
+/* The table of every rank's intact blocks (where each payload is in its
+ * file, its aligned time base), and the source decoding them from the
+ * reader's mappings of the rank files. */
+static pdt_status block_table(pdt_run *run, evcopy *ec, pdt_err *err)
 {
     int nranks = pdt_run_nranks(run);
     size_t nblk = 0;
@@ -839,38 +929,26 @@ static pdt_status write_blocks(pdt_run *run, int fd, ihdr *h, evcopy *ec, pdt_er
     }
     ec->blk = malloc((nblk ? nblk : 1) * sizeof *ec->blk);
     ec->rank_blk = malloc(((size_t)nranks + 1) * sizeof *ec->rank_blk);
-    if (!ec->blk || !ec->rank_blk) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    uint64_t pos = 0; /* in the section */
+    ec->src.file = calloc((size_t)nranks + 1, sizeof *ec->src.file);
+    ec->src.file_len = calloc((size_t)nranks + 1, sizeof *ec->src.file_len);
+    if (!ec->blk || !ec->rank_blk || !ec->src.file || !ec->src.file_len)
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     size_t k = 0;
     for (int q = 0; q < nranks; q++) {
         const pdt_block_ref *b;
         const uint8_t *file;
         int64_t shift;
         size_t nb = pdt_run_rank_blocks(run, q, &b, &file, &shift);
+        pdt_rank_info ri;
+        pdt_run_rank_info(run, q, &ri);
         ec->rank_blk[q] = k;
-        if (!nb) continue;
-        uint64_t from = b[0].off, to = b[nb - 1].off + PDT_BLOCK_HEADER_BYTES + b[nb - 1].len;
+        ec->src.file[q] = file;
+        ec->src.file_len[q] = file ? ri.bytes : 0;
         for (size_t j = 0; j < nb; j++, k++)
-            ec->blk[k] = (pdt_block_ref){pos + (b[j].off - from) + PDT_BLOCK_HEADER_BYTES,
-                                         b[j].first, b[j].base_t + (uint64_t)shift, b[j].len,
-                                         b[j].count};
-        /* the file's bytes in steps, their mapped pages given back behind */
-        const uint64_t STEP = (uint64_t)8 << 20;
-        for (uint64_t o = from; o < to; o += STEP) {
-            size_t len = (size_t)(to - o < STEP ? to - o : STEP);
-            if (!write_all(fd, file + o, len, HDR_BYTES + pos + (o - from)))
-                return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-            crc_feed(&ec->blocks_crc, file + o, len);
-            uintptr_t lo = ((uintptr_t)(file + o) + 4095) & ~(uintptr_t)4095,
-                      hi = (uintptr_t)(file + o + len) & ~(uintptr_t)4095;
-            if (hi > lo) madvise((void *)lo, hi - lo, MADV_DONTNEED);
-        }
-        pos += to - from;
+            ec->blk[k] = (pdt_block_ref){b[j].off + PDT_BLOCK_HEADER_BYTES, b[j].first,
+                                         b[j].base_t + (uint64_t)shift, b[j].len, b[j].count};
     }
     ec->rank_blk[nranks] = k;
-    h->sec[S_BLOCKS] = (isec){HDR_BYTES, pos, 0, 0};
-    h->count[S_BLOCKS] = pos;
-    ec->src.nbytes = pos;
     ec->src.nblk = nblk;
     ec->src.nranks = nranks;
     return PDT_OK;
@@ -925,7 +1003,6 @@ static int stream_finish(evstream *es, pdt_err *err)
         return 0;
     }
     pdt_evsrc *src = &es->ec->src;
-    src->bytes = (const uint8_t *)es->map + HDR_BYTES;
     src->blk = es->ec->blk;
     src->rank_blk = es->ec->rank_blk;
     src->seg = (const pdt_evseg *)(void *)((const char *)es->map + es->at);
@@ -1071,7 +1148,7 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     uint64_t off = pc->off;
     for (int i = 0; i < NSEC; i++) {
         h->count[i] = count[i];
-        if (i == S_BLOCKS || i == S_SEGS) continue; /* written first (write_blocks, write_segs) */
+        if (i == S_SEGS) continue; /* written first (stream_next) */
         if (i == S_CKPT) { /* their sizes are known once they are made */
             off = (off + 63) & ~(uint64_t)63;
             if (!write_checkpoints(r, fd, off, &ck_crc)) {
@@ -1107,9 +1184,8 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     int have = tab && todo;
     for (int i = 0; have && i < NSEC; i++) {
         uint64_t nc = chunks_of(h->sec[i].bytes);
-        if (i == S_BLOCKS || i == S_SEGS) {
-            have = crc_done(i == S_BLOCKS ? &ec->blocks_crc : &ec->segs_crc, h->sec[i].bytes,
-                            tab + first[i]);
+        if (i == S_SEGS) {
+            have = crc_done(&ec->segs_crc, h->sec[i].bytes, tab + first[i]);
         } else if (i == S_CKPT) {
             have = crc_done(&ck_crc, h->sec[i].bytes, tab + first[i]);
         } else if (r->streamed && (i == S_TRIS || i == S_HIST)) {
@@ -1220,14 +1296,14 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     es.cur.rank = UINT32_MAX;
     es.buf = malloc(SEG_BATCH * sizeof *es.buf);
     placer pc = {&es, fd, 0, -1};
-    pdt_status st = h && es.buf ? write_blocks(run, fd, h, &ec, err)
+    pdt_status st = h && es.buf ? block_table(run, &ec, err)
                                 : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     if (st == PDT_OK) st = pdt_merge_open(run, &es.mg, err);
     if (st == PDT_OK) {
         es.fd = fd;
         es.h = h;
         es.ec = &ec;
-        es.at = es.off = (HDR_BYTES + h->sec[S_BLOCKS].bytes + 63) & ~(uint64_t)63;
+        es.at = es.off = HDR_BYTES;
         es.place_off = &pc.off;
         if ((pc.sfd = open_spill(tmp)) < 0)
             st = pdt_err_set(err, PDT_ERR_IO, "%s: a scratch file beside it: %s", tmp, strerror(errno));
@@ -1259,7 +1335,8 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     free(h);
     free(ec.blk);
     free(ec.rank_blk);
-    free(ec.blocks_crc.crc);
+    free(ec.src.file);
+    free(ec.src.file_len);
     free(ec.segs_crc.crc);
     return st;
 }
@@ -1287,7 +1364,7 @@ pdt_status pdt_replay_open_kept(const char *dir, uint64_t budget, pdt_replay **o
     for (int where = 0; where < 2; where++) {
         char why[160];
         if (!index_path(dir, where, path, sizeof path)) continue;
-        pdt_replay *r = load(path, ident, NULL, 0, 1, why, sizeof why);
+        pdt_replay *r = load(path, dir, ident, NULL, 0, 1, why, sizeof why);
         if (!r) {
             if (where == 0 || strcmp(why, "no index yet"))
                 snprintf(info->why, sizeof info->why, "%s", why);
@@ -1347,7 +1424,7 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
     for (int where = 0; where < 2 && !r; where++) {
         char why[160];
         if (!index_path(dir, where, path, sizeof path)) continue;
-        r = load(path, ident, pts, n, 1, why, sizeof why);
+        r = load(path, dir, ident, pts, n, 1, why, sizeof why);
         if (!r && where == 0) snprintf(info->why, sizeof info->why, "%s", why);
         if (!r && where == 1 && strcmp(why, "no index yet"))
             snprintf(info->why, sizeof info->why, "%s", why);
@@ -1367,7 +1444,7 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
                 continue;
             }
             char why[160];
-            r = load(path, ident, pts, n, 0, why, sizeof why);
+            r = load(path, dir, ident, pts, n, 0, why, sizeof why);
         }
         info->built = r != NULL;
         info->build_s = now_s() - t0;

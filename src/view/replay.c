@@ -1035,10 +1035,6 @@ void pdt_replay_free(pdt_replay *r)
     if (!r) return;
     for (size_t c = 0; c < r->nck; c++) pdt_rstate_free(r->ck[c]);
     free(r->ck);
-    if (r->src && r->map) { /* a kept index's: the replay owns it (a build's is its caller's) */
-        pdt_evsrc_clear(r->src);
-        free(r->src);
-    }
     if (r->map) { /* the tables live in the kept index's mapping */
         pdt_index_unmap(r);
         free(r);

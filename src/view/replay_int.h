@@ -10,11 +10,11 @@
 
 /* ---- the merged events of a kept index, decoded on demand (evsrc.c) ----------
  *
- * A kept index holds no decoded events: it holds a copy of the rank files'
- * encoded blocks (their payloads, one after the other, rank by rank), a
- * table of those blocks, and the merged order as segments, each a stretch
- * of consecutive merged events that are consecutive events of one rank.
- * An event is decoded when asked for, with its block, into a small cache. */
+ * A kept index holds no events: it holds a table of the rank files'
+ * encoded blocks (where each is in its file) and the merged order as
+ * segments, each a stretch of consecutive merged events that are
+ * consecutive events of one rank.  An event is decoded when asked for, with
+ * its block, from the rank file (mapped), into a small cache. */
 
 /* The merged events [start, next segment's start) are events seq0, seq0 + 1,
  * ... of rank `rank`. */
@@ -23,10 +23,11 @@ typedef struct pdt_evseg {
 } pdt_evseg;
 
 typedef struct pdt_evsrc {
-    const uint8_t *bytes;        /* the payloads */
-    uint64_t nbytes;
-    const pdt_block_ref *blk;    /* every rank's blocks, rank by rank; off: in bytes,
-                                  * base_t: the aligned time base (shift added) */
+    const uint8_t **file;        /* per rank: its file's bytes (mapped), or NULL */
+    uint64_t *file_len;          /* per rank */
+    const pdt_block_ref *blk;    /* every rank's blocks, rank by rank; off: of the
+                                  * payload in its file, base_t: the aligned time
+                                  * base (the shift added) */
     size_t nblk;
     const uint64_t *rank_blk;    /* nranks + 1: rank q's blocks are
                                   * blk[rank_blk[q] .. rank_blk[q + 1]) */
@@ -37,9 +38,13 @@ typedef struct pdt_evsrc {
     struct evslot *slot;
     size_t nslot, hot, last_seg;
     uint64_t tick;
-    int drop_behind;             /* give back the mapped payload pages behind a forward
-                                  * pass (madvise; the build's one-way passes) */
-    uint64_t released;
+    int drop_behind;             /* give back the mapped pages behind a forward pass
+                                  * (madvise; the build's one-way passes) */
+    uint64_t *released;          /* (per rank, made when needed) */
+    int verify;                  /* check each block's checksum when it is decoded;
+                                  * on a mismatch call damaged(damaged_ctx, rank) */
+    void (*damaged)(void *ctx, uint32_t rank);
+    void *damaged_ctx;
 } pdt_evsrc;
 
 /* Event i (< m) of the merged order, decoded: a pointer into the cache,
@@ -48,8 +53,10 @@ typedef struct pdt_evsrc {
 const pdt_rec *pdt_evsrc_get(pdt_evsrc *s, size_t i);
 /* The rank of event i (no decoding). */
 uint32_t pdt_evsrc_rank(pdt_evsrc *s, size_t i);
-/* Free the cache (the tables are not s's). */
+/* Free the cache (the tables and the files' mappings are not s's). */
 void pdt_evsrc_clear(pdt_evsrc *s);
+/* 1 if the checksum of block b (its header and payload) matches. */
+int pdt_evsrc_block_ok(const pdt_evsrc *s, size_t b, uint32_t rank);
 
 typedef struct slot_change {
     uint32_t ev;
