@@ -55,7 +55,7 @@ _Static_assert(ICK_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint'
 #define EST_BYTES_PER_EVENT 100u /* what the replay model holds per event in memory */
 
 enum {
-    S_SEGS, S_EVOBJ, S_EVENT, S_TRIS, S_HIST, S_EDGES, S_NODES, S_PHASES, S_MERGES,
+    S_SEGS, S_EVOBJ, S_TRIS, S_HIST, S_EDGES, S_NODES, S_PHASES, S_MERGES,
     S_MSGS, S_HULLS, S_CH, S_SLOTCH, S_SLOTSTART, S_LIFT, S_SORT, S_DEL, S_SORTPOS, S_BOXLO,
     S_BOXHI, S_HASBOX, S_POINTS, S_WARN, S_EVKIND, S_BLKTAB, S_RANKBLK, S_CKPT, NSEC
 };
@@ -108,7 +108,6 @@ static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_
     SEC(S_BLKTAB, src->blk, r->src->nblk);
     SEC(S_RANKBLK, src->rank_blk, (uint64_t)r->nranks + 1);
     SEC(S_EVOBJ, ev_obj, r->m);
-    SEC(S_EVENT, ev_ent, r->m);
     SEC(S_TRIS, tris, r->ntri);
     SEC(S_HIST, hist, r->nhist);
     SEC(S_EDGES, edges, r->nedge);

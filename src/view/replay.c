@@ -115,14 +115,20 @@ static int km_put(keymap *km, uint64_t hi, uint64_t lo, int32_t v)
 
 #define NONE32 UINT32_MAX
 
-/* ev_ent of a triangle's first event carries this bit (when there are fewer
- * than 2^31 history entries, as in every run so far): stepping back over
- * it leaves the triangle with no entry, and no step has to read the
- * triangle table (random places in 20 bytes per triangle: on a kept index,
- * the first step back into a part of it paid for checking 16 MiB of it). */
-#define FIRST_ENTRY 0x80000000u
+/* ev_kind: the event's kind in the low bits (KIND_UNKNOWN for kinds beyond
+ * them), and KIND_FIRST on a triangle's first event: stepping forwards over
+ * it gives the triangle its first history entry (tris[t].h0; in a build,
+ * ev_ent), stepping back over it leaves the triangle with none, and every
+ * other event of a triangle moves it one entry on or back (a triangle's
+ * entries are consecutive, in event order).  So the replay keeps no entry
+ * per event (ev_ent is the build's). */
+#define KIND_MASK 0x3f
+#define KIND_UNKNOWN 0x3f
+#define KIND_FIRST 0x80
+_Static_assert(PDT_EV_KIND_COUNT <= KIND_UNKNOWN, "every kind has a code below KIND_UNKNOWN");
 
-static int first_flagged(const pdt_replay *r) { return r->nhist < FIRST_ENTRY; }
+static int kind_at(const pdt_replay *r, size_t i) { return r->ev_kind[i] & KIND_MASK; }
+
 
 /* Event i (< m): from the array, or decoded (a kept index: the pointer
  * holds for PDT_EVSRC_KEEP - 1 more calls). */
@@ -330,9 +336,9 @@ static int set_slot(builder *b, uint32_t ev, int rank, int slot, int32_t val)
     pdt_replay *r = b->r;
     size_t s = (size_t)rank * PDT_SLOT_PER_RANK + (size_t)slot;
     if (!grow((void **)&r->ch, &r->cap_ch, r->nch + 1, sizeof *r->ch)) return 0;
-    r->ch[r->nch] = (slot_change){ev, val, b->cur[s]};
-    r->ev_obj[ev] = (int32_t)s;
-    r->ev_ent[ev] = (uint32_t)r->nch;
+    if (r->nch >= INT32_MAX) return 0;
+    r->ch[r->nch] = (slot_change){ev, val, b->cur[s], (uint32_t)s};
+    r->ev_obj[ev] = (int32_t)r->nch;  /* the change (its slot: ch[].slot) */
     r->nch++;
     b->cur[s] = val;
     return 1;
@@ -603,7 +609,7 @@ typedef struct gslot {
  * was its rank's open one from its MERGE_BEGIN to its MERGE_END. */
 static pdt_rtri_hist hist_of(const pdt_replay *r, uint32_t ev)
 {
-    int kind = r->ev_kind[ev];
+    int kind = kind_at(r, ev);
     uint8_t sub = (uint8_t)r->ev_ent[ev];
     int32_t g = r->ev_obj[ev];
     pdt_rtri_hist h = {ev, NONE32, tri_status_of(kind), sub, {0, 0}};
@@ -789,7 +795,7 @@ static int tri_ids(builder *b)
             int32_t a = r->ev_obj[i + PREFETCH_AHEAD];
             if (a >= 0 && is_tri_kind(r->ev_kind[i + PREFETCH_AHEAD])) __builtin_prefetch(&r->ev_obj[a]);
         }
-        if (!is_tri_kind(r->ev_kind[i])) continue;
+        if (!is_tri_kind(kind_at(r, i))) continue;
         int32_t o = r->ev_obj[i];
         if (o == -1) continue;  /* skipped */
         if (o >= 0) {
@@ -799,7 +805,7 @@ static int tri_ids(builder *b)
         const pdt_rec *rec = rec_at(r, i);
         to[b->pl ? nb++ : r->ntri] = (pdt_rtri){{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank,
                                                r->ev_ent[i], (uint32_t)(-1 - o)};
-        if (first_flagged(r)) r->ev_ent[i] |= FIRST_ENTRY;
+        r->ev_kind[i] |= KIND_FIRST;
         r->ev_obj[i] = (int32_t)r->ntri++;
         if (nb == TBUF) {
             if (!tput(b, NULL, r->tris_at, r->ntri - nb, tb, nb, sizeof *tb)) return 0;
@@ -875,7 +881,7 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         r->ev_obj[i] = -1;
         r->ev_ent[i] = 0;
         const pdt_rec *rec = pl ? &b.win[i - b.win_lo] : rec_at(r, i);
-        r->ev_kind[i] = rec->ev.kind;
+        r->ev_kind[i] = rec->ev.kind < KIND_UNKNOWN ? rec->ev.kind : KIND_UNKNOWN;
         if (rec->rank >= (uint32_t)r->nranks) {
             r->skipped++;
             continue;
@@ -886,7 +892,7 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             if (p) __builtin_prefetch(p);
             if (also) __builtin_prefetch(also);
         }
-        if (r->ev_kind[i] < PDT_EV_KIND_COUNT) r->kind_count[r->ev_kind[i]]++;
+        if (rec->ev.kind < PDT_EV_KIND_COUNT) r->kind_count[rec->ev.kind]++;
         if (!index_event(&b, (uint32_t)i, rec, lifted_any)) goto out;
     }
     if (pl) { /* the stream's end (it finishes its part: pl->src is ready) */
@@ -947,13 +953,13 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
     r->slot_start = calloc(nslot + 1, sizeof *r->slot_start);
     r->slot_ch = malloc((r->nch ? r->nch : 1) * sizeof *r->slot_ch);
     if (!r->slot_start || !r->slot_ch) goto out;
-    for (size_t c = 0; c < r->nch; c++) r->slot_start[r->ev_obj[r->ch[c].ev] + 1]++;
+    for (size_t c = 0; c < r->nch; c++) r->slot_start[r->ch[c].slot + 1]++;
     for (size_t s = 0; s < nslot; s++) r->slot_start[s + 1] += r->slot_start[s];
     {
         uint32_t *fill = malloc((nslot ? nslot : 1) * sizeof *fill);
         if (!fill) goto out;
         memcpy(fill, r->slot_start, nslot * sizeof *fill);
-        for (size_t c = 0; c < r->nch; c++) r->slot_ch[fill[r->ev_obj[r->ch[c].ev]]++] = (uint32_t)c;
+        for (size_t c = 0; c < r->nch; c++) r->slot_ch[fill[r->ch[c].slot]++] = (uint32_t)c;
         free(fill);
     }
     st = PDT_OK;
@@ -1025,6 +1031,11 @@ pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs,
     if (st != PDT_OK) {
         pdt_replay_free(r);
         return st;
+    }
+    if (!pl) { /* stepping finds a triangle's first entry in tris (streamed: the caller
+                * steps before it writes tris, and frees ev_ent with the replay) */
+        free(r->ev_ent);
+        r->ev_ent = NULL;
     }
     *out = r;
     return PDT_OK;
@@ -1229,9 +1240,8 @@ static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
 {
     int32_t obj = r->ev_obj[i];
     if (obj < 0) return;
-    uint32_t ent = r->ev_ent[i];
     int kind = r->ev_kind[i];
-    switch (kind) {
+    switch (kind & KIND_MASK) {
     case PDT_EV_LIFT:
     case PDT_EV_SORT:
     case PDT_EV_DELETE:
@@ -1246,15 +1256,15 @@ static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
         s->mflight[obj] = alive(r->msgs[obj].send_ev, r->msgs[obj].recv_ev, s->k);
         return;
     default:
-        if (is_tri_kind(kind)) {
-            if (first_flagged(r))
-                s->tcur[obj] = fwd ? ent & ~FIRST_ENTRY : ent & FIRST_ENTRY ? NONE32 : ent - 1;
-            else
-                s->tcur[obj] = fwd ? ent : (ent > r->tris[obj].h0 ? ent - 1 : NONE32);
+        if (is_tri_kind(kind & KIND_MASK)) {
+            uint32_t *t = &s->tcur[obj];
+            if (!(kind & KIND_FIRST)) *t = fwd ? *t + 1 : *t - 1;
+            else *t = !fwd ? NONE32 : r->ev_ent ? r->ev_ent[i] : r->tris[obj].h0;
             return;
         }
         /* a slot change */
-        s->slot[obj] = fwd ? r->ch[ent].val : r->ch[ent].prev;
+        const slot_change *c = &r->ch[obj];
+        s->slot[c->slot] = fwd ? c->val : c->prev;
         return;
     }
 }
@@ -1592,12 +1602,12 @@ size_t pdt_replay_find(const pdt_replay *r, size_t k, int dir, int c, const uint
     if (k > r->m) k = r->m;
     if (dir > 0) {
         for (size_t i = k; i < r->m; i++)
-            if (pdt_ev_in_class(r->ev_kind[i], c) &&
+            if (pdt_ev_in_class(kind_at(r, i), c) &&
                 (!rank_visible || rank_visible[pdt_replay_rank_of(r, i)]))
                 return i + 1;
     } else {
         for (size_t i = k >= 2 ? k - 1 : 0; i-- > 0;)
-            if (pdt_ev_in_class(r->ev_kind[i], c) &&
+            if (pdt_ev_in_class(kind_at(r, i), c) &&
                 (!rank_visible || rank_visible[pdt_replay_rank_of(r, i)]))
                 return i + 1;
         if (k >= 1) return 0;
@@ -1630,7 +1640,7 @@ size_t pdt_replay_find_phase_name(const pdt_replay *r, const char *name)
     base[len] = 0;
     if (colon) level = strtol(colon + 1, NULL, 10);
     for (size_t i = 0; i < r->m; i++) {
-        if (r->ev_kind[i] != PDT_EV_PHASE_BEGIN) continue;
+        if (kind_at(r, i) != PDT_EV_PHASE_BEGIN) continue;
         const pdt_event *e = &rec_at(r, i)->ev;
         const char *nm = pdt_phase_name(e->sub);
         if (nm && !strcmp(nm, base) && (level < 0 || (long)e->a == level)) return i + 1;

@@ -61,6 +61,7 @@ int pdt_evsrc_block_ok(const pdt_evsrc *s, size_t b, uint32_t rank);
 typedef struct slot_change {
     uint32_t ev;
     int32_t val, prev;
+    uint32_t slot;  /* rank * PDT_SLOT_PER_RANK + slot */
 } slot_change;
 
 struct pdt_replay {
@@ -70,10 +71,12 @@ struct pdt_replay {
     pdt_evsrc *src;       /* (kept index) */
     size_t m, skipped;
     int nranks;
-    int32_t *ev_obj;   /* per event: object (see build()) or -1 */
-    uint32_t *ev_ent;  /* per event: entry (history / change index, or flag; a
-                        * triangle's first event: | FIRST_ENTRY, replay.c) */
-    uint8_t *ev_kind;  /* per event: its kind (stepping reads no records) */
+    int32_t *ev_obj;   /* per event: object (see build(); a slot change: its index
+                        * in ch) or -1 */
+    uint32_t *ev_ent;  /* per event, while building only (then NULL): its history
+                        * entry (a triangle event) */
+    uint8_t *ev_kind;  /* per event: its kind and a mark (replay.c: KIND_*;
+                        * stepping reads no records) */
 
     pdt_rtri *tris;
     size_t ntri, cap_tri;
