@@ -697,11 +697,19 @@ static int map_ranks(pdt_replay *r, const char *dir, lazy *L, char *why, size_t 
         }
         src->file[q] = m;
         src->file_len[q] = (uint64_t)sb.st_size;
-        for (size_t b = src->rank_blk[q]; !L && b < src->rank_blk[q + 1]; b++)
+        size_t released = 0;  /* (checked whole: its pages let go behind, 16 MiB at a time) */
+        for (size_t b = src->rank_blk[q]; !L && b < src->rank_blk[q + 1]; b++) {
             if (!pdt_evsrc_block_ok(src, b, (uint32_t)q)) {
                 snprintf(why, wcap, "stale: rank-%04zu.trace does not match it (a block's checksum)", q);
                 return 0;
             }
+            size_t upto = (size_t)src->blk[b].off & ~(size_t)4095;
+            if (upto - released >= ((size_t)16 << 20) || b + 1 == src->rank_blk[q + 1]) {
+                if (b + 1 == src->rank_blk[q + 1]) upto = (size_t)sb.st_size;
+                madvise((char *)m + released, upto - released, MADV_DONTNEED);
+                released = upto;
+            }
+        }
     }
     if (L) {
         src->verify = 1;
