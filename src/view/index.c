@@ -1020,9 +1020,8 @@ static int stream_finish(evstream *es, pdt_err *err)
     return 1;
 }
 
-static int stream_next(void *ctx, pdt_rec *out, size_t max, pdt_err *err)
+static int stream_fill(evstream *es, pdt_rec *out, size_t max, pdt_err *err)
 {
-    evstream *es = *(evstream **)ctx;
     size_t j = 0;
     while (!es->done && j < max) {
         int got = pdt_merge_next(es->mg, &out[j], err);
@@ -1043,6 +1042,120 @@ static int stream_next(void *ctx, pdt_rec *out, size_t max, pdt_err *err)
         es->count++;
     }
     return (int)j;
+}
+
+
+/* The merge (decoding the rank files, the busier half of the build's first
+ * pass) runs in a thread of its own, a batch of events ahead of the build:
+ * two batches, one filled while the other is read. */
+enum { PIPE_BATCH = 8192 };
+
+typedef struct evpipe {
+    evstream *es;
+    pthread_t th;
+    int started;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    pdt_rec *buf[2];
+    size_t n[2];
+    int full[2];      /* filled, not yet read */
+    int last[2];      /* the stream ends after this batch (n may be 0) */
+    int failed[2];    /* the stream failed filling it (perr) */
+    int stop;         /* the reader is gone: stop filling */
+    pdt_err perr;
+    size_t slot, at;  /* the reader's batch and place in it */
+    int ended;
+} evpipe;
+
+static void *pipe_worker(void *arg)
+{
+    evpipe *p = arg;
+    for (size_t k = 0;; k ^= 1) {
+        pthread_mutex_lock(&p->mu);
+        while (p->full[k] && !p->stop) pthread_cond_wait(&p->cv, &p->mu);
+        int stop = p->stop;
+        pthread_mutex_unlock(&p->mu);
+        if (stop) return NULL;
+        int got = stream_fill(p->es, p->buf[k], PIPE_BATCH, &p->perr);
+        pthread_mutex_lock(&p->mu);
+        p->n[k] = got > 0 ? (size_t)got : 0;
+        p->failed[k] = got < 0;
+        p->last[k] = got <= 0 || p->es->done;
+        p->full[k] = 1;
+        int end = p->last[k];
+        pthread_cond_broadcast(&p->cv);
+        pthread_mutex_unlock(&p->mu);
+        if (end) return NULL;
+    }
+}
+
+static int stream_next(void *ctx, pdt_rec *out, size_t max, pdt_err *err)
+{
+    evpipe *p = *(evpipe **)ctx;
+    size_t j = 0;
+    while (j < max && !p->ended) {
+        size_t k = p->slot;
+        pthread_mutex_lock(&p->mu);
+        while (!p->full[k]) pthread_cond_wait(&p->cv, &p->mu);
+        pthread_mutex_unlock(&p->mu);
+        if (p->failed[k]) {
+            *err = p->perr;
+            return -1;
+        }
+        size_t take = p->n[k] - p->at < max - j ? p->n[k] - p->at : max - j;
+        memcpy(out + j, p->buf[k] + p->at, take * sizeof *out);
+        j += take;
+        p->at += take;
+        if (p->at == p->n[k]) { /* give the batch back */
+            if (p->last[k]) p->ended = 1;
+            pthread_mutex_lock(&p->mu);
+            p->full[k] = 0;
+            pthread_cond_broadcast(&p->cv);
+            pthread_mutex_unlock(&p->mu);
+            p->slot ^= 1;
+            p->at = 0;
+        }
+    }
+    return (int)j;
+}
+
+/* Start the merge's thread (or, without one, fill the batches in turn
+ * from stream_next's caller: not done; 0 and err set). */
+static int pipe_start(evpipe *p, evstream *es, pdt_err *err)
+{
+    memset(p, 0, sizeof *p);
+    p->es = es;
+    p->buf[0] = malloc(PIPE_BATCH * sizeof *p->buf[0]);
+    p->buf[1] = malloc(PIPE_BATCH * sizeof *p->buf[1]);
+    if (!p->buf[0] || !p->buf[1]) {
+        pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+        return 0;
+    }
+    pthread_mutex_init(&p->mu, NULL);
+    pthread_cond_init(&p->cv, NULL);
+    if (pthread_create(&p->th, NULL, pipe_worker, p) != 0) {
+        pdt_err_set(err, PDT_ERR_NOMEM, "cannot start a thread: %s", strerror(errno));
+        return 0;
+    }
+    p->started = 1;
+    return 1;
+}
+
+/* Stop the merge's thread (wherever it is) and free the batches. */
+static void pipe_stop(evpipe *p)
+{
+    if (p->started) {
+        pthread_mutex_lock(&p->mu);
+        p->stop = 1;
+        pthread_cond_broadcast(&p->cv);
+        pthread_mutex_unlock(&p->mu);
+        pthread_join(p->th, NULL);
+        pthread_mutex_destroy(&p->mu);
+        pthread_cond_destroy(&p->cv);
+    }
+    free(p->buf[0]);
+    free(p->buf[1]);
+    p->started = 0;
 }
 
 /* The state at every r->ick_every-th cursor, stepped forwards from 0,
@@ -1077,7 +1190,7 @@ static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
  * beside the index (O_TMPFILE), dropped (closed) once they are grouped: its
  * pages leave the page cache with it, mostly before they were written back. */
 typedef struct placer {
-    struct evstream *es; /* (first: the stream's context is the placer's) */
+    struct evpipe *pipe; /* (first: the stream's context is the placer's) */
     int fd;
     uint64_t off;  /* where the next table goes */
     int sfd;       /* the spill */
@@ -1302,7 +1415,9 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     memset(&es, 0, sizeof es);
     es.cur.rank = UINT32_MAX;
     es.buf = malloc(SEG_BATCH * sizeof *es.buf);
-    placer pc = {&es, fd, 0, -1};
+    evpipe pipe;
+    memset(&pipe, 0, sizeof pipe);
+    placer pc = {&pipe, fd, 0, -1};
     pdt_status st = h && es.buf ? block_table(run, &ec, err)
                                 : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     if (st == PDT_OK) st = pdt_merge_open(run, &es.mg, err);
@@ -1315,9 +1430,11 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         if ((pc.sfd = open_spill(tmp)) < 0)
             st = pdt_err_set(err, PDT_ERR_IO, "%s: a scratch file beside it: %s", tmp, strerror(errno));
     }
+    if (st == PDT_OK && !pipe_start(&pipe, &es, err)) st = err->code;
     pdt_replay_place pl = {place_reserve, place_put, place_get, spill_put, spill_get,
                            &pc,           budget,    stream_next, &ec.src};
     if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
+    pipe_stop(&pipe);
     if (pc.sfd >= 0) close(pc.sfd);  /* the spill, grouped: gone */
     if (st == PDT_OK) {
         r->warnings = pdt_run_warnings(run);
