@@ -1119,8 +1119,7 @@ static int stream_next(void *ctx, pdt_rec *out, size_t max, pdt_err *err)
     return (int)j;
 }
 
-/* Start the merge's thread (or, without one, fill the batches in turn
- * from stream_next's caller: not done; 0 and err set). */
+/* Start the merge's thread: 1, or 0 and err set. */
 static int pipe_start(evpipe *p, evstream *es, pdt_err *err)
 {
     memset(p, 0, sizeof *p);
