@@ -1256,42 +1256,62 @@ static int open_spill(const char *path)
 
 /* Write the tables of r after the records and the streamed ones (at pc->off),
  * then the header. */
+/* write_checkpoints in a thread of its own (stepping through the run takes
+ * a core while the tables are written). */
+typedef struct ck_job {
+    pdt_replay *r;
+    int fd, ok;
+    uint64_t off;
+    crcacc crc;
+} ck_job;
+
+static void *ck_worker(void *arg)
+{
+    ck_job *j = arg;
+    j->ok = write_checkpoints(j->r, j->fd, j->off, &j->crc);
+    return NULL;
+}
+
 static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
                                evcopy *ec, pdt_err *err)
 {
-    crcacc ck_crc = {0};
     void **ptr[NSEC];
     size_t elem[NSEC];
     uint64_t count[NSEC];
     sections(r, ptr, elem, count);
+    /* the places of the tables (the checkpoints last: their sizes are known
+     * once they are made) */
     uint64_t off = pc->off;
     for (int i = 0; i < NSEC; i++) {
         h->count[i] = count[i];
-        if (i == S_SEGS) continue; /* written first (stream_next) */
-        if (i == S_CKPT) { /* their sizes are known once they are made */
-            off = (off + 63) & ~(uint64_t)63;
-            if (!write_checkpoints(r, fd, off, &ck_crc)) {
-                free(ck_crc.crc);
-                return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-            }
-            h->count[i] = r->nick ? r->ick_off[r->nick] : 0;
-            h->sec[i] = (isec){off, h->count[i], 0, 0};
-            off += h->count[i];
-            continue;
-        }
+        if (i == S_SEGS || i == S_CKPT) continue; /* (S_SEGS: written first, stream_next) */
         if (r->streamed && (i == S_TRIS || i == S_HIST)) {
             h->sec[i] = (isec){i == S_TRIS ? r->tris_at : r->hist_at, count[i] * elem[i], 0, 0};
             continue;
         }
         off = (off + 63) & ~(uint64_t)63;
-        size_t bytes = (size_t)count[i] * elem[i];
-        if (bytes && !write_all(fd, *ptr[i], bytes, off)) {
-            free(ck_crc.crc);
-            return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-        }
-        h->sec[i] = (isec){off, bytes, 0, 0};
-        off += bytes;
+        h->sec[i] = (isec){off, count[i] * elem[i], 0, 0};
+        off += h->sec[i].bytes;
     }
+    off = (off + 63) & ~(uint64_t)63;
+    ck_job ck = {r, fd, 0, off, {0}};
+    pthread_t th;
+    int threaded = pthread_create(&th, NULL, ck_worker, &ck) == 0;
+    int wrote = 1;
+    for (int i = 0; wrote && i < NSEC; i++) {
+        if (i == S_SEGS || i == S_CKPT || (r->streamed && (i == S_TRIS || i == S_HIST))) continue;
+        if (h->sec[i].bytes) wrote = write_all(fd, *ptr[i], (size_t)h->sec[i].bytes, h->sec[i].off);
+    }
+    if (threaded) pthread_join(th, NULL);
+    else ck_worker(&ck);
+    crcacc ck_crc = ck.crc;
+    if (!wrote || !ck.ok) {
+        free(ck_crc.crc);
+        return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+    }
+    h->count[S_CKPT] = r->nick ? r->ick_off[r->nick] : 0;
+    h->sec[S_CKPT] = (isec){off, h->count[S_CKPT], 0, 0};
+    off += h->count[S_CKPT];
     /* the chunk checksums: of the tables in memory from memory, of the
      * records and checkpoints as they were written, of the streamed
      * triangles and histories read back (pread, by up to four threads) */
@@ -1333,7 +1353,7 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     }
     off = (off + 63) & ~(uint64_t)63;
     h->ctab = (isec){off, n * sizeof *tab, pdt_crc32c(0, tab, (size_t)(n * sizeof *tab)), 0};
-    int wrote = write_all(fd, tab, (size_t)(n * sizeof *tab), off);
+    wrote = write_all(fd, tab, (size_t)(n * sizeof *tab), off);
     free(tab);
     if (!wrote) return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
     off += h->ctab.bytes;
