@@ -59,17 +59,19 @@ typedef struct pdt_rtri {
     uint32_t h0, hn;    /* its history entries: hist[h0 .. h0+hn) */
 } pdt_rtri;
 
-/* One change of a triangle's status. */
+/* One change of a triangle's status (12 bytes: a kept index holds one per
+ * triangle event).  The event itself (pdt_replay_rec(r, ev)) says the rest:
+ * the rank that reported it, and v (RA_DEFER: touched rank; SHIP:
+ * destination; DISCARD: witness). */
 typedef struct pdt_rtri_hist {
     uint32_t ev;        /* event index */
-    uint32_t rank;      /* rank that reported it */
-    uint8_t status;     /* pdt_tri_status after the event */
-    uint8_t run;        /* TRI_NEW: 0 local kernel, 1 border kernel */
-    int64_t v;          /* RA_DEFER: touched rank; SHIP: destination; DISCARD: witness */
     uint32_t until;     /* TRI_NEW of a border kernel: the MERGE_END of its merge step.
                          * A candidate still in this state after that event was
                          * neither kept nor shipped: the merge dropped it without
                          * an event (pdt_rstate_tri_visible).  Else UINT32_MAX. */
+    uint8_t status;     /* pdt_tri_status after the event */
+    uint8_t run;        /* TRI_NEW: 0 local kernel, 1 border kernel (the event's sub) */
+    uint8_t pad[2];
 } pdt_rtri_hist;
 
 /* A kernel edge (level 2) between its EDGE_ADD and EDGE_DEL. */
@@ -148,7 +150,12 @@ size_t pdt_replay_skipped(const pdt_replay *r);     /* events ignored as malform
 size_t pdt_replay_kind_count(const pdt_replay *r, int kind); /* events of a pdt_event_kind */
 int pdt_replay_nranks(const pdt_replay *r);
 const pdt_point *pdt_replay_points(const pdt_replay *r, size_t *n);
-const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i);  /* NULL if i >= count */
+/* Event i of the merged order, NULL if i >= count.  A replay opened from a
+ * kept index decodes it on demand into a small cache: the pointer holds for
+ * the next 7 calls at least (copy the record to keep it longer). */
+const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i);
+/* The rank of event i, without decoding it; UINT32_MAX if i >= count. */
+uint32_t pdt_replay_rank_of(const pdt_replay *r, size_t i);
 const pdt_rtri *pdt_replay_tris(const pdt_replay *r, size_t *n);
 const pdt_rtri_hist *pdt_replay_tri_hist(const pdt_replay *r);
 const pdt_redge *pdt_replay_edges(const pdt_replay *r, size_t *n);
@@ -260,23 +267,28 @@ typedef struct pdt_replay_open_info {
  * index when holding the run in memory would take more than a quarter of
  * `budget` bytes (about 100 bytes per event).
  *
- * The kept index (the merged events and every table of the replay) is
- * DIR/.pdtview-index, or, when the folder cannot take a file,
+ * The kept index (every table of the replay, the merged order of the
+ * events and the table of the rank files' blocks: the events themselves
+ * stay in the rank files, decoded on demand) is DIR/.pdtview-index, or, when the folder cannot take a file,
  * $XDG_CACHE_HOME/pdt (else ~/.cache/pdt)/run-HASH.pdtview-index, keyed by
  * the folder's real path.  It is checked at every opening (identity of the
  * run's files: names, sizes, modification times, the manifest's bytes;
- * checksums of every section; its size) and rebuilt when stale or damaged,
- * written to a temporary file and renamed.  Then it is memory-mapped: the
- * replay's own memory is its checkpoints (pdt_replay_set_mem(budget)).
- * Building streams the merged events into the file (pdt_merge_*) and needs
- * the tables in memory once (about 60 bytes per event).  When no index can
+ * checksums of every section; its size; each rank file block's checksum,
+ * at the opening or when the block is decoded) and rebuilt when stale or
+ * damaged, written to a temporary file and renamed.  Then it and the rank
+ * files are memory-mapped: the replay's own memory is its checkpoints
+ * (pdt_replay_set_mem(budget)) and a few decoded blocks.  Building takes
+ * the merged events once as a stream (pdt_merge_*), spills the triangle
+ * events (16 bytes each) to a scratch file beside the index, and holds 9
+ * bytes per event and 28 per point in memory.  When no index can
  * be written anywhere, the run is held in memory (info->write_error says why).
  * Returns PDT_OK and *out (pdt_replay_free), or an error; info may be NULL. */
 pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, int use_index,
                                pdt_replay **out, pdt_replay_open_info *info, pdt_err *err);
 
-/* The replay of run folder `dir` from its kept index alone, without reading
- * the run (the index holds the points too): *out = NULL (and PDT_OK, with
+/* The replay of run folder `dir` from its kept index, without opening the
+ * run (the index holds the points; the rank files are mapped, and read only
+ * for the events decoded): *out = NULL (and PDT_OK, with
  * info->why) when there is no valid index beside the run or in the cache.
  * Errors: the folder cannot be listed, out of memory. */
 pdt_status pdt_replay_open_kept(const char *dir, uint64_t budget, pdt_replay **out,
@@ -287,8 +299,11 @@ pdt_status pdt_replay_open_kept(const char *dir, uint64_t budget, pdt_replay **o
  * opens them, chaining any handler installed before).  When a chunk does not
  * match its checksum, the index file is removed and on_damage is called with
  * a message naming it, from the signal handler: it may only make
- * async-signal-safe calls (write, _exit) and must not return.  Without this
- * call (or with on_damage NULL), every index is verified whole when opened. */
+ * async-signal-safe calls (write, _exit) and must not return.  Such an
+ * index's rank file blocks are checked as they are decoded (a mismatch:
+ * the same, from the replay's caller).  Without this call (or with
+ * on_damage NULL), every index is verified whole when opened, and the rank
+ * files' blocks with it. */
 void pdt_replay_lazy_verify(void (*on_damage)(const char *msg), uint64_t min_bytes);
 
 /* What the reader said about damage in the run when the kept index was

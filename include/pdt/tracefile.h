@@ -228,6 +228,33 @@ char *pdt_event_format(const pdt_event *ev, char *buf, size_t cap);
 /* Kind by name ("push", "tri-final", ...); -1 if unknown. */
 int pdt_event_kind_by_name(const char *name);
 
+/* ---- the encoded blocks, for random access (pdtview's kept index) ----------- */
+
+/* One intact block of a rank's file, as pdt_run_open indexed it: its
+ * header at byte `off` of the file (PDT_BLOCK_HEADER_BYTES), then `len`
+ * bytes of payload holding events first .. first + count - 1 of the rank,
+ * their times deltas from base_t (the rank's own clock).  A rank's blocks
+ * follow each other: the first starts at event 0, each at the end of the
+ * one before. */
+typedef struct pdt_block_ref {
+    uint64_t off, first, base_t;
+    uint32_t len, count;
+} pdt_block_ref;
+#define PDT_BLOCK_HEADER_BYTES 32
+
+/* The intact blocks of `rank` (owned by run), the rank file's bytes as
+ * mapped (*file; a payload is at file + off + PDT_BLOCK_HEADER_BYTES) and
+ * the shift that aligns its times (added to every decoded time).  Returns
+ * the number of blocks (0 for a rank out of range or without events). */
+size_t pdt_run_rank_blocks(const pdt_run *run, int rank, const pdt_block_ref **blk,
+                           const uint8_t **file, int64_t *shift);
+/* Decode one block payload (`len` bytes, `count` events, times from
+ * base_t: pass base_t + shift for aligned times) into out[0 .. count).
+ * Returns 0, or -1 when the payload is malformed (out then partly
+ * written). */
+int pdt_block_decode(const uint8_t *payload, uint32_t len, uint32_t count, uint64_t base_t,
+                     pdt_event *out);
+
 /* ---- export ------------------------------------------------------------------ */
 
 /* What pdt_run_export_otf2 wrote (over all ranks). */

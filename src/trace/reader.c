@@ -11,12 +11,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-typedef struct tf_block {
-    uint64_t off;     /* of the block header */
-    uint64_t first;   /* index of the first event */
-    uint64_t base_t;
-    uint32_t len, count;
-} tf_block;
+typedef pdt_block_ref tf_block;  /* off: of the block header; first: its first event */
+_Static_assert(PDT_BLOCK_HEADER_BYTES == TF_BLOCK_HEADER_SIZE, "tracefile.h says the header size");
 
 typedef struct tf_rank {
     int present, complete, level;
@@ -443,6 +439,26 @@ void pdt_run_rank_info(const pdt_run *run, int rank, pdt_rank_info *info)
     info->complete = rk->complete;
     info->present = rk->present;
     info->level = rk->level;
+}
+
+size_t pdt_run_rank_blocks(const pdt_run *run, int rank, const pdt_block_ref **blk,
+                           const uint8_t **file, int64_t *shift)
+{
+    *blk = NULL;
+    *file = NULL;
+    *shift = 0;
+    if (rank < 0 || rank >= run->nranks) return 0;
+    const tf_rank *rk = &run->rk[rank];
+    *blk = rk->blk;
+    *file = rk->map;
+    *shift = rk->shift;
+    return rk->nblk;
+}
+
+int pdt_block_decode(const uint8_t *payload, uint32_t len, uint32_t count, uint64_t base_t,
+                     pdt_event *out)
+{
+    return pdt_tf_decode(payload, len, count, base_t, out);
 }
 
 /* malloc() for the big arrays of decoded and merged events (hundreds of MB

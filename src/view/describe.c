@@ -200,7 +200,8 @@ void pdt_replay_describe_state(const pdt_replay *r, const pdt_rstate *s, size_t 
                  pdt_replay_nranks(r));
         return;
     }
-    const pdt_rec *rec = pdt_replay_rec(r, k - 1);
+    const pdt_rec held = *pdt_replay_rec(r, k - 1); /* (a kept index's pointer is short-lived) */
+    const pdt_rec *rec = &held;
     const pdt_event *e = &rec->ev;
     char p1[64], p2[64], t3[48], why[192];
     int n = snprintf(buf, cap, "rank %u: ", rec->rank);

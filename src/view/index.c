@@ -7,7 +7,11 @@
  *                    offset and length, the place of the chunk checksums
  *                    (a CRC-32C per 16 MiB of every section: verified by
  *                    several threads at each opening); the header's own CRC
- *   sections         the merged event records, then the triangle
+ *   sections         the events: the merged order as segments of
+ *                    consecutive events of one rank (the events themselves
+ *                    stay in the rank files: the table of their encoded
+ *                    blocks is a section below; decoded on demand, each
+ *                    block's checksum checked: evsrc.c); then the triangle
  *                    histories and the triangles (streamed here while they
  *                    are built: pdt_replay_build), then every other table of
  *                    the replay (replay_int.h), the points and the reader's
@@ -40,9 +44,9 @@
 #include <unistd.h>
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 6u
+#define INDEX_VERSION 7u
 #define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/16 events, at least this */
-#define ICK_PARTS 16u
+#define ICK_PARTS 8u
 _Static_assert(ICK_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint's place");
 #define CHUNK_BYTES ((uint64_t)16 << 20) /* sections are checksummed in chunks of this: the
                                           * least a lazily checked frame reads (1 MiB made
@@ -51,9 +55,9 @@ _Static_assert(ICK_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint'
 #define EST_BYTES_PER_EVENT 100u /* what the replay model holds per event in memory */
 
 enum {
-    S_RECS, S_EVOBJ, S_EVENT, S_TRIS, S_HIST, S_EDGES, S_NODES, S_PHASES, S_MERGES, S_MSGS,
-    S_HULLS, S_CH, S_SLOTCH, S_SLOTSTART, S_LIFT, S_SORT, S_DEL, S_SORTPOS, S_BOXLO, S_BOXHI,
-    S_HASBOX, S_POINTS, S_WARN, S_EVKIND, S_CKPT, NSEC
+    S_SEGS, S_EVOBJ, S_TRIS, S_HIST, S_EDGES, S_NODES, S_PHASES, S_MERGES,
+    S_MSGS, S_HULLS, S_CH, S_SLOTCH, S_SLOTSTART, S_LIFT, S_SORT, S_DEL, S_SORTPOS, S_BOXLO,
+    S_BOXHI, S_HASBOX, S_POINTS, S_WARN, S_EVKIND, S_BLKTAB, S_RANKBLK, S_CKPT, NSEC
 };
 
 typedef struct isec {
@@ -84,14 +88,15 @@ static const char magic[8] = {'P', 'D', 'T', 'V', 'I', 'D', 'X', '\n'};
 
 static void layout_of(uint32_t out[12])
 {
-    const uint32_t l[12] = {sizeof(pdt_rec), sizeof(pdt_rtri), sizeof(pdt_rtri_hist),
+    const uint32_t l[12] = {sizeof(pdt_block_ref) << 8 | sizeof(pdt_evseg), sizeof(pdt_rtri), sizeof(pdt_rtri_hist),
                             sizeof(pdt_redge), sizeof(pdt_rnode), sizeof(pdt_rphase),
                             sizeof(pdt_rmerge), sizeof(pdt_rmsg), sizeof(pdt_rhull),
                             sizeof(slot_change), sizeof(pdt_point), PDT_SLOT_PER_RANK};
     memcpy(out, l, sizeof l);
 }
 
-/* Where each section lives in r and how big its elements are; counts from r. */
+/* Where each section lives in r (and its event source r->src) and how big
+ * its elements are; counts from r. */
 static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_t count[NSEC])
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
@@ -99,9 +104,10 @@ static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_
     ptr[i] = (void **)&r->field;          \
     elem[i] = sizeof *r->field;           \
     count[i] = (cnt)
-    SEC(S_RECS, recs, r->m);
+    SEC(S_SEGS, src->seg, r->src->nseg);
+    SEC(S_BLKTAB, src->blk, r->src->nblk);
+    SEC(S_RANKBLK, src->rank_blk, (uint64_t)r->nranks + 1);
     SEC(S_EVOBJ, ev_obj, r->m);
-    SEC(S_EVENT, ev_ent, r->m);
     SEC(S_TRIS, tris, r->ntri);
     SEC(S_HIST, hist, r->nhist);
     SEC(S_EDGES, edges, r->nedge);
@@ -114,9 +120,9 @@ static void sections(pdt_replay *r, void **ptr[NSEC], size_t elem[NSEC], uint64_
     SEC(S_SLOTCH, slot_ch, r->nch);
     SEC(S_SLOTSTART, slot_start, nslot + 1);
     SEC(S_LIFT, lift_ev, r->n);
-    SEC(S_SORT, sort_ev, r->n);
-    SEC(S_DEL, del_ev, r->n);
-    SEC(S_SORTPOS, sort_pos, r->n);
+    SEC(S_SORT, sort_ev, r->sort_ev ? r->n : 0);  /* (none: NULL, see load) */
+    SEC(S_DEL, del_ev, r->sort_ev ? r->n : 0);
+    SEC(S_SORTPOS, sort_pos, r->sort_ev ? r->n : 0);
     SEC(S_BOXLO, box_lo, (uint64_t)r->nranks);
     SEC(S_BOXHI, box_hi, (uint64_t)r->nranks);
     SEC(S_HASBOX, has_box, (uint64_t)r->nranks);
@@ -513,8 +519,11 @@ static void lazy_stop(lazy *L)
     free(L);
 }
 
+static void unmap_ranks(pdt_replay *r);
+
 void pdt_index_unmap(pdt_replay *r)
 {
+    unmap_ranks(r);
     if (r->lazy) lazy_stop(r->lazy);
     else munmap(r->map, r->map_len);
     r->lazy = NULL;
@@ -634,8 +643,98 @@ static int index_path(const char *dir, int where, char *buf, size_t cap)
  * reason in why when it is missing, stale or damaged.  verify: check every
  * section's checksum (reading the file through a small buffer), or, for an
  * index of at least lazy_min_bytes, each chunk when it is first read. */
-static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, size_t n,
-                        int verify, char *why, size_t wcap)
+/* A rank file's block did not match its checksum when it was decoded (a
+ * lazily verified index's source): the run folder changed behind the index
+ * (its files' sizes and times are the same).  Remove the index, tell the
+ * program, stop: the replay cannot go on without its events. */
+static void run_damaged(void *ctx, uint32_t rank)
+{
+    lazy *L = ctx;
+    char *m = L->msg, *end = L->msg + sizeof L->msg - 1, num[16];
+    snprintf(num, sizeof num, "%04u", rank);
+    m = cat(m, end, "the kept index ");
+    m = cat(m, end, L->path);
+    m = cat(m, end, " refers to rank-");
+    m = cat(m, end, num);
+    m = cat(m, end, ".trace, which no longer matches it (a block's checksum); the index was removed: "
+                    "open the run again to rebuild it");
+    *m = 0;
+    unlink(L->path);
+    if (damage_hook) damage_hook(L->msg);
+    abort();
+}
+
+/* Map the rank files of run folder `dir` that the index's block table
+ * refers to (into r->src), and unless the index is verified lazily (L),
+ * check every block's checksum now.  0 with a reason in why. */
+static int map_ranks(pdt_replay *r, const char *dir, lazy *L, char *why, size_t wcap)
+{
+    pdt_evsrc *src = r->src;
+    size_t q1 = (size_t)r->nranks;
+    src->file = calloc(q1, sizeof *src->file);
+    src->file_len = calloc(q1, sizeof *src->file_len);
+    if (!src->file || !src->file_len) {
+        snprintf(why, wcap, "out of memory");
+        return 0;
+    }
+    for (size_t q = 0; q < q1; q++) {
+        if (src->rank_blk[q] > src->rank_blk[q + 1] || src->rank_blk[q + 1] > src->nblk) {
+            snprintf(why, wcap, "damaged: block table of rank %zu", q);
+            return 0;
+        }
+        if (src->rank_blk[q] == src->rank_blk[q + 1]) continue;
+        char p[PATH_MAX + 32];
+        snprintf(p, sizeof p, "%s/rank-%04zu.trace", dir, q);
+        int fd = open(p, O_RDONLY | O_CLOEXEC);
+        struct stat sb;
+        void *m = MAP_FAILED;
+        if (fd >= 0 && fstat(fd, &sb) == 0 && sb.st_size > 0)
+            m = mmap(NULL, (size_t)sb.st_size, PROT_READ, MAP_SHARED, fd, 0);
+        if (fd >= 0) close(fd);
+        if (m == MAP_FAILED) {
+            snprintf(why, wcap, "stale: rank-%04zu.trace cannot be read", q);
+            return 0;
+        }
+        src->file[q] = m;
+        src->file_len[q] = (uint64_t)sb.st_size;
+        size_t released = 0;  /* (checked whole: its pages let go behind, 16 MiB at a time) */
+        for (size_t b = src->rank_blk[q]; !L && b < src->rank_blk[q + 1]; b++) {
+            if (!pdt_evsrc_block_ok(src, b, (uint32_t)q)) {
+                snprintf(why, wcap, "stale: rank-%04zu.trace does not match it (a block's checksum)", q);
+                return 0;
+            }
+            size_t upto = (size_t)src->blk[b].off & ~(size_t)4095;
+            if (upto - released >= ((size_t)16 << 20) || b + 1 == src->rank_blk[q + 1]) {
+                if (b + 1 == src->rank_blk[q + 1]) upto = (size_t)sb.st_size;
+                madvise((char *)m + released, upto - released, MADV_DONTNEED);
+                released = upto;
+            }
+        }
+    }
+    if (L) {
+        src->verify = 1;
+        src->damaged = run_damaged;
+        src->damaged_ctx = L;
+    }
+    return 1;
+}
+
+/* Unmap the rank files and free r->src (a kept index's). */
+static void unmap_ranks(pdt_replay *r)
+{
+    pdt_evsrc *src = r->src;
+    if (!src) return;
+    for (size_t q = 0; src->file && q < (size_t)r->nranks; q++)
+        if (src->file[q]) munmap((void *)src->file[q], (size_t)src->file_len[q]);
+    pdt_evsrc_clear(src);
+    free(src->file);
+    free(src->file_len);
+    free(src);
+    r->src = NULL;
+}
+
+static pdt_replay *load(const char *path, const char *dir, uint64_t ident, const pdt_point *pts,
+                        size_t n, int verify, char *why, size_t wcap)
 {
     int fd = open(path, O_RDONLY | O_CLOEXEC);
     if (fd < 0) {
@@ -704,10 +803,17 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
         }
     }
     r = calloc(1, sizeof *r);
-    if (!r) {
+    if (r) r->src = calloc(1, sizeof *r->src);
+    if (!r || !r->src) {
+        free(r);
+        r = NULL;
         snprintf(why, wcap, "out of memory");
         goto fail;
     }
+    r->src->nseg = h.count[S_SEGS];
+    r->src->nblk = h.count[S_BLKTAB];
+    r->src->m = h.m;
+    r->src->nranks = (int)h.nranks;
     r->n = h.n;
     r->m = h.m;
     r->skipped = h.skipped;
@@ -739,6 +845,7 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
     }
     if (!ck_ok) {
         snprintf(why, wcap, "damaged: checkpoints do not fit the tables");
+        free(r->src);
         free(r);
         r = NULL;
         goto fail;
@@ -748,17 +855,30 @@ static pdt_replay *load(const char *path, uint64_t ident, const pdt_point *pts, 
     uint64_t count[NSEC];
     sections(r, ptr, elem, count);
     count[S_WARN] = h.count[S_WARN];
+    if (h.count[S_SORT]) count[S_SORT] = count[S_DEL] = count[S_SORTPOS] = r->n;  /* Graham's */
     for (int i = 0; i < NSEC; i++) {
         if (count[i] != h.count[i] || count[i] * elem[i] != h.sec[i].bytes) {
             snprintf(why, wcap, "damaged: section %d has the wrong size", i);
+            free(r->src);
             free(r);
             r = NULL;
             goto fail;
         }
         *ptr[i] = (char *)map + h.sec[i].off;
     }
+    if (!h.count[S_SORT]) { /* a run without Graham's sort */
+        r->sort_ev = r->del_ev = NULL;
+        r->sort_pos = NULL;
+    }
     if (h.count[S_WARN] && ((const char *)map)[h.sec[S_WARN].off + h.count[S_WARN] - 1]) {
         snprintf(why, wcap, "damaged: warnings not terminated");
+        free(r->src);
+        free(r);
+        r = NULL;
+        goto fail;
+    }
+    if (!map_ranks(r, dir, L, why, wcap)) {
+        unmap_ranks(r);
         free(r);
         r = NULL;
         goto fail;
@@ -791,45 +911,250 @@ static int write_all(int fd, const void *p, size_t len, uint64_t off)
     return 1;
 }
 
-/* Stream the merged records of run into fd at HDR_BYTES (the reader's
- * merge: one decoded block per rank in memory).  Sets h->sec[S_RECS] and *m,
- * and counts what the replay's build would count in a first pass over them
- * (pdt_replay_place): fine[PDT_REPLAY_NFINE] and kinds[PDT_EV_KIND_COUNT],
- * for a run of n points and nranks ranks. */
-static pdt_status write_recs(pdt_run *run, int fd, ihdr *h, size_t *m, size_t n, int nranks,
-                             uint64_t *fine, uint64_t *kinds, crcacc *crc, pdt_err *err)
+/* The events of a build: the merged order as segments (S_SEGS), and the
+ * tables that find a block of a rank file (held here until write_tables
+ * writes them). */
+typedef struct evcopy {
+    pdt_evsrc src;           /* over the reader's mappings and S_SEGS, once written */
+    pdt_block_ref *blk;      /* src.blk */
+    uint64_t *rank_blk;      /* src.rank_blk */
+    crcacc segs_crc;
+} evcopy;
+
+/* The table of every rank's intact blocks (where each payload is in its
+ * file, its aligned time base), and the source decoding them from the
+ * reader's mappings of the rank files. */
+static pdt_status block_table(pdt_run *run, evcopy *ec, pdt_err *err)
 {
-    enum { BATCH = 8192 };
-    pdt_rec *buf = malloc(BATCH * sizeof *buf);
-    pdt_merge *mg = NULL;
-    if (!buf) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    pdt_status st = pdt_merge_open(run, &mg, err);
-    uint64_t off = HDR_BYTES;
-    size_t count = 0, nb = 0;
-    int got = 1;
-    while (st == PDT_OK && got > 0) {
-        got = pdt_merge_next(mg, &buf[nb], err);
-        if (got < 0) st = err->code ? err->code : PDT_ERR_NOMEM;
-        if (got > 0) {
-            const pdt_rec *rec = &buf[nb];
-            if (rec->ev.kind < PDT_EV_KIND_COUNT) kinds[rec->ev.kind]++;
-            size_t f = pdt_replay_fine_of(rec, n, nranks);
-            if (f < PDT_REPLAY_NFINE) fine[f]++;
-            nb++, count++;
+    int nranks = pdt_run_nranks(run);
+    size_t nblk = 0;
+    for (int q = 0; q < nranks; q++) {
+        const pdt_block_ref *b;
+        const uint8_t *file;
+        int64_t shift;
+        nblk += pdt_run_rank_blocks(run, q, &b, &file, &shift);
+    }
+    ec->blk = malloc((nblk ? nblk : 1) * sizeof *ec->blk);
+    ec->rank_blk = malloc(((size_t)nranks + 1) * sizeof *ec->rank_blk);
+    ec->src.file = calloc((size_t)nranks + 1, sizeof *ec->src.file);
+    ec->src.file_len = calloc((size_t)nranks + 1, sizeof *ec->src.file_len);
+    if (!ec->blk || !ec->rank_blk || !ec->src.file || !ec->src.file_len)
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    size_t k = 0;
+    for (int q = 0; q < nranks; q++) {
+        const pdt_block_ref *b;
+        const uint8_t *file;
+        int64_t shift;
+        size_t nb = pdt_run_rank_blocks(run, q, &b, &file, &shift);
+        pdt_rank_info ri;
+        pdt_run_rank_info(run, q, &ri);
+        ec->rank_blk[q] = k;
+        ec->src.file[q] = file;
+        ec->src.file_len[q] = file ? ri.bytes : 0;
+        for (size_t j = 0; j < nb; j++, k++)
+            ec->blk[k] = (pdt_block_ref){b[j].off + PDT_BLOCK_HEADER_BYTES, b[j].first,
+                                         b[j].base_t + (uint64_t)shift, b[j].len, b[j].count};
+    }
+    ec->rank_blk[nranks] = k;
+    ec->src.nblk = nblk;
+    ec->src.nranks = nranks;
+    return PDT_OK;
+}
+
+/* The merged order of run, streamed to the build (pass 1) by the reader's
+ * merge (one decoded block per rank in memory), and written as it goes
+ * into fd after the blocks as segments (S_SEGS).  At its end the blocks and
+ * segments are mapped, and ec->src decodes the events from there. */
+typedef struct evstream {
+    pdt_merge *mg;
+    int fd;
+    ihdr *h;
+    evcopy *ec;
+    uint64_t at, off;     /* S_SEGS: where it starts, where the next batch goes */
+    pdt_evseg cur, *buf;  /* the segment being made; a batch of finished ones */
+    size_t nb, count, nseg;
+    void *map;            /* at the end: [0, the end of S_SEGS) of the file */
+    size_t map_len;
+    uint64_t *place_off;  /* the placer's start: after S_SEGS */
+    int done;
+} evstream;
+
+enum { SEG_BATCH = 8192 };
+
+static int seg_flush(evstream *es, pdt_err *err)
+{
+    if (!es->nb) return 1;
+    if (!write_all(es->fd, es->buf, es->nb * sizeof *es->buf, es->off)) {
+        pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+        return 0;
+    }
+    crc_feed(&es->ec->segs_crc, es->buf, es->nb * sizeof *es->buf);
+    es->off += es->nb * sizeof *es->buf;
+    es->nseg += es->nb;
+    es->nb = 0;
+    return 1;
+}
+
+/* The last segment out, the section's place, the mapping for ec->src. */
+static int stream_finish(evstream *es, pdt_err *err)
+{
+    if (es->cur.rank != UINT32_MAX) es->buf[es->nb++] = es->cur;
+    if (!seg_flush(es, err)) return 0;
+    es->h->sec[S_SEGS] = (isec){es->at, (uint64_t)es->nseg * sizeof(pdt_evseg), 0, 0};
+    es->h->count[S_SEGS] = es->nseg;
+    es->map_len = (size_t)es->off;
+    es->map = mmap(NULL, es->map_len, PROT_READ, MAP_SHARED, es->fd, 0);
+    if (es->map == MAP_FAILED) {
+        es->map = NULL;
+        pdt_err_set(err, PDT_ERR_IO, "mapping the index: %s", strerror(errno));
+        return 0;
+    }
+    pdt_evsrc *src = &es->ec->src;
+    src->blk = es->ec->blk;
+    src->rank_blk = es->ec->rank_blk;
+    src->seg = (const pdt_evseg *)(void *)((const char *)es->map + es->at);
+    src->nseg = es->nseg;
+    src->m = es->count;
+    src->drop_behind = 1;
+    *es->place_off = es->off;
+    return 1;
+}
+
+static int stream_fill(evstream *es, pdt_rec *out, size_t max, pdt_err *err)
+{
+    size_t j = 0;
+    while (!es->done && j < max) {
+        int got = pdt_merge_next(es->mg, &out[j], err);
+        if (got < 0) return -1;
+        if (got == 0) {
+            es->done = 1;
+            if (!stream_finish(es, err)) return -1;
+            break;
         }
-        if (st == PDT_OK && (nb == BATCH || (got == 0 && nb))) {
-            if (!write_all(fd, buf, nb * sizeof *buf, off))
-                st = pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-            crc_feed(crc, buf, nb * sizeof *buf);
-            off += nb * sizeof *buf;
-            nb = 0;
+        const pdt_rec *rec = &out[j++];
+        if (rec->rank != es->cur.rank || rec->seq - es->cur.seq0 != es->count - es->cur.start) {
+            if (es->cur.rank != UINT32_MAX) {
+                es->buf[es->nb++] = es->cur;
+                if (es->nb == SEG_BATCH && !seg_flush(es, err)) return -1;
+            }
+            es->cur = (pdt_evseg){(uint32_t)es->count, rec->rank, rec->seq};
+        }
+        es->count++;
+    }
+    return (int)j;
+}
+
+
+/* The merge (decoding the rank files, the busier half of the build's first
+ * pass) runs in a thread of its own, a batch of events ahead of the build:
+ * two batches, one filled while the other is read. */
+enum { PIPE_BATCH = 8192 };
+
+typedef struct evpipe {
+    evstream *es;
+    pthread_t th;
+    int started;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    pdt_rec *buf[2];
+    size_t n[2];
+    int full[2];      /* filled, not yet read */
+    int last[2];      /* the stream ends after this batch (n may be 0) */
+    int failed[2];    /* the stream failed filling it (perr) */
+    int stop;         /* the reader is gone: stop filling */
+    pdt_err perr;
+    size_t slot, at;  /* the reader's batch and place in it */
+    int ended;
+} evpipe;
+
+static void *pipe_worker(void *arg)
+{
+    evpipe *p = arg;
+    for (size_t k = 0;; k ^= 1) {
+        pthread_mutex_lock(&p->mu);
+        while (p->full[k] && !p->stop) pthread_cond_wait(&p->cv, &p->mu);
+        int stop = p->stop;
+        pthread_mutex_unlock(&p->mu);
+        if (stop) return NULL;
+        int got = stream_fill(p->es, p->buf[k], PIPE_BATCH, &p->perr);
+        pthread_mutex_lock(&p->mu);
+        p->n[k] = got > 0 ? (size_t)got : 0;
+        p->failed[k] = got < 0;
+        p->last[k] = got <= 0 || p->es->done;
+        p->full[k] = 1;
+        int end = p->last[k];
+        pthread_cond_broadcast(&p->cv);
+        pthread_mutex_unlock(&p->mu);
+        if (end) return NULL;
+    }
+}
+
+static int stream_next(void *ctx, pdt_rec *out, size_t max, pdt_err *err)
+{
+    evpipe *p = *(evpipe **)ctx;
+    size_t j = 0;
+    while (j < max && !p->ended) {
+        size_t k = p->slot;
+        pthread_mutex_lock(&p->mu);
+        while (!p->full[k]) pthread_cond_wait(&p->cv, &p->mu);
+        pthread_mutex_unlock(&p->mu);
+        if (p->failed[k]) {
+            *err = p->perr;
+            return -1;
+        }
+        size_t take = p->n[k] - p->at < max - j ? p->n[k] - p->at : max - j;
+        memcpy(out + j, p->buf[k] + p->at, take * sizeof *out);
+        j += take;
+        p->at += take;
+        if (p->at == p->n[k]) { /* give the batch back */
+            if (p->last[k]) p->ended = 1;
+            pthread_mutex_lock(&p->mu);
+            p->full[k] = 0;
+            pthread_cond_broadcast(&p->cv);
+            pthread_mutex_unlock(&p->mu);
+            p->slot ^= 1;
+            p->at = 0;
         }
     }
-    pdt_merge_close(mg);
-    free(buf);
-    h->sec[S_RECS] = (isec){HDR_BYTES, (uint64_t)count * sizeof(pdt_rec), 0, 0};
-    *m = count;
-    return st;
+    return (int)j;
+}
+
+/* Start the merge's thread: 1, or 0 and err set. */
+static int pipe_start(evpipe *p, evstream *es, pdt_err *err)
+{
+    memset(p, 0, sizeof *p);
+    p->es = es;
+    p->buf[0] = malloc(PIPE_BATCH * sizeof *p->buf[0]);
+    p->buf[1] = malloc(PIPE_BATCH * sizeof *p->buf[1]);
+    if (!p->buf[0] || !p->buf[1]) {
+        pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+        return 0;
+    }
+    pthread_mutex_init(&p->mu, NULL);
+    pthread_cond_init(&p->cv, NULL);
+    if (pthread_create(&p->th, NULL, pipe_worker, p) != 0) {
+        pdt_err_set(err, PDT_ERR_NOMEM, "cannot start a thread: %s", strerror(errno));
+        return 0;
+    }
+    p->started = 1;
+    return 1;
+}
+
+/* Stop the merge's thread (wherever it is) and free the batches. */
+static void pipe_stop(evpipe *p)
+{
+    if (p->started) {
+        pthread_mutex_lock(&p->mu);
+        p->stop = 1;
+        pthread_cond_broadcast(&p->cv);
+        pthread_mutex_unlock(&p->mu);
+        pthread_join(p->th, NULL);
+        pthread_mutex_destroy(&p->mu);
+        pthread_cond_destroy(&p->cv);
+    }
+    free(p->buf[0]);
+    free(p->buf[1]);
+    p->started = 0;
 }
 
 /* The state at every r->ick_every-th cursor, stepped forwards from 0,
@@ -859,10 +1184,15 @@ static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
 /* The triangles and histories of a replay being built, streamed to the index
  * file itself (pdt_replay_place): written once, in place, by pwrite (not
  * through a shared mapping: on this file system page faults on a file being
- * written back wait for the disk), and never held in memory. */
+ * written back wait for the disk), and never held in memory.  The triangle
+ * events the build groups go to a spill of their own, an unnamed file
+ * beside the index (O_TMPFILE), dropped (closed) once they are grouped: its
+ * pages leave the page cache with it, mostly before they were written back. */
 typedef struct placer {
+    struct evpipe *pipe; /* (first: the stream's context is the placer's) */
     int fd;
     uint64_t off;  /* where the next table goes */
+    int sfd;       /* the spill */
 } placer;
 
 static uint64_t place_reserve(void *ctx, uint64_t bytes)
@@ -878,11 +1208,11 @@ static int place_put(void *ctx, uint64_t at, const void *p, size_t bytes)
     return write_all(((placer *)ctx)->fd, p, bytes, at);
 }
 
-static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
+static int read_all(int fd, uint64_t at, void *p, size_t bytes)
 {
     char *b = p;
     while (bytes) {
-        ssize_t got = pread(((placer *)ctx)->fd, b, bytes, (off_t)at);
+        ssize_t got = pread(fd, b, bytes, (off_t)at);
         if (got <= 0) return 0;
         b += got;
         bytes -= (size_t)got;
@@ -891,44 +1221,97 @@ static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
     return 1;
 }
 
+static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
+{
+    return read_all(((placer *)ctx)->fd, at, p, bytes);
+}
+
+static int spill_put(void *ctx, uint64_t at, const void *p, size_t bytes)
+{
+    return write_all(((placer *)ctx)->sfd, p, bytes, at);
+}
+
+static int spill_get(void *ctx, uint64_t at, void *p, size_t bytes)
+{
+    return read_all(((placer *)ctx)->sfd, at, p, bytes);
+}
+
+/* An unnamed scratch file in the folder of `path` (O_TMPFILE; where the file
+ * system has none, a named one removed at once), or -1. */
+static int open_spill(const char *path)
+{
+    char dir[PATH_MAX + 128];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    if (slash) *slash = 0;
+    else snprintf(dir, sizeof dir, ".");
+    int fd = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    if (fd >= 0) return fd;
+    char name[PATH_MAX + 160];
+    snprintf(name, sizeof name, "%s.spill", path);
+    fd = open(name, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd >= 0) unlink(name);
+    return fd;
+}
+
 /* Write the tables of r after the records and the streamed ones (at pc->off),
  * then the header. */
-static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
-                               crcacc *recs_crc, pdt_err *err)
+/* write_checkpoints in a thread of its own (stepping through the run takes
+ * a core while the tables are written). */
+typedef struct ck_job {
+    pdt_replay *r;
+    int fd, ok;
+    uint64_t off;
+    crcacc crc;
+} ck_job;
+
+static void *ck_worker(void *arg)
 {
-    crcacc ck_crc = {0};
+    ck_job *j = arg;
+    j->ok = write_checkpoints(j->r, j->fd, j->off, &j->crc);
+    return NULL;
+}
+
+static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
+                               evcopy *ec, pdt_err *err)
+{
     void **ptr[NSEC];
     size_t elem[NSEC];
     uint64_t count[NSEC];
     sections(r, ptr, elem, count);
+    /* the places of the tables (the checkpoints last: their sizes are known
+     * once they are made) */
     uint64_t off = pc->off;
     for (int i = 0; i < NSEC; i++) {
         h->count[i] = count[i];
-        if (i == S_RECS) continue;
-        if (i == S_CKPT) { /* their sizes are known once they are made */
-            off = (off + 63) & ~(uint64_t)63;
-            if (!write_checkpoints(r, fd, off, &ck_crc)) {
-                free(ck_crc.crc);
-                return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-            }
-            h->count[i] = r->nick ? r->ick_off[r->nick] : 0;
-            h->sec[i] = (isec){off, h->count[i], 0, 0};
-            off += h->count[i];
-            continue;
-        }
+        if (i == S_SEGS || i == S_CKPT) continue; /* (S_SEGS: written first, stream_next) */
         if (r->streamed && (i == S_TRIS || i == S_HIST)) {
             h->sec[i] = (isec){i == S_TRIS ? r->tris_at : r->hist_at, count[i] * elem[i], 0, 0};
             continue;
         }
         off = (off + 63) & ~(uint64_t)63;
-        size_t bytes = (size_t)count[i] * elem[i];
-        if (bytes && !write_all(fd, *ptr[i], bytes, off)) {
-            free(ck_crc.crc);
-            return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-        }
-        h->sec[i] = (isec){off, bytes, 0, 0};
-        off += bytes;
+        h->sec[i] = (isec){off, count[i] * elem[i], 0, 0};
+        off += h->sec[i].bytes;
     }
+    off = (off + 63) & ~(uint64_t)63;
+    ck_job ck = {r, fd, 0, off, {0}};
+    pthread_t th;
+    int threaded = pthread_create(&th, NULL, ck_worker, &ck) == 0;
+    int wrote = 1;
+    for (int i = 0; wrote && i < NSEC; i++) {
+        if (i == S_SEGS || i == S_CKPT || (r->streamed && (i == S_TRIS || i == S_HIST))) continue;
+        if (h->sec[i].bytes) wrote = write_all(fd, *ptr[i], (size_t)h->sec[i].bytes, h->sec[i].off);
+    }
+    if (threaded) pthread_join(th, NULL);
+    else ck_worker(&ck);
+    crcacc ck_crc = ck.crc;
+    if (!wrote || !ck.ok) {
+        free(ck_crc.crc);
+        return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+    }
+    h->count[S_CKPT] = r->nick ? r->ick_off[r->nick] : 0;
+    h->sec[S_CKPT] = (isec){off, h->count[S_CKPT], 0, 0};
+    off += h->count[S_CKPT];
     /* the chunk checksums: of the tables in memory from memory, of the
      * records and checkpoints as they were written, of the streamed
      * triangles and histories read back (pread, by up to four threads) */
@@ -940,8 +1323,8 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     int have = tab && todo;
     for (int i = 0; have && i < NSEC; i++) {
         uint64_t nc = chunks_of(h->sec[i].bytes);
-        if (i == S_RECS) {
-            have = crc_done(recs_crc, h->sec[i].bytes, tab + first[i]);
+        if (i == S_SEGS) {
+            have = crc_done(&ec->segs_crc, h->sec[i].bytes, tab + first[i]);
         } else if (i == S_CKPT) {
             have = crc_done(&ck_crc, h->sec[i].bytes, tab + first[i]);
         } else if (r->streamed && (i == S_TRIS || i == S_HIST)) {
@@ -970,7 +1353,7 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     }
     off = (off + 63) & ~(uint64_t)63;
     h->ctab = (isec){off, n * sizeof *tab, pdt_crc32c(0, tab, (size_t)(n * sizeof *tab)), 0};
-    int wrote = write_all(fd, tab, (size_t)(n * sizeof *tab), off);
+    wrote = write_all(fd, tab, (size_t)(n * sizeof *tab), off);
     free(tab);
     if (!wrote) return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
     off += h->ctab.bytes;
@@ -1037,35 +1420,54 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     int fd = open(tmp, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd < 0) return pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
     ihdr *h = calloc(1, sizeof *h);
+    evcopy ec;
+    memset(&ec, 0, sizeof ec);
     pdt_replay *r = NULL;
-    void *recs = MAP_FAILED;
-    size_t m = 0, recs_len = 0;
-    uint64_t fine[PDT_REPLAY_NFINE] = {0}, kinds[PDT_EV_KIND_COUNT] = {0};
-    crcacc recs_crc = {0};
-    pdt_status st = h ? write_recs(run, fd, h, &m, n, nranks, fine, kinds, &recs_crc, err)
-                      : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    if (st == PDT_OK) {
-        /* the records as the replay's input: mapped from the file, so they
-         * take no memory of their own while the tables are built */
-        recs_len = HDR_BYTES + m * sizeof(pdt_rec);
-        recs = mmap(NULL, recs_len, PROT_READ, MAP_SHARED, fd, 0);
-        if (recs == MAP_FAILED) st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
+    uint64_t events = 0;
+    for (int q = 0; q < nranks; q++) {
+        pdt_rank_info ri;
+        pdt_run_rank_info(run, q, &ri);
+        events += ri.events;
     }
-    placer pc = {fd, recs_len};
-    pdt_replay_place pl = {place_reserve, place_put, place_get, &pc, budget, fine, kinds};
-    if (st == PDT_OK)
-        st = pdt_replay_build(pts, n, (const pdt_rec *)((char *)recs + HDR_BYTES), m, nranks, &pl,
-                              &r, err);
+    size_t m = (size_t)events;
+    evstream es;
+    memset(&es, 0, sizeof es);
+    es.cur.rank = UINT32_MAX;
+    es.buf = malloc(SEG_BATCH * sizeof *es.buf);
+    evpipe pipe;
+    memset(&pipe, 0, sizeof pipe);
+    placer pc = {&pipe, fd, 0, -1};
+    pdt_status st = h && es.buf ? block_table(run, &ec, err)
+                                : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    if (st == PDT_OK) st = pdt_merge_open(run, &es.mg, err);
+    if (st == PDT_OK) {
+        es.fd = fd;
+        es.h = h;
+        es.ec = &ec;
+        es.at = es.off = HDR_BYTES;
+        es.place_off = &pc.off;
+        if ((pc.sfd = open_spill(tmp)) < 0)
+            st = pdt_err_set(err, PDT_ERR_IO, "%s: a scratch file beside it: %s", tmp, strerror(errno));
+    }
+    if (st == PDT_OK && !pipe_start(&pipe, &es, err)) st = err->code;
+    pdt_replay_place pl = {place_reserve, place_put, place_get, spill_put, spill_get,
+                           &pc,           budget,    stream_next, &ec.src};
+    if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
+    pipe_stop(&pipe);
+    if (pc.sfd >= 0) close(pc.sfd);  /* the spill, grouped: gone */
     if (st == PDT_OK) {
         r->warnings = pdt_run_warnings(run);
         size_t every = r->m / ICK_PARTS;
         r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
         r->nick = r->m / r->ick_every + 1;
-        st = write_tables(r, fd, h, ident, &pc, &recs_crc, err);
+        st = write_tables(r, fd, h, ident, &pc, &ec, err);
         r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
     }
     pdt_replay_free(r);
-    if (recs != MAP_FAILED) munmap(recs, recs_len);
+    pdt_evsrc_clear(&ec.src);
+    pdt_merge_close(es.mg);
+    free(es.buf);
+    if (es.map) munmap(es.map, es.map_len);
     if (close(fd) != 0 && st == PDT_OK)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
     /* into place over a stale index without ext4 writing the new one back
@@ -1074,7 +1476,11 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", path, strerror(errno));
     if (st != PDT_OK) unlink(tmp);
     free(h);
-    free(recs_crc.crc);
+    free(ec.blk);
+    free(ec.rank_blk);
+    free(ec.src.file);
+    free(ec.src.file_len);
+    free(ec.segs_crc.crc);
     return st;
 }
 
@@ -1101,7 +1507,7 @@ pdt_status pdt_replay_open_kept(const char *dir, uint64_t budget, pdt_replay **o
     for (int where = 0; where < 2; where++) {
         char why[160];
         if (!index_path(dir, where, path, sizeof path)) continue;
-        pdt_replay *r = load(path, ident, NULL, 0, 1, why, sizeof why);
+        pdt_replay *r = load(path, dir, ident, NULL, 0, 1, why, sizeof why);
         if (!r) {
             if (where == 0 || strcmp(why, "no index yet"))
                 snprintf(info->why, sizeof info->why, "%s", why);
@@ -1161,7 +1567,7 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
     for (int where = 0; where < 2 && !r; where++) {
         char why[160];
         if (!index_path(dir, where, path, sizeof path)) continue;
-        r = load(path, ident, pts, n, 1, why, sizeof why);
+        r = load(path, dir, ident, pts, n, 1, why, sizeof why);
         if (!r && where == 0) snprintf(info->why, sizeof info->why, "%s", why);
         if (!r && where == 1 && strcmp(why, "no index yet"))
             snprintf(info->why, sizeof info->why, "%s", why);
@@ -1181,7 +1587,7 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
                 continue;
             }
             char why[160];
-            r = load(path, ident, pts, n, 0, why, sizeof why);
+            r = load(path, dir, ident, pts, n, 0, why, sizeof why);
         }
         info->built = r != NULL;
         info->build_s = now_s() - t0;

@@ -67,9 +67,13 @@ size_t pdt_replay_inside_count(const pdt_replay *r, const uint32_t v[3])
 
 int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
 {
-    const pdt_rec *e = s->k ? pdt_replay_rec(r, s->k - 1) : NULL;
+    if (!s->k || s->k > pdt_replay_count(r)) {
+        *id = PDT_CODE_SRM;
+        return -1;
+    }
+    const pdt_rec held = *pdt_replay_rec(r, s->k - 1); /* (a kept index's pointer is short-lived) */
+    const pdt_rec *e = &held;
     *id = PDT_CODE_SRM;
-    if (!e) return -1;
     const pdt_event *ev = &e->ev;
     int32_t ph = pdt_rstate_slot(r, s, (int)e->rank, PDT_SLOT_PHASE);
     size_t np;
@@ -147,10 +151,10 @@ size_t pdt_replay_find_rank(const pdt_replay *r, size_t k, int dir, int rank)
     if (k > m) k = m;
     if (dir > 0) {
         for (size_t i = k; i < m; i++)
-            if (pdt_replay_rec(r, i)->rank == (uint32_t)rank) return i + 1;
+            if (pdt_replay_rank_of(r, i) == (uint32_t)rank) return i + 1;
     } else {
         for (size_t i = k > 1 ? k - 1 : 0; i-- > 0;)
-            if (pdt_replay_rec(r, i)->rank == (uint32_t)rank) return i + 1;
+            if (pdt_replay_rank_of(r, i) == (uint32_t)rank) return i + 1;
     }
     return k;
 }
@@ -162,8 +166,8 @@ size_t pdt_replay_nearest_of_rank(const pdt_replay *r, size_t k, int rank)
     size_t e = k ? k - 1 : 0; /* the event at that cursor */
     if (e >= m) e = m - 1;
     for (size_t d = 0; d < m; d++) {
-        if (e + d < m && pdt_replay_rec(r, e + d)->rank == (uint32_t)rank) return e + d + 1;
-        if (d <= e && pdt_replay_rec(r, e - d)->rank == (uint32_t)rank) return e - d + 1;
+        if (e + d < m && pdt_replay_rank_of(r, e + d) == (uint32_t)rank) return e + d + 1;
+        if (d <= e && pdt_replay_rank_of(r, e - d) == (uint32_t)rank) return e - d + 1;
         if (e + d >= m && d > e) break;
     }
     return (size_t)-1;

@@ -100,7 +100,10 @@ pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, cons
     c.T = pdt_theme_get(v->theme);
     pdt_render_layout_view(w, h, c.nranks, v, &c.L);
     c.X = pdt_geo_xform(r, v, w, h);
-    c.cur = s->k ? pdt_replay_rec(r, s->k - 1) : NULL;
+    if (s->k) {
+        c.cur_copy = *pdt_replay_rec(r, s->k - 1);
+        c.cur = &c.cur_copy;
+    }
     c.all_lifted = pdt_replay_kind_count(r, PDT_EV_LIFT) == 0 &&
                    pdt_replay_kind_count(r, PDT_EV_TRI_NEW) > 0;
     c.no_lift = pdt_replay_kind_count(r, PDT_EV_LIFT) == 0 && !c.all_lifted;

@@ -73,7 +73,9 @@ typedef struct ctx {
     size_t n;
     int nranks;
     double lw;      /* base line width */
-    const pdt_rec *cur;  /* the current event or NULL */
+    const pdt_rec *cur;  /* the current event or NULL (&cur_copy: a kept index's
+                          * pointer would not outlast the frame's other reads) */
+    pdt_rec cur_copy;
     int all_lifted;      /* no lift events but triangles: show every point lifted */
     int no_lift;         /* no lift events and no triangles (a hull-only run) */
     double spacing;      /* typical distance between points, pixels */

@@ -115,14 +115,27 @@ static int km_put(keymap *km, uint64_t hi, uint64_t lo, int32_t v)
 
 #define NONE32 UINT32_MAX
 
-/* ev_ent of a triangle's first event carries this bit (when there are fewer
- * than 2^31 history entries, as in every run so far): stepping back over
- * it leaves the triangle with no entry, and no step has to read the
- * triangle table (random places in 20 bytes per triangle: on a kept index,
- * the first step back into a part of it paid for checking 16 MiB of it). */
-#define FIRST_ENTRY 0x80000000u
+/* ev_kind: the event's kind in the low bits (KIND_UNKNOWN for kinds beyond
+ * them), and KIND_FIRST on a triangle's first event: stepping forwards over
+ * it gives the triangle its first history entry (tris[t].h0; in a build,
+ * ev_ent), stepping back over it leaves the triangle with none, and every
+ * other event of a triangle moves it one entry on or back (a triangle's
+ * entries are consecutive, in event order).  So the replay keeps no entry
+ * per event (ev_ent is the build's). */
+#define KIND_MASK 0x3f
+#define KIND_UNKNOWN 0x3f
+#define KIND_FIRST 0x80
+_Static_assert(PDT_EV_KIND_COUNT <= KIND_UNKNOWN, "every kind has a code below KIND_UNKNOWN");
 
-static int first_flagged(const pdt_replay *r) { return r->nhist < FIRST_ENTRY; }
+static int kind_at(const pdt_replay *r, size_t i) { return r->ev_kind[i] & KIND_MASK; }
+
+
+/* Event i (< m): from the array, or decoded (a kept index: the pointer
+ * holds for PDT_EVSRC_KEEP - 1 more calls). */
+static inline const pdt_rec *rec_at(const pdt_replay *r, size_t i)
+{
+    return r->recs ? &r->recs[i] : pdt_evsrc_get(r->src, i);
+}
 
 static int is_tri_kind(int k)
 {
@@ -154,26 +167,25 @@ static void sort3(uint32_t v[3], const uint32_t in[3])
 
 /* ---- triangles: their events grouped by triangle, in buckets of bounded size ----
  *
- * The first pass writes every triangle event, with its triangle's key (the
- * corners sorted), into the place of a history entry (the same size), sorted
- * by a hash of the key into NFINE fine buckets, each in event order.  Then
- * runs of consecutive fine buckets that fit the working budget are grouped
- * one after the other with a hash table of their own size (tri_groups): the
- * events of one triangle are all in one fine bucket, so each run's triangles
- * are whole, and their history entries are written over the run's records.
- * A last pass in event order numbers the triangles by their first event
- * (tri_ids).  Memory: the tables themselves (which may be the caller's, e.g.
- * a mapping of the index file) and a working set bounded by the budget. */
+ * The first pass writes every triangle event as its triangle's key (the
+ * corners sorted) and its event index into a spill (memory, or the place's
+ * spill file), sorted by a hash of the key into NFINE fine buckets, each in
+ * event order; what its history entry needs besides (its sub field, and for
+ * a border kernel's candidate the merge step open on its rank) waits in
+ * ev_ent and ev_obj, which the grouping overwrites.  Then runs of
+ * consecutive fine buckets that fit the working budget are grouped one
+ * after the other with a hash table of their own size (tri_groups): the
+ * events of one triangle are all in one fine bucket, so each run's
+ * triangles are whole, and their history entries take the run's place in
+ * the history table.  A last pass in event order numbers the triangles by
+ * their first event (tri_ids).  Memory: the tables themselves (which may be
+ * the caller's, e.g. a mapping of the index file) and a working set bounded
+ * by the budget. */
 
 typedef struct tri_rec {
     uint32_t s[3];  /* corners, sorted: the triangle's key */
-    uint32_t ev, rank;
-    uint8_t kind, sub;
-    uint16_t pad;
-    int64_t v;
+    uint32_t ev;
 } tri_rec;
-
-_Static_assert(sizeof(tri_rec) == sizeof(pdt_rtri_hist), "a triangle event fits its history entry");
 
 #define FINE_BITS 8
 #define NFINE ((size_t)1 << FINE_BITS)
@@ -212,11 +224,33 @@ typedef struct builder {
     size_t *fine_off;     /* per fine bucket: its first history entry; NFINE + 1 */
     const pdt_replay_place *pl;  /* streamed: the place, and per fine bucket a buffer */
     tri_rec *fbuf;        /* NFINE * FBUF records */
+    tri_rec *spill;       /* not streamed: the triangle events by fine bucket */
+    /* streamed: the spill is written a buffer (a chunk) at a time, where it
+     * ends; chunk k of fine bucket f is chunk[ck_start[f] + k] after pass 1 */
+    struct spill_chunk *chunk;
+    size_t nchunk, cap_chunk, *ck_start;
+    uint64_t spill_end;   /* bytes */
+    int stream_failed;    /* the place's stream of events failed (err set by it) */
+    pdt_rec *win;         /* streamed: events win_lo .. win_lo + win_n - 1 of the stream */
+    size_t win_lo, win_n;
     uint32_t *fbn;        /* records in each buffer */
     int failed;           /* a put or get failed */
 } builder;
 
-#define FBUF 256u  /* records buffered per fine bucket (streamed) */
+#define FBUF 1024u  /* records buffered per fine bucket (streamed): a chunk of the spill */
+
+#define WIN 8192u  /* events of the stream at hand (streamed) */
+
+/* The index pass is bound by cache misses in the edge map (random slots in
+ * a table of 10^8 bytes at level 2).  The events are all known in advance,
+ * so the slot an event a few places ahead will probe is fetched while the
+ * current one is handled.  A hint only: nothing depends on it. */
+#define PREFETCH_AHEAD 12
+
+typedef struct spill_chunk {
+    uint64_t off;      /* in the spill */
+    uint32_t f, n;     /* fine bucket, records */
+} spill_chunk;
 
 /* A big table of `bytes` (malloc'd, asking for huge pages), or NULL. */
 static void *big_table(size_t bytes)
@@ -239,12 +273,62 @@ static int tput(builder *b, void *arr, uint64_t base, size_t at, const void *p, 
     return !b->failed;
 }
 
-/* Flush the buffer of fine bucket f (streamed). */
+/* Flush the buffer of fine bucket f (streamed) to the end of the spill, a
+ * chunk of it. */
 static int fine_flush(builder *b, size_t f)
 {
     size_t k = b->fbn[f];
     b->fbn[f] = 0;
-    return tput(b, NULL, b->r->hist_at, b->fine_fill[f] - k, b->fbuf + f * FBUF, k, sizeof(tri_rec));
+    if (!k) return 1;
+    if (!grow((void **)&b->chunk, &b->cap_chunk, b->nchunk + 1, sizeof *b->chunk)) return 0;
+    if (!b->pl->sput(b->pl->ctx, b->spill_end, b->fbuf + f * FBUF, k * sizeof(tri_rec))) {
+        b->failed = 1;
+        return 0;
+    }
+    b->chunk[b->nchunk++] = (spill_chunk){b->spill_end, (uint32_t)f, (uint32_t)k};
+    b->spill_end += k * sizeof(tri_rec);
+    return 1;
+}
+
+/* Streamed pass 1: have events i .. i + PREFETCH_AHEAD (or to the end) in
+ * the window.  0 when the stream failed or ended early (err set). */
+static int win_fill(builder *b, size_t i, pdt_err *err)
+{
+    size_t end = b->win_lo + b->win_n;
+    if (i + PREFETCH_AHEAD < end || end == b->r->m) return 1;
+    size_t keep = end - i;
+    memmove(b->win, b->win + (i - b->win_lo), keep * sizeof *b->win);
+    b->win_lo = i;
+    size_t want = WIN - keep;
+    if (want > b->r->m - end) want = b->r->m - end;
+    int got = b->pl->next(b->pl->ctx, b->win + keep, want, err);
+    if (got < 0 || (got == 0 && keep == 0)) {
+        if (got == 0) pdt_err_set(err, PDT_ERR_FORMAT, "the run has fewer events than counted");
+        b->stream_failed = 1;
+        return 0;
+    }
+    b->win_n = keep + (size_t)got;
+    return 1;
+}
+
+/* After pass 1 (streamed): the chunks ordered by fine bucket, each
+ * bucket's in the order written (its events' order). */
+static int chunks_by_bucket(builder *b)
+{
+    b->ck_start = calloc(NFINE + 1, sizeof *b->ck_start);
+    spill_chunk *sorted = malloc((b->nchunk ? b->nchunk : 1) * sizeof *sorted);
+    size_t fill[NFINE];
+    if (!b->ck_start || !sorted) {
+        free(sorted);
+        return 0;
+    }
+    for (size_t c = 0; c < b->nchunk; c++) b->ck_start[b->chunk[c].f + 1]++;
+    for (size_t f = 0; f < NFINE; f++) b->ck_start[f + 1] += b->ck_start[f];
+    memcpy(fill, b->ck_start, sizeof fill);
+    for (size_t c = 0; c < b->nchunk; c++) sorted[fill[b->chunk[c].f]++] = b->chunk[c];
+    free(b->chunk);
+    b->chunk = sorted;
+    return 1;
 }
 
 static int set_slot(builder *b, uint32_t ev, int rank, int slot, int32_t val)
@@ -252,9 +336,9 @@ static int set_slot(builder *b, uint32_t ev, int rank, int slot, int32_t val)
     pdt_replay *r = b->r;
     size_t s = (size_t)rank * PDT_SLOT_PER_RANK + (size_t)slot;
     if (!grow((void **)&r->ch, &r->cap_ch, r->nch + 1, sizeof *r->ch)) return 0;
-    r->ch[r->nch] = (slot_change){ev, val, b->cur[s]};
-    r->ev_obj[ev] = (int32_t)s;
-    r->ev_ent[ev] = (uint32_t)r->nch;
+    if (r->nch >= INT32_MAX) return 0;
+    r->ch[r->nch] = (slot_change){ev, val, b->cur[s], (uint32_t)s};
+    r->ev_obj[ev] = (int32_t)r->nch;  /* the change (its slot: ch[].slot) */
     r->nch++;
     b->cur[s] = val;
     return 1;
@@ -280,11 +364,35 @@ static void box_add(pdt_replay *r, uint32_t rank, pdt_point p)
     if (p.y > r->box_hi[rank].y) r->box_hi[rank].y = p.y;
 }
 
+/* The per-point tables of Graham's sort (sort_ev, del_ev, sort_pos), made
+ * at the first SORT or DELETE event: a run without any (every
+ * triangulation) has none, in memory or in its kept index.  0 when out of
+ * memory. */
+static int graham_tables(pdt_replay *r)
+{
+    size_t n = r->n;
+    r->sort_ev = big_table(n * sizeof *r->sort_ev);
+    r->del_ev = big_table(n * sizeof *r->del_ev);
+    r->sort_pos = big_table(n * sizeof *r->sort_pos);
+    if (!r->sort_ev || !r->del_ev || !r->sort_pos) {
+        free(r->sort_ev);
+        free(r->del_ev);
+        free(r->sort_pos);
+        r->sort_ev = r->del_ev = NULL;
+        r->sort_pos = NULL;
+        return 0;
+    }
+    for (size_t p = 0; p < n; p++) {
+        r->sort_ev[p] = r->del_ev[p] = NONE32;
+        r->sort_pos[p] = -1;
+    }
+    return 1;
+}
+
 /* Pass 1: every object but triangle histories, which need counts first. */
-static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
+static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lifted_any)
 {
     pdt_replay *r = b->r;
-    const pdt_rec *rec = &r->recs[i];
     const pdt_event *e = &rec->ev;
     int rank = (int)rec->rank;
     int32_t *cur = b->cur + (size_t)rank * PDT_SLOT_PER_RANK;
@@ -370,6 +478,7 @@ static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
             r->skipped++;
             return 1;
         }
+        if (e->kind != PDT_EV_LIFT && !r->sort_ev && !graham_tables(r)) return 0;
         uint32_t *first = e->kind == PDT_EV_LIFT ? r->lift_ev
                           : e->kind == PDT_EV_SORT ? r->sort_ev : r->del_ev;
         r->ev_obj[i] = (int32_t)e->a;
@@ -449,40 +558,35 @@ static int index_event(builder *b, uint32_t i, uint8_t *lifted_any)
         uint32_t in[3] = {e->a, e->b, e->c};
         sort3(t.s, in);
         t.ev = i;
-        t.rank = rec->rank;
-        t.kind = e->kind;
-        t.sub = e->sub;
-        t.pad = 0;
-        t.v = e->v;
+        /* for hist_of, until the grouping writes these two */
+        r->ev_ent[i] = e->sub;
+        r->ev_obj[i] = e->kind == PDT_EV_TRI_NEW && e->sub == 1 ? cur[PDT_SLOT_MERGE] : -1;
         size_t f = fine_of(t.s);
         if (!b->pl) {
-            memcpy(&r->hist[b->fine_fill[f]++], &t, sizeof t);
+            b->spill[b->fine_fill[f]++] = t;
             return 1;
         }
+        /* (streamed: fine_fill counts the bucket's events) */
         b->fbuf[f * FBUF + b->fbn[f]++] = t;
         b->fine_fill[f]++;
         return b->fbn[f] < FBUF || fine_flush(b, f);
     }
 }
 
-/* The index pass is bound by cache misses in the edge map (random slots in
- * a table of 10^8 bytes at level 2).  The events are all known in advance,
- * so the slot an event a few places ahead will probe is fetched while the
- * current one is handled.  A hint only: nothing depends on it. */
-#define PREFETCH_AHEAD 12
+/* (PREFETCH_AHEAD: see probe_addr) */
 
 /* The slot that looking up event i will probe first, or NULL; for a lift,
  * sort or deletion, the point's entry of its first such event, and (*also)
  * for a lift its coordinates (random places in tables of 4 and 8 bytes per
  * point).  (The caller prefetches them: GCC drops a __builtin_prefetch
  * inside a helper function, which it deems free of side effects.) */
-static const void *probe_addr(const builder *b, size_t i, const void **also)
+static const void *probe_addr(const builder *b, const pdt_rec *rec, const void **also)
 {
-    const pdt_rec *rec = &b->r->recs[i];
     const pdt_event *e = &rec->ev;
     const pdt_replay *r = b->r;
     *also = NULL;
-    if ((e->kind == PDT_EV_LIFT || e->kind == PDT_EV_SORT || e->kind == PDT_EV_DELETE) && e->a < r->n) {
+    if ((e->kind == PDT_EV_LIFT || (r->sort_ev && (e->kind == PDT_EV_SORT || e->kind == PDT_EV_DELETE))) &&
+        e->a < r->n) {
         if (e->kind == PDT_EV_LIFT) *also = &r->pts[e->a];
         return e->kind == PDT_EV_LIFT ? &r->lift_ev[e->a]
                : e->kind == PDT_EV_SORT ? &r->sort_ev[e->a] : &r->del_ev[e->a];
@@ -498,15 +602,19 @@ typedef struct gslot {
     uint32_t s[3], g;
 } gslot;
 
-/* The history entry of the triangle event in t (the status it sets). */
-static pdt_rtri_hist hist_of(const pdt_replay *r, const tri_rec *t)
+/* The history entry of triangle event ev (the status it sets), from what
+ * the first pass left in ev_ent (its sub field) and ev_obj (a border
+ * kernel's candidate: the merge step open on its rank, else -1).  That step
+ * is the one whose MERGE_END the candidate waits for: a merge step that ends
+ * was its rank's open one from its MERGE_BEGIN to its MERGE_END. */
+static pdt_rtri_hist hist_of(const pdt_replay *r, uint32_t ev)
 {
-    pdt_rtri_hist h = {t->ev, t->rank, tri_status_of(t->kind), t->sub, t->v, NONE32};
-    if (t->kind == PDT_EV_TRI_NEW && t->sub == 1) /* border kernel: which merge step? */
-        for (size_t g = 0; g < r->nmerge; g++)
-            if (r->merges[g].rank == t->rank && r->merges[g].begin_ev < t->ev &&
-                r->merges[g].end_ev != NONE32 && t->ev < r->merges[g].end_ev)
-                h.until = r->merges[g].end_ev;
+    int kind = kind_at(r, ev);
+    uint8_t sub = (uint8_t)r->ev_ent[ev];
+    int32_t g = r->ev_obj[ev];
+    pdt_rtri_hist h = {ev, NONE32, tri_status_of(kind), sub, {0, 0}};
+    if (kind == PDT_EV_TRI_NEW && sub == 1 && g >= 0 && (size_t)g < r->nmerge)
+        h.until = r->merges[g].end_ev;  /* (NONE32: it never ended) */
     return h;
 }
 
@@ -546,12 +654,19 @@ static void *group_worker(void *arg)
         if (k >= J->nrun) break;
         size_t base = b->fine_off[J->run[k]], nb = b->fine_off[J->run[k + 1]] - base;
         if (!nb) continue;
-        if (!b->pl) memcpy(buf, &r->hist[base], nb * sizeof *buf);
-        else if (!b->pl->get(b->pl->ctx, r->hist_at + base * sizeof *buf, buf, nb * sizeof *buf)) {
-            J->io = 1;
-            ok = 0;
-            break;
+        if (!b->pl) memcpy(buf, &b->spill[base], nb * sizeof *buf);
+        for (size_t c = b->pl ? b->ck_start[J->run[k]] : 0, got = 0;
+             b->pl && c < b->ck_start[J->run[k + 1]]; c++) { /* the run's chunks, bucket by bucket */
+            const spill_chunk *ck = &b->chunk[c];
+            if (got + ck->n > nb ||
+                !b->pl->sget(b->pl->ctx, ck->off, buf + got, ck->n * sizeof *buf)) {
+                J->io = 1;
+                ok = 0;
+                break;
+            }
+            got += ck->n;
         }
+        if (!ok) break;
         size_t hc = 1024;
         while (hc / 4 * 3 < nb) hc *= 2;
         size_t mask = hc - 1;
@@ -575,14 +690,15 @@ static void *group_worker(void *arg)
         }
         size_t h = base;
         for (uint32_t q = 0; q < ng; q++) gfill[q] = (uint32_t)h, h += gn[q];
-        pdt_rtri_hist *to = b->pl ? out - base : r->hist;
+        pdt_rtri_hist *to = b->pl ? out : r->hist + base;
         for (size_t j = 0; j < nb; j++) {
-            if (j + PREFETCH_AHEAD < nb) { /* random places in two tables of 4 bytes per event */
+            if (j + PREFETCH_AHEAD < nb) { /* random places in three tables of 4, 4, 1 bytes per event */
                 __builtin_prefetch(&r->ev_ent[buf[j + PREFETCH_AHEAD].ev], 1);
                 __builtin_prefetch(&r->ev_obj[buf[j + PREFETCH_AHEAD].ev], 1);
+                __builtin_prefetch(&r->ev_kind[buf[j + PREFETCH_AHEAD].ev]);
             }
             uint32_t q = gid[j], ev = buf[j].ev, at = gfill[q]++;
-            to[at] = hist_of(r, &buf[j]);
+            to[at - base] = hist_of(r, ev);
             r->ev_ent[ev] = at;  /* (threads write distinct events) */
             r->ev_obj[ev] = ev == gfirst[q] ? -1 - (int32_t)gn[q] : (int32_t)gfirst[q];
         }
@@ -656,7 +772,7 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
 
 static void drop_recs(const builder *b, size_t upto)
 {
-    if (!b->pl || !upto || upto % DROP_EVERY) return;
+    if (!b->pl || !b->r->recs || !upto || upto % DROP_EVERY) return;
     uintptr_t lo = ((uintptr_t)(b->r->recs + upto - DROP_EVERY) + 4095) & ~(uintptr_t)4095,
               hi = (uintptr_t)(b->r->recs + upto) & ~(uintptr_t)4095;
     if (hi > lo) madvise((void *)lo, hi - lo, MADV_DONTNEED);
@@ -679,17 +795,17 @@ static int tri_ids(builder *b)
             int32_t a = r->ev_obj[i + PREFETCH_AHEAD];
             if (a >= 0 && is_tri_kind(r->ev_kind[i + PREFETCH_AHEAD])) __builtin_prefetch(&r->ev_obj[a]);
         }
-        if (!is_tri_kind(r->ev_kind[i])) continue;
+        if (!is_tri_kind(kind_at(r, i))) continue;
         int32_t o = r->ev_obj[i];
         if (o == -1) continue;  /* skipped */
         if (o >= 0) {
             r->ev_obj[i] = r->ev_obj[o];
             continue;
         }
-        const pdt_rec *rec = &r->recs[i];
+        const pdt_rec *rec = rec_at(r, i);
         to[b->pl ? nb++ : r->ntri] = (pdt_rtri){{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank,
                                                r->ev_ent[i], (uint32_t)(-1 - o)};
-        if (first_flagged(r)) r->ev_ent[i] |= FIRST_ENTRY;
+        r->ev_kind[i] |= KIND_FIRST;
         r->ev_obj[i] = (int32_t)r->ntri++;
         if (nb == TBUF) {
             if (!tput(b, NULL, r->tris_at, r->ntri - nb, tb, nb, sizeof *tb)) return 0;
@@ -701,11 +817,12 @@ static int tri_ids(builder *b)
 
 
 /* What a streamed build of m events and n points holds in memory besides
- * tri_groups' working set: the per-event and per-point tables, the run's
- * points, and some room for the small tables. */
+ * tri_groups' working set: the per-event tables (object, entry, kind), the
+ * run's points and each point's first lift, and some room for the small
+ * tables (a run with Graham's sort holds 16 bytes more per point). */
 static uint64_t held_bytes(size_t m, size_t n)
 {
-    return (uint64_t)m * 9 + (uint64_t)n * 28 + ((uint64_t)16 << 20);
+    return (uint64_t)m * 9 + (uint64_t)n * 12 + ((uint64_t)16 << 20);
 }
 
 static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
@@ -724,17 +841,14 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
     if (!b.cur || !b.lastst || !lifted_any || !b.fine_fill || !b.fine_off) goto out;
     for (size_t s = 0; s < nslot; s++) b.cur[s] = -1;
     for (int q = 0; q < r->nranks; q++) b.lastst[q] = -1;
-    /* size the tables once: counts of the events that create objects, and
-     * of the triangle events per fine bucket */
+    /* in memory, size the tables once: counts of the events that create
+     * objects, and of the triangle events per fine bucket (streamed: the
+     * events come once, the fine buckets are spilled in chunks, counted as
+     * they come, and the small tables grow) */
     {
         size_t cnt[PDT_EV_KIND_COUNT] = {0};
-        if (pl && pl->fine_count) { /* counted by the caller as it wrote the records */
-            for (size_t f = 0; f < NFINE; f++) b.fine_off[f + 1] = (size_t)pl->fine_count[f];
-            for (int k = 0; k < PDT_EV_KIND_COUNT; k++) cnt[k] = (size_t)pl->kind_count[k];
-        }
-        for (size_t i = 0; !(pl && pl->fine_count) && i < r->m; i++) {
-            drop_recs(&b, i);
-            const pdt_rec *rec = &r->recs[i];
+        for (size_t i = 0; !pl && i < r->m; i++) {
+            const pdt_rec *rec = rec_at(r, i);
             if (rec->ev.kind < PDT_EV_KIND_COUNT) cnt[rec->ev.kind]++;
             size_t f = pdt_replay_fine_of(rec, r->n, r->nranks);
             if (f < NFINE) b.fine_off[f + 1]++;
@@ -744,15 +858,16 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         r->nhist = b.fine_off[NFINE];
         if (pl) {
             r->streamed = 1;
-            r->hist_at = pl->reserve(pl->ctx, (uint64_t)r->nhist * sizeof *r->hist);
             b.fbuf = big_table(NFINE * FBUF * sizeof *b.fbuf);
             b.fbn = calloc(NFINE, sizeof *b.fbn);
-            if (r->hist_at == UINT64_MAX || !b.fbuf || !b.fbn) goto out;
+            b.win = malloc(WIN * sizeof *b.win);
+            if (!b.fbuf || !b.fbn || !b.win) goto out;
         } else {
             r->hist = big_table(r->nhist * sizeof *r->hist);
             r->tris = big_table(r->nhist * sizeof *r->tris); /* at most one per event */
             r->cap_tri = r->nhist;
-            if (!r->hist || !r->tris) goto out;
+            b.spill = big_table(r->nhist * sizeof *b.spill);
+            if (!r->hist || !r->tris || !b.spill) goto out;
         }
         if (!km_alloc(&b.edge_map, cnt[PDT_EV_EDGE_ADD]) ||
             !km_alloc(&b.msg_map, cnt[PDT_EV_SEND]) ||
@@ -763,20 +878,34 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
 
     for (size_t i = 0; i < r->m; i++) {
         drop_recs(&b, i);
+        if (pl && !win_fill(&b, i, err)) goto out;
         r->ev_obj[i] = -1;
         r->ev_ent[i] = 0;
-        r->ev_kind[i] = r->recs[i].ev.kind;
-        if (r->recs[i].rank >= (uint32_t)r->nranks) {
+        const pdt_rec *rec = pl ? &b.win[i - b.win_lo] : rec_at(r, i);
+        r->ev_kind[i] = rec->ev.kind < KIND_UNKNOWN ? rec->ev.kind : KIND_UNKNOWN;
+        if (rec->rank >= (uint32_t)r->nranks) {
             r->skipped++;
             continue;
         }
-        if (i + PREFETCH_AHEAD < r->m) {
-            const void *also, *p = probe_addr(&b, i + PREFETCH_AHEAD, &also);
+        if (pl ? i + PREFETCH_AHEAD < b.win_lo + b.win_n : i + PREFETCH_AHEAD < r->m) {
+            const pdt_rec *ahead = pl ? &b.win[i + PREFETCH_AHEAD - b.win_lo] : rec_at(r, i + PREFETCH_AHEAD);
+            const void *also, *p = probe_addr(&b, ahead, &also);
             if (p) __builtin_prefetch(p);
             if (also) __builtin_prefetch(also);
         }
-        if (r->recs[i].ev.kind < PDT_EV_KIND_COUNT) r->kind_count[r->recs[i].ev.kind]++;
-        if (!index_event(&b, (uint32_t)i, lifted_any)) goto out;
+        if (rec->ev.kind < PDT_EV_KIND_COUNT) r->kind_count[rec->ev.kind]++;
+        if (!index_event(&b, (uint32_t)i, rec, lifted_any)) goto out;
+    }
+    if (pl) { /* the stream's end (it finishes its part: pl->src is ready) */
+        pdt_rec extra;
+        int more = pl->next(pl->ctx, &extra, 1, err);
+        if (more != 0) {
+            if (more > 0) pdt_err_set(err, PDT_ERR_FORMAT, "the run has more events than counted");
+            b.stream_failed = 1;
+            goto out;
+        }
+        free(b.win);
+        b.win = NULL;
     }
     /* Phases that open a cluster of overlapping same phases (any rank). */
     {
@@ -798,8 +927,15 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         km_free(&last_end);
     }
     /* Triangle histories: grouped by triangle, then the triangles numbered. */
-    for (size_t f = 0; pl && f < NFINE; f++)
-        if (!fine_flush(&b, f)) goto out;
+    if (pl) { /* the last chunks; the buckets' places in the history table */
+        for (size_t f = 0; f < NFINE; f++)
+            if (!fine_flush(&b, f)) goto out;
+        if (!chunks_by_bucket(&b)) goto out;
+        for (size_t f = 0; f < NFINE; f++) b.fine_off[f + 1] = b.fine_off[f] + b.fine_fill[f];
+        r->nhist = b.fine_off[NFINE];
+        if ((r->hist_at = pl->reserve(pl->ctx, (uint64_t)r->nhist * sizeof *r->hist)) == UINT64_MAX)
+            goto out;
+    }
     free(b.fbuf);
     b.fbuf = NULL;
     size_t ntri;
@@ -809,6 +945,8 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         work = pl->budget > held + pl->budget / 4 ? pl->budget - held : pl->budget / 4;
     }
     if (!tri_groups(&b, work, &ntri)) goto out;
+    free(b.spill);
+    b.spill = NULL;
     if (pl && (r->tris_at = pl->reserve(pl->ctx, (uint64_t)ntri * sizeof *r->tris)) == UINT64_MAX)
         goto out;
     if (!tri_ids(&b)) goto out;
@@ -816,13 +954,13 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
     r->slot_start = calloc(nslot + 1, sizeof *r->slot_start);
     r->slot_ch = malloc((r->nch ? r->nch : 1) * sizeof *r->slot_ch);
     if (!r->slot_start || !r->slot_ch) goto out;
-    for (size_t c = 0; c < r->nch; c++) r->slot_start[r->ev_obj[r->ch[c].ev] + 1]++;
+    for (size_t c = 0; c < r->nch; c++) r->slot_start[r->ch[c].slot + 1]++;
     for (size_t s = 0; s < nslot; s++) r->slot_start[s + 1] += r->slot_start[s];
     {
         uint32_t *fill = malloc((nslot ? nslot : 1) * sizeof *fill);
         if (!fill) goto out;
         memcpy(fill, r->slot_start, nslot * sizeof *fill);
-        for (size_t c = 0; c < r->nch; c++) r->slot_ch[fill[r->ev_obj[r->ch[c].ev]]++] = (uint32_t)c;
+        for (size_t c = 0; c < r->nch; c++) r->slot_ch[fill[r->ch[c].slot]++] = (uint32_t)c;
         free(fill);
     }
     st = PDT_OK;
@@ -834,9 +972,14 @@ out:
     free(b.fine_off);
     free(b.fbuf);
     free(b.fbn);
+    free(b.spill);
+    free(b.chunk);
+    free(b.ck_start);
+    free(b.win);
     km_free(&b.edge_map);
     km_free(&b.msg_map);
-    if (st != PDT_OK && b.failed) pdt_err_set(err, PDT_ERR_IO, "the index file: %s", strerror(errno));
+    if (st != PDT_OK && b.stream_failed) st = err->code ? err->code : PDT_ERR_IO;
+    else if (st != PDT_OK && b.failed) pdt_err_set(err, PDT_ERR_IO, "the index file: %s", strerror(errno));
     else if (st != PDT_OK) pdt_err_set(err, st, "out of memory indexing %zu events", r->m);
     return st;
 }
@@ -853,6 +996,8 @@ pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs,
     *out = NULL;
     if (m >= NONE32 || n >= NONE32)
         return pdt_err_set(err, PDT_ERR_ARG, "too many events or points (%zu, %zu)", m, n);
+    if (!recs && m && (!pl || !pl->src || nranks <= 0))
+        return pdt_err_set(err, PDT_ERR_ARG, "no events to build a replay of");
     if (nranks <= 0) {
         uint32_t mx = 0;
         for (size_t i = 0; i < m; i++)
@@ -864,6 +1009,7 @@ pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs,
     r->pts = pts;
     r->n = n;
     r->recs = recs;
+    r->src = recs || !pl ? NULL : pl->src;
     r->m = m;
     r->nranks = nranks;
     size_t q1 = (size_t)nranks;
@@ -871,25 +1017,26 @@ pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs,
     r->ev_ent = big_table(m * sizeof *r->ev_ent);
     r->ev_kind = big_table(m * sizeof *r->ev_kind);
     r->lift_ev = big_table(n * sizeof *r->lift_ev);
-    r->sort_ev = big_table(n * sizeof *r->sort_ev);
-    r->del_ev = big_table(n * sizeof *r->del_ev);
-    r->sort_pos = big_table(n * sizeof *r->sort_pos);
     r->box_lo = malloc(q1 * sizeof *r->box_lo);
     r->box_hi = malloc(q1 * sizeof *r->box_hi);
     r->has_box = calloc(q1, 1);
-    if (!r->ev_obj || !r->ev_ent || !r->ev_kind || !r->lift_ev || !r->sort_ev || !r->del_ev || !r->sort_pos ||
+    if (!r->ev_obj || !r->ev_ent || !r->ev_kind || !r->lift_ev ||
         !r->box_lo || !r->box_hi || !r->has_box) {
         pdt_replay_free(r);
         return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for %zu events", m);
     }
     for (size_t p = 0; p < n; p++) {
-        r->lift_ev[p] = r->sort_ev[p] = r->del_ev[p] = NONE32;
-        r->sort_pos[p] = -1;
+        r->lift_ev[p] = NONE32;
     }
     pdt_status st = build(r, pl, err);
     if (st != PDT_OK) {
         pdt_replay_free(r);
         return st;
+    }
+    if (!pl) { /* stepping finds a triangle's first entry in tris (streamed: the caller
+                * steps before it writes tris, and frees ev_ent with the replay) */
+        free(r->ev_ent);
+        r->ev_ent = NULL;
     }
     *out = r;
     return PDT_OK;
@@ -945,7 +1092,13 @@ const pdt_point *pdt_replay_points(const pdt_replay *r, size_t *n)
     return r->pts;
 }
 
-const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i) { return i < r->m ? &r->recs[i] : NULL; }
+const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i) { return i < r->m ? rec_at(r, i) : NULL; }
+
+uint32_t pdt_replay_rank_of(const pdt_replay *r, size_t i)
+{
+    if (i >= r->m) return UINT32_MAX;
+    return r->recs ? r->recs[i].rank : pdt_evsrc_rank(r->src, i);
+}
 
 #define TABLE(fn, type, arr, cnt)                                \
     const type *fn(const pdt_replay *r, size_t *n)               \
@@ -964,7 +1117,10 @@ TABLE(pdt_replay_hulls, pdt_rhull, hulls, nhull)
 
 const pdt_rtri_hist *pdt_replay_tri_hist(const pdt_replay *r) { return r->hist; }
 
-int64_t pdt_replay_sort_pos(const pdt_replay *r, size_t p) { return p < r->n ? r->sort_pos[p] : -1; }
+int64_t pdt_replay_sort_pos(const pdt_replay *r, size_t p)
+{
+    return p < r->n && r->sort_pos ? r->sort_pos[p] : -1;
+}
 
 uint32_t pdt_replay_lift_ev(const pdt_replay *r, size_t p) { return p < r->n ? r->lift_ev[p] : NONE32; }
 
@@ -1029,8 +1185,8 @@ void pdt_rstate_free(pdt_rstate *s)
 static uint8_t point_flags(const pdt_replay *r, size_t p, size_t k)
 {
     return (uint8_t)((r->lift_ev[p] < k ? PDT_PF_LIFTED : 0) |
-                     (r->sort_ev[p] < k ? PDT_PF_SORTED : 0) |
-                     (r->del_ev[p] < k ? PDT_PF_DELETED : 0));
+                     (r->sort_ev && r->sort_ev[p] < k ? PDT_PF_SORTED : 0) |
+                     (r->del_ev && r->del_ev[p] < k ? PDT_PF_DELETED : 0));
 }
 
 static uint8_t alive(uint32_t from, uint32_t to, size_t k)
@@ -1085,9 +1241,8 @@ static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
 {
     int32_t obj = r->ev_obj[i];
     if (obj < 0) return;
-    uint32_t ent = r->ev_ent[i];
     int kind = r->ev_kind[i];
-    switch (kind) {
+    switch (kind & KIND_MASK) {
     case PDT_EV_LIFT:
     case PDT_EV_SORT:
     case PDT_EV_DELETE:
@@ -1102,15 +1257,15 @@ static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
         s->mflight[obj] = alive(r->msgs[obj].send_ev, r->msgs[obj].recv_ev, s->k);
         return;
     default:
-        if (is_tri_kind(kind)) {
-            if (first_flagged(r))
-                s->tcur[obj] = fwd ? ent & ~FIRST_ENTRY : ent & FIRST_ENTRY ? NONE32 : ent - 1;
-            else
-                s->tcur[obj] = fwd ? ent : (ent > r->tris[obj].h0 ? ent - 1 : NONE32);
+        if (is_tri_kind(kind & KIND_MASK)) {
+            uint32_t *t = &s->tcur[obj];
+            if (!(kind & KIND_FIRST)) *t = fwd ? *t + 1 : *t - 1;
+            else *t = !fwd ? NONE32 : r->ev_ent ? r->ev_ent[i] : r->tris[obj].h0;
             return;
         }
         /* a slot change */
-        s->slot[obj] = fwd ? r->ch[ent].val : r->ch[ent].prev;
+        const slot_change *c = &r->ch[obj];
+        s->slot[c->slot] = fwd ? c->val : c->prev;
         return;
     }
 }
@@ -1448,13 +1603,13 @@ size_t pdt_replay_find(const pdt_replay *r, size_t k, int dir, int c, const uint
     if (k > r->m) k = r->m;
     if (dir > 0) {
         for (size_t i = k; i < r->m; i++)
-            if (pdt_ev_in_class(r->recs[i].ev.kind, c) &&
-                (!rank_visible || rank_visible[r->recs[i].rank]))
+            if (pdt_ev_in_class(kind_at(r, i), c) &&
+                (!rank_visible || rank_visible[pdt_replay_rank_of(r, i)]))
                 return i + 1;
     } else {
         for (size_t i = k >= 2 ? k - 1 : 0; i-- > 0;)
-            if (pdt_ev_in_class(r->recs[i].ev.kind, c) &&
-                (!rank_visible || rank_visible[r->recs[i].rank]))
+            if (pdt_ev_in_class(kind_at(r, i), c) &&
+                (!rank_visible || rank_visible[pdt_replay_rank_of(r, i)]))
                 return i + 1;
         if (k >= 1) return 0;
     }
@@ -1486,8 +1641,8 @@ size_t pdt_replay_find_phase_name(const pdt_replay *r, const char *name)
     base[len] = 0;
     if (colon) level = strtol(colon + 1, NULL, 10);
     for (size_t i = 0; i < r->m; i++) {
-        const pdt_event *e = &r->recs[i].ev;
-        if (e->kind != PDT_EV_PHASE_BEGIN) continue;
+        if (kind_at(r, i) != PDT_EV_PHASE_BEGIN) continue;
+        const pdt_event *e = &rec_at(r, i)->ev;
         const char *nm = pdt_phase_name(e->sub);
         if (nm && !strcmp(nm, base) && (level < 0 || (long)e->a == level)) return i + 1;
     }

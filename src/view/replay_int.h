@@ -8,21 +8,75 @@
 /* Checkpoints a kept index holds, at most (index.c makes 17 at most). */
 #define PDT_ICK_MAX 24
 
+/* ---- the merged events of a kept index, decoded on demand (evsrc.c) ----------
+ *
+ * A kept index holds no events: it holds a table of the rank files'
+ * encoded blocks (where each is in its file) and the merged order as
+ * segments, each a stretch of consecutive merged events that are
+ * consecutive events of one rank.  An event is decoded when asked for, with
+ * its block, from the rank file (mapped), into a small cache. */
+
+/* The merged events [start, next segment's start) are events seq0, seq0 + 1,
+ * ... of rank `rank`. */
+typedef struct pdt_evseg {
+    uint32_t start, rank, seq0;
+} pdt_evseg;
+
+typedef struct pdt_evsrc {
+    const uint8_t **file;        /* per rank: its file's bytes (mapped), or NULL */
+    uint64_t *file_len;          /* per rank */
+    const pdt_block_ref *blk;    /* every rank's blocks, rank by rank; off: of the
+                                  * payload in its file, base_t: the aligned time
+                                  * base (the shift added) */
+    size_t nblk;
+    const uint64_t *rank_blk;    /* nranks + 1: rank q's blocks are
+                                  * blk[rank_blk[q] .. rank_blk[q + 1]) */
+    const pdt_evseg *seg;
+    size_t nseg, m;
+    int nranks;
+    /* the decoded blocks (a cache; owned) */
+    struct evslot *slot;
+    size_t nslot, hot, last_seg;
+    uint64_t tick;
+    int drop_behind;             /* give back the mapped pages behind a forward pass
+                                  * (madvise; the build's one-way passes) */
+    uint64_t *released;          /* (per rank, made when needed) */
+    int verify;                  /* check each block's checksum when it is decoded;
+                                  * on a mismatch call damaged(damaged_ctx, rank) */
+    void (*damaged)(void *ctx, uint32_t rank);
+    void *damaged_ctx;
+} pdt_evsrc;
+
+/* Event i (< m) of the merged order, decoded: a pointer into the cache,
+ * valid at least until PDT_EVSRC_KEEP - 1 more calls. */
+#define PDT_EVSRC_KEEP 8
+const pdt_rec *pdt_evsrc_get(pdt_evsrc *s, size_t i);
+/* The rank of event i (no decoding). */
+uint32_t pdt_evsrc_rank(pdt_evsrc *s, size_t i);
+/* Free the cache (the tables and the files' mappings are not s's). */
+void pdt_evsrc_clear(pdt_evsrc *s);
+/* 1 if the checksum of block b (its header and payload) matches. */
+int pdt_evsrc_block_ok(const pdt_evsrc *s, size_t b, uint32_t rank);
+
 typedef struct slot_change {
     uint32_t ev;
     int32_t val, prev;
+    uint32_t slot;  /* rank * PDT_SLOT_PER_RANK + slot */
 } slot_change;
 
 struct pdt_replay {
     const pdt_point *pts;
     size_t n;
-    const pdt_rec *recs;
+    const pdt_rec *recs;  /* the merged events, or NULL: decoded on demand from src */
+    pdt_evsrc *src;       /* (kept index) */
     size_t m, skipped;
     int nranks;
-    int32_t *ev_obj;   /* per event: object (see build()) or -1 */
-    uint32_t *ev_ent;  /* per event: entry (history / change index, or flag; a
-                        * triangle's first event: | FIRST_ENTRY, replay.c) */
-    uint8_t *ev_kind;  /* per event: its kind (stepping reads no records) */
+    int32_t *ev_obj;   /* per event: object (see build(); a slot change: its index
+                        * in ch) or -1 */
+    uint32_t *ev_ent;  /* per event, while building only (then NULL): its history
+                        * entry (a triangle event) */
+    uint8_t *ev_kind;  /* per event: its kind and a mark (replay.c: KIND_*;
+                        * stepping reads no records) */
 
     pdt_rtri *tris;
     size_t ntri, cap_tri;
@@ -47,7 +101,8 @@ struct pdt_replay {
     uint32_t *slot_start;
 
     uint32_t *lift_ev, *sort_ev, *del_ev;  /* per point: first such event or UINT32_MAX */
-    int64_t *sort_pos;
+    int64_t *sort_pos;  /* sort_ev, del_ev, sort_pos: NULL when the run has no SORT
+                         * and no DELETE event (then all none) */
     pdt_point *box_lo, *box_hi;  /* per rank */
     uint8_t *has_box;
     size_t kind_count[PDT_EV_KIND_COUNT];
@@ -90,14 +145,18 @@ typedef struct pdt_replay_place {
     uint64_t (*reserve)(void *ctx, uint64_t bytes);
     int (*put)(void *ctx, uint64_t at, const void *p, size_t bytes);
     int (*get)(void *ctx, uint64_t at, void *p, size_t bytes);
+    /* scratch of 16 bytes per triangle event, written once and read once
+     * while the build groups them (at: from 0): e.g. a temporary file */
+    int (*sput)(void *ctx, uint64_t at, const void *p, size_t bytes);
+    int (*sget)(void *ctx, uint64_t at, void *p, size_t bytes);
     void *ctx;
     uint64_t budget;
-    /* NULL, or the counts the build's first pass would make, made by the
-     * caller as it wrote the records (the pass is then skipped): per fine
-     * bucket the triangle events (pdt_replay_fine_of), PDT_REPLAY_NFINE of
-     * them, and the events of every kind (PDT_EV_KIND_COUNT; kinds beyond
-     * it not counted). */
-    const uint64_t *fine_count, *kind_count;
+    /* The events (the build is given no array of them: recs NULL), in
+     * order, once: up to max of them into out; returns how many, 0 at the
+     * end, -1 on an error (err set).  When it has given them all, src must be
+     * ready: the second pass (numbering the triangles) decodes them there. */
+    int (*next)(void *ctx, pdt_rec *out, size_t max, pdt_err *err);
+    pdt_evsrc *src;
 } pdt_replay_place;
 
 /* The triangle events of a build are grouped in this many buckets by a hash
@@ -109,7 +168,8 @@ typedef struct pdt_replay_place {
 size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks);
 
 /* pdt_replay_new, with the triangles and histories streamed to pl (NULL:
- * held in memory, no budget: pdt_replay_new). */
+ * held in memory, no budget: pdt_replay_new); recs NULL: the events are
+ * pl->src's (nranks must then be given). */
 pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs, size_t m,
                             int nranks, const pdt_replay_place *pl, pdt_replay **out, pdt_err *err);
 

@@ -175,7 +175,7 @@ static void key(shell *sh, SDL_Keycode k, Uint16 mod)
         case SDLK_LEFT: {
             /* next / previous event of the current event's rank */
             size_t cur = sh->s->k;
-            int q = cur ? (int)pdt_replay_rec(sh->r, cur - 1)->rank : 0;
+            int q = cur ? (int)pdt_replay_rank_of(sh->r, cur - 1) : 0;
             sh->playing = 0;
             seek(sh, pdt_replay_find_rank(sh->r, cur, k == SDLK_RIGHT ? 1 : -1, q));
             return;

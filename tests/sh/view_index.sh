@@ -23,6 +23,25 @@ if [ "$got" = "$mem" ] && [ -s "$IDX" ] && [ ! -s "$TMP/e1" ]; then ok index_bui
 else fail index_built_same_counts "got '$got' want '$mem'; $(cat "$TMP/e1")"; fi
 ls "$R"/.pdtview-index.tmp* >/dev/null 2>&1 && fail no_temp_left "a temporary index is left" || ok no_temp_left
 
+# the index holds no events: it refers to the rank files' blocks, and checks
+# each block as it decodes it.  A rank file changed behind it (same size and
+# time) is found: at the opening when the index is checked whole (rebuilt,
+# saying why), or when the block is first decoded when it is checked lazily
+# (the index removed, with a message naming it)
+flip_rank() { # DIR: flip a bit inside rank 0's last block (200 bytes before the end), keep its time
+    python3 -c 'import sys, os; p = sys.argv[1]; o = os.path.getsize(p) - 200; f = open(p, "r+b"); f.seek(o); b = f.read(1); f.seek(o); f.write(bytes([b[0] ^ 0x01]))' "$1/rank-0000.trace"
+    touch -r "$R/rank-0000.trace" "$1/rank-0000.trace"
+}
+"$V" "$R" --counts --end --mem 1M >/dev/null 2>&1
+cp -a "$R" "$TMP/rund1"; cp -a "$R" "$TMP/rund2"
+flip_rank "$TMP/rund1"; flip_rank "$TMP/rund2"
+"$V" "$TMP/rund1" --counts --end --mem 1M 2>&1 >/dev/null | grep -q "rebuilt the index (stale: rank-0000.trace does not match it" &&
+    ok rank_file_changed_rebuilt || fail rank_file_changed_rebuilt "$("$V" "$TMP/rund1" --counts --end --mem 1M 2>&1)"
+PDTVIEW_VERIFY=lazy "$V" "$TMP/rund2" --describe --mem 1M >/dev/null 2>"$TMP/ed1"; rc=$?
+if [ $rc -ne 0 ] && grep -q "refers to rank-0000.trace, which no longer matches it" "$TMP/ed1" &&
+   [ ! -e "$TMP/rund2/.pdtview-index" ]; then ok rank_file_changed_lazy
+else fail rank_file_changed_lazy "exit $rc: $(cat "$TMP/ed1")"; fi
+
 # what the window shows (event lines, lit code lines) is the same at every event
 "$V" "$R" --describe --index off > "$TMP/d_mem.txt"
 "$V" "$R" --describe --mem 1M > "$TMP/d_idx.txt"
@@ -159,6 +178,19 @@ if mpirun -np 3 "$ROOT/bin/pdt" triangulate "$TMP/u3.txt" -o "$TMP/u3.tri" --tra
 else
     fail ranks3_record "mpirun -np 3 failed"
 fi
+
+# a hull run (Graham's sort: the per-point sort tables, which a triangulation's
+# index leaves out) gives the same event lines and seeks through the index
+RH=$TMP/runh
+"$PDT" gen uniform 2000 --seed 5 > "$TMP/uh.txt"
+"$PDT" hull "$TMP/uh.txt" -o "$TMP/uh.out" --trace "$RH" >/dev/null 2>&1 || fail hull_record
+"$V" "$RH" --describe --index off > "$TMP/dhm.txt"
+"$V" "$RH" --describe --mem 64K > "$TMP/dhi.txt"
+if [ -s "$RH/.pdtview-index" ] && [ -s "$TMP/dhm.txt" ] && cmp -s "$TMP/dhm.txt" "$TMP/dhi.txt"
+then ok hull_run_same_events
+else fail hull_run_same_events "$(diff "$TMP/dhm.txt" "$TMP/dhi.txt" | head -3)"; fi
+case "$("$V" "$RH" --check --mem 64K)" in *", 0 differ"*) ok hull_run_check ;;
+    *) fail hull_run_check "$("$V" "$RH" --check --mem 64K)" ;; esac
 
 # bad budgets
 for bad in 0 12Q -5 ''; do
