@@ -58,15 +58,28 @@ pdt_status pdt_delaunay_hull_on(pdt_point *pts, size_t n, uint32_t *id, void *wo
  * canonical output order, identical for every algorithm and every rank count. */
 void pdt_tri_canonical(pdt_tri *tris, size_t ntri);
 
-/* pdt_tri_canonical with the caller's scratch: room for ntri triangles, not
- * overlapping tris (NULL: allocated and freed inside). */
-void pdt_tri_canonical_on(pdt_tri *tris, size_t ntri, pdt_tri *scratch);
+/* The canonical order in buckets, for triangles spread over ranks (the order
+ * phase of a parallel run): bucket b holds the triangles whose smallest index
+ * v has v >> shift == b.  Every rank counts its triangles by bucket
+ * (pdt_tri_bucket_count, which rotates each to start at its smallest index),
+ * groups them by bucket (pdt_tri_bucket_scatter) and sends each rank a range
+ * of buckets; the receiver orders what it got (pdt_tri_bucket_order).  The
+ * result is the canonical order of the union, whatever the grouping. */
 
-/* The same from in[0, ntri) into out[0, ntri): out may be in or overlap it
- * (in is read whole first, and its triangles are rotated in place); scratch
- * (room for ntri) overlaps neither.  A receive buffer is ordered into the
- * front of its block without a copy first. */
-void pdt_tri_canonical_to(pdt_tri *in, pdt_tri *out, size_t ntri, pdt_tri *scratch);
+/* Rotate each of t[0, n) to start at its smallest index v and add 1 to
+ * hist[v >> shift] (hist: room for every bucket that occurs). */
+void pdt_tri_bucket_count(pdt_tri *t, size_t n, int shift, uint64_t *hist);
+
+/* Copy each of t[0, n) (rotated) to dst[at[b]++], b its bucket. */
+void pdt_tri_bucket_scatter(const pdt_tri *t, size_t n, int shift, uint64_t *at, pdt_tri *dst);
+
+/* The ns runs src[k][0, len[k]) (rotated, each grouped by bucket in
+ * increasing order, no triangle twice) into out in canonical order; out has
+ * room for them all and overlaps none.  2^shift counters are allocated
+ * (8 bytes each: keep shift small, 21 is 16 MiB): PDT_ERR_NOMEM when that
+ * fails. */
+pdt_status pdt_tri_bucket_order(const pdt_tri *const *src, const size_t *len, size_t ns, int shift,
+                                pdt_tri *out);
 
 /* Figures reported by the pipeline. */
 typedef struct pdt_tri_stats {

@@ -770,6 +770,21 @@ static void order_first_runs(pdt_tri *t, size_t lo, size_t hi)
     }
 }
 
+/* One bucket of first indices [base, base + nlo) whose triangles lie in ns
+ * places seg[k][0, len[k]) and have been counted by first index into
+ * lc[v - base + 1] (lc: nlo + 1 counters): written to out in canonical order
+ * (a counting pass by first index, then the runs of one first index by the
+ * other two). */
+static void bucket_place(const pdt_tri *const *seg, const size_t *len, size_t ns, uint32_t base,
+                         size_t nlo, size_t *lc, pdt_tri *out)
+{
+    lc[0] = 0;
+    for (size_t l = 1; l <= nlo; l++) lc[l] += lc[l - 1];
+    for (size_t k = 0; k < ns; k++)
+        for (size_t i = 0; i < len[k]; i++) out[lc[seg[k][i].v[0] - base]++] = seg[k][i];
+    order_first_runs(out, 0, lc[nlo]);
+}
+
 /* The triangles are put in order by their first (smallest) index with two
  * counting passes: first by its high bits into at most 2048 buckets (2048
  * output streams: cache lines and huge pages enough for all), then each
@@ -789,8 +804,6 @@ static void canonical(pdt_tri *in, pdt_tri *out, size_t ntri, pdt_tri *scratch)
         if (in[i].v[0] > maxv) maxv = in[i].v[0];
         if (in[i].v[0] < minv) minv = in[i].v[0];
     }
-    /* the buckets span [minv, maxv] only: a rank of a parallel run orders the
-     * triangles of one index range */
     uint32_t span = maxv - minv;
     int bits = 32 - __builtin_clz(span | 1u), shift = bits > 11 ? bits - 11 : 0;
     size_t nhi = ((size_t)span >> shift) + 1, nlo = (size_t)1 << shift;
@@ -808,17 +821,16 @@ static void canonical(pdt_tri *in, pdt_tri *out, size_t ntri, pdt_tri *scratch)
     for (size_t h = 1; h <= nhi; h++) hc[h] += hc[h - 1];
     for (size_t i = 0; i < ntri; i++) tmp[hc[(in[i].v[0] - minv) >> shift]++] = in[i];
     /* hc[h] is now the end of high bucket h */
-    uint32_t lmask = (uint32_t)(nlo - 1);
     size_t start = 0;
     for (size_t h = 0; h < nhi; h++) {
         size_t end = hc[h];
         if (end == start) continue; /* (no counters to clear for an empty bucket) */
+        const pdt_tri *seg = tmp + start;
+        size_t len = end - start;
+        uint32_t base = minv + ((uint32_t)h << shift);
         memset(lc, 0, (nlo + 1) * sizeof *lc);
-        for (size_t i = start; i < end; i++) lc[((tmp[i].v[0] - minv) & lmask) + 1]++;
-        lc[0] = start;
-        for (size_t l = 1; l <= nlo; l++) lc[l] += lc[l - 1];
-        for (size_t i = start; i < end; i++) out[lc[(tmp[i].v[0] - minv) & lmask]++] = tmp[i];
-        order_first_runs(out, start, end);
+        for (size_t i = 0; i < len; i++) lc[seg[i].v[0] - base + 1]++;
+        bucket_place(&seg, &len, 1, base, nlo, lc, out + start);
         start = end;
     }
     if (tmp != scratch) pdt_big_free(tmp, ntri * sizeof *tmp);
@@ -831,14 +843,53 @@ void pdt_tri_canonical(pdt_tri *tris, size_t ntri)
     canonical(tris, tris, ntri, NULL);
 }
 
-void pdt_tri_canonical_on(pdt_tri *tris, size_t ntri, pdt_tri *scratch)
+/* ---- the canonical order in buckets (spread over ranks) ---- */
+
+void pdt_tri_bucket_count(pdt_tri *t, size_t n, int shift, uint64_t *hist)
 {
-    canonical(tris, tris, ntri, scratch);
+    for (size_t i = 0; i < n; i++) {
+        tri_rotate(&t[i]);
+        hist[t[i].v[0] >> shift]++;
+    }
 }
 
-void pdt_tri_canonical_to(pdt_tri *in, pdt_tri *out, size_t ntri, pdt_tri *scratch)
+void pdt_tri_bucket_scatter(const pdt_tri *t, size_t n, int shift, uint64_t *at, pdt_tri *dst)
 {
-    canonical(in, out, ntri, scratch);
+    for (size_t i = 0; i < n; i++) dst[at[t[i].v[0] >> shift]++] = t[i];
+}
+
+/* Each bucket in turn, the smallest at a run's head first: its part of every
+ * run found and counted by first index in one scan, then placed. */
+pdt_status pdt_tri_bucket_order(const pdt_tri *const *src, const size_t *len, size_t ns, int shift,
+                                pdt_tri *out)
+{
+    size_t nlo = (size_t)1 << shift;
+    size_t *lc = malloc((nlo + 1) * sizeof *lc), *at = calloc(ns + 1, sizeof *at),
+           *sl = malloc((ns + 1) * sizeof *sl);
+    const pdt_tri **seg = malloc((ns + 1) * sizeof *seg);
+    pdt_status st = lc && at && sl && seg ? PDT_OK : PDT_ERR_NOMEM;
+    while (st == PDT_OK) {
+        uint64_t b = UINT64_MAX;
+        for (size_t k = 0; k < ns; k++)
+            if (at[k] < len[k] && (src[k][at[k]].v[0] >> shift) < b) b = src[k][at[k]].v[0] >> shift;
+        if (b == UINT64_MAX) break;
+        uint32_t base = (uint32_t)(b << shift);
+        memset(lc, 0, (nlo + 1) * sizeof *lc);
+        for (size_t k = 0; k < ns; k++) {
+            size_t e = at[k];
+            for (; e < len[k] && (src[k][e].v[0] >> shift) == b; e++) lc[src[k][e].v[0] - base + 1]++;
+            seg[k] = src[k] + at[k];
+            sl[k] = e - at[k];
+            at[k] = e;
+        }
+        bucket_place(seg, sl, ns, base, nlo, lc, out);
+        out += lc[nlo];
+    }
+    free(lc);
+    free(at);
+    free(sl);
+    free((void *)seg);
+    return st;
 }
 
 /* ---- sort and dedupe ---- */

@@ -465,11 +465,14 @@ static pdt_status merge_tree(drv *d, pdt_err *err)
 
 /* The canonical order sorts by smallest index first, so the output splits
  * into ranges of smallest index: rank q writes the triangles whose smallest
- * index lies in its range.  Every rank puts its own final triangles in
- * canonical order first (the plain run's counting sort), so the part for
- * each rank is one consecutive run of each array: no grouping pass; one
- * histogram of smallest indices (read off the sorted arrays), one exchange
- * of 12-byte records, and each rank merges the sorted runs it got. */
+ * index lies in its range.  The ranges are made of buckets of 2^shift
+ * consecutive indices, the same on every rank (pdt_tri_bucket_*): each rank
+ * counts its final triangles by bucket, the counts summed over the ranks
+ * (one allreduce) give each rank a range of buckets holding about T / p
+ * triangles, each rank groups its triangles by bucket (one pass: the runs
+ * for the ranks are then consecutive), one exchange of 12-byte records, and
+ * each rank puts what it got in order bucket by bucket -- the counting sort
+ * of the plain run, split at the exchange, with no sorted runs to merge. */
 
 /* The final triangles of a rank: the local phase's and the merges'. */
 typedef struct finals {
@@ -477,187 +480,126 @@ typedef struct finals {
     size_t n[2];
 } finals;
 
-/* First i with t[i].v[0] >= key in t[0, n) (canonical: v[0] is the smallest
- * index, nondecreasing). */
-static size_t first_at_least(const pdt_tri *t, size_t n, uint64_t key)
+/* The buckets: 2^shift consecutive smallest indices each, at least 2048 of
+ * them over [0, n_total) (the plain run's first counting pass: each bucket's
+ * counters fit the cache) and about 256 per rank (a bucket is never split
+ * between ranks), at most 2^16. */
+static int order_shift(const drv *d)
 {
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (t[mid].v[0] < key) lo = mid + 1;
-        else hi = mid;
-    }
-    return lo;
-}
-
-/* The ranges: the smallest indices [0, n_total) in buckets of 2^sh
- * consecutive indices (at most 256 p, at most 2^16 buckets); the histogram of
- * every rank's final triangles summed (allreduce); bucket b goes to rank
- * owner(b), nondecreasing in b, so that every rank gets about T / p
- * triangles (a bucket is never split).  mine[2 q + k]: how many of f.t[k]
- * (sorted) go to rank q, a consecutive run of it. */
-static pdt_status order_ranges(drv *d, const finals *f, uint64_t *mine, pdt_err *err)
-{
-    int p = d->p;
     uint64_t top = d->n_total ? d->n_total - 1 : 0;
-    uint64_t want = (uint64_t)256 * (uint64_t)p;
+    uint64_t want = (uint64_t)256 * (uint64_t)d->p;
+    if (want < 2048) want = 2048;
     if (want > ((uint64_t)1 << 16)) want = (uint64_t)1 << 16;
     int sh = 0;
     while ((top >> sh) + 1 > want) sh++;
-    size_t nb = (size_t)(top >> sh) + 1;
-    uint64_t *h = calloc(nb, sizeof *h), *local = calloc(2 * nb, sizeof *local);
-    if (!h || !local) {
-        free(h);
-        free(local);
+    return sh;
+}
+
+/* The plan of the exchange: hist[b], this rank's triangles in bucket b; the
+ * buckets' owners from the sum over the ranks (the rank whose share holds a
+ * bucket's middle: nondecreasing in b); sc[q], how many this rank sends
+ * rank q; at[b], where bucket b starts in the grouped array. */
+typedef struct order_plan {
+    int shift;
+    size_t nb;
+    uint64_t *hist, *at, *sc, *rc;
+} order_plan;
+
+static void order_plan_free(order_plan *o)
+{
+    free(o->hist);
+    free(o->at);
+    free(o->sc);
+    free(o->rc);
+}
+
+static pdt_status order_plan_make(drv *d, finals *f, order_plan *o, pdt_err *err)
+{
+    int p = d->p;
+    o->shift = order_shift(d);
+    o->nb = (size_t)((d->n_total ? d->n_total - 1 : 0) >> o->shift) + 1;
+    o->hist = calloc(o->nb, sizeof *o->hist);
+    o->at = calloc(o->nb, sizeof *o->at);
+    o->sc = calloc((size_t)p, sizeof *o->sc);
+    o->rc = calloc((size_t)p, sizeof *o->rc);
+    uint64_t *sum = calloc(o->nb, sizeof *sum);
+    if (!o->hist || !o->at || !o->sc || !o->rc || !sum) {
+        free(sum);
         return nomem(d, "order");
     }
-    for (int k = 0; k < 2; k++) {
-        size_t at = 0;
-        for (size_t b = 0; b < nb; b++) {
-            size_t end = first_at_least(f->t[k] + at, f->n[k] - at, (uint64_t)(b + 1) << sh) + at;
-            local[k * nb + b] = end - at;
-            at = end;
-        }
-    }
-    for (size_t b = 0; b < nb; b++) h[b] = local[b] + local[nb + b];
-    pdt_status st = pdt_comm_allreduce_u64(d->c, h, nb, PDT_COMM_SUM, err);
+    for (int k = 0; k < 2; k++) pdt_tri_bucket_count(f->t[k], f->n[k], o->shift, o->hist);
+    memcpy(sum, o->hist, o->nb * sizeof *sum);
+    pdt_status st = pdt_comm_allreduce_u64(d->c, sum, o->nb, PDT_COMM_SUM, err);
     if (st == PDT_OK) {
-        note_all(d, TAG_ORDER, nb * sizeof *h);
-        uint64_t total = 0, before = 0;
-        for (size_t b = 0; b < nb; b++) total += h[b];
-        for (size_t b = 0; b < nb; b++) { /* the rank whose share holds the bucket's middle */
-            uint64_t q = total ? (before + h[b] / 2) * (uint64_t)p / total : 0;
-            int own = q < (uint64_t)p ? (int)q : p - 1;
-            before += h[b];
-            mine[2 * own] += local[b]; /* this rank's triangles for that rank */
-            mine[2 * own + 1] += local[nb + b];
+        note_all(d, TAG_ORDER, o->nb * sizeof *sum);
+        uint64_t total = 0, before = 0, pos = 0;
+        for (size_t b = 0; b < o->nb; b++) total += sum[b];
+        for (size_t b = 0; b < o->nb; b++) {
+            uint64_t q = total ? (before + sum[b] / 2) * (uint64_t)p / total : 0;
+            before += sum[b];
+            o->sc[q < (uint64_t)p ? q : (uint64_t)p - 1] += o->hist[b];
+            o->at[b] = pos;
+            pos += o->hist[b];
         }
+        st = pdt_comm_alltoall(d->c, o->sc, sizeof *o->sc, o->rc, err);
+        if (st == PDT_OK) note_all(d, TAG_COUNTS, sizeof *o->sc);
     }
-    free(h);
-    free(local);
+    free(sum);
     return st;
 }
 
-/* One sorted run of received triangles [at, end) and the heap of runs of the
- * merge below, by their first triangle. */
-typedef struct run {
-    const pdt_tri *at, *end;
-} run;
-
-static int tri_before(const pdt_tri *a, const pdt_tri *b)
-{
-    if (a->v[0] != b->v[0]) return a->v[0] < b->v[0];
-    if (a->v[1] != b->v[1]) return a->v[1] < b->v[1];
-    return a->v[2] < b->v[2];
-}
-
-static void heap_down(run *h, size_t n, size_t i)
-{
-    for (;;) {
-        size_t l = 2 * i + 1, m = i;
-        if (l < n && tri_before(h[l].at, h[m].at)) m = l;
-        if (l + 1 < n && tri_before(h[l + 1].at, h[m].at)) m = l + 1;
-        if (m == i) return;
-        run t = h[i];
-        h[i] = h[m];
-        h[m] = t;
-        i = m;
-    }
-}
-
-/* The order of a triangle among the finals: its first two indices (no two
- * triangles of a triangulation share them: the edge v0 -> v1 has one
- * triangle on its left). */
-static inline uint64_t tri_key(const pdt_tri *t)
-{
-    return (uint64_t)t->v[0] << 32 | t->v[1];
-}
-
-/* Up to four runs (two ranks' local and merge finals): the smallest of the
- * four heads by conditional moves, an exhausted run's key past every key
- * (which run's head is next is random: the heap's comparisons mispredicted
- * about once a triangle). */
-static void merge_four(run *h, size_t n, pdt_tri *out)
-{
-    uint64_t key[4];
-    size_t left = 0;
-    for (size_t i = 0; i < 4; i++) {
-        key[i] = i < n ? tri_key(h[i].at) : UINT64_MAX;
-        left += i < n ? (size_t)(h[i].end - h[i].at) : 0;
-    }
-    for (; left > 0; left--) {
-        size_t a = key[1] < key[0], b = 2 + (key[3] < key[2]);
-        size_t m = key[b] < key[a] ? b : a;
-        *out++ = *h[m].at++;
-        key[m] = h[m].at < h[m].end ? tri_key(h[m].at) : UINT64_MAX;
-    }
-}
-
-/* Merge the nonempty runs of h[0, n) (sorted, no triangle twice) into out,
- * which overlaps none of them (one pass: the four-way choice above, or a
- * heap of the runs' heads when there are more). */
-static void merge_runs(run *h, size_t n, pdt_tri *out)
-{
-    size_t k = 0;
-    for (size_t i = 0; i < n; i++)
-        if (h[i].at < h[i].end) h[k++] = h[i];
-    n = k;
-    if (n <= 4) {
-        merge_four(h, n, out);
-        return;
-    }
-    for (size_t i = n / 2; i-- > 0;) heap_down(h, n, i);
-    while (n > 1) {
-        *out++ = *h[0].at++;
-        if (h[0].at == h[0].end) h[0] = h[--n];
-        heap_down(h, n, 0);
-    }
-    if (n == 1) {
-        size_t left = (size_t)(h[0].end - h[0].at);
-        memcpy(out, h[0].at, left * sizeof *out);
-    }
-}
-
-/* Where the order phase receives and merges: in the rank's block when the
- * received triangles fit at its end and the output at its front without
- * overlapping (the local finals at the front have been sent by then), else
- * in new arrays. */
+/* Where the order phase groups, receives and orders: in the rank's block
+ * (room for cap triangles, the local finals at its front) when each fits
+ * without overlapping what is still to be read, else in arrays of their own.
+ * grp (the grouped triangles) behind the finals; got (received) at the
+ * block's end, past grp (which is sent before anything arrives); out at the
+ * front, below got (the finals and grp have been read by then). */
 typedef struct order_room {
-    pdt_tri *blk;      /* the block (s.fin), room for cap triangles */
+    pdt_tri *blk;
     size_t cap;
-    pdt_tri *got, *out;
-    int got_own, out_own; /* got / out is an array of its own */
+    pdt_tri *grp, *got, *out;
+    int grp_own, got_own, out_own;
 } order_room;
 
-static pdt_status order_room_get(drv *d, order_room *o, size_t total)
+static void order_room_free(order_room *o)
 {
+    if (o->grp_own) free(o->grp);
+    if (o->got_own) free(o->got);
+    if (o->out_own) free(o->out);
+}
+
+static pdt_status order_room_grp(drv *d, order_room *o, const finals *f)
+{
+    size_t mine = f->n[0] + f->n[1];
     o->blk = d->s.fin;
     o->cap = o->blk ? d->blk_bytes / sizeof(pdt_tri) : 0; /* the strip's points are not needed */
-    if (o->blk && 2 * total + 2 <= o->cap && d->s.nfin + total <= o->cap) {
-        o->out = o->blk;
-        o->got = o->blk + (o->cap - total);
+    if (o->blk && f->n[0] + mine <= o->cap) {
+        o->grp = o->blk + f->n[0];
         return PDT_OK;
     }
-    o->got = srm_big((total + 1) * sizeof *o->got);
-    o->got_own = 1;
-    if (o->blk && total <= o->cap) {
+    o->grp = srm_big((mine + 1) * sizeof *o->grp);
+    o->grp_own = 1;
+    return o->grp ? PDT_OK : nomem(d, "order");
+}
+
+static pdt_status order_room_out(drv *d, order_room *o, const finals *f, size_t total)
+{
+    size_t busy = o->grp_own ? 0 : f->n[0] + f->n[0] + f->n[1]; /* below: grp */
+    size_t got_at = o->cap;
+    if (o->blk && total <= o->cap && o->cap - total >= busy) {
+        got_at = o->cap - total;
+        o->got = o->blk + got_at;
+    } else {
+        o->got = srm_big((total + 1) * sizeof *o->got);
+        o->got_own = 1;
+    }
+    if (o->blk && total <= got_at) {
         o->out = o->blk;
     } else {
         o->out = srm_big((total + 1) * sizeof *o->out);
         o->out_own = 1;
     }
     return o->got && o->out ? PDT_OK : nomem(d, "order");
-}
-
-/* This rank's finals in canonical order, each array on its own (the block's
- * room behind the local finals as the counting sort's scratch). */
-static void order_local(drv *d, finals *f)
-{
-    pdt_tri *blk = d->s.fin;
-    size_t cap = blk ? d->blk_bytes / sizeof(pdt_tri) : 0;
-    pdt_tri *scratch = blk && 2 * f->n[0] <= cap ? blk + f->n[0] : NULL;
-    pdt_tri_canonical_on(f->t[0], f->n[0], scratch);
-    pdt_tri_canonical_on(f->t[1], f->n[1], scratch && f->n[1] <= f->n[0] ? scratch : NULL);
 }
 
 /* Phase 4: the final triangles go to the rank of their smallest index's
@@ -667,40 +609,34 @@ static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
 {
     int p = d->p;
     finals f = {{d->s.fin, d->s.more}, {d->s.nfin, d->s.nmore}};
-    pdt_status st = PDT_OK;
-    size_t *cnt = calloc(2 * (size_t)p, sizeof *cnt), *rcnt = calloc(2 * (size_t)p, sizeof *rcnt);
-    uint64_t *sc = calloc(2 * (size_t)p, sizeof *sc), *rc = calloc(2 * (size_t)p, sizeof *rc);
-    run *runs = calloc(2 * (size_t)p, sizeof *runs);
+    order_plan o = {0};
     order_room room = {0};
-    if (!cnt || !rcnt || !sc || !rc || !runs) {
+    size_t *cnt = calloc((size_t)p, sizeof *cnt), *rcnt = calloc((size_t)p, sizeof *rcnt);
+    size_t *len = calloc((size_t)p, sizeof *len);
+    const pdt_tri **src = calloc((size_t)p, sizeof *src);
+    pdt_status st = cnt && rcnt && len && src ? PDT_OK : nomem(d, "order");
+    if (st == PDT_OK) st = order_plan_make(d, &f, &o, err);
+    if (st == PDT_OK) st = order_room_grp(d, &room, &f);
+    if (st != PDT_OK) goto done;
+    for (int k = 0; k < 2; k++) pdt_tri_bucket_scatter(f.t[k], f.n[k], o.shift, o.at, room.grp);
+    size_t total = 0;
+    for (int q = 0; q < p; q++) {
+        cnt[q] = (size_t)o.sc[q] * sizeof(pdt_tri);
+        rcnt[q] = (size_t)o.rc[q] * sizeof(pdt_tri);
+        total += (size_t)o.rc[q];
+    }
+    st = order_room_out(d, &room, &f, total);
+    if (st == PDT_OK) st = pdt_comm_alltoallv(d->c, room.grp, cnt, room.got, rcnt, err);
+    if (st != PDT_OK) goto done;
+    note_v(d, TAG_ORDER, cnt, rcnt);
+    for (size_t q = 0, at = 0; q < (size_t)p; at += len[q], q++) { /* rank q's run, by bucket */
+        src[q] = room.got + at;
+        len[q] = (size_t)o.rc[q];
+    }
+    if (pdt_tri_bucket_order(src, len, (size_t)p, o.shift, room.out) != PDT_OK) {
         st = nomem(d, "order");
         goto done;
     }
-    order_local(d, &f);
-    st = order_ranges(d, &f, sc, err);
-    if (st == PDT_OK) st = pdt_comm_alltoall(d->c, sc, 2 * sizeof *sc, rc, err);
-    if (st != PDT_OK) goto done;
-    note_all(d, TAG_COUNTS, 2 * sizeof *sc);
-    size_t total = 0;
-    for (int k = 0; k < 2; k++)
-        for (int q = 0; q < p; q++) {
-            cnt[k * p + q] = (size_t)sc[2 * q + k] * sizeof(pdt_tri);
-            rcnt[k * p + q] = (size_t)rc[2 * q + k] * sizeof(pdt_tri);
-            total += (size_t)rc[2 * q + k];
-        }
-    st = order_room_get(d, &room, total);
-    if (st != PDT_OK) goto done;
-    pdt_tri *at = room.got;
-    for (int k = 0; k < 2 && st == PDT_OK; k++) {
-        st = pdt_comm_alltoallv(d->c, f.t[k], cnt + k * p, at, rcnt + k * p, err);
-        if (st == PDT_OK) note_v(d, TAG_ORDER, cnt + k * p, rcnt + k * p);
-        for (int q = 0; q < p; q++) { /* the sorted run from rank q */
-            runs[k * p + q] = (run){at, at + rc[2 * q + k]};
-            at += rc[2 * q + k];
-        }
-    }
-    if (st != PDT_OK) goto done;
-    merge_runs(runs, 2 * (size_t)p, room.out);
     free(d->s.more); /* every triangle went somewhere (itself included) */
     d->s.more = NULL;
     d->s.nmore = d->s.capmore = 0;
@@ -713,6 +649,7 @@ static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
         free(room.blk);
     }
     room.blk = NULL;
+    room.out_own = 0;
     uint64_t first = 0, all = total;
     st = pdt_comm_exscan_u64(d->c, total, &first, err); /* place in the whole output */
     if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, &all, 1, PDT_COMM_SUM, err);
@@ -723,13 +660,12 @@ static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
     room.out = NULL;
     if (st == PDT_OK) note_all(d, TAG_ORDER, sizeof all);
 done:
-    if (room.got_own) free(room.got);
-    if (room.out_own) free(room.out);
+    order_room_free(&room);
+    order_plan_free(&o);
     free(cnt);
     free(rcnt);
-    free(sc);
-    free(rc);
-    free(runs);
+    free(len);
+    free((void *)src);
     return st;
 }
 

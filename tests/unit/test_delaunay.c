@@ -298,29 +298,85 @@ TEST(canonical_order)
     CHECK(t[3].v[0] == 2 && t[3].v[1] == 9 && t[3].v[2] == 5);
 }
 
-/* pdt_tri_canonical_to: from a buffer behind the front of a block into its
- * front (overlapping when the buffer is longer than the gap), scratch
- * behind the buffer, as the parallel order phase calls it; the same as
- * pdt_tri_canonical in place, for small (insertion) and large (radix) counts
- * and a narrow index range (one rank's share). */
-TEST(canonical_to_front_of_block)
+/* The canonical order in buckets, as the parallel order phase uses it: the
+ * triangles dealt at random to ns ranks, each rank counts and groups its own
+ * by bucket, every rank gets a range of buckets (cut at random places) from
+ * every rank and orders them; the ranks' outputs one after the other are
+ * pdt_tri_canonical's order, for small and large counts, shifts from 0 (a
+ * bucket per index) to past the largest index (one bucket), and with runs of
+ * equal triangles. */
+TEST(bucket_order_is_canonical)
 {
-    size_t sizes[] = {1, 50, 64, 65, 3000, 200000};
-    for (size_t k = 0; k < sizeof sizes / sizeof *sizes; k++) {
-        size_t n = sizes[k], gap = n / 3 + 1;
-        pdt_tri *blk = malloc((gap + 2 * n) * sizeof *blk), *ref = malloc(n * sizeof *ref);
-        uint32_t lo = (uint32_t)(k * 1000003u), span = (uint32_t)(n / 2 + 3);
-        for (size_t i = 0; i < n; i++) {
-            for (int e = 0; e < 3; e++) ref[i].v[e] = lo + (uint32_t)(rand() % (int)span);
-            if (i % 7 == 3 && i) ref[i] = ref[i - 1]; /* runs of equal triangles */
-        }
-        memcpy(blk + gap, ref, n * sizeof *ref);
-        pdt_tri_canonical(ref, n);
-        pdt_tri_canonical_to(blk + gap, blk, n, blk + gap + n);
-        CHECK_MSG(memcmp(blk, ref, n * sizeof *ref) == 0, "n = %zu: order differs", n);
-        free(blk);
-        free(ref);
-    }
+    size_t sizes[] = {0, 1, 50, 3000, 200000};
+    int shifts[] = {0, 3, 11, 20};
+    for (size_t k = 0; k < sizeof sizes / sizeof *sizes; k++)
+        for (size_t si = 0; si < sizeof shifts / sizeof *shifts; si++)
+            for (size_t ns = 1; ns <= 5; ns += 2) {
+                size_t n = sizes[k];
+                int shift = shifts[si];
+                uint32_t lo = (uint32_t)(k * 1003u), span = (uint32_t)(2 * n + 3);
+                pdt_tri *ref = malloc((n + 1) * sizeof *ref), *all = malloc((n + 1) * sizeof *all);
+                pdt_tri *grp = malloc((n + 1) * sizeof *grp), *out = malloc((n + 1) * sizeof *out);
+                size_t nb = (size_t)((lo + span) >> shift) + 1;
+                uint64_t *hist = calloc(ns * nb, sizeof *hist), *at = calloc(ns * nb, sizeof *at);
+                size_t *cut = calloc(ns + 1, sizeof *cut), *cnt = calloc(ns + 1, sizeof *cnt);
+                size_t *first = calloc(ns + 1, sizeof *first);
+                for (size_t i = 0; i < n; i++) {
+                    for (int e = 0; e < 3; e++) ref[i].v[e] = lo + (uint32_t)(rand() % (int)span);
+                    if (i % 7 == 3) ref[i] = ref[i - 1]; /* runs of equal triangles */
+                }
+                /* deal: rank r holds all[first[r], first[r] + cnt[r]) */
+                for (size_t i = 0; i < n; i++) cnt[(size_t)rand() % ns]++;
+                for (size_t r = 1; r <= ns; r++) first[r] = first[r - 1] + cnt[r - 1];
+                memcpy(all, ref, n * sizeof *ref);
+                pdt_tri_canonical(ref, n);
+                for (size_t r = 0; r < ns; r++) /* count, then group by bucket */
+                    pdt_tri_bucket_count(all + first[r], cnt[r], shift, hist + r * nb);
+                for (size_t r = 0; r < ns; r++) {
+                    uint64_t pos = first[r];
+                    for (size_t b = 0; b < nb; b++) {
+                        at[r * nb + b] = pos;
+                        pos += hist[r * nb + b];
+                    }
+                    pdt_tri_bucket_scatter(all + first[r], cnt[r], shift, at + r * nb, grp);
+                }
+                /* rank q gets buckets [cut[q], cut[q + 1]) of every rank */
+                for (size_t q = 1; q < ns; q++) cut[q] = (size_t)rand() % (nb + 1);
+                cut[ns] = nb;
+                for (size_t q = 1; q < ns; q++)
+                    for (size_t j = q; j > 1 && cut[j - 1] > cut[j]; j--) {
+                        size_t t = cut[j];
+                        cut[j] = cut[j - 1];
+                        cut[j - 1] = t;
+                    }
+                pdt_tri *o = out;
+                for (size_t q = 0; q < ns; q++) {
+                    const pdt_tri *src[5];
+                    size_t len[5], got = 0;
+                    for (size_t r = 0; r < ns; r++) {
+                        size_t from = first[r], to;
+                        for (size_t b = 0; b < cut[q]; b++) from += hist[r * nb + b];
+                        to = from;
+                        for (size_t b = cut[q]; b < cut[q + 1]; b++) to += hist[r * nb + b];
+                        src[r] = grp + from;
+                        len[r] = to - from;
+                        got += len[r];
+                    }
+                    CHECK(pdt_tri_bucket_order(src, len, ns, shift, o) == PDT_OK);
+                    o += got;
+                }
+                CHECK_MSG((size_t)(o - out) == n && (n == 0 || memcmp(out, ref, n * sizeof *ref) == 0),
+                          "n = %zu, shift %d, %zu ranks: order differs", n, shift, ns);
+                free(ref);
+                free(all);
+                free(grp);
+                free(out);
+                free(hist);
+                free(at);
+                free(cut);
+                free(cnt);
+                free(first);
+            }
 }
 
 TEST(trace_events)
@@ -532,7 +588,7 @@ int main(void)
     RUN(sort_unique_keeps_smallest_index);
     RUN(kernel_rejects_unsorted_or_duplicate_points);
     RUN(canonical_order);
-    RUN(canonical_to_front_of_block);
+    RUN(bucket_order_is_canonical);
     RUN(trace_events);
     RUN(symmetric_parabola_and_circle_large);
     RUN(high_degree_vertex);

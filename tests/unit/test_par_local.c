@@ -12,15 +12,6 @@
 #include "pdt/gen.h"
 #include "pdt/hull.h"
 
-static uint64_t rng_state = 0x2545f4914f6cdd1dull;
-static uint64_t rnd(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return rng_state;
-}
-
 static int cmp_key(const void *a, const void *b)
 {
     uint64_t x = pdt_key(*(const pdt_point *)a), y = pdt_key(*(const pdt_point *)b);
@@ -142,31 +133,9 @@ TEST(kernel_hull_is_chain_hull)
     CHECK(degenerate > 0 && degenerate < runs);
 }
 
-/* The canonical order with the caller's scratch is pdt_tri_canonical's. */
-TEST(canonical_on_scratch)
-{
-    static const size_t ns[] = {0, 1, 64, 65, 5000, 100000};
-    for (size_t ni = 0; ni < sizeof ns / sizeof *ns; ni++) {
-        size_t n = ns[ni];
-        pdt_tri *a = malloc((n + 1) * sizeof *a), *b = malloc((n + 1) * sizeof *b);
-        pdt_tri *scratch = malloc((n + 1) * sizeof *scratch);
-        uint32_t base = (uint32_t)(rnd() % 1000000);
-        for (size_t i = 0; i < n; i++)
-            for (int k = 0; k < 3; k++) a[i].v[k] = base + (uint32_t)(rnd() % (2 * n + 3));
-        if (n) memcpy(b, a, n * sizeof *a);
-        pdt_tri_canonical(a, n);
-        pdt_tri_canonical_on(b, n, scratch);
-        CHECK_MSG(n == 0 || memcmp(a, b, n * sizeof *a) == 0, "n=%zu differs", n);
-        free(a);
-        free(b);
-        free(scratch);
-    }
-}
-
 int main(void)
 {
     RUN(delaunay_on_equals_delaunay);
     RUN(kernel_hull_is_chain_hull);
-    RUN(canonical_on_scratch);
     return test_summary();
 }
