@@ -58,6 +58,20 @@ pdt_status pdt_delaunay_hull_on(pdt_point *pts, size_t n, uint32_t *id, void *wo
  * canonical output order, identical for every algorithm and every rank count. */
 void pdt_tri_canonical(pdt_tri *tris, size_t ntri);
 
+/* The kernel for one strip of a parallel run (untraced), leaving the points
+ * in its own order: pts[0, n) distinct and sorted, name[i] the name of
+ * pts[i], work as for pdt_delaunay_on.  Afterwards pts and name are in the
+ * kernel's order (the same permutation applied to both), the *ntri
+ * triangles at work's front and the hull (*hull, malloc'd, the caller
+ * frees: counter-clockwise from the lexicographically smallest point, the
+ * collinear boundary points included) name positions in that order: vertex
+ * v is pts[v], called name[v].  The same triangles, in the same order and
+ * orientation, and the same hull as pdt_delaunay_hull_on's, named so.  When there is no hull (the points on a line, or
+ * n < 3), no triangle, *hull = NULL, and pts and name are given back in
+ * their first order.  PDT_ERR_ARG for unsorted points or too small a work. */
+pdt_status pdt_delaunay_strip(pdt_point *pts, size_t n, uint32_t *name, void *work,
+                              size_t work_bytes, size_t *ntri, uint32_t **hull, size_t *nhull);
+
 /* The canonical order in buckets, for triangles spread over ranks (the order
  * phase of a parallel run): bucket b holds the triangles whose smallest index
  * v has v >> shift == b.  Every rank counts its triangles by bucket

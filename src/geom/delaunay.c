@@ -498,7 +498,10 @@ static int build(dt *d, uint32_t lo, uint32_t hi, int axis, uint32_t *le, uint32
  * triangles. */
 enum { PF_AHEAD = 16 };
 
-static size_t collect(dt *d, const uint32_t *id, const uint32_t *tid, int run)
+/* The triangles, written over the edge records as they are read, named
+ * id[v] (or v when id is NULL: the caller specializes both, inlined). */
+static inline __attribute__((always_inline)) size_t collect(dt *d, const uint32_t *id,
+                                                             const uint32_t *tid, int run)
 {
     pdt_trace *tr = d->tr;
     const edge *r = d->e;
@@ -519,12 +522,12 @@ static size_t collect(dt *d, const uint32_t *id, const uint32_t *tid, int run)
         int c0 = (g.oprev > e) & (h0.oprev > e) & (pdt_orient_fast(pf, pg, p[h0.org]) > 0);
         int c1 = (f.oprev > e + 1) & (h1.oprev > e + 1) &
                  (pdt_orient_fast(pg, pf, p[h1.org]) > 0);
-        uint32_t fi = id[f.org], gi = id[g.org];
-        out[nt] = (pdt_tri){{fi, gi, id[h0.org]}};
+        uint32_t fi = id ? id[f.org] : f.org, gi = id ? id[g.org] : g.org;
+        out[nt] = (pdt_tri){{fi, gi, id ? id[h0.org] : h0.org}};
         if (PDT_TRACING(tr, 1) && c0)
             PDT_TRACE(tr, 1, PDT_EV_TRI_NEW, run, tid[f.org], tid[g.org], tid[h0.org], 0);
         nt += (size_t)c0;
-        out[nt] = (pdt_tri){{gi, fi, id[h1.org]}};
+        out[nt] = (pdt_tri){{gi, fi, id ? id[h1.org] : h1.org}};
         if (PDT_TRACING(tr, 1) && c1)
             PDT_TRACE(tr, 1, PDT_EV_TRI_NEW, run, tid[g.org], tid[f.org], tid[h1.org], 0);
         nt += (size_t)c1;
@@ -538,7 +541,8 @@ static size_t collect(dt *d, const uint32_t *id, const uint32_t *tid, int run)
  * goes around the hull counter-clockwise; every boundary point is a vertex
  * of the outer face, the collinear ones included.  *hull (malloc'd) names
  * them as id[v]; on a line the walk goes out and back (more than n steps)
- * and nothing is given.  Returns 0 when out of memory. */
+ * and nothing is given (id NULL: the vertices themselves).  Returns 0 when
+ * out of memory. */
 static int outer_hull(const dt *d, uint32_t le, size_t n, const uint32_t *id, uint32_t **hull,
                       size_t *nhull)
 {
@@ -550,14 +554,18 @@ static int outer_hull(const dt *d, uint32_t le, size_t n, const uint32_t *id, ui
     } while (e != le);
     uint32_t *h = malloc(k * sizeof *h);
     if (!h) return 0;
-    for (size_t i = 0; i < k; i++, e = rprev(d, e)) h[i] = id[org(d, e)];
+    for (size_t i = 0; i < k; i++, e = rprev(d, e)) h[i] = id ? id[org(d, e)] : org(d, e);
     *hull = h;
     *nhull = k;
     return 1;
 }
 
+/* The kernel on q[0, n) (distinct, sorted), moved to its leaf order along
+ * with id; the triangles (and the hull) named id[v], or the vertex v itself
+ * when by_vertex. */
 static pdt_status kernel_on(uint32_t *id, pdt_point *q, size_t n, edge *e, size_t cap,
-                            size_t *ntri, int run, pdt_trace *tr, uint32_t **hull, size_t *nhull)
+                            size_t *ntri, int run, pdt_trace *tr, uint32_t **hull, size_t *nhull,
+                            int by_vertex)
 {
     *ntri = 0;
     dt d;
@@ -599,8 +607,8 @@ static pdt_status kernel_on(uint32_t *id, pdt_point *q, size_t n, edge *e, size_
     }
     uint32_t le, re;
     int ok = build(&d, 0, (uint32_t)n, 0, &le, &re);
-    if (ok && hull && n >= 3) ok = outer_hull(&d, le, n, id, hull, nhull);
-    if (ok) *ntri = collect(&d, id, tid, run);
+    if (ok && hull && n >= 3) ok = outer_hull(&d, le, n, by_vertex ? NULL : id, hull, nhull);
+    if (ok) *ntri = by_vertex ? collect(&d, NULL, tid, run) : collect(&d, id, tid, run);
     free(tmap);
     return ok ? PDT_OK : PDT_ERR_NOMEM;
 }
@@ -634,7 +642,7 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
     for (uint32_t i = 0; i < (uint32_t)n; i++) id[i] = i;
     memcpy(q, pts, n * sizeof *q);
     size_t nt = 0;
-    pdt_status s = kernel_on(id, q, n, e, cap, &nt, run, tr, NULL, NULL);
+    pdt_status s = kernel_on(id, q, n, e, cap, &nt, run, tr, NULL, NULL, 0);
     free(id);
     pdt_big_free(q, n * sizeof *q);
     if (s != PDT_OK || nt == 0) {
@@ -666,7 +674,7 @@ pdt_status pdt_delaunay_hull_on(pdt_point *pts, size_t n, uint32_t *id, void *wo
         if (pdt_key(pts[i - 1]) >= pdt_key(pts[i])) return PDT_ERR_ARG;
     for (uint32_t i = 0; i < (uint32_t)n; i++) id[i] = i;
     size_t nt = 0;
-    pdt_status s = kernel_on(id, pts, n, (edge *)work, edge_cap(n), &nt, run, tr, hull, nhull);
+    pdt_status s = kernel_on(id, pts, n, (edge *)work, edge_cap(n), &nt, run, tr, hull, nhull, 0);
     pdt_point *tmp = (pdt_point *)(void *)((pdt_tri *)work + (s == PDT_OK ? nt : 0));
     memcpy(tmp, pts, n * sizeof *tmp);
     for (size_t v = 0; v < n; v++) pts[id[v]] = tmp[v];
@@ -683,6 +691,53 @@ pdt_status pdt_delaunay_on(pdt_point *pts, size_t n, uint32_t *id, void *work, s
                            size_t *ntri, int run, pdt_trace *tr)
 {
     return pdt_delaunay_hull_on(pts, n, id, work, work_bytes, ntri, NULL, NULL, run, tr);
+}
+
+/* A point and its name, for putting a strip back in order (below). */
+typedef struct named_pt {
+    pdt_point p;
+    uint32_t name;
+} named_pt;
+
+static int named_cmp(const void *a, const void *b)
+{
+    uint64_t ka = pdt_key(((const named_pt *)a)->p), kb = pdt_key(((const named_pt *)b)->p);
+    return ka < kb ? -1 : ka > kb;
+}
+
+/* The kernel without putting the points back: the caller reads the
+ * triangles against the leaf order, which is the order they come out in
+ * (the restore was a random scatter of every point, and the caller's pass
+ * over the triangles then read the points out of order).  Only a strip with
+ * no hull (a line, or fewer than 3 points) is put back in order, by a sort:
+ * the caller runs its own chain on it. */
+pdt_status pdt_delaunay_strip(pdt_point *pts, size_t n, uint32_t *name, void *work,
+                              size_t work_bytes, size_t *ntri, uint32_t **hull, size_t *nhull)
+{
+    *ntri = 0;
+    *hull = NULL;
+    *nhull = 0;
+    if (n < 2) return PDT_OK;
+    if (n > PDT_KERNEL_MAX_POINTS || work_bytes < PDT_DELAUNAY_WORK(n)) return PDT_ERR_ARG;
+    for (size_t i = 1; i < n; i++) /* the precondition: distinct and sorted */
+        if (pdt_key(pts[i - 1]) >= pdt_key(pts[i])) return PDT_ERR_ARG;
+    size_t nt = 0;
+    pdt_status s = kernel_on(name, pts, n, (edge *)work, edge_cap(n), &nt, 0, NULL, hull, nhull, 1);
+    if (s == PDT_OK && *hull && nt > 0) {
+        *ntri = nt;
+        return PDT_OK;
+    }
+    free(*hull);
+    *hull = NULL;
+    *nhull = 0;
+    named_pt *tmp = work; /* no triangle to keep: 12 of the 72 bytes per point */
+    for (size_t i = 0; i < n; i++) tmp[i] = (named_pt){pts[i], name[i]};
+    qsort(tmp, n, sizeof *tmp, named_cmp);
+    for (size_t i = 0; i < n; i++) {
+        pts[i] = tmp[i].p;
+        name[i] = tmp[i].name;
+    }
+    return s;
 }
 
 /* ---- canonical order ---- */
@@ -1285,7 +1340,7 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
      * (tr->gid composed) */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_KERNEL, 0, 0, 0, 0);
     size_t nt = 0;
-    pdt_status s = nu >= 2 ? kernel_on(order, pts, nu, R, cap, &nt, 0, tr, NULL, NULL) : PDT_OK;
+    pdt_status s = nu >= 2 ? kernel_on(order, pts, nu, R, cap, &nt, 0, tr, NULL, NULL, 0) : PDT_OK;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
     pdt_prefault_stop(pf); /* (long done, but it must end before R shrinks) */
     double t2 = now();

@@ -215,19 +215,31 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
         }
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_LIFT, 0, 0, 0, 0);
 
-    /* local kernel, in the block, on the strip's own points (no copy); when
-     * not tracing, the strip hull comes with it (the triangulation's outer
-     * face) */
+    /* local kernel, in the block, on the strip's own points (no copy).
+     * Traced: the points are put back in their order afterwards, named
+     * gid[j], and the strip hull is the chain's (its events are part of the
+     * lesson).  Untraced: the points stay in the kernel's order, named id[v]
+     * (the global indices moved along with them), the triangles come out in
+     * that order (read below with the points near each other in memory),
+     * and the strip hull is the triangulation's outer face. */
     int traced = PDT_TRACING(tr, 1);
+    const uint32_t *names = gid;
     uint32_t *kh = NULL;
     size_t nkh = 0;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_KERNEL, 0, 0, 0, 0);
     size_t ntri = 0;
-    const uint32_t *saved = tr ? tr->gid : NULL;
-    if (tr) tr->gid = gid;
-    pdt_status st = pdt_delaunay_hull_on(pts, m, id, block, PDT_DELAUNAY_WORK(m), &ntri,
-                                         traced ? NULL : &kh, &nkh, 0, tr);
-    if (tr) tr->gid = saved;
+    pdt_status st;
+    if (traced) {
+        const uint32_t *saved = tr->gid;
+        tr->gid = gid;
+        st = pdt_delaunay_hull_on(pts, m, id, block, PDT_DELAUNAY_WORK(m), &ntri, NULL, NULL, 0,
+                                  tr);
+        tr->gid = saved;
+    } else {
+        memcpy(id, gid, m * sizeof *id);
+        st = pdt_delaunay_strip(pts, m, id, block, PDT_DELAUNAY_WORK(m), &ntri, &kh, &nkh);
+        names = kh ? id : gid; /* (no hull: the points are back in their order) */
+    }
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
     if (st != PDT_OK)
         return pdt_err_set(err, st, "rank %d: local kernel failed (%s)", s->rank,
@@ -242,6 +254,7 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
     size_t nh = nkh;
     int deg = 0;
     if (!kh) {
+        const uint32_t *saved = tr ? tr->gid : NULL;
         if (tr) tr->gid = gid;
         st = pdt_hull_chain(pts, m, h, &nh, &deg, PDT_STACK_LOWER, PDT_STACK_UPPER, tr);
         if (tr) tr->gid = saved;
@@ -252,7 +265,8 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
         free(kh);
         return nomem(err, s->rank, "hull");
     }
-    for (size_t i = 0; i < nh; i++) s->hull[i] = (srm_pt){pts[h[i]].x, pts[h[i]].y, gid[h[i]]};
+    for (size_t i = 0; i < nh; i++)
+        s->hull[i] = (srm_pt){pts[h[i]].x, pts[h[i]].y, names[h[i]]};
     free(kh);
     s->nhull = nh;
     s->hull_degenerate = deg;
@@ -270,19 +284,19 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
     srm_slab slab; /* most triangles are settled by the cheap slab test */
     pdt_srm_slab_of(&slab, s->strip, s->p, s->rank);
     size_t k = 0;
-    enum { AHEAD = 16 }; /* the kernel's triangles are in its (leaf) order, the
-                          * points in lexicographic order: fetch ahead */
+    enum { AHEAD = 16 }; /* the triangles are in the kernel's (leaf) order:
+                          * fetch ahead (traced: the points in their own) */
     for (size_t i = 0; i < ntri; i++) {
         if (i + AHEAD < ntri)
             for (int e = 0; e < 3; e++) {
                 uint32_t j = tris[i + AHEAD].v[e];
                 __builtin_prefetch(&pts[j]);
-                __builtin_prefetch(&gid[j]);
+                __builtin_prefetch(&names[j]);
             }
         srm_pt v[3];
         for (int e = 0; e < 3; e++) {
             uint32_t j = tris[i].v[e];
-            v[e] = (srm_pt){pts[j].x, pts[j].y, gid[j]};
+            v[e] = (srm_pt){pts[j].x, pts[j].y, names[j]};
         }
         int who;
         int lev = alone || srm_disk_in_slab(&slab, v[0], v[1], v[2])

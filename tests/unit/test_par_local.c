@@ -133,9 +133,75 @@ TEST(kernel_hull_is_chain_hull)
     CHECK(degenerate > 0 && degenerate < runs);
 }
 
+/* The strip kernel (the points left in the kernel's order) against
+ * pdt_delaunay_hull_on on the same points: named through the permuted
+ * names, the same triangles in the same order and the same hull; every
+ * point still called by its own name; with no hull (degenerate sets), the
+ * points and names back as they were.  Names are a scramble of the
+ * indices, as a strip's global indices are. */
+TEST(strip_kernel_same_as_hull_on)
+{
+    int runs = 0, degenerate = 0;
+    for (const char *const *k = pdt_gen_kinds(); *k; k++) {
+        static const size_t ns[] = {0, 1, 2, 3, 4, 5, 9, 100, 2500, 20000};
+        for (size_t ni = 0; ni < sizeof ns / sizeof *ns; ni++) {
+            pdt_point *pts = NULL;
+            pdt_err err;
+            pdt_err_clear(&err);
+            if (pdt_gen(*k, ns[ni], 13 + ni, &pts, &err) != PDT_OK) {
+                CHECK_MSG(0, "gen %s: %s", *k, err.msg);
+                continue;
+            }
+            size_t n = sort_distinct(pts, ns[ni]);
+            pdt_point *orig = malloc((n + 1) * sizeof *orig);
+            uint32_t *id = malloc((n + 1) * sizeof *id), *name = malloc((n + 1) * sizeof *name);
+            uint32_t *name0 = malloc((n + 1) * sizeof *name0);
+            for (size_t i = 0; i < n; i++) name0[i] = name[i] = (uint32_t)(i * 2654435761u);
+            if (n) memcpy(orig, pts, n * sizeof *pts);
+            size_t wb = PDT_DELAUNAY_WORK(n), nref = 0, nt = 0, nrh = 0, nkh = 0;
+            pdt_tri *ref = malloc(wb), *t = malloc(wb);
+            uint32_t *rh = NULL, *kh = NULL;
+            CHECK(pdt_delaunay_hull_on(pts, n, id, ref, wb, &nref, &rh, &nrh, 0, NULL) == PDT_OK);
+            CHECK(pdt_delaunay_strip(pts, n, name, t, wb, &nt, &kh, &nkh) == PDT_OK);
+            int same = nt == nref && nkh == nrh;
+            for (size_t i = 0; same && i < nt; i++)
+                for (int e = 0; e < 3; e++)
+                    same &= name[t[i].v[e]] == name0[ref[i].v[e]];
+            for (size_t i = 0; same && i < nkh; i++) same &= name[kh[i]] == name0[rh[i]];
+            CHECK_MSG(same, "%s n=%zu: %zu triangles and %zu hull vertices, expected %zu and %zu",
+                      *k, n, nt, nkh, nref, nrh);
+            int named = 1; /* pts[v] is still called name[v] */
+            for (size_t v = 0; v < n; v++) {
+                size_t j = (size_t)(name[v] * 244002641u); /* the inverse of the scramble */
+                named &= j < n && pts[v].x == orig[j].x && pts[v].y == orig[j].y;
+            }
+            CHECK_MSG(named, "%s n=%zu: a point lost its name", *k, n);
+            if (!kh) {
+                degenerate++;
+                CHECK_MSG(nt == 0 && (n == 0 || (memcmp(pts, orig, n * sizeof *pts) == 0 &&
+                                                 memcmp(name, name0, n * sizeof *name) == 0)),
+                          "%s n=%zu: no hull, and not given back in order", *k, n);
+            }
+            runs++;
+            free(orig);
+            free(id);
+            free(name);
+            free(name0);
+            free(ref);
+            free(t);
+            free(rh);
+            free(kh);
+            free(pts);
+        }
+    }
+    printf("# %d sets, %d of them without a hull\n", runs, degenerate);
+    CHECK(degenerate > 0 && degenerate < runs);
+}
+
 int main(void)
 {
     RUN(delaunay_on_equals_delaunay);
     RUN(kernel_hull_is_chain_hull);
+    RUN(strip_kernel_same_as_hull_on);
     return test_summary();
 }
