@@ -352,7 +352,7 @@ static const char *const srm_code[] = {
     "8    B = border set; lift(B); T_B = DT(B)",
     "9    keep crossing or shipped; discard rest",
     "10   H = merge hulls; reclassify kept",
-    "11 sort, send by index range, merge, write",
+    "11 count by index range, send, order, write",
 };
 
 static const struct {
