@@ -195,17 +195,18 @@ void pdt_srm_free(srm_rank *s)
 
 /* ---- Phases 1 and 2 ----------------------------------------------------------- */
 
-pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_t *gid,
-                         uint32_t *id, size_t m, pdt_err *err)
+/* A strip's points during the local phase: pts[j] is called name[j] (its
+ * global index); ntri triangles at the block's front name positions j. */
+typedef struct strip_pts {
+    pdt_point *pts;
+    const uint32_t *name;
+    size_t m, ntri;
+} strip_pts;
+
+/* The lift-up, as events only (the kernel lifts on the fly). */
+static void lift_up(srm_rank *s, const pdt_point *pts, const uint32_t *gid, size_t m)
 {
     pdt_trace *tr = s->tr;
-    double t0 = now(s), c0 = cpu_now();
-    pdt_tri *tris = block;
-    free(s->fin); /* (none: the local phase comes first) */
-    s->fin = tris; /* the block is this rank's from here on */
-    s->nfin = 0;
-    s->capfin = PDT_DELAUNAY_WORK(m) / sizeof *tris;
-    /* lift-up */
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_LIFT, 0, 0, 0, 0);
     if (PDT_TRACING(tr, 1))
         for (size_t i = 0; i < m; i++) {
@@ -214,41 +215,49 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
             PDT_TRACE(tr, 1, PDT_EV_LIFT, 0, gid[i], 0, 0, (int64_t)z);
         }
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_LIFT, 0, 0, 0, 0);
+}
 
-    /* local kernel, in the block, on the strip's own points (no copy).
-     * Traced: the points are put back in their order afterwards, named
-     * gid[j], and the strip hull is the chain's (its events are part of the
-     * lesson).  Untraced: the points stay in the kernel's order, named id[v]
-     * (the global indices moved along with them), the triangles come out in
-     * that order (read below with the points near each other in memory),
-     * and the strip hull is the triangulation's outer face. */
-    int traced = PDT_TRACING(tr, 1);
-    const uint32_t *names = gid;
-    uint32_t *kh = NULL;
-    size_t nkh = 0;
-    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_KERNEL, 0, 0, 0, 0);
-    size_t ntri = 0;
+/* The local kernel, in the block, on the strip's own points (no copy).
+ * Traced: the points are put back in their order afterwards, named gid[j],
+ * and *kh = NULL (the chain makes the strip hull: its events are part of the
+ * lesson).  Untraced: the points stay in the kernel's order, named id[v]
+ * (the global indices moved along with them), the triangles come out in that
+ * order (read by the classification with the points near each other in
+ * memory), and *kh is the triangulation's outer face (NULL for a degenerate
+ * strip, whose points are then back in their order). */
+static pdt_status local_kernel(srm_rank *s, void *block, const uint32_t *gid, uint32_t *id,
+                               strip_pts *sp, uint32_t **kh, size_t *nkh, pdt_err *err)
+{
+    pdt_trace *tr = s->tr;
+    size_t m = sp->m;
     pdt_status st;
-    if (traced) {
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_KERNEL, 0, 0, 0, 0);
+    if (PDT_TRACING(tr, 1)) {
         const uint32_t *saved = tr->gid;
         tr->gid = gid;
-        st = pdt_delaunay_hull_on(pts, m, id, block, PDT_DELAUNAY_WORK(m), &ntri, NULL, NULL, 0,
-                                  tr);
+        st = pdt_delaunay_hull_on(sp->pts, m, id, block, PDT_DELAUNAY_WORK(m), &sp->ntri, NULL,
+                                  NULL, 0, tr);
         tr->gid = saved;
     } else {
         memcpy(id, gid, m * sizeof *id);
-        st = pdt_delaunay_strip(pts, m, id, block, PDT_DELAUNAY_WORK(m), &ntri, &kh, &nkh);
-        names = kh ? id : gid; /* (no hull: the points are back in their order) */
+        st = pdt_delaunay_strip(sp->pts, m, id, block, PDT_DELAUNAY_WORK(m), &sp->ntri, kh, nkh);
+        sp->name = *kh ? id : gid;
     }
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
     if (st != PDT_OK)
         return pdt_err_set(err, st, "rank %d: local kernel failed (%s)", s->rank,
                            pdt_status_str(st));
-    s->cnt.local_tris = ntri;
+    s->cnt.local_tris = sp->ntri;
+    return PDT_OK;
+}
 
-    /* strip hull: monotone chain (Graham's scan with the origin at infinity),
-     * its stack in the kernel's id scratch -- traced, or when the kernel gave
-     * none (a degenerate strip: the chain says how) */
+/* The strip hull into s->hull: the kernel's (kh, freed here), or the
+ * monotone chain's (Graham's scan with the origin at infinity, its stack in
+ * the kernel's id scratch) when traced or degenerate (the chain says how). */
+static pdt_status strip_hull(srm_rank *s, const strip_pts *sp, const uint32_t *gid, uint32_t *id,
+                             uint32_t *kh, size_t nkh, pdt_err *err)
+{
+    pdt_trace *tr = s->tr;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_HULL, 0, 0, 0, 0);
     uint32_t *h = kh ? kh : id;
     size_t nh = nkh;
@@ -256,7 +265,8 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
     if (!kh) {
         const uint32_t *saved = tr ? tr->gid : NULL;
         if (tr) tr->gid = gid;
-        st = pdt_hull_chain(pts, m, h, &nh, &deg, PDT_STACK_LOWER, PDT_STACK_UPPER, tr);
+        pdt_status st = pdt_hull_chain(sp->pts, sp->m, h, &nh, &deg, PDT_STACK_LOWER,
+                                       PDT_STACK_UPPER, tr);
         if (tr) tr->gid = saved;
         if (st != PDT_OK) return pdt_err_set(err, st, "rank %d: strip hull failed", s->rank);
     }
@@ -266,19 +276,26 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
         return nomem(err, s->rank, "hull");
     }
     for (size_t i = 0; i < nh; i++)
-        s->hull[i] = (srm_pt){pts[h[i]].x, pts[h[i]].y, names[h[i]]};
+        s->hull[i] = (srm_pt){sp->pts[h[i]].x, sp->pts[h[i]].y, sp->name[h[i]]};
     free(kh);
     s->nhull = nh;
     s->hull_degenerate = deg;
     s->holds_hull = 1;
     PDT_TRACE(tr, 1, PDT_EV_HULL, 0, nh, deg, 0, 0);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_HULL, 0, 0, 0, 0);
+    return PDT_OK;
+}
 
-    /* classification: final at once, or deferred until a merge level (with
-     * no other strip at all, everything is final without a test).  The
-     * final triangles stay in the kernel's array, renamed to global indices
-     * and moved down over the deferred ones (k <= i): s->fin, no second
-     * array */
+/* Classification: final at once, or deferred until a merge level (with no
+ * other strip at all, everything is final without a test).  The final
+ * triangles stay in the kernel's array, renamed to global indices and moved
+ * down over the deferred ones (k <= i): s->fin, no second array. */
+static pdt_status classify(srm_rank *s, pdt_tri *tris, const strip_pts *sp, pdt_err *err)
+{
+    pdt_trace *tr = s->tr;
+    const pdt_point *pts = sp->pts;
+    const uint32_t *name = sp->name;
+    size_t ntri = sp->ntri;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_CLASSIFY, 0, 0, 0, 0);
     int alone = s->nne == 0 || (s->nne == 1 && s->nonempty[0] == s->rank);
     srm_slab slab; /* most triangles are settled by the cheap slab test */
@@ -291,12 +308,12 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
             for (int e = 0; e < 3; e++) {
                 uint32_t j = tris[i + AHEAD].v[e];
                 __builtin_prefetch(&pts[j]);
-                __builtin_prefetch(&names[j]);
+                __builtin_prefetch(&name[j]);
             }
         srm_pt v[3];
         for (int e = 0; e < 3; e++) {
             uint32_t j = tris[i].v[e];
-            v[e] = (srm_pt){pts[j].x, pts[j].y, names[j]};
+            v[e] = (srm_pt){pts[j].x, pts[j].y, name[j]};
         }
         int who;
         int lev = alone || srm_disk_in_slab(&slab, v[0], v[1], v[2])
@@ -315,9 +332,27 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
     s->cnt.final_at_once = k;
     s->nfin = k;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_CLASSIFY, 0, 0, 0, 0);
+    return PDT_OK;
+}
+
+pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_t *gid,
+                         uint32_t *id, size_t m, pdt_err *err)
+{
+    double t0 = now(s), c0 = cpu_now();
+    free(s->fin); /* (none: the local phase comes first) */
+    s->fin = block; /* the block is this rank's from here on */
+    s->nfin = 0;
+    s->capfin = PDT_DELAUNAY_WORK(m) / sizeof *s->fin;
+    strip_pts sp = {pts, gid, m, 0};
+    uint32_t *kh = NULL;
+    size_t nkh = 0;
+    lift_up(s, pts, gid, m);
+    pdt_status st = local_kernel(s, block, gid, id, &sp, &kh, &nkh, err);
+    if (st == PDT_OK) st = strip_hull(s, &sp, gid, id, kh, nkh, err);
+    if (st == PDT_OK) st = classify(s, s->fin, &sp, err);
     s->cnt.critical_path += now(s) - t0;
     s->cnt.critical_cpu += cpu_now() - c0;
-    return PDT_OK;
+    return st;
 }
 
 /* ---- messages ------------------------------------------------------------------ */
