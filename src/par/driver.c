@@ -568,11 +568,22 @@ static void order_room_free(order_room *o)
     if (o->out_own) free(o->out);
 }
 
+/* PDT_TEST_ORDER_ROOM=N: the order phase sees at most N triangles of room
+ * in the block (tests: every choice of room below runs on small inputs). */
+static size_t test_order_room(size_t cap)
+{
+    const char *e = getenv("PDT_TEST_ORDER_ROOM");
+    char *end;
+    unsigned long long v = e && *e ? strtoull(e, &end, 10) : 0;
+    return e && *e && !*end && v < cap ? (size_t)v : cap;
+}
+
 static pdt_status order_room_grp(drv *d, order_room *o, const finals *f)
 {
     size_t mine = f->n[0] + f->n[1];
     o->blk = d->s.fin;
-    o->cap = o->blk ? d->blk_bytes / sizeof(pdt_tri) : 0; /* the strip's points are not needed */
+    o->cap = o->blk ? test_order_room(d->blk_bytes / sizeof(pdt_tri)) : 0; /* (the strip's
+                                                                              points are done) */
     if (o->blk && f->n[0] + mine <= o->cap) {
         o->grp = o->blk + f->n[0];
         return PDT_OK;
