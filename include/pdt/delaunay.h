@@ -66,9 +66,10 @@ void pdt_tri_canonical(pdt_tri *tris, size_t ntri);
  * frees: counter-clockwise from the lexicographically smallest point, the
  * collinear boundary points included) name positions in that order: vertex
  * v is pts[v], called name[v].  The same triangles, in the same order and
- * orientation, and the same hull as pdt_delaunay_hull_on's, named so.  When there is no hull (the points on a line, or
- * n < 3), no triangle, *hull = NULL, and pts and name are given back in
- * their first order.  PDT_ERR_ARG for unsorted points or too small a work. */
+ * orientation, and the same hull as pdt_delaunay_hull_on's, named so.  When
+ * there is no hull (the points on a line, or n < 3): no triangle, *hull =
+ * NULL, and pts and name given back in their first order.  PDT_ERR_ARG for
+ * unsorted points or too small a work. */
 pdt_status pdt_delaunay_strip(pdt_point *pts, size_t n, uint32_t *name, void *work,
                               size_t work_bytes, size_t *ntri, uint32_t **hull, size_t *nhull);
 

@@ -655,6 +655,16 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
     return PDT_OK;
 }
 
+/* The contract of the kernels on the caller's memory: not too many points,
+ * work_bytes >= PDT_DELAUNAY_WORK(n), the points distinct and sorted. */
+static int on_args_ok(const pdt_point *pts, size_t n, size_t work_bytes)
+{
+    if (n > PDT_KERNEL_MAX_POINTS || work_bytes < PDT_DELAUNAY_WORK(n)) return 0;
+    for (size_t i = 1; i < n; i++)
+        if (pdt_key(pts[i - 1]) >= pdt_key(pts[i])) return 0;
+    return 1;
+}
+
 /* The kernel on the caller's memory, with no copy of the points: they are
  * the kernel's (leaf-order) array during the call and are put back from
  * id afterwards, through scratch in work beyond the triangles (8 bytes per
@@ -669,9 +679,7 @@ pdt_status pdt_delaunay_hull_on(pdt_point *pts, size_t n, uint32_t *id, void *wo
         *nhull = 0;
     }
     if (n < 2) return PDT_OK;
-    if (n > PDT_KERNEL_MAX_POINTS || work_bytes < PDT_DELAUNAY_WORK(n)) return PDT_ERR_ARG;
-    for (size_t i = 1; i < n; i++) /* the precondition: distinct and sorted */
-        if (pdt_key(pts[i - 1]) >= pdt_key(pts[i])) return PDT_ERR_ARG;
+    if (!on_args_ok(pts, n, work_bytes)) return PDT_ERR_ARG;
     for (uint32_t i = 0; i < (uint32_t)n; i++) id[i] = i;
     size_t nt = 0;
     pdt_status s = kernel_on(id, pts, n, (edge *)work, edge_cap(n), &nt, run, tr, hull, nhull, 0);
@@ -718,9 +726,7 @@ pdt_status pdt_delaunay_strip(pdt_point *pts, size_t n, uint32_t *name, void *wo
     *hull = NULL;
     *nhull = 0;
     if (n < 2) return PDT_OK;
-    if (n > PDT_KERNEL_MAX_POINTS || work_bytes < PDT_DELAUNAY_WORK(n)) return PDT_ERR_ARG;
-    for (size_t i = 1; i < n; i++) /* the precondition: distinct and sorted */
-        if (pdt_key(pts[i - 1]) >= pdt_key(pts[i])) return PDT_ERR_ARG;
+    if (!on_args_ok(pts, n, work_bytes)) return PDT_ERR_ARG;
     size_t nt = 0;
     pdt_status s = kernel_on(name, pts, n, (edge *)work, edge_cap(n), &nt, 0, NULL, hull, nhull, 1);
     if (s == PDT_OK && *hull && nt > 0) {
@@ -925,14 +931,17 @@ pdt_status pdt_tri_bucket_order(const pdt_tri *const *src, const size_t *len, si
     pdt_status st = lc && at && sl && seg ? PDT_OK : PDT_ERR_NOMEM;
     while (st == PDT_OK) {
         uint64_t b = UINT64_MAX;
-        for (size_t k = 0; k < ns; k++)
-            if (at[k] < len[k] && (src[k][at[k]].v[0] >> shift) < b) b = src[k][at[k]].v[0] >> shift;
+        for (size_t k = 0; k < ns; k++) {
+            uint64_t head = at[k] < len[k] ? src[k][at[k]].v[0] >> shift : UINT64_MAX;
+            b = head < b ? head : b;
+        }
         if (b == UINT64_MAX) break;
         uint32_t base = (uint32_t)(b << shift);
         memset(lc, 0, (nlo + 1) * sizeof *lc);
         for (size_t k = 0; k < ns; k++) {
             size_t e = at[k];
-            for (; e < len[k] && (src[k][e].v[0] >> shift) == b; e++) lc[src[k][e].v[0] - base + 1]++;
+            for (; e < len[k] && (src[k][e].v[0] >> shift) == b; e++)
+                lc[src[k][e].v[0] - base + 1]++;
             seg[k] = src[k] + at[k];
             sl[k] = e - at[k];
             at[k] = e;

@@ -365,8 +365,9 @@ TEST(bucket_order_is_canonical)
                     CHECK(pdt_tri_bucket_order(src, len, ns, shift, o) == PDT_OK);
                     o += got;
                 }
-                CHECK_MSG((size_t)(o - out) == n && (n == 0 || memcmp(out, ref, n * sizeof *ref) == 0),
-                          "n = %zu, shift %d, %zu ranks: order differs", n, shift, ns);
+                int same = (size_t)(o - out) == n &&
+                           (n == 0 || memcmp(out, ref, n * sizeof *ref) == 0);
+                CHECK_MSG(same, "n = %zu, shift %d, %zu ranks: order differs", n, shift, ns);
                 free(ref);
                 free(all);
                 free(grp);
