@@ -14,13 +14,18 @@
  * int displacement is ever needed. */
 #include "comm_int.h"
 
+#include <arpa/inet.h>
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
 #include <mpi.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -65,6 +70,39 @@ static void one_node_defaults(void)
     setenv("OMPI_MCA_pml", "ob1", 0);
 }
 
+/* The connection to the node's launcher daemon (PMIx over TCP on the
+ * loopback with Open MPI 4.1) without Nagle's algorithm.  MPI_Finalize ends
+ * with a fence through the daemon; its small request waited for the
+ * daemon's delayed acknowledgement of the previous message: 45 ms of every
+ * run (2 ms of CPU), 3 ms with TCP_NODELAY on our end (a 10-line MPI program,
+ * 2 ranks, medians of 3, both ways, 26 Nov 2026).  Our sockets are
+ * PMIx's, made inside MPI_Init: every TCP socket of this process connected
+ * to a loopback address gets the option; nothing else is touched, and a
+ * failure changes nothing but the delay. */
+static void launcher_nodelay(void)
+{
+    DIR *dir = opendir("/proc/self/fd");
+    if (!dir) return;
+    for (struct dirent *e; (e = readdir(dir)) != NULL;) {
+        char *end;
+        long fd = strtol(e->d_name, &end, 10);
+        if (*end || fd < 0 || fd == dirfd(dir)) continue;
+        struct sockaddr_storage peer;
+        socklen_t len = sizeof peer;
+        int type = 0, one = 1;
+        socklen_t tlen = sizeof type;
+        if (getsockopt((int)fd, SOL_SOCKET, SO_TYPE, &type, &tlen) != 0 || type != SOCK_STREAM ||
+            getpeername((int)fd, (struct sockaddr *)&peer, &len) != 0)
+            continue;
+        int loop = (peer.ss_family == AF_INET &&
+                    (ntohl(((struct sockaddr_in *)&peer)->sin_addr.s_addr) >> 24) == 127) ||
+                   (peer.ss_family == AF_INET6 &&
+                    IN6_IS_ADDR_LOOPBACK(&((struct sockaddr_in6 *)&peer)->sin6_addr));
+        if (loop) (void)setsockopt((int)fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    }
+    closedir(dir);
+}
+
 pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out, pdt_err *err)
 {
     *out = NULL;
@@ -89,6 +127,7 @@ pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out,
         free(c);
         return pdt_err_set(err, PDT_ERR_MPI, "MPI_Init failed (code %d)", rc);
     }
+    launcher_nodelay();
     /* From here on errors come back as codes instead of aborting. */
     pdt_status s = mpi_check(MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN),
                              "MPI_Comm_set_errhandler", c, err);
