@@ -1157,26 +1157,42 @@ static void pipe_stop(evpipe *p)
     p->started = 0;
 }
 
-/* The state at every r->ick_every-th cursor, stepped forwards from 0,
- * written at off one after the other (r->nick of them), each holding the
- * triangles born before its cursor; sets r->ick_off and r->ick_born. */
+static int read_all(int fd, uint64_t at, void *p, size_t bytes);
+
+static int fd_get(void *ctx, uint64_t at, void *p, size_t bytes)
+{
+    return read_all(*(const int *)ctx, at, p, bytes);
+}
+
+/* The state at every r->ick_every-th cursor, stepped forwards from 0 (the
+ * streamed replay's tables read back from fd), written at off one after
+ * the other (r->nick of them), each holding the triangles born before its
+ * cursor; sets r->ick_off and r->ick_born.  Memory: one state. */
 static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
 {
+    static const uint8_t zeros[8];
     r->ick_off[0] = 0;
     if (!r->nick) return 1;
     pdt_rstate *s = pdt_rstate_new(r);
-    uint8_t *blob = malloc(pdt_rstate_blob_bytes(r, r->ntri));
-    int ok = s && blob;
+    pdt_fwd *fw = pdt_fwd_new(r, fd_get, &fd);
+    int ok = s && fw;
     for (size_t c = 0; ok && c < r->nick; c++) {
-        while (s->k < c * r->ick_every) pdt_replay_step(r, s, 1);
+        ok = pdt_fwd_to(fw, s, c * r->ick_every);
         size_t born = pdt_rstate_born(r, s), bytes = pdt_rstate_blob_bytes(r, born);
-        pdt_rstate_to_blob(r, s, born, blob);
-        ok = write_all(fd, blob, bytes, off + r->ick_off[c]);
-        crc_feed(crc, blob, bytes);
+        const void *part[5];
+        size_t len[5], pad[5];
+        uint64_t at = off + r->ick_off[c];
+        pdt_rstate_blob_parts(r, s, born, part, len, pad);
+        for (int j = 0; ok && j < 5; j++) {
+            ok = write_all(fd, part[j], len[j], at) && write_all(fd, zeros, pad[j], at + len[j]);
+            crc_feed(crc, part[j], len[j]);
+            crc_feed(crc, zeros, pad[j]);
+            at += len[j] + pad[j];
+        }
         r->ick_born[c] = born;
         r->ick_off[c + 1] = r->ick_off[c] + bytes;
     }
-    free(blob);
+    pdt_fwd_free(fw);
     pdt_rstate_free(s);
     return ok;
 }
@@ -1192,7 +1208,9 @@ typedef struct placer {
     struct evpipe *pipe; /* (first: the stream's context is the placer's) */
     int fd;
     uint64_t off;  /* where the next table goes */
-    int sfd;       /* the spill */
+    int sfd[PDT_SCR_COUNT];  /* the scratch files (-1: not made yet, or dropped) */
+    const char *near;        /* made in the folder of this path */
+    pthread_mutex_t mu;      /* (the grouping's threads make them) */
 } placer;
 
 static uint64_t place_reserve(void *ctx, uint64_t bytes)
@@ -1226,14 +1244,34 @@ static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
     return read_all(((placer *)ctx)->fd, at, p, bytes);
 }
 
-static int spill_put(void *ctx, uint64_t at, const void *p, size_t bytes)
+static int open_spill(const char *path);
+
+static int scratch_put(void *ctx, int file, uint64_t at, const void *p, size_t bytes)
 {
-    return write_all(((placer *)ctx)->sfd, p, bytes, at);
+    placer *pc = ctx;
+    if (file < 0 || file >= PDT_SCR_COUNT) return 0;
+    pthread_mutex_lock(&pc->mu);
+    if (pc->sfd[file] < 0) pc->sfd[file] = open_spill(pc->near);
+    int fd = pc->sfd[file];
+    pthread_mutex_unlock(&pc->mu);
+    return fd >= 0 && write_all(fd, p, bytes, at);
 }
 
-static int spill_get(void *ctx, uint64_t at, void *p, size_t bytes)
+static int scratch_get(void *ctx, int file, uint64_t at, void *p, size_t bytes)
 {
-    return read_all(((placer *)ctx)->sfd, at, p, bytes);
+    placer *pc = ctx;
+    if (file < 0 || file >= PDT_SCR_COUNT || pc->sfd[file] < 0) return 0;
+    return read_all(pc->sfd[file], at, p, bytes);
+}
+
+/* A scratch file done with: closed (unnamed: its pages go with it, mostly
+ * before they were written back). */
+static void scratch_drop(void *ctx, int file)
+{
+    placer *pc = ctx;
+    if (file < 0 || file >= PDT_SCR_COUNT || pc->sfd[file] < 0) return;
+    close(pc->sfd[file]);
+    pc->sfd[file] = -1;
 }
 
 /* An unnamed scratch file in the folder of `path` (O_TMPFILE; where the file
@@ -1272,6 +1310,19 @@ static void *ck_worker(void *arg)
     return NULL;
 }
 
+/* 1 if section i of a streamed replay was written by the build (at *at). */
+static int streamed_sec(const pdt_replay *r, int i, uint64_t *at)
+{
+    if (!r->streamed) return 0;
+    switch (i) {
+    case S_TRIS: *at = r->tris_at; return 1;
+    case S_HIST: *at = r->hist_at; return 1;
+    case S_EVOBJ: *at = r->evobj_at; return 1;
+    case S_EVKIND: *at = r->evkind_at; return 1;
+    default: return 0;
+    }
+}
+
 static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
                                evcopy *ec, pdt_err *err)
 {
@@ -1285,8 +1336,9 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     for (int i = 0; i < NSEC; i++) {
         h->count[i] = count[i];
         if (i == S_SEGS || i == S_CKPT) continue; /* (S_SEGS: written first, stream_next) */
-        if (r->streamed && (i == S_TRIS || i == S_HIST)) {
-            h->sec[i] = (isec){i == S_TRIS ? r->tris_at : r->hist_at, count[i] * elem[i], 0, 0};
+        uint64_t at;
+        if (streamed_sec(r, i, &at)) {
+            h->sec[i] = (isec){at, count[i] * elem[i], 0, 0};
             continue;
         }
         off = (off + 63) & ~(uint64_t)63;
@@ -1299,7 +1351,8 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     int threaded = pthread_create(&th, NULL, ck_worker, &ck) == 0;
     int wrote = 1;
     for (int i = 0; wrote && i < NSEC; i++) {
-        if (i == S_SEGS || i == S_CKPT || (r->streamed && (i == S_TRIS || i == S_HIST))) continue;
+        uint64_t at;
+        if (i == S_SEGS || i == S_CKPT || streamed_sec(r, i, &at)) continue;
         if (h->sec[i].bytes) wrote = write_all(fd, *ptr[i], (size_t)h->sec[i].bytes, h->sec[i].off);
     }
     if (threaded) pthread_join(th, NULL);
@@ -1322,12 +1375,12 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     uint8_t *todo = calloc(n ? n : 1, 1);
     int have = tab && todo;
     for (int i = 0; have && i < NSEC; i++) {
-        uint64_t nc = chunks_of(h->sec[i].bytes);
+        uint64_t nc = chunks_of(h->sec[i].bytes), at;
         if (i == S_SEGS) {
             have = crc_done(&ec->segs_crc, h->sec[i].bytes, tab + first[i]);
         } else if (i == S_CKPT) {
             have = crc_done(&ck_crc, h->sec[i].bytes, tab + first[i]);
-        } else if (r->streamed && (i == S_TRIS || i == S_HIST)) {
+        } else if (streamed_sec(r, i, &at)) {
             memset(todo + first[i], 1, nc);
         } else {
             const char *p = *ptr[i];
@@ -1412,7 +1465,7 @@ static void clean_stale_temps(const char *path)
 
 /* Build the index of run at `path` (temporary file + rename). */
 static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks, uint64_t ident,
-                        const char *path, uint64_t budget, pdt_err *err)
+                        const char *path, uint64_t budget, uint64_t *work, pdt_err *err)
 {
     char tmp[PATH_MAX + 128];
     clean_stale_temps(path);
@@ -1436,7 +1489,8 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     es.buf = malloc(SEG_BATCH * sizeof *es.buf);
     evpipe pipe;
     memset(&pipe, 0, sizeof pipe);
-    placer pc = {&pipe, fd, 0, -1};
+    placer pc = {&pipe, fd, 0, {0}, tmp, PTHREAD_MUTEX_INITIALIZER};
+    for (int k = 0; k < PDT_SCR_COUNT; k++) pc.sfd[k] = -1;
     pdt_status st = h && es.buf ? block_table(run, &ec, err)
                                 : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     if (st == PDT_OK) st = pdt_merge_open(run, &es.mg, err);
@@ -1446,21 +1500,22 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         es.ec = &ec;
         es.at = es.off = HDR_BYTES;
         es.place_off = &pc.off;
-        if ((pc.sfd = open_spill(tmp)) < 0)
+        if ((pc.sfd[PDT_SCR_SPILL] = open_spill(tmp)) < 0)
             st = pdt_err_set(err, PDT_ERR_IO, "%s: a scratch file beside it: %s", tmp, strerror(errno));
     }
     if (st == PDT_OK && !pipe_start(&pipe, &es, err)) st = err->code;
-    pdt_replay_place pl = {place_reserve, place_put, place_get, spill_put, spill_get,
-                           &pc,           budget,    stream_next, &ec.src};
+    pdt_replay_place pl = {place_reserve, place_put,    place_get, scratch_put, scratch_get,
+                           scratch_drop,  &pc,          budget,    stream_next, &ec.src};
     if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
     pipe_stop(&pipe);
-    if (pc.sfd >= 0) close(pc.sfd);  /* the spill, grouped: gone */
+    for (int k = 0; k < PDT_SCR_COUNT; k++) scratch_drop(&pc, k);  /* the scratch: gone */
     if (st == PDT_OK) {
         r->warnings = pdt_run_warnings(run);
         size_t every = r->m / ICK_PARTS;
         r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
         r->nick = r->m / r->ick_every + 1;
         st = write_tables(r, fd, h, ident, &pc, &ec, err);
+        *work = r->build_peak + pdt_replay_state_bytes(r);  /* (the checkpoints' state) */
         r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
     }
     pdt_replay_free(r);
@@ -1581,7 +1636,7 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
                 if (!cache_dir(cdir, sizeof cdir) || !make_dirs(cdir)) continue;
             }
             pdt_err e2 = {0};
-            if (build(run, pts, n, nranks, ident, path, budget, &e2) != PDT_OK) {
+            if (build(run, pts, n, nranks, ident, path, budget, &info->build_bytes, &e2) != PDT_OK) {
                 snprintf(info->write_error, sizeof info->write_error, "%s", e2.msg);
                 pdt_err_clear(&e2);
                 continue;

@@ -823,6 +823,9 @@ int main(int argc, char **argv)
         if (info.indexed)
             printf("kept index %s: %s%s%s\n", info.path,
                    info.built ? "built at this opening" : "mapped", *info.why ? "; " : "", info.why);
+        if (info.built)
+            printf("index build: working memory %.1f MiB (budget %.1f MiB)\n",
+                   (double)info.build_bytes / 1048576.0, (double)o.mem / 1048576.0);
         else
             printf("in memory (no kept index)%s%s\n", *info.write_error ? ": " : "", info.write_error);
     } else if (!o.quiet && info.built && *info.why && strcmp(info.why, "no index yet")) {
