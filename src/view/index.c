@@ -1319,6 +1319,7 @@ static int streamed_sec(const pdt_replay *r, int i, uint64_t *at)
     case S_HIST: *at = r->hist_at; return 1;
     case S_EVOBJ: *at = r->evobj_at; return 1;
     case S_EVKIND: *at = r->evkind_at; return 1;
+    case S_LIFT: *at = r->lift_at; return 1;
     default: return 0;
     }
 }

@@ -223,6 +223,13 @@ size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks)
     return fine_of(s);
 }
 
+/* A chunk of a spill: where, whose (fine bucket, or window of points), how
+ * many records. */
+typedef struct spill_chunk {
+    uint64_t off;      /* in the spill */
+    uint32_t f, n;     /* fine bucket, records */
+} spill_chunk;
+
 /* Build state while indexing: the current slot values of every rank. */
 typedef struct builder {
     pdt_replay *r;
@@ -250,6 +257,14 @@ typedef struct builder {
     uint8_t *wkind;
     size_t wlo;
     size_t *tcount;       /* streamed: triangles per fine bucket (NFINE) */
+    /* streamed: what lifts and pushes do to points (pt_rec), spilled by
+     * point window (PT_WINDOW points each) to PDT_SCR_POINTS in chunks */
+    struct pt_rec *pbuf;  /* npw * PBUF records */
+    uint32_t *pbn;
+    size_t npw;
+    struct spill_chunk *pchunk;
+    size_t npchunk, cap_pchunk;
+    uint64_t pspill_end;
     _Atomic uint64_t held, peak;  /* streamed: working memory (bytes) */
 } builder;
 
@@ -275,6 +290,44 @@ static void bfree(builder *b, void *p, size_t bytes)
 
 static void set_obj(builder *b, size_t i, int32_t v) { b->wobj[i - b->wlo] = v; }
 
+/* ---- points: first lifts and the ranks' boxes, streamed ---------------------------
+ *
+ * A streamed build holds no table per point of its own: a lift and a push
+ * that counts for its rank's box are written down (pt_rec) by window of
+ * points, and after pass 1 each window's records give its points' first
+ * lifts (the place's lift table, at lift_at) and their share of the boxes
+ * (the points read a window at a time).  A rank's box is the box of the
+ * points it lifted outside a merge, or, when it lifted none, of the points
+ * it pushed: what box_add makes in event order. */
+typedef struct pt_rec {
+    uint32_t p, ev, rank, what;  /* what: PT_PUSH, PT_LIFT (in a merge), PT_LIFT_BOX */
+} pt_rec;
+enum { PT_PUSH, PT_LIFT, PT_LIFT_BOX };
+#define PT_WINDOW ((size_t)1 << 20)  /* points per window */
+#define PBUF 256u                    /* records buffered per window */
+
+static int pt_flush(builder *b, size_t w)
+{
+    size_t k = b->pbn[w];
+    b->pbn[w] = 0;
+    if (!k) return 1;
+    if (!grow((void **)&b->pchunk, &b->cap_pchunk, b->npchunk + 1, sizeof *b->pchunk)) return 0;
+    if (!b->pl->sput(b->pl->ctx, PDT_SCR_POINTS, b->pspill_end, b->pbuf + w * PBUF, k * sizeof(pt_rec))) {
+        b->failed = 1;
+        return 0;
+    }
+    b->pchunk[b->npchunk++] = (spill_chunk){b->pspill_end, (uint32_t)w, (uint32_t)k};
+    b->pspill_end += k * sizeof(pt_rec);
+    return 1;
+}
+
+static int pt_note(builder *b, uint32_t p, uint32_t ev, uint32_t rank, uint32_t what)
+{
+    size_t w = p / PT_WINDOW;
+    b->pbuf[w * PBUF + b->pbn[w]++] = (pt_rec){p, ev, rank, what};
+    return b->pbn[w] < PBUF || pt_flush(b, w);
+}
+
 #define FBUF 1024u  /* records buffered per fine bucket (streamed): a chunk of the spill */
 
 #define WIN 8192u  /* events of the stream at hand (streamed) */
@@ -285,10 +338,6 @@ static void set_obj(builder *b, size_t i, int32_t v) { b->wobj[i - b->wlo] = v; 
  * current one is handled.  A hint only: nothing depends on it. */
 #define PREFETCH_AHEAD 12
 
-typedef struct spill_chunk {
-    uint64_t off;      /* in the spill */
-    uint32_t f, n;     /* fine bucket, records */
-} spill_chunk;
 
 /* A big table of `bytes` (malloc'd, asking for huge pages), or NULL. */
 static void *big_table(size_t bytes)
@@ -487,7 +536,10 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
         if (!grow((void **)&r->nodes, &r->cap_node, r->nnode + 1, sizeof *r->nodes)) return 0;
         r->nodes[r->nnode] = (pdt_rnode){e->a, parent, d, NONE32};
         r->nnode++;
-        if (!lifted_any[rank]) box_add(r, rec->rank, r->pts[e->a]);
+        if (!lifted_any[rank]) {
+            if (b->pl && !pt_note(b, e->a, i, rec->rank, PT_PUSH)) return 0;
+            if (!b->pl) box_add(r, rec->rank, r->pts[e->a]);
+        }
         return set_slot(b, i, rank, slot, (int32_t)(r->nnode - 1));
     }
     case PDT_EV_HULL: {
@@ -520,7 +572,8 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
         uint32_t *first = e->kind == PDT_EV_LIFT ? r->lift_ev
                           : e->kind == PDT_EV_SORT ? r->sort_ev : r->del_ev;
         set_obj(b, i, (int32_t)e->a);
-        if (first[e->a] == NONE32) {
+        if (!first) { /* a streamed build's lift (see pt_rec) */
+        } else if (first[e->a] == NONE32) {
             first[e->a] = i;
             if (e->kind == PDT_EV_SORT) r->sort_pos[e->a] = e->b;
         }
@@ -529,6 +582,10 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
             int in_merge = cur[PDT_SLOT_MERGE] >= 0;
             for (; ph >= 0 && !in_merge; ph = r->phases[ph].parent)
                 if (r->phases[ph].phase == PDT_PH_MERGE) in_merge = 1;
+            if (b->pl) {
+                if (!in_merge) lifted_any[rank] = 1;
+                return pt_note(b, e->a, i, rec->rank, in_merge ? PT_LIFT : PT_LIFT_BOX);
+            }
             if (!in_merge) {
                 if (!lifted_any[rank]) r->has_box[rank] = 0;  /* forget pushed points */
                 lifted_any[rank] = 1;
@@ -625,7 +682,8 @@ static const void *probe_addr(const builder *b, const pdt_rec *rec, const void *
     const pdt_event *e = &rec->ev;
     const pdt_replay *r = b->r;
     *also = NULL;
-    if ((e->kind == PDT_EV_LIFT || (r->sort_ev && (e->kind == PDT_EV_SORT || e->kind == PDT_EV_DELETE))) &&
+    if (((e->kind == PDT_EV_LIFT && r->lift_ev) ||
+         (r->sort_ev && (e->kind == PDT_EV_SORT || e->kind == PDT_EV_DELETE))) &&
         e->a < r->n) {
         if (e->kind == PDT_EV_LIFT) *also = &r->pts[e->a];
         return e->kind == PDT_EV_LIFT ? &r->lift_ev[e->a]
@@ -1199,6 +1257,69 @@ static int ev_tables(builder *b)
     return ok;
 }
 
+/* After pass 1 (streamed): each window of points' records (pt_rec) gives
+ * its first lifts (to lift_at of the place) and its share of the ranks'
+ * boxes (lifted_any: the ranks that lifted a point outside a merge). */
+static int points_pass(builder *b, const uint8_t *lifted_any)
+{
+    pdt_replay *r = b->r;
+    const pdt_replay_place *pl = b->pl;
+    size_t q1 = (size_t)r->nranks;
+    for (size_t w = 0; w < b->npw; w++)
+        if (!pt_flush(b, w)) return 0;
+    /* the chunks by window (each window's in the order written) */
+    size_t *start = calloc(b->npw + 1, sizeof *start);
+    spill_chunk *sorted = malloc((b->npchunk ? b->npchunk : 1) * sizeof *sorted);
+    uint32_t *lift = bmalloc(b, PT_WINDOW * sizeof *lift);
+    pt_rec *rec = bmalloc(b, PBUF * sizeof *rec);
+    pdt_point *lo = malloc(2 * q1 * sizeof *lo), *hi = malloc(2 * q1 * sizeof *hi);
+    uint8_t *has = calloc(2 * q1, 1);  /* [0, q1): pushed points' boxes, [q1, 2 q1): lifted */
+    int ok = start && sorted && lift && rec && lo && hi && has;
+    for (size_t c = 0; ok && c < b->npchunk; c++) start[b->pchunk[c].f + 1]++;
+    for (size_t w = 0; ok && w < b->npw; w++) start[w + 1] += start[w];
+    for (size_t c = 0, *fill = start; ok && c < b->npchunk; c++) { /* (start moves to the ends) */
+        sorted[fill[b->pchunk[c].f]++] = b->pchunk[c];
+    }
+    for (size_t w = 0, c = 0; ok && w < b->npw; w++) {
+        size_t p0 = w * PT_WINDOW, np = r->n - p0 < PT_WINDOW ? r->n - p0 : PT_WINDOW;
+        memset(lift, 0xff, np * sizeof *lift);
+        for (; ok && c < start[w]; c++) { /* (start[w]: the end of window w's chunks) */
+            ok = pl->sget(pl->ctx, PDT_SCR_POINTS, sorted[c].off, rec, sorted[c].n * sizeof *rec);
+            for (size_t j = 0; ok && j < sorted[c].n; j++) {
+                const pt_rec *t = &rec[j];
+                if (t->what != PT_PUSH && t->ev < lift[t->p - p0]) lift[t->p - p0] = t->ev;
+                if (t->what == PT_LIFT) continue;
+                size_t k = t->what == PT_PUSH ? t->rank : q1 + t->rank;
+                pdt_point pt = r->pts[t->p];
+                if (!has[k]) {
+                    lo[k] = hi[k] = pt;
+                    has[k] = 1;
+                    continue;
+                }
+                if (pt.x < lo[k].x) lo[k].x = pt.x;
+                if (pt.y < lo[k].y) lo[k].y = pt.y;
+                if (pt.x > hi[k].x) hi[k].x = pt.x;
+                if (pt.y > hi[k].y) hi[k].y = pt.y;
+            }
+        }
+        ok = ok && pl->put(pl->ctx, r->lift_at + (uint64_t)p0 * sizeof *lift, lift, np * sizeof *lift);
+    }
+    for (size_t q = 0; ok && q < q1; q++) {
+        size_t k = lifted_any[q] ? q1 + q : q;
+        r->has_box[q] = has[k];
+        if (has[k]) r->box_lo[q] = lo[k], r->box_hi[q] = hi[k];
+    }
+    if (!ok) b->failed = 1;
+    free(start);
+    free(sorted);
+    bfree(b, lift, PT_WINDOW * sizeof *lift);
+    bfree(b, rec, PBUF * sizeof *rec);
+    free(lo);
+    free(hi);
+    free(has);
+    return ok;
+}
+
 /* Pass 1 of a streamed build: the window of per-event tables out to
  * PDT_SCR_EVENTS when event i is past it (or at the end: i == m). */
 static int ev_window(builder *b, size_t i)
@@ -1216,11 +1337,11 @@ static int ev_window(builder *b, size_t i)
 }
 
 /* What a streamed build of n points holds in memory besides its working
- * set: the run's points and each point's first lift, and some room for the
- * small tables (a run with Graham's sort holds 16 bytes more per point). */
+ * set: the run's points (the caller's), and some room for the small tables
+ * (a run with Graham's sort holds 16 bytes more per point). */
 static uint64_t held_bytes(size_t n)
 {
-    return (uint64_t)n * 12 + ((uint64_t)16 << 20);
+    return (uint64_t)n * sizeof(pdt_point) + ((uint64_t)16 << 20);
 }
 
 static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
@@ -1262,7 +1383,11 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             b.wobj = bmalloc(&b, EVW * sizeof *b.wobj);
             b.wkind = bmalloc(&b, EVW);
             b.tcount = calloc(NFINE, sizeof *b.tcount);
-            if (!b.fbuf || !b.fbn || !b.win || !b.wobj || !b.wkind || !b.tcount) goto out;
+            b.npw = (r->n + PT_WINDOW - 1) / PT_WINDOW;
+            b.pbuf = bmalloc(&b, (b.npw ? b.npw : 1) * PBUF * sizeof *b.pbuf);
+            b.pbn = calloc(b.npw + 1, sizeof *b.pbn);
+            if (!b.fbuf || !b.fbn || !b.win || !b.wobj || !b.wkind || !b.tcount || !b.pbuf || !b.pbn)
+                goto out;
             pdt_big_advise(b.fbuf, NFINE * FBUF * sizeof *b.fbuf);
         } else {
             b.wobj = r->ev_obj;
@@ -1315,6 +1440,12 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         bfree(&b, b.wkind, EVW);
         b.wobj = NULL;
         b.wkind = NULL;
+        if ((r->lift_at = pl->reserve(pl->ctx, (uint64_t)r->n * sizeof(uint32_t))) == UINT64_MAX ||
+            !points_pass(&b, lifted_any))
+            goto out;
+        pl->sdrop(pl->ctx, PDT_SCR_POINTS);
+        bfree(&b, b.pbuf, (b.npw ? b.npw : 1) * PBUF * sizeof *b.pbuf);
+        b.pbuf = NULL;
     }
     /* Phases that open a cluster of overlapping same phases (any rank). */
     {
@@ -1397,11 +1528,14 @@ out:
         bfree(&b, b.win, WIN * sizeof *b.win);
         bfree(&b, b.wobj, EVW * sizeof *b.wobj);
         bfree(&b, b.wkind, EVW);
+        bfree(&b, b.pbuf, (b.npw ? b.npw : 1) * PBUF * sizeof *b.pbuf);
         b.win = NULL;
         r->build_peak = atomic_load(&b.peak);
     } else {
         free(b.fbuf);
     }
+    free(b.pbn);
+    free(b.pchunk);
     free(b.tcount);
     free(b.fbn);
     free(b.spill);
@@ -1445,23 +1579,21 @@ pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs,
     r->m = m;
     r->nranks = nranks;
     size_t q1 = (size_t)nranks;
-    if (!pl) { /* (streamed: none per event in memory) */
+    if (!pl) { /* (streamed: none per event or point in memory) */
         r->ev_obj = big_table(m * sizeof *r->ev_obj);
         r->ev_ent = big_table(m * sizeof *r->ev_ent);
         r->ev_kind = big_table(m * sizeof *r->ev_kind);
+        r->lift_ev = big_table(n * sizeof *r->lift_ev);
     }
-    r->lift_ev = big_table(n * sizeof *r->lift_ev);
     r->box_lo = malloc(q1 * sizeof *r->box_lo);
     r->box_hi = malloc(q1 * sizeof *r->box_hi);
     r->has_box = calloc(q1, 1);
-    if ((!pl && (!r->ev_obj || !r->ev_ent || !r->ev_kind)) || !r->lift_ev ||
+    if ((!pl && (!r->ev_obj || !r->ev_ent || !r->ev_kind || !r->lift_ev)) ||
         !r->box_lo || !r->box_hi || !r->has_box) {
         pdt_replay_free(r);
         return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for %zu events", m);
     }
-    for (size_t p = 0; p < n; p++) {
-        r->lift_ev[p] = NONE32;
-    }
+    for (size_t p = 0; r->lift_ev && p < n; p++) r->lift_ev[p] = NONE32;
     pdt_status st = build(r, pl, err);
     if (st != PDT_OK) {
         pdt_replay_free(r);
@@ -1815,7 +1947,13 @@ int pdt_fwd_to(pdt_fwd *f, pdt_rstate *s, size_t k)
             s->tcur[obj] = h0;
             continue;
         }
-        apply_obj(r, s, obj, kind, 1, NONE32);
+        switch (kind & KIND_MASK) { /* (streamed: no table per point; forwards the
+                                     * flags only gather: what point_flags gives) */
+        case PDT_EV_LIFT: s->pflags[obj] |= PDT_PF_LIFTED; continue;
+        case PDT_EV_SORT: s->pflags[obj] |= PDT_PF_SORTED; continue;
+        case PDT_EV_DELETE: s->pflags[obj] |= PDT_PF_DELETED; continue;
+        default: apply_obj(r, s, obj, kind, 1, NONE32);
+        }
     }
     return 1;
 }

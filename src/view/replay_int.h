@@ -114,11 +114,11 @@ struct pdt_replay {
     size_t map_len;
     /* Streamed (pdt_replay_build with a place): no table per event and none
      * per triangle in memory (ev_obj, ev_ent, ev_kind, tris and hist are
-     * NULL): they are at evobj_at, evkind_at, tris_at and hist_at of the
-     * place; the replay steps forwards through them (pdt_fwd: the index's
+     * NULL, and so is lift_ev): they are at evobj_at, evkind_at, tris_at,
+     * hist_at and lift_at of the place; the replay steps forwards through them (pdt_fwd: the index's
      * checkpoints) but draws nothing. */
     int streamed;
-    uint64_t tris_at, hist_at, evobj_at, evkind_at;
+    uint64_t tris_at, hist_at, evobj_at, evkind_at, lift_at;
     uint64_t build_peak;   /* the build's own working memory, at most (bytes) */
     struct lazy *lazy;     /* the map is verified chunk by chunk as it is read (index.c) */
     const char *warnings;  /* the reader's warnings about the run (kept index), or NULL */
@@ -150,6 +150,7 @@ enum {
     PDT_SCR_TRIS,    /* per triangle, by fine bucket: its first event and
                       * its entries (8 bytes) */
     PDT_SCR_IDS,     /* per triangle, by fine bucket: its number (4 bytes) */
+    PDT_SCR_POINTS,  /* lifts and pushes by window of points (replay.c: pt_rec) */
     PDT_SCR_COUNT
 };
 
@@ -158,8 +159,9 @@ enum {
  * reserve(ctx, bytes) gives a place for a table (e.g. a file offset;
  * UINT64_MAX: none), put and get write and read bytes there (1 on success).
  * budget: the build's working memory (0: no limit); what it holds besides
- * is per point (the points, each point's first lift: 12 bytes) and the
- * small tables (phases, merges, stacks, edges, messages, slot changes). */
+ * is the points (the caller's), the small tables (phases, merges, stacks,
+ * edges, messages, slot changes) and for a run with Graham's sort 16 bytes
+ * per point. */
 typedef struct pdt_replay_place {
     uint64_t (*reserve)(void *ctx, uint64_t bytes);
     int (*put)(void *ctx, uint64_t at, const void *p, size_t bytes);
