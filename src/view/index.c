@@ -1210,6 +1210,7 @@ typedef struct placer {
     uint64_t off;  /* where the next table goes */
     int sfd[PDT_SCR_COUNT];  /* the scratch files (-1: not made yet, or dropped) */
     const char *near;        /* made in the folder of this path */
+    pdt_run *run;
     pthread_mutex_t mu;      /* (the grouping's threads make them) */
 } placer;
 
@@ -1263,6 +1264,8 @@ static int scratch_get(void *ctx, int file, uint64_t at, void *p, size_t bytes)
     if (file < 0 || file >= PDT_SCR_COUNT || pc->sfd[file] < 0) return 0;
     return read_all(pc->sfd[file], at, p, bytes);
 }
+
+static void points_read(void *ctx) { pdt_run_release_points(((placer *)ctx)->run); }
 
 /* A scratch file done with: closed (unnamed: its pages go with it, mostly
  * before they were written back). */
@@ -1490,7 +1493,7 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     es.buf = malloc(SEG_BATCH * sizeof *es.buf);
     evpipe pipe;
     memset(&pipe, 0, sizeof pipe);
-    placer pc = {&pipe, fd, 0, {0}, tmp, PTHREAD_MUTEX_INITIALIZER};
+    placer pc = {&pipe, fd, 0, {0}, tmp, run, PTHREAD_MUTEX_INITIALIZER};
     for (int k = 0; k < PDT_SCR_COUNT; k++) pc.sfd[k] = -1;
     pdt_status st = h && es.buf ? block_table(run, &ec, err)
                                 : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
@@ -1505,8 +1508,9 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
             st = pdt_err_set(err, PDT_ERR_IO, "%s: a scratch file beside it: %s", tmp, strerror(errno));
     }
     if (st == PDT_OK && !pipe_start(&pipe, &es, err)) st = err->code;
-    pdt_replay_place pl = {place_reserve, place_put,    place_get, scratch_put, scratch_get,
-                           scratch_drop,  &pc,          budget,    stream_next, &ec.src};
+    pdt_replay_place pl = {place_reserve, place_put,   place_get, scratch_put, scratch_get,
+                           scratch_drop,  points_read, &pc,       budget,      stream_next,
+                           &ec.src};
     if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
     pipe_stop(&pipe);
     for (int k = 0; k < PDT_SCR_COUNT; k++) scratch_drop(&pc, k);  /* the scratch: gone */
@@ -1516,6 +1520,7 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
         r->nick = r->m / r->ick_every + 1;
         st = write_tables(r, fd, h, ident, &pc, &ec, err);
+        pdt_run_release_points(run);  /* (written from them) */
         *work = r->build_peak + pdt_replay_state_bytes(r);  /* (the checkpoints' state) */
         r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
     }

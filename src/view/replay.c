@@ -1444,6 +1444,7 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             !points_pass(&b, lifted_any))
             goto out;
         pl->sdrop(pl->ctx, PDT_SCR_POINTS);
+        if (pl->points_read) pl->points_read(pl->ctx);
         bfree(&b, b.pbuf, (b.npw ? b.npw : 1) * PBUF * sizeof *b.pbuf);
         b.pbuf = NULL;
     }

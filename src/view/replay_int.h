@@ -171,6 +171,9 @@ typedef struct pdt_replay_place {
     int (*sput)(void *ctx, int file, uint64_t at, const void *p, size_t bytes);
     int (*sget)(void *ctx, int file, uint64_t at, void *p, size_t bytes);
     void (*sdrop)(void *ctx, int file);
+    /* the build is done reading the points (their resident pages may be
+     * given back: pdt_run_release_points); NULL: nothing to do */
+    void (*points_read)(void *ctx);
     void *ctx;
     uint64_t budget;
     /* The events (the build is given no array of them: recs NULL), in
