@@ -530,6 +530,18 @@ void pdt_index_unmap(pdt_replay *r)
     r->map = NULL;
 }
 
+void pdt_index_release(const pdt_replay *r, const void *p, size_t len)
+{
+    if (!r->map || !len) return;
+    uintptr_t base = (uintptr_t)r->map, lo = (uintptr_t)p, hi = lo + len;
+    if (hi <= base || lo >= base + r->map_len) return;
+    if (lo < base) lo = base;
+    if (hi > base + r->map_len) hi = base + r->map_len;
+    lo = (lo + 4095) & ~(uintptr_t)4095;
+    hi &= ~(uintptr_t)4095;
+    if (hi > lo) madvise((void *)lo, hi - lo, MADV_DONTNEED);
+}
+
 /* ---- the run's identity and the index's place ---------------------------------- */
 
 static uint64_t fnv(uint64_t h, const void *p, size_t n)

@@ -962,7 +962,11 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
     pthread_t th[GROUP_THREADS];
     int started = 0;
     long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-    for (int t = 1; t < GROUP_THREADS && t < cpus && (size_t)t < nrun; t++)
+    /* one thread when a single fine bucket is all the budget takes (a huge
+     * run under a small budget: a bucket is the least a run is) */
+    int threads = budget && (uint64_t)most * GROUP_BYTES_PER_EVENT * GROUP_THREADS > budget ? 1
+                                                                                       : GROUP_THREADS;
+    for (int t = 1; t < threads && t < cpus && (size_t)t < nrun; t++)
         if (pthread_create(&th[t], NULL, b->pl ? group_worker_streamed : group_worker, &J) == 0)
             started |= 1 << t;
     (b->pl ? group_worker_streamed : group_worker)(&J);
@@ -2099,8 +2103,10 @@ void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k)
         if (c >= r->nick) c = r->nick - 1;
         size_t ck = c * r->ick_every;
         size_t bytes = (size_t)(r->ick_off[c + 1] - r->ick_off[c]);
-        if (from_here > dist(ck, k) * STEP_FACTOR + bytes / 64)
+        if (from_here > dist(ck, k) * STEP_FACTOR + bytes / 64) {
             pdt_rstate_from_blob(r, s, r->ick + r->ick_off[c], r->ick_born[c], ck);
+            pdt_index_release(r, r->ick + r->ick_off[c], bytes); /* (copied: not kept) */
+        }
         step_to(r, s, k);
         return;
     }
@@ -2211,6 +2217,8 @@ static int band_range(const double x[3], const double y[3], double lo, double hi
 }
 
 #define COV_AHEAD 16  /* triangles ahead whose points are fetched (pdt_replay_coverage) */
+#define COV_RELEASE ((size_t)1 << 18) /* triangles between givings back of a kept
+                                       * index's pages (pdt_index_release) */
 
 size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, double y0,
                            double x1, double y1, int cols, int rows,
@@ -2222,6 +2230,13 @@ size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, 
     double sx = cols / (x1 - x0), sy = rows / (y1 - y0);
     size_t binned = 0;
     for (size_t t = 0; t < r->ntri; t++) {
+        if (t && t % COV_RELEASE == 0) { /* the triangles read (in order), and the
+                                          * histories' pages (each fine bucket's
+                                          * entries are read in order: a few
+                                          * pages come back) */
+            pdt_index_release(r, &r->tris[t - COV_RELEASE], COV_RELEASE * sizeof *r->tris);
+            pdt_index_release(r, r->hist, r->nhist * sizeof *r->hist);
+        }
         /* the corners' points and the history entry of a triangle a few
          * ahead: random places in tables of 10^8 bytes (a hint only) */
         if (t + COV_AHEAD < r->ntri && s->tcur[t + COV_AHEAD] != NONE32) {

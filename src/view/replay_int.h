@@ -229,6 +229,12 @@ void pdt_fwd_free(pdt_fwd *f);
 void pdt_rstate_blob_parts(const pdt_replay *r, const pdt_rstate *s, size_t born,
                            const void *part[5], size_t len[5], size_t pad[5]);
 
+/* Give back the resident pages of [p, p + len) of a replay's kept index
+ * mapping (whole pages inside it; nothing when p is not in it): a read
+ * of them again faults them in from the page cache.  Touched pages of a
+ * shared mapping count as the process's memory until given back. */
+void pdt_index_release(const pdt_replay *r, const void *p, size_t len);
+
 /* Unmap a replay's kept index (index.c). */
 void pdt_index_unmap(pdt_replay *r);
 
