@@ -1507,6 +1507,9 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     memset(&pipe, 0, sizeof pipe);
     placer pc = {&pipe, fd, 0, {0}, tmp, run, PTHREAD_MUTEX_INITIALIZER};
     for (int k = 0; k < PDT_SCR_COUNT; k++) pc.sfd[k] = -1;
+    pdt_replay_place pl = {place_reserve, place_put,   place_get, scratch_put, scratch_get,
+                           scratch_drop,  points_read, &pc,       budget,      stream_next,
+                           &ec.src,       0,           0};
     pdt_status st = h && es.buf ? block_table(run, &ec, err)
                                 : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     if (st == PDT_OK) st = pdt_merge_open(run, &es.mg, err);
@@ -1514,15 +1517,17 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         es.fd = fd;
         es.h = h;
         es.ec = &ec;
-        es.at = es.off = HDR_BYTES;
+        /* the per-event tables first (their sizes are known: pass 1 writes
+         * them as it goes), then the segments */
+        pc.off = HDR_BYTES;
+        pl.evobj_at = place_reserve(&pc, (uint64_t)m * sizeof(int32_t));
+        pl.evkind_at = place_reserve(&pc, m);
+        es.at = es.off = (pc.off + 63) & ~(uint64_t)63;
         es.place_off = &pc.off;
         if ((pc.sfd[PDT_SCR_SPILL] = open_spill(tmp)) < 0)
             st = pdt_err_set(err, PDT_ERR_IO, "%s: a scratch file beside it: %s", tmp, strerror(errno));
     }
     if (st == PDT_OK && !pipe_start(&pipe, &es, err)) st = err->code;
-    pdt_replay_place pl = {place_reserve, place_put,   place_get, scratch_put, scratch_get,
-                           scratch_drop,  points_read, &pc,       budget,      stream_next,
-                           &ec.src};
     if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
     pipe_stop(&pipe);
     for (int k = 0; k < PDT_SCR_COUNT; k++) scratch_drop(&pc, k);  /* the scratch: gone */

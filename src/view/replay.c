@@ -252,7 +252,7 @@ typedef struct builder {
     uint32_t *fbn;        /* records in each buffer */
     int failed;           /* a put or get failed */
     /* the per-event tables as pass 1 writes them: the replay's (in memory)
-     * or a window of EVW events from wlo (streamed: then to PDT_SCR_EVENTS) */
+     * or a window of EVW events from wlo (streamed: then to the place) */
     int32_t *wobj;
     uint8_t *wkind;
     size_t wlo;
@@ -1040,7 +1040,7 @@ static int tri_ids(builder *b)
  * a window of events at a time, which numbers them (the triangle table,
  * and per bucket the numbers: PDT_SCR_IDS); tri_join gives each bucket's
  * triangle events their numbers; ev_tables merges them into the per-event
- * tables that pass 1 wrote (PDT_SCR_EVENTS) a window at a time.  Memory:
+ * tables that pass 1 wrote (at the place) a window at a time.  Memory:
  * a buffer per bucket and a window, independent of the run's size (but for
  * the numbers of the largest bucket's triangles in tri_join). */
 
@@ -1218,9 +1218,9 @@ static int tri_join(builder *b)
     return ok;
 }
 
-/* The per-event tables (to evobj_at and evkind_at of the place): pass 1's
- * (PDT_SCR_EVENTS), with every triangle event's triangle and the mark on a
- * triangle's first event (PDT_SCR_TRIEV, bucket by bucket in event order). */
+/* The per-event tables (at evobj_at and evkind_at of the place): pass 1's,
+ * completed in place with every triangle event's triangle and the mark on
+ * a triangle's first event (PDT_SCR_TRIEV, bucket by bucket in event order). */
 static int ev_tables(builder *b)
 {
     pdt_replay *r = b->r;
@@ -1234,11 +1234,10 @@ static int ev_tables(builder *b)
         ec[f].at = (uint64_t)b->fine_off[f] * sizeof(tri_ev);
         ec[f].left = b->fine_off[f + 1] - b->fine_off[f];
     }
-    uint64_t kinds = (uint64_t)r->m * sizeof *obj;
     for (size_t lo = 0; ok && lo < r->m; lo += NUM_WINDOW) {
         size_t hi = r->m - lo < NUM_WINDOW ? r->m : lo + NUM_WINDOW, k = hi - lo;
-        ok = pl->sget(pl->ctx, PDT_SCR_EVENTS, (uint64_t)lo * sizeof *obj, obj, k * sizeof *obj) &&
-             pl->sget(pl->ctx, PDT_SCR_EVENTS, kinds + lo, kind, k);
+        ok = pl->get(pl->ctx, r->evobj_at + (uint64_t)lo * sizeof *obj, obj, k * sizeof *obj) &&
+             pl->get(pl->ctx, r->evkind_at + lo, kind, k);
         for (size_t f = 0; ok && f < NFINE; f++) {
             const tri_ev *t;
             while ((t = bcur_peek(b, &ec[f])) && t->ev < hi) {
@@ -1324,15 +1323,15 @@ static int points_pass(builder *b, const uint8_t *lifted_any)
     return ok;
 }
 
-/* Pass 1 of a streamed build: the window of per-event tables out to
- * PDT_SCR_EVENTS when event i is past it (or at the end: i == m). */
+/* Pass 1 of a streamed build: the window of per-event tables out to the
+ * place when event i is past it (or at the end: i == m). */
 static int ev_window(builder *b, size_t i)
 {
     if (i - b->wlo < EVW && i < b->r->m) return 1;
     size_t k = i - b->wlo;
     const pdt_replay_place *pl = b->pl;
-    if (k && (!pl->sput(pl->ctx, PDT_SCR_EVENTS, (uint64_t)b->wlo * 4, b->wobj, k * 4) ||
-              !pl->sput(pl->ctx, PDT_SCR_EVENTS, (uint64_t)b->r->m * 4 + b->wlo, b->wkind, k))) {
+    if (k && (!pl->put(pl->ctx, b->r->evobj_at + (uint64_t)b->wlo * 4, b->wobj, k * 4) ||
+              !pl->put(pl->ctx, b->r->evkind_at + b->wlo, b->wkind, k))) {
         b->failed = 1;
         return 0;
     }
@@ -1381,6 +1380,8 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         r->nhist = b.fine_off[NFINE];
         if (pl) {
             r->streamed = 1;
+            r->evobj_at = pl->evobj_at;
+            r->evkind_at = pl->evkind_at;
             b.fbuf = bmalloc(&b, NFINE * FBUF * sizeof *b.fbuf);
             b.fbn = calloc(NFINE, sizeof *b.fbn);
             b.win = bmalloc(&b, WIN * sizeof *b.win);
@@ -1411,7 +1412,7 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
 
     for (size_t i = 0; i < r->m; i++) {
         drop_recs(&b, i);
-        if (pl && (!win_fill(&b, i, err) || !ev_window(&b, i))) goto out;
+        if (pl && (!win_fill(&b, i, err) || (i - b.wlo == EVW && !ev_window(&b, i)))) goto out;
         set_obj(&b, i, -1);
         if (r->ev_ent) r->ev_ent[i] = 0;
         const pdt_rec *rec = pl ? &b.win[i - b.win_lo] : rec_at(r, i);
@@ -1500,11 +1501,8 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             goto out;
         pl->sdrop(pl->ctx, PDT_SCR_TRIS);
         pl->sdrop(pl->ctx, PDT_SCR_IDS);
-        if ((r->evobj_at = pl->reserve(pl->ctx, (uint64_t)r->m * sizeof(int32_t))) == UINT64_MAX ||
-            (r->evkind_at = pl->reserve(pl->ctx, r->m)) == UINT64_MAX || !ev_tables(&b))
-            goto out;
+        if (!ev_tables(&b)) goto out;
         pl->sdrop(pl->ctx, PDT_SCR_TRIEV);
-        pl->sdrop(pl->ctx, PDT_SCR_EVENTS);
     } else if (!tri_ids(&b)) {
         goto out;
     }

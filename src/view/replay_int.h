@@ -143,8 +143,6 @@ struct pdt_replay {
  * each written and read back by the build only, in chunks. */
 enum {
     PDT_SCR_SPILL,   /* the triangle events by fine bucket, 20 bytes each */
-    PDT_SCR_EVENTS,  /* per event, in event order: its object (4 bytes), then
-                      * after the m objects its kind (1 byte) */
     PDT_SCR_TRIEV,   /* per triangle event, by fine bucket: the event and its
                       * triangle (8 bytes) */
     PDT_SCR_TRIS,    /* per triangle, by fine bucket: its first event and
@@ -183,6 +181,10 @@ typedef struct pdt_replay_place {
      * there. */
     int (*next)(void *ctx, pdt_rec *out, size_t max, pdt_err *err);
     pdt_evsrc *src;
+    /* Where the per-event tables go (the caller's places for m objects of
+     * 4 bytes and m kind bytes): pass 1 writes them there as the events
+     * come, and the triangle events' objects and marks are filled in last. */
+    uint64_t evobj_at, evkind_at;
 } pdt_replay_place;
 
 /* The triangle events of a build are grouped in this many buckets by a hash
