@@ -910,7 +910,7 @@ static void *group_worker_streamed(void *arg)
             }
             g0 = g1;
         }
-        if (!ok || !pl->put(pl->ctx, r->hist_at + base * sizeof *out, out, nb * sizeof *out) ||
+        if (!ok || !pl->sput(pl->ctx, PDT_SCR_HIST, base * sizeof *out, out, nb * sizeof *out) ||
             !pl->sput(pl->ctx, PDT_SCR_TRIEV, (uint64_t)base * sizeof *eout, eout, nb * sizeof *eout)) {
             J->io = 1;
             ok = 0;
@@ -1116,21 +1116,24 @@ static void bcurs_free(builder *b, bcur *c, size_t rec)
     bfree(b, c, NFINE * sizeof *c);
 }
 
-/* Number the triangles by their first events: the triangle table (streamed
- * to tris_at), a bucket's numbers in PDT_SCR_IDS (from fine_off[f]); the
- * corners and maker of a triangle from its first event (decoded, in event
- * order).  Each bucket's entries are its triangles' in order, from its
- * fine_off. */
+/* Number the triangles by their first events: the triangle table and the
+ * history table in the triangles' order (streamed to tris_at and hist_at:
+ * a pass over the triangles reads their entries in order), a bucket's
+ * numbers in PDT_SCR_IDS (from fine_off[f]); the corners and maker of a
+ * triangle from its first event (decoded, in event order).  Each bucket's
+ * entries (PDT_SCR_HIST, from its fine_off) are its triangles' in order. */
 static int tri_number(builder *b)
 {
     pdt_replay *r = b->r;
-    bcur *tc = bcurs_new(b, sizeof(tri_first)), *ic = bcurs_new(b, sizeof(uint32_t)), tw;
-    uint64_t *h0 = bmalloc(b, NFINE * sizeof *h0);
-    uint32_t *wn = bmalloc(b, NUM_WINDOW * sizeof *wn), *wh = bmalloc(b, NUM_WINDOW * sizeof *wh);
+    bcur *tc = bcurs_new(b, sizeof(tri_first)), *ic = bcurs_new(b, sizeof(uint32_t));
+    bcur *hc = bcurs_new(b, sizeof(pdt_rtri_hist)), tw, hw;
+    uint32_t *wn = bmalloc(b, NUM_WINDOW * sizeof *wn);
     uint16_t *wf = bmalloc(b, NUM_WINDOW * sizeof *wf);
     memset(&tw, 0, sizeof tw);
+    memset(&hw, 0, sizeof hw);
     tw.buf = bmalloc(b, CUR_RECS * sizeof(pdt_rtri));
-    int ok = tc && ic && h0 && wn && wh && wf && tw.buf;
+    hw.buf = bmalloc(b, CUR_RECS * sizeof(pdt_rtri_hist));
+    int ok = tc && ic && hc && wn && wf && tw.buf && hw.buf;
     if (ok) {
         for (size_t f = 0; f < NFINE; f++) {
             tc[f].file = PDT_SCR_TRIS;
@@ -1138,13 +1141,18 @@ static int tri_number(builder *b)
             tc[f].left = b->tcount[f];
             ic[f].file = PDT_SCR_IDS;
             ic[f].at = (uint64_t)b->fine_off[f] * sizeof(uint32_t);
-            h0[f] = b->fine_off[f];
+            hc[f].file = PDT_SCR_HIST;
+            hc[f].at = (uint64_t)b->fine_off[f] * sizeof(pdt_rtri_hist);
+            hc[f].left = b->fine_off[f + 1] - b->fine_off[f];
         }
-        tw.file = -1;
+        tw.file = hw.file = -1;
         tw.at = r->tris_at;
         tw.rec = sizeof(pdt_rtri);
+        hw.at = r->hist_at;
+        hw.rec = sizeof(pdt_rtri_hist);
     }
     r->ntri = 0;
+    size_t h0 = 0;
     for (size_t lo = 0; ok && lo < r->m; lo += NUM_WINDOW) {
         size_t hi = r->m - lo < NUM_WINDOW ? r->m : lo + NUM_WINDOW;
         memset(wn, 0, (hi - lo) * sizeof *wn);
@@ -1156,30 +1164,35 @@ static int tri_number(builder *b)
                     break;
                 }
                 wn[t->ev - lo] = t->n;
-                wh[t->ev - lo] = (uint32_t)h0[f];
                 wf[t->ev - lo] = (uint16_t)f;
-                h0[f] += t->n;
                 tc[f].i++;
             }
         }
         for (size_t k = 0; ok && k < hi - lo; k++) {
             if (!wn[k]) continue;
             const pdt_rec *rec = rec_at(r, lo + k);
-            pdt_rtri t = {{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank, wh[k], wn[k]};
+            pdt_rtri t = {{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank, (uint32_t)h0, wn[k]};
             uint32_t id = (uint32_t)r->ntri++;
             ok = bput(b, &tw, &t) && bput(b, &ic[wf[k]], &id);
+            for (uint32_t j = 0; ok && j < wn[k]; j++) { /* its entries, from its bucket's */
+                const pdt_rtri_hist *e = bcur_peek(b, &hc[wf[k]]);
+                ok = e && bput(b, &hw, e);
+                hc[wf[k]].i++;
+            }
+            h0 += wn[k];
         }
         ok = ok && !b->failed;
     }
     for (size_t f = 0; ok && f < NFINE; f++) ok = bput_flush(b, &ic[f]);
-    ok = ok && bput_flush(b, &tw);
+    ok = ok && bput_flush(b, &tw) && bput_flush(b, &hw) && h0 == r->nhist;
     bfree(b, tw.buf, CUR_RECS * sizeof(pdt_rtri));
+    bfree(b, hw.buf, CUR_RECS * sizeof(pdt_rtri_hist));
     bfree(b, wn, NUM_WINDOW * sizeof *wn);
-    bfree(b, wh, NUM_WINDOW * sizeof *wh);
     bfree(b, wf, NUM_WINDOW * sizeof *wf);
-    bfree(b, h0, NFINE * sizeof *h0);
     bcurs_free(b, tc, sizeof(tri_first));
     bcurs_free(b, ic, sizeof(uint32_t));
+    bcurs_free(b, hc, sizeof(pdt_rtri_hist));
+    if (!ok) b->failed = 1;
     return ok;
 }
 
@@ -1501,6 +1514,7 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             goto out;
         pl->sdrop(pl->ctx, PDT_SCR_TRIS);
         pl->sdrop(pl->ctx, PDT_SCR_IDS);
+        pl->sdrop(pl->ctx, PDT_SCR_HIST);
         if (!ev_tables(&b)) goto out;
         pl->sdrop(pl->ctx, PDT_SCR_TRIEV);
     } else if (!tri_ids(&b)) {
@@ -2215,7 +2229,7 @@ static int band_range(const double x[3], const double y[3], double lo, double hi
 }
 
 #define COV_AHEAD 16  /* triangles ahead whose points are fetched (pdt_replay_coverage) */
-#define COV_RELEASE ((size_t)1 << 18) /* triangles between givings back of a kept
+#define COV_RELEASE ((size_t)1 << 16) /* triangles between givings back of a kept
                                        * index's pages (pdt_index_release) */
 
 size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, double y0,
@@ -2228,12 +2242,12 @@ size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, 
     double sx = cols / (x1 - x0), sy = rows / (y1 - y0);
     size_t binned = 0;
     for (size_t t = 0; t < r->ntri; t++) {
-        if (t && t % COV_RELEASE == 0) { /* the triangles read (in order), and the
-                                          * histories' pages (each fine bucket's
-                                          * entries are read in order: a few
-                                          * pages come back) */
-            pdt_index_release(r, &r->tris[t - COV_RELEASE], COV_RELEASE * sizeof *r->tris);
-            pdt_index_release(r, r->hist, r->nhist * sizeof *r->hist);
+        if (t && t % COV_RELEASE == 0) { /* the triangles read and their entries (a
+                                          * kept index holds them in the
+                                          * triangles' order): behind the pass */
+            const pdt_rtri *from = &r->tris[t - COV_RELEASE];
+            pdt_index_release(r, from, COV_RELEASE * sizeof *r->tris);
+            pdt_index_release(r, &r->hist[from->h0], (r->tris[t].h0 - from->h0) * sizeof *r->hist);
         }
         /* the corners' points and the history entry of a triangle a few
          * ahead: random places in tables of 10^8 bytes (a hint only) */

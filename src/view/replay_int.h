@@ -148,6 +148,7 @@ enum {
     PDT_SCR_TRIS,    /* per triangle, by fine bucket: its first event and
                       * its entries (8 bytes) */
     PDT_SCR_IDS,     /* per triangle, by fine bucket: its number (4 bytes) */
+    PDT_SCR_HIST,    /* the history entries by fine bucket (12 bytes each) */
     PDT_SCR_POINTS,  /* lifts and pushes by window of points (replay.c: pt_rec) */
     PDT_SCR_COUNT
 };
