@@ -1977,6 +1977,10 @@ int pdt_fwd_to(pdt_fwd *f, pdt_rstate *s, size_t k)
 
 /* ---- checkpoints --------------------------------------------------------------- */
 
+/* A seek that steps over this many events or more gives back the kept
+ * index's pages it read (pdt_index_release). */
+#define SEEK_RELEASE ((size_t)1 << 16)
+
 /* A seek this many events away or closer steps there instead (a step costs
  * about what looking at one object costs in pdt_replay_seek_direct). */
 #define STEP_FACTOR 1
@@ -2119,7 +2123,18 @@ void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k)
             pdt_rstate_from_blob(r, s, r->ick + r->ick_off[c], r->ick_born[c], ck);
             pdt_index_release(r, r->ick + r->ick_off[c], bytes); /* (copied: not kept) */
         }
+        size_t from = s->k;
         step_to(r, s, k);
+        if (dist(from, k) >= SEEK_RELEASE) { /* the per-event tables stepped over, and the
+                                              * triangles born there (read in order) */
+            size_t lo = from < k ? from : k, hi = from < k ? k : from;
+            pdt_index_release(r, &r->ev_obj[lo], (hi - lo) * sizeof *r->ev_obj);
+            pdt_index_release(r, &r->ev_kind[lo], hi - lo);
+            size_t c0 = lo / r->ick_every, c1 = hi / r->ick_every + 1;
+            size_t t0 = c0 < r->nick ? r->ick_born[c0] : r->ntri;
+            size_t t1 = c1 < r->nick ? r->ick_born[c1] : r->ntri;
+            if (t1 > t0) pdt_index_release(r, &r->tris[t0], (t1 - t0) * sizeof *r->tris);
+        }
         return;
     }
     if (from_here <= direct && (!r->nck || from_here <= r->ck_every / 2)) {
