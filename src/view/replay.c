@@ -2083,21 +2083,35 @@ void pdt_rstate_blob_parts(const pdt_replay *r, const pdt_rstate *s, size_t born
     for (int j = 0; j < 5; j++) part[j] = p[j], len[j] = l[j], pad[j] = up8(l[j]) - l[j];
 }
 
+#define BLOB_STEP ((size_t)8 << 20) /* bytes of a kept checkpoint copied between givings back */
+
+/* memcpy from a kept index's mapping, its pages given back behind the copy
+ * (a checkpoint of a huge run is 10^8 bytes: its pages would double what a
+ * seek holds). */
+static void copy_out(const pdt_replay *r, void *to, const uint8_t *from, size_t len)
+{
+    for (size_t o = 0; o < len; o += BLOB_STEP) {
+        size_t k = len - o < BLOB_STEP ? len - o : BLOB_STEP;
+        memcpy((char *)to + o, from + o, k);
+        pdt_index_release(r, from + o, k);
+    }
+}
+
 void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in, size_t born,
                           size_t k)
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
     s->k = k;
-    memcpy(s->pflags, in, r->n);
+    copy_out(r, s->pflags, in, r->n);
     in += up8(r->n);
-    memcpy(s->tcur, in, born * 4);
+    copy_out(r, s->tcur, in, born * 4);
     memset(s->tcur + born, 0xff, (r->ntri - born) * sizeof *s->tcur);
     in += up8(born * 4);
-    memcpy(s->ealive, in, r->nedge);
+    copy_out(r, s->ealive, in, r->nedge);
     in += up8(r->nedge);
-    memcpy(s->mflight, in, r->nmsg);
+    copy_out(r, s->mflight, in, r->nmsg);
     in += up8(r->nmsg);
-    memcpy(s->slot, in, nslot * 4);
+    copy_out(r, s->slot, in, nslot * 4);
 }
 
 static void step_to(const pdt_replay *r, pdt_rstate *s, size_t k)
