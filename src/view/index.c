@@ -7,13 +7,16 @@
  *                    offset and length, the place of the chunk checksums
  *                    (a CRC-32C per 16 MiB of every section: verified by
  *                    several threads at each opening); the header's own CRC
- *   sections         the events: the merged order as segments of
+ *   sections         the per-event tables (object, kind: written by the
+ *                    build's first pass as the events come, completed last);
+ *                    the events: the merged order as segments of
  *                    consecutive events of one rank (the events themselves
  *                    stay in the rank files: the table of their encoded
  *                    blocks is a section below; decoded on demand, each
- *                    block's checksum checked: evsrc.c); then the triangle
- *                    histories and the triangles (streamed here while they
- *                    are built: pdt_replay_build), then every other table of
+ *                    block's checksum checked: evsrc.c); then the points'
+ *                    first lifts, the triangles and their histories, in the
+ *                    triangles' order (streamed here while they are built:
+ *                    pdt_replay_build), then every other table of
  *                    the replay (replay_int.h), the points and the reader's
  *                    warnings about the run, each at a 64-byte boundary
  *                    (so that a valid index opens without reading the run),
