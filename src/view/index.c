@@ -1372,7 +1372,13 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     for (int i = 0; wrote && i < NSEC; i++) {
         uint64_t at;
         if (i == S_SEGS || i == S_CKPT || streamed_sec(r, i, &at)) continue;
-        if (h->sec[i].bytes) wrote = write_all(fd, *ptr[i], (size_t)h->sec[i].bytes, h->sec[i].off);
+        /* (the points, read in place from the run: a chunk at a time, their
+         * pages given back behind, while the checkpoints' state is held) */
+        for (uint64_t o = 0; wrote && o < h->sec[i].bytes; o += CHUNK_BYTES) {
+            uint64_t k = h->sec[i].bytes - o < CHUNK_BYTES ? h->sec[i].bytes - o : CHUNK_BYTES;
+            wrote = write_all(fd, (const char *)*ptr[i] + o, (size_t)k, h->sec[i].off + o);
+            if (i == S_POINTS) pdt_run_release_points(pc->run);
+        }
     }
     if (threaded) pthread_join(th, NULL);
     else ck_worker(&ck);
@@ -1407,6 +1413,7 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
                 uint64_t lo = c * CHUNK_BYTES, hi = lo + CHUNK_BYTES;
                 if (hi > h->sec[i].bytes) hi = h->sec[i].bytes;
                 tab[first[i] + c] = pdt_crc32c(0, p + lo, (size_t)(hi - lo));
+                if (i == S_POINTS) pdt_run_release_points(pc->run);
             }
         }
     }
