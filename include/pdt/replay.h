@@ -256,6 +256,9 @@ typedef struct pdt_replay_open_info {
     int indexed;             /* 1: the tables are mapped from a kept index (path) */
     int built;               /* 1: the index was built at this opening */
     double build_s;          /* seconds the build took */
+    uint64_t build_bytes;    /* the build's working memory at most (its buffers,
+                              * and the state it steps for the checkpoints),
+                              * besides the run's points and the small tables */
     char path[4096];         /* the index file */
     char why[160];           /* why an index found was not used ("stale: ...", "damaged: ...") */
     char write_error[1024];   /* why no index could be written (then: in memory) */

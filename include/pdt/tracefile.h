@@ -163,7 +163,12 @@ pdt_status pdt_run_open(const char *dir, pdt_run **run, pdt_err *err);
 void pdt_run_close(pdt_run *run);
 
 const pdt_manifest *pdt_run_manifest(const pdt_run *run);
+/* The run's points (read in place from points.bin's mapping where the
+ * host's layout allows: then only the pages read are resident). */
 const pdt_point *pdt_run_points(const pdt_run *run, size_t *n);
+/* Give back the resident pages of the points (they are read again from the
+ * page cache when used); nothing when they are a copy. */
+void pdt_run_release_points(const pdt_run *run);
 /* Text describing damage found while opening ("" if none). */
 const char *pdt_run_warnings(const pdt_run *run);
 

@@ -31,6 +31,8 @@ struct pdt_run {
     pdt_manifest m;
     pdt_point *pts;
     size_t npts;
+    uint8_t *pts_map;  /* points.bin, when pts points into it (no copy) */
+    size_t pts_map_size;
     int nranks;
     tf_rank *rk;
     char *warn;
@@ -111,6 +113,32 @@ static size_t release_pages(uint8_t *map, size_t from, size_t to)
     size_t a = (from + page - 1) / page * page, b = to / page * page;
     if (map && b > a) madvise(map + a, b - a, MADV_DONTNEED);
     return b > from ? b : from;
+}
+
+/* points.bin's points read in place: pts into its mapping (the file's
+ * layout, little-endian int32 pairs, is the host's), the header and both
+ * checksums verified (as pdt_tf_points_parse does).  0 when they cannot be
+ * (another byte order, or the file is not right: then pdt_tf_points_parse
+ * copies them, or says what is wrong). */
+static int points_in_place(const uint8_t *map, size_t size, pdt_point **pts, size_t *n)
+{
+    const uint16_t one = 1;
+    if (*(const uint8_t *)&one != 1 || sizeof(pdt_point) != 8 || size < PTS_HEADER_SIZE ||
+        memcmp(map, PTS_MAGIC, 8) != 0 || tf_get32(map + 20) != pdt_crc32c(0, map, 20))
+        return 0;
+    uint64_t cnt = tf_get64(map + 8);
+    const uint8_t *d = map + PTS_HEADER_SIZE;
+    if ((size - PTS_HEADER_SIZE) / 8 != cnt || (size - PTS_HEADER_SIZE) % 8 ||
+        ((uintptr_t)d % _Alignof(pdt_point)) || tf_get32(map + 16) != pdt_crc32c(0, d, (size_t)cnt * 8))
+        return 0;
+    *pts = (pdt_point *)(void *)(uintptr_t)d;
+    *n = (size_t)cnt;
+    return 1;
+}
+
+void pdt_run_release_points(const pdt_run *run)
+{
+    if (run->pts_map) release_pages(run->pts_map, 0, run->pts_map_size);
 }
 
 /* Validate the header and index the blocks of one rank file. */
@@ -329,8 +357,12 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
             warnf(run, "points.bin: %s: the run cannot be replayed or checked", strerror(e));
         else {
             pdt_err perr = {0};
-            if (pdt_tf_points_parse("points.bin", map, size, &run->pts, &run->npts, &perr) !=
-                PDT_OK) {
+            if (points_in_place(map, size, &run->pts, &run->npts)) {
+                run->pts_map = map; /* (kept: the points are read from it) */
+                run->pts_map_size = size;
+            }
+            if (!run->pts_map &&
+                pdt_tf_points_parse("points.bin", map, size, &run->pts, &run->npts, &perr) != PDT_OK) {
                 if (perr.code == PDT_ERR_NOMEM) st = pdt_err_set(err, perr.code, "%s", perr.msg);
                 else warnf(run, "%s", perr.msg);
             } else if (run->npts != run->m.n) {
@@ -340,7 +372,8 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
                 warnf(run, "points.bin: points do not match the manifest's input_checksum");
             }
         }
-        if (map) munmap(map, size);
+        if (run->pts_map) release_pages(map, 0, size); /* (the checksums read every page) */
+        else if (map) munmap(map, size);
         free(ppath);
         if (st != PDT_OK) {
             pdt_run_close(run);
@@ -400,7 +433,8 @@ void pdt_run_close(pdt_run *run)
     }
     free(run->rk);
     pdt_manifest_free(&run->m);
-    free(run->pts);
+    if (run->pts_map) munmap(run->pts_map, run->pts_map_size);
+    else free(run->pts);
     free(run->warn);
     free(run->merged);
     free(run->dir);

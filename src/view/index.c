@@ -7,13 +7,16 @@
  *                    offset and length, the place of the chunk checksums
  *                    (a CRC-32C per 16 MiB of every section: verified by
  *                    several threads at each opening); the header's own CRC
- *   sections         the events: the merged order as segments of
+ *   sections         the per-event tables (object, kind: written by the
+ *                    build's first pass as the events come, completed last);
+ *                    the events: the merged order as segments of
  *                    consecutive events of one rank (the events themselves
  *                    stay in the rank files: the table of their encoded
  *                    blocks is a section below; decoded on demand, each
- *                    block's checksum checked: evsrc.c); then the triangle
- *                    histories and the triangles (streamed here while they
- *                    are built: pdt_replay_build), then every other table of
+ *                    block's checksum checked: evsrc.c); then the points'
+ *                    first lifts, the triangles and their histories, in the
+ *                    triangles' order (streamed here while they are built:
+ *                    pdt_replay_build), then every other table of
  *                    the replay (replay_int.h), the points and the reader's
  *                    warnings about the run, each at a 64-byte boundary
  *                    (so that a valid index opens without reading the run),
@@ -44,7 +47,7 @@
 #include <unistd.h>
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 7u
+#define INDEX_VERSION 8u /* 8: the histories in the triangles' order */
 #define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/16 events, at least this */
 #define ICK_PARTS 8u
 _Static_assert(ICK_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint's place");
@@ -528,6 +531,18 @@ void pdt_index_unmap(pdt_replay *r)
     else munmap(r->map, r->map_len);
     r->lazy = NULL;
     r->map = NULL;
+}
+
+void pdt_index_release(const pdt_replay *r, const void *p, size_t len)
+{
+    if (!r->map || !len) return;
+    uintptr_t base = (uintptr_t)r->map, lo = (uintptr_t)p, hi = lo + len;
+    if (hi <= base || lo >= base + r->map_len) return;
+    if (lo < base) lo = base;
+    if (hi > base + r->map_len) hi = base + r->map_len;
+    lo = (lo + 4095) & ~(uintptr_t)4095;
+    hi &= ~(uintptr_t)4095;
+    if (hi > lo) madvise((void *)lo, hi - lo, MADV_DONTNEED);
 }
 
 /* ---- the run's identity and the index's place ---------------------------------- */
@@ -1157,26 +1172,42 @@ static void pipe_stop(evpipe *p)
     p->started = 0;
 }
 
-/* The state at every r->ick_every-th cursor, stepped forwards from 0,
- * written at off one after the other (r->nick of them), each holding the
- * triangles born before its cursor; sets r->ick_off and r->ick_born. */
+static int read_all(int fd, uint64_t at, void *p, size_t bytes);
+
+static int fd_get(void *ctx, uint64_t at, void *p, size_t bytes)
+{
+    return read_all(*(const int *)ctx, at, p, bytes);
+}
+
+/* The state at every r->ick_every-th cursor, stepped forwards from 0 (the
+ * streamed replay's tables read back from fd), written at off one after
+ * the other (r->nick of them), each holding the triangles born before its
+ * cursor; sets r->ick_off and r->ick_born.  Memory: one state. */
 static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
 {
+    static const uint8_t zeros[8];
     r->ick_off[0] = 0;
     if (!r->nick) return 1;
     pdt_rstate *s = pdt_rstate_new(r);
-    uint8_t *blob = malloc(pdt_rstate_blob_bytes(r, r->ntri));
-    int ok = s && blob;
+    pdt_fwd *fw = pdt_fwd_new(r, fd_get, &fd);
+    int ok = s && fw;
     for (size_t c = 0; ok && c < r->nick; c++) {
-        while (s->k < c * r->ick_every) pdt_replay_step(r, s, 1);
+        ok = pdt_fwd_to(fw, s, c * r->ick_every);
         size_t born = pdt_rstate_born(r, s), bytes = pdt_rstate_blob_bytes(r, born);
-        pdt_rstate_to_blob(r, s, born, blob);
-        ok = write_all(fd, blob, bytes, off + r->ick_off[c]);
-        crc_feed(crc, blob, bytes);
+        const void *part[5];
+        size_t len[5], pad[5];
+        uint64_t at = off + r->ick_off[c];
+        pdt_rstate_blob_parts(r, s, born, part, len, pad);
+        for (int j = 0; ok && j < 5; j++) {
+            ok = write_all(fd, part[j], len[j], at) && write_all(fd, zeros, pad[j], at + len[j]);
+            crc_feed(crc, part[j], len[j]);
+            crc_feed(crc, zeros, pad[j]);
+            at += len[j] + pad[j];
+        }
         r->ick_born[c] = born;
         r->ick_off[c + 1] = r->ick_off[c] + bytes;
     }
-    free(blob);
+    pdt_fwd_free(fw);
     pdt_rstate_free(s);
     return ok;
 }
@@ -1192,7 +1223,10 @@ typedef struct placer {
     struct evpipe *pipe; /* (first: the stream's context is the placer's) */
     int fd;
     uint64_t off;  /* where the next table goes */
-    int sfd;       /* the spill */
+    int sfd[PDT_SCR_COUNT];  /* the scratch files (-1: not made yet, or dropped) */
+    const char *near;        /* made in the folder of this path */
+    pdt_run *run;
+    pthread_mutex_t mu;      /* (the grouping's threads make them) */
 } placer;
 
 static uint64_t place_reserve(void *ctx, uint64_t bytes)
@@ -1226,14 +1260,36 @@ static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
     return read_all(((placer *)ctx)->fd, at, p, bytes);
 }
 
-static int spill_put(void *ctx, uint64_t at, const void *p, size_t bytes)
+static int open_spill(const char *path);
+
+static int scratch_put(void *ctx, int file, uint64_t at, const void *p, size_t bytes)
 {
-    return write_all(((placer *)ctx)->sfd, p, bytes, at);
+    placer *pc = ctx;
+    if (file < 0 || file >= PDT_SCR_COUNT) return 0;
+    pthread_mutex_lock(&pc->mu);
+    if (pc->sfd[file] < 0) pc->sfd[file] = open_spill(pc->near);
+    int fd = pc->sfd[file];
+    pthread_mutex_unlock(&pc->mu);
+    return fd >= 0 && write_all(fd, p, bytes, at);
 }
 
-static int spill_get(void *ctx, uint64_t at, void *p, size_t bytes)
+static int scratch_get(void *ctx, int file, uint64_t at, void *p, size_t bytes)
 {
-    return read_all(((placer *)ctx)->sfd, at, p, bytes);
+    placer *pc = ctx;
+    if (file < 0 || file >= PDT_SCR_COUNT || pc->sfd[file] < 0) return 0;
+    return read_all(pc->sfd[file], at, p, bytes);
+}
+
+static void points_read(void *ctx) { pdt_run_release_points(((placer *)ctx)->run); }
+
+/* A scratch file done with: closed (unnamed: its pages go with it, mostly
+ * before they were written back). */
+static void scratch_drop(void *ctx, int file)
+{
+    placer *pc = ctx;
+    if (file < 0 || file >= PDT_SCR_COUNT || pc->sfd[file] < 0) return;
+    close(pc->sfd[file]);
+    pc->sfd[file] = -1;
 }
 
 /* An unnamed scratch file in the folder of `path` (O_TMPFILE; where the file
@@ -1272,6 +1328,20 @@ static void *ck_worker(void *arg)
     return NULL;
 }
 
+/* 1 if section i of a streamed replay was written by the build (at *at). */
+static int streamed_sec(const pdt_replay *r, int i, uint64_t *at)
+{
+    if (!r->streamed) return 0;
+    switch (i) {
+    case S_TRIS: *at = r->tris_at; return 1;
+    case S_HIST: *at = r->hist_at; return 1;
+    case S_EVOBJ: *at = r->evobj_at; return 1;
+    case S_EVKIND: *at = r->evkind_at; return 1;
+    case S_LIFT: *at = r->lift_at; return 1;
+    default: return 0;
+    }
+}
+
 static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
                                evcopy *ec, pdt_err *err)
 {
@@ -1285,8 +1355,9 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     for (int i = 0; i < NSEC; i++) {
         h->count[i] = count[i];
         if (i == S_SEGS || i == S_CKPT) continue; /* (S_SEGS: written first, stream_next) */
-        if (r->streamed && (i == S_TRIS || i == S_HIST)) {
-            h->sec[i] = (isec){i == S_TRIS ? r->tris_at : r->hist_at, count[i] * elem[i], 0, 0};
+        uint64_t at;
+        if (streamed_sec(r, i, &at)) {
+            h->sec[i] = (isec){at, count[i] * elem[i], 0, 0};
             continue;
         }
         off = (off + 63) & ~(uint64_t)63;
@@ -1299,8 +1370,15 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     int threaded = pthread_create(&th, NULL, ck_worker, &ck) == 0;
     int wrote = 1;
     for (int i = 0; wrote && i < NSEC; i++) {
-        if (i == S_SEGS || i == S_CKPT || (r->streamed && (i == S_TRIS || i == S_HIST))) continue;
-        if (h->sec[i].bytes) wrote = write_all(fd, *ptr[i], (size_t)h->sec[i].bytes, h->sec[i].off);
+        uint64_t at;
+        if (i == S_SEGS || i == S_CKPT || streamed_sec(r, i, &at)) continue;
+        /* (the points, read in place from the run: a chunk at a time, their
+         * pages given back behind, while the checkpoints' state is held) */
+        for (uint64_t o = 0; wrote && o < h->sec[i].bytes; o += CHUNK_BYTES) {
+            uint64_t k = h->sec[i].bytes - o < CHUNK_BYTES ? h->sec[i].bytes - o : CHUNK_BYTES;
+            wrote = write_all(fd, (const char *)*ptr[i] + o, (size_t)k, h->sec[i].off + o);
+            if (i == S_POINTS) pdt_run_release_points(pc->run);
+        }
     }
     if (threaded) pthread_join(th, NULL);
     else ck_worker(&ck);
@@ -1322,12 +1400,12 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     uint8_t *todo = calloc(n ? n : 1, 1);
     int have = tab && todo;
     for (int i = 0; have && i < NSEC; i++) {
-        uint64_t nc = chunks_of(h->sec[i].bytes);
+        uint64_t nc = chunks_of(h->sec[i].bytes), at;
         if (i == S_SEGS) {
             have = crc_done(&ec->segs_crc, h->sec[i].bytes, tab + first[i]);
         } else if (i == S_CKPT) {
             have = crc_done(&ck_crc, h->sec[i].bytes, tab + first[i]);
-        } else if (r->streamed && (i == S_TRIS || i == S_HIST)) {
+        } else if (streamed_sec(r, i, &at)) {
             memset(todo + first[i], 1, nc);
         } else {
             const char *p = *ptr[i];
@@ -1335,6 +1413,7 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
                 uint64_t lo = c * CHUNK_BYTES, hi = lo + CHUNK_BYTES;
                 if (hi > h->sec[i].bytes) hi = h->sec[i].bytes;
                 tab[first[i] + c] = pdt_crc32c(0, p + lo, (size_t)(hi - lo));
+                if (i == S_POINTS) pdt_run_release_points(pc->run);
             }
         }
     }
@@ -1412,7 +1491,7 @@ static void clean_stale_temps(const char *path)
 
 /* Build the index of run at `path` (temporary file + rename). */
 static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks, uint64_t ident,
-                        const char *path, uint64_t budget, pdt_err *err)
+                        const char *path, uint64_t budget, uint64_t *work, pdt_err *err)
 {
     char tmp[PATH_MAX + 128];
     clean_stale_temps(path);
@@ -1436,7 +1515,11 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     es.buf = malloc(SEG_BATCH * sizeof *es.buf);
     evpipe pipe;
     memset(&pipe, 0, sizeof pipe);
-    placer pc = {&pipe, fd, 0, -1};
+    placer pc = {&pipe, fd, 0, {0}, tmp, run, PTHREAD_MUTEX_INITIALIZER};
+    for (int k = 0; k < PDT_SCR_COUNT; k++) pc.sfd[k] = -1;
+    pdt_replay_place pl = {place_reserve, place_put,   place_get, scratch_put, scratch_get,
+                           scratch_drop,  points_read, &pc,       budget,      stream_next,
+                           &ec.src,       0,           0};
     pdt_status st = h && es.buf ? block_table(run, &ec, err)
                                 : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     if (st == PDT_OK) st = pdt_merge_open(run, &es.mg, err);
@@ -1444,23 +1527,28 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         es.fd = fd;
         es.h = h;
         es.ec = &ec;
-        es.at = es.off = HDR_BYTES;
+        /* the per-event tables first (their sizes are known: pass 1 writes
+         * them as it goes), then the segments */
+        pc.off = HDR_BYTES;
+        pl.evobj_at = place_reserve(&pc, (uint64_t)m * sizeof(int32_t));
+        pl.evkind_at = place_reserve(&pc, m);
+        es.at = es.off = (pc.off + 63) & ~(uint64_t)63;
         es.place_off = &pc.off;
-        if ((pc.sfd = open_spill(tmp)) < 0)
+        if ((pc.sfd[PDT_SCR_SPILL] = open_spill(tmp)) < 0)
             st = pdt_err_set(err, PDT_ERR_IO, "%s: a scratch file beside it: %s", tmp, strerror(errno));
     }
     if (st == PDT_OK && !pipe_start(&pipe, &es, err)) st = err->code;
-    pdt_replay_place pl = {place_reserve, place_put, place_get, spill_put, spill_get,
-                           &pc,           budget,    stream_next, &ec.src};
     if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
     pipe_stop(&pipe);
-    if (pc.sfd >= 0) close(pc.sfd);  /* the spill, grouped: gone */
+    for (int k = 0; k < PDT_SCR_COUNT; k++) scratch_drop(&pc, k);  /* the scratch: gone */
     if (st == PDT_OK) {
         r->warnings = pdt_run_warnings(run);
         size_t every = r->m / ICK_PARTS;
         r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
         r->nick = r->m / r->ick_every + 1;
         st = write_tables(r, fd, h, ident, &pc, &ec, err);
+        pdt_run_release_points(run);  /* (written from them) */
+        *work = r->build_peak + pdt_replay_state_bytes(r);  /* (the checkpoints' state) */
         r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
     }
     pdt_replay_free(r);
@@ -1581,7 +1669,7 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
                 if (!cache_dir(cdir, sizeof cdir) || !make_dirs(cdir)) continue;
             }
             pdt_err e2 = {0};
-            if (build(run, pts, n, nranks, ident, path, budget, &e2) != PDT_OK) {
+            if (build(run, pts, n, nranks, ident, path, budget, &info->build_bytes, &e2) != PDT_OK) {
                 snprintf(info->write_error, sizeof info->write_error, "%s", e2.msg);
                 pdt_err_clear(&e2);
                 continue;

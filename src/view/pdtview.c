@@ -407,11 +407,12 @@ static double median(double *v, size_t n)
 
 /* The process's peak and current memory (/proc/self/status): mapped index
  * pages count in RssFile, the replay's own memory in RssAnon. */
-static void print_memory(void)
+static void print_memory(const char *label)
 {
     FILE *f = fopen("/proc/self/status", "r");
     if (!f) return;
-    char line[256], out[256] = "memory:";
+    char line[256], out[256];
+    snprintf(out, sizeof out, "%s:", label);
     while (fgets(line, sizeof line, f)) {
         static const char *const keys[] = {"VmHWM:", "VmRSS:", "RssAnon:", "RssFile:"};
         for (int i = 0; i < 4; i++) {
@@ -456,6 +457,7 @@ static int bench(const pdt_replay *r, pdt_rstate *s, const pdt_view *v, const op
                "wall, %.2f ms CPU\n", round ? "again" : "first round", NSEEK,
                1e3 * median(t, NSEEK), 1e3 * median(tc, NSEEK), 1e3 * worst, 1e3 * worst_c);
     }
+    print_memory("memory after the seeks");
     size_t every, made, nck = pdt_replay_checkpoints(r, &every, &made);
     if (nck)
         printf("checkpoints: every %zu events, %zu of %zu made, %.1f MiB each\n", every, made, nck,
@@ -495,7 +497,7 @@ static int bench(const pdt_replay *r, pdt_rstate *s, const pdt_view *v, const op
     printf("draw %zu triangles (%zu edges) at %dx%d: %.1f frames/s wall, %.1f ms CPU per frame "
            "(= %.1f frames/s on an idle core; %d frames)\n", drawn, 3 * drawn, o->w, o->h, frames / el,
            1e3 * cpu / frames, frames / cpu, frames);
-    print_memory();
+    print_memory("memory");
     return 0;
 }
 
@@ -820,6 +822,9 @@ int main(int argc, char **argv)
         printf("open %zu events, %zu points, %d ranks: %.3f s (read %.3f s + index %.3f s; "
                "cpu %.3f s + %.3f s)\n", pdt_replay_count(r), L.n, L.nranks, now_s() - t0,
                t1 - t0, now_s() - t1, c1 - c0, cpu_s() - c1);
+        if (info.indexed && info.built)
+            printf("index build: working memory %.1f MiB (budget %.1f MiB)\n",
+                   (double)info.build_bytes / 1048576.0, (double)o.mem / 1048576.0);
         if (info.indexed)
             printf("kept index %s: %s%s%s\n", info.path,
                    info.built ? "built at this opening" : "mapped", *info.why ? "; " : "", info.why);

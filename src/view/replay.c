@@ -187,6 +187,15 @@ typedef struct tri_rec {
     uint32_t ev;
 } tri_rec;
 
+/* A streamed build's spill record: what the history entry needs besides
+ * the key and the event travels with it (the build keeps nothing per
+ * event): x = XREC_BORDER | (merge step + 1) for a border kernel's
+ * candidate (TRI_NEW, sub 1), else kind | sub << 8. */
+typedef struct tri_xrec {
+    uint32_t s[3], ev, x;
+} tri_xrec;
+#define XREC_BORDER 0x80000000u
+
 #define FINE_BITS 8
 #define NFINE ((size_t)1 << FINE_BITS)
 _Static_assert(NFINE == PDT_REPLAY_NFINE, "replay_int.h says how many fine buckets");
@@ -214,6 +223,13 @@ size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks)
     return fine_of(s);
 }
 
+/* A chunk of a spill: where, whose (fine bucket, or window of points), how
+ * many records. */
+typedef struct spill_chunk {
+    uint64_t off;      /* in the spill */
+    uint32_t f, n;     /* fine bucket, records */
+} spill_chunk;
+
 /* Build state while indexing: the current slot values of every rank. */
 typedef struct builder {
     pdt_replay *r;
@@ -223,7 +239,7 @@ typedef struct builder {
     size_t *fine_fill;    /* per fine bucket: the next free history entry (pass 1) */
     size_t *fine_off;     /* per fine bucket: its first history entry; NFINE + 1 */
     const pdt_replay_place *pl;  /* streamed: the place, and per fine bucket a buffer */
-    tri_rec *fbuf;        /* NFINE * FBUF records */
+    tri_xrec *fbuf;       /* NFINE * FBUF records */
     tri_rec *spill;       /* not streamed: the triangle events by fine bucket */
     /* streamed: the spill is written a buffer (a chunk) at a time, where it
      * ends; chunk k of fine bucket f is chunk[ck_start[f] + k] after pass 1 */
@@ -235,7 +251,82 @@ typedef struct builder {
     size_t win_lo, win_n;
     uint32_t *fbn;        /* records in each buffer */
     int failed;           /* a put or get failed */
+    /* the per-event tables as pass 1 writes them: the replay's (in memory)
+     * or a window of EVW events from wlo (streamed: then to the place) */
+    int32_t *wobj;
+    uint8_t *wkind;
+    size_t wlo;
+    size_t *tcount;       /* streamed: triangles per fine bucket (NFINE) */
+    /* streamed: what lifts and pushes do to points (pt_rec), spilled by
+     * point window (PT_WINDOW points each) to PDT_SCR_POINTS in chunks */
+    struct pt_rec *pbuf;  /* npw * PBUF records */
+    uint32_t *pbn;
+    size_t npw;
+    struct spill_chunk *pchunk;
+    size_t npchunk, cap_pchunk;
+    uint64_t pspill_end;
+    _Atomic uint64_t held, peak;  /* streamed: working memory (bytes) */
 } builder;
+
+#define EVW 65536u  /* events per window of the per-event tables (streamed) */
+
+/* The builder's accounting of its working memory (streamed builds): what
+ * bmalloc gives, until bfree. */
+static void *bmalloc(builder *b, size_t bytes)
+{
+    void *p = malloc(bytes ? bytes : 1);
+    if (!p) return NULL;
+    uint64_t now = atomic_fetch_add(&b->held, bytes) + bytes, pk = atomic_load(&b->peak);
+    while (now > pk && !atomic_compare_exchange_weak(&b->peak, &pk, now)) {}
+    return p;
+}
+
+static void bfree(builder *b, void *p, size_t bytes)
+{
+    if (!p) return;
+    free(p);
+    atomic_fetch_sub(&b->held, bytes);
+}
+
+static void set_obj(builder *b, size_t i, int32_t v) { b->wobj[i - b->wlo] = v; }
+
+/* ---- points: first lifts and the ranks' boxes, streamed ---------------------------
+ *
+ * A streamed build holds no table per point of its own: a lift and a push
+ * that counts for its rank's box are written down (pt_rec) by window of
+ * points, and after pass 1 each window's records give its points' first
+ * lifts (the place's lift table, at lift_at) and their share of the boxes
+ * (the points read a window at a time).  A rank's box is the box of the
+ * points it lifted outside a merge, or, when it lifted none, of the points
+ * it pushed: what box_add makes in event order. */
+typedef struct pt_rec {
+    uint32_t p, ev, rank, what;  /* what: PT_PUSH, PT_LIFT (in a merge), PT_LIFT_BOX */
+} pt_rec;
+enum { PT_PUSH, PT_LIFT, PT_LIFT_BOX };
+#define PT_WINDOW ((size_t)1 << 20)  /* points per window */
+#define PBUF 256u                    /* records buffered per window */
+
+static int pt_flush(builder *b, size_t w)
+{
+    size_t k = b->pbn[w];
+    b->pbn[w] = 0;
+    if (!k) return 1;
+    if (!grow((void **)&b->pchunk, &b->cap_pchunk, b->npchunk + 1, sizeof *b->pchunk)) return 0;
+    if (!b->pl->sput(b->pl->ctx, PDT_SCR_POINTS, b->pspill_end, b->pbuf + w * PBUF, k * sizeof(pt_rec))) {
+        b->failed = 1;
+        return 0;
+    }
+    b->pchunk[b->npchunk++] = (spill_chunk){b->pspill_end, (uint32_t)w, (uint32_t)k};
+    b->pspill_end += k * sizeof(pt_rec);
+    return 1;
+}
+
+static int pt_note(builder *b, uint32_t p, uint32_t ev, uint32_t rank, uint32_t what)
+{
+    size_t w = p / PT_WINDOW;
+    b->pbuf[w * PBUF + b->pbn[w]++] = (pt_rec){p, ev, rank, what};
+    return b->pbn[w] < PBUF || pt_flush(b, w);
+}
 
 #define FBUF 1024u  /* records buffered per fine bucket (streamed): a chunk of the spill */
 
@@ -247,10 +338,6 @@ typedef struct builder {
  * current one is handled.  A hint only: nothing depends on it. */
 #define PREFETCH_AHEAD 12
 
-typedef struct spill_chunk {
-    uint64_t off;      /* in the spill */
-    uint32_t f, n;     /* fine bucket, records */
-} spill_chunk;
 
 /* A big table of `bytes` (malloc'd, asking for huge pages), or NULL. */
 static void *big_table(size_t bytes)
@@ -281,12 +368,12 @@ static int fine_flush(builder *b, size_t f)
     b->fbn[f] = 0;
     if (!k) return 1;
     if (!grow((void **)&b->chunk, &b->cap_chunk, b->nchunk + 1, sizeof *b->chunk)) return 0;
-    if (!b->pl->sput(b->pl->ctx, b->spill_end, b->fbuf + f * FBUF, k * sizeof(tri_rec))) {
+    if (!b->pl->sput(b->pl->ctx, PDT_SCR_SPILL, b->spill_end, b->fbuf + f * FBUF, k * sizeof(tri_xrec))) {
         b->failed = 1;
         return 0;
     }
     b->chunk[b->nchunk++] = (spill_chunk){b->spill_end, (uint32_t)f, (uint32_t)k};
-    b->spill_end += k * sizeof(tri_rec);
+    b->spill_end += k * sizeof(tri_xrec);
     return 1;
 }
 
@@ -338,7 +425,7 @@ static int set_slot(builder *b, uint32_t ev, int rank, int slot, int32_t val)
     if (!grow((void **)&r->ch, &r->cap_ch, r->nch + 1, sizeof *r->ch)) return 0;
     if (r->nch >= INT32_MAX) return 0;
     r->ch[r->nch] = (slot_change){ev, val, b->cur[s], (uint32_t)s};
-    r->ev_obj[ev] = (int32_t)r->nch;  /* the change (its slot: ch[].slot) */
+    set_obj(b, ev, (int32_t)r->nch);  /* the change (its slot: ch[].slot) */
     r->nch++;
     b->cur[s] = val;
     return 1;
@@ -449,7 +536,10 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
         if (!grow((void **)&r->nodes, &r->cap_node, r->nnode + 1, sizeof *r->nodes)) return 0;
         r->nodes[r->nnode] = (pdt_rnode){e->a, parent, d, NONE32};
         r->nnode++;
-        if (!lifted_any[rank]) box_add(r, rec->rank, r->pts[e->a]);
+        if (!lifted_any[rank]) {
+            if (b->pl && !pt_note(b, e->a, i, rec->rank, PT_PUSH)) return 0;
+            if (!b->pl) box_add(r, rec->rank, r->pts[e->a]);
+        }
         return set_slot(b, i, rank, slot, (int32_t)(r->nnode - 1));
     }
     case PDT_EV_HULL: {
@@ -481,9 +571,9 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
         if (e->kind != PDT_EV_LIFT && !r->sort_ev && !graham_tables(r)) return 0;
         uint32_t *first = e->kind == PDT_EV_LIFT ? r->lift_ev
                           : e->kind == PDT_EV_SORT ? r->sort_ev : r->del_ev;
-        r->ev_obj[i] = (int32_t)e->a;
-        r->ev_ent[i] = first[e->a] == NONE32;
-        if (first[e->a] == NONE32) {
+        set_obj(b, i, (int32_t)e->a);
+        if (!first) { /* a streamed build's lift (see pt_rec) */
+        } else if (first[e->a] == NONE32) {
             first[e->a] = i;
             if (e->kind == PDT_EV_SORT) r->sort_pos[e->a] = e->b;
         }
@@ -492,6 +582,10 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
             int in_merge = cur[PDT_SLOT_MERGE] >= 0;
             for (; ph >= 0 && !in_merge; ph = r->phases[ph].parent)
                 if (r->phases[ph].phase == PDT_PH_MERGE) in_merge = 1;
+            if (b->pl) {
+                if (!in_merge) lifted_any[rank] = 1;
+                return pt_note(b, e->a, i, rec->rank, in_merge ? PT_LIFT : PT_LIFT_BOX);
+            }
             if (!in_merge) {
                 if (!lifted_any[rank]) r->has_box[rank] = 0;  /* forget pushed points */
                 lifted_any[rank] = 1;
@@ -514,11 +608,11 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
             if (!grow((void **)&r->edges, &r->cap_edge, r->nedge + 1, sizeof *r->edges)) return 0;
             r->edges[r->nedge] = (pdt_redge){e->a, e->b, rec->rank, i, NONE32};
             if (!km_put(&b->edge_map, rec->rank, k, (int32_t)r->nedge)) return 0;
-            r->ev_obj[i] = (int32_t)r->nedge;
+            set_obj(b, i, (int32_t)r->nedge);
             r->nedge++;
         } else if (have) {
             r->edges[id].del_ev = i;
-            r->ev_obj[i] = id;
+            set_obj(b, i, id);
             if (!km_put(&b->edge_map, rec->rank, k, -1)) return 0;
         } else {
             r->skipped++;
@@ -545,7 +639,7 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
         }
         if (send) r->msgs[id].send_ev = i;
         else r->msgs[id].recv_ev = i;
-        r->ev_obj[i] = id;
+        set_obj(b, i, id);
         return 1;
     }
     default:
@@ -558,16 +652,19 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
         uint32_t in[3] = {e->a, e->b, e->c};
         sort3(t.s, in);
         t.ev = i;
-        /* for hist_of, until the grouping writes these two */
-        r->ev_ent[i] = e->sub;
-        r->ev_obj[i] = e->kind == PDT_EV_TRI_NEW && e->sub == 1 ? cur[PDT_SLOT_MERGE] : -1;
+        int border = e->kind == PDT_EV_TRI_NEW && e->sub == 1;
         size_t f = fine_of(t.s);
-        if (!b->pl) {
+        if (!b->pl) { /* for hist_of, until the grouping writes these two */
+            r->ev_ent[i] = e->sub;
+            r->ev_obj[i] = border ? cur[PDT_SLOT_MERGE] : -1;
             b->spill[b->fine_fill[f]++] = t;
             return 1;
         }
         /* (streamed: fine_fill counts the bucket's events) */
-        b->fbuf[f * FBUF + b->fbn[f]++] = t;
+        b->fbuf[f * FBUF + b->fbn[f]++] =
+            (tri_xrec){{t.s[0], t.s[1], t.s[2]}, i,
+                       border ? XREC_BORDER | (uint32_t)(cur[PDT_SLOT_MERGE] + 1)
+                              : (uint32_t)e->kind | (uint32_t)e->sub << 8};
         b->fine_fill[f]++;
         return b->fbn[f] < FBUF || fine_flush(b, f);
     }
@@ -585,7 +682,8 @@ static const void *probe_addr(const builder *b, const pdt_rec *rec, const void *
     const pdt_event *e = &rec->ev;
     const pdt_replay *r = b->r;
     *also = NULL;
-    if ((e->kind == PDT_EV_LIFT || (r->sort_ev && (e->kind == PDT_EV_SORT || e->kind == PDT_EV_DELETE))) &&
+    if (((e->kind == PDT_EV_LIFT && r->lift_ev) ||
+         (r->sort_ev && (e->kind == PDT_EV_SORT || e->kind == PDT_EV_DELETE))) &&
         e->a < r->n) {
         if (e->kind == PDT_EV_LIFT) *also = &r->pts[e->a];
         return e->kind == PDT_EV_LIFT ? &r->lift_ev[e->a]
@@ -631,6 +729,42 @@ typedef struct group_job {
     _Atomic size_t ntri;    /* triangles found */
 } group_job;
 
+/* Group the nb records at buf (stride bytes apart, each beginning with a
+ * tri_rec) by their key, with the hash table slot (room for nb at load 3/4):
+ * gid[j] is record j's group, numbered by first appearance; gfirst[g] the
+ * event of group g's first record, gn[g] its records.  Returns the groups. */
+static uint32_t group_keys(const void *buf, size_t stride, size_t nb, gslot *slot, uint32_t *gid,
+                           uint32_t *gfirst, uint32_t *gn)
+{
+#define KREC(j) ((const tri_rec *)(const void *)((const char *)buf + (j) * stride))
+    size_t hc = 1024;
+    while (hc / 4 * 3 < nb) hc *= 2;
+    size_t mask = hc - 1;
+    for (size_t q = 0; q < hc; q++) slot[q].g = NONE32;
+    uint32_t ng = 0;
+    for (size_t j = 0; j < nb; j++) {
+        if (j + PREFETCH_AHEAD < nb)
+            __builtin_prefetch(&slot[(size_t)key_hash(KREC(j + PREFETCH_AHEAD)->s) & mask]);
+        const uint32_t *s = KREC(j)->s;
+        size_t q = (size_t)key_hash(s) & mask;
+        while (slot[q].g != NONE32 &&
+               (slot[q].s[0] != s[0] || slot[q].s[1] != s[1] || slot[q].s[2] != s[2]))
+            q = (q + 1) & mask;
+        if (slot[q].g == NONE32) {
+            slot[q] = (gslot){{s[0], s[1], s[2]}, ng};
+            gfirst[ng] = KREC(j)->ev;
+            gn[ng++] = 0;
+        }
+        gid[j] = slot[q].g;
+        gn[gid[j]]++;
+    }
+    return ng;
+#undef KREC
+}
+
+/* The in-memory build's grouping: the entries into r->hist, and per event
+ * its entry (ev_ent) and its triangle's first event (ev_obj; see
+ * tri_groups). */
 static void *group_worker(void *arg)
 {
     group_job *J = arg;
@@ -642,8 +776,7 @@ static void *group_worker(void *arg)
     gslot *slot = malloc(hcap * sizeof *slot);
     uint32_t *gid = malloc(most * sizeof *gid), *gfirst = malloc(most * sizeof *gfirst);
     uint32_t *gn = malloc(most * sizeof *gn), *gfill = malloc(most * sizeof *gfill);
-    pdt_rtri_hist *out = b->pl ? malloc(most * sizeof *out) : NULL;  /* streamed: the run's entries */
-    int ok = buf && slot && gid && gfirst && gn && gfill && (out || !b->pl);
+    int ok = buf && slot && gid && gfirst && gn && gfill;
     if (ok) {
         pdt_big_advise(buf, most * sizeof *buf);
         pdt_big_advise(slot, hcap * sizeof *slot);
@@ -654,43 +787,11 @@ static void *group_worker(void *arg)
         if (k >= J->nrun) break;
         size_t base = b->fine_off[J->run[k]], nb = b->fine_off[J->run[k + 1]] - base;
         if (!nb) continue;
-        if (!b->pl) memcpy(buf, &b->spill[base], nb * sizeof *buf);
-        for (size_t c = b->pl ? b->ck_start[J->run[k]] : 0, got = 0;
-             b->pl && c < b->ck_start[J->run[k + 1]]; c++) { /* the run's chunks, bucket by bucket */
-            const spill_chunk *ck = &b->chunk[c];
-            if (got + ck->n > nb ||
-                !b->pl->sget(b->pl->ctx, ck->off, buf + got, ck->n * sizeof *buf)) {
-                J->io = 1;
-                ok = 0;
-                break;
-            }
-            got += ck->n;
-        }
-        if (!ok) break;
-        size_t hc = 1024;
-        while (hc / 4 * 3 < nb) hc *= 2;
-        size_t mask = hc - 1;
-        for (size_t q = 0; q < hc; q++) slot[q].g = NONE32;
-        uint32_t ng = 0;
-        for (size_t j = 0; j < nb; j++) {
-            if (j + PREFETCH_AHEAD < nb)
-                __builtin_prefetch(&slot[(size_t)key_hash(buf[j + PREFETCH_AHEAD].s) & mask]);
-            const uint32_t *s = buf[j].s;
-            size_t q = (size_t)key_hash(s) & mask;
-            while (slot[q].g != NONE32 &&
-                   (slot[q].s[0] != s[0] || slot[q].s[1] != s[1] || slot[q].s[2] != s[2]))
-                q = (q + 1) & mask;
-            if (slot[q].g == NONE32) {
-                slot[q] = (gslot){{s[0], s[1], s[2]}, ng};
-                gfirst[ng] = buf[j].ev;
-                gn[ng++] = 0;
-            }
-            gid[j] = slot[q].g;
-            gn[gid[j]]++;
-        }
+        memcpy(buf, &b->spill[base], nb * sizeof *buf);
+        uint32_t ng = group_keys(buf, sizeof *buf, nb, slot, gid, gfirst, gn);
         size_t h = base;
         for (uint32_t q = 0; q < ng; q++) gfill[q] = (uint32_t)h, h += gn[q];
-        pdt_rtri_hist *to = b->pl ? out : r->hist + base;
+        pdt_rtri_hist *to = r->hist + base;
         for (size_t j = 0; j < nb; j++) {
             if (j + PREFETCH_AHEAD < nb) { /* random places in three tables of 4, 4, 1 bytes per event */
                 __builtin_prefetch(&r->ev_ent[buf[j + PREFETCH_AHEAD].ev], 1);
@@ -702,7 +803,115 @@ static void *group_worker(void *arg)
             r->ev_ent[ev] = at;  /* (threads write distinct events) */
             r->ev_obj[ev] = ev == gfirst[q] ? -1 - (int32_t)gn[q] : (int32_t)gfirst[q];
         }
-        if (b->pl && !b->pl->put(b->pl->ctx, r->hist_at + base * sizeof *out, out, nb * sizeof *out)) {
+        found += ng;
+    }
+    if (!ok) J->failed = 1;
+    J->ntri += found;
+    free(buf);
+    free(slot);
+    free(gid);
+    free(gfirst);
+    free(gn);
+    free(gfill);
+    return NULL;
+}
+
+/* The history entry of a streamed build's spill record (hist_of, from what
+ * the record carries). */
+static pdt_rtri_hist hist_of_x(const pdt_replay *r, const tri_xrec *t)
+{
+    int kind = PDT_EV_TRI_NEW;
+    uint8_t sub = 1;
+    int32_t g = -1;
+    if (t->x & XREC_BORDER) g = (int32_t)(t->x & ~XREC_BORDER) - 1;
+    else kind = (int)(t->x & 0xff), sub = (uint8_t)(t->x >> 8);
+    pdt_rtri_hist h = {t->ev, NONE32, tri_status_of(kind), sub, {0, 0}};
+    if (kind == PDT_EV_TRI_NEW && sub == 1 && g >= 0 && (size_t)g < r->nmerge)
+        h.until = r->merges[g].end_ev;
+    return h;
+}
+
+/* A triangle event's record in PDT_SCR_TRIEV: its event, and its triangle
+ * (its number in its fine bucket, then after tri_join its number in the
+ * replay), TEV_FIRST on the triangle's first event. */
+typedef struct tri_ev {
+    uint32_t ev, t;
+} tri_ev;
+#define TEV_FIRST 0x80000000u
+
+/* A triangle's record in PDT_SCR_TRIS: its first event, its entries. */
+typedef struct tri_first {
+    uint32_t ev, n;
+} tri_first;
+
+/* The streamed build's grouping: a run's entries to the place's history
+ * table; per triangle event a tri_ev (PDT_SCR_TRIEV, at its place in the
+ * bucket order), per triangle a tri_first (PDT_SCR_TRIS, from its bucket's
+ * first place: fine_off[f]), both in event order within each bucket, and
+ * the triangles per bucket (tcount).  Nothing is written per event in
+ * memory: numbering the triangles comes after (tri_number). */
+static void *group_worker_streamed(void *arg)
+{
+    group_job *J = arg;
+    builder *b = J->b;
+    pdt_replay *r = b->r;
+    const pdt_replay_place *pl = b->pl;
+    size_t most = J->most, hcap = 1024;
+    while (hcap / 4 * 3 < most) hcap *= 2;
+    tri_xrec *buf = bmalloc(b, most * sizeof *buf);
+    gslot *slot = bmalloc(b, hcap * sizeof *slot);
+    uint32_t *gid = bmalloc(b, most * sizeof *gid), *gfirst = bmalloc(b, most * sizeof *gfirst);
+    uint32_t *gn = bmalloc(b, most * sizeof *gn), *gfill = bmalloc(b, most * sizeof *gfill);
+    pdt_rtri_hist *out = bmalloc(b, most * sizeof *out);  /* the run's entries */
+    tri_ev *eout = bmalloc(b, most * sizeof *eout);
+    tri_first *tout = bmalloc(b, most * sizeof *tout);
+    int ok = buf && slot && gid && gfirst && gn && gfill && out && eout && tout;
+    if (ok) {
+        pdt_big_advise(buf, most * sizeof *buf);
+        pdt_big_advise(slot, hcap * sizeof *slot);
+    }
+    size_t found = 0;
+    while (ok && !J->failed) {
+        size_t k = J->next++;
+        if (k >= J->nrun) break;
+        size_t base = b->fine_off[J->run[k]], nb = b->fine_off[J->run[k + 1]] - base;
+        if (!nb) continue;
+        for (size_t c = b->ck_start[J->run[k]], got = 0; c < b->ck_start[J->run[k + 1]]; c++) {
+            const spill_chunk *ck = &b->chunk[c]; /* the run's chunks, bucket by bucket */
+            if (got + ck->n > nb ||
+                !pl->sget(pl->ctx, PDT_SCR_SPILL, ck->off, buf + got, ck->n * sizeof *buf)) {
+                J->io = 1;
+                ok = 0;
+                break;
+            }
+            got += ck->n;
+        }
+        if (!ok) break;
+        uint32_t ng = group_keys(buf, sizeof *buf, nb, slot, gid, gfirst, gn);
+        size_t h = base;
+        for (uint32_t q = 0; q < ng; q++) gfill[q] = (uint32_t)h, h += gn[q];
+        /* bucket by bucket: its triangles are the groups first seen in it */
+        uint32_t g0 = 0;
+        for (size_t f = J->run[k]; f < J->run[k + 1]; f++) {
+            size_t j0 = b->fine_off[f] - base, j1 = b->fine_off[f + 1] - base;
+            uint32_t g1 = g0;
+            for (size_t j = j0; j < j1; j++) {
+                uint32_t q = gid[j], ev = buf[j].ev, at = gfill[q]++;
+                if (q >= g1) g1 = q + 1;
+                out[at - base] = hist_of_x(r, &buf[j]);
+                eout[j] = (tri_ev){ev, (q - g0) | (ev == gfirst[q] ? TEV_FIRST : 0)};
+            }
+            for (uint32_t q = g0; q < g1; q++) tout[q - g0] = (tri_first){gfirst[q], gn[q]};
+            b->tcount[f] = g1 - g0;
+            if (g1 > g0 && !pl->sput(pl->ctx, PDT_SCR_TRIS, (uint64_t)b->fine_off[f] * sizeof *tout,
+                                     tout, (g1 - g0) * sizeof *tout)) {
+                ok = 0;
+                break;
+            }
+            g0 = g1;
+        }
+        if (!ok || !pl->sput(pl->ctx, PDT_SCR_HIST, base * sizeof *out, out, nb * sizeof *out) ||
+            !pl->sput(pl->ctx, PDT_SCR_TRIEV, (uint64_t)base * sizeof *eout, eout, nb * sizeof *eout)) {
             J->io = 1;
             ok = 0;
         }
@@ -710,13 +919,15 @@ static void *group_worker(void *arg)
     }
     if (!ok) J->failed = 1;
     J->ntri += found;
-    free(out);
-    free(buf);
-    free(slot);
-    free(gid);
-    free(gfirst);
-    free(gn);
-    free(gfill);
+    bfree(b, out, most * sizeof *out);
+    bfree(b, eout, most * sizeof *eout);
+    bfree(b, tout, most * sizeof *tout);
+    bfree(b, buf, most * sizeof *buf);
+    bfree(b, slot, hcap * sizeof *slot);
+    bfree(b, gid, most * sizeof *gid);
+    bfree(b, gfirst, most * sizeof *gfirst);
+    bfree(b, gn, most * sizeof *gn);
+    bfree(b, gfill, most * sizeof *gfill);
     return NULL;
 }
 
@@ -751,9 +962,14 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
     pthread_t th[GROUP_THREADS];
     int started = 0;
     long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-    for (int t = 1; t < GROUP_THREADS && t < cpus && (size_t)t < nrun; t++)
-        if (pthread_create(&th[t], NULL, group_worker, &J) == 0) started |= 1 << t;
-    group_worker(&J);
+    /* one thread when a single fine bucket is all the budget takes (a huge
+     * run under a small budget: a bucket is the least a run is) */
+    int threads = budget && (uint64_t)most * GROUP_BYTES_PER_EVENT * GROUP_THREADS > budget ? 1
+                                                                                       : GROUP_THREADS;
+    for (int t = 1; t < threads && t < cpus && (size_t)t < nrun; t++)
+        if (pthread_create(&th[t], NULL, b->pl ? group_worker_streamed : group_worker, &J) == 0)
+            started |= 1 << t;
+    (b->pl ? group_worker_streamed : group_worker)(&J);
     for (int t = 1; t < GROUP_THREADS; t++)
         if (started & (1 << t)) pthread_join(th[t], NULL);
     if (J.failed) {
@@ -816,13 +1032,332 @@ static int tri_ids(builder *b)
 }
 
 
-/* What a streamed build of m events and n points holds in memory besides
- * tri_groups' working set: the per-event tables (object, entry, kind), the
- * run's points and each point's first lift, and some room for the small
- * tables (a run with Graham's sort holds 16 bytes more per point). */
-static uint64_t held_bytes(size_t m, size_t n)
+/* ---- the streamed build's numbering, in windows of events -------------------------
+ *
+ * After the grouping (group_worker_streamed) each fine bucket has, in event
+ * order, its triangles (tri_first) and its triangle events (tri_ev).
+ * tri_number takes the buckets' triangles in order of their first events,
+ * a window of events at a time, which numbers them (the triangle table,
+ * and per bucket the numbers: PDT_SCR_IDS); tri_join gives each bucket's
+ * triangle events their numbers; ev_tables merges them into the per-event
+ * tables that pass 1 wrote (at the place) a window at a time.  Memory:
+ * a buffer per bucket and a window, independent of the run's size (but for
+ * the numbers of the largest bucket's triangles in tri_join). */
+
+#define NUM_WINDOW ((size_t)1 << 18)  /* events per window (tri_number, ev_tables) */
+#define CUR_RECS 512u                 /* records buffered per bucket */
+
+/* Records of `rec` bytes, read in order from `left` of them at `at` of
+ * scratch file `file`, CUR_RECS at a time. */
+typedef struct bcur {
+    int file;
+    uint64_t at;
+    size_t left, rec, n, i;
+    unsigned char *buf;
+} bcur;
+
+/* The next record, or NULL at the end (or when a read failed: b->failed). */
+static const void *bcur_peek(builder *b, bcur *c)
 {
-    return (uint64_t)m * 9 + (uint64_t)n * 12 + ((uint64_t)16 << 20);
+    if (c->i < c->n) return c->buf + c->i * c->rec;
+    if (!c->left) return NULL;
+    size_t k = c->left < CUR_RECS ? c->left : CUR_RECS;
+    if (!b->pl->sget(b->pl->ctx, c->file, c->at, c->buf, k * c->rec)) {
+        b->failed = 1;
+        c->left = 0;
+        return NULL;
+    }
+    c->at += k * c->rec;
+    c->left -= k;
+    c->n = k;
+    c->i = 0;
+    return c->buf;
+}
+
+/* Records appended at `at` of scratch file `file` (file < 0: of the place),
+ * CUR_RECS at a time.  0 when a write failed. */
+static int bput_flush(builder *b, bcur *c)
+{
+    if (!c->n) return 1;
+    size_t bytes = c->n * c->rec;
+    int ok = c->file < 0 ? b->pl->put(b->pl->ctx, c->at, c->buf, bytes)
+                         : b->pl->sput(b->pl->ctx, c->file, c->at, c->buf, bytes);
+    c->at += bytes;
+    c->n = 0;
+    if (!ok) b->failed = 1;
+    return ok;
+}
+
+static int bput(builder *b, bcur *c, const void *p)
+{
+    memcpy(c->buf + c->n * c->rec, p, c->rec);
+    return ++c->n < CUR_RECS || bput_flush(b, c);
+}
+
+/* NFINE cursors over records of rec bytes with one buffer; NULL when out of memory. */
+static bcur *bcurs_new(builder *b, size_t rec)
+{
+    bcur *c = bmalloc(b, NFINE * sizeof *c);
+    unsigned char *buf = bmalloc(b, (size_t)NFINE * CUR_RECS * rec);
+    if (!c || !buf) {
+        bfree(b, c, NFINE * sizeof *c);
+        bfree(b, buf, (size_t)NFINE * CUR_RECS * rec);
+        return NULL;
+    }
+    memset(c, 0, NFINE * sizeof *c);
+    for (size_t f = 0; f < NFINE; f++) c[f].buf = buf + f * CUR_RECS * rec, c[f].rec = rec;
+    return c;
+}
+
+static void bcurs_free(builder *b, bcur *c, size_t rec)
+{
+    if (!c) return;
+    bfree(b, c[0].buf, (size_t)NFINE * CUR_RECS * rec);
+    bfree(b, c, NFINE * sizeof *c);
+}
+
+/* Number the triangles by their first events: the triangle table and the
+ * history table in the triangles' order (streamed to tris_at and hist_at:
+ * a pass over the triangles reads their entries in order), a bucket's
+ * numbers in PDT_SCR_IDS (from fine_off[f]); the corners and maker of a
+ * triangle from its first event (decoded, in event order).  Each bucket's
+ * entries (PDT_SCR_HIST, from its fine_off) are its triangles' in order. */
+static int tri_number(builder *b)
+{
+    pdt_replay *r = b->r;
+    bcur *tc = bcurs_new(b, sizeof(tri_first)), *ic = bcurs_new(b, sizeof(uint32_t));
+    bcur *hc = bcurs_new(b, sizeof(pdt_rtri_hist)), tw, hw;
+    uint32_t *wn = bmalloc(b, NUM_WINDOW * sizeof *wn);
+    uint16_t *wf = bmalloc(b, NUM_WINDOW * sizeof *wf);
+    memset(&tw, 0, sizeof tw);
+    memset(&hw, 0, sizeof hw);
+    tw.buf = bmalloc(b, CUR_RECS * sizeof(pdt_rtri));
+    hw.buf = bmalloc(b, CUR_RECS * sizeof(pdt_rtri_hist));
+    int ok = tc && ic && hc && wn && wf && tw.buf && hw.buf;
+    if (ok) {
+        for (size_t f = 0; f < NFINE; f++) {
+            tc[f].file = PDT_SCR_TRIS;
+            tc[f].at = (uint64_t)b->fine_off[f] * sizeof(tri_first);
+            tc[f].left = b->tcount[f];
+            ic[f].file = PDT_SCR_IDS;
+            ic[f].at = (uint64_t)b->fine_off[f] * sizeof(uint32_t);
+            hc[f].file = PDT_SCR_HIST;
+            hc[f].at = (uint64_t)b->fine_off[f] * sizeof(pdt_rtri_hist);
+            hc[f].left = b->fine_off[f + 1] - b->fine_off[f];
+        }
+        tw.file = hw.file = -1;
+        tw.at = r->tris_at;
+        tw.rec = sizeof(pdt_rtri);
+        hw.at = r->hist_at;
+        hw.rec = sizeof(pdt_rtri_hist);
+    }
+    r->ntri = 0;
+    size_t h0 = 0;
+    for (size_t lo = 0; ok && lo < r->m; lo += NUM_WINDOW) {
+        size_t hi = r->m - lo < NUM_WINDOW ? r->m : lo + NUM_WINDOW;
+        memset(wn, 0, (hi - lo) * sizeof *wn);
+        for (size_t f = 0; f < NFINE; f++) {
+            const tri_first *t;
+            while ((t = bcur_peek(b, &tc[f])) && t->ev < hi) {
+                if (t->ev < lo || !t->n) { /* (not in event order: never written so) */
+                    b->failed = 1;
+                    break;
+                }
+                wn[t->ev - lo] = t->n;
+                wf[t->ev - lo] = (uint16_t)f;
+                tc[f].i++;
+            }
+        }
+        for (size_t k = 0; ok && k < hi - lo; k++) {
+            if (!wn[k]) continue;
+            const pdt_rec *rec = rec_at(r, lo + k);
+            pdt_rtri t = {{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank, (uint32_t)h0, wn[k]};
+            uint32_t id = (uint32_t)r->ntri++;
+            ok = bput(b, &tw, &t) && bput(b, &ic[wf[k]], &id);
+            for (uint32_t j = 0; ok && j < wn[k]; j++) { /* its entries, from its bucket's */
+                const pdt_rtri_hist *e = bcur_peek(b, &hc[wf[k]]);
+                ok = e && bput(b, &hw, e);
+                hc[wf[k]].i++;
+            }
+            h0 += wn[k];
+        }
+        ok = ok && !b->failed;
+    }
+    for (size_t f = 0; ok && f < NFINE; f++) ok = bput_flush(b, &ic[f]);
+    ok = ok && bput_flush(b, &tw) && bput_flush(b, &hw) && h0 == r->nhist;
+    bfree(b, tw.buf, CUR_RECS * sizeof(pdt_rtri));
+    bfree(b, hw.buf, CUR_RECS * sizeof(pdt_rtri_hist));
+    bfree(b, wn, NUM_WINDOW * sizeof *wn);
+    bfree(b, wf, NUM_WINDOW * sizeof *wf);
+    bcurs_free(b, tc, sizeof(tri_first));
+    bcurs_free(b, ic, sizeof(uint32_t));
+    bcurs_free(b, hc, sizeof(pdt_rtri_hist));
+    if (!ok) b->failed = 1;
+    return ok;
+}
+
+/* Give every triangle event of every bucket its triangle's number (in
+ * place in PDT_SCR_TRIEV), with the bucket's numbers in memory. */
+static int tri_join(builder *b)
+{
+    size_t most = 0;
+    for (size_t f = 0; f < NFINE; f++)
+        if (b->tcount[f] > most) most = b->tcount[f];
+    enum { JOIN_RECS = 1 << 16 };
+    uint32_t *ids = bmalloc(b, most * sizeof *ids);
+    tri_ev *ev = bmalloc(b, JOIN_RECS * sizeof *ev);
+    int ok = ids && ev;
+    for (size_t f = 0; ok && f < NFINE; f++) {
+        ok = !b->tcount[f] || b->pl->sget(b->pl->ctx, PDT_SCR_IDS, (uint64_t)b->fine_off[f] * sizeof *ids,
+                                         ids, b->tcount[f] * sizeof *ids);
+        for (size_t j = b->fine_off[f]; ok && j < b->fine_off[f + 1]; j += JOIN_RECS) {
+            size_t k = b->fine_off[f + 1] - j < JOIN_RECS ? b->fine_off[f + 1] - j : JOIN_RECS;
+            uint64_t at = (uint64_t)j * sizeof *ev;
+            ok = b->pl->sget(b->pl->ctx, PDT_SCR_TRIEV, at, ev, k * sizeof *ev);
+            for (size_t i = 0; ok && i < k; i++) {
+                uint32_t q = ev[i].t & ~TEV_FIRST;
+                if (q >= b->tcount[f]) {
+                    ok = 0;
+                    break;
+                }
+                ev[i].t = ids[q] | (ev[i].t & TEV_FIRST);
+            }
+            ok = ok && b->pl->sput(b->pl->ctx, PDT_SCR_TRIEV, at, ev, k * sizeof *ev);
+        }
+    }
+    if (!ok) b->failed = 1;
+    bfree(b, ids, most * sizeof *ids);
+    bfree(b, ev, JOIN_RECS * sizeof *ev);
+    return ok;
+}
+
+/* The per-event tables (at evobj_at and evkind_at of the place): pass 1's,
+ * completed in place with every triangle event's triangle and the mark on
+ * a triangle's first event (PDT_SCR_TRIEV, bucket by bucket in event order). */
+static int ev_tables(builder *b)
+{
+    pdt_replay *r = b->r;
+    const pdt_replay_place *pl = b->pl;
+    bcur *ec = bcurs_new(b, sizeof(tri_ev));
+    int32_t *obj = bmalloc(b, NUM_WINDOW * sizeof *obj);
+    uint8_t *kind = bmalloc(b, NUM_WINDOW);
+    int ok = ec && obj && kind;
+    for (size_t f = 0; ok && f < NFINE; f++) {
+        ec[f].file = PDT_SCR_TRIEV;
+        ec[f].at = (uint64_t)b->fine_off[f] * sizeof(tri_ev);
+        ec[f].left = b->fine_off[f + 1] - b->fine_off[f];
+    }
+    for (size_t lo = 0; ok && lo < r->m; lo += NUM_WINDOW) {
+        size_t hi = r->m - lo < NUM_WINDOW ? r->m : lo + NUM_WINDOW, k = hi - lo;
+        ok = pl->get(pl->ctx, r->evobj_at + (uint64_t)lo * sizeof *obj, obj, k * sizeof *obj) &&
+             pl->get(pl->ctx, r->evkind_at + lo, kind, k);
+        for (size_t f = 0; ok && f < NFINE; f++) {
+            const tri_ev *t;
+            while ((t = bcur_peek(b, &ec[f])) && t->ev < hi) {
+                if (t->ev < lo) {
+                    b->failed = 1;
+                    break;
+                }
+                obj[t->ev - lo] = (int32_t)(t->t & ~TEV_FIRST);
+                if (t->t & TEV_FIRST) kind[t->ev - lo] |= KIND_FIRST;
+                ec[f].i++;
+            }
+        }
+        ok = ok && !b->failed && pl->put(pl->ctx, r->evobj_at + (uint64_t)lo * sizeof *obj, obj, k * sizeof *obj) &&
+             pl->put(pl->ctx, r->evkind_at + lo, kind, k);
+    }
+    if (!ok) b->failed = 1;
+    bfree(b, obj, NUM_WINDOW * sizeof *obj);
+    bfree(b, kind, NUM_WINDOW);
+    bcurs_free(b, ec, sizeof(tri_ev));
+    return ok;
+}
+
+/* After pass 1 (streamed): each window of points' records (pt_rec) gives
+ * its first lifts (to lift_at of the place) and its share of the ranks'
+ * boxes (lifted_any: the ranks that lifted a point outside a merge). */
+static int points_pass(builder *b, const uint8_t *lifted_any)
+{
+    pdt_replay *r = b->r;
+    const pdt_replay_place *pl = b->pl;
+    size_t q1 = (size_t)r->nranks;
+    for (size_t w = 0; w < b->npw; w++)
+        if (!pt_flush(b, w)) return 0;
+    /* the chunks by window (each window's in the order written) */
+    size_t *start = calloc(b->npw + 1, sizeof *start);
+    spill_chunk *sorted = malloc((b->npchunk ? b->npchunk : 1) * sizeof *sorted);
+    uint32_t *lift = bmalloc(b, PT_WINDOW * sizeof *lift);
+    pt_rec *rec = bmalloc(b, PBUF * sizeof *rec);
+    pdt_point *lo = malloc(2 * q1 * sizeof *lo), *hi = malloc(2 * q1 * sizeof *hi);
+    uint8_t *has = calloc(2 * q1, 1);  /* [0, q1): pushed points' boxes, [q1, 2 q1): lifted */
+    int ok = start && sorted && lift && rec && lo && hi && has;
+    for (size_t c = 0; ok && c < b->npchunk; c++) start[b->pchunk[c].f + 1]++;
+    for (size_t w = 0; ok && w < b->npw; w++) start[w + 1] += start[w];
+    for (size_t c = 0, *fill = start; ok && c < b->npchunk; c++) { /* (start moves to the ends) */
+        sorted[fill[b->pchunk[c].f]++] = b->pchunk[c];
+    }
+    for (size_t w = 0, c = 0; ok && w < b->npw; w++) {
+        size_t p0 = w * PT_WINDOW, np = r->n - p0 < PT_WINDOW ? r->n - p0 : PT_WINDOW;
+        memset(lift, 0xff, np * sizeof *lift);
+        for (; ok && c < start[w]; c++) { /* (start[w]: the end of window w's chunks) */
+            ok = pl->sget(pl->ctx, PDT_SCR_POINTS, sorted[c].off, rec, sorted[c].n * sizeof *rec);
+            for (size_t j = 0; ok && j < sorted[c].n; j++) {
+                const pt_rec *t = &rec[j];
+                if (t->what != PT_PUSH && t->ev < lift[t->p - p0]) lift[t->p - p0] = t->ev;
+                if (t->what == PT_LIFT) continue;
+                size_t k = t->what == PT_PUSH ? t->rank : q1 + t->rank;
+                pdt_point pt = r->pts[t->p];
+                if (!has[k]) {
+                    lo[k] = hi[k] = pt;
+                    has[k] = 1;
+                    continue;
+                }
+                if (pt.x < lo[k].x) lo[k].x = pt.x;
+                if (pt.y < lo[k].y) lo[k].y = pt.y;
+                if (pt.x > hi[k].x) hi[k].x = pt.x;
+                if (pt.y > hi[k].y) hi[k].y = pt.y;
+            }
+        }
+        ok = ok && pl->put(pl->ctx, r->lift_at + (uint64_t)p0 * sizeof *lift, lift, np * sizeof *lift);
+    }
+    for (size_t q = 0; ok && q < q1; q++) {
+        size_t k = lifted_any[q] ? q1 + q : q;
+        r->has_box[q] = has[k];
+        if (has[k]) r->box_lo[q] = lo[k], r->box_hi[q] = hi[k];
+    }
+    if (!ok) b->failed = 1;
+    free(start);
+    free(sorted);
+    bfree(b, lift, PT_WINDOW * sizeof *lift);
+    bfree(b, rec, PBUF * sizeof *rec);
+    free(lo);
+    free(hi);
+    free(has);
+    return ok;
+}
+
+/* Pass 1 of a streamed build: the window of per-event tables out to the
+ * place when event i is past it (or at the end: i == m). */
+static int ev_window(builder *b, size_t i)
+{
+    if (i - b->wlo < EVW && i < b->r->m) return 1;
+    size_t k = i - b->wlo;
+    const pdt_replay_place *pl = b->pl;
+    if (k && (!pl->put(pl->ctx, b->r->evobj_at + (uint64_t)b->wlo * 4, b->wobj, k * 4) ||
+              !pl->put(pl->ctx, b->r->evkind_at + b->wlo, b->wkind, k))) {
+        b->failed = 1;
+        return 0;
+    }
+    b->wlo = i;
+    return 1;
+}
+
+/* What a streamed build of n points holds in memory besides its working
+ * set: the run's points (the caller's), and some room for the small tables
+ * (a run with Graham's sort holds 16 bytes more per point). */
+static uint64_t held_bytes(size_t n)
+{
+    return (uint64_t)n * sizeof(pdt_point) + ((uint64_t)16 << 20);
 }
 
 static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
@@ -858,11 +1393,23 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         r->nhist = b.fine_off[NFINE];
         if (pl) {
             r->streamed = 1;
-            b.fbuf = big_table(NFINE * FBUF * sizeof *b.fbuf);
+            r->evobj_at = pl->evobj_at;
+            r->evkind_at = pl->evkind_at;
+            b.fbuf = bmalloc(&b, NFINE * FBUF * sizeof *b.fbuf);
             b.fbn = calloc(NFINE, sizeof *b.fbn);
-            b.win = malloc(WIN * sizeof *b.win);
-            if (!b.fbuf || !b.fbn || !b.win) goto out;
+            b.win = bmalloc(&b, WIN * sizeof *b.win);
+            b.wobj = bmalloc(&b, EVW * sizeof *b.wobj);
+            b.wkind = bmalloc(&b, EVW);
+            b.tcount = calloc(NFINE, sizeof *b.tcount);
+            b.npw = (r->n + PT_WINDOW - 1) / PT_WINDOW;
+            b.pbuf = bmalloc(&b, (b.npw ? b.npw : 1) * PBUF * sizeof *b.pbuf);
+            b.pbn = calloc(b.npw + 1, sizeof *b.pbn);
+            if (!b.fbuf || !b.fbn || !b.win || !b.wobj || !b.wkind || !b.tcount || !b.pbuf || !b.pbn)
+                goto out;
+            pdt_big_advise(b.fbuf, NFINE * FBUF * sizeof *b.fbuf);
         } else {
+            b.wobj = r->ev_obj;
+            b.wkind = r->ev_kind;
             r->hist = big_table(r->nhist * sizeof *r->hist);
             r->tris = big_table(r->nhist * sizeof *r->tris); /* at most one per event */
             r->cap_tri = r->nhist;
@@ -878,11 +1425,11 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
 
     for (size_t i = 0; i < r->m; i++) {
         drop_recs(&b, i);
-        if (pl && !win_fill(&b, i, err)) goto out;
-        r->ev_obj[i] = -1;
-        r->ev_ent[i] = 0;
+        if (pl && (!win_fill(&b, i, err) || (i - b.wlo == EVW && !ev_window(&b, i)))) goto out;
+        set_obj(&b, i, -1);
+        if (r->ev_ent) r->ev_ent[i] = 0;
         const pdt_rec *rec = pl ? &b.win[i - b.win_lo] : rec_at(r, i);
-        r->ev_kind[i] = rec->ev.kind < KIND_UNKNOWN ? rec->ev.kind : KIND_UNKNOWN;
+        b.wkind[i - b.wlo] = rec->ev.kind < KIND_UNKNOWN ? rec->ev.kind : KIND_UNKNOWN;
         if (rec->rank >= (uint32_t)r->nranks) {
             r->skipped++;
             continue;
@@ -904,8 +1451,20 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             b.stream_failed = 1;
             goto out;
         }
-        free(b.win);
+        bfree(&b, b.win, WIN * sizeof *b.win);
         b.win = NULL;
+        if (!ev_window(&b, r->m)) goto out;
+        bfree(&b, b.wobj, EVW * sizeof *b.wobj);
+        bfree(&b, b.wkind, EVW);
+        b.wobj = NULL;
+        b.wkind = NULL;
+        if ((r->lift_at = pl->reserve(pl->ctx, (uint64_t)r->n * sizeof(uint32_t))) == UINT64_MAX ||
+            !points_pass(&b, lifted_any))
+            goto out;
+        pl->sdrop(pl->ctx, PDT_SCR_POINTS);
+        if (pl->points_read) pl->points_read(pl->ctx);
+        bfree(&b, b.pbuf, (b.npw ? b.npw : 1) * PBUF * sizeof *b.pbuf);
+        b.pbuf = NULL;
     }
     /* Phases that open a cluster of overlapping same phases (any rank). */
     {
@@ -936,20 +1495,31 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         if ((r->hist_at = pl->reserve(pl->ctx, (uint64_t)r->nhist * sizeof *r->hist)) == UINT64_MAX)
             goto out;
     }
-    free(b.fbuf);
+    if (pl) bfree(&b, b.fbuf, NFINE * FBUF * sizeof *b.fbuf);
+    else free(b.fbuf);
     b.fbuf = NULL;
     size_t ntri;
     uint64_t work = 0; /* tri_groups' share of the budget: what the replay does not hold */
     if (pl) {
-        uint64_t held = held_bytes(r->m, r->n);
+        uint64_t held = held_bytes(r->n);
         work = pl->budget > held + pl->budget / 4 ? pl->budget - held : pl->budget / 4;
     }
     if (!tri_groups(&b, work, &ntri)) goto out;
     free(b.spill);
     b.spill = NULL;
-    if (pl && (r->tris_at = pl->reserve(pl->ctx, (uint64_t)ntri * sizeof *r->tris)) == UINT64_MAX)
+    if (pl) { /* number the triangles, then the per-event tables (none in memory) */
+        pl->sdrop(pl->ctx, PDT_SCR_SPILL);
+        if ((r->tris_at = pl->reserve(pl->ctx, (uint64_t)ntri * sizeof *r->tris)) == UINT64_MAX ||
+            !tri_number(&b) || !tri_join(&b))
+            goto out;
+        pl->sdrop(pl->ctx, PDT_SCR_TRIS);
+        pl->sdrop(pl->ctx, PDT_SCR_IDS);
+        pl->sdrop(pl->ctx, PDT_SCR_HIST);
+        if (!ev_tables(&b)) goto out;
+        pl->sdrop(pl->ctx, PDT_SCR_TRIEV);
+    } else if (!tri_ids(&b)) {
         goto out;
-    if (!tri_ids(&b)) goto out;
+    }
     /* Slot changes grouped by slot (counting sort keeps event order). */
     r->slot_start = calloc(nslot + 1, sizeof *r->slot_start);
     r->slot_ch = malloc((r->nch ? r->nch : 1) * sizeof *r->slot_ch);
@@ -970,7 +1540,20 @@ out:
     free(lifted_any);
     free(b.fine_fill);
     free(b.fine_off);
-    free(b.fbuf);
+    if (pl) {
+        bfree(&b, b.fbuf, NFINE * FBUF * sizeof *b.fbuf);
+        bfree(&b, b.win, WIN * sizeof *b.win);
+        bfree(&b, b.wobj, EVW * sizeof *b.wobj);
+        bfree(&b, b.wkind, EVW);
+        bfree(&b, b.pbuf, (b.npw ? b.npw : 1) * PBUF * sizeof *b.pbuf);
+        b.win = NULL;
+        r->build_peak = atomic_load(&b.peak);
+    } else {
+        free(b.fbuf);
+    }
+    free(b.pbn);
+    free(b.pchunk);
+    free(b.tcount);
     free(b.fbn);
     free(b.spill);
     free(b.chunk);
@@ -1013,21 +1596,21 @@ pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs,
     r->m = m;
     r->nranks = nranks;
     size_t q1 = (size_t)nranks;
-    r->ev_obj = big_table(m * sizeof *r->ev_obj);
-    r->ev_ent = big_table(m * sizeof *r->ev_ent);
-    r->ev_kind = big_table(m * sizeof *r->ev_kind);
-    r->lift_ev = big_table(n * sizeof *r->lift_ev);
+    if (!pl) { /* (streamed: none per event or point in memory) */
+        r->ev_obj = big_table(m * sizeof *r->ev_obj);
+        r->ev_ent = big_table(m * sizeof *r->ev_ent);
+        r->ev_kind = big_table(m * sizeof *r->ev_kind);
+        r->lift_ev = big_table(n * sizeof *r->lift_ev);
+    }
     r->box_lo = malloc(q1 * sizeof *r->box_lo);
     r->box_hi = malloc(q1 * sizeof *r->box_hi);
     r->has_box = calloc(q1, 1);
-    if (!r->ev_obj || !r->ev_ent || !r->ev_kind || !r->lift_ev ||
+    if ((!pl && (!r->ev_obj || !r->ev_ent || !r->ev_kind || !r->lift_ev)) ||
         !r->box_lo || !r->box_hi || !r->has_box) {
         pdt_replay_free(r);
         return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for %zu events", m);
     }
-    for (size_t p = 0; p < n; p++) {
-        r->lift_ev[p] = NONE32;
-    }
+    for (size_t p = 0; r->lift_ev && p < n; p++) r->lift_ev[p] = NONE32;
     pdt_status st = build(r, pl, err);
     if (st != PDT_OK) {
         pdt_replay_free(r);
@@ -1236,12 +1819,11 @@ void pdt_replay_seek_direct(const pdt_replay *r, pdt_rstate *s, size_t k)
     }
 }
 
-/* Apply (fwd) or undo (!fwd) event i; s->k is already the new cursor. */
-static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
+/* Apply (fwd) or undo (!fwd) an event of object obj (>= 0) and kind (with
+ * its mark); s->k is already the new cursor.  h0: for a triangle's first
+ * event, the triangle's first entry. */
+static void apply_obj(const pdt_replay *r, pdt_rstate *s, int32_t obj, int kind, int fwd, uint32_t h0)
 {
-    int32_t obj = r->ev_obj[i];
-    if (obj < 0) return;
-    int kind = r->ev_kind[i];
     switch (kind & KIND_MASK) {
     case PDT_EV_LIFT:
     case PDT_EV_SORT:
@@ -1260,7 +1842,7 @@ static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
         if (is_tri_kind(kind & KIND_MASK)) {
             uint32_t *t = &s->tcur[obj];
             if (!(kind & KIND_FIRST)) *t = fwd ? *t + 1 : *t - 1;
-            else *t = !fwd ? NONE32 : r->ev_ent ? r->ev_ent[i] : r->tris[obj].h0;
+            else *t = fwd ? h0 : NONE32;
             return;
         }
         /* a slot change */
@@ -1268,6 +1850,17 @@ static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
         s->slot[c->slot] = fwd ? c->val : c->prev;
         return;
     }
+}
+
+/* Apply (fwd) or undo (!fwd) event i; s->k is already the new cursor. */
+static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
+{
+    int32_t obj = r->ev_obj[i];
+    if (obj < 0) return;
+    int kind = r->ev_kind[i];
+    uint32_t h0 = NONE32;
+    if ((kind & KIND_FIRST) && fwd) h0 = r->ev_ent ? r->ev_ent[i] : r->tris[obj].h0;
+    apply_obj(r, s, obj, kind, fwd, h0);
 }
 
 int pdt_replay_step(const pdt_replay *r, pdt_rstate *s, int dir)
@@ -1287,7 +1880,106 @@ int pdt_replay_step(const pdt_replay *r, pdt_rstate *s, int dir)
     return 0;
 }
 
+/* ---- a forward pass over a streamed replay ------------------------------------------ */
+
+#define FWD_EVENTS 65536u  /* events per window of the per-event tables */
+#define FWD_TRIS 4096u     /* triangles per window of the triangle table */
+
+struct pdt_fwd {
+    const pdt_replay *r;
+    int (*get)(void *ctx, uint64_t at, void *p, size_t bytes);
+    void *ctx;
+    int32_t *obj;
+    uint8_t *kind;
+    size_t lo, n;      /* the window of events: lo .. lo + n - 1 */
+    pdt_rtri *tri;
+    size_t tlo, tn;    /* the window of triangles */
+};
+
+pdt_fwd *pdt_fwd_new(const pdt_replay *r, int (*get)(void *ctx, uint64_t at, void *p, size_t bytes),
+                     void *ctx)
+{
+    pdt_fwd *f = calloc(1, sizeof *f);
+    if (!f) return NULL;
+    f->r = r;
+    f->get = get;
+    f->ctx = ctx;
+    f->obj = malloc(FWD_EVENTS * sizeof *f->obj);
+    f->kind = malloc(FWD_EVENTS);
+    f->tri = malloc(FWD_TRIS * sizeof *f->tri);
+    if (!f->obj || !f->kind || !f->tri) {
+        pdt_fwd_free(f);
+        return NULL;
+    }
+    return f;
+}
+
+void pdt_fwd_free(pdt_fwd *f)
+{
+    if (!f) return;
+    free(f->obj);
+    free(f->kind);
+    free(f->tri);
+    free(f);
+}
+
+/* The first history entry of triangle t (the triangles are born in order:
+ * the window moves forwards). */
+static int fwd_h0(pdt_fwd *f, size_t t, uint32_t *h0)
+{
+    const pdt_replay *r = f->r;
+    if (t >= r->ntri) return 0;
+    if (t < f->tlo || t >= f->tlo + f->tn) {
+        size_t k = r->ntri - t < FWD_TRIS ? r->ntri - t : FWD_TRIS;
+        if (!f->get(f->ctx, r->tris_at + (uint64_t)t * sizeof *f->tri, f->tri, k * sizeof *f->tri))
+            return 0;
+        f->tlo = t;
+        f->tn = k;
+    }
+    *h0 = f->tri[t - f->tlo].h0;
+    return 1;
+}
+
+int pdt_fwd_to(pdt_fwd *f, pdt_rstate *s, size_t k)
+{
+    const pdt_replay *r = f->r;
+    if (k > r->m) k = r->m;
+    while (s->k < k) {
+        size_t i = s->k;
+        if (i < f->lo || i >= f->lo + f->n) {
+            size_t n = r->m - i < FWD_EVENTS ? r->m - i : FWD_EVENTS;
+            if (!f->get(f->ctx, r->evobj_at + (uint64_t)i * sizeof *f->obj, f->obj, n * sizeof *f->obj) ||
+                !f->get(f->ctx, r->evkind_at + i, f->kind, n))
+                return 0;
+            f->lo = i;
+            f->n = n;
+        }
+        s->k++;
+        int32_t obj = f->obj[i - f->lo];
+        int kind = f->kind[i - f->lo];
+        if (obj < 0) continue;
+        if (is_tri_kind(kind & KIND_MASK) && (kind & KIND_FIRST)) {
+            uint32_t h0;
+            if (!fwd_h0(f, (size_t)obj, &h0)) return 0;
+            s->tcur[obj] = h0;
+            continue;
+        }
+        switch (kind & KIND_MASK) { /* (streamed: no table per point; forwards the
+                                     * flags only gather: what point_flags gives) */
+        case PDT_EV_LIFT: s->pflags[obj] |= PDT_PF_LIFTED; continue;
+        case PDT_EV_SORT: s->pflags[obj] |= PDT_PF_SORTED; continue;
+        case PDT_EV_DELETE: s->pflags[obj] |= PDT_PF_DELETED; continue;
+        default: apply_obj(r, s, obj, kind, 1, NONE32);
+        }
+    }
+    return 1;
+}
+
 /* ---- checkpoints --------------------------------------------------------------- */
+
+/* A seek that steps over this many events or more gives back the kept
+ * index's pages it read (pdt_index_release). */
+#define SEEK_RELEASE ((size_t)1 << 16)
 
 /* A seek this many events away or closer steps there instead (a step costs
  * about what looking at one object costs in pdt_replay_seek_direct). */
@@ -1382,21 +2074,44 @@ void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, size_t born, u
     memcpy(out, s->slot, nslot * 4);
 }
 
+void pdt_rstate_blob_parts(const pdt_replay *r, const pdt_rstate *s, size_t born,
+                           const void *part[5], size_t len[5], size_t pad[5])
+{
+    size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
+    const void *p[5] = {s->pflags, s->tcur, s->ealive, s->mflight, s->slot};
+    size_t l[5] = {r->n, born * 4, r->nedge, r->nmsg, nslot * 4};
+    for (int j = 0; j < 5; j++) part[j] = p[j], len[j] = l[j], pad[j] = up8(l[j]) - l[j];
+}
+
+#define BLOB_STEP ((size_t)8 << 20) /* bytes of a kept checkpoint copied between givings back */
+
+/* memcpy from a kept index's mapping, its pages given back behind the copy
+ * (a checkpoint of a huge run is 10^8 bytes: its pages would double what a
+ * seek holds). */
+static void copy_out(const pdt_replay *r, void *to, const uint8_t *from, size_t len)
+{
+    for (size_t o = 0; o < len; o += BLOB_STEP) {
+        size_t k = len - o < BLOB_STEP ? len - o : BLOB_STEP;
+        memcpy((char *)to + o, from + o, k);
+        pdt_index_release(r, from + o, k);
+    }
+}
+
 void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in, size_t born,
                           size_t k)
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
     s->k = k;
-    memcpy(s->pflags, in, r->n);
+    copy_out(r, s->pflags, in, r->n);
     in += up8(r->n);
-    memcpy(s->tcur, in, born * 4);
+    copy_out(r, s->tcur, in, born * 4);
     memset(s->tcur + born, 0xff, (r->ntri - born) * sizeof *s->tcur);
     in += up8(born * 4);
-    memcpy(s->ealive, in, r->nedge);
+    copy_out(r, s->ealive, in, r->nedge);
     in += up8(r->nedge);
-    memcpy(s->mflight, in, r->nmsg);
+    copy_out(r, s->mflight, in, r->nmsg);
     in += up8(r->nmsg);
-    memcpy(s->slot, in, nslot * 4);
+    copy_out(r, s->slot, in, nslot * 4);
 }
 
 static void step_to(const pdt_replay *r, pdt_rstate *s, size_t k)
@@ -1418,9 +2133,22 @@ void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k)
         if (c >= r->nick) c = r->nick - 1;
         size_t ck = c * r->ick_every;
         size_t bytes = (size_t)(r->ick_off[c + 1] - r->ick_off[c]);
-        if (from_here > dist(ck, k) * STEP_FACTOR + bytes / 64)
+        if (from_here > dist(ck, k) * STEP_FACTOR + bytes / 64) {
             pdt_rstate_from_blob(r, s, r->ick + r->ick_off[c], r->ick_born[c], ck);
+            pdt_index_release(r, r->ick + r->ick_off[c], bytes); /* (copied: not kept) */
+        }
+        size_t from = s->k;
         step_to(r, s, k);
+        if (dist(from, k) >= SEEK_RELEASE) { /* the per-event tables stepped over, and the
+                                              * triangles born there (read in order) */
+            size_t lo = from < k ? from : k, hi = from < k ? k : from;
+            pdt_index_release(r, &r->ev_obj[lo], (hi - lo) * sizeof *r->ev_obj);
+            pdt_index_release(r, &r->ev_kind[lo], hi - lo);
+            size_t c0 = lo / r->ick_every, c1 = hi / r->ick_every + 1;
+            size_t t0 = c0 < r->nick ? r->ick_born[c0] : r->ntri;
+            size_t t1 = c1 < r->nick ? r->ick_born[c1] : r->ntri;
+            if (t1 > t0) pdt_index_release(r, &r->tris[t0], (t1 - t0) * sizeof *r->tris);
+        }
         return;
     }
     if (from_here <= direct && (!r->nck || from_here <= r->ck_every / 2)) {
@@ -1530,6 +2258,8 @@ static int band_range(const double x[3], const double y[3], double lo, double hi
 }
 
 #define COV_AHEAD 16  /* triangles ahead whose points are fetched (pdt_replay_coverage) */
+#define COV_RELEASE ((size_t)1 << 16) /* triangles between givings back of a kept
+                                       * index's pages (pdt_index_release) */
 
 size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, double y0,
                            double x1, double y1, int cols, int rows,
@@ -1541,6 +2271,13 @@ size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, 
     double sx = cols / (x1 - x0), sy = rows / (y1 - y0);
     size_t binned = 0;
     for (size_t t = 0; t < r->ntri; t++) {
+        if (t && t % COV_RELEASE == 0) { /* the triangles read and their entries (a
+                                          * kept index holds them in the
+                                          * triangles' order): behind the pass */
+            const pdt_rtri *from = &r->tris[t - COV_RELEASE];
+            pdt_index_release(r, from, COV_RELEASE * sizeof *r->tris);
+            pdt_index_release(r, &r->hist[from->h0], (r->tris[t].h0 - from->h0) * sizeof *r->hist);
+        }
         /* the corners' points and the history entry of a triangle a few
          * ahead: random places in tables of 10^8 bytes (a hint only) */
         if (t + COV_AHEAD < r->ntri && s->tcur[t + COV_AHEAD] != NONE32) {

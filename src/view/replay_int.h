@@ -112,11 +112,14 @@ struct pdt_replay {
      * instead of freeing the tables. */
     void *map;
     size_t map_len;
-    /* Streamed (pdt_replay_build with a place): tris and hist are NULL, the
-     * tables are at tris_at and hist_at of the place; the replay steps (the
-     * index's checkpoints) but draws nothing. */
+    /* Streamed (pdt_replay_build with a place): no table per event and none
+     * per triangle in memory (ev_obj, ev_ent, ev_kind, tris and hist are
+     * NULL, and so is lift_ev): they are at evobj_at, evkind_at, tris_at,
+     * hist_at and lift_at of the place; the replay steps forwards through them (pdt_fwd: the index's
+     * checkpoints) but draws nothing. */
     int streamed;
-    uint64_t tris_at, hist_at;
+    uint64_t tris_at, hist_at, evobj_at, evkind_at, lift_at;
+    uint64_t build_peak;   /* the build's own working memory, at most (bytes) */
     struct lazy *lazy;     /* the map is verified chunk by chunk as it is read (index.c) */
     const char *warnings;  /* the reader's warnings about the run (kept index), or NULL */
 
@@ -136,27 +139,53 @@ struct pdt_replay {
     uint64_t ick_born[PDT_ICK_MAX];
 };
 
-/* Where pdt_replay_build streams the triangles and their histories (the
- * biggest tables) instead of holding them: reserve(ctx, bytes) gives a place
- * for a table (e.g. a file offset; UINT64_MAX: none), put and get write and
- * read bytes there (1 on success).  budget: the working memory of grouping
- * the triangle events by triangle (0: no limit). */
+/* Scratch files of a streamed build (pdt_replay_place's sput, sget, sdrop):
+ * each written and read back by the build only, in chunks. */
+enum {
+    PDT_SCR_SPILL,   /* the triangle events by fine bucket, 20 bytes each */
+    PDT_SCR_TRIEV,   /* per triangle event, by fine bucket: the event and its
+                      * triangle (8 bytes) */
+    PDT_SCR_TRIS,    /* per triangle, by fine bucket: its first event and
+                      * its entries (8 bytes) */
+    PDT_SCR_IDS,     /* per triangle, by fine bucket: its number (4 bytes) */
+    PDT_SCR_HIST,    /* the history entries by fine bucket (12 bytes each) */
+    PDT_SCR_POINTS,  /* lifts and pushes by window of points (replay.c: pt_rec) */
+    PDT_SCR_COUNT
+};
+
+/* Where pdt_replay_build streams the replay's big tables (the per-event
+ * tables, the triangles and their histories) instead of holding them:
+ * reserve(ctx, bytes) gives a place for a table (e.g. a file offset;
+ * UINT64_MAX: none), put and get write and read bytes there (1 on success).
+ * budget: the build's working memory (0: no limit); what it holds besides
+ * is the points (the caller's), the small tables (phases, merges, stacks,
+ * edges, messages, slot changes) and for a run with Graham's sort 16 bytes
+ * per point. */
 typedef struct pdt_replay_place {
     uint64_t (*reserve)(void *ctx, uint64_t bytes);
     int (*put)(void *ctx, uint64_t at, const void *p, size_t bytes);
     int (*get)(void *ctx, uint64_t at, void *p, size_t bytes);
-    /* scratch of 16 bytes per triangle event, written once and read once
-     * while the build groups them (at: from 0): e.g. a temporary file */
-    int (*sput)(void *ctx, uint64_t at, const void *p, size_t bytes);
-    int (*sget)(void *ctx, uint64_t at, void *p, size_t bytes);
+    /* scratch file `file` (PDT_SCR_*, from 0 each): written and read by the
+     * build only; sdrop: the build is done with it (its pages may go) */
+    int (*sput)(void *ctx, int file, uint64_t at, const void *p, size_t bytes);
+    int (*sget)(void *ctx, int file, uint64_t at, void *p, size_t bytes);
+    void (*sdrop)(void *ctx, int file);
+    /* the build is done reading the points (their resident pages may be
+     * given back: pdt_run_release_points); NULL: nothing to do */
+    void (*points_read)(void *ctx);
     void *ctx;
     uint64_t budget;
     /* The events (the build is given no array of them: recs NULL), in
      * order, once: up to max of them into out; returns how many, 0 at the
      * end, -1 on an error (err set).  When it has given them all, src must be
-     * ready: the second pass (numbering the triangles) decodes them there. */
+     * ready: the numbering of the triangles decodes their first events
+     * there. */
     int (*next)(void *ctx, pdt_rec *out, size_t max, pdt_err *err);
     pdt_evsrc *src;
+    /* Where the per-event tables go (the caller's places for m objects of
+     * 4 bytes and m kind bytes): pass 1 writes them there as the events
+     * come, and the triangle events' objects and marks are filled in last. */
+    uint64_t evobj_at, evkind_at;
 } pdt_replay_place;
 
 /* The triangle events of a build are grouped in this many buckets by a hash
@@ -186,6 +215,28 @@ void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, size_t born, u
 /* s = the state of the blob at `in` (made with `born`) at cursor k. */
 void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in, size_t born,
                           size_t k);
+
+/* A forward pass over a streamed replay's events (the index's checkpoints):
+ * the per-event tables and the triangles read from the place through get
+ * (a window of each), the state stepped as pdt_replay_step would.  NULL
+ * when out of memory. */
+typedef struct pdt_fwd pdt_fwd;
+pdt_fwd *pdt_fwd_new(const pdt_replay *r, int (*get)(void *ctx, uint64_t at, void *p, size_t bytes),
+                     void *ctx);
+/* Step s (at or before k) forwards to cursor k.  0 when a read failed. */
+int pdt_fwd_to(pdt_fwd *f, pdt_rstate *s, size_t k);
+void pdt_fwd_free(pdt_fwd *f);
+
+/* The pieces of pdt_rstate_to_blob's bytes, in order, without copying
+ * them: piece j is len[j] bytes at part[j], followed by pad[j] zero bytes. */
+void pdt_rstate_blob_parts(const pdt_replay *r, const pdt_rstate *s, size_t born,
+                           const void *part[5], size_t len[5], size_t pad[5]);
+
+/* Give back the resident pages of [p, p + len) of a replay's kept index
+ * mapping (whole pages inside it; nothing when p is not in it): a read
+ * of them again faults them in from the page cache.  Touched pages of a
+ * shared mapping count as the process's memory until given back. */
+void pdt_index_release(const pdt_replay *r, const void *p, size_t len);
 
 /* Unmap a replay's kept index (index.c). */
 void pdt_index_unmap(pdt_replay *r);

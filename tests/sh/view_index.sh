@@ -192,6 +192,33 @@ else fail hull_run_same_events "$(diff "$TMP/dhm.txt" "$TMP/dhi.txt" | head -3)"
 case "$("$V" "$RH" --check --mem 64K)" in *", 0 differ"*) ok hull_run_check ;;
     *) fail hull_run_check "$("$V" "$RH" --check --mem 64K)" ;; esac
 
+# the build holds no table per event or per point (they go to the index
+# and to scratch files a window at a time): its working memory, as it
+# counts it, stays within --mem and does not grow with the run (a run four
+# times the events, the same budget); and what it builds is what memory gives
+build_mem() { # RUN: the build's working memory in KiB, under --mem 16M
+    rm -f "$1/.pdtview-index"
+    "$V" "$1" --bench --mem 16M | sed -n 's/^index build: working memory \([0-9.]*\) MiB.*/\1/p' |
+        awk '{ printf "%d", $1 * 1024 }'
+}
+for np in 10000 40000; do
+    "$PDT" gen uniform $np --seed 13 > "$TMP/ub$np.txt"
+    "$PDT" triangulate "$TMP/ub$np.txt" -o "$TMP/ub.tri" --trace "$TMP/runb$np" >/dev/null 2>&1 ||
+        fail "record_$np"
+done
+small=$(build_mem "$TMP/runb10000"); big=$(build_mem "$TMP/runb40000")
+if [ -n "$small" ] && [ -n "$big" ] && [ "$big" -le $((16 * 1024)) ] && [ "$big" -le $((small + small / 10)) ]
+then ok build_memory_bounded
+else fail build_memory_bounded "working memory ${small:-?} KiB (10000 points), ${big:-?} KiB (40000 points), budget 16384 KiB"; fi
+RB=$TMP/runb40000
+same_b=1
+for at in "--at 123457" "--end"; do
+    "$V" --headless "$RB" $at -o "$TMP/mb.png" --size 640x400 --quiet --index off
+    "$V" --headless "$RB" $at -o "$TMP/ib.png" --size 640x400 --quiet --mem 16M
+    cmp -s "$TMP/mb.png" "$TMP/ib.png" || same_b=0
+done
+[ $same_b -eq 1 ] && ok build_bounded_same_pictures || fail build_bounded_same_pictures
+
 # bad budgets
 for bad in 0 12Q -5 ''; do
     "$V" "$R" --counts --mem "$bad" >/dev/null 2>"$TMP/eb"; rc=$?
