@@ -1,5 +1,5 @@
 # pdt — helpers for shell tests (source this file).
-#   ok NAME / fail NAME MSG / expect NAME CMD... / summary
+#   ok NAME / fail NAME MSG / check NAME CMD... / summary / par_same (an MPI run = the plain one)
 # BIN (the programs' folder) and ROOT (the repository) come from tests/run.sh.
 : "${ROOT:=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)}"
 : "${BIN:=$ROOT/bin}"
@@ -13,3 +13,19 @@ fail() { echo "not ok - $1"; shift; [ $# -gt 0 ] && echo "#   $*"; T_FAIL=$((T_F
 # check NAME COMMAND... : passes when the command exits 0
 check() { local n=$1; shift; if "$@"; then ok "$n"; else fail "$n" "command failed: $*"; fi; }
 summary() { echo "# $T_PASS passed, $T_FAIL failed"; [ "$T_FAIL" -eq 0 ]; }
+# par_same NAME REF NP INPUT [VAR=VALUE...]: `mpirun -np NP pdt triangulate INPUT`, with the
+# variables given passed to every rank (-x), exits 0 and writes the bytes of the plain run's REF
+par_same() {
+    local name=$1 ref=$2 np=$3 in=$4 out=$1.tri x=() e
+    shift 4
+    for e in "$@"; do x+=(-x "$e"); done
+    timeout 120 mpirun -np "$np" "${x[@]}" "$PDT" triangulate "$in" -o "$out" > mpi.out 2> mpi.err
+    local rc=$?
+    if [ "$rc" -ne 0 ]; then
+        fail "$name" "exit $rc $(head -3 mpi.err)"
+    elif ! cmp -s "$ref" "$out"; then
+        fail "$name" "output differs from the plain run ($(wc -l < "$out") vs $(wc -l < "$ref") lines)"
+    else
+        ok "$name"
+    fi
+}

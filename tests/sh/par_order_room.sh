@@ -13,20 +13,6 @@ export ASAN_OPTIONS="${ASAN_OPTIONS:-}:fast_unwind_on_malloc=0"
 export OMPI_MCA_mca_base_component_disable_dlclose=1 PMIX_MCA_mca_base_component_disable_dlclose=1
 if ! command -v mpirun > /dev/null; then fail mpirun_available "mpirun not found"; summary; exit; fi
 
-run_case() { # NAME ROOM NP INPUT REF
-    local name=$1 room=$2 np=$3 in=$4 ref=$5 out=$1.tri
-    timeout 120 mpirun -np "$np" -x PDT_TEST_ORDER_ROOM="$room" "$PDT" triangulate "$in" -o "$out" \
-        > mpi.out 2> mpi.err
-    local rc=$?
-    if [ "$rc" -ne 0 ]; then
-        fail "$name" "exit $rc $(head -3 mpi.err)"
-    elif ! cmp -s "$ref" "$out"; then
-        fail "$name" "output differs from the plain run ($(wc -l < "$out") vs $(wc -l < "$ref") lines)"
-    else
-        ok "$name"
-    fi
-}
-
 # 3000 uniform points: about 2000 final triangles per rank at P = 3, 1500 at
 # P = 4; a circle: every triangle final in the last merge, on one rank
 for kind in uniform circle; do
@@ -35,7 +21,7 @@ for kind in uniform circle; do
     "$PDT" triangulate "$in" -o "$ref" || { fail "plain_$kind"; continue; }
     for np in 3 4; do
         for room in 0 1500 3000 4500 6000; do
-            run_case "${kind}_np${np}_room${room}" "$room" "$np" "$in" "$ref"
+            par_same "${kind}_np${np}_room${room}" "$ref" "$np" "$in" PDT_TEST_ORDER_ROOM="$room"
         done
     done
 done
