@@ -230,6 +230,13 @@ typedef struct spill_chunk {
     uint32_t f, n;     /* fine bucket, records */
 } spill_chunk;
 
+/* A spill's chunks as written, and where the spill ends (bytes). */
+typedef struct spill_log {
+    spill_chunk *chunk;
+    size_t n, cap;
+    uint64_t end;
+} spill_log;
+
 /* Build state while indexing: the current slot values of every rank. */
 typedef struct builder {
     pdt_replay *r;
@@ -243,9 +250,8 @@ typedef struct builder {
     tri_rec *spill;       /* not streamed: the triangle events by fine bucket */
     /* streamed: the spill is written a buffer (a chunk) at a time, where it
      * ends; chunk k of fine bucket f is chunk[ck_start[f] + k] after pass 1 */
-    struct spill_chunk *chunk;
-    size_t nchunk, cap_chunk, *ck_start;
-    uint64_t spill_end;   /* bytes */
+    spill_log tlog;
+    size_t *ck_start;
     int stream_failed;    /* the place's stream of events failed (err set by it) */
     pdt_rec *win;         /* streamed: events win_lo .. win_lo + win_n - 1 of the stream */
     size_t win_lo, win_n;
@@ -262,9 +268,7 @@ typedef struct builder {
     struct pt_rec *pbuf;  /* npw * PBUF records */
     uint32_t *pbn;
     size_t npw;
-    struct spill_chunk *pchunk;
-    size_t npchunk, cap_pchunk;
-    uint64_t pspill_end;
+    spill_log plog;
     _Atomic uint64_t held, peak;  /* streamed: working memory (bytes) */
 } builder;
 
@@ -306,19 +310,50 @@ enum { PT_PUSH, PT_LIFT, PT_LIFT_BOX };
 #define PT_WINDOW ((size_t)1 << 20)  /* points per window */
 #define PBUF 256u                    /* records buffered per window */
 
+/* Write k records of `rec` bytes from buf where scratch stream scr ends, a
+ * chunk of bucket f in lg.  0 when out of memory or the write failed. */
+static int spill_put(builder *b, int scr, spill_log *lg, const void *buf, size_t k, size_t rec,
+                     size_t f)
+{
+    if (!k) return 1;
+    if (!grow((void **)&lg->chunk, &lg->cap, lg->n + 1, sizeof *lg->chunk)) return 0;
+    if (!b->pl->sput(b->pl->ctx, scr, lg->end, buf, k * rec)) {
+        b->failed = 1;
+        return 0;
+    }
+    lg->chunk[lg->n++] = (spill_chunk){lg->end, (uint32_t)f, (uint32_t)k};
+    lg->end += k * rec;
+    return 1;
+}
+
+/* lg's chunks ordered by bucket, each bucket's in the order written (its
+ * records' order): start[f] .. start[f + 1] - 1 are bucket f's (start: nb +
+ * 1 entries, zeroed by the caller).  0 when out of memory. */
+static int spill_group(spill_log *lg, size_t nb, size_t *start)
+{
+    spill_chunk *sorted = malloc((lg->n ? lg->n : 1) * sizeof *sorted);
+    size_t *fill = malloc((nb + 1) * sizeof *fill);
+    if (!sorted || !fill) {
+        free(sorted);
+        free(fill);
+        return 0;
+    }
+    for (size_t c = 0; c < lg->n; c++) start[lg->chunk[c].f + 1]++;
+    for (size_t f = 0; f < nb; f++) start[f + 1] += start[f];
+    memcpy(fill, start, (nb + 1) * sizeof *fill);
+    for (size_t c = 0; c < lg->n; c++) sorted[fill[lg->chunk[c].f]++] = lg->chunk[c];
+    free(fill);
+    free(lg->chunk);
+    lg->chunk = sorted;
+    lg->cap = lg->n;
+    return 1;
+}
+
 static int pt_flush(builder *b, size_t w)
 {
     size_t k = b->pbn[w];
     b->pbn[w] = 0;
-    if (!k) return 1;
-    if (!grow((void **)&b->pchunk, &b->cap_pchunk, b->npchunk + 1, sizeof *b->pchunk)) return 0;
-    if (!b->pl->sput(b->pl->ctx, PDT_SCR_POINTS, b->pspill_end, b->pbuf + w * PBUF, k * sizeof(pt_rec))) {
-        b->failed = 1;
-        return 0;
-    }
-    b->pchunk[b->npchunk++] = (spill_chunk){b->pspill_end, (uint32_t)w, (uint32_t)k};
-    b->pspill_end += k * sizeof(pt_rec);
-    return 1;
+    return spill_put(b, PDT_SCR_POINTS, &b->plog, b->pbuf + w * PBUF, k, sizeof(pt_rec), w);
 }
 
 static int pt_note(builder *b, uint32_t p, uint32_t ev, uint32_t rank, uint32_t what)
@@ -366,15 +401,7 @@ static int fine_flush(builder *b, size_t f)
 {
     size_t k = b->fbn[f];
     b->fbn[f] = 0;
-    if (!k) return 1;
-    if (!grow((void **)&b->chunk, &b->cap_chunk, b->nchunk + 1, sizeof *b->chunk)) return 0;
-    if (!b->pl->sput(b->pl->ctx, PDT_SCR_SPILL, b->spill_end, b->fbuf + f * FBUF, k * sizeof(tri_xrec))) {
-        b->failed = 1;
-        return 0;
-    }
-    b->chunk[b->nchunk++] = (spill_chunk){b->spill_end, (uint32_t)f, (uint32_t)k};
-    b->spill_end += k * sizeof(tri_xrec);
-    return 1;
+    return spill_put(b, PDT_SCR_SPILL, &b->tlog, b->fbuf + f * FBUF, k, sizeof(tri_xrec), f);
 }
 
 /* Streamed pass 1: have events i .. i + PREFETCH_AHEAD (or to the end) in
@@ -403,19 +430,7 @@ static int win_fill(builder *b, size_t i, pdt_err *err)
 static int chunks_by_bucket(builder *b)
 {
     b->ck_start = calloc(NFINE + 1, sizeof *b->ck_start);
-    spill_chunk *sorted = malloc((b->nchunk ? b->nchunk : 1) * sizeof *sorted);
-    size_t fill[NFINE];
-    if (!b->ck_start || !sorted) {
-        free(sorted);
-        return 0;
-    }
-    for (size_t c = 0; c < b->nchunk; c++) b->ck_start[b->chunk[c].f + 1]++;
-    for (size_t f = 0; f < NFINE; f++) b->ck_start[f + 1] += b->ck_start[f];
-    memcpy(fill, b->ck_start, sizeof fill);
-    for (size_t c = 0; c < b->nchunk; c++) sorted[fill[b->chunk[c].f]++] = b->chunk[c];
-    free(b->chunk);
-    b->chunk = sorted;
-    return 1;
+    return b->ck_start && spill_group(&b->tlog, NFINE, b->ck_start);
 }
 
 static int set_slot(builder *b, uint32_t ev, int rank, int slot, int32_t val)
@@ -877,7 +892,7 @@ static void *group_worker_streamed(void *arg)
         size_t base = b->fine_off[J->run[k]], nb = b->fine_off[J->run[k + 1]] - base;
         if (!nb) continue;
         for (size_t c = b->ck_start[J->run[k]], got = 0; c < b->ck_start[J->run[k + 1]]; c++) {
-            const spill_chunk *ck = &b->chunk[c]; /* the run's chunks, bucket by bucket */
+            const spill_chunk *ck = &b->tlog.chunk[c]; /* the run's chunks, bucket by bucket */
             if (got + ck->n > nb ||
                 !pl->sget(pl->ctx, PDT_SCR_SPILL, ck->off, buf + got, ck->n * sizeof *buf)) {
                 J->io = 1;
@@ -1285,21 +1300,16 @@ static int points_pass(builder *b, const uint8_t *lifted_any)
         if (!pt_flush(b, w)) return 0;
     /* the chunks by window (each window's in the order written) */
     size_t *start = calloc(b->npw + 1, sizeof *start);
-    spill_chunk *sorted = malloc((b->npchunk ? b->npchunk : 1) * sizeof *sorted);
     uint32_t *lift = bmalloc(b, PT_WINDOW * sizeof *lift);
     pt_rec *rec = bmalloc(b, PBUF * sizeof *rec);
     pdt_point *lo = malloc(2 * q1 * sizeof *lo), *hi = malloc(2 * q1 * sizeof *hi);
     uint8_t *has = calloc(2 * q1, 1);  /* [0, q1): pushed points' boxes, [q1, 2 q1): lifted */
-    int ok = start && sorted && lift && rec && lo && hi && has;
-    for (size_t c = 0; ok && c < b->npchunk; c++) start[b->pchunk[c].f + 1]++;
-    for (size_t w = 0; ok && w < b->npw; w++) start[w + 1] += start[w];
-    for (size_t c = 0, *fill = start; ok && c < b->npchunk; c++) { /* (start moves to the ends) */
-        sorted[fill[b->pchunk[c].f]++] = b->pchunk[c];
-    }
+    int ok = start && lift && rec && lo && hi && has && spill_group(&b->plog, b->npw, start);
+    const spill_chunk *sorted = b->plog.chunk;
     for (size_t w = 0, c = 0; ok && w < b->npw; w++) {
         size_t p0 = w * PT_WINDOW, np = r->n - p0 < PT_WINDOW ? r->n - p0 : PT_WINDOW;
         memset(lift, 0xff, np * sizeof *lift);
-        for (; ok && c < start[w]; c++) { /* (start[w]: the end of window w's chunks) */
+        for (; ok && c < start[w + 1]; c++) {
             ok = pl->sget(pl->ctx, PDT_SCR_POINTS, sorted[c].off, rec, sorted[c].n * sizeof *rec);
             for (size_t j = 0; ok && j < sorted[c].n; j++) {
                 const pt_rec *t = &rec[j];
@@ -1327,7 +1337,6 @@ static int points_pass(builder *b, const uint8_t *lifted_any)
     }
     if (!ok) b->failed = 1;
     free(start);
-    free(sorted);
     bfree(b, lift, PT_WINDOW * sizeof *lift);
     bfree(b, rec, PBUF * sizeof *rec);
     free(lo);
@@ -1552,11 +1561,11 @@ out:
         free(b.fbuf);
     }
     free(b.pbn);
-    free(b.pchunk);
+    free(b.plog.chunk);
     free(b.tcount);
     free(b.fbn);
     free(b.spill);
-    free(b.chunk);
+    free(b.tlog.chunk);
     free(b.ck_start);
     free(b.win);
     km_free(&b.edge_map);
