@@ -480,10 +480,10 @@ typedef struct finals {
     size_t n[2];
 } finals;
 
-/* The buckets: 2^shift consecutive smallest indices each, at least 2048 of
- * them over [0, n_total) (the plain run's first counting pass: each bucket's
- * counters fit the cache) and about 256 per rank (a bucket is never split
- * between ranks), at most 2^16. */
+/* The buckets: 2^shift consecutive smallest indices each, as many over
+ * [0, n_total) as fit in max(2048, 256 p), at most 2^16: about 256 per rank
+ * (a bucket is never split between ranks), and narrow enough that one
+ * bucket's counters (8 bytes an index) stay a third of its triangles. */
 static int order_shift(const drv *d)
 {
     uint64_t top = d->n_total ? d->n_total - 1 : 0;
@@ -595,7 +595,8 @@ static pdt_status order_room_grp(drv *d, order_room *o, const finals *f)
 
 static pdt_status order_room_out(drv *d, order_room *o, const finals *f, size_t total)
 {
-    size_t busy = o->grp_own ? 0 : f->n[0] + f->n[0] + f->n[1]; /* below: grp */
+    size_t grp_end = f->n[0] + f->n[0] + f->n[1]; /* grp: behind the finals, as many */
+    size_t busy = o->grp_own ? 0 : grp_end;
     size_t got_at = o->cap;
     if (o->blk && total <= o->cap && o->cap - total >= busy) {
         got_at = o->cap - total;
