@@ -27,6 +27,8 @@
 # Environment: SIZES="100000 1000000 4000000 10000000" PS="1 2 4 8" RUNS=3
 #              QUICK=1 (SIZES="20000 100000" PS="1 2 8" RUNS=3: a minute)
 #              NICE=0 KEEP=0 (KEEP=1 keeps build/table1/*.txt inputs)
+#              MEMSTATE=warm|cold|asis: the memory state each timed command
+#              starts in (scripts/bench/memstate.sh; default warm)
 set -u
 cd "$(dirname "$0")/.."
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
@@ -41,6 +43,8 @@ PDT=$PWD/bin/pdt
 CORES=$(nproc)
 W=${TABLE1_DIR:-build/table1}
 mkdir -p "$W"
+. scripts/bench/memstate.sh
+memstate_build build/bench
 command -v mpirun > /dev/null || { echo "table1: mpirun not found" >&2; exit 1; }
 command -v python3 > /dev/null || { echo "table1: python3 not found" >&2; exit 1; }
 [ -x "$PDT" ] || { echo "table1: $PDT not built (make)" >&2; exit 1; }
@@ -52,6 +56,7 @@ command -v python3 > /dev/null || { echo "table1: python3 not found" >&2; exit 1
 run_once() {
     local label=$1 i=$2; shift 2
     local t0 t1
+    memstate_prepare "$WARM_MB"
     t0=$(date +%s.%N)
     /usr/bin/time -f "%S" -o "$W/$label.$i.sys" nice -n "$NICE" "$@" -o "$W/out.tri" --stats \
         2> "$W/$label.$i.json" > /dev/null || {
@@ -77,6 +82,7 @@ pieces() {
 ceiling_once() {
     local label=$1 k=$2
     local t0 t1
+    memstate_prepare "$WARM_MB"
     t0=$(date +%s.%N)
     /usr/bin/time -f "%S" -o "$W/$label.sys" bash -c '
         for i in $(seq 0 $(($2 - 1))); do
@@ -89,12 +95,14 @@ ceiling_once() {
 
 echo "pdt Table 1 — wall time against the plain run, uniform points, median of $RUNS runs"
 echo "machine: $CORES cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
+echo "memory state before each run: MEMSTATE=$MEMSTATE (scripts/bench/memstate.sh)"
 echo "uptime before: $(uptime)"
 echo
 # The runs of one size go in rounds (plain, each P, each ceiling, then again),
 # so that a change in the machine's state in the middle touches every row.
 for n in $SIZES; do
     in=$W/uniform-$n.txt
+    WARM_MB=$((n * 150 / 1000000 + 64)) # what a run of n points touches, with room
     [ -s "$in" ] || "$PDT" gen uniform "$n" --seed 1 -o "$in"
     ceil_ps=""
     for p in $PS; do [ "$p" -gt 1 ] && [ "$p" -le "$CORES" ] && ceil_ps="$ceil_ps $p"; done

@@ -16,6 +16,8 @@
 #   SCALING_QUICK=1  the same as SCALING_UNIFORM="1e5 1e6" SCALING_OTHER="1e6"
 # This section alone: make bench BENCH_ONLY=scaling (3*10^7 points need about
 # 2.5 GB for pdt (84 bytes per point), more for CGAL, and 0.5 GB of input text in build/bench).
+# MEMSTATE=warm|cold|asis: the memory state each timed run (pdt's and CGAL's)
+# starts in (scripts/bench/memstate.sh; default warm).
 # Inputs are cached in build/bench/scaling/.  The load average is printed
 # before and after: on a loaded machine the seconds measure the contention.
 set -u
@@ -33,6 +35,8 @@ else
     OTH=${SCALING_OTHER:-"1e6 1e7"}
 fi
 RUNS=${SCALING_RUNS:-1}
+. scripts/bench/memstate.sh
+memstate_build "$B"
 [ -x "$PDT" ] || { echo "bin/pdt is missing: run make first"; exit 1; }
 TIME=/usr/bin/time
 [ -x "$TIME" ] || { echo "scaling: /usr/bin/time missing (Debian package 'time'), skipped"; exit 0; }
@@ -53,6 +57,7 @@ num() { python3 -c "print(int(float('$1')))"; }
 
 RES=$W/results.tsv
 : > "$RES"
+echo "memory state before each run: MEMSTATE=$MEMSTATE (scripts/bench/memstate.sh)"
 echo "load before: $(uptime)"
 inputs=()
 for s in $UNI; do inputs+=("uniform:$s"); done
@@ -67,6 +72,8 @@ for spec in "${inputs[@]}"; do
         # a new output each run: replacing the last one would add its unlink to
         # the write phase (0.2 s for the 1.5 GB of 3*10^7 points here)
         rm -f "$W/out.tri"
+        warm_mb=$((n * 150 / 1000000 + 64)) # pdt's 84 bytes per point, the output's pages, room
+        memstate_prepare "$warm_mb"
         "$TIME" -f '%M %U %S' -o "$W/time.out" "$PDT" triangulate "$in" -o "$W/out.tri" --stats \
             2> "$W/run.err" > /dev/null || { echo "  pdt failed: $(tail -2 "$W/run.err")"; exit 1; }
         stats=$(grep '^{' "$W/run.err" | tail -1)
@@ -74,6 +81,7 @@ for spec in "${inputs[@]}"; do
         cpu=$(tail -1 "$W/time.out" | awk '{print $2 + $3}')
         cg=-
         if [ $HAVE_CGAL = 1 ]; then
+            memstate_prepare $((warm_mb * 2)) # CGAL holds more per point
             cg=$("$B/cgal_dt" "$in" | python3 -c 'import json,sys; print(json.load(sys.stdin)["build"])') || cg=-
         fi
         printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$kind" "$n" "$kib" "$cpu" "$cg" "$stats" >> "$RES"

@@ -390,8 +390,9 @@ static pdt_status local(drv *d, int prefault, pdt_err *err)
     unsigned char *blk = d->blk;
     d->blk = NULL;
     pdt_prefault *pf = NULL;
-    if (prefault) { /* the kernel's edges grow past the partition's records */
-        size_t front = 2 * d->blk_cap * sizeof(srm_rec), work = PDT_DELAUNAY_WORK(d->blk_cap);
+    if (prefault) { /* the kernel's edges grow past the partition's records, up to its
+                     * bound for this strip's points (the block has room for more) */
+        size_t front = 2 * d->blk_cap * sizeof(srm_rec), work = PDT_DELAUNAY_WORK(d->m);
         pdt_range edges = {blk + front, work > front ? work - front : 0};
         pf = pdt_prefault_start(&edges, 1);
         d->me->prefault = pf != NULL;

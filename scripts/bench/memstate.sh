@@ -1,0 +1,38 @@
+# Sourced by the benchmarks that time whole runs (table1.sh, bench/60-scaling.sh).
+#
+# The memory state a timed run starts in, MEMSTATE:
+#   warm (default)  just before the run, build/bench/warm touches and frees
+#                   enough memory for it: the run meets memory the machine
+#                   has backed, as on a machine without free page reporting;
+#   cold            3 s of pause before the run: the VM has handed its free
+#                   memory back to the host, and every page the run touches
+#                   first costs about 1.25 s per GiB (this project's VMs);
+#   asis            neither (the state the previous commands left: what
+#                   these benchmarks did before 26 Nov 2026).
+# See tools/warm.c and docs/geometry.md, "Fresh memory".
+MEMSTATE=${MEMSTATE:-warm}
+case "$MEMSTATE" in
+    warm|cold|asis) ;;
+    *) echo "MEMSTATE=$MEMSTATE: expected warm, cold or asis" >&2; exit 2 ;;
+esac
+
+# memstate_build BUILD_DIR: compile the warm tool into BUILD_DIR/warm
+memstate_build() {
+    local b=$1 src
+    src=$(dirname "${BASH_SOURCE[0]}")/tools/warm.c
+    [ "$MEMSTATE" = warm ] || return 0
+    if [ ! -x "$b/warm" ] || [ "$src" -nt "$b/warm" ]; then
+        mkdir -p "$b"
+        cc -O2 -pthread -o "$b/warm" "$src" || { echo "memstate: cannot compile $src" >&2; exit 1; }
+    fi
+    MEMSTATE_WARM=$b/warm
+}
+
+# memstate_prepare MB: put the machine in MEMSTATE before a timed run that
+# touches up to MB megabytes
+memstate_prepare() {
+    case "$MEMSTATE" in
+        warm) "$MEMSTATE_WARM" "$1" ;;
+        cold) sleep 3 ;;
+    esac
+}
