@@ -8,7 +8,10 @@
 # median of RUNS runs of
 #   wall       the whole `mpirun -np P pdt triangulate IN -o OUT` (MPI
 #              start-up, read, compute, write) and of the plain run;
-#   speedup    plain wall / wall;
+#   speedup    plain wall / wall, the plain run being the faster of the
+#              default (from 2^18 points: two strips one after the other, to
+#              save memory) and the whole kernel at once (PDT_PLAIN_STRIPS=0),
+#              both shown;
 #   phases     read, partition, local, merge, order, write: seconds, the
 #              largest over the ranks (from `--stats` per_rank[].seconds;
 #              older builds without it: rank 0's read and write, and
@@ -108,10 +111,12 @@ for n in $SIZES; do
     for p in $PS; do [ "$p" -gt 1 ] && [ "$p" -le "$CORES" ] && ceil_ps="$ceil_ps $p"; done
     for p in $ceil_ps; do pieces "$p" "$in"; done
     : > "$W/seq-$n.runs"
+    : > "$W/whole-$n.runs"
     for p in $PS; do : > "$W/p$p-$n.runs"; done
     for p in $ceil_ps; do : > "$W/ceil$p-$n.runs"; done
     for i in $(seq 1 "$RUNS"); do
         run_once "seq-$n" "$i" "$PDT" triangulate "$in"
+        run_once "whole-$n" "$i" env PDT_PLAIN_STRIPS=0 "$PDT" triangulate "$in"
         for p in $PS; do run_once "p$p-$n" "$i" mpirun -np "$p" "$PDT" triangulate "$in"; done
         for p in $ceil_ps; do ceiling_once "ceil$p-$n" "$p"; done
     done

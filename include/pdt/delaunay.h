@@ -58,6 +58,10 @@ pdt_status pdt_delaunay_hull_on(pdt_point *pts, size_t n, uint32_t *id, void *wo
  * canonical output order, identical for every algorithm and every rank count. */
 void pdt_tri_canonical(pdt_tri *tris, size_t ntri);
 
+/* The same with the caller's scratch: room for ntri triangles overlapping
+ * tris nowhere (nothing of size ntri is allocated). */
+void pdt_tri_canonical_on(pdt_tri *tris, size_t ntri, pdt_tri *scratch);
+
 /* The kernel for one strip of a parallel run (untraced), leaving the points
  * in its own order: pts[0, n) distinct and sorted, name[i] the name of
  * pts[i], work as for pdt_delaunay_on.  Afterwards pts and name are in the

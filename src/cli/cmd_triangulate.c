@@ -319,7 +319,8 @@ static void json_rank(int q, const pdt_par_rank_stats *r)
             "\"merges\": %llu, \"border_max\": %llu, \"kept\": %llu, \"discarded\": %llu, "
             "\"final_by_merge\": %llu, \"emitted\": %llu, \"written\": %llu, "
             "\"bytes_sent\": %llu, \"bytes_received\": %llu, \"merge_bytes_sent\": %llu, "
-            "\"merge_bytes_received\": %llu, \"critical_path_s\": %.6f, \"prefault\": %s}",
+            "\"merge_bytes_received\": %llu, \"critical_path_s\": %.6f, \"prefault\": %s, "
+            "\"strips\": %d}",
             (long long)r->peak_rss_kib, (unsigned long long)r->points,
             (unsigned long long)r->local_tris, (unsigned long long)r->final_at_once,
             (unsigned long long)r->deferred, (unsigned long long)r->shipped,
@@ -329,7 +330,7 @@ static void json_rank(int q, const pdt_par_rank_stats *r)
             (unsigned long long)r->written, (unsigned long long)r->bytes_sent,
             (unsigned long long)r->bytes_recv, (unsigned long long)r->merge_bytes_sent,
             (unsigned long long)r->merge_bytes_recv, r->critical_path,
-            r->prefault ? "true" : "false");
+            r->prefault ? "true" : "false", (int)r->strips);
 }
 
 /* The communication figures of an MPI run and per_rank[] again (what make

@@ -904,6 +904,11 @@ void pdt_tri_canonical(pdt_tri *tris, size_t ntri)
     canonical(tris, tris, ntri, NULL);
 }
 
+void pdt_tri_canonical_on(pdt_tri *tris, size_t ntri, pdt_tri *scratch)
+{
+    canonical(tris, tris, ntri, scratch);
+}
+
 /* ---- the canonical order in buckets (spread over ranks) ---- */
 
 void pdt_tri_bucket_count(pdt_tri *t, size_t n, int shift, uint64_t *hist)

@@ -167,6 +167,22 @@ static int send_level(const srm_rank *s, int h, int from, srm_pt a, srm_pt b, sr
 
 /* ---- set-up ---------------------------------------------------------------- */
 
+srm_strip pdt_srm_strip_of(const pdt_point *pts, size_t m)
+{
+    srm_strip st = {m, 0, 0, 0, 0, 0, 0};
+    if (m == 0) return st;
+    st.first_key = pdt_key(pts[0]);
+    st.last_key = pdt_key(pts[m - 1]);
+    st.xmin = pts[0].x;
+    st.xmax = pts[m - 1].x;
+    st.ymin = st.ymax = pts[0].y;
+    for (size_t i = 1; i < m; i++) {
+        if (pts[i].y < st.ymin) st.ymin = pts[i].y;
+        if (pts[i].y > st.ymax) st.ymax = pts[i].y;
+    }
+    return st;
+}
+
 pdt_status pdt_srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pdt_trace *tr,
                     pdt_err *err)
 {

@@ -18,6 +18,7 @@
 #include <stdlib.h>
 
 #include "../geom/bigmem.h"
+#include "pdt/delaunay.h"
 
 /* A point with its identity: global input index of its representative. */
 typedef struct srm_pt {
@@ -203,6 +204,9 @@ typedef struct srm_rank {
     void *clock_user;
 } srm_rank;
 
+/* The descriptor of a strip of m distinct points in lexicographic order. */
+srm_strip pdt_srm_strip_of(const pdt_point *pts, size_t m);
+
 /* Set up (strip: p descriptors, kept by pointer).  Frees with pdt_srm_free. */
 pdt_status pdt_srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pdt_trace *tr,
                     pdt_err *err);
@@ -243,5 +247,21 @@ pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t 
 
 /* ceil(log2 p): the number of merge levels. */
 int pdt_srm_ceil_log2(int p);
+
+/* ---- plain.c: the plain run on strips, one after the other ---------------- */
+
+#define PDT_PLAIN_MAX_STRIPS 16
+
+/* The pipeline of pdt_triangulate_inplace (PDT_PTS_SPEND, untraced) run as
+ * SRM on k >= 2 strips of the sorted points, one strip after the other in one
+ * block: strip s's kernel writes its final triangles where strip s-1's end,
+ * so the block holds the edges of one strip and the triangles found so far
+ * instead of the edges of all points (62 bytes per point at the peak instead
+ * of 84 with k = 2).  The triangles and stats are those of
+ * pdt_triangulate_inplace (the SRM's output is T* for any number of strips);
+ * pts[] are spent.  With `prefault` a second thread faults the block in
+ * ahead of use. */
+pdt_status pdt_srm_plain(pdt_point *pts, size_t n, int k, int prefault, pdt_tri **tris,
+                         size_t *ntri, pdt_tri_stats *stats, pdt_err *err);
 
 #endif

@@ -1,0 +1,213 @@
+/* pdt — the plain run on strips, one after the other (pdt_srm_plain in
+ * srm.h): the memory of the sequential pipeline cut by the thesis' own
+ * algorithm.
+ *
+ * The kernel on all n points holds 72 bytes of edge records per point at
+ * its end (docs/geometry.md); with the points (8) and their input indices
+ * (4) the plain run peaked at 84 bytes per point.  Here the sorted points
+ * are cut into k strips by count, as k ranks would hold them, and SRM
+ * (algorithm.md §3) runs on one strip after the other in one block R:
+ *
+ *   R[0, 48n)   the sort's records and sorted points (pdt_sort_unique_on);
+ *   then        strip 0's kernel at R's front: its final triangles stay at
+ *               the front (12 bytes each, about 24 bytes per point of the
+ *               strip), strip 1's kernel right after them, and so on: R
+ *               holds the edges of one strip and the triangles of the strips
+ *               before it (k = 2: 12 + 36 bytes per point);
+ *   then        the merges (border sets only: the SRM's own small arrays),
+ *               their triangles appended, the canonical order with the room
+ *               that is left as scratch.
+ *
+ * Peak: the points (8), their indices (4), R (48) and one strip's kernel
+ * scratch (4 per point of the strip): about 62 bytes per point with k = 2.
+ * The output is the same triangles in the same order: the SRM's final
+ * triangles are T* for any number of strips (tests: par_same, plain_strips). */
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "pdt/delaunay.h"
+#include "srm.h"
+
+static double mono(void *user)
+{
+    (void)user;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* The plan: strip s is pts[first[s], first[s + 1]). */
+typedef struct plan {
+    int k;
+    size_t first[PDT_PLAIN_MAX_STRIPS + 1];
+    srm_strip strip[PDT_PLAIN_MAX_STRIPS];
+    srm_rank rk[PDT_PLAIN_MAX_STRIPS];
+    int init[PDT_PLAIN_MAX_STRIPS];
+} plan;
+
+/* R's size for n input points on k strips, the most of: the sort's records
+ * and sorted points; for each strip s, the triangles of the strips before it
+ * (at most 2 per point: 24 bytes) and its kernel (with the n' <= n distinct
+ * points a strip may hold one point more); all triangles and the canonical
+ * order's scratch as many again (48 bytes per point). */
+static size_t block_bytes(size_t n, int k)
+{
+    size_t need = PDT_SORT_WORK(n) + n * sizeof(pdt_point);
+    for (int s = 0; s < k; s++) {
+        size_t a = n * (size_t)s / (size_t)k, b = n * (size_t)(s + 1) / (size_t)k;
+        size_t strip = 24 * a + PDT_DELAUNAY_WORK(b - a + 1);
+        if (strip > need) need = strip;
+    }
+    if (48 * n > need) need = 48 * n;
+    return need + 256;
+}
+
+/* Sort and dedupe: pts[0, nu) the distinct points in lexicographic order,
+ * order[i] the input index of pts[i] (the smallest among equal points). */
+static void sort_points(pdt_point *pts, size_t n, unsigned char *R, uint32_t *order, size_t *nu)
+{
+    pdt_point *q = (pdt_point *)(void *)(R + PDT_SORT_WORK(n));
+    pdt_sort_unique_on(pts, n, R, order, q, nu);
+    memcpy(pts, q, *nu * sizeof *pts);
+}
+
+/* Strip s's local phase in R at *off: its final triangles end at R + *off
+ * (advanced past them, an odd one set aside in *spare so the next strip's
+ * block stays 8-byte aligned). */
+static pdt_status strip_local(plan *P, int s, pdt_point *pts, uint32_t *order, uint32_t *id,
+                              unsigned char *R, size_t *off, pdt_tri *spare, size_t *nspare,
+                              pdt_err *err)
+{
+    srm_rank *S = &P->rk[s];
+    pdt_status st = pdt_srm_init(S, s, P->k, P->strip, NULL, err);
+    if (st != PDT_OK) return st;
+    P->init[s] = 1;
+    S->clock = mono;
+    size_t a = P->first[s], m = P->first[s + 1] - a;
+    pdt_tri *fin = (pdt_tri *)(void *)(R + *off);
+    st = pdt_srm_local(S, fin, pts + a, order + a, id, m, err);
+    size_t nf = S->nfin;
+    S->fin = NULL; /* R's, not the state's */
+    S->nfin = 0;
+    if (st != PDT_OK) return st;
+    if (nf % 2) spare[(*nspare)++] = fin[--nf];
+    *off += nf * sizeof *fin;
+    return PDT_OK;
+}
+
+/* The merge tree over the strips, level by level: every strip of a pair
+ * packs its message, the pair's merge strip merges them. */
+static pdt_status merge_tree(plan *P, pdt_err *err)
+{
+    pdt_status st = PDT_OK;
+    int levels = pdt_srm_ceil_log2(P->k);
+    void *msg[PDT_PLAIN_MAX_STRIPS];
+    size_t len[PDT_PLAIN_MAX_STRIPS];
+    for (int level = 0; level < levels && st == PDT_OK; level++) {
+        for (int gl = 0; gl < P->k && st == PDT_OK;) {
+            int l, gr, ge;
+            if (!pdt_srm_pair(gl, P->k, level, &l, &gr, &ge) || l != gl) {
+                gl++; /* alone at this level (a pair starts at its first strip) */
+                continue;
+            }
+            memset(msg, 0, sizeof msg);
+            for (int r = gl; r < ge && st == PDT_OK; r++)
+                st = pdt_srm_pack(&P->rk[r], level, &msg[r - gl], &len[r - gl], err);
+            if (st == PDT_OK) st = pdt_srm_merge(&P->rk[gr], level, msg, len, err);
+            for (int r = gl; r < ge; r++) free(msg[r - gl]);
+            gl = ge;
+        }
+    }
+    for (int s = 0; s < P->k && st == PDT_OK; s++)
+        if (P->rk[s].npend)
+            st = pdt_err_set(err, PDT_ERR_CHECK, "strip %d: %zu triangles still pending after "
+                             "the last merge", s, P->rk[s].npend);
+    return st;
+}
+
+/* The triangles the merges made, and those set aside, after the strips'
+ * ones at t[nt]: the new count. */
+static size_t append_rest(plan *P, pdt_tri *t, size_t nt, const pdt_tri *spare, size_t nspare)
+{
+    memcpy(t + nt, spare, nspare * sizeof *t);
+    nt += nspare;
+    for (int s = 0; s < P->k; s++) {
+        if (P->rk[s].nmore) memcpy(t + nt, P->rk[s].more, P->rk[s].nmore * sizeof *t);
+        nt += P->rk[s].nmore;
+    }
+    return nt;
+}
+
+pdt_status pdt_srm_plain(pdt_point *pts, size_t n, int k, int prefault, pdt_tri **tris,
+                         size_t *ntri, pdt_tri_stats *stats, pdt_err *err)
+{
+    *tris = NULL;
+    *ntri = 0;
+    memset(stats, 0, sizeof *stats);
+    stats->n_in = n;
+    if (k < 2 || k > PDT_PLAIN_MAX_STRIPS || n > PDT_KERNEL_MAX_POINTS)
+        return pdt_err_set(err, PDT_ERR_ARG, "plain strips: %d strips of %zu points", k, n);
+    double t0 = mono(NULL);
+    size_t bytes = block_bytes(n, k), big = n / (size_t)k + 2;
+    unsigned char *R = srm_big(bytes);
+    uint32_t *order = srm_big((n + 1) * sizeof *order), *id = malloc(big * sizeof *id);
+    plan *P = calloc(1, sizeof *P);
+    pdt_status st = R && order && id && P ? PDT_OK : pdt_err_set(err, PDT_ERR_NOMEM,
+                                                                 "out of memory");
+    pdt_prefault *pf = NULL;
+    if (st == PDT_OK && prefault && bytes >= (8u << 20)) {
+        /* as the sort and the strips use them: the sort's bucket writes
+         * (R[16n, 24n)), the index list, its other records, then the rest
+         * where the strips' edges grow, and the kernel's scratch ids */
+        pdt_range rr[5] = {{R + 16 * n, 8 * n}, {order, n * sizeof *order}, {R, 16 * n},
+                           {R + 24 * n, bytes - 24 * n}, {id, big * sizeof *id}};
+        pf = pdt_prefault_start(rr, 5);
+        stats->prefaulted = pf != NULL;
+    }
+    size_t nu = 0, nt = 0, nspare = 0, off = 0;
+    pdt_tri spare[PDT_PLAIN_MAX_STRIPS];
+    if (st == PDT_OK) sort_points(pts, n, R, order, &nu);
+    double t1 = mono(NULL);
+    if (st == PDT_OK) {
+        P->k = k;
+        for (int s = 0; s <= k; s++) P->first[s] = nu * (size_t)s / (size_t)k;
+        for (int s = 0; s < k; s++)
+            P->strip[s] = pdt_srm_strip_of(pts + P->first[s], P->first[s + 1] - P->first[s]);
+    }
+    for (int s = 0; s < k && st == PDT_OK; s++)
+        st = strip_local(P, s, pts, order, id, R, &off, spare, &nspare, err);
+    if (st == PDT_OK) st = merge_tree(P, err);
+    pdt_prefault_stop(pf);
+    double t2 = mono(NULL);
+    pdt_tri *t = (pdt_tri *)(void *)R;
+    if (st == PDT_OK) {
+        nt = append_rest(P, t, off / sizeof *t, spare, nspare);
+        pdt_tri_canonical_on(t, nt, t + nt);
+    }
+    double t3 = mono(NULL);
+    for (int s = 0; s < k; s++)
+        if (P && P->init[s]) pdt_srm_free(&P->rk[s]);
+    free(P);
+    free(order);
+    free(id);
+    if (st != PDT_OK || nt == 0) {
+        free(R);
+        R = NULL;
+    } else {
+        pdt_tri *shrunk = realloc(R, nt * sizeof *shrunk);
+        if (shrunk) R = (unsigned char *)shrunk;
+    }
+    if (st != PDT_OK) return st;
+    stats->n_unique = nu;
+    stats->n_dup = n - nu;
+    stats->n_tri = nt;
+    stats->collinear = nt == 0;
+    stats->n_hull = nt ? 2 * nu - 2 - nt : nu; /* Euler, as the plain pipeline counts it */
+    stats->t_sort = t1 - t0;
+    stats->t_kernel = t2 - t1;
+    stats->t_canon = t3 - t2;
+    *tris = (pdt_tri *)(void *)R;
+    *ntri = nt;
+    return PDT_OK;
+}

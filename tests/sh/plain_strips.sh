@@ -1,0 +1,80 @@
+#!/bin/bash
+# The plain run on strips (src/par/plain.c): an untraced run with a .tri
+# output of at least 2^18 points sorts its points, cuts them into 2 strips
+# and runs SRM on one strip after the other in one block, to hold the edges
+# of half the points instead of all.  The triangles must be the bytes of the
+# whole kernel's, on every generator family (grids, circles, collinear runs,
+# duplicates) and every size down to 1 point; PDT_PLAIN_STRIPS=K forces
+# K strips (0: the whole kernel) at any size.  --stats says which way a run
+# went (per_rank[].strips) and has the same figures both ways; the peak
+# memory of a 6*10^5-point run is measured, not timed.
+# san: yes
+source "$(dirname "$0")/lib.sh"
+cd "$TMP"
+
+# same NAME IN K: `pdt triangulate IN` with K strips writes ref.tri's bytes and
+# the same figures (and says it worked on K strips)
+same() {
+    local name=$1 in=$2 k=$3
+    if ! PDT_PLAIN_STRIPS=$k "$PDT" triangulate "$in" -o out.tri --stats > /dev/null \
+        2> out.json; then
+        fail "$name" "exit non-zero: $(head -3 out.json)"
+    elif ! cmp -s ref.tri out.tri; then
+        fail "$name" "output differs from the whole kernel's ($(wc -l < out.tri) vs $(wc -l < ref.tri) lines)"
+    elif [ "$(figures out.json)" != "$(figures ref.json)" ]; then
+        fail "$name" "figures differ: $(figures out.json) vs $(figures ref.json)"
+    elif ! grep -q "\"strips\": $k}" out.json; then
+        fail "$name" "per_rank[].strips is not $k: $(grep -o '"strips": [0-9]*' out.json)"
+    else
+        ok "$name"
+    fi
+}
+figures() { grep -o '"\(n\|unique\|duplicates\|triangles\|hull\|collinear\)": [a-z0-9]*' "$1" | tr '\n' ' '; }
+
+for kind in uniform grid circle circle-round parabola clusters collinear duplicates column; do
+    for n in 1 2 3 4 7 40 1000; do
+        in=$kind-$n.txt
+        "$PDT" gen "$kind" "$n" --seed 3 -o "$in" 2> /dev/null || continue
+        PDT_PLAIN_STRIPS=0 "$PDT" triangulate "$in" -o ref.tri --stats > /dev/null \
+            2> ref.json || { fail "whole_${kind}_$n" "$(head -3 ref.json)"; continue; }
+        for k in 2 3 5 16; do same "${kind}_${n}_k$k" "$in" "$k"; done
+    done
+done
+
+# by default: 2 strips from 2^18 points on, the whole kernel below, traced or
+# with points to write (.ele needs the points back in input order)
+"$PDT" gen clusters 600000 --seed 7 -o big.txt || fail gen_big
+PDT_PLAIN_STRIPS=0 /usr/bin/time -f "%M" -o whole.kib "$PDT" triangulate big.txt -o ref.tri \
+    --stats > /dev/null 2> ref.json || fail whole_big "$(head -3 ref.json)"
+/usr/bin/time -f "%M" -o strips.kib "$PDT" triangulate big.txt -o out.tri --stats > /dev/null \
+    2> out.json || fail strips_big "$(head -3 out.json)"
+if cmp -s ref.tri out.tri && grep -q '"strips": 2}' out.json; then
+    ok default_big_two_strips
+else
+    fail default_big_two_strips "$(grep -o '"strips": [0-9]*' out.json), cmp $(cmp ref.tri out.tri 2>&1)"
+fi
+# (the whole kernel holds 72 bytes of edges per point, two strips 36 + 12:
+# about 84 against 62 bytes per point, plus the program)
+whole=$(tail -1 whole.kib) strips=$(tail -1 strips.kib)
+if [ "$BIN" != "$ROOT/bin" ]; then
+    ok "peak_memory_smaller # skip: sanitizer build ($strips vs $whole KiB)"
+elif [ "$strips" -lt $((whole * 85 / 100)) ]; then
+    ok "peak_memory_smaller # $strips KiB against $whole KiB"
+else
+    fail peak_memory_smaller "$strips KiB against $whole KiB (want below 85 %)"
+fi
+"$PDT" gen uniform 300000 --seed 2 -o mid.txt || fail gen_mid
+for case in "below:200000:0:tri" "traced:300000:0:tri" "ele:300000:0:ele"; do
+    IFS=: read -r name n want ext <<< "$case"
+    head -"$n" mid.txt > c.txt
+    extra=()
+    [ "$name" = traced ] && extra=(--trace run)
+    rm -rf run
+    if "$PDT" triangulate c.txt -o "c.$ext" "${extra[@]}" --stats > /dev/null 2> c.json &&
+        grep -q "\"strips\": $want}" c.json; then
+        ok "default_${name}_whole_kernel"
+    else
+        fail "default_${name}_whole_kernel" "$(grep -o '"strips": [0-9]*' c.json) $(head -2 c.json)"
+    fi
+done
+summary
