@@ -1,7 +1,7 @@
 # Sourced by the benchmarks that time whole runs (table1.sh, bench/60-scaling.sh).
 #
 # The memory state a timed run starts in, MEMSTATE:
-#   warm (default)  just before the run, build/bench/warm touches and frees
+#   warm (default)  just before the run (after a sync), build/bench/warm touches and frees
 #                   enough memory for it: the run meets memory the machine
 #                   has backed, as on a machine without free page reporting;
 #   cold            3 s of pause before the run: the VM has handed its free
@@ -29,10 +29,13 @@ memstate_build() {
 }
 
 # memstate_prepare MB: put the machine in MEMSTATE before a timed run that
-# touches up to MB megabytes
+# touches up to MB megabytes.  warm and cold first wait for the files written
+# so far to reach the disk (sync): a run at 3*10^7 points writes 1.5 GB, and
+# the next run's write phase met that file's writeback (0.97-1.07 s after a
+# sync, up to 1.49 s without).
 memstate_prepare() {
     case "$MEMSTATE" in
-        warm) "$MEMSTATE_WARM" "$1" ;;
-        cold) sleep 3 ;;
+        warm) sync; "$MEMSTATE_WARM" "$1" ;;
+        cold) sync; sleep 3 ;;
     esac
 }
