@@ -9,7 +9,7 @@
 #   wall       the whole `mpirun -np P pdt triangulate IN -o OUT` (MPI
 #              start-up, read, compute, write) and of the plain run;
 #   speedup    plain wall / wall, the plain run being the faster of the
-#              default (from 2^18 points: two strips one after the other, to
+#              default (from 2^21 points: two strips one after the other, to
 #              save memory) and the whole kernel at once (PDT_PLAIN_STRIPS=0),
 #              both shown;
 #   phases     read, partition, local, merge, order, write: seconds, the

@@ -125,7 +125,7 @@ def main():
         print(line)
     print()
     print("wall = the whole command (MPI start-up, read, compute, write); speedup = plain wall / wall,")
-    print("the plain run being the faster of the two plain rows (default: from 2^18 points two strips")
+    print("the plain run being the faster of the two plain rows (default: from 2^21 points two strips")
     print("one after the other, 62 bytes per point; PDT_PLAIN_STRIPS=0: the whole kernel, 84).")
     print("sys = the command's system CPU seconds (all its processes), median: memory the VM has")
     print("handed back to its host costs about 1.25 s per GiB on first touch (0.05 s when it was in")
