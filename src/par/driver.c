@@ -12,7 +12,9 @@
  *              range (ranges balanced by a histogram) and are put in
  *              canonical order there: rank q ends with a consecutive block.
  *
- * With one rank the sequential pipeline (pdt_triangulate) does all of it. */
+ * With one rank the sequential pipeline does all of it: pdt_triangulate_inplace,
+ * or for a large untraced .tri run the same SRM on two strips one after the
+ * other in one process (pdt_srm_plain, plain.c), to hold less memory. */
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -706,8 +708,6 @@ static double cpu_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* One rank: the sequential pipeline on the whole input, its figures in the
- * same shape; the trace gets the final triangles as a parallel run does. */
 /* How many strips a plain run works on one after the other (pdt_srm_plain):
  * 2 for an untraced run of at least 2^21 points whose points may be spent
  * (a .tri output), else 0 (the whole kernel at once: traces keep the events
@@ -726,6 +726,9 @@ static int plain_strips(const pdt_par_input *in, const pdt_trace *tr)
     return in->n >= ((size_t)1 << 21) ? 2 : 0;
 }
 
+/* One rank: the sequential pipeline on the whole input (the whole kernel, or
+ * plain_strips strips one after the other), its figures in the same shape;
+ * the trace gets the final triangles as a parallel run does. */
 static pdt_status sequential(pdt_comm *c, pdt_par_input *in, pdt_par_output *out,
                              pdt_par_rank_stats *me, pdt_trace *tr, pdt_err *err)
 {
