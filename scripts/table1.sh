@@ -31,7 +31,7 @@
 #              QUICK=1 (SIZES="20000 100000" PS="1 2 8" RUNS=3: a minute)
 #              NICE=0 KEEP=0 (KEEP=1 keeps build/table1/*.txt inputs)
 #              MEMSTATE=warm|cold|asis: the memory state each timed command
-#              starts in (scripts/bench/memstate.sh; default warm)
+#              starts in (scripts/bench/tools/memstate.sh; default warm)
 set -u
 cd "$(dirname "$0")/.."
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
@@ -46,7 +46,7 @@ PDT=$PWD/bin/pdt
 CORES=$(nproc)
 W=${TABLE1_DIR:-build/table1}
 mkdir -p "$W"
-. scripts/bench/memstate.sh
+. scripts/bench/tools/memstate.sh
 memstate_build build/bench
 command -v mpirun > /dev/null || { echo "table1: mpirun not found" >&2; exit 1; }
 command -v python3 > /dev/null || { echo "table1: python3 not found" >&2; exit 1; }
@@ -103,7 +103,7 @@ ceiling_once() {
 
 echo "pdt Table 1 — wall time against the plain run, uniform points, median of $RUNS runs"
 echo "machine: $CORES cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
-echo "memory state before each run: MEMSTATE=$MEMSTATE (scripts/bench/memstate.sh)"
+echo "memory state before each run: MEMSTATE=$MEMSTATE (scripts/bench/tools/memstate.sh)"
 echo "uptime before: $(uptime)"
 echo
 # The runs of one size go in rounds (plain, each P, each ceiling, then again),

@@ -17,7 +17,7 @@
 # This section alone: make bench BENCH_ONLY=scaling (3*10^7 points need about
 # 2.5 GB for pdt (84 bytes per point), more for CGAL, and 0.5 GB of input text in build/bench).
 # MEMSTATE=warm|cold|asis: the memory state each timed run (pdt's and CGAL's)
-# starts in (scripts/bench/memstate.sh; default warm).
+# starts in (scripts/bench/tools/memstate.sh; default warm).
 # Inputs are cached in build/bench/scaling/.  The load average is printed
 # before and after: on a loaded machine the seconds measure the contention.
 set -u
@@ -35,7 +35,7 @@ else
     OTH=${SCALING_OTHER:-"1e6 1e7"}
 fi
 RUNS=${SCALING_RUNS:-1}
-. scripts/bench/memstate.sh
+. scripts/bench/tools/memstate.sh
 memstate_build "$B"
 [ -x "$PDT" ] || { echo "bin/pdt is missing: run make first"; exit 1; }
 TIME=/usr/bin/time
@@ -57,7 +57,7 @@ num() { python3 -c "print(int(float('$1')))"; }
 
 RES=$W/results.tsv
 : > "$RES"
-echo "memory state before each run: MEMSTATE=$MEMSTATE (scripts/bench/memstate.sh)"
+echo "memory state before each run: MEMSTATE=$MEMSTATE (scripts/bench/tools/memstate.sh)"
 echo "load before: $(uptime)"
 inputs=()
 for s in $UNI; do inputs+=("uniform:$s"); done

@@ -1,6 +1,6 @@
 /* build/bench/warm MB: touch MB megabytes of new memory on every CPU, then
  * give them back: the memory state the benchmarks' MEMSTATE=warm asks for
- * before each timed run (scripts/bench/memstate.sh).
+ * before each timed run (scripts/bench/tools/memstate.sh).
  *
  * On this project's VMs the guest hands memory it has not used for about
  * 2 s back to the host (virtio-balloon free page reporting); touching such

@@ -9,7 +9,7 @@
 #                   first costs about 1.25 s per GiB (this project's VMs);
 #   asis            neither (the state the previous commands left: what
 #                   these benchmarks did before 26 Nov 2026).
-# See tools/warm.c and docs/geometry.md, "Fresh memory".
+# See warm.c beside this file and docs/geometry.md, "Fresh memory".
 MEMSTATE=${MEMSTATE:-warm}
 case "$MEMSTATE" in
     warm|cold|asis) ;;
@@ -19,7 +19,7 @@ esac
 # memstate_build BUILD_DIR: compile the warm tool into BUILD_DIR/warm
 memstate_build() {
     local b=$1 src
-    src=$(dirname "${BASH_SOURCE[0]}")/tools/warm.c
+    src=$(dirname "${BASH_SOURCE[0]}")/warm.c
     [ "$MEMSTATE" = warm ] || return 0
     if [ ! -x "$b/warm" ] || [ "$src" -nt "$b/warm" ]; then
         mkdir -p "$b"
