@@ -22,6 +22,7 @@
  * scratch (4 per point of the strip): about 62 bytes per point with k = 2.
  * The output is the same triangles in the same order: the SRM's final
  * triangles are T* for any number of strips (tests: par_same, plain_strips). */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -139,6 +140,20 @@ static size_t append_rest(plan *P, pdt_tri *t, size_t nt, const pdt_tri *spare, 
     return nt;
 }
 
+/* A failure worded for a plain run, as the whole kernel's are ("triangulation
+ * failed: ..."), a strip named as such where the SRM's message names a rank. */
+static pdt_status plain_failure(pdt_status st, int k, pdt_err *err)
+{
+    if (!err) return st;
+    char was[sizeof err->msg];
+    snprintf(was, sizeof was, "%s", err->msg[0] ? err->msg : pdt_status_str(st));
+    pdt_err_clear(err);
+    int r = 0, at = 0;
+    if (sscanf(was, "rank %d: %n", &r, &at) == 1 && at > 0)
+        return pdt_err_set(err, st, "triangulation failed: strip %d of %d: %s", r + 1, k, was + at);
+    return pdt_err_set(err, st, "triangulation failed: %s", was);
+}
+
 pdt_status pdt_srm_plain(pdt_point *pts, size_t n, int k, int prefault, pdt_tri **tris,
                          size_t *ntri, pdt_tri_stats *stats, pdt_err *err)
 {
@@ -147,7 +162,8 @@ pdt_status pdt_srm_plain(pdt_point *pts, size_t n, int k, int prefault, pdt_tri 
     memset(stats, 0, sizeof *stats);
     stats->n_in = n;
     if (k < 2 || k > PDT_PLAIN_MAX_STRIPS || n > PDT_KERNEL_MAX_POINTS)
-        return pdt_err_set(err, PDT_ERR_ARG, "plain strips: %d strips of %zu points", k, n);
+        return pdt_err_set(err, PDT_ERR_ARG, "triangulation failed: %d strips of %zu points", k,
+                           n);
     double t0 = mono(NULL);
     size_t bytes = block_bytes(n, k), big = n / (size_t)k + 2;
     unsigned char *R = srm_big(bytes);
@@ -198,7 +214,7 @@ pdt_status pdt_srm_plain(pdt_point *pts, size_t n, int k, int prefault, pdt_tri 
         pdt_tri *shrunk = realloc(R, nt * sizeof *shrunk);
         if (shrunk) R = (unsigned char *)shrunk;
     }
-    if (st != PDT_OK) return st;
+    if (st != PDT_OK) return plain_failure(st, k, err);
     stats->n_unique = nu;
     stats->n_dup = n - nu;
     stats->n_tri = nt;

@@ -701,7 +701,8 @@ static pdt_status border_kernel(merge_job *j)
     if (tr) tr->gid = j->bg;
     pdt_status st = pdt_delaunay(j->bp, nb, &j->tris, &j->ntri, 1, tr);
     if (tr) tr->gid = saved;
-    if (st != PDT_OK) return pdt_err_set(j->err, st, "rank %d: border kernel failed", s->rank);
+    if (st != PDT_OK) return pdt_err_set(j->err, st, "rank %d: border kernel failed (%s)", s->rank,
+                                         pdt_status_str(st));
     return PDT_OK;
 }
 

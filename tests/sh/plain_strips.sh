@@ -76,4 +76,29 @@ for case in "below:2000000:0:tri" "traced:2200000:0:tri" "ele:2200000:0:ele"; do
         fail "default_${name}_whole_kernel" "$(grep -o '"strips": [0-9]*' c.json) $(head -2 c.json)"
     fi
 done
+# what the memory buys: under an address-space limit that the whole kernel
+# cannot run in (it needs about 198 MB here for 2.2*10^6 points, two strips
+# about 152 MB), the default run succeeds; under a lower one both fail with
+# the plain run's message (no rank named), exit 2 and no output
+limited() { (ulimit -v "$1"; env $2 "$PDT" triangulate big.txt -o lim.tri > /dev/null 2> lim.err); }
+rm -f lim.tri
+if limited 175000 PDT_PLAIN_STRIPS=0; then
+    fail whole_kernel_over_limit "ran in 175000 KiB of address space (the limit says nothing here)"
+elif limited 175000 PDT_PLAIN_STRIPS=2 && cmp -s ref.tri lim.tri; then
+    ok "two_strips_under_limit_whole_kernel_cannot"
+else
+    fail two_strips_under_limit_whole_kernel_cannot "$(head -2 lim.err)"
+fi
+rm -f lim.tri
+for v in 150000 120000; do
+    limited "$v" PDT_PLAIN_STRIPS=2
+    rc=$?
+    if [ "$rc" -eq 2 ] && [ ! -e lim.tri ] && grep -q '^pdt: triangulation failed: .*out of memory' lim.err &&
+        ! grep -q 'rank' lim.err; then
+        ok "out_of_memory_message_$v # $(grep -v duplicate lim.err)"
+    else
+        fail "out_of_memory_message_$v" "exit $rc, $(head -2 lim.err)"
+    fi
+    rm -f lim.tri
+done
 summary
