@@ -15,7 +15,7 @@
 #   SCALING_OTHER    grid (k x k) and clusters        (default 1e6 1e7)
 #   SCALING_QUICK=1  the same as SCALING_UNIFORM="1e5 1e6" SCALING_OTHER="1e6"
 # This section alone: make bench BENCH_ONLY=scaling (3*10^7 points need about
-# 2.5 GB for pdt (84 bytes per point), more for CGAL, and 0.5 GB of input text in build/bench).
+# 1.9 GB for pdt (62 bytes per point; 84 with PDT_PLAIN_STRIPS=0), more for CGAL, and 0.5 GB of input text in build/bench).
 # MEMSTATE=warm|cold|asis: the memory state each timed run (pdt's and CGAL's)
 # starts in (scripts/bench/tools/memstate.sh; default warm).
 # Inputs are cached in build/bench/scaling/.  The load average is printed
@@ -72,7 +72,7 @@ for spec in "${inputs[@]}"; do
         # a new output each run: replacing the last one would add its unlink to
         # the write phase (0.2 s for the 1.5 GB of 3*10^7 points here)
         rm -f "$W/out.tri"
-        warm_mb=$((n * 150 / 1000000 + 64)) # pdt's 84 bytes per point, the output's pages, room
+        warm_mb=$((n * 150 / 1000000 + 64)) # pdt's 62-84 bytes per point, the output's pages, room
         memstate_prepare "$warm_mb"
         "$TIME" -f '%M %U %S' -o "$W/time.out" "$PDT" triangulate "$in" -o "$W/out.tri" --stats \
             2> "$W/run.err" > /dev/null || { echo "  pdt failed: $(tail -2 "$W/run.err")"; exit 1; }
