@@ -154,6 +154,71 @@ static pdt_status plain_failure(pdt_status st, int k, pdt_err *err)
     return pdt_err_set(err, st, "triangulation failed: %s", was);
 }
 
+/* The pipeline's arrays: R (block_bytes), the index list, the kernel's
+ * scratch ids for the largest strip, the plan; and the prefault thread. */
+typedef struct arrays {
+    unsigned char *R;
+    size_t bytes, big;
+    uint32_t *order, *id;
+    plan *P;
+    pdt_prefault *pf;
+} arrays;
+
+static pdt_status arrays_get(arrays *a, size_t n, int k, int prefault, pdt_err *err)
+{
+    memset(a, 0, sizeof *a);
+    a->bytes = block_bytes(n, k);
+    a->big = n / (size_t)k + 2;
+    a->R = srm_big(a->bytes);
+    a->order = srm_big((n + 1) * sizeof *a->order);
+    a->id = malloc(a->big * sizeof *a->id);
+    a->P = calloc(1, sizeof *a->P);
+    if (!a->R || !a->order || !a->id || !a->P)
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    if (prefault && a->bytes >= (8u << 20)) {
+        /* as the sort and the strips use them: the sort's bucket writes
+         * (R[16n, 24n)), the index list, its other records, then the rest
+         * where the strips' edges grow, and the kernel's scratch ids */
+        pdt_range rr[5] = {{a->R + 16 * n, 8 * n}, {a->order, n * sizeof *a->order},
+                           {a->R, 16 * n}, {a->R + 24 * n, a->bytes - 24 * n},
+                           {a->id, a->big * sizeof *a->id}};
+        a->pf = pdt_prefault_start(rr, 5);
+    }
+    return PDT_OK;
+}
+
+/* Everything but R (and the prefault thread, stopped before). */
+static void arrays_put(arrays *a, int k)
+{
+    for (int s = 0; s < k; s++)
+        if (a->P && a->P->init[s]) pdt_srm_free(&a->P->rk[s]);
+    free(a->P);
+    free(a->order);
+    free(a->id);
+    a->P = NULL;
+    a->order = a->id = NULL;
+}
+
+/* The strips: k consecutive blocks of the nu sorted points, by count. */
+static void plan_strips(plan *P, const pdt_point *pts, size_t nu, int k)
+{
+    P->k = k;
+    for (int s = 0; s <= k; s++) P->first[s] = nu * (size_t)s / (size_t)k;
+    for (int s = 0; s < k; s++)
+        P->strip[s] = pdt_srm_strip_of(pts + P->first[s], P->first[s + 1] - P->first[s]);
+}
+
+/* R shrunk to the nt triangles at its front (freed if none). */
+static pdt_tri *shrink(unsigned char *R, size_t nt)
+{
+    if (nt == 0) {
+        free(R);
+        return NULL;
+    }
+    pdt_tri *t = realloc(R, nt * sizeof *t);
+    return t ? t : (pdt_tri *)(void *)R;
+}
+
 pdt_status pdt_srm_plain(pdt_point *pts, size_t n, int k, int prefault, pdt_tri **tris,
                          size_t *ntri, pdt_tri_stats *stats, pdt_err *err)
 {
@@ -165,56 +230,30 @@ pdt_status pdt_srm_plain(pdt_point *pts, size_t n, int k, int prefault, pdt_tri 
         return pdt_err_set(err, PDT_ERR_ARG, "triangulation failed: %d strips of %zu points", k,
                            n);
     double t0 = mono(NULL);
-    size_t bytes = block_bytes(n, k), big = n / (size_t)k + 2;
-    unsigned char *R = srm_big(bytes);
-    uint32_t *order = srm_big((n + 1) * sizeof *order), *id = malloc(big * sizeof *id);
-    plan *P = calloc(1, sizeof *P);
-    pdt_status st = R && order && id && P ? PDT_OK : pdt_err_set(err, PDT_ERR_NOMEM,
-                                                                 "out of memory");
-    pdt_prefault *pf = NULL;
-    if (st == PDT_OK && prefault && bytes >= (8u << 20)) {
-        /* as the sort and the strips use them: the sort's bucket writes
-         * (R[16n, 24n)), the index list, its other records, then the rest
-         * where the strips' edges grow, and the kernel's scratch ids */
-        pdt_range rr[5] = {{R + 16 * n, 8 * n}, {order, n * sizeof *order}, {R, 16 * n},
-                           {R + 24 * n, bytes - 24 * n}, {id, big * sizeof *id}};
-        pf = pdt_prefault_start(rr, 5);
-        stats->prefaulted = pf != NULL;
-    }
+    arrays a;
+    pdt_status st = arrays_get(&a, n, k, prefault, err);
+    stats->prefaulted = a.pf != NULL;
     size_t nu = 0, nt = 0, nspare = 0, off = 0;
     pdt_tri spare[PDT_PLAIN_MAX_STRIPS];
-    if (st == PDT_OK) sort_points(pts, n, R, order, &nu);
+    if (st == PDT_OK) sort_points(pts, n, a.R, a.order, &nu);
     double t1 = mono(NULL);
-    if (st == PDT_OK) {
-        P->k = k;
-        for (int s = 0; s <= k; s++) P->first[s] = nu * (size_t)s / (size_t)k;
-        for (int s = 0; s < k; s++)
-            P->strip[s] = pdt_srm_strip_of(pts + P->first[s], P->first[s + 1] - P->first[s]);
-    }
+    if (st == PDT_OK) plan_strips(a.P, pts, nu, k);
     for (int s = 0; s < k && st == PDT_OK; s++)
-        st = strip_local(P, s, pts, order, id, R, &off, spare, &nspare, err);
-    if (st == PDT_OK) st = merge_tree(P, err);
-    pdt_prefault_stop(pf);
+        st = strip_local(a.P, s, pts, a.order, a.id, a.R, &off, spare, &nspare, err);
+    if (st == PDT_OK) st = merge_tree(a.P, err);
+    pdt_prefault_stop(a.pf);
     double t2 = mono(NULL);
-    pdt_tri *t = (pdt_tri *)(void *)R;
+    pdt_tri *t = (pdt_tri *)(void *)a.R;
     if (st == PDT_OK) {
-        nt = append_rest(P, t, off / sizeof *t, spare, nspare);
+        nt = append_rest(a.P, t, off / sizeof *t, spare, nspare);
         pdt_tri_canonical_on(t, nt, t + nt);
     }
     double t3 = mono(NULL);
-    for (int s = 0; s < k; s++)
-        if (P && P->init[s]) pdt_srm_free(&P->rk[s]);
-    free(P);
-    free(order);
-    free(id);
-    if (st != PDT_OK || nt == 0) {
-        free(R);
-        R = NULL;
-    } else {
-        pdt_tri *shrunk = realloc(R, nt * sizeof *shrunk);
-        if (shrunk) R = (unsigned char *)shrunk;
+    arrays_put(&a, k);
+    if (st != PDT_OK) {
+        free(a.R);
+        return plain_failure(st, k, err);
     }
-    if (st != PDT_OK) return plain_failure(st, k, err);
     stats->n_unique = nu;
     stats->n_dup = n - nu;
     stats->n_tri = nt;
@@ -223,7 +262,7 @@ pdt_status pdt_srm_plain(pdt_point *pts, size_t n, int k, int prefault, pdt_tri 
     stats->t_sort = t1 - t0;
     stats->t_kernel = t2 - t1;
     stats->t_canon = t3 - t2;
-    *tris = (pdt_tri *)(void *)R;
+    *tris = shrink(a.R, nt);
     *ntri = nt;
     return PDT_OK;
 }
