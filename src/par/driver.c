@@ -712,7 +712,8 @@ static double cpu_seconds(void)
  * 2 for an untraced run of at least 2^21 points whose points may be spent
  * (a .tri output), else 0 (the whole kernel at once: traces keep the events
  * of one kernel run, the lessons count them; below 2^21 points, some 180 MB,
- * the 22 bytes per point saved are worth less than the 8-12 % of time).
+ * the 22 bytes per point saved are worth less than the 8-12 % of time), or
+ * when a sample says the merge would redo most of the work (pdt_srm_plain_pays).
  * $PDT_PLAIN_STRIPS=K decides for every size: 0 the whole kernel (about 8 %
  * faster at 10^7 points, 84 bytes per point instead of 62), 2..16 strips. */
 static int plain_strips(const pdt_par_input *in, const pdt_trace *tr)
@@ -723,7 +724,7 @@ static int plain_strips(const pdt_par_input *in, const pdt_trace *tr)
         int k = atoi(t);
         return k >= 2 && k <= PDT_PLAIN_MAX_STRIPS ? k : 0;
     }
-    return in->n >= ((size_t)1 << 21) ? 2 : 0;
+    return in->n >= ((size_t)1 << 21) && pdt_srm_plain_pays(in->pts, in->n) ? 2 : 0;
 }
 
 /* One rank: the sequential pipeline on the whole input (the whole kernel, or

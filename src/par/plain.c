@@ -22,6 +22,7 @@
  * scratch (4 per point of the strip): about 62 bytes per point with k = 2.
  * The output is the same triangles in the same order: the SRM's final
  * triangles are T* for any number of strips (tests: par_same, plain_strips). */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -138,6 +139,44 @@ static size_t append_rest(plan *P, pdt_tri *t, size_t nt, const pdt_tri *spare, 
         nt += P->rk[s].nmore;
     }
     return nt;
+}
+
+/* ---- whether the strips pay ---------------------------------------------------- */
+
+static int key_cmp(const void *a, const void *b)
+{
+    uint64_t x = pdt_key(*(const pdt_point *)a), y = pdt_key(*(const pdt_point *)b);
+    return x < y ? -1 : x > y;
+}
+
+int pdt_srm_plain_pays(const pdt_point *pts, size_t n)
+{
+    enum { SAMPLE = 4096 };
+    if (n < 4 * (size_t)SAMPLE) return 1;
+    pdt_point *s = malloc(SAMPLE * sizeof *s);
+    if (!s) return 1;
+    for (size_t i = 0; i < SAMPLE; i++) s[i] = pts[i * (n / SAMPLE)];
+    qsort(s, SAMPLE, sizeof *s, key_cmp);
+    size_t m = 0;
+    for (size_t i = 0; i < SAMPLE; i++)
+        if (m == 0 || s[i].x != s[m - 1].x || s[i].y != s[m - 1].y) s[m++] = s[i];
+    pdt_tri *t = NULL;
+    size_t nt = 0, open = 0;
+    int pays = 1;
+    if (m >= 64 && pdt_delaunay(s, m, &t, &nt, 0, NULL) == PDT_OK && nt > 0) {
+        /* the two strips' slabs, as pdt_srm_slab_of makes them */
+        srm_slab left = {-INFINITY, (double)s[m / 2].x}, right = {(double)s[m / 2 - 1].x, INFINITY};
+        for (size_t i = 0; i < nt; i++) {
+            srm_pt v[3];
+            for (int e = 0; e < 3; e++) v[e] = (srm_pt){s[t[i].v[e]].x, s[t[i].v[e]].y, 0};
+            open += !srm_disk_in_slab(&left, v[0], v[1], v[2]) &&
+                    !srm_disk_in_slab(&right, v[0], v[1], v[2]);
+        }
+        pays = open * 4 <= nt;
+    }
+    free(t);
+    free(s);
+    return pays;
 }
 
 /* A failure worded for a plain run, as the whole kernel's are ("triangulation
