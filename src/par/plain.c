@@ -21,7 +21,7 @@
  * Peak: the points (8), their indices (4), R (48) and one strip's kernel
  * scratch (4 per point of the strip): about 62 bytes per point with k = 2.
  * The output is the same triangles in the same order: the SRM's final
- * triangles are T* for any number of strips (tests: par_same, plain_strips). */
+ * triangles are T* for any number of strips (tests/sh/plain_strips.sh). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -67,11 +67,13 @@ static size_t block_bytes(size_t n, int k)
 
 /* Sort and dedupe: pts[0, nu) the distinct points in lexicographic order,
  * order[i] the input index of pts[i] (the smallest among equal points). */
-static void sort_points(pdt_point *pts, size_t n, unsigned char *R, uint32_t *order, size_t *nu)
+static pdt_status sort_points(pdt_point *pts, size_t n, unsigned char *R, uint32_t *order,
+                              size_t *nu)
 {
     pdt_point *q = (pdt_point *)(void *)(R + PDT_SORT_WORK(n));
-    pdt_sort_unique_on(pts, n, R, order, q, nu);
-    memcpy(pts, q, *nu * sizeof *pts);
+    pdt_status st = pdt_sort_unique_on(pts, n, R, order, q, nu);
+    if (st == PDT_OK) memcpy(pts, q, *nu * sizeof *pts);
+    return st;
 }
 
 /* Strip s's local phase in R at *off: its final triangles end at R + *off
@@ -123,8 +125,8 @@ static pdt_status merge_tree(plan *P, pdt_err *err)
     }
     for (int s = 0; s < P->k && st == PDT_OK; s++)
         if (P->rk[s].npend)
-            st = pdt_err_set(err, PDT_ERR_CHECK, "strip %d: %zu triangles still pending after "
-                             "the last merge", s, P->rk[s].npend);
+            st = pdt_err_set(err, PDT_ERR_CHECK, "strip %d of %d: %zu triangles still pending "
+                             "after the last merge", s + 1, P->k, P->rk[s].npend);
     return st;
 }
 
@@ -274,7 +276,7 @@ pdt_status pdt_srm_plain(pdt_point *pts, size_t n, int k, int prefault, pdt_tri 
     stats->prefaulted = a.pf != NULL;
     size_t nu = 0, nt = 0, nspare = 0, off = 0;
     pdt_tri spare[PDT_PLAIN_MAX_STRIPS];
-    if (st == PDT_OK) sort_points(pts, n, a.R, a.order, &nu);
+    if (st == PDT_OK) st = sort_points(pts, n, a.R, a.order, &nu);
     double t1 = mono(NULL);
     if (st == PDT_OK) plan_strips(a.P, pts, nu, k);
     for (int s = 0; s < k && st == PDT_OK; s++)
