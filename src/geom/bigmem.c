@@ -72,10 +72,9 @@ static void *prefault_run(void *arg)
     return NULL;
 }
 
-/* A process bound to one CPU (mpirun binds a job's only rank to a core)
- * would run the helper on that CPU, taking turns with the main thread: the
- * helper goes to the other CPUs online instead. */
-static void helper_cpus(pthread_t th)
+/* (bigmem.h) A process bound to one CPU would run the helper on that CPU,
+ * taking turns with the main thread. */
+void pdt_helper_off_my_cpu(pthread_t th)
 {
     cpu_set_t mine, other;
     if (sched_getaffinity(0, sizeof mine, &mine) != 0 || CPU_COUNT(&mine) != 1) return;
@@ -98,7 +97,7 @@ pdt_prefault *pdt_prefault_start(const pdt_range *r, int nr)
         free(pf);
         return NULL;
     }
-    helper_cpus(pf->th);
+    pdt_helper_off_my_cpu(pf->th);
     return pf;
 }
 

@@ -43,4 +43,10 @@ typedef struct pdt_range {
 pdt_prefault *pdt_prefault_start(const pdt_range *r, int nr);
 void pdt_prefault_stop(pdt_prefault *pf);
 
+/* For a helper thread just started: when the process is bound to one CPU
+ * (mpirun binds a job's only rank to a core), move the thread to the other
+ * CPUs online, so that it does not take turns with the caller. */
+#include <pthread.h>
+void pdt_helper_off_my_cpu(pthread_t th);
+
 #endif

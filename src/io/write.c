@@ -3,9 +3,14 @@
  * than the triangulation itself on big outputs. */
 #include "pdt/io.h"
 
+#include "../geom/bigmem.h"
+
 #include <errno.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 enum { WBUF = 1 << 20 };
 
@@ -14,11 +19,18 @@ typedef struct wbuf {
     char b[WBUF];
     size_t n;
     int bad;
+    int err; /* errno of the first failed write */
 } wbuf;
+
+static void wb_fail(wbuf *w, int e)
+{
+    if (!w->bad) w->err = e;
+    w->bad = 1;
+}
 
 static void wb_flush(wbuf *w)
 {
-    if (w->n && fwrite(w->b, 1, w->n, w->fp) != w->n) w->bad = 1;
+    if (w->n && fwrite(w->b, 1, w->n, w->fp) != w->n) wb_fail(w, errno);
     w->n = 0;
 }
 
@@ -228,9 +240,172 @@ size_t pdt_format_node_header(char *buf, uint64_t npts)
 
 /* ---- the plain writer: the same lines through a buffer ------------------------ */
 
-/* items[0..n) as lines of `kind`, a buffer's worth at a time. */
+/* ---- long sections on several threads ------------------------------------------
+ *
+ * Printing numbers is most of a big write (0.24 of the 0.30 s that 2*10^7
+ * triangles take here), and the copy into the page cache is the rest; on a
+ * plain run every other core is idle by then.  So a long section of a regular
+ * file is cut into chunks of `chunk` items, and T threads take turns: thread t
+ * prints chunks t, t + T, ... into its own buffer, waits until chunk j - 1 has
+ * claimed its bytes, claims the next ones and writes them at their offset
+ * (pwrite) while the others print.  The bytes are those of the one-thread
+ * loop. */
+
+enum { SEC_CHUNK = WBUF / PDT_LINE_MAX, SEC_MIN_ITEMS = 1 << 18, SEC_MAX_THREADS = 8 };
+
+typedef struct section_job {
+    int fd;
+    pdt_lines kind;
+    const char *items;
+    size_t elem, n, chunk;
+    int nthreads;
+    pthread_mutex_t mu;
+    pthread_cond_t turn;
+    size_t claimed;  /* chunks [0, claimed) have their offsets */
+    uint64_t end;    /* the file offset after them */
+    int failed, err; /* a write failed (errno): everyone stops */
+} section_job;
+
+typedef struct section_worker {
+    section_job *job;
+    int t;
+} section_worker;
+
+static int write_all_at(int fd, const char *b, size_t len, uint64_t off)
+{
+    while (len) {
+        ssize_t k = pwrite(fd, b, len, (off_t)off);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return k < 0 ? errno : EIO;
+        b += k;
+        len -= (size_t)k;
+        off += (uint64_t)k;
+    }
+    return 0;
+}
+
+/* Chunk j's turn: wait for chunks before it, take their end as its offset. */
+static int section_claim(section_job *jb, size_t j, size_t len, uint64_t *off)
+{
+    pthread_mutex_lock(&jb->mu);
+    while (jb->claimed != j && !jb->failed) pthread_cond_wait(&jb->turn, &jb->mu);
+    int ok = !jb->failed;
+    if (ok) {
+        *off = jb->end;
+        jb->end += len;
+        jb->claimed = j + 1;
+        pthread_cond_broadcast(&jb->turn);
+    }
+    pthread_mutex_unlock(&jb->mu);
+    return ok;
+}
+
+static void section_fail(section_job *jb, int e)
+{
+    pthread_mutex_lock(&jb->mu);
+    if (!jb->failed) jb->err = e;
+    jb->failed = 1;
+    pthread_cond_broadcast(&jb->turn);
+    pthread_mutex_unlock(&jb->mu);
+}
+
+static void *section_work(void *arg)
+{
+    section_worker *wk = arg;
+    section_job *jb = wk->job;
+    char *buf = malloc(jb->chunk * PDT_LINE_MAX);
+    if (!buf) {
+        section_fail(jb, ENOMEM);
+        return NULL;
+    }
+    size_t nchunks = (jb->n + jb->chunk - 1) / jb->chunk;
+    for (size_t j = (size_t)wk->t; j < nchunks; j += (size_t)jb->nthreads) {
+        size_t i = j * jb->chunk, k = jb->n - i < jb->chunk ? jb->n - i : jb->chunk;
+        size_t len = pdt_format_lines(buf, jb->kind, jb->items + i * jb->elem, k, i);
+        uint64_t off;
+        if (!section_claim(jb, j, len, &off)) break;
+        int e = write_all_at(jb->fd, buf, len, off);
+        if (e) {
+            section_fail(jb, e);
+            break;
+        }
+    }
+    free(buf);
+    return NULL;
+}
+
+/* PDT_WRITE_THREADS=N if set (1 = the one-thread loop), else the CPUs
+ * online, at most SEC_MAX_THREADS.  (A process that mpirun bound to one core
+ * has its helpers moved to the others: pdt_helper_off_my_cpu.) */
+static int section_threads(void)
+{
+    const char *e = getenv("PDT_WRITE_THREADS");
+    long t = e && *e ? atol(e) : sysconf(_SC_NPROCESSORS_ONLN);
+    return t < 1 ? 1 : t > SEC_MAX_THREADS ? SEC_MAX_THREADS : (int)t;
+}
+
+/* Items per chunk: SEC_CHUNK, or PDT_TEST_WRITE_CHUNK (tests: many chunks on
+ * small inputs, every thread's turn taken). */
+static size_t section_chunk(void)
+{
+    const char *e = getenv("PDT_TEST_WRITE_CHUNK");
+    long c = e ? atol(e) : 0;
+    return c > 0 && (size_t)c < SEC_CHUNK ? (size_t)c : SEC_CHUNK;
+}
+
+/* Try the section on threads; returns 0 if it is not for threads (short, one
+ * CPU, not a regular file), and then nothing was written. */
+static int wb_lines_threaded(wbuf *w, pdt_lines kind, const void *items, size_t elem, size_t n)
+{
+    size_t chunk = section_chunk();
+    int nt = section_threads();
+    if (nt < 2 || (n < SEC_MIN_ITEMS && chunk == SEC_CHUNK)) return 0;
+    int fd = fileno(w->fp);
+    struct stat sb;
+    if (fd < 0 || fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) return 0;
+    wb_flush(w);
+    if (w->bad || fflush(w->fp) != 0) {
+        if (!w->bad) wb_fail(w, errno);
+        return 1;
+    }
+    off_t start = ftello(w->fp);
+    if (start < 0) return 0;
+    section_job jb = { .fd = fd, .kind = kind, .items = items, .elem = elem, .n = n,
+                       .chunk = chunk, .nthreads = nt, .end = (uint64_t)start };
+    pthread_mutex_init(&jb.mu, NULL);
+    pthread_cond_init(&jb.turn, NULL);
+    section_worker wk[SEC_MAX_THREADS];
+    pthread_t th[SEC_MAX_THREADS];
+    int started = 1;
+    for (int t = 0; t < nt; t++) wk[t] = (section_worker){ &jb, t };
+    for (int t = 1; t < nt; t++) {
+        if (pthread_create(&th[t], NULL, section_work, &wk[t]) != 0) break;
+        pdt_helper_off_my_cpu(th[t]);
+        started++;
+    }
+    if (started < nt) { /* fewer threads than planned: their chunks would wait forever */
+        section_fail(&jb, EAGAIN);
+        for (int t = 1; t < started; t++) pthread_join(th[t], NULL);
+        pthread_mutex_destroy(&jb.mu);
+        pthread_cond_destroy(&jb.turn);
+        jb.failed = 0;
+        if (fseeko(w->fp, start, SEEK_SET) != 0) wb_fail(w, errno);
+        return 0; /* nothing claimed past `start`: the one-thread loop rewrites it */
+    }
+    section_work(&wk[0]);
+    for (int t = 1; t < nt; t++) pthread_join(th[t], NULL);
+    pthread_mutex_destroy(&jb.mu);
+    pthread_cond_destroy(&jb.turn);
+    if (jb.failed) wb_fail(w, jb.err);
+    else if (fseeko(w->fp, (off_t)jb.end, SEEK_SET) != 0) wb_fail(w, errno);
+    return 1;
+}
+
+/* items[0..n) as lines of `kind`: on several threads when long enough, else a
+ * buffer's worth at a time. */
 static void wb_lines(wbuf *w, pdt_lines kind, const void *items, size_t elem, size_t n)
 {
+    if (wb_lines_threaded(w, kind, items, elem, n)) return;
     const size_t step = WBUF / PDT_LINE_MAX;
     for (size_t i = 0; i < n; i += step) {
         size_t k = n - i < step ? n - i : step;
@@ -257,7 +432,7 @@ static pdt_status finish(pdt_outfile *o, wbuf *w, pdt_err *err)
 {
     wb_flush(w);
     if (w->bad) {
-        int e = errno;
+        int e = w->err;
         const char *name = o->path ? o->path : "standard output";
         pdt_err_set(err, PDT_ERR_IO, "%s: write error: %s", name, strerror(e));
         pdt_out_abort(o);
@@ -289,7 +464,7 @@ pdt_status pdt_write_points(const char *path, const pdt_point *pts, size_t n, pd
     }
     w->fp = o.fp;
     w->n = 0;
-    w->bad = 0;
+    w->bad = w->err = 0;
     emit_points(w, pts, n, has_ext(path, ".node"));
     st = finish(&o, w, err);
     free(w);
@@ -353,11 +528,12 @@ pdt_status pdt_write_tris(const char *path, pdt_tri_format fmt, const pdt_point 
         if (st == PDT_OK) {
             w->fp = onode.fp;
             w->n = 0;
-            w->bad = 0;
+            w->bad = w->err = 0;
             emit_points(w, pts, n, 1);
             wb_flush(w);
-            if (w->bad || fflush(onode.fp) != 0)
-                st = pdt_err_set(err, PDT_ERR_IO, "%s: write error: %s", npath, strerror(errno));
+            if (!w->bad && fflush(onode.fp) != 0) wb_fail(w, errno);
+            if (w->bad)
+                st = pdt_err_set(err, PDT_ERR_IO, "%s: write error: %s", npath, strerror(w->err));
         }
         if (st != PDT_OK) {
             if (onode.fp) pdt_out_abort(&onode);
@@ -370,7 +546,7 @@ pdt_status pdt_write_tris(const char *path, pdt_tri_format fmt, const pdt_point 
     if (st == PDT_OK) {
         w->fp = o.fp;
         w->n = 0;
-        w->bad = 0;
+        w->bad = w->err = 0;
         emit_tris(w, fmt, pts, n, tris, ntri);
         st = finish(&o, w, err);
     }
