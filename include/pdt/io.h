@@ -169,6 +169,13 @@ pdt_tri_format pdt_tri_format_of(const char *path);
 pdt_status pdt_write_tris(const char *path, pdt_tri_format fmt, const pdt_point *pts, size_t n,
                           const pdt_tri *tris, size_t ntri, pdt_err *err);
 
+/* pdt_write_tris, and the pages of `tris` are given back to the system as
+ * they are written (whole 2 MiB pages): their contents are lost, so the
+ * caller frees tris next and reads nothing from it, whatever the status.
+ * The file's page cache then reuses memory that was just in use. */
+pdt_status pdt_write_tris_releasing(const char *path, pdt_tri_format fmt, const pdt_point *pts,
+                                    size_t n, pdt_tri *tris, size_t ntri, pdt_err *err);
+
 /* ---- formatting, for writers that place the bytes themselves ----------------
  * (the parallel write: every rank formats its block of lines and writes it
  * at its offset; the plain writer above formats with the same functions). */

@@ -166,6 +166,9 @@ typedef struct pdt_par_output {
     size_t ntri;
     uint64_t first;      /* index of tris[0] in the whole output */
     uint64_t n_total;    /* triangles in the whole output (every rank) */
+    int release_tris;    /* 1: pdt_par_write gives the pages of tris back as it
+                          * writes them (pdt_write_tris_releasing): the caller
+                          * frees tris next, whatever the status */
 } pdt_par_output;
 
 void pdt_par_input_free(pdt_par_input *in);

@@ -284,6 +284,8 @@ static pdt_status write_output(run *R, pdt_err *err)
     set_phase(R, "write");
     double t0 = pdt_comm_wtime(R->c);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_WRITE, 0, 0, 0, 0);
+    R->out.release_tris = 1; /* nothing reads them after the write: their memory
+                              * serves the output's page cache */
     pdt_status st = pdt_par_write(R->c, R->o->output, pdt_tri_format_of(R->o->output), &R->in,
                                   &R->out, err);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_WRITE, 0, 0, 0, 0);

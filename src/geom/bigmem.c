@@ -40,6 +40,15 @@ void pdt_big_free(void *p, size_t bytes)
     else munmap(p, bytes);
 }
 
+void pdt_big_release_front(void *base, size_t from, size_t to)
+{
+    uintptr_t b0 = (uintptr_t)base;
+    uintptr_t a = (b0 + from) & ~(uintptr_t)(HUGE_PAGE - 1); /* the page `from` is in ... */
+    if (a < b0) a = (b0 + HUGE_PAGE - 1) & ~(uintptr_t)(HUGE_PAGE - 1); /* ... if all ours */
+    uintptr_t b = (b0 + to) & ~(uintptr_t)(HUGE_PAGE - 1);
+    if (b > a) (void)madvise((void *)a, b - a, MADV_DONTNEED);
+}
+
 /* ---- faulting in ahead of use (bigmem.h) ---- */
 
 enum { PF_MAX = 8, PF_STEP = 1 << 21 };

@@ -20,6 +20,17 @@ void pdt_big_free(void *p, size_t bytes);
  * (of any allocation, e.g. a large malloc'd block).  Only a hint. */
 void pdt_big_advise(void *p, size_t bytes);
 
+/* An array used front to back, whose front [0, to) is no longer needed
+ * (its contents there read as zeros if touched again): give back to the
+ * system the whole 2 MiB pages of it not given back yet, `from` being the
+ * `to` of the previous call (0 at first).  Whole huge pages only: giving back
+ * part of one splits it and frees nothing until the kernel gets round to it;
+ * the page that holds `to` goes with a later call.  The memory can serve the
+ * next allocation (e.g. the page cache of a file being written) at once,
+ * which on this project's VMs is far cheaper than memory the host has taken
+ * back (see below). */
+void pdt_big_release_front(void *base, size_t from, size_t to);
+
 /* Fault in memory ahead of use, on an idle core.  On this project's test
  * machine (a Firecracker VM) the first touch of memory new to a process is
  * its dearest cost: about 2 s per GiB (the host backs each page on demand;

@@ -253,6 +253,19 @@ size_t pdt_format_node_header(char *buf, uint64_t npts)
 
 enum { SEC_CHUNK = WBUF / PDT_LINE_MAX, SEC_MIN_ITEMS = 1 << 18, SEC_MAX_THREADS = 8 };
 
+/* pdt_write_tris_releasing: the triangles already printed are given back
+ * RELEASE_STEP items at a time or more (whole 2 MiB pages: pdt_big_release).
+ * The page cache of the file being written then takes memory that was in use
+ * a moment before, not memory the host has taken back: on this project's VM
+ * that made the write of 3*10^7 points' triangles 0.49-0.53 s in every run
+ * instead of 0.49-0.93 s. */
+enum { RELEASE_STEP = 1 << 18 };
+
+static void release_items(const char *items, size_t elem, size_t from, size_t to)
+{
+    if (to > from) pdt_big_release_front((void *)(uintptr_t)items, from * elem, to * elem);
+}
+
 typedef struct section_job {
     int fd;
     pdt_lines kind;
@@ -264,6 +277,8 @@ typedef struct section_job {
     size_t claimed;  /* chunks [0, claimed) have their offsets */
     uint64_t end;    /* the file offset after them */
     int failed, err; /* a write failed (errno): everyone stops */
+    int release;     /* give back the items' pages once printed */
+    size_t released; /* items [0, released) given back */
 } section_job;
 
 typedef struct section_worker {
@@ -284,8 +299,11 @@ static int write_all_at(int fd, const char *b, size_t len, uint64_t off)
     return 0;
 }
 
-/* Chunk j's turn: wait for chunks before it, take their end as its offset. */
-static int section_claim(section_job *jb, size_t j, size_t len, uint64_t *off)
+/* Chunk j's turn: wait for chunks before it, take their end as its offset.
+ * Every chunk up to j is printed by then: with `release`, [*rel, *rel_end)
+ * are items no one has given back yet. */
+static int section_claim(section_job *jb, size_t j, size_t len, uint64_t *off, size_t *rel,
+                         size_t *rel_end)
 {
     pthread_mutex_lock(&jb->mu);
     while (jb->claimed != j && !jb->failed) pthread_cond_wait(&jb->turn, &jb->mu);
@@ -294,6 +312,10 @@ static int section_claim(section_job *jb, size_t j, size_t len, uint64_t *off)
         *off = jb->end;
         jb->end += len;
         jb->claimed = j + 1;
+        *rel = *rel_end = jb->released;
+        size_t printed = (j + 1) * jb->chunk < jb->n ? (j + 1) * jb->chunk : jb->n;
+        if (jb->release && printed - jb->released >= RELEASE_STEP)
+            *rel_end = jb->released = printed;
         pthread_cond_broadcast(&jb->turn);
     }
     pthread_mutex_unlock(&jb->mu);
@@ -323,7 +345,9 @@ static void *section_work(void *arg)
         size_t i = j * jb->chunk, k = jb->n - i < jb->chunk ? jb->n - i : jb->chunk;
         size_t len = pdt_format_lines(buf, jb->kind, jb->items + i * jb->elem, k, i);
         uint64_t off;
-        if (!section_claim(jb, j, len, &off)) break;
+        size_t rel, rel_end;
+        if (!section_claim(jb, j, len, &off, &rel, &rel_end)) break;
+        release_items(jb->items, jb->elem, rel, rel_end);
         int e = write_all_at(jb->fd, buf, len, off);
         if (e) {
             section_fail(jb, e);
@@ -354,8 +378,9 @@ static size_t section_chunk(void)
 }
 
 /* Try the section on threads; returns 0 if it is not for threads (short, one
- * CPU, not a regular file), and then nothing was written. */
-static int wb_lines_threaded(wbuf *w, pdt_lines kind, const void *items, size_t elem, size_t n)
+ * CPU, not a regular file), and then nothing was written or given back. */
+static int wb_lines_threaded(wbuf *w, pdt_lines kind, const void *items, size_t elem, size_t n,
+                             int release)
 {
     size_t chunk = section_chunk();
     int nt = section_threads();
@@ -371,7 +396,8 @@ static int wb_lines_threaded(wbuf *w, pdt_lines kind, const void *items, size_t 
     off_t start = ftello(w->fp);
     if (start < 0) return 0;
     section_job jb = { .fd = fd, .kind = kind, .items = items, .elem = elem, .n = n,
-                       .chunk = chunk, .nthreads = nt, .end = (uint64_t)start };
+                       .chunk = chunk, .nthreads = nt, .end = (uint64_t)start,
+                       .release = release };
     pthread_mutex_init(&jb.mu, NULL);
     pthread_cond_init(&jb.turn, NULL);
     section_worker wk[SEC_MAX_THREADS];
@@ -402,15 +428,22 @@ static int wb_lines_threaded(wbuf *w, pdt_lines kind, const void *items, size_t 
 }
 
 /* items[0..n) as lines of `kind`: on several threads when long enough, else a
- * buffer's worth at a time. */
-static void wb_lines(wbuf *w, pdt_lines kind, const void *items, size_t elem, size_t n)
+ * buffer's worth at a time; with `release`, the items' pages are given back
+ * once printed. */
+static void wb_lines(wbuf *w, pdt_lines kind, const void *items, size_t elem, size_t n,
+                     int release)
 {
-    if (wb_lines_threaded(w, kind, items, elem, n)) return;
+    if (wb_lines_threaded(w, kind, items, elem, n, release)) return;
     const size_t step = WBUF / PDT_LINE_MAX;
+    size_t released = 0;
     for (size_t i = 0; i < n; i += step) {
         size_t k = n - i < step ? n - i : step;
         if (w->n + k * PDT_LINE_MAX > WBUF) wb_flush(w);
         w->n += pdt_format_lines(w->b + w->n, kind, (const char *)items + i * elem, k, i);
+        if (release && i + k - released >= RELEASE_STEP) {
+            release_items(items, elem, released, i + k);
+            released = i + k;
+        }
     }
 }
 
@@ -449,7 +482,7 @@ static void emit_points(wbuf *w, const pdt_point *pts, size_t n, int node)
         char h[256];
         wb_header(w, h, pdt_format_node_header(h, n));
     }
-    wb_lines(w, node ? PDT_LINES_NODE : PDT_LINES_XY, pts, sizeof *pts, n);
+    wb_lines(w, node ? PDT_LINES_NODE : PDT_LINES_XY, pts, sizeof *pts, n, 0);
 }
 
 pdt_status pdt_write_points(const char *path, const pdt_point *pts, size_t n, pdt_err *err)
@@ -481,14 +514,14 @@ pdt_tri_format pdt_tri_format_of(const char *path)
 }
 
 static void emit_tris(wbuf *w, pdt_tri_format fmt, const pdt_point *pts, size_t n,
-                      const pdt_tri *t, size_t ntri)
+                      const pdt_tri *t, size_t ntri, int release)
 {
     char h[256];
     wb_header(w, h, pdt_format_tri_header(h, fmt, n, ntri));
-    if (fmt == PDT_FMT_OFF) wb_lines(w, PDT_LINES_OFF_POINT, pts, sizeof *pts, n);
+    if (fmt == PDT_FMT_OFF) wb_lines(w, PDT_LINES_OFF_POINT, pts, sizeof *pts, n, 0);
     wb_lines(w, fmt == PDT_FMT_ELE ? PDT_LINES_ELE : fmt == PDT_FMT_OFF ? PDT_LINES_OFF_TRI
                                                                          : PDT_LINES_TRI,
-             t, sizeof *t, ntri);
+             t, sizeof *t, ntri, release);
 }
 
 /* "X.ele" -> "X.node" (malloc'd). */
@@ -503,8 +536,8 @@ static char *node_path_of(const char *ele)
     return p;
 }
 
-pdt_status pdt_write_tris(const char *path, pdt_tri_format fmt, const pdt_point *pts, size_t n,
-                          const pdt_tri *tris, size_t ntri, pdt_err *err)
+static pdt_status write_tris(const char *path, pdt_tri_format fmt, const pdt_point *pts, size_t n,
+                             const pdt_tri *tris, size_t ntri, int release, pdt_err *err)
 {
     if ((fmt == PDT_FMT_ELE || fmt == PDT_FMT_OFF) && !pts && n > 0)
         return pdt_err_set(err, PDT_ERR_ARG, "writing .ele or .off needs the points");
@@ -547,7 +580,7 @@ pdt_status pdt_write_tris(const char *path, pdt_tri_format fmt, const pdt_point 
         w->fp = o.fp;
         w->n = 0;
         w->bad = w->err = 0;
-        emit_tris(w, fmt, pts, n, tris, ntri);
+        emit_tris(w, fmt, pts, n, tris, ntri, release);
         st = finish(&o, w, err);
     }
     if (fmt == PDT_FMT_ELE) {
@@ -557,4 +590,16 @@ pdt_status pdt_write_tris(const char *path, pdt_tri_format fmt, const pdt_point 
     free(npath);
     free(w);
     return st;
+}
+
+pdt_status pdt_write_tris(const char *path, pdt_tri_format fmt, const pdt_point *pts, size_t n,
+                          const pdt_tri *tris, size_t ntri, pdt_err *err)
+{
+    return write_tris(path, fmt, pts, n, tris, ntri, 0, err);
+}
+
+pdt_status pdt_write_tris_releasing(const char *path, pdt_tri_format fmt, const pdt_point *pts,
+                                    size_t n, pdt_tri *tris, size_t ntri, pdt_err *err)
+{
+    return write_tris(path, fmt, pts, n, tris, ntri, 1, err);
 }

@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "pdt/io.h"
+#include "../geom/bigmem.h"
 #include "pdt/par.h"
 
 /* Bytes formatted at once (then written): 4 MiB of the longest lines. */
@@ -32,6 +33,7 @@ typedef struct section {
     const void *items;
     size_t elem, n;
     uint64_t first;   /* number of this block's first line (.ele, .node) */
+    int release;      /* give the items' pages back once printed */
 } section;
 
 /* One file: its final name, its temporary, its header, its sections. */
@@ -173,6 +175,8 @@ static pdt_status write_section(pdt_comm_file *f, const section *s, uint64_t at,
         size_t k = s->n - i < PIECE_LINES ? s->n - i : PIECE_LINES;
         size_t len = pdt_format_lines(buf, s->kind, (const char *)s->items + i * s->elem, k,
                                       s->first + i);
+        if (s->release) pdt_big_release_front((void *)(uintptr_t)s->items, i * s->elem,
+                                              (i + k) * s->elem);
         st = pdt_comm_file_write_at(f, at, buf, len, err);
         at += len;
     }
@@ -266,7 +270,9 @@ pdt_status pdt_par_write(pdt_comm *c, const char *path, pdt_tri_format fmt,
                          const pdt_par_input *in, const pdt_par_output *out, pdt_err *err)
 {
     if (pdt_comm_size(c) == 1)
-        return pdt_write_tris(path, fmt, in->pts, in->n, out->tris, out->ntri, err);
+        return out->release_tris
+                   ? pdt_write_tris_releasing(path, fmt, in->pts, in->n, out->tris, out->ntri, err)
+                   : pdt_write_tris(path, fmt, in->pts, in->n, out->tris, out->ntri, err);
     int direct = renamable(path) && strlen(path) < 3000;
     if (pdt_par_agree(c, direct ? PDT_OK : PDT_ERR_ARG, NULL, err) != PDT_OK) {
         pdt_err_clear(err);
@@ -278,18 +284,19 @@ pdt_status pdt_par_write(pdt_comm *c, const char *path, pdt_tri_format fmt,
     const section tris = {fmt == PDT_FMT_ELE   ? PDT_LINES_ELE
                           : fmt == PDT_FMT_OFF ? PDT_LINES_OFF_TRI
                                                : PDT_LINES_TRI,
-                          out->tris, sizeof(pdt_tri), out->ntri, out->first};
+                          out->tris, sizeof(pdt_tri), out->ntri, out->first,
+                          out->release_tris};
     o[0].path = path;
     o[0].hlen = pdt_format_tri_header(o[0].head, fmt, in->n_total, out->n_total);
     if (fmt == PDT_FMT_OFF)
         o[0].sec[o[0].nsec++] = (section){PDT_LINES_OFF_POINT, in->pts, sizeof(pdt_point), in->n,
-                                          in->first};
+                                          in->first, 0};
     o[0].sec[o[0].nsec++] = tris;
     if (fmt != PDT_FMT_ELE) return write_files(c, o, 1, err);
     node_path(npath, sizeof npath, path);
     o[1].path = npath;
     o[1].hlen = pdt_format_node_header(o[1].head, in->n_total);
     o[1].sec[o[1].nsec++] = (section){PDT_LINES_NODE, in->pts, sizeof(pdt_point), in->n,
-                                      in->first};
+                                      in->first, 0};
     return write_files(c, o, 2, err);
 }

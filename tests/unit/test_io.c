@@ -450,6 +450,66 @@ TEST(tris_write_formats)
     CHECK(pdt_write_tris("-", PDT_FMT_ELE, pts, 4, t, 2, &err) == PDT_ERR_ARG);
 }
 
+/* pdt_write_tris_releasing writes pdt_write_tris's bytes, with one thread
+ * and several, chunks of every size, and .ele; and it does give the array's
+ * memory back: whole 2 MiB pages inside it read as zeros afterwards, while
+ * the bytes around them (a page the array shares with others) are kept. */
+TEST(tris_write_releasing)
+{
+    clean();
+    const size_t nt = 1000003; /* 12 MB: several 2 MiB pages, not a whole number of them */
+    pdt_tri *ref = malloc(nt * sizeof *ref);
+    pdt_point pts[3] = { { 0, 0 }, { 1, 0 }, { 0, 1 } };
+    CHECK(ref != NULL);
+    if (!ref) return;
+    for (size_t i = 0; i < nt; i++)
+        ref[i] = (pdt_tri){ { (uint32_t)i, (uint32_t)(i * 7 + 1), (uint32_t)(nt - i) } };
+    pdt_err err;
+    pdt_err_clear(&err);
+    CHECK(pdt_write_tris(path("ref.tri"), PDT_FMT_TRI, pts, 3, ref, nt, &err) == PDT_OK);
+    CHECK(pdt_write_tris(path("ref.ele"), PDT_FMT_ELE, pts, 3, ref, nt, &err) == PDT_OK);
+    char *want = slurp(path("ref.tri")), *want_ele = slurp(path("ref.ele"));
+    static const char *threads[] = { "1", "2", "3" }, *chunks[] = { "", "1000", "77777" };
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) {
+            setenv("PDT_WRITE_THREADS", threads[a], 1);
+            setenv("PDT_TEST_WRITE_CHUNK", chunks[b], 1);
+            for (int ele = 0; ele < 2; ele++) {
+                /* the array inside a larger block: the bytes just before and
+                 * after it must survive */
+                unsigned char *blk = malloc(nt * sizeof(pdt_tri) + 2 * 4096);
+                CHECK(blk != NULL);
+                if (!blk) continue;
+                memset(blk, 0xA5, 4096);
+                memset(blk + 4096 + nt * sizeof(pdt_tri), 0x5A, 4096);
+                pdt_tri *t = (pdt_tri *)(void *)(blk + 4096);
+                memcpy(t, ref, nt * sizeof *t);
+                const char *name = ele ? "rel.ele" : "rel.tri";
+                CHECK(pdt_write_tris_releasing(path(name), ele ? PDT_FMT_ELE : PDT_FMT_TRI, pts, 3,
+                                               t, nt, &err) == PDT_OK);
+                char *got = slurp(path(name));
+                CHECK_MSG(got && strcmp(got, ele ? want_ele : want) == 0,
+                          "threads %s, chunks '%s', %s: bytes differ", threads[a], chunks[b], name);
+                free(got);
+                size_t zero = 0;
+                for (size_t i = 0; i < nt; i++)
+                    zero += t[i].v[0] == 0 && t[i].v[1] == 0 && t[i].v[2] == 0;
+                CHECK_MSG(zero >= nt / 2, "threads %s: only %zu of %zu triangles given back",
+                          threads[a], zero, nt);
+                size_t kept = 0;
+                for (int i = 0; i < 4096; i++)
+                    kept += blk[i] == 0xA5 && blk[4096 + nt * sizeof(pdt_tri) + (size_t)i] == 0x5A;
+                CHECK(kept == 4096);
+                free(blk);
+            }
+        }
+    unsetenv("PDT_WRITE_THREADS");
+    unsetenv("PDT_TEST_WRITE_CHUNK");
+    free(want);
+    free(want_ele);
+    free(ref);
+}
+
 /* Expect reading triangles `text` as `name` (with npts points) to fail with msg. */
 static int badtri(const char *name, const char *text, size_t npts, const char *msg)
 {
@@ -749,6 +809,7 @@ int main(void)
     RUN(text_numbers_every_length);
     RUN(read_prefault_same_points);
     RUN(tris_write_formats);
+    RUN(tris_write_releasing);
     RUN(tris_read_bad_inputs);
     RUN(atomic_write_leaves_nothing);
     RUN(large_file_mapped_exact_pages);
