@@ -777,6 +777,53 @@ static uint32_t group_keys(const void *buf, size_t stride, size_t nb, gslot *slo
 #undef KREC
 }
 
+/* A grouping thread's scratch (both builds): `most` records of `rec` bytes,
+ * the hash table for them, the per-record group and the per-group tables
+ * (group_keys), and the next place of each group (gfill). */
+typedef struct group_scratch {
+    void *buf;
+    gslot *slot;
+    uint32_t *gid, *gfirst, *gn, *gfill;
+    size_t most, hcap, rec;
+} group_scratch;
+
+static int scratch_get(builder *b, group_scratch *s, size_t most, size_t rec)
+{
+    size_t hcap = 1024;
+    while (hcap / 4 * 3 < most) hcap *= 2;
+    *s = (group_scratch){.most = most, .hcap = hcap, .rec = rec};
+    s->buf = bmalloc(b, most * rec);
+    s->slot = bmalloc(b, hcap * sizeof *s->slot);
+    s->gid = bmalloc(b, most * sizeof *s->gid);
+    s->gfirst = bmalloc(b, most * sizeof *s->gfirst);
+    s->gn = bmalloc(b, most * sizeof *s->gn);
+    s->gfill = bmalloc(b, most * sizeof *s->gfill);
+    if (!(s->buf && s->slot && s->gid && s->gfirst && s->gn && s->gfill)) return 0;
+    pdt_big_advise(s->buf, most * rec);
+    pdt_big_advise(s->slot, hcap * sizeof *s->slot);
+    return 1;
+}
+
+static void scratch_put(builder *b, group_scratch *s)
+{
+    bfree(b, s->buf, s->most * s->rec);
+    bfree(b, s->slot, s->hcap * sizeof *s->slot);
+    bfree(b, s->gid, s->most * sizeof *s->gid);
+    bfree(b, s->gfirst, s->most * sizeof *s->gfirst);
+    bfree(b, s->gn, s->most * sizeof *s->gn);
+    bfree(b, s->gfill, s->most * sizeof *s->gfill);
+}
+
+/* Group the nb records in s->buf; gfill[g] = base + the entries of groups
+ * before g (where group g's entries begin).  Returns the groups. */
+static uint32_t scratch_group(group_scratch *s, size_t nb, size_t base)
+{
+    uint32_t ng = group_keys(s->buf, s->rec, nb, s->slot, s->gid, s->gfirst, s->gn);
+    size_t h = base;
+    for (uint32_t q = 0; q < ng; q++) s->gfill[q] = (uint32_t)h, h += s->gn[q];
+    return ng;
+}
+
 /* The in-memory build's grouping: the entries into r->hist, and per event
  * its entry (ev_ent) and its triangle's first event (ev_obj; see
  * tri_groups). */
@@ -785,27 +832,17 @@ static void *group_worker(void *arg)
     group_job *J = arg;
     builder *b = J->b;
     pdt_replay *r = b->r;
-    size_t most = J->most, hcap = 1024;
-    while (hcap / 4 * 3 < most) hcap *= 2;
-    tri_rec *buf = malloc(most * sizeof *buf);
-    gslot *slot = malloc(hcap * sizeof *slot);
-    uint32_t *gid = malloc(most * sizeof *gid), *gfirst = malloc(most * sizeof *gfirst);
-    uint32_t *gn = malloc(most * sizeof *gn), *gfill = malloc(most * sizeof *gfill);
-    int ok = buf && slot && gid && gfirst && gn && gfill;
-    if (ok) {
-        pdt_big_advise(buf, most * sizeof *buf);
-        pdt_big_advise(slot, hcap * sizeof *slot);
-    }
+    group_scratch S;
+    int ok = scratch_get(b, &S, J->most, sizeof(tri_rec));
+    const tri_rec *buf = S.buf;
     size_t found = 0;
     while (ok && !J->failed) {
         size_t k = J->next++;
         if (k >= J->nrun) break;
         size_t base = b->fine_off[J->run[k]], nb = b->fine_off[J->run[k + 1]] - base;
         if (!nb) continue;
-        memcpy(buf, &b->spill[base], nb * sizeof *buf);
-        uint32_t ng = group_keys(buf, sizeof *buf, nb, slot, gid, gfirst, gn);
-        size_t h = base;
-        for (uint32_t q = 0; q < ng; q++) gfill[q] = (uint32_t)h, h += gn[q];
+        memcpy(S.buf, &b->spill[base], nb * sizeof *buf);
+        uint32_t ng = scratch_group(&S, nb, base);
         pdt_rtri_hist *to = r->hist + base;
         for (size_t j = 0; j < nb; j++) {
             if (j + PREFETCH_AHEAD < nb) { /* random places in three tables of 4, 4, 1 bytes per event */
@@ -813,21 +850,16 @@ static void *group_worker(void *arg)
                 __builtin_prefetch(&r->ev_obj[buf[j + PREFETCH_AHEAD].ev], 1);
                 __builtin_prefetch(&r->ev_kind[buf[j + PREFETCH_AHEAD].ev]);
             }
-            uint32_t q = gid[j], ev = buf[j].ev, at = gfill[q]++;
+            uint32_t q = S.gid[j], ev = buf[j].ev, at = S.gfill[q]++;
             to[at - base] = hist_of(r, ev);
             r->ev_ent[ev] = at;  /* (threads write distinct events) */
-            r->ev_obj[ev] = ev == gfirst[q] ? -1 - (int32_t)gn[q] : (int32_t)gfirst[q];
+            r->ev_obj[ev] = ev == S.gfirst[q] ? -1 - (int32_t)S.gn[q] : (int32_t)S.gfirst[q];
         }
         found += ng;
     }
     if (!ok) J->failed = 1;
     J->ntri += found;
-    free(buf);
-    free(slot);
-    free(gid);
-    free(gfirst);
-    free(gn);
-    free(gfill);
+    scratch_put(b, &S);
     return NULL;
 }
 
@@ -871,20 +903,14 @@ static void *group_worker_streamed(void *arg)
     builder *b = J->b;
     pdt_replay *r = b->r;
     const pdt_replay_place *pl = b->pl;
-    size_t most = J->most, hcap = 1024;
-    while (hcap / 4 * 3 < most) hcap *= 2;
-    tri_xrec *buf = bmalloc(b, most * sizeof *buf);
-    gslot *slot = bmalloc(b, hcap * sizeof *slot);
-    uint32_t *gid = bmalloc(b, most * sizeof *gid), *gfirst = bmalloc(b, most * sizeof *gfirst);
-    uint32_t *gn = bmalloc(b, most * sizeof *gn), *gfill = bmalloc(b, most * sizeof *gfill);
+    size_t most = J->most;
+    group_scratch S;
+    int ok = scratch_get(b, &S, most, sizeof(tri_xrec));
+    tri_xrec *buf = S.buf;
     pdt_rtri_hist *out = bmalloc(b, most * sizeof *out);  /* the run's entries */
     tri_ev *eout = bmalloc(b, most * sizeof *eout);
     tri_first *tout = bmalloc(b, most * sizeof *tout);
-    int ok = buf && slot && gid && gfirst && gn && gfill && out && eout && tout;
-    if (ok) {
-        pdt_big_advise(buf, most * sizeof *buf);
-        pdt_big_advise(slot, hcap * sizeof *slot);
-    }
+    ok = ok && out && eout && tout;
     size_t found = 0;
     while (ok && !J->failed) {
         size_t k = J->next++;
@@ -902,21 +928,19 @@ static void *group_worker_streamed(void *arg)
             got += ck->n;
         }
         if (!ok) break;
-        uint32_t ng = group_keys(buf, sizeof *buf, nb, slot, gid, gfirst, gn);
-        size_t h = base;
-        for (uint32_t q = 0; q < ng; q++) gfill[q] = (uint32_t)h, h += gn[q];
+        uint32_t ng = scratch_group(&S, nb, base);
         /* bucket by bucket: its triangles are the groups first seen in it */
         uint32_t g0 = 0;
         for (size_t f = J->run[k]; f < J->run[k + 1]; f++) {
             size_t j0 = b->fine_off[f] - base, j1 = b->fine_off[f + 1] - base;
             uint32_t g1 = g0;
             for (size_t j = j0; j < j1; j++) {
-                uint32_t q = gid[j], ev = buf[j].ev, at = gfill[q]++;
+                uint32_t q = S.gid[j], ev = buf[j].ev, at = S.gfill[q]++;
                 if (q >= g1) g1 = q + 1;
                 out[at - base] = hist_of_x(r, &buf[j]);
-                eout[j] = (tri_ev){ev, (q - g0) | (ev == gfirst[q] ? TEV_FIRST : 0)};
+                eout[j] = (tri_ev){ev, (q - g0) | (ev == S.gfirst[q] ? TEV_FIRST : 0)};
             }
-            for (uint32_t q = g0; q < g1; q++) tout[q - g0] = (tri_first){gfirst[q], gn[q]};
+            for (uint32_t q = g0; q < g1; q++) tout[q - g0] = (tri_first){S.gfirst[q], S.gn[q]};
             b->tcount[f] = g1 - g0;
             if (g1 > g0 && !pl->sput(pl->ctx, PDT_SCR_TRIS, (uint64_t)b->fine_off[f] * sizeof *tout,
                                      tout, (g1 - g0) * sizeof *tout)) {
@@ -937,12 +961,7 @@ static void *group_worker_streamed(void *arg)
     bfree(b, out, most * sizeof *out);
     bfree(b, eout, most * sizeof *eout);
     bfree(b, tout, most * sizeof *tout);
-    bfree(b, buf, most * sizeof *buf);
-    bfree(b, slot, hcap * sizeof *slot);
-    bfree(b, gid, most * sizeof *gid);
-    bfree(b, gfirst, most * sizeof *gfirst);
-    bfree(b, gn, most * sizeof *gn);
-    bfree(b, gfill, most * sizeof *gfill);
+    scratch_put(b, &S);
     return NULL;
 }
 
