@@ -450,6 +450,53 @@ TEST(tris_write_formats)
     CHECK(pdt_write_tris("-", PDT_FMT_ELE, pts, 4, t, 2, &err) == PDT_ERR_ARG);
 }
 
+/* The printer's eight-digits-at-once path (below 10^8) and the loop above
+ * it, against printf: every value below 2*10^6 (every length up to 7
+ * digits), each power of ten and its neighbours up to 2^32 - 1, and a
+ * million pseudo-random values of every magnitude. */
+TEST(format_lines_every_length)
+{
+    enum { K = 4096 };
+    pdt_tri *t = malloc(K * sizeof *t);
+    char *buf = malloc((size_t)K * PDT_LINE_MAX), *want = malloc((size_t)K * 40);
+    CHECK(t && buf && want);
+    if (!t || !buf || !want) return;
+    uint64_t seed = 88172645463325252ull, bad = 0, done = 0;
+    for (int phase = 0; phase < 3; phase++) {
+        size_t rounds = phase == 0 ? 2000000 / (3 * K) + 1 : phase == 1 ? 1 : 1000000 / (3 * K) + 1;
+        for (size_t r = 0; r < rounds; r++) {
+            for (int i = 0; i < K; i++)
+                for (int c = 0; c < 3; c++) {
+                    uint32_t v;
+                    if (phase == 0) {
+                        v = (uint32_t)((r * K + (size_t)i) * 3 + (size_t)c);
+                    } else if (phase == 1) {
+                        uint64_t p10 = 1;
+                        int k = (i * 3 + c) % 33; /* 10^0 .. 10^10, each with -1, +0, +1 */
+                        for (int e = 0; e < k / 3; e++) p10 *= 10;
+                        uint64_t w = p10 + (uint64_t)(k % 3) - 1;
+                        v = w > UINT32_MAX ? UINT32_MAX - (uint32_t)(k % 3) : (uint32_t)w;
+                    } else {
+                        seed ^= seed << 13, seed ^= seed >> 7, seed ^= seed << 17;
+                        v = (uint32_t)(seed >> (seed & 31)); /* every magnitude */
+                    }
+                    t[i].v[c] = v;
+                }
+            size_t n = pdt_format_lines(buf, PDT_LINES_TRI, t, K, 0), m = 0;
+            for (int i = 0; i < K; i++)
+                m += (size_t)sprintf(want + m, "%u %u %u\n", t[i].v[0], t[i].v[1], t[i].v[2]);
+            bad += n != m || memcmp(buf, want, n) != 0;
+            CHECK(pdt_lines_bytes(PDT_LINES_TRI, t, K, 0) == m);
+            done++;
+        }
+    }
+    CHECK_MSG(bad == 0, "%llu of %llu blocks printed wrong", (unsigned long long)bad,
+              (unsigned long long)done);
+    free(t);
+    free(buf);
+    free(want);
+}
+
 /* pdt_write_tris_releasing writes pdt_write_tris's bytes, with one thread
  * and several, chunks of every size, and .ele; and it does give the array's
  * memory back: whole 2 MiB pages inside it read as zeros afterwards, while
@@ -810,6 +857,7 @@ int main(void)
     RUN(read_prefault_same_points);
     RUN(tris_write_formats);
     RUN(tris_write_releasing);
+    RUN(format_lines_every_length);
     RUN(tris_read_bad_inputs);
     RUN(atomic_write_leaves_nothing);
     RUN(large_file_mapped_exact_pages);
