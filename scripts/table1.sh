@@ -52,23 +52,32 @@ command -v mpirun > /dev/null || { echo "table1: mpirun not found" >&2; exit 1; 
 command -v python3 > /dev/null || { echo "table1: python3 not found" >&2; exit 1; }
 [ -x "$PDT" ] || { echo "table1: $PDT not built (make)" >&2; exit 1; }
 
+# The CPU seconds the host took from this VM's CPUs so far (steal, /proc/stat):
+# a run during which the host ran something else on one of our two CPUs takes
+# up to twice as long (a two-rank run more than a plain one, which mostly uses
+# one CPU); each run's share is in the table's "steal s" column.
+TICK=$(getconf CLK_TCK 2> /dev/null || echo 100)
+steal_now() { awk -v t="$TICK" '/^cpu /{ printf "%.2f", $9 / t }' /proc/stat; }
+
 # run_once LABEL I CMD... : run I of LABEL; appends "wall_seconds stats_json_file
-# system_seconds" to $W/LABEL.runs (system seconds of the whole command, its
-# children included: on this project's VMs memory new to the machine makes
-# them jump, 0.3 s -> 2 s at 10^7 points, and the wall with them)
+# system_seconds steal_seconds" to $W/LABEL.runs (system seconds of the whole
+# command, its children included: on this project's VMs memory new to the
+# machine makes them jump, 0.3 s -> 2 s at 10^7 points, and the wall with them)
 run_once() {
     local label=$1 i=$2; shift 2
-    local t0 t1
+    local t0 t1 s0
     # a new output each run (replacing the last one would add the unlink of
     # its page cache to the write phase)
     rm -f "$W/out.tri"
     memstate_prepare "$WARM_MB"
+    s0=$(steal_now)
     t0=$(date +%s.%N)
     /usr/bin/time -f "%S" -o "$W/$label.$i.sys" nice -n "$NICE" "$@" -o "$W/out.tri" --stats \
         2> "$W/$label.$i.json" > /dev/null || {
         echo "table1: $label run $i failed:" >&2; tail -3 "$W/$label.$i.json" >&2; exit 1; }
     t1=$(date +%s.%N)
-    echo "$(awk "BEGIN { print $t1 - $t0 }") $W/$label.$i.json $(tail -1 "$W/$label.$i.sys")" >> "$W/$label.runs"
+    echo "$(awk "BEGIN { print $t1 - $t0 }") $W/$label.$i.json $(tail -1 "$W/$label.$i.sys")" \
+        "$(awk "BEGIN { print $(steal_now) - $s0 }")" >> "$W/$label.runs"
 }
 
 # pieces K IN: K consecutive K-ths of the input's lines (same kind of points,
@@ -87,9 +96,10 @@ pieces() {
 # a K-rank run could reach here (each with the whole kernel, the faster way).
 ceiling_once() {
     local label=$1 k=$2
-    local t0 t1
+    local t0 t1 s0
     rm -f "$W"/piece*.tri
     memstate_prepare "$WARM_MB"
+    s0=$(steal_now)
     t0=$(date +%s.%N)
     /usr/bin/time -f "%S" -o "$W/$label.sys" bash -c '
         for i in $(seq 0 $(($2 - 1))); do
@@ -98,7 +108,8 @@ ceiling_once() {
         done
         wait' _ "$W" "$k" "$NICE" "$PDT"
     t1=$(date +%s.%N)
-    echo "$(awk "BEGIN { print $t1 - $t0 }") - $(tail -1 "$W/$label.sys")" >> "$W/$label.runs"
+    echo "$(awk "BEGIN { print $t1 - $t0 }") - $(tail -1 "$W/$label.sys")" \
+        "$(awk "BEGIN { print $(steal_now) - $s0 }")" >> "$W/$label.runs"
 }
 
 echo "pdt Table 1 — wall time against the plain run, uniform points, median of $RUNS runs"

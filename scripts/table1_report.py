@@ -2,9 +2,9 @@
 """pdt — the figures of `make table1` (scripts/table1.sh) from its runs.
 
 Usage: table1_report.py DIR CORES "SIZES" "PS"
-DIR holds LABEL.runs files (lines "wall_seconds stats.json [system_seconds]"),
-LABEL = seq-N (the plain run), pP-N (mpirun -np P) or ceilP-N (the ceiling,
-"wall_seconds - [system_seconds]")."""
+DIR holds LABEL.runs files (lines "wall_seconds stats.json [system_seconds
+[steal_seconds]]"), LABEL = seq-N (the plain run), pP-N (mpirun -np P) or
+ceilP-N (the ceiling, "wall_seconds - [system_seconds [steal_seconds]]")."""
 import json
 import statistics
 import sys
@@ -29,6 +29,20 @@ def sys_col(w, label):
         if len(f) >= 3:
             vals.append(float(f[2]))
     return f"{statistics.median(vals):.2f}" if vals else ""
+
+
+def steal_col(w, label):
+    """The CPU seconds stolen by the host during LABEL's runs: the largest, and
+    how many runs lost more than 0.05 s ("" when not recorded)."""
+    vals = []
+    for line in open(f"{w}/{label}.runs"):
+        f = line.split()
+        if len(f) >= 4:
+            vals.append(float(f[3]))
+    if not vals:
+        return ""
+    hit = sum(v > 0.05 for v in vals)
+    return f"{max(vals):.2f}" + (f" ({hit} of {len(vals)})" if hit else "")
 
 
 def rank_phases(j):
@@ -60,7 +74,7 @@ def peak_kib(j):
 def main():
     w, cores, sizes, ps = sys.argv[1], int(sys.argv[2]), sys.argv[3].split(), sys.argv[4].split()
     med = statistics.median
-    hdr = ("n", "run", "wall s", "speedup") + tuple(f"{k} s" for k in PHASES) + ("sys s", "")
+    hdr = ("n", "run", "wall s", "speedup") + tuple(f"{k} s" for k in PHASES) + ("sys s", "steal s", "")
     print("| " + " | ".join(hdr) + " |")
     print("|" + "|".join("---" for _ in hdr) + "|")
     all_native = True
@@ -87,7 +101,8 @@ def main():
             wr = med([x.get("write", 0.0) for x in s])
             peaks[name] = med([j.get("peak_rss_kib", 0) for _, j in rows])
             print(f"| {int(n):,} | {name} | {walls[label]:.3f} | {ref / walls[label]:.2f} | {rd:.3f} | | "
-                  f"{walls[label] - rd - wr:.3f}† | | | {wr:.3f} | {sys_col(w, label)} | |")
+                  f"{walls[label] - rd - wr:.3f}† | | | {wr:.3f} | {sys_col(w, label)} | "
+                  f"{steal_col(w, label)} | |")
         seq_wall = ref
         for p in ps:
             runs = load(w, f"p{p}-{n}")
@@ -97,13 +112,13 @@ def main():
             cols = " | ".join(f"{med([x[k] for x, _ in ph]):.3f}" for k in PHASES)
             mark = "* P > cores" if int(p) > cores else ""
             print(f"| {int(n):,} | mpirun -np {p} | {wall:.3f} | {seq_wall / wall:.2f} | {cols} | "
-                  f"{sys_col(w, f'p{p}-{n}')} | {mark} |")
+                  f"{sys_col(w, f'p{p}-{n}')} | {steal_col(w, f'p{p}-{n}')} | {mark} |")
         for p in ps:
             try:
                 walls = [float(line.split()[0]) for line in open(f"{w}/ceil{p}-{n}.runs")]
             except OSError:
                 continue
-            sysc = sys_col(w, f"ceil{p}-{n}")
+            sysc = sys_col(w, f"ceil{p}-{n}") + " | " + steal_col(w, f"ceil{p}-{n}")
             wall = med(walls)
             blank = " | ".join("" for _ in PHASES)
             print(f"| {int(n):,} | ceiling: {p} plain runs on n/{p} at once | {wall:.3f} | "
@@ -127,10 +142,16 @@ def main():
     print("wall = the whole command (MPI start-up, read, compute, write); speedup = plain wall / wall,")
     print("the plain run being the faster of the two plain rows (default: from 2^21 points two strips")
     print("one after the other, 62 bytes per point; PDT_PLAIN_STRIPS=0: the whole kernel, 84).")
+    print("A plain run prints its output on one thread per CPU (PDT_WRITE_THREADS; a rank prints")
+    print("its own block on its one CPU), so on this machine its write phase uses both cores, as")
+    print("do the ceiling's runs.")
     print("sys = the command's system CPU seconds (all its processes), median: memory the VM has")
     print("handed back to its host costs about 1.25 s per GiB on first touch (0.05 s when it was in")
     print("use a moment before), and the wall with it; MEMSTATE (printed above) says which state")
-    print("each command started in.  The runs go in rounds (plain, each P, each ceiling, again).")
+    print("each command started in.  steal = CPU seconds the host took from this VM during a")
+    print("command (/proc/stat): the largest over the runs, and how many lost more than 0.05 s;")
+    print("such a run of two ranks can take twice its time.  The runs go in rounds (plain, each")
+    print("P, each ceiling, again).")
     print("Phases: seconds, the largest over the ranks, median over the runs.  † plain run:")
     print("everything between read and write (sort, kernel, canonical order).")
     print("‡ ceiling: P plain runs started together, each on a consecutive n/P of the input's")
