@@ -9,6 +9,7 @@
 #ifndef PDT_GEOM_BIGMEM_H
 #define PDT_GEOM_BIGMEM_H
 
+#include <pthread.h>
 #include <stddef.h>
 
 /* An uninitialised array of `bytes` bytes, or NULL.  Free it with
@@ -57,7 +58,6 @@ void pdt_prefault_stop(pdt_prefault *pf);
 /* For a helper thread just started: when the process is bound to one CPU
  * (mpirun binds a job's only rank to a core), move the thread to the other
  * CPUs online, so that it does not take turns with the caller. */
-#include <pthread.h>
 void pdt_helper_off_my_cpu(pthread_t th);
 
 #endif

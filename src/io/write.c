@@ -278,11 +278,13 @@ size_t pdt_format_node_header(char *buf, uint64_t npts)
 enum { SEC_CHUNK = WBUF / PDT_LINE_MAX, SEC_MIN_ITEMS = 1 << 18, SEC_MAX_THREADS = 8 };
 
 /* pdt_write_tris_releasing: the triangles already printed are given back
- * RELEASE_STEP items at a time or more (whole 2 MiB pages: pdt_big_release).
- * The page cache of the file being written then takes memory that was in use
- * a moment before, not memory the host has taken back: on this project's VM
- * that made the write of 3*10^7 points' triangles 0.49-0.53 s in every run
- * instead of 0.49-0.93 s. */
+ * RELEASE_STEP items at a time or more (whole 2 MiB pages:
+ * pdt_big_release_front).  The page cache of the file being written then
+ * takes memory that was in use a moment before rather than memory the host
+ * has taken back: on this project's VM the write of 3*10^7 points' triangles
+ * took 0.48, 0.49 and 0.74 s in three runs, against 0.49, 0.89 and 0.99 s
+ * without (the triangles are half the file's size: the other half still
+ * comes from the free lists). */
 enum { RELEASE_STEP = 1 << 18 };
 
 static void release_items(const char *items, size_t elem, size_t from, size_t to)
@@ -438,7 +440,6 @@ static int wb_lines_threaded(wbuf *w, pdt_lines kind, const void *items, size_t 
         for (int t = 1; t < started; t++) pthread_join(th[t], NULL);
         pthread_mutex_destroy(&jb.mu);
         pthread_cond_destroy(&jb.turn);
-        jb.failed = 0;
         if (fseeko(w->fp, start, SEEK_SET) != 0) wb_fail(w, errno);
         return 0; /* nothing claimed past `start`: the one-thread loop rewrites it */
     }
