@@ -52,13 +52,6 @@ command -v mpirun > /dev/null || { echo "table1: mpirun not found" >&2; exit 1; 
 command -v python3 > /dev/null || { echo "table1: python3 not found" >&2; exit 1; }
 [ -x "$PDT" ] || { echo "table1: $PDT not built (make)" >&2; exit 1; }
 
-# The CPU seconds the host took from this VM's CPUs so far (steal, /proc/stat):
-# a run during which the host ran something else on one of our two CPUs takes
-# up to twice as long (a two-rank run more than a plain one, which mostly uses
-# one CPU); each run's share is in the table's "steal s" column.
-TICK=$(getconf CLK_TCK 2> /dev/null || echo 100)
-steal_now() { awk -v t="$TICK" '/^cpu /{ printf "%.2f", $9 / t }' /proc/stat; }
-
 # run_once LABEL I CMD... : run I of LABEL; appends "wall_seconds stats_json_file
 # system_seconds steal_seconds" to $W/LABEL.runs (system seconds of the whole
 # command, its children included: on this project's VMs memory new to the

@@ -74,8 +74,10 @@ for spec in "${inputs[@]}"; do
         rm -f "$W/out.tri"
         warm_mb=$((n * 150 / 1000000 + 64)) # pdt's 62-84 bytes per point, the output's pages, room
         memstate_prepare "$warm_mb"
+        s0=$(steal_now)
         "$TIME" -f '%M %U %S' -o "$W/time.out" "$PDT" triangulate "$in" -o "$W/out.tri" --stats \
             2> "$W/run.err" > /dev/null || { echo "  pdt failed: $(tail -2 "$W/run.err")"; exit 1; }
+        steal=$(awk "BEGIN { print $(steal_now) - $s0 }")
         stats=$(grep '^{' "$W/run.err" | tail -1)
         kib=$(tail -1 "$W/time.out" | awk '{print $1}')
         cpu=$(tail -1 "$W/time.out" | awk '{print $2 + $3}')
@@ -84,7 +86,7 @@ for spec in "${inputs[@]}"; do
             memstate_prepare $((warm_mb * 2)) # CGAL holds more per point
             cg=$("$B/cgal_dt" "$in" | python3 -c 'import json,sys; print(json.load(sys.stdin)["build"])') || cg=-
         fi
-        printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$kind" "$n" "$kib" "$cpu" "$cg" "$stats" >> "$RES"
+        printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$kind" "$n" "$kib" "$cpu" "$cg" "$steal" "$stats" >> "$RES"
     done
 done
 rm -f "$W/out.tri" "$W/time.out" "$W/run.err"
@@ -95,12 +97,12 @@ import json, statistics, sys
 from collections import OrderedDict
 rows = OrderedDict()
 for line in open(sys.argv[1]):
-    kind, n, kib, cpu, cg, st = line.rstrip("\n").split("\t", 5)
-    rows.setdefault((kind, int(n)), []).append((int(kib), None if cg == "-" else float(cg), json.loads(st), float(cpu)))
+    kind, n, kib, cpu, cg, steal, st = line.rstrip("\n").split("\t", 6)
+    rows.setdefault((kind, int(n)), []).append((int(kib), None if cg == "-" else float(cg), json.loads(st), float(cpu), float(steal)))
 ph = ["read", "sort", "kernel", "canonical", "write", "total"]
 print()
 print(f"pdt triangulate IN -o OUT.tri --stats, per phase (medians of {sys.argv[2]} run(s)); CGAL insert in the same run")
-hdr = f"{'input':<9} {'n':>10} " + " ".join(f"{p:>9}" for p in ph) + f" {'cpu s':>7} {'CGAL':>8} {'(s+k)/CGAL':>10} {'peak B/pt':>9}"
+hdr = f"{'input':<9} {'n':>10} " + " ".join(f"{p:>9}" for p in ph) + f" {'cpu s':>7} {'CGAL':>8} {'(s+k)/CGAL':>10} {'peak B/pt':>9} {'steal s':>7}"
 print(hdr)
 print("-" * len(hdr))
 for (kind, n), r in rows.items():
@@ -111,7 +113,8 @@ for (kind, n), r in rows.items():
     ratio = (sec["sort"] + sec["kernel"]) / cg if cg else None
     cpu = statistics.median(x[3] for x in r)
     print(f"{kind:<9} {n:>10} " + " ".join(f"{sec[p]:>9.3f}" for p in ph) + f" {cpu:>7.2f}" +
-          (f" {cg:>8.3f} {ratio:>10.2f}" if cg else f" {'-':>8} {'-':>10}") + f" {kib * 1024 / n:>9.1f}")
+          (f" {cg:>8.3f} {ratio:>10.2f}" if cg else f" {'-':>8} {'-':>10}") + f" {kib * 1024 / n:>9.1f}" +
+          f" {max(x[4] for x in r):>7.2f}")
     print(f"{'  ns/pt':<20} " + " ".join(f"{sec[p] * 1e9 / n:>9.1f}" for p in ph) + f" {'':>7}" +
           (f" {cg * 1e9 / n:>8.1f}" if cg else f" {'-':>8}"))
 print()
@@ -119,5 +122,6 @@ print("seconds per phase from --stats (wall; read: text parse; write: the .tri f
 print("ns/pt: the same per")
 print("input point; cpu s: the process's user + system seconds (both threads: the prefault thread's")
 print("included); CGAL: Delaunay_triangulation_2::insert of the range (s, then ns/pt); (s+k)/CGAL:")
-print("pdt sort + kernel over CGAL's insert (below 1: pdt faster); peak: max RSS / n (time -f %M).")
+print("pdt sort + kernel over CGAL's insert (below 1: pdt faster); peak: max RSS / n (time -f %M);")
+print("steal s: the most CPU seconds the host took from this VM during one of the row's pdt runs.")
 PY

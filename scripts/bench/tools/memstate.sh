@@ -39,3 +39,11 @@ memstate_prepare() {
         cold) sync; sleep 3 ;;
     esac
 }
+
+# steal_now: the CPU seconds the host has taken from this VM's CPUs so far
+# (steal, /proc/stat; 0 on a machine that is not a VM).  A run during which
+# the host ran something else on one of our CPUs takes up to twice as long (a
+# two-rank run more than a plain one, which mostly uses one CPU): the
+# benchmarks print each run's share.
+MEMSTATE_TICK=$(getconf CLK_TCK 2> /dev/null || echo 100)
+steal_now() { awk -v t="$MEMSTATE_TICK" '/^cpu /{ printf "%.2f", $9 / t }' /proc/stat; }
