@@ -40,6 +40,19 @@ void pdt_big_free(void *p, size_t bytes)
     else munmap(p, bytes);
 }
 
+size_t pdt_page_size(void)
+{
+    long pg = sysconf(_SC_PAGESIZE);
+    return pg > 0 ? (size_t)pg : 4096;
+}
+
+void pdt_release_pages(const void *p, size_t len)
+{
+    uintptr_t m = pdt_page_size() - 1;
+    uintptr_t lo = ((uintptr_t)p + m) & ~m, hi = ((uintptr_t)p + len) & ~m;
+    if (hi > lo) (void)madvise((void *)lo, hi - lo, MADV_DONTNEED);
+}
+
 void pdt_big_release_front(void *base, size_t from, size_t to)
 {
     uintptr_t b0 = (uintptr_t)base;
@@ -64,7 +77,7 @@ static void *prefault_run(void *arg)
 {
     pdt_prefault *pf = arg;
 #ifdef MADV_POPULATE_WRITE
-    long pg = 4096;
+    long pg = (long)pdt_page_size();
     for (int k = 0; k < pf->nr; k++) {
         /* whole pages inside the range only: a page it shares with another
          * allocation is left to that allocation's owner */

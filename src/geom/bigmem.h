@@ -21,6 +21,15 @@ void pdt_big_free(void *p, size_t bytes);
  * (of any allocation, e.g. a large malloc'd block).  Only a hint. */
 void pdt_big_advise(void *p, size_t bytes);
 
+/* The system's page size (sysconf), for code that gives pages back. */
+size_t pdt_page_size(void);
+
+/* Give back to the system the whole pages inside [p, p + len) of a mapping
+ * whose contents there are not needed now (an anonymous mapping then reads
+ * zeros there, a file's mapping reads the file again); a page that the range
+ * only shares with something else is kept. */
+void pdt_release_pages(const void *p, size_t len);
+
 /* An array used front to back, whose front [0, to) is no longer needed
  * (its contents there read as zeros if touched again): give back to the
  * system the whole 2 MiB pages of it not given back yet, `from` being the

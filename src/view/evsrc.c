@@ -11,6 +11,7 @@
  * one or a few blocks (some 50 microseconds each). */
 #include "pdt/tracefile.h"
 #include "replay_int.h"
+#include "../geom/bigmem.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -90,13 +91,11 @@ static void drop_behind(pdt_evsrc *s, uint32_t q, uint64_t off)
     if (!s->released && !(s->released = calloc((size_t)s->nranks, sizeof *s->released))) return;
     uint64_t *rel = &s->released[q];
     if (off < *rel) {
-        *rel = off & ~(uint64_t)4095;
+        *rel = off & ~(uint64_t)(pdt_page_size() - 1);
         return;
     }
     if (off - *rel < RELEASE_STEP) return;
-    uintptr_t lo = ((uintptr_t)(s->file[q] + *rel) + 4095) & ~(uintptr_t)4095,
-              hi = (uintptr_t)(s->file[q] + off) & ~(uintptr_t)4095;
-    if (hi > lo) madvise((void *)lo, hi - lo, MADV_DONTNEED);
+    pdt_release_pages(s->file[q] + *rel, off - *rel);
     *rel = off;
 }
 

@@ -30,6 +30,7 @@
 #include "pdt/io.h"
 #include "pdt/replay.h"
 #include "replay_int.h"
+#include "../geom/bigmem.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -540,9 +541,7 @@ void pdt_index_release(const pdt_replay *r, const void *p, size_t len)
     if (hi <= base || lo >= base + r->map_len) return;
     if (lo < base) lo = base;
     if (hi > base + r->map_len) hi = base + r->map_len;
-    lo = (lo + 4095) & ~(uintptr_t)4095;
-    hi &= ~(uintptr_t)4095;
-    if (hi > lo) madvise((void *)lo, hi - lo, MADV_DONTNEED);
+    pdt_release_pages((const void *)lo, hi - lo);
 }
 
 /* ---- the run's identity and the index's place ---------------------------------- */
@@ -718,11 +717,11 @@ static int map_ranks(pdt_replay *r, const char *dir, lazy *L, char *why, size_t 
                 snprintf(why, wcap, "stale: rank-%04zu.trace does not match it (a block's checksum)", q);
                 return 0;
             }
-            size_t upto = (size_t)src->blk[b].off & ~(size_t)4095;
+            size_t upto = (size_t)src->blk[b].off;
             if (upto - released >= ((size_t)16 << 20) || b + 1 == src->rank_blk[q + 1]) {
                 if (b + 1 == src->rank_blk[q + 1]) upto = (size_t)sb.st_size;
-                madvise((char *)m + released, upto - released, MADV_DONTNEED);
-                released = upto;
+                pdt_release_pages((char *)m + released, upto - released);
+                released = upto & ~(pdt_page_size() - 1);
             }
         }
     }

@@ -1023,9 +1023,7 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
 static void drop_recs(const builder *b, size_t upto)
 {
     if (!b->pl || !b->r->recs || !upto || upto % DROP_EVERY) return;
-    uintptr_t lo = ((uintptr_t)(b->r->recs + upto - DROP_EVERY) + 4095) & ~(uintptr_t)4095,
-              hi = (uintptr_t)(b->r->recs + upto) & ~(uintptr_t)4095;
-    if (hi > lo) madvise((void *)lo, hi - lo, MADV_DONTNEED);
+    pdt_release_pages(b->r->recs + upto - DROP_EVERY, DROP_EVERY * sizeof *b->r->recs);
 }
 
 /* Number the triangles by their first event (after tri_groups): the
