@@ -265,6 +265,13 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
 pdt_status pdt_par_write(pdt_comm *c, const char *path, pdt_tri_format fmt, const pdt_par_input *in,
                          const pdt_par_output *out, pdt_err *err);
 
+/* T* of n points (a pdt_tstar_fn for pdt_run_check_tstar): as a plain run
+ * computes it for a .tri output, on two strips one after the other from 2^21
+ * points on ($PDT_PLAIN_STRIPS as for the plain run), else the whole kernel;
+ * on a copy of the points.  *strips: the strips (0: the whole kernel). */
+pdt_status pdt_par_tstar(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
+                         int *strips);
+
 /* Remove the temporaries of a parallel write still in progress at this rank
  * (none: nothing happens).  Async-signal-safe (unlink only): for a handler
  * of the signal that ends the job when another rank died. */

@@ -286,8 +286,9 @@ pdt_status pdt_run_export_otf2(pdt_run *run, const char *dir, pdt_otf2_counts *c
  * and depths agree; Graham's final stack is the hull of the points; lift-ups
  * cover the distinct points once (local) and |B| at each merge, with
  * z = x*x + y*y; every TRI_FINAL once across ranks and the set equals
- * T*(points) (recomputed with pdt_triangulate); merge steps begin and end on
- * one rank and do not overlap within a level; every SEND has its RECV.
+ * T*(points) (recomputed with pdt_triangulate, or see pdt_run_check_tstar);
+ * merge steps begin and end on one rank and do not overlap within a level;
+ * every SEND has its RECV.
  * Returns PDT_OK and a one-line summary in `summary` (cap bytes), or
  * PDT_ERR_CHECK with the first violation in err. */
 pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err);
@@ -303,5 +304,17 @@ pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err);
  * with the number of messages and merge steps is not part of the budget. */
 pdt_status pdt_run_check_mem(pdt_run *run, uint64_t budget, char *summary, size_t cap,
                              pdt_err *err);
+
+/* How the check recomputes T* of the run's n points: its canonical triangles
+ * (pdt_tri_canonical order, malloc'd) into *tris, *ntri, and in *strips the
+ * strips it worked on one after the other (0: the whole kernel at once). */
+typedef pdt_status (*pdt_tstar_fn)(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
+                                   int *strips);
+
+/* pdt_run_check_mem, T* recomputed by `tstar` (NULL: pdt_triangulate).  The
+ * cli passes pdt_par_tstar (pdt/par.h), which needs less memory on big runs;
+ * the summary then says on how many strips. */
+pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar, char *summary,
+                               size_t cap, pdt_err *err);
 
 #endif

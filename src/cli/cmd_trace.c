@@ -8,6 +8,7 @@
 
 #include "cli.h"
 #include "pdt/io.h"
+#include "pdt/par.h"
 #include "pdt/tracefile.h"
 
 static const char help_main[] =
@@ -299,7 +300,7 @@ static int cmd_check(const char *dir, uint64_t budget)
         return PDT_EXIT_USAGE;
     }
     char summary[512];
-    pdt_status st = pdt_run_check_mem(run, budget, summary, sizeof summary, &err);
+    pdt_status st = pdt_run_check_tstar(run, budget, pdt_par_tstar, summary, sizeof summary, &err);
     pdt_run_close(run);
     if (st != PDT_OK) {
         fprintf(stderr, "pdt trace check: %s: %s\n", dir, err.msg);

@@ -716,15 +716,38 @@ static double cpu_seconds(void)
  * when a sample says the merge would redo most of the work (pdt_srm_plain_pays).
  * $PDT_PLAIN_STRIPS=K decides for every size: 0 the whole kernel (about 8 %
  * faster at 10^7 points, 84 bytes per point instead of 62), 2..16 strips. */
-static int plain_strips(const pdt_par_input *in, const pdt_trace *tr)
+static int strips_for(const pdt_point *pts, size_t n)
 {
-    if (tr || !in->release_pts) return 0;
     const char *t = getenv("PDT_PLAIN_STRIPS");
     if (t && *t) {
         int k = atoi(t);
         return k >= 2 && k <= PDT_PLAIN_MAX_STRIPS ? k : 0;
     }
-    return in->n >= ((size_t)1 << 21) && pdt_srm_plain_pays(in->pts, in->n) ? 2 : 0;
+    return n >= ((size_t)1 << 21) && pdt_srm_plain_pays(pts, n) ? 2 : 0;
+}
+
+static int plain_strips(const pdt_par_input *in, const pdt_trace *tr)
+{
+    return tr || !in->release_pts ? 0 : strips_for(in->pts, in->n);
+}
+
+/* T* of the points (pdt/par.h): on a copy the pipeline may spend, on
+ * strips_for strips like a plain run's .tri output. */
+pdt_status pdt_par_tstar(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *ntri,
+                         int *strips)
+{
+    *tris = NULL;
+    *ntri = 0;
+    *strips = strips_for(pts, n);
+    pdt_point *copy = malloc(n ? n * sizeof *copy : 1);
+    if (!copy) return PDT_ERR_NOMEM;
+    memcpy(copy, pts, n * sizeof *copy);
+    pdt_tri_stats ts;
+    pdt_err err = {0};
+    pdt_status st = *strips ? pdt_srm_plain(copy, n, *strips, 0, tris, ntri, &ts, &err)
+                            : pdt_triangulate_inplace(copy, n, PDT_PTS_SPEND, tris, ntri, &ts, NULL);
+    free(copy);
+    return st;
 }
 
 /* One rank: the sequential pipeline on the whole input (the whole kernel, or

@@ -49,6 +49,8 @@ typedef struct chk {
     size_t nfin, capfin;
     size_t maxfin;          /* finals held in memory before a spill (from the budget) */
     uint64_t budget;        /* the memory budget (bytes) */
+    pdt_tstar_fn tstar;     /* recomputes T* (NULL: pdt_triangulate) */
+    int tstar_strips;       /* the strips it worked on (0: the whole kernel) */
     FILE **runs;            /* sorted runs of finals spilled to temporary files */
     size_t nruns, capruns;
     uint64_t totfin;        /* final triangles recorded in all */
@@ -828,7 +830,8 @@ static pdt_status check_finals(chk *c)
     }
     pdt_tri *ref = NULL;
     size_t nref = 0;
-    pdt_status st = pdt_triangulate(c->pts, c->npts, &ref, &nref, NULL, NULL);
+    pdt_status st = c->tstar ? c->tstar(c->pts, c->npts, &ref, &nref, &c->tstar_strips)
+                             : pdt_triangulate(c->pts, c->npts, &ref, &nref, NULL, NULL);
     if (st != PDT_OK) {
         free(ref);
         return pdt_err_set(c->err, st, "recomputing T* of the run's points failed: %s",
@@ -947,6 +950,12 @@ pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
 pdt_status pdt_run_check_mem(pdt_run *run, uint64_t budget, char *summary, size_t cap,
                              pdt_err *err)
 {
+    return pdt_run_check_tstar(run, budget, NULL, summary, cap, err);
+}
+
+pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar, char *summary,
+                               size_t cap, pdt_err *err)
+{
     if (cap) summary[0] = '\0';
     const char *w = pdt_run_warnings(run);
     if (*w) {
@@ -960,6 +969,7 @@ pdt_status pdt_run_check_mem(pdt_run *run, uint64_t budget, char *summary, size_
     c.err = err;
     c.pts = pdt_run_points(run, &c.npts);
     c.budget = budget;
+    c.tstar = tstar;
     /* half the budget for the finals' buffer; at least a few, so that a tiny
      * budget spills often instead of failing */
     c.maxfin = (size_t)(budget / 2 / sizeof(fin) < 16 ? 16 : budget / 2 / sizeof(fin));
@@ -1037,6 +1047,10 @@ pdt_status pdt_run_check_mem(pdt_run *run, uint64_t budget, char *summary, size_
                  pdt_run_nranks(run), pdt_run_nranks(run) == 1 ? "" : "s", c.events, c.instances,
                  c.pushes, c.pops, c.hulls, c.lifts_local, c.lifts_merge, (size_t)c.totfin,
                  c.is_tri ? " = T*" : "", c.nmg, c.nmsg / 2, c.edge_scopes);
+    if (st == PDT_OK && cap && c.tstar_strips) {
+        size_t len = strlen(summary);
+        snprintf(summary + len, cap - len, " (T* recomputed on %d strips)", c.tstar_strips);
+    }
     if (st == PDT_OK && cap && c.spills) {
         size_t len = strlen(summary);
         snprintf(summary + len, cap - len, " (final triangles sorted on disk in %" PRIu64

@@ -15,10 +15,13 @@
 #include "pdt/hull.h"
 #include "pdt/predicates.h"
 #include "pdt/tracefile.h"
+#include "pdt/par.h"
 
 static char tmpdir[256];
 /* memory budget of the checks (tiny_budget_spills makes it tiny) */
 static uint64_t budget = PDT_TRACE_MEM_DEFAULT;
+/* how the checks recompute T* (strips_tstar_same_verdicts: the cli's way) */
+static pdt_tstar_fn tstar = NULL;
 
 static void meta(const char *dir, const char *command, const pdt_point *pts, size_t n, int nranks)
 {
@@ -77,7 +80,7 @@ static pdt_status check_dir(const char *dir, char *msg, size_t cap)
         return err.code;
     }
     char summary[512];
-    pdt_status st = pdt_run_check_mem(run, budget, summary, sizeof summary, &err);
+    pdt_status st = pdt_run_check_tstar(run, budget, tstar, summary, sizeof summary, &err);
     snprintf(msg, cap, "%s", st == PDT_OK ? summary : err.msg);
     pdt_run_close(run);
     return st;
@@ -432,12 +435,53 @@ TEST(tiny_budget_spills)
     free(pts);
 }
 
+/* T* recomputed as the cli does (pdt_par_tstar), on 3 strips forced by
+ * PDT_PLAIN_STRIPS (its own default is two strips from 2^21 points on): the
+ * same verdicts as the whole kernel's, and the summary says so.  With
+ * PDT_PLAIN_STRIPS=0 it runs the whole kernel and says nothing. */
+TEST(strips_tstar_same_verdicts)
+{
+    char msg[1100];
+    pdt_point *pts = uniform(2000);
+    edit_pts = pts;
+    edit_n = 2000;
+    tstar = pdt_par_tstar;
+    setenv("PDT_PLAIN_STRIPS", "3", 1);
+    record_tri(sub("st"), pts, 2000, 1);
+    CHECK_MSG(check_dir(sub("st"), msg, sizeof msg) == PDT_OK, "%s", msg);
+    CHECK_MSG(strstr(msg, "= T*") && strstr(msg, "(T* recomputed on 3 strips)"), "%s", msg);
+    uint64_t k = find_kind(sub("st"), PDT_EV_TRI_FINAL, 1000);
+    copy_run(sub("st"), sub("st-nofinal"), k, UINT64_MAX, NULL);
+    expect_fail(sub("st-nofinal"), "was never made final");
+    k = find_kind(sub("st"), PDT_EV_TRI_FINAL, 2500);
+    copy_run(sub("st"), sub("st-wrong"), UINT64_MAX, k, swap_point);
+    expect_fail(sub("st-wrong"), "is not in T* of the run's points");
+    record_tri_dup(sub("st-dup"), pts, 2000, 7);
+    expect_fail(sub("st-dup"), "made final twice");
+    /* every generator family: degenerate sets on strips too */
+    static const char *fam[] = {"grid", "circle", "collinear", "duplicates", "parabola"};
+    for (size_t f = 0; f < sizeof fam / sizeof *fam; f++) {
+        pdt_point *q;
+        pdt_err err = {0};
+        if (pdt_gen(fam[f], 700, 5, &q, &err) != PDT_OK) continue;
+        record_tri(sub("st-fam"), q, 700, 1);
+        CHECK_MSG(check_dir(sub("st-fam"), msg, sizeof msg) == PDT_OK, "%s: %s", fam[f], msg);
+        free(q);
+    }
+    setenv("PDT_PLAIN_STRIPS", "0", 1);
+    CHECK_MSG(check_dir(sub("st"), msg, sizeof msg) == PDT_OK && !strstr(msg, "strips"), "%s", msg);
+    unsetenv("PDT_PLAIN_STRIPS");
+    tstar = NULL;
+    free(pts);
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "%s/pdt-ttc.XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
     if (!mkdtemp(tmpdir)) return 1;
     RUN(every_family_passes);
     RUN(removed_events_are_named);
+    RUN(strips_tstar_same_verdicts);
     RUN(edited_events_are_named);
     RUN(damaged_files_fail);
     RUN(messages_and_merges);
