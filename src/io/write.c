@@ -6,6 +6,7 @@
 #include "../geom/bigmem.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -417,6 +418,9 @@ static int wb_lines_threaded(wbuf *w, pdt_lines kind, const void *items, size_t 
     int fd = fileno(w->fp);
     struct stat sb;
     if (fd < 0 || fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) return 0;
+    int fl = fcntl(fd, F_GETFL);
+    if (fl < 0 || (fl & O_APPEND)) return 0; /* (standard output opened with >>: pwrite
+                                              * would append, whatever the offset) */
     wb_flush(w);
     if (w->bad || fflush(w->fp) != 0) {
         if (!w->bad) wb_fail(w, errno);

@@ -8,7 +8,8 @@
 # taken, a last chunk shorter than the others).  A write that fails on a
 # helper's chunk (file size limit: EFBIG) must end the run with the file's name
 # and the reason, exit 2, and leave neither the output nor a temporary file.
-# Standard output (a pipe) keeps the one-thread loop and the same bytes.
+# Standard output keeps the same bytes: through a pipe and appending to a
+# file (>>) with the one-thread loop, redirected to a file (>) on threads.
 # san: yes
 source "$(dirname "$0")/lib.sh"
 cd "$TMP"
@@ -67,6 +68,18 @@ run 1 "" triangulate in.txt -o ref.tri
 run 3 5 triangulate in.txt -o - | cat > pipe.tri
 if cmp -s ref.tri pipe.tri; then ok "standard output through a pipe: same bytes"
 else fail "standard output through a pipe: same bytes"; fi
+
+# standard output redirected to a regular file: threads when it is opened
+# plainly (>), the one-thread loop when it appends (>>: pwrite would append
+# whatever its offset, and the chunks would land in the order they were done)
+run 3 5 triangulate in.txt -o - > redir.tri
+if cmp -s ref.tri redir.tri; then ok "standard output to a file (>): same bytes"
+else fail "standard output to a file (>): same bytes"; fi
+echo "first line" > app.tri
+run 3 5 triangulate in.txt -o - >> app.tri
+{ echo "first line"; cat ref.tri; } > app-want.tri
+if cmp -s app-want.tri app.tri; then ok "standard output appending to a file (>>): same bytes after the old ones"
+else fail "standard output appending to a file (>>): same bytes after the old ones"; fi
 
 # a failed write: the file size limit (bytes in 512-byte blocks) is met by some
 # chunk after the first one, on whichever thread printed it
