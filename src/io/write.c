@@ -407,25 +407,54 @@ static size_t section_chunk(void)
     return c > 0 && (size_t)c < SEC_CHUNK ? (size_t)c : SEC_CHUNK;
 }
 
+/* The descriptor for pwrite if w writes a regular file at a position pwrite
+ * can honour, else -1 (a pipe, a terminal; a file opened for appending, as
+ * standard output is with >>: pwrite would append whatever its offset). */
+static int section_fd(const wbuf *w)
+{
+    int fd = fileno(w->fp);
+    struct stat sb;
+    if (fd < 0 || fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) return -1;
+    int fl = fcntl(fd, F_GETFL);
+    return fl < 0 || (fl & O_APPEND) ? -1 : fd;
+}
+
+/* Run the job on its threads (the caller's is thread 0).  Returns 0, having
+ * written and given back nothing, if a helper could not be started (its
+ * chunks would have waited forever: everyone is stopped before chunk 0). */
+static int section_run(section_job *jb)
+{
+    section_worker wk[SEC_MAX_THREADS];
+    pthread_t th[SEC_MAX_THREADS];
+    int started = 1;
+    for (int t = 0; t < jb->nthreads; t++) wk[t] = (section_worker){ jb, t };
+    const char *cap = getenv("PDT_TEST_WRITE_HELPERS"); /* tests: helpers that can start */
+    int most = cap && *cap ? atoi(cap) : SEC_MAX_THREADS;
+    for (; started < jb->nthreads; started++) {
+        if (started > most ||
+            pthread_create(&th[started], NULL, section_work, &wk[started]) != 0)
+            break;
+        pdt_helper_off_my_cpu(th[started]);
+    }
+    int all = started == jb->nthreads;
+    if (all) section_work(&wk[0]);
+    else section_fail(jb, EAGAIN);
+    for (int t = 1; t < started; t++) pthread_join(th[t], NULL);
+    return all;
+}
+
 /* Try the section on threads; returns 0 if it is not for threads (short, one
- * CPU, not a regular file), and then nothing was written or given back. */
+ * CPU, not a file pwrite can place bytes in), and then nothing was written
+ * or given back. */
 static int wb_lines_threaded(wbuf *w, pdt_lines kind, const void *items, size_t elem, size_t n,
                              int release)
 {
     size_t chunk = section_chunk();
-    int nt = section_threads();
-    if (nt < 2 || (n < SEC_MIN_ITEMS && chunk == SEC_CHUNK)) return 0;
-    int fd = fileno(w->fp);
-    struct stat sb;
-    if (fd < 0 || fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) return 0;
-    int fl = fcntl(fd, F_GETFL);
-    if (fl < 0 || (fl & O_APPEND)) return 0; /* (standard output opened with >>: pwrite
-                                              * would append, whatever the offset) */
+    int nt = section_threads(), fd;
+    if (nt < 2 || (n < SEC_MIN_ITEMS && chunk == SEC_CHUNK) || (fd = section_fd(w)) < 0) return 0;
     wb_flush(w);
-    if (w->bad || fflush(w->fp) != 0) {
-        if (!w->bad) wb_fail(w, errno);
-        return 1;
-    }
+    if (!w->bad && fflush(w->fp) != 0) wb_fail(w, errno);
+    if (w->bad) return 1;
     off_t start = ftello(w->fp);
     if (start < 0) return 0;
     section_job jb = { .fd = fd, .kind = kind, .items = items, .elem = elem, .n = n,
@@ -433,27 +462,10 @@ static int wb_lines_threaded(wbuf *w, pdt_lines kind, const void *items, size_t 
                        .release = release };
     pthread_mutex_init(&jb.mu, NULL);
     pthread_cond_init(&jb.turn, NULL);
-    section_worker wk[SEC_MAX_THREADS];
-    pthread_t th[SEC_MAX_THREADS];
-    int started = 1;
-    for (int t = 0; t < nt; t++) wk[t] = (section_worker){ &jb, t };
-    for (int t = 1; t < nt; t++) {
-        if (pthread_create(&th[t], NULL, section_work, &wk[t]) != 0) break;
-        pdt_helper_off_my_cpu(th[t]);
-        started++;
-    }
-    if (started < nt) { /* fewer threads than planned: their chunks would wait forever */
-        section_fail(&jb, EAGAIN);
-        for (int t = 1; t < started; t++) pthread_join(th[t], NULL);
-        pthread_mutex_destroy(&jb.mu);
-        pthread_cond_destroy(&jb.turn);
-        if (fseeko(w->fp, start, SEEK_SET) != 0) wb_fail(w, errno);
-        return 0; /* nothing claimed past `start`: the one-thread loop rewrites it */
-    }
-    section_work(&wk[0]);
-    for (int t = 1; t < nt; t++) pthread_join(th[t], NULL);
+    int ran = section_run(&jb);
     pthread_mutex_destroy(&jb.mu);
     pthread_cond_destroy(&jb.turn);
+    if (!ran) return 0; /* the one-thread loop writes it from `start` */
     if (jb.failed) wb_fail(w, jb.err);
     else if (fseeko(w->fp, (off_t)jb.end, SEEK_SET) != 0) wb_fail(w, errno);
     return 1;

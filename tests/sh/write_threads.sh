@@ -81,6 +81,15 @@ run 3 5 triangulate in.txt -o - >> app.tri
 if cmp -s app-want.tri app.tri; then ok "standard output appending to a file (>>): same bytes after the old ones"
 else fail "standard output appending to a file (>>): same bytes after the old ones"; fi
 
+# a helper that cannot be started (PDT_TEST_WRITE_HELPERS=K: only K start):
+# those started are stopped before any chunk is written, and the one-thread
+# loop writes the same bytes
+for k in 0 1; do
+    if PDT_TEST_WRITE_HELPERS=$k run 3 5 triangulate in.txt -o nohelp.tri && cmp -s ref.tri nohelp.tri
+    then ok "only $k of 2 helpers start: the one-thread loop, same bytes"
+    else fail "only $k of 2 helpers start: the one-thread loop, same bytes" "$(cat err.txt)"; fi
+done
+
 # a failed write: the file size limit (bytes in 512-byte blocks) is met by some
 # chunk after the first one, on whichever thread printed it
 rm -f out.tri
