@@ -31,9 +31,12 @@ def sys_col(w, label):
     return f"{statistics.median(vals):.2f}" if vals else ""
 
 
+STEAL_OK = 0.05  # seconds stolen by the host that a run may lose and still count as clean
+
+
 def steal_col(w, label):
     """The CPU seconds stolen by the host during LABEL's runs: the largest, and
-    how many runs lost more than 0.05 s ("" when not recorded)."""
+    how many runs lost more than STEAL_OK ("" when not recorded)."""
     vals = []
     for line in open(f"{w}/{label}.runs"):
         f = line.split()
@@ -41,7 +44,7 @@ def steal_col(w, label):
             vals.append(float(f[3]))
     if not vals:
         return ""
-    hit = sum(v > 0.05 for v in vals)
+    hit = sum(v > STEAL_OK for v in vals)
     return f"{max(vals):.2f}" + (f" ({hit} of {len(vals)})" if hit else "")
 
 
@@ -57,9 +60,6 @@ def clean_walls(w, label):
         if float(f[3]) <= STEAL_OK:
             walls.append(float(f[0]))
     return walls, total
-
-
-STEAL_OK = 0.05
 
 
 def rank_phases(j):
