@@ -185,6 +185,16 @@ static void expect_fail(const char *dir, const char *want)
     CHECK_MSG(strstr(msg, want) != NULL, "%s: message '%s' lacks '%s'", dir, msg, want);
 }
 
+/* A copy of run `base` without its nth event of `kind` (edit NULL), or with
+ * that event changed by edit, fails the check with `want` in the message. */
+static void expect_fail_copy(const char *base, const char *name, int kind, int nth,
+                             void (*edit)(pdt_event *), const char *want)
+{
+    uint64_t k = find_kind(sub(base), kind, nth);
+    copy_run(sub(base), sub(name), edit ? UINT64_MAX : k, edit ? k : UINT64_MAX, edit);
+    expect_fail(sub(name), want);
+}
+
 TEST(removed_events_are_named)
 {
     pdt_point *pts = uniform(500);
@@ -197,38 +207,24 @@ TEST(removed_events_are_named)
     copy_run(sub("base"), sub("same"), UINT64_MAX, UINT64_MAX, NULL);
     CHECK_MSG(check_dir(sub("same"), msg, sizeof msg) == PDT_OK, "%s", msg);
 
-    uint64_t k = find_kind(sub("base"), PDT_EV_TRI_FINAL, 10);
-    copy_run(sub("base"), sub("nofinal"), k, UINT64_MAX, NULL);
-    expect_fail(sub("nofinal"), "was never made final");
+    expect_fail_copy("base", "nofinal", PDT_EV_TRI_FINAL, 10, NULL, "was never made final");
 
-    k = find_kind(sub("base"), PDT_EV_LIFT, 17);
-    copy_run(sub("base"), sub("nolift"), k, UINT64_MAX, NULL);
-    expect_fail(sub("nolift"), "was never lifted");
+    expect_fail_copy("base", "nolift", PDT_EV_LIFT, 17, NULL, "was never lifted");
 
-    k = find_kind(sub("base"), PDT_EV_PHASE_END, 1);
-    copy_run(sub("base"), sub("nophaseend"), k, UINT64_MAX, NULL);
-    expect_fail(sub("nophaseend"), "phase lift begun at event #2 never ends");
+    expect_fail_copy("base", "nophaseend", PDT_EV_PHASE_END, 1, NULL, "phase lift begun at event #2 never ends");
 
-    k = find_kind(sub("baseh"), PDT_EV_POP, 3);
-    copy_run(sub("baseh"), sub("nopop"), k, UINT64_MAX, NULL);
-    expect_fail(sub("nopop"), "rank 0 event #");
+    expect_fail_copy("baseh", "nopop", PDT_EV_POP, 3, NULL, "rank 0 event #");
 
-    k = find_kind(sub("baseh"), PDT_EV_PUSH, 5);
-    copy_run(sub("baseh"), sub("nopush"), k, UINT64_MAX, NULL);
-    expect_fail(sub("nopush"), "depth after push should be");
+    expect_fail_copy("baseh", "nopush", PDT_EV_PUSH, 5, NULL, "depth after push should be");
 
     /* level 2: the kernel's edges replay to exactly the triangles' edges */
     record_tri(sub("base-l2"), pts, 500, 2);
     CHECK_MSG(check_dir(sub("base-l2"), msg, sizeof msg) == PDT_OK, "%s", msg);
     CHECK_MSG(strstr(msg, "1 kernel runs with edges replayed") != NULL, "%s", msg);
-    k = find_kind(sub("base-l2"), PDT_EV_EDGE_DEL, 20);
-    copy_run(sub("base-l2"), sub("noedgedel"), k, UINT64_MAX, NULL);
-    expect_fail(sub("noedgedel"), "rank 0 event #");
-    k = find_kind(sub("base-l2"), PDT_EV_EDGE_ADD, 30);
-    copy_run(sub("base-l2"), sub("noedgeadd"), k, UINT64_MAX, NULL);
-    expect_fail(sub("noedgeadd"), "rank 0 event #");
+    expect_fail_copy("base-l2", "noedgedel", PDT_EV_EDGE_DEL, 20, NULL, "rank 0 event #");
+    expect_fail_copy("base-l2", "noedgeadd", PDT_EV_EDGE_ADD, 30, NULL, "rank 0 event #");
 
-    k = find_kind(sub("baseh"), PDT_EV_DELETE, 0);
+    uint64_t k = find_kind(sub("baseh"), PDT_EV_DELETE, 0);
     if (k != UINT64_MAX) {
         copy_run(sub("baseh"), sub("nodelete"), k, UINT64_MAX, NULL);
         expect_fail(sub("nodelete"), "neither deleted nor pushed");
@@ -262,12 +258,8 @@ TEST(edited_events_are_named)
 {
     pdt_point *pts = uniform(200);
     record_tri(sub("base2"), pts, 200, 1);
-    uint64_t k = find_kind(sub("base2"), PDT_EV_LIFT, 3);
-    copy_run(sub("base2"), sub("badz"), UINT64_MAX, k, bad_z);
-    expect_fail(sub("badz"), "z should be x*x + y*y");
-    k = find_kind(sub("base2"), PDT_EV_TRI_FINAL, 4);
-    copy_run(sub("base2"), sub("cw"), UINT64_MAX, k, cw);
-    expect_fail(sub("cw"), "not counter-clockwise");
+    expect_fail_copy("base2", "badz", PDT_EV_LIFT, 3, bad_z, "z should be x*x + y*y");
+    expect_fail_copy("base2", "cw", PDT_EV_TRI_FINAL, 4, cw, "not counter-clockwise");
     free(pts);
 }
 
@@ -419,18 +411,12 @@ TEST(tiny_budget_spills)
     CHECK_MSG(check_dir(sub("tb"), msg, sizeof msg) == PDT_OK && !strstr(msg, "on disk"), "%s",
               msg);
     budget = 256;
-    uint64_t k = find_kind(sub("tb"), PDT_EV_TRI_FINAL, 1000);
-    copy_run(sub("tb"), sub("tb-nofinal"), k, UINT64_MAX, NULL);
-    expect_fail(sub("tb-nofinal"), "was never made final");
+    expect_fail_copy("tb", "tb-nofinal", PDT_EV_TRI_FINAL, 1000, NULL, "was never made final");
     record_tri_dup(sub("tb-dup"), pts, 2000, 7);
     expect_fail(sub("tb-dup"), "made final twice");
-    k = find_kind(sub("tb"), PDT_EV_TRI_FINAL, 3000);
-    copy_run(sub("tb"), sub("tb-cw"), UINT64_MAX, k, cw);
-    expect_fail(sub("tb-cw"), "not counter-clockwise");
+    expect_fail_copy("tb", "tb-cw", PDT_EV_TRI_FINAL, 3000, cw, "not counter-clockwise");
     /* a foreign triangle in place of a true one */
-    k = find_kind(sub("tb"), PDT_EV_TRI_FINAL, 2500);
-    copy_run(sub("tb"), sub("tb-wrong"), UINT64_MAX, k, swap_point);
-    expect_fail(sub("tb-wrong"), "is not in T* of the run's points");
+    expect_fail_copy("tb", "tb-wrong", PDT_EV_TRI_FINAL, 2500, swap_point, "is not in T* of the run's points");
     budget = PDT_TRACE_MEM_DEFAULT;
     free(pts);
 }
@@ -450,12 +436,8 @@ TEST(strips_tstar_same_verdicts)
     record_tri(sub("st"), pts, 2000, 1);
     CHECK_MSG(check_dir(sub("st"), msg, sizeof msg) == PDT_OK, "%s", msg);
     CHECK_MSG(strstr(msg, "= T*") && strstr(msg, "(T* recomputed on 3 strips)"), "%s", msg);
-    uint64_t k = find_kind(sub("st"), PDT_EV_TRI_FINAL, 1000);
-    copy_run(sub("st"), sub("st-nofinal"), k, UINT64_MAX, NULL);
-    expect_fail(sub("st-nofinal"), "was never made final");
-    k = find_kind(sub("st"), PDT_EV_TRI_FINAL, 2500);
-    copy_run(sub("st"), sub("st-wrong"), UINT64_MAX, k, swap_point);
-    expect_fail(sub("st-wrong"), "is not in T* of the run's points");
+    expect_fail_copy("st", "st-nofinal", PDT_EV_TRI_FINAL, 1000, NULL, "was never made final");
+    expect_fail_copy("st", "st-wrong", PDT_EV_TRI_FINAL, 2500, swap_point, "is not in T* of the run's points");
     record_tri_dup(sub("st-dup"), pts, 2000, 7);
     expect_fail(sub("st-dup"), "made final twice");
     /* every generator family: degenerate sets on strips too */
