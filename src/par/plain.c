@@ -85,8 +85,10 @@ static pdt_status strip_local(plan *P, int s, pdt_point *pts, uint32_t *order, u
 {
     srm_rank *S = &P->rk[s];
     pdt_status st = pdt_srm_init(S, s, P->k, P->strip, NULL, err);
-    if (st != PDT_OK) return st;
+    if (st != PDT_OK) /* (its message names a rank) */
+        return pdt_err_set(err, st, "strip %d of %d: %s", s + 1, P->k, pdt_status_str(st));
     P->init[s] = 1;
+    snprintf(S->who, sizeof S->who, "strip %d of %d", s + 1, P->k);
     S->clock = mono;
     size_t a = P->first[s], m = P->first[s + 1] - a;
     pdt_tri *fin = (pdt_tri *)(void *)(R + *off);
@@ -181,17 +183,14 @@ int pdt_srm_plain_pays(const pdt_point *pts, size_t n)
     return pays;
 }
 
-/* A failure worded for a plain run, as the whole kernel's are ("triangulation
- * failed: ..."), a strip named as such where the SRM's message names a rank. */
-static pdt_status plain_failure(pdt_status st, int k, pdt_err *err)
+/* A failure worded for a plain run, as the whole kernel's are
+ * ("triangulation failed: ..."; the SRM names the strip: srm_rank.who). */
+static pdt_status plain_failure(pdt_status st, pdt_err *err)
 {
     if (!err) return st;
     char was[sizeof err->msg];
     snprintf(was, sizeof was, "%s", err->msg[0] ? err->msg : pdt_status_str(st));
     pdt_err_clear(err);
-    int r = 0, at = 0;
-    if (sscanf(was, "rank %d: %n", &r, &at) == 1 && at > 0)
-        return pdt_err_set(err, st, "triangulation failed: strip %d of %d: %s", r + 1, k, was + at);
     return pdt_err_set(err, st, "triangulation failed: %s", was);
 }
 
@@ -293,7 +292,7 @@ pdt_status pdt_srm_plain(pdt_point *pts, size_t n, int k, int prefault, pdt_tri 
     arrays_put(&a, k);
     if (st != PDT_OK) {
         free(a.R);
-        return plain_failure(st, k, err);
+        return plain_failure(st, err);
     }
     stats->n_unique = nu;
     stats->n_dup = n - nu;

@@ -78,9 +78,9 @@ static double cpu_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static pdt_status nomem(pdt_err *err, int rank, const char *what)
+static pdt_status nomem(pdt_err *err, const char *who, const char *what)
 {
-    return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", rank, what);
+    return pdt_err_set(err, PDT_ERR_NOMEM, "%s: %s: out of memory", who, what);
 }
 
 /* realloc for arrays that may be large: a large new block asks for huge
@@ -188,12 +188,13 @@ pdt_status pdt_srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pd
 {
     memset(s, 0, sizeof *s);
     s->rank = rank;
+    snprintf(s->who, sizeof s->who, "rank %d", rank);
     s->p = p;
     s->levels = pdt_srm_ceil_log2(p);
     s->strip = strip;
     s->tr = tr;
     s->nonempty = malloc((size_t)p * sizeof *s->nonempty);
-    if (!s->nonempty) return nomem(err, rank, "init");
+    if (!s->nonempty) return nomem(err, s->who, "init");
     for (int q = 0; q < p; q++)
         if (strip[q].count) s->nonempty[s->nne++] = q;
     return PDT_OK;
@@ -261,7 +262,7 @@ static pdt_status local_kernel(srm_rank *s, void *block, const uint32_t *gid, ui
     }
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
     if (st != PDT_OK)
-        return pdt_err_set(err, st, "rank %d: local kernel failed (%s)", s->rank,
+        return pdt_err_set(err, st, "%s: local kernel failed (%s)", s->who,
                            pdt_status_str(st));
     s->cnt.local_tris = sp->ntri;
     return PDT_OK;
@@ -284,12 +285,12 @@ static pdt_status strip_hull(srm_rank *s, const strip_pts *sp, const uint32_t *g
         pdt_status st = pdt_hull_chain(sp->pts, sp->m, h, &nh, &deg, PDT_STACK_LOWER,
                                        PDT_STACK_UPPER, tr);
         if (tr) tr->gid = saved;
-        if (st != PDT_OK) return pdt_err_set(err, st, "rank %d: strip hull failed", s->rank);
+        if (st != PDT_OK) return pdt_err_set(err, st, "%s: strip hull failed", s->who);
     }
     s->hull = malloc((nh + 1) * sizeof *s->hull);
     if (!s->hull) {
         free(kh);
-        return nomem(err, s->rank, "hull");
+        return nomem(err, s->who, "hull");
     }
     for (size_t i = 0; i < nh; i++)
         s->hull[i] = (srm_pt){sp->pts[h[i]].x, sp->pts[h[i]].y, sp->name[h[i]]};
@@ -340,7 +341,7 @@ static pdt_status classify(srm_rank *s, pdt_tri *tris, const strip_pts *sp, pdt_
             PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, v[0].gid, v[1].gid, v[2].gid, 0);
         } else {
             if (add_pending(s, v[0], v[1], v[2], lev) != PDT_OK)
-                return nomem(err, s->rank, "classify");
+                return nomem(err, s->who, "classify");
             s->cnt.deferred++;
             PDT_TRACE(tr, 1, PDT_EV_RA_DEFER, 0, v[0].gid, v[1].gid, v[2].gid, who);
         }
@@ -400,7 +401,7 @@ pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err
     size_t nh = send_hull ? s->nhull : 0;
     /* point table: distinct vertices of the shipped triangles and the hull */
     srm_pt *tab = srm_big((3 * nt + nh + 1) * sizeof *tab);
-    if (!tab) return nomem(err, s->rank, "pack");
+    if (!tab) return nomem(err, s->who, "pack");
     size_t np = 0;
     for (size_t i = 0; i < s->npend; i++)
         if (s->pend[i].level == level)
@@ -416,7 +417,7 @@ pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err
     unsigned char *b = malloc(bytes);
     if (!b) {
         free(tab);
-        return nomem(err, s->rank, "pack");
+        return nomem(err, s->who, "pack");
     }
     unsigned char *w = b + sizeof(msg_head);
     uint32_t prev = 0;
@@ -618,7 +619,7 @@ static pdt_status read_messages(merge_job *j, void *const *msg, const size_t *le
 {
     srm_rank *s = j->s;
     j->mv = calloc((size_t)j->nm, sizeof *j->mv);
-    if (!j->mv) return nomem(j->err, s->rank, "merge");
+    if (!j->mv) return nomem(j->err, s->who, "merge");
     j->cp_in = s->cnt.critical_path;
     j->cpu_in = s->cnt.critical_cpu;
     j->hl = j->hr = -1;
@@ -652,7 +653,7 @@ static pdt_status border_set(merge_job *j)
     }
     j->shipped = malloc((nship + 1) * sizeof *j->shipped);
     j->B = malloc((nbmax + 1) * sizeof *j->B);
-    if (!j->shipped || !j->B) return nomem(j->err, s->rank, "merge");
+    if (!j->shipped || !j->B) return nomem(j->err, s->who, "merge");
     size_t ns = 0, nb = 0;
     srm_pt *B = j->B;
     for (int i = 0; i < j->nm; i++) {
@@ -687,7 +688,7 @@ static pdt_status border_kernel(merge_job *j)
     size_t nb = j->nb;
     j->bp = malloc((nb + 1) * sizeof *j->bp);
     j->bg = malloc((nb + 1) * sizeof *j->bg);
-    if (!j->bp || !j->bg) return nomem(j->err, s->rank, "merge");
+    if (!j->bp || !j->bg) return nomem(j->err, s->who, "merge");
     for (size_t i = 0; i < nb; i++) {
         srm_pt b = j->B[i];
         j->bp[i] = (pdt_point){b.x, b.y};
@@ -701,7 +702,7 @@ static pdt_status border_kernel(merge_job *j)
     if (tr) tr->gid = j->bg;
     pdt_status st = pdt_delaunay(j->bp, nb, &j->tris, &j->ntri, 1, tr);
     if (tr) tr->gid = saved;
-    if (st != PDT_OK) return pdt_err_set(j->err, st, "rank %d: border kernel failed (%s)", s->rank,
+    if (st != PDT_OK) return pdt_err_set(j->err, st, "%s: border kernel failed (%s)", s->who,
                                          pdt_status_str(st));
     return PDT_OK;
 }
@@ -723,7 +724,7 @@ static pdt_status select_kept(merge_job *j)
             break;
         }
     j->tb = malloc((j->ntri + 1) * sizeof *j->tb);
-    if (!j->tb) return nomem(j->err, s->rank, "merge");
+    if (!j->tb) return nomem(j->err, s->who, "merge");
     for (size_t i = 0; i < j->ntri; i++) {
         const uint32_t *v = j->tris[i].v;
         gtri g = canon3(j->bg[v[0]], j->bg[v[1]], j->bg[v[2]]);
@@ -745,7 +746,7 @@ static pdt_status select_kept(merge_job *j)
             st = add_pending(s, B[v[0]], B[v[1]], B[v[2]], lev);
             PDT_TRACE(tr, 1, PDT_EV_RA_DEFER, 0, B[v[0]].gid, B[v[1]].gid, B[v[2]].gid, who);
         }
-        if (st != PDT_OK) return nomem(j->err, s->rank, "merge");
+        if (st != PDT_OK) return nomem(j->err, s->who, "merge");
     }
     s->cnt.kept += j->kept;
     return PDT_OK;
@@ -808,7 +809,7 @@ static pdt_status merge_hulls(merge_job *j)
     pdt_point *pp = malloc((nh + 1) * sizeof *pp);
     pdt_status st = PDT_OK;
     if (!hp || !hidx || !pp || !pg || !nhull) {
-        st = nomem(j->err, s->rank, "hull merge");
+        st = nomem(j->err, s->who, "hull merge");
         goto done;
     }
     size_t k = 0;
@@ -827,7 +828,7 @@ static pdt_status merge_hulls(merge_job *j)
                         tr);
     if (tr) tr->gid = saved;
     if (st != PDT_OK) {
-        pdt_err_set(j->err, st, "rank %d: hull merge failed", s->rank);
+        pdt_err_set(j->err, st, "%s: hull merge failed", s->who);
         goto done;
     }
     for (size_t i = 0; i < nout; i++) nhull[i] = hp[hidx[i]];

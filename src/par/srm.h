@@ -182,6 +182,8 @@ typedef struct srm_counts {
 
 typedef struct srm_rank {
     int rank, p, levels;          /* levels = ceil(log2 p) */
+    char who[40];                 /* how messages name it: "rank R" (pdt_srm_init), or
+                                   * "strip S of K" in a plain run (plain.c) */
     const srm_strip *strip;       /* p descriptors (not owned) */
     int *nonempty;                /* ranks with points, in order (x-sorted boxes) */
     int nne;
