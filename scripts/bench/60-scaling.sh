@@ -117,11 +117,40 @@ for (kind, n), r in rows.items():
           f" {max(x[4] for x in r):>7.2f}")
     print(f"{'  ns/pt':<20} " + " ".join(f"{sec[p] * 1e9 / n:>9.1f}" for p in ph) + f" {'':>7}" +
           (f" {cg * 1e9 / n:>8.1f}" if cg else f" {'-':>8}"))
+STEAL_OK = 0.05  # seconds the host may take from a run that still counts as undisturbed
+def per_point(r, n):
+    """Each phase's median ns per point over the runs r (None when r is empty)."""
+    return {p: statistics.median(x[2]["seconds"][p] for x in r) * 1e9 / n for p in ph} if r else None
+def sci(n):
+    """10^6, 3*10^7, ..."""
+    e = len(str(n)) - 1
+    m = n // 10 ** e
+    return (f"{m}*" if m != 1 else "") + f"10^{e}" if n == m * 10 ** e else str(n)
+uni = sorted(n for (kind, n) in rows if kind == "uniform")
+pairs = [(a, b) for a, b in ((1000000, 10000000), (10000000, 30000000)) if a in uni and b in uni]
+if pairs:
+    print()
+    print("growth of the cost per point (issue 11's goal: every phase within 1.15x), uniform points:")
+    for a, b in pairs:
+        for label, keep in (("all runs", lambda x: True),
+                            (f"runs that lost at most {STEAL_OK} s to the host", lambda x: x[4] <= STEAL_OK)):
+            ra = [x for x in rows[("uniform", a)] if keep(x)]
+            rb = [x for x in rows[("uniform", b)] if keep(x)]
+            pa, pb = per_point(ra, a), per_point(rb, b)
+            head = f"  {sci(a)} -> {sci(b)}, {label} ({len(ra)} and {len(rb)}):"
+            if not pa or not pb:
+                print(head + " none")
+                continue
+            worst = max((p for p in ph if p != "total"), key=lambda p: pb[p] / pa[p])
+            print(head + " " + ", ".join(f"{p} {pb[p] / pa[p]:.2f}x" for p in ph if p != "total") +
+                  f"; the largest: {worst}")
 print()
 print("seconds per phase from --stats (wall; read: text parse; write: the .tri file, a new one each run);")
 print("ns/pt: the same per")
 print("input point; cpu s: the process's user + system seconds (both threads: the prefault thread's")
 print("included); CGAL: Delaunay_triangulation_2::insert of the range (s, then ns/pt); (s+k)/CGAL:")
 print("pdt sort + kernel over CGAL's insert (below 1: pdt faster); peak: max RSS / n (time -f %M);")
-print("steal s: the most CPU seconds the host took from this VM during one of the row's pdt runs.")
+print("steal s: the most CPU seconds the host took from this VM during one of the row's pdt runs;")
+print("growth: median ns per point at the larger n over the same at the smaller (all runs, then")
+print("only the runs the host took at most 0.05 s from: a run it took from loses up to twice that).")
 PY
