@@ -540,11 +540,16 @@ static pdt_status order_plan_make(drv *d, finals *f, order_plan *o, pdt_err *err
 }
 
 /* Where the order phase groups, receives and orders: in the rank's block
- * (room for cap triangles, the local finals at its front) when each fits
- * without overlapping what is still to be read, else in arrays of their own.
- * grp (the grouped triangles) behind the finals; got (received) at the
- * block's end, past grp (which is sent before anything arrives); out at the
- * front, below got (the finals and grp have been read by then). */
+ * (room for cap triangles, the local finals at its front) when each fits,
+ * else in arrays of their own, and each as low in the block as it fits, so
+ * that the phase touches about the pages the kernel did (finals, grp and got
+ * take some 6 triangles per point, the kernel's edges 72 bytes), not the
+ * block's far end (room for 1/16 more points than the strip holds):
+ *   grp  the grouped triangles, behind the finals;
+ *   got  the received ones, right past grp (sent before anything arrives)
+ *        or past out, whichever ends later;
+ *   out  the ordered output at the front (the finals and grp have been read
+ *        by then). */
 typedef struct order_room {
     pdt_tri *blk;
     size_t cap;
@@ -586,17 +591,15 @@ static pdt_status order_room_grp(drv *d, order_room *o, const finals *f)
 
 static pdt_status order_room_out(drv *d, order_room *o, const finals *f, size_t total)
 {
-    size_t grp_end = f->n[0] + f->n[0] + f->n[1]; /* grp: behind the finals, as many */
-    size_t busy = o->grp_own ? 0 : grp_end;
-    size_t got_at = o->cap;
-    if (o->blk && total <= o->cap && o->cap - total >= busy) {
-        got_at = o->cap - total;
+    size_t busy = o->grp_own ? 0 : 2 * f->n[0] + f->n[1]; /* grp, until it has been sent */
+    size_t got_at = busy > total ? busy : total;
+    if (o->blk && got_at <= o->cap && o->cap - got_at >= total) {
         o->got = o->blk + got_at;
     } else {
         o->got = srm_big((total + 1) * sizeof *o->got);
         o->got_own = 1;
     }
-    if (o->blk && total <= got_at) {
+    if (o->blk && total <= o->cap) { /* below got, if got is in the block */
         o->out = o->blk;
     } else {
         o->out = srm_big((total + 1) * sizeof *o->out);
