@@ -52,6 +52,10 @@ void pdt_err_clear(pdt_err *err);
 /* Short English name of a status code ("out of memory", ...). */
 const char *pdt_status_str(pdt_status s);
 
+/* Seconds on the monotonic clock (CLOCK_MONOTONIC): what phase timings,
+ * frame times and budgets of time read. */
+double pdt_seconds(void);
+
 /* Lexicographic key of a point: unsigned comparison of keys equals (x, then y)
  * comparison of the signed coordinates. */
 static inline uint64_t pdt_key(pdt_point p)

@@ -27,9 +27,7 @@ int pdt_cli_same_file(const char *a, const char *b)
 
 double pdt_cli_now(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return pdt_seconds();
 }
 
 long pdt_cli_peak_kib(void)

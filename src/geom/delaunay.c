@@ -1245,13 +1245,6 @@ pdt_status pdt_sort_unique(const pdt_point *pts, size_t n, uint32_t *order, size
 /* Working memory below this is not worth a thread faulting it in. */
 enum { PREFAULT_MIN = 8 << 20 };
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Put pts back as they were: the distinct points from q (== pts[0, nu), in
  * the kernel's order, id naming them) through a copy in `scratch` (room for
  * nu points), then each dropped copy from the point kept for it. */
@@ -1290,7 +1283,7 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
         return PDT_OK;
     }
 
-    double t0 = now();
+    double t0 = pdt_seconds();
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_PARTITION, 0, 0, 0, 0);
     size_t cap = edge_cap(n);
     edge *R = malloc(cap * sizeof *R);
@@ -1339,7 +1332,7 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_PARTITION, 0, 0, 0, 0);
     st.n_unique = nu;
     st.n_dup = n - nu;
-    double t1 = now();
+    double t1 = pdt_seconds();
 
     if (PDT_TRACING(tr, 1)) {
         PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_LIFT, 0, 0, 0, 0);
@@ -1357,7 +1350,7 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
     pdt_status s = nu >= 2 ? kernel_on(order, pts, nu, R, cap, &nt, 0, tr, NULL, NULL, 0) : PDT_OK;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_KERNEL, 0, 0, 0, 0);
     pdt_prefault_stop(pf); /* (long done, but it must end before R shrinks) */
-    double t2 = now();
+    double t2 = pdt_seconds();
 
     /* the triangles fill R[0, nt) (12 bytes each: at most 24 bytes per point);
      * the rest of R is scratch for what follows */
@@ -1380,7 +1373,7 @@ pdt_status pdt_triangulate_inplace(pdt_point *pts, size_t n, int keep, pdt_tri *
         pdt_tri *shrunk = realloc(t, nt * sizeof *shrunk);
         if (shrunk) t = shrunk;
     }
-    double t3 = now();
+    double t3 = pdt_seconds();
 
     st.n_tri = nt;
     st.collinear = nt == 0;

@@ -34,9 +34,7 @@
 static double mono(void *user)
 {
     (void)user;
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return pdt_seconds();
 }
 
 /* The plan: strip s is pts[first[s], first[s + 1]). */
@@ -88,7 +86,7 @@ static pdt_status strip_local(plan *P, int s, pdt_point *pts, uint32_t *order, u
     if (st != PDT_OK) /* (its message names a rank) */
         return pdt_err_set(err, st, "strip %d of %d: %s", s + 1, P->k, pdt_status_str(st));
     P->init[s] = 1;
-    snprintf(S->who, sizeof S->who, "strip %d of %d", s + 1, P->k);
+    pdt_srm_as_strips(S);
     S->clock = mono;
     size_t a = P->first[s], m = P->first[s + 1] - a;
     pdt_tri *fin = (pdt_tri *)(void *)(R + *off);

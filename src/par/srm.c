@@ -183,13 +183,25 @@ srm_strip pdt_srm_strip_of(const pdt_point *pts, size_t m)
     return st;
 }
 
+void pdt_srm_name(const srm_rank *s, int r, char *buf, size_t cap)
+{
+    if (s->as_strips) snprintf(buf, cap, "strip %d of %d", r + 1, s->p);
+    else snprintf(buf, cap, "rank %d", r);
+}
+
+void pdt_srm_as_strips(srm_rank *s)
+{
+    s->as_strips = 1;
+    pdt_srm_name(s, s->rank, s->who, sizeof s->who);
+}
+
 pdt_status pdt_srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pdt_trace *tr,
                     pdt_err *err)
 {
     memset(s, 0, sizeof *s);
     s->rank = rank;
-    snprintf(s->who, sizeof s->who, "rank %d", rank);
     s->p = p;
+    pdt_srm_name(s, rank, s->who, sizeof s->who);
     s->levels = pdt_srm_ceil_log2(p);
     s->strip = strip;
     s->tr = tr;
@@ -479,26 +491,26 @@ static void msg_view_free(msg_view *v)
     v->tri = v->hull = NULL;
 }
 
-static pdt_status decode(const void *buf, size_t len, int level, int from, msg_view *v,
+static pdt_status decode(const void *buf, size_t len, int level, const char *from, msg_view *v,
                          pdt_err *err)
 {
     if (len < sizeof(msg_head))
-        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: too short", from);
+        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from %s: too short", from);
     memcpy(&v->h, buf, sizeof v->h);
     const msg_head *h = &v->h;
     if (h->magic != SRM_MSG_MAGIC || h->level != (uint32_t)level ||
         h->payload != (uint64_t)(len - sizeof(msg_head)))
-        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: bad header", from);
+        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from %s: bad header", from);
     /* every count is at most the payload (a varint takes a byte at least) */
     if (h->npts > h->payload || h->ntri > h->payload / 3 ||
         h->nhull > h->payload - 3 * h->ntri)
-        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: bad counts", from);
+        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from %s: bad counts", from);
     size_t ni = 3 * (size_t)h->ntri + (size_t)h->nhull;
     v->pts = malloc(((size_t)h->npts + 1) * sizeof *v->pts);
     v->tri = malloc((ni + 1) * sizeof *v->tri);
     if (!v->pts || !v->tri) {
         msg_view_free(v);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "merge message from rank %d: out of memory",
+        return pdt_err_set(err, PDT_ERR_NOMEM, "merge message from %s: out of memory",
                            from);
     }
     v->hull = v->tri + 3 * (size_t)h->ntri;
@@ -521,7 +533,7 @@ static pdt_status decode(const void *buf, size_t len, int level, int from, msg_v
     return PDT_OK;
 bad:
     msg_view_free(v);
-    return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from rank %d: damaged payload", from);
+    return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from %s: damaged payload", from);
 }
 
 /* ---- the merge step ------------------------------------------------------------ */
@@ -624,7 +636,9 @@ static pdt_status read_messages(merge_job *j, void *const *msg, const size_t *le
     j->cpu_in = s->cnt.critical_cpu;
     j->hl = j->hr = -1;
     for (int i = 0; i < j->nm; i++) {
-        pdt_status st = decode(msg[i], len[i], j->level, j->gl + i, &j->mv[i], j->err);
+        char from[40];
+        pdt_srm_name(s, j->gl + i, from, sizeof from);
+        pdt_status st = decode(msg[i], len[i], j->level, from, &j->mv[i], j->err);
         if (st != PDT_OK) return st;
         const msg_view *v = &j->mv[i];
         if (v->h.cp > j->cp_in) j->cp_in = v->h.cp;

@@ -182,8 +182,8 @@ typedef struct srm_counts {
 
 typedef struct srm_rank {
     int rank, p, levels;          /* levels = ceil(log2 p) */
-    char who[40];                 /* how messages name it: "rank R" (pdt_srm_init), or
-                                   * "strip S of K" in a plain run (plain.c) */
+    int as_strips;                /* 1: the strips of one plain run (plain.c), 0: ranks */
+    char who[40];                 /* how messages name it (pdt_srm_name) */
     const srm_strip *strip;       /* p descriptors (not owned) */
     int *nonempty;                /* ranks with points, in order (x-sorted boxes) */
     int nne;
@@ -208,6 +208,13 @@ typedef struct srm_rank {
 
 /* The descriptor of a strip of m distinct points in lexicographic order. */
 srm_strip pdt_srm_strip_of(const pdt_point *pts, size_t m);
+
+/* How messages name participant r of s's run: "rank R", or "strip R+1 of
+ * P" among the strips of a plain run (s->as_strips). */
+void pdt_srm_name(const srm_rank *s, int r, char *buf, size_t cap);
+
+/* After pdt_srm_init in a plain run: s and the others are named as strips. */
+void pdt_srm_as_strips(srm_rank *s);
 
 /* Set up (strip: p descriptors, kept by pointer).  Frees with pdt_srm_free. */
 pdt_status pdt_srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pdt_trace *tr,

@@ -95,13 +95,6 @@ static pdt_status reserve(pdt_editor *ed, size_t n, pdt_err *err)
 
 /* ---- run and reload ----------------------------------------------------------- */
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Where cursor k of replay `old` is in terms of phases: the innermost phase
  * of rank 0 open at k (its id, level and the offset from its begin). */
 static size_t same_place(const pdt_replay *old, const pdt_rstate *s, const pdt_replay *r)
@@ -126,7 +119,7 @@ static size_t same_place(const pdt_replay *old, const pdt_rstate *s, const pdt_r
  * same place as the old one. */
 static pdt_status rerun(pdt_editor *ed, pdt_err *err)
 {
-    double t0 = now_s();
+    double t0 = pdt_seconds();
     pdt_live_result run;
     pdt_replay *r = NULL;
     pdt_rstate *s = NULL;
@@ -148,7 +141,7 @@ static pdt_status rerun(pdt_editor *ed, pdt_err *err)
     ed->r = r;
     ed->s = s;
     ed->changed = 1;
-    ed->last_run_s = now_s() - t0;
+    ed->last_run_s = pdt_seconds() - t0;
     return PDT_OK;
 }
 

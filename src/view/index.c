@@ -1573,13 +1573,6 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
 
 /* ---- opening a run ---------------------------------------------------------------- */
 
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
 pdt_status pdt_replay_open_kept(const char *dir, uint64_t budget, pdt_replay **out,
                                 pdt_replay_open_info *info, pdt_err *err)
 {
@@ -1660,7 +1653,7 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
             snprintf(info->why, sizeof info->why, "%s", why);
     }
     if (!r) { /* (re)build it: beside the run if the folder takes it, else in the cache */
-        double t0 = now_s();
+        double t0 = pdt_seconds();
         for (int where = 0; where < 2 && !r; where++) {
             if (!index_path(dir, where, path, sizeof path)) continue;
             if (where == 1) {
@@ -1677,7 +1670,7 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
             r = load(path, dir, ident, pts, n, 0, why, sizeof why);
         }
         info->built = r != NULL;
-        info->build_s = now_s() - t0;
+        info->build_s = pdt_seconds() - t0;
     }
     if (!r) { /* no place to keep an index: the whole run in memory */
         st = in_memory(run, pts, n, nranks, out, err);

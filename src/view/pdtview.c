@@ -379,13 +379,6 @@ static int animate(const pdt_replay *r, pdt_rstate *s, const pdt_view *v, const 
     return 0;
 }
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static double cpu_s(void)
 {
     struct timespec ts;
@@ -443,9 +436,9 @@ static int bench(const pdt_replay *r, pdt_rstate *s, const pdt_view *v, const op
         for (int i = 0; i < NSEEK; i++) {
             x ^= x << 13, x ^= x >> 7, x ^= x << 17;
             size_t k = m ? (size_t)(x % (m + 1)) : 0;
-            double t0 = now_s(), c0 = cpu_s();
+            double t0 = pdt_seconds(), c0 = cpu_s();
             pdt_replay_seek(r, s, k);
-            t[i] = now_s() - t0;
+            t[i] = pdt_seconds() - t0;
             tc[i] = cpu_s() - c0;
         }
         double worst = 0, worst_c = 0;
@@ -466,9 +459,9 @@ static int bench(const pdt_replay *r, pdt_rstate *s, const pdt_view *v, const op
         printf("checkpoints: none (the budget holds fewer than two states of %.1f MiB)\n",
                (double)pdt_replay_state_bytes(r) / 1048576.0);
     for (int i = 0; i < NSEEK; i++) {
-        double t0 = now_s();
+        double t0 = pdt_seconds();
         for (int j = 0; j < 1000; j++) pdt_replay_step(r, s, -1);
-        t[i] = (now_s() - t0) / 1000;
+        t[i] = (pdt_seconds() - t0) / 1000;
     }
     printf("step back (median): %.3f us\n", 1e6 * median(t, NSEEK));
     pdt_replay_seek(r, s, m);
@@ -478,7 +471,7 @@ static int bench(const pdt_replay *r, pdt_rstate *s, const pdt_view *v, const op
             drawn++;
     cairo_surface_t *sf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, o->w, o->h);
     int frames = 0;
-    double t0 = now_s(), el = 0, c0 = cpu_s();
+    double t0 = pdt_seconds(), el = 0, c0 = cpu_s();
     pdt_err err = {0};
     while (frames < 3 || (el < 3.0 && frames < 200)) {
         cairo_t *cr = cairo_create(sf);
@@ -490,7 +483,7 @@ static int bench(const pdt_replay *r, pdt_rstate *s, const pdt_view *v, const op
         }
         cairo_destroy(cr);
         frames++;
-        el = now_s() - t0;
+        el = pdt_seconds() - t0;
     }
     cairo_surface_destroy(sf);
     double cpu = cpu_s() - c0;
@@ -715,13 +708,13 @@ static int bench_live(const opts *o)
         goto out;
     /* the opening frame: the window draws it when the editor opens, before
      * any click can come (fonts and cairo's caches warm up here) */
-    double o0 = now_s(), oc0 = cpu_s();
+    double o0 = pdt_seconds(), oc0 = cpu_s();
     if (draw_once(sf, o, ed, &v, &err) != PDT_OK) goto out;
-    double open_wall = now_s() - o0, open_cpu = cpu_s() - oc0;
+    double open_wall = pdt_seconds() - o0, open_cpu = cpu_s() - oc0;
     uint64_t x = 88172645463325252ull;
     for (int i = 0; i < NCLICK; i++) {
         x ^= x << 13, x ^= x >> 7, x ^= x << 17;
-        double t0 = now_s(), c0 = cpu_s();
+        double t0 = pdt_seconds(), c0 = cpu_s();
         size_t n;
         pdt_editor_points(ed, &n);
         pdt_status st = i % 2 ? pdt_editor_delete(ed, n - 1, &err)
@@ -729,7 +722,7 @@ static int bench_live(const opts *o)
         if (st != PDT_OK) goto out;
         tr[i] = pdt_editor_last_run_s(ed);
         if (draw_once(sf, o, ed, &v, &err) != PDT_OK) goto out;
-        t[i] = now_s() - t0;
+        t[i] = pdt_seconds() - t0;
         tc[i] = cpu_s() - c0;
     }
     double worst = 0, worst_cpu = 0;
@@ -790,7 +783,7 @@ int main(int argc, char **argv)
     pdt_rstate *s = NULL;
     uint8_t *hidden = NULL;
     int rc = 1;
-    double t0 = now_s(), c0 = cpu_s();
+    double t0 = pdt_seconds(), c0 = cpu_s();
     pdt_replay_open_info info;
     memset(&L, 0, sizeof L);
     /* a run folder with a valid kept index opens from the index alone */
@@ -805,7 +798,7 @@ int main(int argc, char **argv)
     } else if (load(o.run, &L, &err) != PDT_OK) {
         goto out;
     }
-    double t1 = now_s(), c1 = cpu_s();
+    double t1 = pdt_seconds(), c1 = cpu_s();
     if (o.write_run) {
         if (L.run && pdt_run_merged(L.run, &L.recs, &L.m, &err) != PDT_OK) goto out;
         rc = write_run(o.write_run, &L, "triangulate", 2, &err);
@@ -820,8 +813,8 @@ int main(int argc, char **argv)
     }
     if (o.bench) {
         printf("open %zu events, %zu points, %d ranks: %.3f s (read %.3f s + index %.3f s; "
-               "cpu %.3f s + %.3f s)\n", pdt_replay_count(r), L.n, L.nranks, now_s() - t0,
-               t1 - t0, now_s() - t1, c1 - c0, cpu_s() - c1);
+               "cpu %.3f s + %.3f s)\n", pdt_replay_count(r), L.n, L.nranks, pdt_seconds() - t0,
+               t1 - t0, pdt_seconds() - t1, c1 - c0, cpu_s() - c1);
         if (info.indexed && info.built)
             printf("index build: working memory %.1f MiB (budget %.1f MiB)\n",
                    (double)info.build_bytes / 1048576.0, (double)o.mem / 1048576.0);

@@ -360,6 +360,22 @@ TEST(merge_message_header)
                   err.msg);
         free(c);
     }
+    /* the same among the strips of a plain run: the sender named as a strip */
+    pdt_srm_as_strips(&rk[1]);
+    CHECK_MSG(strcmp(rk[1].who, "strip 2 of 2") == 0, "%s", rk[1].who);
+    {
+        unsigned char *c = malloc(len[0]);
+        memcpy(c, msg[0], len[0]);
+        srm_msg_head bad = h;
+        bad.payload += wrap;
+        memcpy(c, &bad, sizeof bad);
+        void *mm[2] = {c, msg[1]};
+        pdt_err_clear(&err);
+        CHECK(pdt_srm_merge(&rk[1], 0, mm, len, &err) == PDT_ERR_CORRUPT);
+        CHECK_MSG(strstr(err.msg, "merge message from strip 1 of 2: bad header") != NULL, "%s",
+                  err.msg);
+        free(c);
+    }
     /* the undamaged messages merge: every triangle final, none pending */
     pdt_err_clear(&err);
     CHECK(pdt_srm_merge(&rk[1], 0, msg, len, &err) == PDT_OK);
