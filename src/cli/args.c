@@ -6,7 +6,6 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
-#include <time.h>
 
 #include "cli.h"
 #include "run_opts.h"
@@ -23,11 +22,6 @@ int pdt_cli_same_file(const char *a, const char *b)
     if (!a || !b || strcmp(a, "-") == 0 || strcmp(b, "-") == 0) return 0;
     return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
            sa.st_ino == sb.st_ino;
-}
-
-double pdt_cli_now(void)
-{
-    return pdt_seconds();
 }
 
 long pdt_cli_peak_kib(void)

@@ -74,8 +74,6 @@ int pdt_cli_fail(const pdt_err *err);
 /* 1 if paths a and b name the same existing file (never for "-"). */
 int pdt_cli_same_file(const char *a, const char *b);
 
-/* Monotonic clock in seconds. */
-double pdt_cli_now(void);
 /* Peak resident memory of this process in KiB (getrusage), or 0. */
 long pdt_cli_peak_kib(void);
 

@@ -52,24 +52,24 @@ int pdt_cmd_hull(int argc, char **argv)
     int rc = pdt_cli_parse_run_opts("hull", help, argc, argv, &o);
     if (rc >= 0) return rc;
 
-    double t0 = pdt_cli_now(), t1 = t0, t2 = t0, t3 = t0;
+    double t0 = pdt_seconds(), t1 = t0, t2 = t0, t3 = t0;
     pdt_err err = { PDT_OK, "" };
     pdt_point *pts = NULL;
     uint32_t *hull = NULL;
     size_t n = 0, nh = 0, coll = 0;
     pdt_status st = pdt_read_points(o.input, o.scale, &pts, &n, &coll, &err);
-    t1 = pdt_cli_now();
+    t1 = pdt_seconds();
     if (st == PDT_OK) {
         hull = malloc((n ? n : 1) * sizeof *hull);
         if (!hull) st = pdt_err_set(&err, PDT_ERR_NOMEM, "out of memory");
     }
     if (st == PDT_OK) st = compute(&o, pts, n, hull, &nh, &err);
-    t2 = pdt_cli_now();
+    t2 = pdt_seconds();
     if (st == PDT_OK && pdt_cli_same_file(o.output, o.input))
         st = pdt_err_set(&err, PDT_ERR_ARG, "%s: output would replace the input; choose another "
                          "-o name", o.output);
     if (st == PDT_OK) st = write_hull(o.output, hull, nh, &err);
-    t3 = pdt_cli_now();
+    t3 = pdt_seconds();
 
     if (st == PDT_OK) {
         if (coll)

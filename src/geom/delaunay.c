@@ -41,7 +41,6 @@
 
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #define NIL UINT32_MAX
 

@@ -44,7 +44,6 @@
 #include <string.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #define INDEX_NAME ".pdtview-index"
