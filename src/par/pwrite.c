@@ -21,8 +21,9 @@
 #include <unistd.h>
 
 #include "pdt/io.h"
-#include "../geom/bigmem.h"
 #include "pdt/par.h"
+
+#include "../geom/bigmem.h"
 
 /* Bytes formatted at once (then written): 4 MiB of the longest lines. */
 enum { PIECE_LINES = 65536 };
