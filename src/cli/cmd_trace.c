@@ -299,7 +299,7 @@ static int cmd_check(const char *dir, uint64_t budget)
         fprintf(stderr, "pdt trace check: %s\n", err.msg);
         return PDT_EXIT_USAGE;
     }
-    char summary[512];
+    char summary[1024];
     pdt_status st = pdt_run_check_tstar(run, budget, pdt_par_tstar, summary, sizeof summary, &err);
     pdt_run_close(run);
     if (st != PDT_OK) {

@@ -9,13 +9,16 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include "pdt/delaunay.h"
 #include "pdt/hull.h"
 #include "pdt/predicates.h"
 #include "pdt/tracefile.h"
+#include "certify.h"
 #include "tf_internal.h"
+#include "xsort.h"
 #include "../geom/bigmem.h"
 
 typedef struct fin {   /* a TRI_FINAL, rotated to start at its smallest index */
@@ -45,6 +48,13 @@ typedef struct chk {
     size_t npts;
     int is_tri, is_hull;
     uint8_t *mark;          /* per point: see M_* */
+    size_t mark_map;        /* bytes of the marks' file mapping (0: in memory) */
+    int certify;            /* T* certified on disk, not recomputed (over budget) */
+    int dedup_on_disk;      /* the distinct points found by a sort on disk */
+    uint64_t dedup_runs;    /* sorted runs that sort wrote */
+    int give_back;          /* give back the pages of the points and marks (tick) */
+    uint64_t ticks;
+    uint64_t cert_runs;     /* sorted runs the certificate wrote */
     fin *fin;               /* final triangles not yet spilled (see spill_finals) */
     size_t nfin, capfin;
     size_t maxfin;          /* finals held in memory before a spill (from the budget) */
@@ -184,6 +194,7 @@ typedef struct rank_state {
     u32vec scope_tris;      /* 3 points per TRI_NEW */
     uint64_t edge_events;   /* in the current scope */
     uint64_t scope_seq;     /* event that opened the scope */
+    int edges_traced;       /* the rank file's level has the kernel's edges (2) */
 } rank_state;
 
 static void rank_state_free(rank_state *s)
@@ -486,11 +497,18 @@ static void fm_close(fin_merge *m)
     free(m->heap);
 }
 
-static pdt_status io_fail(chk *c, const char *what)
+/* A temporary file's failure: "temporary file for <of> in DIR: <what>: why". */
+static pdt_status tmp_fail(chk *c, const char *of, const char *what)
 {
     const char *dir = getenv("TMPDIR");
-    return pdt_err_set(c->err, PDT_ERR_IO, "temporary file for the final triangles in %s: %s: %s",
+    if (errno == ENOMEM) return nomem(c);
+    return pdt_err_set(c->err, PDT_ERR_IO, "temporary file for %s in %s: %s: %s", of,
                        dir && *dir ? dir : "/tmp", what, strerror(errno));
+}
+
+static pdt_status io_fail(chk *c, const char *what)
+{
+    return tmp_fail(c, "the final triangles", what);
 }
 
 /* A new anonymous temporary file in $TMPDIR (else /tmp), or NULL (errno). */
@@ -585,8 +603,10 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
         break;
     }
     case PDT_EV_TRI_NEW:
-        if (u32_push(&rs->scope_tris, e->a) || u32_push(&rs->scope_tris, e->b) ||
-            u32_push(&rs->scope_tris, e->c))
+        /* kept for the edges' replay only (a level-1 trace has none: its
+         * kernel's triangles would take 12 bytes each for nothing) */
+        if (rs->edges_traced && (u32_push(&rs->scope_tris, e->a) || u32_push(&rs->scope_tris, e->b) ||
+            u32_push(&rs->scope_tris, e->c)))
             return nomem(c);
         break;
     case PDT_EV_PUSH: {
@@ -661,6 +681,10 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
             if ((st = need_pt(c, r, seq, e, v[i])) != PDT_OK) return st;
         if (pdt_orient(c->pts[v[0]], c->pts[v[1]], c->pts[v[2]]) <= 0)
             return viol(c, r, seq, e, "the triangle is not counter-clockwise");
+        for (int i = 0; i < 3; i++)
+            if (!(c->mark[v[i]] & M_REP))
+                return viol(c, r, seq, e, "pt %" PRIu32 " is a copy of an earlier input point and "
+                                          "cannot be a corner of T*", v[i]);
         int k = v[0] < v[1] ? (v[0] < v[2] ? 0 : 2) : (v[1] < v[2] ? 1 : 2);
         if (c->nfin == c->maxfin && (st = spill_finals(c)) != PDT_OK) return st;
         if (c->nfin == c->capfin && c->capfin == 0) {
@@ -764,6 +788,8 @@ static int is_tri_event(int kind)
            kind == PDT_EV_SHIP || kind == PDT_EV_DISCARD;
 }
 
+static void tick(chk *c);
+
 static pdt_status check_rank(chk *c, uint32_t r)
 {
     rank_state *rs = calloc(1, sizeof *rs);
@@ -771,6 +797,9 @@ static pdt_status check_rank(chk *c, uint32_t r)
     if (!rs) return nomem(c);
     rs->open_merge = -1;
     rs->last_stack = -1;
+    pdt_rank_info info;
+    pdt_run_rank_info(c->run, (int)r, &info);
+    rs->edges_traced = info.level >= 2;
     pdt_status st = pdt_cursor_open(c->run, (int)r, &cur, c->err);
     /* events are read CHECK_AHEAD ahead of the one checked, and the points a
      * lift or a triangle will read are fetched meanwhile (random places in
@@ -791,6 +820,7 @@ static pdt_status check_rank(chk *c, uint32_t r)
         }
         if (done == got) break;
         c->events++;
+        tick(c);
         st = check_event(c, rs, r, seqs[done % CHECK_AHEAD], &ring[done % CHECK_AHEAD]);
         done++;
     }
@@ -812,48 +842,23 @@ static pdt_status check_rank(chk *c, uint32_t r)
     return st;
 }
 
-/* Every final triangle once, and their set equals T* of the run's points.
- * The finals come sorted out of the runs and the buffer; T* is recomputed
- * after the buffer has been given back (the kernel needs its memory). */
-static pdt_status check_finals(chk *c)
+/* "made final twice" for two equal finals met in sorted order. */
+static pdt_status twice(chk *c, const fin *f, const fin *prev)
 {
-    uint64_t held = (uint64_t)c->capfin * sizeof *c->fin;  /* the buffer as allocated */
-    if (c->nruns || held + (uint64_t)c->npts * TSTAR_BYTES_PER_POINT > c->budget) {
-        /* out of memory's reach (or T* needs the room): the rest goes to disk too */
-        pdt_status st = spill_finals(c);
-        if (st != PDT_OK) return st;
-        free(c->fin);
-        c->fin = NULL;
-        c->capfin = 0;
-    } else if (c->nfin) {
-        sort_fins(c->fin, c->nfin, c->npts);
-    }
-    pdt_tri *ref = NULL;
-    size_t nref = 0;
-    pdt_status st = c->tstar ? c->tstar(c->pts, c->npts, &ref, &nref, &c->tstar_strips)
-                             : pdt_triangulate(c->pts, c->npts, &ref, &nref, NULL, NULL);
-    if (st != PDT_OK) {
-        free(ref);
-        return pdt_err_set(c->err, st, "recomputing T* of the run's points failed: %s",
-                           pdt_status_str(st));
-    }
-    fin_merge m;
-    if (fm_open(&m, c->runs, c->nruns, c->fin, c->nfin)) {
-        fm_close(&m);
-        free(ref);
-        return nomem(c);
-    }
+    return viol(c, 0, 0, NULL, "triangle %" PRIu32 " %" PRIu32 " %" PRIu32 " made final twice: "
+                "rank %" PRIu32 " event #%" PRIu64 " and rank %" PRIu32 " event #%" PRIu64,
+                f->t.v[0], f->t.v[1], f->t.v[2], prev->rank, prev->seq, f->rank, f->seq);
+}
+
+/* The merged finals compared with T* recomputed: both in sorted order. */
+static pdt_status compare_tstar(chk *c, fin_merge *m, const pdt_tri *ref, size_t nref)
+{
+    pdt_status st = PDT_OK;
     fin f, prev;
-    int have = fm_next(&m, &f), had = 0;
+    int have = fm_next(m, &f), had = 0;
     size_t j = 0;
     while (st == PDT_OK && (have || j < nref)) {
-        if (have && had && !cmp_tri(&f.t, &prev.t)) {
-            st = viol(c, 0, 0, NULL, "triangle %" PRIu32 " %" PRIu32 " %" PRIu32
-                                     " made final twice: rank %" PRIu32 " event #%" PRIu64
-                                     " and rank %" PRIu32 " event #%" PRIu64,
-                      f.t.v[0], f.t.v[1], f.t.v[2], prev.rank, prev.seq, f.rank, f.seq);
-            break;
-        }
+        if (have && had && !cmp_tri(&f.t, &prev.t)) return twice(c, &f, &prev);
         int k = !have ? 1 : j == nref ? -1 : cmp_tri(&f.t, &ref[j]);
         if (k < 0) {
             st = viol(c, 0, 0, NULL, "rank %" PRIu32 " event #%" PRIu64 ": final triangle %"
@@ -870,9 +875,82 @@ static pdt_status check_finals(chk *c)
         if (k <= 0) {
             prev = f;
             had = 1;
-            have = fm_next(&m, &f);
+            have = fm_next(m, &f);
         }
     }
+    return st;
+}
+
+/* With no final triangles, T* must be empty: fewer than three distinct
+ * points, or all of them on one line. */
+static pdt_status check_no_finals(chk *c, size_t nu)
+{
+    size_t first = SIZE_MAX, second = SIZE_MAX;
+    for (size_t i = 0; nu >= 3 && i < c->npts; i++) {
+        if (!(c->mark[i] & M_REP)) continue;
+        if (first == SIZE_MAX) first = i;
+        else if (second == SIZE_MAX) second = i;
+        else if (pdt_orient(c->pts[first], c->pts[second], c->pts[i]) != 0)
+            return viol(c, 0, 0, NULL, "no triangle was made final, but T* of the run's points "
+                                       "has triangles: points %zu, %zu and %zu are distinct and not "
+                                       "on one line", first, second, i);
+    }
+    return PDT_OK;
+}
+
+/* The merged finals certified to be T* edge by edge on disk (certify.h),
+ * when recomputing T* would not fit the budget. */
+static pdt_status certify_tstar(chk *c, fin_merge *m, size_t nu)
+{
+    pdt_cert *cert = pdt_cert_new(c->run, c->budget);
+    if (!cert) return nomem(c);
+    pdt_status st = PDT_OK;
+    fin f, prev;
+    int had = 0;
+    while (st == PDT_OK && fm_next(m, &f)) {
+        if (had && !cmp_tri(&f.t, &prev.t)) st = twice(c, &f, &prev);
+        else st = pdt_cert_add(cert, f.t.v, c->err);
+        prev = f;
+        had = 1;
+    }
+    if (st == PDT_OK && !had) st = check_no_finals(c, nu);
+    if (st == PDT_OK) st = pdt_cert_finish(cert, nu, c->err);
+    c->cert_runs = pdt_cert_runs(cert);
+    pdt_cert_free(cert);
+    return st;
+}
+
+/* Every final triangle once, and their set equals T* of the run's points.
+ * The finals come sorted out of the runs and the buffer; T* is recomputed
+ * after the buffer has been given back (the kernel needs its memory), or
+ * certified on disk when recomputing it would not fit the budget. */
+static pdt_status check_finals(chk *c, size_t nu)
+{
+    uint64_t held = (uint64_t)c->capfin * sizeof *c->fin;  /* the buffer as allocated */
+    if (c->nruns || c->certify || held + (uint64_t)c->npts * TSTAR_BYTES_PER_POINT > c->budget) {
+        /* out of memory's reach (or T* needs the room): the rest goes to disk too */
+        pdt_status st = spill_finals(c);
+        if (st != PDT_OK) return st;
+        free(c->fin);
+        c->fin = NULL;
+        c->capfin = 0;
+    } else if (c->nfin) {
+        sort_fins(c->fin, c->nfin, c->npts);
+    }
+    pdt_tri *ref = NULL;
+    size_t nref = 0;
+    pdt_status st = PDT_OK;
+    if (!c->certify)
+        st = c->tstar ? c->tstar(c->pts, c->npts, &ref, &nref, &c->tstar_strips)
+                      : pdt_triangulate(c->pts, c->npts, &ref, &nref, NULL, NULL);
+    if (st != PDT_OK) {
+        free(ref);
+        return pdt_err_set(c->err, st, "recomputing T* of the run's points failed: %s",
+                           pdt_status_str(st));
+    }
+    fin_merge m;
+    if (fm_open(&m, c->runs, c->nruns, c->fin, c->nfin)) st = nomem(c);
+    else st = c->certify ? certify_tstar(c, &m, nu) : compare_tstar(c, &m, ref, nref);
     fm_close(&m);
     free(ref);
     return st;
@@ -942,6 +1020,107 @@ static pdt_status check_merges(chk *c)
     return PDT_OK;
 }
 
+/* ---- per-point state within the budget --------------------------------------
+ *
+ * What grows with the points is held in memory while it fits the budget:
+ * the marks (a byte per point) up to a quarter of it, the sort that finds
+ * the distinct points (DEDUP_BYTES_PER_POINT) and T* recomputed
+ * (TSTAR_BYTES_PER_POINT) up to all of it.  Beyond, the marks live in a
+ * mapping of an anonymous temporary file, the distinct points are found by
+ * a sort on disk (xsort.h) and T* is certified on disk instead of
+ * recomputed (certify.h); the resident pages of the marks and of the
+ * points are then given back every GIVE_BACK_EVERY reads (they stay in the
+ * page cache, or go to disk under pressure), so the check's memory is the
+ * budget whatever the run's size. */
+#define DEDUP_BYTES_PER_POINT 36u  /* pdt_sort_unique: order 4, work 32 */
+#define GIVE_BACK_EVERY ((uint64_t)1 << 16)
+
+static int marks_new(chk *c)
+{
+    size_t n = c->npts ? c->npts : 1;
+    if ((uint64_t)n <= c->budget / 4) return (c->mark = calloc(n, 1)) ? 0 : -1;
+    FILE *f = spill_file();
+    if (!f) return -1;
+    void *p = MAP_FAILED;
+    if (ftruncate(fileno(f), (off_t)n) == 0)
+        p = mmap(NULL, n, PROT_READ | PROT_WRITE, MAP_SHARED, fileno(f), 0);
+    int e = errno;
+    fclose(f);  /* the mapping keeps the file */
+    errno = e;
+    if (p == MAP_FAILED) return -1;
+    c->mark = p;
+    c->mark_map = n;
+    return 0;
+}
+
+static void marks_free(chk *c)
+{
+    if (c->mark_map) munmap(c->mark, c->mark_map);
+    else free(c->mark);
+}
+
+/* Every GIVE_BACK_EVERY calls, when the points or the marks are too big to
+ * keep: their resident pages are given back. */
+static void tick(chk *c)
+{
+    if (!c->give_back || ++c->ticks % GIVE_BACK_EVERY) return;
+    if (c->mark_map) madvise(c->mark, c->mark_map, MADV_DONTNEED);
+    pdt_run_release_points(c->run);
+}
+
+/* (x, y) as an unsigned key in lexicographic order. */
+static uint64_t lex_key(pdt_point p)
+{
+    return (uint64_t)((uint32_t)p.x ^ 0x80000000u) << 32 | ((uint32_t)p.y ^ 0x80000000u);
+}
+
+/* M_REP on the smallest index of each distinct point, and their number. */
+static pdt_status find_distinct(chk *c, size_t *nu)
+{
+    *nu = 0;
+    if (!c->dedup_on_disk) {
+        uint32_t *order = malloc((c->npts ? c->npts : 1) * sizeof *order);
+        if (!order) return nomem(c);
+        pdt_status st = pdt_sort_unique(c->pts, c->npts, order, nu);
+        if (st != PDT_OK)
+            pdt_err_set(c->err, st, "sorting the run's points failed: %s", pdt_status_str(st));
+        for (size_t i = 0; st == PDT_OK && i < *nu; i++) c->mark[order[i]] |= M_REP;
+        free(order);
+        return st;
+    }
+    pdt_xsort *x = pdt_xsort_new(c->budget / 2);
+    if (!x) return nomem(c);
+    pdt_status st = PDT_OK;
+    for (size_t i = 0; st == PDT_OK && i < c->npts; i++) {
+        tick(c);
+        if (pdt_xsort_put(x, lex_key(c->pts[i]), i)) st = tmp_fail(c, "the points", "cannot write");
+    }
+    if (st == PDT_OK && pdt_xsort_done(x)) st = tmp_fail(c, "the points", "cannot read back");
+    pdt_kv kv;
+    uint64_t key = 0, rep = 0;
+    int any = 0, r = 0;
+    while (st == PDT_OK && (r = pdt_xsort_get(x, &kv)) == 1) {
+        if (any && kv.key == key) {  /* a copy: the smallest index represents them */
+            if (kv.val < rep) rep = kv.val;
+            continue;
+        }
+        if (any) c->mark[rep] |= M_REP;
+        tick(c);
+        *nu += any;
+        key = kv.key;
+        rep = kv.val;
+        any = 1;
+    }
+    if (st == PDT_OK && r < 0) st = tmp_fail(c, "the points", "cannot read back");
+    if (st == PDT_OK && any) {
+        c->mark[rep] |= M_REP;
+        (*nu)++;
+    }
+    c->dedup_runs = pdt_xsort_runs(x);
+    pdt_xsort_free(x);
+    return st;
+}
+
 pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
 {
     return pdt_run_check_mem(run, PDT_TRACE_MEM_DEFAULT, summary, cap, err);
@@ -976,19 +1155,18 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
     const pdt_manifest *m = pdt_run_manifest(run);
     c.is_tri = !strcmp(m->command, "triangulate");
     c.is_hull = !strcmp(m->command, "hull");
-    c.mark = calloc(c.npts ? c.npts : 1, 1);
+    c.certify = (uint64_t)c.npts * TSTAR_BYTES_PER_POINT > budget;
+    c.dedup_on_disk = (uint64_t)c.npts * DEDUP_BYTES_PER_POINT > budget;
     size_t nr = (size_t)pdt_run_nranks(run);
     c.kmin = calloc(nr, sizeof *c.kmin);
     c.kmax = calloc(nr, sizeof *c.kmax);
     c.nlocal = calloc(nr, sizeof *c.nlocal);
-    uint32_t *order = malloc((c.npts ? c.npts : 1) * sizeof *order);
     size_t nu = 0;
     pdt_status st = PDT_OK;
-    if (!c.mark || !order || !c.kmin || !c.kmax || !c.nlocal) st = nomem(&c);
-    else if ((st = pdt_sort_unique(c.pts, c.npts, order, &nu)) != PDT_OK)
-        pdt_err_set(err, st, "sorting the run's points failed: %s", pdt_status_str(st));
-    for (size_t i = 0; st == PDT_OK && i < nu; i++) c.mark[order[i]] |= M_REP;
-    free(order);
+    if (!c.kmin || !c.kmax || !c.nlocal) st = nomem(&c);
+    else if (marks_new(&c)) st = tmp_fail(&c, "the marks of the points", "cannot create");
+    c.give_back = c.mark_map || (uint64_t)c.npts * sizeof *c.pts > budget / 4;
+    if (st == PDT_OK) st = find_distinct(&c, &nu);
 
     for (int r = 0; st == PDT_OK && r < pdt_run_nranks(run); r++) st = check_rank(&c, (uint32_t)r);
 
@@ -1009,7 +1187,7 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
                                       "overlap", r, c.nlocal[r], prev);
         prev = r;
     }
-    if (st == PDT_OK && c.is_tri) st = check_finals(&c);
+    if (st == PDT_OK && c.is_tri) st = check_finals(&c, nu);
     if (st == PDT_OK && c.is_hull) {
         /* every point sorted; each deleted or pushed; the final stack is the hull */
         for (size_t i = 0; st == PDT_OK && i < c.npts; i++) {
@@ -1051,12 +1229,20 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
         size_t len = strlen(summary);
         snprintf(summary + len, cap - len, " (T* recomputed on %d strips)", c.tstar_strips);
     }
+    if (st == PDT_OK && cap && c.certify && c.is_tri) {
+        size_t len = strlen(summary);
+        char runs[64] = "";
+        if (c.cert_runs) snprintf(runs, sizeof runs, " on disk in %" PRIu64 " sorted runs",
+                                  c.cert_runs);
+        snprintf(summary + len, cap - len, " (T* certified side by side%s: recomputing it would "
+                 "not fit the memory budget)", runs);
+    }
     if (st == PDT_OK && cap && c.spills) {
         size_t len = strlen(summary);
         snprintf(summary + len, cap - len, " (final triangles sorted on disk in %" PRIu64
                  " runs: over the memory budget)", c.spills);
     }
-    free(c.mark);
+    marks_free(&c);
     free(c.kmin);
     free(c.kmax);
     free(c.nlocal);

@@ -79,7 +79,7 @@ static pdt_status check_dir(const char *dir, char *msg, size_t cap)
         snprintf(msg, cap, "open: %s", err.msg);
         return err.code;
     }
-    char summary[512];
+    char summary[1024];
     pdt_status st = pdt_run_check_tstar(run, budget, tstar, summary, sizeof summary, &err);
     snprintf(msg, cap, "%s", st == PDT_OK ? summary : err.msg);
     pdt_run_close(run);
@@ -395,8 +395,9 @@ static void record_tri_dup(const char *dir, const pdt_point *pts, size_t n, size
 }
 
 /* With a budget of a few hundred bytes the final triangles go to disk in
- * sorted runs of 16 (more than 64 runs: merged into one on the way): the
- * verdicts are the same as in memory. */
+ * sorted runs of 16 (more than 64 runs: merged into one on the way), and T*
+ * is certified side by side on disk instead of recomputed: the verdicts are
+ * the same as in memory, the reasons given are the certificate's. */
 TEST(tiny_budget_spills)
 {
     char msg[1100];
@@ -407,16 +408,18 @@ TEST(tiny_budget_spills)
     record_tri(sub("tb"), pts, 2000, 1);
     CHECK_MSG(check_dir(sub("tb"), msg, sizeof msg) == PDT_OK, "%s", msg);
     CHECK_MSG(strstr(msg, "= T*") && strstr(msg, "sorted on disk in"), "%s", msg);
+    CHECK_MSG(strstr(msg, "certified side by side on disk in"), "%s", msg);
     budget = PDT_TRACE_MEM_DEFAULT;
     CHECK_MSG(check_dir(sub("tb"), msg, sizeof msg) == PDT_OK && !strstr(msg, "on disk"), "%s",
               msg);
     budget = 256;
-    expect_fail_copy("tb", "tb-nofinal", PDT_EV_TRI_FINAL, 1000, NULL, "was never made final");
+    /* a triangle missing: a hole, whose boundary turns right */
+    expect_fail_copy("tb", "tb-nofinal", PDT_EV_TRI_FINAL, 1000, NULL, "turns right at point");
     record_tri_dup(sub("tb-dup"), pts, 2000, 7);
     expect_fail(sub("tb-dup"), "made final twice");
     expect_fail_copy("tb", "tb-cw", PDT_EV_TRI_FINAL, 3000, cw, "not counter-clockwise");
     /* a foreign triangle in place of a true one */
-    expect_fail_copy("tb", "tb-wrong", PDT_EV_TRI_FINAL, 2500, swap_point, "is not in T* of the run's points");
+    expect_fail_copy("tb", "tb-wrong", PDT_EV_TRI_FINAL, 2500, swap_point, "the final triangles");
     budget = PDT_TRACE_MEM_DEFAULT;
     free(pts);
 }
@@ -457,6 +460,145 @@ TEST(strips_tstar_same_verdicts)
     free(pts);
 }
 
+/* A traced triangulation of pts whose final triangles are tris[0..nt). */
+static void record_tri_finals(const char *dir, const pdt_point *pts, size_t n, const pdt_tri *tris,
+                              size_t nt)
+{
+    pdt_trace_writer *w;
+    pdt_err err = {0};
+    CHECK(pdt_tw_open(dir, 0, 1, &w, &err) == PDT_OK);
+    meta(dir, "triangulate", pts, n, 1);
+    pdt_trace *tr = pdt_tw_hook(w);
+    pdt_tri *t;
+    size_t k;
+    CHECK(pdt_triangulate(pts, n, &t, &k, NULL, tr) == PDT_OK);
+    free(t);
+    for (size_t i = 0; i < nt; i++)
+        PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, tris[i].v[0], tris[i].v[1], tris[i].v[2], 0);
+    CHECK(pdt_tw_close(w, &err) == PDT_OK);
+}
+
+/* Flip the first side shared by two triangles of t whose quadrilateral is
+ * convex: both new triangles counter-clockwise, the side no longer
+ * Delaunay.  1 if one was flipped. */
+static int flip_one(const pdt_point *p, pdt_tri *t, size_t nt)
+{
+    for (size_t i = 0; i < nt; i++)
+        for (size_t j = i + 1; j < nt; j++)
+            for (int a = 0; a < 3; a++)
+                for (int b = 0; b < 3; b++) {
+                    uint32_t u = t[i].v[a], w = t[i].v[(a + 1) % 3], c = t[i].v[(a + 2) % 3];
+                    if (t[j].v[b] != w || t[j].v[(b + 1) % 3] != u) continue;
+                    uint32_t d = t[j].v[(b + 2) % 3];
+                    if (pdt_orient(p[u], p[d], p[c]) <= 0 || pdt_orient(p[d], p[w], p[c]) <= 0)
+                        continue;
+                    t[i] = (pdt_tri){{u, d, c}};
+                    t[j] = (pdt_tri){{d, w, c}};
+                    return 1;
+                }
+    return 0;
+}
+
+/* T* certified side by side on disk (a budget too small to recompute it):
+ * every family passes, degenerate ones included, and each kind of wrong
+ * set of final triangles is named by the condition it breaks. */
+TEST(certified_tstar)
+{
+    char msg[1100];
+    budget = 256;
+    const char *const *kinds = pdt_gen_kinds();
+    for (int i = 0; kinds[i]; i++) {
+        pdt_point *q;
+        pdt_err err = {0};
+        CHECK(pdt_gen(kinds[i], 700, 11, &q, &err) == PDT_OK);
+        record_tri(sub("ct-fam"), q, 700, 1);
+        CHECK_MSG(check_dir(sub("ct-fam"), msg, sizeof msg) == PDT_OK, "%s: %s", kinds[i], msg);
+        /* collinear points have no triangles: nothing to certify */
+        CHECK_MSG(strstr(msg, "certified") || strstr(msg, " 0 final triangles"), "%s: %s",
+                  kinds[i], msg);
+        free(q);
+    }
+    pdt_point few[4] = {{0, 0}, {4, 0}, {0, 4}, {1, 1}};
+    for (size_t n = 0; n <= 4; n++) {
+        record_tri(sub("ct-tiny"), few, n, 1);
+        CHECK_MSG(check_dir(sub("ct-tiny"), msg, sizeof msg) == PDT_OK, "n=%zu: %s", n, msg);
+    }
+
+    size_t n = 400;
+    pdt_point *pts = uniform(n);
+    pdt_tri *t;
+    size_t nt;
+    CHECK(pdt_triangulate(pts, n, &t, &nt, NULL, NULL) == PDT_OK);
+    record_tri_finals(sub("ct-ok"), pts, n, t, nt);
+    CHECK_MSG(check_dir(sub("ct-ok"), msg, sizeof msg) == PDT_OK, "%s", msg);
+
+    /* a side flipped: a triangulation, but not Delaunay */
+    pdt_tri *f = malloc(nt * sizeof *f);
+    memcpy(f, t, nt * sizeof *f);
+    CHECK(flip_one(pts, f, nt));
+    record_tri_finals(sub("ct-flip"), pts, n, f, nt);
+    expect_fail(sub("ct-flip"), "is not locally Delaunay");
+
+    /* a triangle on top of another: three triangles on a side, or two on
+     * one side of it */
+    memcpy(f, t, nt * sizeof *f);
+    f[5] = f[6];
+    f[5].v[2] = f[7].v[0] == f[6].v[0] || f[7].v[0] == f[6].v[1] ? f[7].v[1] : f[7].v[0];
+    if (pdt_orient(pts[f[5].v[0]], pts[f[5].v[1]], pts[f[5].v[2]]) > 0) {
+        record_tri_finals(sub("ct-over"), pts, n, f, nt);
+        expect_fail(sub("ct-over"), "the final triangles");
+    }
+
+    /* no triangle at all, though the points are not on one line */
+    record_tri_finals(sub("ct-none"), pts, n, t, 0);
+    expect_fail(sub("ct-none"), "no triangle was made final");
+
+    /* T* of the points but one inside: a convex triangulation, locally
+     * Delaunay, with a point too few (Euler's formula) */
+    uint32_t inner = UINT32_MAX;  /* a point near the middle of the square: inside */
+    for (uint32_t p = 0; p < n && inner == UINT32_MAX; p++)
+        if (labs(pts[p].x - (1 << 19)) < (1 << 17) && labs(pts[p].y - (1 << 19)) < (1 << 17))
+            inner = p;
+    CHECK(inner != UINT32_MAX);
+    pdt_point *rest = malloc(n * sizeof *rest);
+    uint32_t *orig = malloc(n * sizeof *orig);
+    size_t m = 0;
+    for (uint32_t p = 0; p < n; p++)
+        if (p != inner) {
+            orig[m] = p;
+            rest[m++] = pts[p];
+        }
+    pdt_tri *u;
+    size_t nu;
+    CHECK(pdt_triangulate(rest, m, &u, &nu, NULL, NULL) == PDT_OK);
+    for (size_t i = 0; i < nu; i++)
+        for (int k = 0; k < 3; k++) u[i].v[k] = orig[u[i].v[k]];
+    record_tri_finals(sub("ct-euler"), pts, n, u, nu);
+    expect_fail(sub("ct-euler"), "by Euler's formula");
+
+    /* a copy of a point as a corner */
+    pdt_point *dup = malloc((n + 1) * sizeof *dup);
+    memcpy(dup, pts, n * sizeof *dup);
+    dup[n] = pts[t[0].v[0]];
+    pdt_tri *g = malloc(nt * sizeof *g);
+    memcpy(g, t, nt * sizeof *g);
+    for (size_t i = 0; i < nt; i++)
+        for (int k = 0; k < 3; k++)
+            if (g[i].v[k] == t[0].v[0]) g[i].v[k] = (uint32_t)n;
+    record_tri_finals(sub("ct-copy"), dup, n + 1, g, nt);
+    expect_fail(sub("ct-copy"), "is a copy of an earlier input point");
+
+    budget = PDT_TRACE_MEM_DEFAULT;
+    free(g);
+    free(dup);
+    free(u);
+    free(rest);
+    free(orig);
+    free(f);
+    free(t);
+    free(pts);
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "%s/pdt-ttc.XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -469,6 +611,7 @@ int main(void)
     RUN(messages_and_merges);
     RUN(chain_hull_counts);
     RUN(tiny_budget_spills);
+    RUN(certified_tstar);
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
     if (system(cmd) != 0) return 1;
