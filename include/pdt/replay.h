@@ -134,6 +134,8 @@ typedef struct pdt_rstate {
     uint8_t *ealive;     /* per kernel edge: 1 while it exists */
     uint8_t *mflight;    /* per message: 1 sent and not yet received */
     int32_t *slot;       /* per rank * PDT_SLOT_PER_RANK: current value or -1 */
+    size_t paged[3];     /* bytes of pflags, tcur, ealive when they live in a
+                          * temporary file's mapping (0: in memory) */
 } pdt_rstate;
 
 /* Build a replay from `n` points and `m` merged event records of `nranks`
@@ -174,9 +176,21 @@ int pdt_replay_bbox(const pdt_replay *r, pdt_point *lo, pdt_point *hi);
 /* Index of the point's first lift event, or UINT32_MAX. */
 uint32_t pdt_replay_lift_ev(const pdt_replay *r, size_t p);
 
-/* Allocate a state for `r`, at cursor 0.  NULL when out of memory. */
+/* Allocate a state for `r`, at cursor 0.  NULL when out of memory.  When
+ * pdt_replay_set_mem found the state too big for its budget (a quarter of
+ * it), its per-point, per-triangle and per-edge arrays live in the mapping
+ * of an anonymous temporary file ($TMPDIR, else /tmp) instead of memory:
+ * paged by the kernel, their resident pages given back by
+ * pdt_replay_give_back. */
 pdt_rstate *pdt_rstate_new(const pdt_replay *r);
 void pdt_rstate_free(pdt_rstate *s);
+
+/* After a seek or a frame: give back the resident pages of what grows with
+ * the run and is read through mappings (a paged state's arrays, the run's
+ * points read in place, the kept index's tables), so that what the viewer
+ * holds stays within its budget.  The next reads take them again from the
+ * page cache.  Nothing for a replay held in memory. */
+void pdt_replay_give_back(const pdt_replay *r, const pdt_rstate *s);
 
 /* Set `s` to the state at cursor k (clamped to count), the cheapest way:
  * stepping from where s is, from the nearest checkpoint (pdt_replay_set_mem),

@@ -1613,6 +1613,11 @@ static pdt_status in_memory(pdt_run *run, const pdt_point *pts, size_t n, int nr
     return pdt_replay_new(pts, n, recs, m, nranks, out, err);
 }
 
+static void release_run_points(const void *run)
+{
+    pdt_run_release_points(run);
+}
+
 pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, int use_index,
                                pdt_replay **out, pdt_replay_open_info *info, pdt_err *err)
 {
@@ -1678,6 +1683,8 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
     }
     info->indexed = 1;
     snprintf(info->path, sizeof info->path, "%s", path);
+    r->release_points = release_run_points;  /* read in place: given back after frames */
+    r->release_ctx = run;
     pdt_replay_set_mem(r, budget);
     *out = r;
     return PDT_OK;

@@ -574,6 +574,7 @@ static int check(const pdt_replay *r)
     printf("check: %zu events, %zu cursors compared both ways, %zu differ", m,
            2 * (m / stride + 1), bad);
     if (nck) printf(" (checkpoints every %zu events: %zu of %zu made)", every, made, nck);
+    if (a->paged[1]) printf(" (states paged: over a quarter of --mem)");
     printf("\n");
     pdt_rstate_free(a);
     pdt_rstate_free(b);

@@ -130,6 +130,7 @@ pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, cons
     if (c.L.timeline.w > 0) pdt_draw_timeline(&c);
     if (v->help) pdt_draw_help(&c, w, h);
     cairo_restore(cr);
+    pdt_replay_give_back(r, s);  /* a big run's pages the frame read */
     cairo_status_t cs = cairo_status(cr);
     if (cs != CAIRO_STATUS_SUCCESS)
         return pdt_err_set(err, PDT_ERR_IO, "cairo: %s",

@@ -4,6 +4,7 @@
 #include "../geom/bigmem.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -1744,38 +1745,88 @@ int pdt_replay_box(const pdt_replay *r, int rank, pdt_point *lo, pdt_point *hi)
 int pdt_replay_bbox(const pdt_replay *r, pdt_point *lo, pdt_point *hi)
 {
     if (!r->n) return 0;
-    *lo = *hi = r->pts[0];
-    for (size_t p = 1; p < r->n; p++) {
-        pdt_point q = r->pts[p];
-        if (q.x < lo->x) lo->x = q.x;
-        if (q.y < lo->y) lo->y = q.y;
-        if (q.x > hi->x) hi->x = q.x;
-        if (q.y > hi->y) hi->y = q.y;
+    /* a kept index's run (its points never change) is scanned once, at the
+     * first frame: 8 bytes a point read at every frame otherwise */
+    pdt_replay *w = (pdt_replay *)r;
+    if (!w->bbox_known) {
+        pdt_point a = r->pts[0], b = r->pts[0];
+        for (size_t p = 1; p < r->n; p++) {
+            pdt_point q = r->pts[p];
+            if (q.x < a.x) a.x = q.x;
+            if (q.y < a.y) a.y = q.y;
+            if (q.x > b.x) b.x = q.x;
+            if (q.y > b.y) b.y = q.y;
+        }
+        w->bbox_lo = a;
+        w->bbox_hi = b;
+        w->bbox_known = r->map != NULL;
     }
+    *lo = w->bbox_lo;
+    *hi = w->bbox_hi;
     return 1;
 }
 
 /* ---- states ------------------------------------------------------------------ */
+
+/* `bytes` of zeros in the mapping of an anonymous temporary file in $TMPDIR
+ * (else /tmp), or NULL. */
+static void *paged_zeros(size_t bytes)
+{
+    const char *dir = getenv("TMPDIR");
+    if (!dir || !*dir) dir = "/tmp";
+    int fd = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    if (fd < 0) {  /* a file system without O_TMPFILE: a named file, unlinked */
+        char path[4096];
+        snprintf(path, sizeof path, "%s/pdtview-state.XXXXXX", dir);
+        if ((fd = mkstemp(path)) < 0) return NULL;
+        unlink(path);
+    }
+    void *p = MAP_FAILED;
+    if (ftruncate(fd, (off_t)bytes) == 0)
+        p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+    close(fd);  /* the mapping keeps the file */
+    return p == MAP_FAILED ? NULL : p;
+}
+
+/* An array of a state: paged (s->paged[i] set) when the replay says so and
+ * a temporary file takes it, else in memory. */
+static void *state_array(const pdt_replay *r, pdt_rstate *s, int i, size_t bytes, int zero)
+{
+    if (!bytes) bytes = 1;
+    if (r->state_paged) {
+        void *p = paged_zeros(bytes);
+        if (p) {
+            s->paged[i] = bytes;
+            return p;
+        }
+    }
+    void *p = zero ? calloc(bytes, 1) : malloc(bytes);
+    /* a state of a huge run is 10^8 bytes, filled at once: huge pages spare
+     * most of the page faults (costly on virtual machines) */
+    if (p) pdt_big_advise(p, bytes);
+    return p;
+}
+
+static void state_array_free(void *p, size_t paged)
+{
+    if (paged) munmap(p, paged);
+    else free(p);
+}
 
 pdt_rstate *pdt_rstate_new(const pdt_replay *r)
 {
     pdt_rstate *s = calloc(1, sizeof *s);
     if (!s) return NULL;
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
-    s->pflags = calloc(r->n ? r->n : 1, 1);
-    s->tcur = malloc((r->ntri ? r->ntri : 1) * sizeof *s->tcur);
-    s->ealive = calloc(r->nedge ? r->nedge : 1, 1);
+    s->pflags = state_array(r, s, 0, r->n, 1);
+    s->tcur = state_array(r, s, 1, r->ntri * sizeof *s->tcur, 0);
+    s->ealive = state_array(r, s, 2, r->nedge, 1);
     s->mflight = calloc(r->nmsg ? r->nmsg : 1, 1);
     s->slot = malloc((nslot ? nslot : 1) * sizeof *s->slot);
     if (!s->pflags || !s->tcur || !s->ealive || !s->mflight || !s->slot) {
         pdt_rstate_free(s);
         return NULL;
     }
-    /* a state of a huge run is 10^8 bytes, filled at once: huge pages spare
-     * most of the page faults (costly on virtual machines) */
-    pdt_big_advise(s->pflags, r->n);
-    pdt_big_advise(s->tcur, r->ntri * sizeof *s->tcur);
-    pdt_big_advise(s->ealive, r->nedge);
     pdt_replay_seek_direct(r, s, 0);
     return s;
 }
@@ -1783,12 +1834,24 @@ pdt_rstate *pdt_rstate_new(const pdt_replay *r)
 void pdt_rstate_free(pdt_rstate *s)
 {
     if (!s) return;
-    free(s->pflags);
-    free(s->tcur);
-    free(s->ealive);
+    state_array_free(s->pflags, s->paged[0]);
+    state_array_free(s->tcur, s->paged[1]);
+    state_array_free(s->ealive, s->paged[2]);
     free(s->mflight);
     free(s->slot);
     free(s);
+}
+
+void pdt_replay_give_back(const pdt_replay *r, const pdt_rstate *s)
+{
+    if (!r->state_paged) return;  /* what is resident fits the budget */
+    if (s) {
+        const void *a[3] = {s->pflags, s->tcur, s->ealive};
+        for (int i = 0; i < 3; i++)
+            if (s->paged[i]) pdt_release_pages(a[i], s->paged[i]);
+    }
+    if (r->release_points) r->release_points(r->release_ctx);
+    pdt_index_release(r, r->map, r->map_len);
 }
 
 static uint8_t point_flags(const pdt_replay *r, size_t p, size_t k)
@@ -2030,6 +2093,8 @@ void pdt_replay_set_mem(pdt_replay *r, uint64_t budget)
     r->ck = NULL;
     r->nck = r->ck_every = 0;
     r->ck_bytes = pdt_replay_state_bytes(r);
+    /* a kept index's replay: a state over a quarter of the budget is paged */
+    r->state_paged = r->map && r->ck_bytes > budget / 4;
     if (r->nick) return;  /* the index's checkpoints serve */
     /* half the budget for checkpoints; one every at least 64 events */
     uint64_t fit = budget / 2 / r->ck_bytes;
@@ -2113,13 +2178,25 @@ void pdt_rstate_blob_parts(const pdt_replay *r, const pdt_rstate *s, size_t born
 
 /* memcpy from a kept index's mapping, its pages given back behind the copy
  * (a checkpoint of a huge run is 10^8 bytes: its pages would double what a
- * seek holds). */
-static void copy_out(const pdt_replay *r, void *to, const uint8_t *from, size_t len)
+ * seek holds), and a paged state's pages too (`paged`: the array is one). */
+static void copy_out(const pdt_replay *r, void *to, const uint8_t *from, size_t len, size_t paged)
 {
     for (size_t o = 0; o < len; o += BLOB_STEP) {
         size_t k = len - o < BLOB_STEP ? len - o : BLOB_STEP;
         memcpy((char *)to + o, from + o, k);
         pdt_index_release(r, from + o, k);
+        if (paged) pdt_release_pages((char *)to + o, k);
+    }
+}
+
+/* memset, a paged state's pages given back behind it. */
+static void fill_out(void *to, int byte, size_t len, size_t paged)
+{
+    size_t step = paged ? BLOB_STEP : len;
+    for (size_t o = 0; o < len; o += step) {
+        size_t k = len - o < step ? len - o : step;
+        memset((char *)to + o, byte, k);
+        if (paged) pdt_release_pages((char *)to + o, k);
     }
 }
 
@@ -2128,22 +2205,25 @@ void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in,
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
     s->k = k;
-    copy_out(r, s->pflags, in, r->n);
+    copy_out(r, s->pflags, in, r->n, s->paged[0]);
     in += up8(r->n);
-    copy_out(r, s->tcur, in, born * 4);
-    memset(s->tcur + born, 0xff, (r->ntri - born) * sizeof *s->tcur);
+    copy_out(r, s->tcur, in, born * 4, s->paged[1]);
+    fill_out(s->tcur + born, 0xff, (r->ntri - born) * sizeof *s->tcur, s->paged[1]);
     in += up8(born * 4);
-    copy_out(r, s->ealive, in, r->nedge);
+    copy_out(r, s->ealive, in, r->nedge, s->paged[2]);
     in += up8(r->nedge);
-    copy_out(r, s->mflight, in, r->nmsg);
+    copy_out(r, s->mflight, in, r->nmsg, 0);
     in += up8(r->nmsg);
-    copy_out(r, s->slot, in, nslot * 4);
+    copy_out(r, s->slot, in, nslot * 4, 0);
 }
 
 static void step_to(const pdt_replay *r, pdt_rstate *s, size_t k)
 {
-    while (s->k < k) pdt_replay_step(r, s, 1);
-    while (s->k > k) pdt_replay_step(r, s, -1);
+    for (size_t n = 1; s->k != k; n++) {
+        pdt_replay_step(r, s, s->k < k ? 1 : -1);
+        /* a paged state: the pages the steps touched, every so often */
+        if (r->state_paged && n % SEEK_RELEASE == 0) pdt_replay_give_back(r, s);
+    }
 }
 
 /* The cheapest of: stepping from where s is; restoring the checkpoint
@@ -2175,6 +2255,7 @@ void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k)
             size_t t1 = c1 < r->nick ? r->ick_born[c1] : r->ntri;
             if (t1 > t0) pdt_index_release(r, &r->tris[t0], (t1 - t0) * sizeof *r->tris);
         }
+        if (r->state_paged) pdt_replay_give_back(r, s);
         return;
     }
     if (from_here <= direct && (!r->nck || from_here <= r->ck_every / 2)) {
@@ -2303,6 +2384,7 @@ size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, 
             const pdt_rtri *from = &r->tris[t - COV_RELEASE];
             pdt_index_release(r, from, COV_RELEASE * sizeof *r->tris);
             pdt_index_release(r, &r->hist[from->h0], (r->tris[t].h0 - from->h0) * sizeof *r->hist);
+            if (r->state_paged) pdt_replay_give_back(r, s);  /* the corners' points too */
         }
         /* the corners' points and the history entry of a triangle a few
          * ahead: random places in tables of 10^8 bytes (a hint only) */

@@ -122,6 +122,13 @@ struct pdt_replay {
     uint64_t build_peak;   /* the build's own working memory, at most (bytes) */
     struct lazy *lazy;     /* the map is verified chunk by chunk as it is read (index.c) */
     const char *warnings;  /* the reader's warnings about the run (kept index), or NULL */
+    int state_paged;       /* states in temporary files' mappings (pdt_rstate_new) */
+    int bbox_known;        /* pdt_replay_bbox's answer, found once */
+    pdt_point bbox_lo, bbox_hi;
+    /* the run's points are read in place: give their resident pages back
+     * (pdt_replay_give_back); NULL: they are the replay's or the caller's */
+    void (*release_points)(const void *ctx);
+    const void *release_ctx;
 
     /* Checkpoints: a copy of the state at every `ck_every`-th cursor, made on
      * the first seek near it (NULL until then); none when ck_every == 0. */

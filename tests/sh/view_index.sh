@@ -53,6 +53,19 @@ for b in 1M 64K; do
     out=$("$V" "$R" --check --mem $b)
     case "$out" in *", 0 differ"*) ok "check_mem_$b" ;; *) fail "check_mem_$b" "$out" ;; esac
 done
+# a state over a quarter of the budget lives in a temporary file's mapping
+# (paged, its pages given back after each seek and frame): the same replay
+# and the same pictures as in memory
+case "$("$V" "$R" --check --mem 32K)" in *", 0 differ"*"(states paged"*) ok paged_state_check ;;
+    *) fail paged_state_check "$("$V" "$R" --check --mem 32K)" ;; esac
+case "$("$V" "$R" --check --mem 1M)" in *"paged"*) fail small_state_not_paged ;; *) ok small_state_not_paged ;; esac
+same_p=1
+for at in "--at 0" "--at 2345" "--end"; do
+    "$V" --headless "$R" $at -o "$TMP/pm.png" --size 640x400 --quiet --index off
+    "$V" --headless "$R" $at -o "$TMP/pp.png" --size 640x400 --quiet --mem 32K
+    cmp -s "$TMP/pm.png" "$TMP/pp.png" || same_p=0
+done
+[ $same_p -eq 1 ] && ok paged_state_same_pictures || fail paged_state_same_pictures
 case "$("$V" "$R" --check --mem 1M)" in *"checkpoints every"*) ok checkpoints_made ;;
     *) fail checkpoints_made "no checkpoints under --mem 1M" ;; esac
 
