@@ -286,7 +286,8 @@ pdt_status pdt_run_export_otf2(pdt_run *run, const char *dir, pdt_otf2_counts *c
  * and depths agree; Graham's final stack is the hull of the points; lift-ups
  * cover the distinct points once (local) and |B| at each merge, with
  * z = x*x + y*y; every TRI_FINAL once across ranks and the set equals
- * T*(points) (recomputed with pdt_triangulate, or see pdt_run_check_tstar);
+ * T*(points) (recomputed with pdt_triangulate, or see pdt_run_check_tstar;
+ * certified on disk over the budget: pdt_run_check_mem);
  * merge steps begin and end on one rank and do not overlap within a level;
  * every SEND has its RECV.
  * Returns PDT_OK and a one-line summary in `summary` (cap bytes), or
@@ -296,12 +297,16 @@ pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err);
 /* Default memory budget of the trace tools (pdt trace check|dump|info|export). */
 #define PDT_TRACE_MEM_DEFAULT ((uint64_t)1 << 30)
 
-/* pdt_run_check with a memory budget in bytes for what grows with the
- * number of events: the final triangles are sorted in memory up to half the
- * budget, beyond it in sorted runs spilled to temporary files (in $TMPDIR,
- * else /tmp; removed at once, so never left behind) and merged.  Memory that grows with the number of points
- * (the points, a byte of marks per point, T* recomputed by the kernel) and
- * with the number of messages and merge steps is not part of the budget. */
+/* pdt_run_check with a memory budget in bytes for what grows with the run:
+ * the final triangles are sorted in memory up to half the budget, beyond it
+ * in sorted runs spilled to temporary files (in $TMPDIR, else /tmp; removed
+ * at once, so never left behind) and merged; the distinct points are found
+ * by a sort on disk and T* is certified side by side on disk instead of
+ * recomputed when doing them in memory would not fit the budget, and the
+ * marks (a byte per point) go to a temporary file's mapping beyond a
+ * quarter of it (docs/trace-format.md, "Memory").  Not part of the budget:
+ * the stacks of one stack instance, a level-2 kernel run's edges, the
+ * messages and merge steps, and a hull run's hull recomputed. */
 pdt_status pdt_run_check_mem(pdt_run *run, uint64_t budget, char *summary, size_t cap,
                              pdt_err *err);
 

@@ -2384,7 +2384,9 @@ size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, 
             const pdt_rtri *from = &r->tris[t - COV_RELEASE];
             pdt_index_release(r, from, COV_RELEASE * sizeof *r->tris);
             pdt_index_release(r, &r->hist[from->h0], (r->tris[t].h0 - from->h0) * sizeof *r->hist);
-            if (r->state_paged) pdt_replay_give_back(r, s);  /* the corners' points too */
+            /* a paged state's entries behind too (the corners' points, read at
+             * random, are kept until the frame is done: pdt_render) */
+            if (s->paged[1]) pdt_release_pages(&s->tcur[t - COV_RELEASE], COV_RELEASE * sizeof *s->tcur);
         }
         /* the corners' points and the history entry of a triangle a few
          * ahead: random places in tables of 10^8 bytes (a hint only) */
