@@ -159,6 +159,11 @@ const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i);
 /* The rank of event i, without decoding it; UINT32_MAX if i >= count. */
 uint32_t pdt_replay_rank_of(const pdt_replay *r, size_t i);
 const pdt_rtri *pdt_replay_tris(const pdt_replay *r, size_t *n);
+/* A bound on the triangles born before cursor k, known without reading a
+ * table: triangles t >= it have no entry at k (the triangles are numbered by
+ * their first event).  A kept index's checkpoints give it (the triangles
+ * born before the first checkpoint at or after k); else all of them. */
+size_t pdt_replay_born_at_most(const pdt_replay *r, size_t k);
 const pdt_rtri_hist *pdt_replay_tri_hist(const pdt_replay *r);
 const pdt_redge *pdt_replay_edges(const pdt_replay *r, size_t *n);
 const pdt_rnode *pdt_replay_nodes(const pdt_replay *r, size_t *n);

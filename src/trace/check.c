@@ -887,6 +887,7 @@ static pdt_status check_no_finals(chk *c, size_t nu)
 {
     size_t first = SIZE_MAX, second = SIZE_MAX;
     for (size_t i = 0; nu >= 3 && i < c->npts; i++) {
+        tick(c);
         if (!(c->mark[i] & M_REP)) continue;
         if (first == SIZE_MAX) first = i;
         else if (second == SIZE_MAX) second = i;
@@ -1231,11 +1232,14 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
     }
     if (st == PDT_OK && cap && c.certify && c.is_tri) {
         size_t len = strlen(summary);
-        char runs[64] = "";
+        char runs[64] = "", dedup[96] = "";
         if (c.cert_runs) snprintf(runs, sizeof runs, " on disk in %" PRIu64 " sorted runs",
                                   c.cert_runs);
-        snprintf(summary + len, cap - len, " (T* certified side by side%s: recomputing it would "
-                 "not fit the memory budget)", runs);
+        if (c.dedup_on_disk)
+            snprintf(dedup, sizeof dedup, ", the distinct points found by a sort on disk in %"
+                     PRIu64 " runs", c.dedup_runs);
+        snprintf(summary + len, cap - len, " (T* certified side by side%s%s: recomputing it would "
+                 "not fit the memory budget)", runs, dedup);
     }
     if (st == PDT_OK && cap && c.spills) {
         size_t len = strlen(summary);

@@ -85,6 +85,7 @@ static void draw_triangles(ctx *c)
     const pdt_rtri *T = pdt_replay_tris(c->r, &nt);
     const pdt_rtri_hist *H = pdt_replay_tri_hist(c->r);
     if (!nt || pdt_draw_lod(c)) return;  /* millions of triangles: their coverage */
+    nt = pdt_replay_born_at_most(c->r, c->s->k);  /* none beyond has an entry yet */
     /* bucket by (status, maker) so that each bucket is one stroke */
     size_t nb = (size_t)PDT_TS_COUNT * (size_t)c->nranks;
     size_t *start = calloc(nb + 1, sizeof *start);

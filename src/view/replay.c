@@ -1842,14 +1842,18 @@ void pdt_rstate_free(pdt_rstate *s)
     free(s);
 }
 
+/* A paged state's resident pages given back. */
+static void state_give_back(const pdt_rstate *s)
+{
+    const void *a[3] = {s->pflags, s->tcur, s->ealive};
+    for (int i = 0; i < 3; i++)
+        if (s->paged[i]) pdt_release_pages(a[i], s->paged[i]);
+}
+
 void pdt_replay_give_back(const pdt_replay *r, const pdt_rstate *s)
 {
     if (!r->state_paged) return;  /* what is resident fits the budget */
-    if (s) {
-        const void *a[3] = {s->pflags, s->tcur, s->ealive};
-        for (int i = 0; i < 3; i++)
-            if (s->paged[i]) pdt_release_pages(a[i], s->paged[i]);
-    }
+    if (s) state_give_back(s);
     if (r->release_points) r->release_points(r->release_ctx);
     pdt_index_release(r, r->map, r->map_len);
 }
@@ -2222,7 +2226,7 @@ static void step_to(const pdt_replay *r, pdt_rstate *s, size_t k)
     for (size_t n = 1; s->k != k; n++) {
         pdt_replay_step(r, s, s->k < k ? 1 : -1);
         /* a paged state: the pages the steps touched, every so often */
-        if (r->state_paged && n % SEEK_RELEASE == 0) pdt_replay_give_back(r, s);
+        if (s->paged[1] && n % SEEK_RELEASE == 0) state_give_back(s);
     }
 }
 
@@ -2368,6 +2372,13 @@ static int band_range(const double x[3], const double y[3], double lo, double hi
 #define COV_RELEASE ((size_t)1 << 16) /* triangles between givings back of a kept
                                        * index's pages (pdt_index_release) */
 
+size_t pdt_replay_born_at_most(const pdt_replay *r, size_t k)
+{
+    for (size_t c = 0; c < r->nick; c++)
+        if (c * r->ick_every >= k) return (size_t)r->ick_born[c];
+    return r->ntri;
+}
+
 size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, double y0,
                            double x1, double y1, int cols, int rows,
                            const uint8_t *rank_visible, pdt_cov_cell *cells)
@@ -2376,8 +2387,8 @@ size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, 
     memset(cells, 0, (size_t)cols * (size_t)rows * sizeof *cells);
     if (!(x1 > x0) || !(y1 > y0)) return 0;
     double sx = cols / (x1 - x0), sy = rows / (y1 - y0);
-    size_t binned = 0;
-    for (size_t t = 0; t < r->ntri; t++) {
+    size_t binned = 0, nt = pdt_replay_born_at_most(r, s->k);
+    for (size_t t = 0; t < nt; t++) {
         if (t && t % COV_RELEASE == 0) { /* the triangles read and their entries (a
                                           * kept index holds them in the
                                           * triangles' order): behind the pass */
@@ -2390,7 +2401,7 @@ size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, 
         }
         /* the corners' points and the history entry of a triangle a few
          * ahead: random places in tables of 10^8 bytes (a hint only) */
-        if (t + COV_AHEAD < r->ntri && s->tcur[t + COV_AHEAD] != NONE32) {
+        if (t + COV_AHEAD < nt && s->tcur[t + COV_AHEAD] != NONE32) {
             const pdt_rtri *ahead = &r->tris[t + COV_AHEAD];
             for (int k = 0; k < 3; k++) __builtin_prefetch(&r->pts[ahead->v[k]]);
             __builtin_prefetch(&r->hist[s->tcur[t + COV_AHEAD]]);
