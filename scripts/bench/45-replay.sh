@@ -45,7 +45,7 @@ one_run() {
     echo "-- $dir: $ev events, $(du -sh "$dir" | cut -f1) on disk (load: $(cut -d' ' -f1-3 /proc/loadavg))"
     measure "pdt trace check" bin/pdt trace check "$dir"
     measure "pdt trace check --mem 64M" bin/pdt trace check "$dir" --mem 64M
-    grep -o 'sorted on disk in [0-9]* runs' "$OUT/cmd.out" | sed 's/^/    /'
+    grep -o 'sorted on disk in [0-9]* runs\|T\* certified[^)]*' "$OUT/cmd.out" | sed 's/^/    /'
     measure "pdt trace dump (merged) >/dev/null" bin/pdt trace dump "$dir"
     rm -rf "$OUT/otf2"
     measure "pdt trace export --otf2" bin/pdt trace export --otf2 "$dir" -o "$OUT/otf2"
@@ -63,7 +63,12 @@ one_run() {
     PDTVIEW_VERIFY=eager measure "pdtview second opening, whole check" bin/pdtview --headless "$dir" --at 0 -o "$OUT/first.png" --size 1280x800
     measure "pdtview second opening (--end frame)" bin/pdtview --headless "$dir" --end -o "$OUT/end.png" --size 1280x800
     measure "pdtview --end, --mem 256M" bin/pdtview --headless "$dir" --end -o "$OUT/end.png" --size 1280x800 --mem 256M
+    # a state over a quarter of the budget is paged (a temporary file's mapping)
+    measure "pdtview --end, --mem 64M" bin/pdtview --headless "$dir" --end -o "$OUT/end64.png" --size 1280x800 --mem 64M
+    cmp -s "$OUT/end.png" "$OUT/end64.png" && echo "    (the same picture)" || echo "    (THE PICTURE DIFFERS)"
     bin/pdtview --bench "$dir" --size 1280x800 | sed 's/^/    /'
+    echo "  pdtview --bench --mem 64M:"
+    bin/pdtview --bench "$dir" --size 1280x800 --mem 64M | grep -E "^seek|^memory after" | sed 's/^/    /'
 }
 
 record "$N1" 1 "$OUT/run-$N1-p1" && one_run "$OUT/run-$N1-p1"
