@@ -136,6 +136,9 @@ typedef struct pdt_rstate {
     int32_t *slot;       /* per rank * PDT_SLOT_PER_RANK: current value or -1 */
     size_t paged[3];     /* bytes of pflags, tcur, ealive when they live in a
                           * temporary file's mapping (0: in memory) */
+    uint64_t *held;      /* the replay's count of state bytes in memory, which
+                          * this state adds to (NULL: none) */
+    uint64_t held_bytes;
 } pdt_rstate;
 
 /* Build a replay from `n` points and `m` merged event records of `nranks`
@@ -181,12 +184,15 @@ int pdt_replay_bbox(const pdt_replay *r, pdt_point *lo, pdt_point *hi);
 /* Index of the point's first lift event, or UINT32_MAX. */
 uint32_t pdt_replay_lift_ev(const pdt_replay *r, size_t p);
 
-/* Allocate a state for `r`, at cursor 0.  NULL when out of memory.  When
- * pdt_replay_set_mem found the state too big for its budget (a quarter of
- * it), its per-point, per-triangle and per-edge arrays live in the mapping
- * of an anonymous temporary file ($TMPDIR, else /tmp) instead of memory:
- * paged by the kernel, their resident pages given back by
- * pdt_replay_give_back. */
+/* Allocate a state for `r`, at cursor 0.  NULL when out of memory.  For a
+ * kept index's run whose state takes more than a quarter of the budget
+ * (pdt_replay_set_mem), a state that would bring the states held in memory
+ * over half the budget has its per-point, per-triangle and per-edge arrays
+ * in the mapping of an anonymous temporary file ($TMPDIR, else /tmp)
+ * instead: paged by the kernel, their resident pages given back by
+ * pdt_replay_give_back.  (The viewer's own state stays in memory while it
+ * fits half the budget: seeks rewrite a paged state through the page cache,
+ * several times slower.) */
 pdt_rstate *pdt_rstate_new(const pdt_replay *r);
 void pdt_rstate_free(pdt_rstate *s);
 

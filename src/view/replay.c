@@ -1788,12 +1788,12 @@ static void *paged_zeros(size_t bytes)
     return p == MAP_FAILED ? NULL : p;
 }
 
-/* An array of a state: paged (s->paged[i] set) when the replay says so and
- * a temporary file takes it, else in memory. */
-static void *state_array(const pdt_replay *r, pdt_rstate *s, int i, size_t bytes, int zero)
+/* An array of a state: paged (s->paged[i] set) when `page` says so and a
+ * temporary file takes it, else in memory. */
+static void *state_array(int page, pdt_rstate *s, int i, size_t bytes, int zero)
 {
     if (!bytes) bytes = 1;
-    if (r->state_paged) {
+    if (page) {
         void *p = paged_zeros(bytes);
         if (p) {
             s->paged[i] = bytes;
@@ -1818,9 +1818,17 @@ pdt_rstate *pdt_rstate_new(const pdt_replay *r)
     pdt_rstate *s = calloc(1, sizeof *s);
     if (!s) return NULL;
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
-    s->pflags = state_array(r, s, 0, r->n, 1);
-    s->tcur = state_array(r, s, 1, r->ntri * sizeof *s->tcur, 0);
-    s->ealive = state_array(r, s, 2, r->nedge, 1);
+    uint64_t bytes = pdt_replay_state_bytes(r);
+    pdt_replay *w = (pdt_replay *)r;  /* (the count of states held is a cache's) */
+    int page = r->state_paged && r->state_held + bytes > r->mem_budget / 2;
+    s->pflags = state_array(page, s, 0, r->n, 1);
+    s->tcur = state_array(page, s, 1, r->ntri * sizeof *s->tcur, 0);
+    s->ealive = state_array(page, s, 2, r->nedge, 1);
+    if (!page && r->map) {  /* (a kept index's replay outlives its states) */
+        s->held = &w->state_held;
+        s->held_bytes = bytes;
+        w->state_held += bytes;
+    }
     s->mflight = calloc(r->nmsg ? r->nmsg : 1, 1);
     s->slot = malloc((nslot ? nslot : 1) * sizeof *s->slot);
     if (!s->pflags || !s->tcur || !s->ealive || !s->mflight || !s->slot) {
@@ -1834,6 +1842,7 @@ pdt_rstate *pdt_rstate_new(const pdt_replay *r)
 void pdt_rstate_free(pdt_rstate *s)
 {
     if (!s) return;
+    if (s->held) *s->held -= s->held_bytes;
     state_array_free(s->pflags, s->paged[0]);
     state_array_free(s->tcur, s->paged[1]);
     state_array_free(s->ealive, s->paged[2]);
@@ -2099,6 +2108,7 @@ void pdt_replay_set_mem(pdt_replay *r, uint64_t budget)
     r->ck_bytes = pdt_replay_state_bytes(r);
     /* a kept index's replay: a state over a quarter of the budget is paged */
     r->state_paged = r->map && r->ck_bytes > budget / 4;
+    r->mem_budget = budget;
     if (r->nick) return;  /* the index's checkpoints serve */
     /* half the budget for checkpoints; one every at least 64 events */
     uint64_t fit = budget / 2 / r->ck_bytes;
@@ -2179,6 +2189,20 @@ void pdt_rstate_blob_parts(const pdt_replay *r, const pdt_rstate *s, size_t born
 }
 
 #define BLOB_STEP ((size_t)8 << 20) /* bytes of a kept checkpoint copied between givings back */
+#define PAGE_STEP ((size_t)4096)
+
+/* memcpy into a paged state a page at a time, leaving a page that holds the
+ * bytes already untouched: a checkpoint restored over a state near it
+ * dirties only the pages that differ (a dirty page of the temporary file is
+ * written to the disk sooner or later; a seek that dirtied the whole state
+ * waited on that). */
+static void paged_copy(char *to, const uint8_t *from, size_t len)
+{
+    for (size_t o = 0; o < len; o += PAGE_STEP) {
+        size_t k = len - o < PAGE_STEP ? len - o : PAGE_STEP;
+        if (memcmp(to + o, from + o, k)) memcpy(to + o, from + o, k);
+    }
+}
 
 /* memcpy from a kept index's mapping, its pages given back behind the copy
  * (a checkpoint of a huge run is 10^8 bytes: its pages would double what a
@@ -2187,20 +2211,31 @@ static void copy_out(const pdt_replay *r, void *to, const uint8_t *from, size_t 
 {
     for (size_t o = 0; o < len; o += BLOB_STEP) {
         size_t k = len - o < BLOB_STEP ? len - o : BLOB_STEP;
-        memcpy((char *)to + o, from + o, k);
+        if (paged) paged_copy((char *)to + o, from + o, k);
+        else memcpy((char *)to + o, from + o, k);
         pdt_index_release(r, from + o, k);
         if (paged) pdt_release_pages((char *)to + o, k);
     }
 }
 
-/* memset, a paged state's pages given back behind it. */
+/* memset, a paged state's pages given back behind it (and, as in
+ * paged_copy, a page that holds the bytes already left clean). */
 static void fill_out(void *to, int byte, size_t len, size_t paged)
 {
-    size_t step = paged ? BLOB_STEP : len;
-    for (size_t o = 0; o < len; o += step) {
-        size_t k = len - o < step ? len - o : step;
-        memset((char *)to + o, byte, k);
-        if (paged) pdt_release_pages((char *)to + o, k);
+    if (!paged) {
+        memset(to, byte, len);
+        return;
+    }
+    uint8_t want[PAGE_STEP];
+    memset(want, byte, sizeof want);
+    char *p = to;
+    for (size_t o = 0; o < len; o += BLOB_STEP) {
+        size_t k = len - o < BLOB_STEP ? len - o : BLOB_STEP;
+        for (size_t i = 0; i < k; i += PAGE_STEP) {
+            size_t j = k - i < PAGE_STEP ? k - i : PAGE_STEP;
+            if (memcmp(p + o + i, want, j)) memset(p + o + i, byte, j);
+        }
+        pdt_release_pages(p + o, k);
     }
 }
 
@@ -2223,11 +2258,11 @@ void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in,
 
 static void step_to(const pdt_replay *r, pdt_rstate *s, size_t k)
 {
-    for (size_t n = 1; s->k != k; n++) {
-        pdt_replay_step(r, s, s->k < k ? 1 : -1);
-        /* a paged state: the pages the steps touched, every so often */
-        if (s->paged[1] && n % SEEK_RELEASE == 0) state_give_back(s);
-    }
+    /* (a paged state's pages are given back when the seek is done, not on
+     * the way: a page of a file mapping written again costs a fault into
+     * the file system, which made seeks several times slower) */
+    while (s->k < k) pdt_replay_step(r, s, 1);
+    while (s->k > k) pdt_replay_step(r, s, -1);
 }
 
 /* The cheapest of: stepping from where s is; restoring the checkpoint

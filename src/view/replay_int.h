@@ -122,7 +122,11 @@ struct pdt_replay {
     uint64_t build_peak;   /* the build's own working memory, at most (bytes) */
     struct lazy *lazy;     /* the map is verified chunk by chunk as it is read (index.c) */
     const char *warnings;  /* the reader's warnings about the run (kept index), or NULL */
-    int state_paged;       /* states in temporary files' mappings (pdt_rstate_new) */
+    int state_paged;       /* a big run's state: pages given back after seeks and
+                            * frames, states beyond half the budget paged
+                            * (pdt_rstate_new) */
+    uint64_t mem_budget;   /* pdt_replay_set_mem's budget */
+    uint64_t state_held;   /* bytes of the states held in memory (a count) */
     int bbox_known;        /* pdt_replay_bbox's answer, found once */
     pdt_point bbox_lo, bbox_hi;
     /* the run's points are read in place: give their resident pages back
