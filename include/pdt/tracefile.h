@@ -304,8 +304,8 @@ pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err);
  * by a sort on disk and T* is certified side by side on disk instead of
  * recomputed when doing them in memory would not fit the budget, and the
  * marks (a byte per point) go to a temporary file's mapping beyond a
- * quarter of it (docs/trace-format.md, "Memory").  Not part of the budget:
- * the stacks of one stack instance, a level-2 kernel run's edges, the
+ * quarter of it, as do a level-2 kernel run's edges (docs/trace-format.md,
+ * "Memory").  Not part of the budget: the stacks of one stack instance, the
  * messages and merge steps, and a hull run's hull recomputed. */
 pdt_status pdt_run_check_mem(pdt_run *run, uint64_t budget, char *summary, size_t cap,
                              pdt_err *err);

@@ -72,6 +72,7 @@ typedef struct chk {
     u32vec graham_final;    /* last finished Graham stack of rank 0 */
     uint64_t events, pushes, pops, instances, lifts_local, lifts_merge, sorts, hulls;
     uint64_t edge_scopes;   /* kernel runs whose level-2 edges were replayed */
+    uint64_t edge_spills;   /* of them, replayed on disk (over a quarter of the budget) */
     /* the strip of each rank: lexicographic keys of its local lift-ups */
     uint64_t *kmin, *kmax, *nlocal;
 } chk;
@@ -195,6 +196,11 @@ typedef struct rank_state {
     uint64_t edge_events;   /* in the current scope */
     uint64_t scope_seq;     /* event that opened the scope */
     int edges_traced;       /* the rank file's level has the kernel's edges (2) */
+    /* a scope whose edges outgrew a quarter of the budget goes on on disk:
+     * every edge event and triangle side a record, replayed at its end
+     * (edges_spill) */
+    pdt_xsort *spill;
+    uint64_t spill_tris;    /* triangles reported in the spilled scope */
 } rank_state;
 
 static void rank_state_free(rank_state *s)
@@ -204,6 +210,7 @@ static void rank_state_free(rank_state *s)
     free(s->phase_seq_lo.v);
     free(s->edges.k);
     free(s->scope_tris.v);
+    pdt_xsort_free(s->spill);
 }
 
 /* Graham's stack of rank 0 finished: remember its content. */
@@ -222,13 +229,19 @@ static void scope_open(rank_state *rs, uint64_t seq)
     rs->scope_tris.n = 0;
     rs->edge_events = 0;
     rs->scope_seq = seq;
+    pdt_xsort_free(rs->spill);
+    rs->spill = NULL;
+    rs->spill_tris = 0;
 }
 
 /* End of a kernel scope: with level-2 edge events, the edges alive are
  * exactly the edges of the triangles the kernel reported. */
+static pdt_status spill_replay(chk *c, rank_state *rs, uint32_t r);
+
 static pdt_status scope_close(chk *c, rank_state *rs, uint32_t r, uint64_t seq,
                               const pdt_event *e)
 {
+    if (rs->spill) return spill_replay(c, rs, r);
     size_t nt = rs->scope_tris.n / 3;
     if (!rs->edge_events || nt == 0) return PDT_OK;
     edge_set tri = {0};
@@ -565,6 +578,112 @@ static pdt_status spill_finals(chk *c)
     return PDT_OK;
 }
 
+/* ---- a kernel scope's edges on disk --------------------------------------------
+ *
+ * Records by edge key: value = event << 2 | SP_ADD or SP_DEL for an edge
+ * event, far corner << 2 | SP_TRI for a side of a reported triangle.  The
+ * edges alive when the scope spills are written as added at the scope's
+ * first event (their events were checked already). */
+enum { SP_ADD = 0, SP_DEL = 1, SP_TRI = 2 };
+
+static uint64_t edges_held(const rank_state *rs)
+{
+    return (uint64_t)rs->edges.cap * sizeof *rs->edges.k +
+           (uint64_t)rs->scope_tris.cap * sizeof *rs->scope_tris.v;
+}
+
+static int spill_tri(pdt_xsort *x, uint32_t a, uint32_t b, uint32_t c)
+{
+    return pdt_xsort_put(x, edge_key(a, b), (uint64_t)c << 2 | SP_TRI) ||
+           pdt_xsort_put(x, edge_key(b, c), (uint64_t)a << 2 | SP_TRI) ||
+           pdt_xsort_put(x, edge_key(c, a), (uint64_t)b << 2 | SP_TRI);
+}
+
+static pdt_status spill_start(chk *c, rank_state *rs)
+{
+    if (!(rs->spill = pdt_xsort_new(c->budget / 4))) return nomem(c);
+    for (size_t i = 0; i < rs->edges.cap; i++)
+        if (rs->edges.k[i] && pdt_xsort_put(rs->spill, rs->edges.k[i], rs->scope_seq << 2 | SP_ADD))
+            return tmp_fail(c, "the kernel's edges", "cannot write");
+    for (size_t i = 0; i + 2 < rs->scope_tris.n; i += 3)
+        if (spill_tri(rs->spill, rs->scope_tris.v[i], rs->scope_tris.v[i + 1], rs->scope_tris.v[i + 2]))
+            return tmp_fail(c, "the kernel's edges", "cannot write");
+    rs->spill_tris = rs->scope_tris.n / 3;
+    free(rs->edges.k);
+    rs->edges = (edge_set){0};
+    free(rs->scope_tris.v);
+    rs->scope_tris = (u32vec){0};
+    c->edge_spills++;
+    return PDT_OK;
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The end of a spilled scope: each edge's events replayed in their order
+ * (added when absent, deleted when present), then the edges alive are
+ * exactly the sides of the reported triangles. */
+static pdt_status spill_replay(chk *c, rank_state *rs, uint32_t r)
+{
+    pdt_xsort *x = rs->spill;
+    rs->spill = NULL;
+    if (!rs->edge_events || !rs->spill_tris) {  /* nothing to compare (as in memory) */
+        pdt_xsort_free(x);
+        return PDT_OK;
+    }
+    pdt_status st = PDT_OK;
+    if (pdt_xsort_done(x)) st = tmp_fail(c, "the kernel's edges", "cannot read back");
+    uint64_t *ev = NULL, alive_n = 0, sides_n = 0;
+    size_t cap = 0;
+    pdt_kv kv;
+    int have = st == PDT_OK ? pdt_xsort_get(x, &kv) : 0;
+    while (st == PDT_OK && have == 1) {
+        uint64_t key = kv.key, far = 0;
+        size_t n = 0, tris = 0;
+        while (have == 1 && kv.key == key && st == PDT_OK) {
+            if ((kv.val & 3) == SP_TRI) {
+                tris++;
+                far = kv.val >> 2;
+            } else if (n == cap && grow((void **)&ev, &cap, n, sizeof *ev)) {
+                st = nomem(c);
+            } else {
+                ev[n++] = kv.val;
+            }
+            have = pdt_xsort_get(x, &kv);
+        }
+        if (st != PDT_OK) break;
+        qsort(ev, n, sizeof *ev, cmp_u64);  /* the edge's events in their order */
+        uint32_t a = (uint32_t)(key >> 32), b = (uint32_t)key;
+        int alive = 0;
+        for (size_t i = 0; i < n && st == PDT_OK; i++) {
+            int add = (ev[i] & 3) == SP_ADD;
+            if (add == alive)
+                st = pdt_err_set(c->err, PDT_ERR_CHECK, "rank %" PRIu32 " event #%" PRIu64
+                                 " (edge %" PRIu32 " %" PRIu32 "): %s", r, ev[i] >> 2, a, b,
+                                 add ? "the edge already exists" : "the edge does not exist");
+            alive = add;
+        }
+        if (st == PDT_OK && tris && !alive)
+            st = viol(c, r, 0, NULL, "rank %" PRIu32 ", the kernel run begun at event #%" PRIu64
+                      ": edge %" PRIu32 " %" PRIu32 " of triangle %" PRIu32 " %" PRIu32 " %" PRIu64
+                      " was never added or was deleted", r, rs->scope_seq, a, b, a, b, far);
+        alive_n += alive;
+        sides_n += tris > 0;
+    }
+    if (st == PDT_OK && have < 0) st = tmp_fail(c, "the kernel's edges", "cannot read back");
+    if (st == PDT_OK && alive_n != sides_n)
+        st = viol(c, r, 0, NULL, "rank %" PRIu32 ": %" PRIu64 " edges alive at the end of the "
+                  "kernel run (begun at event #%" PRIu64 "), but its %" PRIu64 " triangles have %"
+                  PRIu64 " edges", r, alive_n, rs->scope_seq, rs->spill_tris, sides_n);
+    if (st == PDT_OK) c->edge_scopes++;
+    free(ev);
+    pdt_xsort_free(x);
+    return st;
+}
+
 static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, const pdt_event *e)
 {
     pdt_status st = PDT_OK;
@@ -591,8 +710,15 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
         if ((st = need_pt(c, r, seq, e, e->b)) != PDT_OK) return st;
         if (e->a == e->b) return viol(c, r, seq, e, "an edge from a point to itself");
         uint64_t key = edge_key(e->a, e->b);
-        int alive = edge_has(&rs->edges, key);
         rs->edge_events++;
+        if (!rs->spill && edges_held(rs) > c->budget / 4 && (st = spill_start(c, rs)) != PDT_OK)
+            return st;
+        if (rs->spill) {
+            if (pdt_xsort_put(rs->spill, key, seq << 2 | (e->kind == PDT_EV_EDGE_ADD ? SP_ADD : SP_DEL)))
+                return tmp_fail(c, "the kernel's edges", "cannot write");
+            break;
+        }
+        int alive = edge_has(&rs->edges, key);
         if (e->kind == PDT_EV_EDGE_ADD) {
             if (alive) return viol(c, r, seq, e, "the edge already exists");
             if (edge_add(&rs->edges, key)) return nomem(c);
@@ -605,8 +731,17 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
     case PDT_EV_TRI_NEW:
         /* kept for the edges' replay only (a level-1 trace has none: its
          * kernel's triangles would take 12 bytes each for nothing) */
-        if (rs->edges_traced && (u32_push(&rs->scope_tris, e->a) || u32_push(&rs->scope_tris, e->b) ||
-            u32_push(&rs->scope_tris, e->c)))
+        if (!rs->edges_traced) break;
+        if (!rs->spill && edges_held(rs) > c->budget / 4 && (st = spill_start(c, rs)) != PDT_OK)
+            return st;
+        if (rs->spill) {
+            rs->spill_tris++;
+            if (spill_tri(rs->spill, e->a, e->b, e->c))
+                return tmp_fail(c, "the kernel's edges", "cannot write");
+            break;
+        }
+        if (u32_push(&rs->scope_tris, e->a) || u32_push(&rs->scope_tris, e->b) ||
+            u32_push(&rs->scope_tris, e->c))
             return nomem(c);
         break;
     case PDT_EV_PUSH: {
@@ -1229,6 +1364,11 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
     if (st == PDT_OK && cap && c.tstar_strips) {
         size_t len = strlen(summary);
         snprintf(summary + len, cap - len, " (T* recomputed on %d strips)", c.tstar_strips);
+    }
+    if (st == PDT_OK && cap && c.edge_spills) {
+        size_t len = strlen(summary);
+        snprintf(summary + len, cap - len, " (%" PRIu64 " of them replayed on disk: over a quarter "
+                 "of the memory budget)", c.edge_spills);
     }
     if (st == PDT_OK && cap && c.certify && c.is_tri) {
         size_t len = strlen(summary);

@@ -599,6 +599,34 @@ TEST(certified_tstar)
     free(pts);
 }
 
+static void del_to_add(pdt_event *e) { e->kind = PDT_EV_EDGE_ADD; }
+
+/* A level-2 kernel run whose edges outgrow a quarter of the budget is
+ * replayed on disk: the same verdicts, each wrong edge event named by its
+ * rank and event. */
+TEST(level2_edges_on_disk)
+{
+    char msg[1100];
+    pdt_point *pts = uniform(600);
+    record_tri(sub("l2"), pts, 600, 2);
+    budget = 4096;
+    CHECK_MSG(check_dir(sub("l2"), msg, sizeof msg) == PDT_OK, "%s", msg);
+    CHECK_MSG(strstr(msg, "1 kernel runs with edges replayed (1 of them replayed on disk"), "%s", msg);
+    /* an edge never deleted: alive at the end though no triangle has it */
+    expect_fail_copy("l2", "l2-nodel", PDT_EV_EDGE_DEL, 20, NULL, "edges alive at the end of the kernel run");
+    /* an edge never added: a triangle's side missing (here; or deleted while absent) */
+    expect_fail_copy("l2", "l2-noadd", PDT_EV_EDGE_ADD, 30, NULL, "was never added or was deleted");
+    /* a deletion made an addition: the edge is added while it exists */
+    expect_fail_copy("l2", "l2-twice", PDT_EV_EDGE_DEL, 20, del_to_add, "the edge already exists");
+    /* the last edge added missing: a triangle's side never added */
+    uint64_t last = UINT64_MAX;
+    for (int k = 0; find_kind(sub("l2"), PDT_EV_EDGE_ADD, k) != UINT64_MAX; k += 64) last = (uint64_t)k;
+    expect_fail_copy("l2", "l2-nolast", PDT_EV_EDGE_ADD, (int)last, NULL, "rank 0, the kernel run begun at event #");
+    budget = PDT_TRACE_MEM_DEFAULT;
+    CHECK_MSG(check_dir(sub("l2"), msg, sizeof msg) == PDT_OK && !strstr(msg, "on disk"), "%s", msg);
+    free(pts);
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "%s/pdt-ttc.XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -612,6 +640,7 @@ int main(void)
     RUN(chain_hull_counts);
     RUN(tiny_budget_spills);
     RUN(certified_tstar);
+    RUN(level2_edges_on_disk);
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
     if (system(cmd) != 0) return 1;
