@@ -204,11 +204,11 @@ uint64_t pdt_lines_bytes(pdt_lines kind, const void *items, size_t n, uint64_t f
 {
     const pdt_point *q = items;
     uint64_t b = 0;
+    _Static_assert(sizeof(pdt_tri) == 3 * sizeof(uint32_t), "pdt_tri is three packed words");
     switch (kind) {
     case PDT_LINES_TRI:
     case PDT_LINES_ELE:
     case PDT_LINES_OFF_TRI:
-        _Static_assert(sizeof(pdt_tri) == 3 * sizeof(uint32_t), "pdt_tri is three packed words");
         b += digits_sum((const uint32_t *)items, 3 * n);
         b += 3 * (uint64_t)n; /* two spaces and the newline */
         if (kind == PDT_LINES_OFF_TRI) b += 2 * (uint64_t)n;
