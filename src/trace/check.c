@@ -450,23 +450,15 @@ typedef struct fin_merge {
     size_t *heap, n;
 } fin_merge;
 
-static int src_less(const fin_merge *m, size_t a, size_t b)
+static int src_less(const void *ctx, size_t a, size_t b)
 {
+    const fin_merge *m = ctx;
     return cmp_fin(&m->src[a].head, &m->src[b].head) < 0;
 }
 
 static void fm_sift(fin_merge *m, size_t i)
 {
-    for (;;) {
-        size_t l = 2 * i + 1, k = i;
-        if (l < m->n && src_less(m, m->heap[l], m->heap[k])) k = l;
-        if (l + 1 < m->n && src_less(m, m->heap[l + 1], m->heap[k])) k = l + 1;
-        if (k == i) return;
-        size_t t = m->heap[i];
-        m->heap[i] = m->heap[k];
-        m->heap[k] = t;
-        i = k;
-    }
+    pdt_heap_sift(m->heap, m->n, i, src_less, m);
 }
 
 /* Open a merge over the spilled runs and mem[0..nmem) (sorted).  0 or -1. */

@@ -89,23 +89,30 @@ static void src_advance(run_src *s, int *failed)
     }
 }
 
-static int src_less(const pdt_xsort *x, size_t a, size_t b)
+void pdt_heap_sift(size_t *heap, size_t n, size_t i, int (*less)(const void *ctx, size_t a, size_t b),
+                   const void *ctx)
 {
+    for (;;) {
+        size_t l = 2 * i + 1, k = i;
+        if (l < n && less(ctx, heap[l], heap[k])) k = l;
+        if (l + 1 < n && less(ctx, heap[l + 1], heap[k])) k = l + 1;
+        if (k == i) return;
+        size_t t = heap[i];
+        heap[i] = heap[k];
+        heap[k] = t;
+        i = k;
+    }
+}
+
+static int src_less(const void *ctx, size_t a, size_t b)
+{
+    const pdt_xsort *x = ctx;
     return x->src[a].head.key < x->src[b].head.key;
 }
 
 static void heap_sift(pdt_xsort *x, size_t i)
 {
-    for (;;) {
-        size_t l = 2 * i + 1, k = i;
-        if (l < x->nheap && src_less(x, x->heap[l], x->heap[k])) k = l;
-        if (l + 1 < x->nheap && src_less(x, x->heap[l + 1], x->heap[k])) k = l + 1;
-        if (k == i) return;
-        size_t t = x->heap[i];
-        x->heap[i] = x->heap[k];
-        x->heap[k] = t;
-        i = k;
-    }
+    pdt_heap_sift(x->heap, x->nheap, i, src_less, x);
 }
 
 /* Open the merge of the runs on disk and buf[0..nmem) (sorted). */

@@ -12,6 +12,7 @@
 #ifndef PDT_XSORT_H
 #define PDT_XSORT_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 typedef struct pdt_kv {
@@ -38,5 +39,11 @@ uint64_t pdt_xsort_count(const pdt_xsort *x);
 uint64_t pdt_xsort_runs(const pdt_xsort *x);
 
 void pdt_xsort_free(pdt_xsort *x);
+
+/* Sift entry i of a binary min-heap heap[0..n) of source numbers down into
+ * place; less(ctx, a, b) orders sources a and b.  (The merges of sorted
+ * runs here and in check.c share it.) */
+void pdt_heap_sift(size_t *heap, size_t n, size_t i, int (*less)(const void *ctx, size_t a, size_t b),
+                   const void *ctx);
 
 #endif

@@ -11,6 +11,18 @@ R=$TMP/run
 "$PDT" triangulate "$TMP/u.txt" -o "$TMP/u.tri" --trace "$R" || { fail record; summary; exit 1; }
 IDX=$R/.pdtview-index
 inode() { stat -c %i "$1" 2>/dev/null; }
+# same_pictures RUN BUDGET CURSOR...: the frames at each cursor (an --at number, or
+# end) drawn from the run held in memory and through the index under --mem
+# BUDGET are byte-identical
+same_pictures() {
+    local run=$1 budget=$2 at a; shift 2
+    for at in "$@"; do
+        a="--at $at"; [ "$at" = end ] && a=--end
+        "$V" --headless "$run" $a -o "$TMP/sp_mem.png" --size 640x400 --quiet --index off
+        "$V" --headless "$run" $a -o "$TMP/sp_idx.png" --size 640x400 --quiet --mem "$budget"
+        cmp -s "$TMP/sp_mem.png" "$TMP/sp_idx.png" || return 1
+    done
+}
 
 # in memory (the default budget on a small run): no index is written
 mem=$("$V" "$R" --counts --end)
@@ -59,13 +71,7 @@ done
 case "$("$V" "$R" --check --mem 32K)" in *", 0 differ"*"(states paged"*) ok paged_state_check ;;
     *) fail paged_state_check "$("$V" "$R" --check --mem 32K)" ;; esac
 case "$("$V" "$R" --check --mem 1M)" in *"paged"*) fail small_state_not_paged ;; *) ok small_state_not_paged ;; esac
-same_p=1
-for at in "--at 0" "--at 2345" "--end"; do
-    "$V" --headless "$R" $at -o "$TMP/pm.png" --size 640x400 --quiet --index off
-    "$V" --headless "$R" $at -o "$TMP/pp.png" --size 640x400 --quiet --mem 32K
-    cmp -s "$TMP/pm.png" "$TMP/pp.png" || same_p=0
-done
-[ $same_p -eq 1 ] && ok paged_state_same_pictures || fail paged_state_same_pictures
+same_pictures "$R" 32K 0 2345 end && ok paged_state_same_pictures || fail paged_state_same_pictures
 case "$("$V" "$R" --check --mem 1M)" in *"checkpoints every"*) ok checkpoints_made ;;
     *) fail checkpoints_made "no checkpoints under --mem 1M" ;; esac
 
@@ -176,11 +182,7 @@ R3=$TMP/run3
 "$PDT" gen uniform 3000 --seed 11 > "$TMP/u3.txt"
 if mpirun -np 3 "$ROOT/bin/pdt" triangulate "$TMP/u3.txt" -o "$TMP/u3.tri" --trace "$R3" >/dev/null 2>&1; then
     same3=1
-    for at in "--at 9000" "--at 20000" "--end"; do
-        "$V" --headless "$R3" $at -o "$TMP/m3.png" --size 640x400 --quiet --index off
-        "$V" --headless "$R3" $at -o "$TMP/i3.png" --size 640x400 --quiet --mem 256K
-        cmp -s "$TMP/m3.png" "$TMP/i3.png" || same3=0
-    done
+    same_pictures "$R3" 256K 9000 20000 end || same3=0
     "$V" "$R3" --describe --index off > "$TMP/d3m.txt"
     "$V" "$R3" --describe --mem 256K > "$TMP/d3i.txt"
     if [ $same3 = 1 ] && [ -s "$R3/.pdtview-index" ] && [ -s "$TMP/d3m.txt" ] && cmp -s "$TMP/d3m.txt" "$TMP/d3i.txt"
@@ -224,13 +226,7 @@ if [ -n "$small" ] && [ -n "$big" ] && [ "$big" -le $((16 * 1024)) ] && [ "$big"
 then ok build_memory_bounded
 else fail build_memory_bounded "working memory ${small:-?} KiB (10000 points), ${big:-?} KiB (40000 points), budget 16384 KiB"; fi
 RB=$TMP/runb40000
-same_b=1
-for at in "--at 123457" "--end"; do
-    "$V" --headless "$RB" $at -o "$TMP/mb.png" --size 640x400 --quiet --index off
-    "$V" --headless "$RB" $at -o "$TMP/ib.png" --size 640x400 --quiet --mem 16M
-    cmp -s "$TMP/mb.png" "$TMP/ib.png" || same_b=0
-done
-[ $same_b -eq 1 ] && ok build_bounded_same_pictures || fail build_bounded_same_pictures
+same_pictures "$RB" 16M 123457 end && ok build_bounded_same_pictures || fail build_bounded_same_pictures
 
 # bad budgets
 for bad in 0 12Q -5 ''; do

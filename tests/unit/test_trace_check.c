@@ -375,9 +375,9 @@ TEST(chain_hull_counts)
     expect_fail(sub("chain-bad"), "(hull vertices=5): the lower and upper stacks hold 4 hull vertices");
 }
 
-/* A traced triangulation whose final triangle `dup` is reported a second
- * time at the very end (far from the first: another sorted run). */
-static void record_tri_dup(const char *dir, const pdt_point *pts, size_t n, size_t dup)
+/* A traced triangulation of pts whose final triangles are tris[0..nt). */
+static void record_tri_finals(const char *dir, const pdt_point *pts, size_t n, const pdt_tri *tris,
+                              size_t nt)
 {
     pdt_trace_writer *w;
     pdt_err err = {0};
@@ -385,13 +385,27 @@ static void record_tri_dup(const char *dir, const pdt_point *pts, size_t n, size
     meta(dir, "triangulate", pts, n, 1);
     pdt_trace *tr = pdt_tw_hook(w);
     pdt_tri *t;
-    size_t nt;
-    CHECK(pdt_triangulate(pts, n, &t, &nt, NULL, tr) == PDT_OK);
-    for (size_t i = 0; i < nt; i++)
-        PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, t[i].v[0], t[i].v[1], t[i].v[2], 0);
-    if (dup < nt) PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, t[dup].v[1], t[dup].v[2], t[dup].v[0], 0);
+    size_t k;
+    CHECK(pdt_triangulate(pts, n, &t, &k, NULL, tr) == PDT_OK);
     free(t);
+    for (size_t i = 0; i < nt; i++)
+        PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, tris[i].v[0], tris[i].v[1], tris[i].v[2], 0);
     CHECK(pdt_tw_close(w, &err) == PDT_OK);
+}
+
+/* A traced triangulation whose final triangle `dup` is reported a second
+ * time at the very end (far from the first: another sorted run). */
+static void record_tri_dup(const char *dir, const pdt_point *pts, size_t n, size_t dup)
+{
+    pdt_tri *t;
+    size_t nt;
+    CHECK(pdt_triangulate(pts, n, &t, &nt, NULL, NULL) == PDT_OK);
+    pdt_tri *with = malloc((nt + 1) * sizeof *with);
+    memcpy(with, t, nt * sizeof *with);
+    if (dup < nt) with[nt] = (pdt_tri){{t[dup].v[1], t[dup].v[2], t[dup].v[0]}};
+    record_tri_finals(dir, pts, n, with, nt + (dup < nt));
+    free(with);
+    free(t);
 }
 
 /* With a budget of a few hundred bytes the final triangles go to disk in
@@ -458,24 +472,6 @@ TEST(strips_tstar_same_verdicts)
     unsetenv("PDT_PLAIN_STRIPS");
     tstar = NULL;
     free(pts);
-}
-
-/* A traced triangulation of pts whose final triangles are tris[0..nt). */
-static void record_tri_finals(const char *dir, const pdt_point *pts, size_t n, const pdt_tri *tris,
-                              size_t nt)
-{
-    pdt_trace_writer *w;
-    pdt_err err = {0};
-    CHECK(pdt_tw_open(dir, 0, 1, &w, &err) == PDT_OK);
-    meta(dir, "triangulate", pts, n, 1);
-    pdt_trace *tr = pdt_tw_hook(w);
-    pdt_tri *t;
-    size_t k;
-    CHECK(pdt_triangulate(pts, n, &t, &k, NULL, tr) == PDT_OK);
-    free(t);
-    for (size_t i = 0; i < nt; i++)
-        PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, tris[i].v[0], tris[i].v[1], tris[i].v[2], 0);
-    CHECK(pdt_tw_close(w, &err) == PDT_OK);
 }
 
 /* Flip the first side shared by two triangles of t whose quadrilateral is
