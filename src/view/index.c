@@ -48,9 +48,13 @@
 
 #define INDEX_NAME ".pdtview-index"
 #define INDEX_VERSION 8u /* 8: the histories in the triangles' order */
-#define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/16 events, at least this */
+#define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/8 events, at least this */
 #define ICK_PARTS 8u
-_Static_assert(ICK_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint's place");
+/* ... and at most every ICK_MAX_EVERY events while ICK_MAX_PARTS allow (a
+ * seek steps at most half of it: 2^22 events, about 100 ms here) */
+#define ICK_MAX_EVERY ((size_t)1 << 23)
+#define ICK_MAX_PARTS 23u
+_Static_assert(ICK_MAX_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint's place");
 #define CHUNK_BYTES ((uint64_t)16 << 20) /* sections are checksummed in chunks of this: the
                                           * least a lazily checked frame reads (1 MiB made
                                           * lazily checked seeks 5x slower: not understood) */
@@ -1541,7 +1545,9 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     for (int k = 0; k < PDT_SCR_COUNT; k++) scratch_drop(&pc, k);  /* the scratch: gone */
     if (st == PDT_OK) {
         r->warnings = pdt_run_warnings(run);
-        size_t every = r->m / ICK_PARTS;
+        size_t parts = (r->m + ICK_MAX_EVERY - 1) / ICK_MAX_EVERY;
+        parts = parts < ICK_PARTS ? ICK_PARTS : parts > ICK_MAX_PARTS ? ICK_MAX_PARTS : parts;
+        size_t every = r->m / parts;
         r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
         r->nick = r->m / r->ick_every + 1;
         st = write_tables(r, fd, h, ident, &pc, &ec, err);
