@@ -61,8 +61,9 @@ static void radix_sort(pdt_kv **a, pdt_kv **t, size_t n)
 
 /* ---- runs on disk ------------------------------------------------------------ */
 
-/* A new anonymous temporary file in $TMPDIR (else /tmp), or NULL (errno). */
-static FILE *temp_file(void)
+/* A new anonymous temporary file in $TMPDIR (else /tmp) with a stdio
+ * buffer of `buffer` bytes, or NULL (errno). */
+static FILE *temp_file(size_t buffer)
 {
     const char *dir = getenv("TMPDIR");
     char path[4096];
@@ -75,7 +76,9 @@ static FILE *temp_file(void)
         int e = errno;
         close(fd);
         errno = e;
+        return NULL;
     }
+    setvbuf(f, NULL, _IOFBF, buffer);  /* (before any other operation on it) */
     return f;
 }
 
@@ -125,7 +128,6 @@ static void merge_open(pdt_xsort *x, const pdt_kv *mem, size_t nmem)
         if (i < x->nruns) {
             s->f = x->runs[i];
             rewind(s->f);
-            setvbuf(s->f, NULL, _IOFBF, x->run_buffer);
         } else {
             s->mem = mem;
             s->nmem = nmem;
@@ -154,7 +156,7 @@ static int merge_next(pdt_xsort *x, pdt_kv *kv)
 /* Merge every run on disk into one (when MAX_RUNS piled up). */
 static int compact(pdt_xsort *x)
 {
-    FILE *out = temp_file();
+    FILE *out = temp_file(x->run_buffer);
     if (!out) return -1;
     merge_open(x, NULL, 0);
     pdt_kv kv;
@@ -179,7 +181,7 @@ static int spill(pdt_xsort *x)
     if (!x->n) return 0;
     if (x->nruns == MAX_RUNS && compact(x)) return -1;
     radix_sort(&x->buf, &x->tmp, x->n);
-    FILE *f = temp_file();
+    FILE *f = temp_file(x->run_buffer);
     if (!f) return -1;
     x->runs[x->nruns++] = f;
     x->spilled++;
