@@ -24,6 +24,21 @@ measure() {
     printf '  %-37s %8.2f s  %8.1f MiB peak\n' "$label" "$wall" "$(echo "$kib / 1024" | bc -l)"
 }
 
+# anon LABEL CMD...: the command's own memory, its largest RssAnon sampled
+# every 20 ms (GNU time's peak above counts the mapped file pages too)
+anon() {
+    local label=$1; shift
+    "$@" >"$OUT/cmd.out" 2>"$OUT/cmd.err" &
+    local pid=$! peak=0 a
+    while kill -0 $pid 2>/dev/null; do
+        a=$(awk '/^RssAnon/ {print $2}' /proc/$pid/status 2>/dev/null)
+        [ -n "$a" ] && [ "$a" -gt "$peak" ] && peak=$a
+        sleep 0.02
+    done
+    wait $pid || { echo "$label: failed: $(tail -2 "$OUT/cmd.err")"; return 1; }
+    printf '  %-37s %8.1f MiB RssAnon peak\n' "$label" "$(echo "$peak / 1024" | bc -l)"
+}
+
 # record N RANKS DIR: a level-1 traced uniform run (once)
 record() {
     local n=$1 p=$2 dir=$3
@@ -46,6 +61,8 @@ one_run() {
     measure "pdt trace check" bin/pdt trace check "$dir"
     measure "pdt trace check --mem 64M" bin/pdt trace check "$dir" --mem 64M
     grep -o 'sorted on disk in [0-9]* runs\|T\* certified[^)]*' "$OUT/cmd.out" | sed 's/^/    /'
+    anon "pdt trace check (own memory)" bin/pdt trace check "$dir"
+    anon "pdt trace check --mem 64M (own memory)" bin/pdt trace check "$dir" --mem 64M
     measure "pdt trace dump (merged) >/dev/null" bin/pdt trace dump "$dir"
     rm -rf "$OUT/otf2"
     measure "pdt trace export --otf2" bin/pdt trace export --otf2 "$dir" -o "$OUT/otf2"
@@ -65,6 +82,8 @@ one_run() {
     measure "pdtview --end, --mem 256M" bin/pdtview --headless "$dir" --end -o "$OUT/end.png" --size 1280x800 --mem 256M
     # a state over a quarter of the budget is paged (a temporary file's mapping)
     measure "pdtview --end, --mem 64M" bin/pdtview --headless "$dir" --end -o "$OUT/end64.png" --size 1280x800 --mem 64M
+    anon "pdtview --end (own memory)" bin/pdtview --headless "$dir" --end -o "$OUT/end.png" --size 1280x800
+    anon "pdtview --end, --mem 64M (own memory)" bin/pdtview --headless "$dir" --end -o "$OUT/end64.png" --size 1280x800 --mem 64M
     cmp -s "$OUT/end.png" "$OUT/end64.png" && echo "    (the same picture)" || echo "    (THE PICTURE DIFFERS)"
     bin/pdtview --bench "$dir" --size 1280x800 | sed 's/^/    /'
     echo "  pdtview --bench --mem 64M:"
