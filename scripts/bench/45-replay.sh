@@ -25,18 +25,12 @@ measure() {
 }
 
 # anon LABEL CMD...: the command's own memory, its largest RssAnon sampled
-# every 20 ms (GNU time's peak above counts the mapped file pages too)
+# (GNU time's peak above counts the mapped file pages too)
 anon() {
-    local label=$1; shift
-    "$@" >"$OUT/cmd.out" 2>"$OUT/cmd.err" &
-    local pid=$! peak=0 a
-    while kill -0 $pid 2>/dev/null; do
-        a=$(awk '/^RssAnon/ {print $2}' /proc/$pid/status 2>/dev/null)
-        [ -n "$a" ] && [ "$a" -gt "$peak" ] && peak=$a
-        sleep 0.02
-    done
-    wait $pid || { echo "$label: failed: $(tail -2 "$OUT/cmd.err")"; return 1; }
-    printf '  %-37s %8.1f MiB RssAnon peak\n' "$label" "$(echo "$peak / 1024" | bc -l)"
+    local label=$1 kib; shift
+    kib=$(scripts/bench/tools/anon_peak.sh "$OUT/cmd.out" "$@") ||
+        { echo "$label: failed: $(tail -2 "$OUT/cmd.out")"; return 1; }
+    printf '  %-37s %8.1f MiB RssAnon peak\n' "$label" "$(echo "$kib / 1024" | bc -l)"
 }
 
 # record N RANKS DIR: a level-1 traced uniform run (once)

@@ -1,10 +1,13 @@
 /* pdt — large scratch arrays: mmap'd, huge pages asked for (see bigmem.h). */
 #include "bigmem.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <pthread.h>
 #include <sched.h>
 #include <stdatomic.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
@@ -129,4 +132,24 @@ void pdt_prefault_stop(pdt_prefault *pf)
     atomic_store(&pf->stop, 1);
     pthread_join(pf->th, NULL);
     free(pf);
+}
+
+void *pdt_temp_zeros(size_t bytes)
+{
+    const char *dir = getenv("TMPDIR");
+    if (!dir || !*dir) dir = "/tmp";
+    int fd = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    if (fd < 0) {  /* a file system without O_TMPFILE: a named file, unlinked */
+        char path[4096];
+        snprintf(path, sizeof path, "%s/pdt-scratch.XXXXXX", dir);
+        if ((fd = mkstemp(path)) < 0) return NULL;
+        unlink(path);
+    }
+    void *p = MAP_FAILED;
+    if (ftruncate(fd, (off_t)(bytes ? bytes : 1)) == 0)
+        p = mmap(NULL, bytes ? bytes : 1, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+    int e = errno;
+    close(fd);  /* the mapping keeps the file */
+    errno = e;
+    return p == MAP_FAILED ? NULL : p;
 }

@@ -21,6 +21,12 @@ void pdt_big_free(void *p, size_t bytes);
  * (of any allocation, e.g. a large malloc'd block).  Only a hint. */
 void pdt_big_advise(void *p, size_t bytes);
 
+/* `bytes` of zeros in a shared mapping of an anonymous temporary file in
+ * $TMPDIR (else /tmp): memory the kernel pages to that file, whose resident
+ * pages pdt_release_pages gives back without losing them.  NULL with errno
+ * set.  Unmap it with munmap(p, bytes). */
+void *pdt_temp_zeros(size_t bytes);
+
 /* The system's page size (sysconf), for code that gives pages back. */
 size_t pdt_page_size(void);
 

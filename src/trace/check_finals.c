@@ -447,15 +447,8 @@ int chk_marks_new(chk *c)
 {
     size_t n = c->npts ? c->npts : 1;
     if ((uint64_t)n <= c->budget / 4) return (c->mark = calloc(n, 1)) ? 0 : -1;
-    FILE *f = spill_file();
-    if (!f) return -1;
-    void *p = MAP_FAILED;
-    if (ftruncate(fileno(f), (off_t)n) == 0)
-        p = mmap(NULL, n, PROT_READ | PROT_WRITE, MAP_SHARED, fileno(f), 0);
-    int e = errno;
-    fclose(f);  /* the mapping keeps the file */
-    errno = e;
-    if (p == MAP_FAILED) return -1;
+    void *p = pdt_temp_zeros(n);
+    if (!p) return -1;
     c->mark = p;
     c->mark_map = n;
     return 0;

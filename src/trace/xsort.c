@@ -23,7 +23,7 @@ struct pdt_xsort {
     size_t n, alloc, cap;          /* pairs held, allocated, at most (budget) */
     FILE *runs[MAX_RUNS];
     size_t nruns;
-    uint64_t count, spilled;
+    uint64_t spilled;
     size_t run_buffer;             /* stdio buffer of each run read back */
     /* the merge (after pdt_xsort_done) */
     run_src src[MAX_RUNS + 1];
@@ -233,7 +233,6 @@ int pdt_xsort_put(pdt_xsort *x, uint64_t key, uint64_t val)
     x->buf[x->n].key = key;
     x->buf[x->n].val = val;
     x->n++;
-    x->count++;
     return 0;
 }
 
@@ -251,11 +250,6 @@ int pdt_xsort_done(pdt_xsort *x)
 int pdt_xsort_get(pdt_xsort *x, pdt_kv *kv)
 {
     return merge_next(x, kv);
-}
-
-uint64_t pdt_xsort_count(const pdt_xsort *x)
-{
-    return x->count;
 }
 
 uint64_t pdt_xsort_runs(const pdt_xsort *x)

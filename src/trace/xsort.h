@@ -34,8 +34,7 @@ int pdt_xsort_done(pdt_xsort *x);
 /* The next pair by key: 1, 0 at the end, -1 (errno: a read failed). */
 int pdt_xsort_get(pdt_xsort *x, pdt_kv *kv);
 
-/* Pairs put, and sorted runs written to disk. */
-uint64_t pdt_xsort_count(const pdt_xsort *x);
+/* Sorted runs written to disk. */
 uint64_t pdt_xsort_runs(const pdt_xsort *x);
 
 void pdt_xsort_free(pdt_xsort *x);

@@ -4,7 +4,6 @@
 #include "../geom/bigmem.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -1768,33 +1767,13 @@ int pdt_replay_bbox(const pdt_replay *r, pdt_point *lo, pdt_point *hi)
 
 /* ---- states ------------------------------------------------------------------ */
 
-/* `bytes` of zeros in the mapping of an anonymous temporary file in $TMPDIR
- * (else /tmp), or NULL. */
-static void *paged_zeros(size_t bytes)
-{
-    const char *dir = getenv("TMPDIR");
-    if (!dir || !*dir) dir = "/tmp";
-    int fd = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
-    if (fd < 0) {  /* a file system without O_TMPFILE: a named file, unlinked */
-        char path[4096];
-        snprintf(path, sizeof path, "%s/pdtview-state.XXXXXX", dir);
-        if ((fd = mkstemp(path)) < 0) return NULL;
-        unlink(path);
-    }
-    void *p = MAP_FAILED;
-    if (ftruncate(fd, (off_t)bytes) == 0)
-        p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-    close(fd);  /* the mapping keeps the file */
-    return p == MAP_FAILED ? NULL : p;
-}
-
 /* An array of a state: paged (s->paged[i] set) when `page` says so and a
  * temporary file takes it, else in memory. */
 static void *state_array(int page, pdt_rstate *s, int i, size_t bytes, int zero)
 {
     if (!bytes) bytes = 1;
     if (page) {
-        void *p = paged_zeros(bytes);
+        void *p = pdt_temp_zeros(bytes);
         if (p) {
             s->paged[i] = bytes;
             return p;
@@ -2106,7 +2085,9 @@ void pdt_replay_set_mem(pdt_replay *r, uint64_t budget)
     r->ck = NULL;
     r->nck = r->ck_every = 0;
     r->ck_bytes = pdt_replay_state_bytes(r);
-    /* a kept index's replay: a state over a quarter of the budget is paged */
+    /* a kept index's replay whose state takes over a quarter of the budget:
+     * its pages given back after seeks and frames, and states beyond half
+     * of the budget paged (pdt_rstate_new) */
     r->state_paged = r->map && r->ck_bytes > budget / 4;
     r->mem_budget = budget;
     if (r->nick) return;  /* the index's checkpoints serve */

@@ -8,19 +8,11 @@
 # (Release build only: the sanitizers' shadow memory would be measured.)
 source "$(dirname "$0")/lib.sh"
 
-# peak_anon CMD...: run CMD, print the largest RssAnon (KiB) seen, sampled
-# every 10 ms; the command's output goes to $TMP/peak.out, its status to $TMP/peak.rc
+# peak_anon CMD...: the largest RssAnon (KiB) of CMD; its output goes to
+# $TMP/peak.out, its status to $TMP/peak.rc
 peak_anon() {
-    "$@" >"$TMP/peak.out" 2>&1 &
-    local pid=$! peak=0 a
-    while kill -0 $pid 2>/dev/null; do
-        a=$(awk '/^RssAnon/ {print $2}' /proc/$pid/status 2>/dev/null)
-        [ -n "$a" ] && [ "$a" -gt "$peak" ] && peak=$a
-        sleep 0.01
-    done
-    wait $pid
+    "$ROOT/scripts/bench/tools/anon_peak.sh" "$TMP/peak.out" "$@"
     echo $? >"$TMP/peak.rc"
-    echo "$peak"
 }
 
 for n in 50000 200000; do

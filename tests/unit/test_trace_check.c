@@ -535,15 +535,18 @@ TEST(certified_tstar)
     record_tri_finals(sub("ct-flip"), pts, n, f, nt);
     expect_fail(sub("ct-flip"), "is not locally Delaunay");
 
-    /* a triangle on top of another: three triangles on a side, or two on
-     * one side of it */
-    memcpy(f, t, nt * sizeof *f);
-    f[5] = f[6];
-    f[5].v[2] = f[7].v[0] == f[6].v[0] || f[7].v[0] == f[6].v[1] ? f[7].v[1] : f[7].v[0];
-    if (pdt_orient(pts[f[5].v[0]], pts[f[5].v[1]], pts[f[5].v[2]]) > 0) {
-        record_tri_finals(sub("ct-over"), pts, n, f, nt);
-        expect_fail(sub("ct-over"), "the final triangles");
-    }
+    /* a triangle on top of another: a third triangle on the side a-b of
+     * t[0], left of it as t[0] is (three on a side, or two on one side of it) */
+    pdt_tri *g3 = malloc((nt + 1) * sizeof *g3);
+    memcpy(g3, t, nt * sizeof *g3);
+    uint32_t a0 = t[0].v[0], b0 = t[0].v[1], d0 = UINT32_MAX;
+    for (uint32_t p = 0; p < n && d0 == UINT32_MAX; p++)
+        if (p != t[0].v[2] && pdt_orient(pts[a0], pts[b0], pts[p]) > 0) d0 = p;
+    CHECK(d0 != UINT32_MAX);
+    g3[nt] = (pdt_tri){{a0, b0, d0}};
+    record_tri_finals(sub("ct-over"), pts, n, g3, nt + 1);
+    expect_fail(sub("ct-over"), "final triangles");
+    free(g3);
 
     /* no triangle at all, though the points are not on one line */
     record_tri_finals(sub("ct-none"), pts, n, t, 0);
