@@ -129,8 +129,15 @@ static int points_in_place(const uint8_t *map, size_t size, pdt_point **pts, siz
     uint64_t cnt = tf_get64(map + 8);
     const uint8_t *d = map + PTS_HEADER_SIZE;
     if ((size - PTS_HEADER_SIZE) / 8 != cnt || (size - PTS_HEADER_SIZE) % 8 ||
-        ((uintptr_t)d % _Alignof(pdt_point)) || tf_get32(map + 16) != pdt_crc32c(0, d, (size_t)cnt * 8))
+        ((uintptr_t)d % _Alignof(pdt_point)))
         return 0;
+    uint32_t crc = 0; /* (a step at a time, its pages given back: any number of points) */
+    for (size_t o = 0, len = (size_t)cnt * 8; o < len; o += RELEASE_STEP) {
+        size_t k = len - o < RELEASE_STEP ? len - o : RELEASE_STEP;
+        crc = pdt_crc32c(crc, d + o, k);
+        release_pages((uint8_t *)(uintptr_t)map, 0, PTS_HEADER_SIZE + o + k);
+    }
+    if (tf_get32(map + 16) != crc) return 0;
     *pts = (pdt_point *)(void *)(uintptr_t)d;
     *n = (size_t)cnt;
     return 1;

@@ -1201,8 +1201,14 @@ static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
         uint64_t at = off + r->ick_off[c];
         pdt_rstate_blob_parts(r, s, born, part, len, pad);
         for (int j = 0; ok && j < 5; j++) {
-            ok = write_all(fd, part[j], len[j], at) && write_all(fd, zeros, pad[j], at + len[j]);
-            crc_feed(crc, part[j], len[j]);
+            for (size_t o = 0; ok && o < len[j]; o += CHUNK_BYTES) { /* (a paged state's
+                                                                       * pages go back) */
+                size_t k = len[j] - o < CHUNK_BYTES ? len[j] - o : CHUNK_BYTES;
+                ok = write_all(fd, (const char *)part[j] + o, k, at + o);
+                crc_feed(crc, (const char *)part[j] + o, k);
+                pdt_replay_give_back(r, s);
+            }
+            ok = ok && write_all(fd, zeros, pad[j], at + len[j]);
             crc_feed(crc, zeros, pad[j]);
             at += len[j] + pad[j];
         }
@@ -1380,6 +1386,7 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
             uint64_t k = h->sec[i].bytes - o < CHUNK_BYTES ? h->sec[i].bytes - o : CHUNK_BYTES;
             wrote = write_all(fd, (const char *)*ptr[i] + o, (size_t)k, h->sec[i].off + o);
             if (i == S_POINTS) pdt_run_release_points(pc->run);
+            pdt_replay_tab_release(r, (const char *)*ptr[i] + o, (size_t)k);  /* (paged) */
         }
     }
     if (threaded) pthread_join(th, NULL);
@@ -1416,6 +1423,7 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
                 if (hi > h->sec[i].bytes) hi = h->sec[i].bytes;
                 tab[first[i] + c] = pdt_crc32c(0, p + lo, (size_t)(hi - lo));
                 if (i == S_POINTS) pdt_run_release_points(pc->run);
+                pdt_replay_tab_release(r, p + lo, (size_t)(hi - lo));
             }
         }
     }
@@ -1550,9 +1558,14 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         size_t every = r->m / parts;
         r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
         r->nick = r->m / r->ick_every + 1;
+        /* the checkpoints' state: paged beyond a quarter of the budget, as a
+         * replay's is (pdt_replay_set_mem) */
+        r->mem_budget = budget;
+        r->state_paged = budget && pdt_replay_state_bytes(r) > budget / 4;
         st = write_tables(r, fd, h, ident, &pc, &ec, err);
         pdt_run_release_points(run);  /* (written from them) */
-        *work = r->build_peak + pdt_replay_state_bytes(r);  /* (the checkpoints' state) */
+        *work = r->build_peak + (r->state_paged ? 0 : pdt_replay_state_bytes(r)); /* (the
+                                                            * checkpoints' state, when held) */
         r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
     }
     pdt_replay_free(r);

@@ -29,15 +29,19 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
 
 /* ---- a hash map from a 128-bit key to an int32 ------------------------------ */
 
+/* A slot holds val ^ INT32_MIN, so that zeroed memory is empty slots
+ * (INT32_MIN, never a value) and a big map can start as a zero-filled file's
+ * mapping. */
 typedef struct km_slot_t {
     uint64_t hi, lo;
-    int32_t val;  /* INT32_MIN = empty slot */
+    uint32_t enc;  /* 0 = empty slot */
     int32_t pad;
 } km_slot_t;
 
 typedef struct keymap {
     km_slot_t *e;
     size_t cap, used;
+    int paged;  /* e is a temporary file's mapping (beyond `limit` bytes) */
 } keymap;
 
 static uint64_t mix(uint64_t hi, uint64_t lo)
@@ -49,21 +53,26 @@ static uint64_t mix(uint64_t hi, uint64_t lo)
     return h;
 }
 
-/* Room for at least `n` keys at load <= 3/4.  Big tables ask for huge pages:
- * lookups are random, and TLB misses otherwise dominate. */
-static int km_alloc(keymap *km, size_t n)
+/* Room for at least `n` keys at load <= 3/4: in a temporary file's mapping
+ * beyond `limit` bytes (0: no limit), else in memory.  Big tables in memory
+ * ask for huge pages: lookups are random, and TLB misses otherwise
+ * dominate. */
+static int km_alloc(keymap *km, size_t n, uint64_t limit)
 {
     size_t cap = 1024;
     while (cap / 4 * 3 < n) cap *= 2;
     size_t bytes = cap * sizeof *km->e;
-    if (bytes >= ((size_t)4 << 20)) {
+    km->paged = limit && bytes > limit;
+    if (km->paged) {
+        km->e = pdt_temp_zeros(bytes);
+    } else if (bytes >= ((size_t)4 << 20)) {
         km->e = aligned_alloc((size_t)2 << 20, bytes);
         if (km->e) madvise(km->e, bytes, MADV_HUGEPAGE);
+        if (km->e) memset(km->e, 0, bytes);
     } else {
-        km->e = malloc(bytes);
+        km->e = calloc(cap, sizeof *km->e);
     }
     if (!km->e) return 0;
-    for (size_t i = 0; i < cap; i++) km->e[i].val = INT32_MIN;
     km->cap = cap;
     km->used = 0;
     return 1;
@@ -71,15 +80,22 @@ static int km_alloc(keymap *km, size_t n)
 
 static void km_free(keymap *km)
 {
-    free(km->e);
+    if (km->paged && km->e) munmap(km->e, km->cap * sizeof *km->e);
+    else free(km->e);
     memset(km, 0, sizeof *km);
+}
+
+/* A paged map's resident pages given back (the file keeps them). */
+static void km_give_back(const keymap *km)
+{
+    if (km->paged) pdt_release_pages(km->e, km->cap * sizeof *km->e);
 }
 
 /* Slot of key (found, or the empty slot where it would go). */
 static size_t km_slot(const keymap *km, uint64_t hi, uint64_t lo)
 {
     size_t mask = km->cap - 1, i = (size_t)mix(hi, lo) & mask;
-    while (km->e[i].val != INT32_MIN && (km->e[i].hi != hi || km->e[i].lo != lo)) i = (i + 1) & mask;
+    while (km->e[i].enc != 0 && (km->e[i].hi != hi || km->e[i].lo != lo)) i = (i + 1) & mask;
     return i;
 }
 
@@ -87,28 +103,116 @@ static int km_get(const keymap *km, uint64_t hi, uint64_t lo, int32_t *v)
 {
     if (!km->cap) return 0;
     size_t i = km_slot(km, hi, lo);
-    if (km->e[i].val == INT32_MIN) return 0;
-    *v = km->e[i].val;
+    if (km->e[i].enc == 0) return 0;
+    *v = (int32_t)(km->e[i].enc ^ 0x80000000u);
     return 1;
 }
 
-static int km_put(keymap *km, uint64_t hi, uint64_t lo, int32_t v)
+/* (v != INT32_MIN) */
+static int km_put(keymap *km, uint64_t hi, uint64_t lo, int32_t v, uint64_t limit)
 {
     if (km->used + 1 > km->cap / 4 * 3) {
         keymap big;
-        if (!km_alloc(&big, km->cap ? km->cap : 512)) return 0;
+        if (!km_alloc(&big, km->cap ? km->cap : 512, limit)) return 0;
         for (size_t i = 0; i < km->cap; i++) {
-            if (km->e[i].val == INT32_MIN) continue;
+            if (km->e[i].enc == 0) continue;
             big.e[km_slot(&big, km->e[i].hi, km->e[i].lo)] = km->e[i];
-            big.used++;
+            if (++big.used % 65536 == 0) { /* (paged: the pages go back as it goes) */
+                km_give_back(&big);
+                km_give_back(km);
+            }
         }
         km_free(km);
         *km = big;
     }
     size_t i = km_slot(km, hi, lo);
-    if (km->e[i].val == INT32_MIN) km->used++;
-    km->e[i] = (km_slot_t){hi, lo, v, 0};
+    if (km->e[i].enc == 0) km->used++;
+    km->e[i] = (km_slot_t){hi, lo, (uint32_t)v ^ 0x80000000u, 0};
     return 1;
+}
+
+/* ---- the build's tables: in memory, or paged beyond a limit ----------------
+
+ * A streamed build (a kept index) holds its tables of objects within a
+ * share of its budget (r->tab_limit): a table that outgrows it moves to a
+ * temporary file's mapping (pdt_temp_zeros), where the pages the build
+ * touched are given back every TICK_EVENTS events (tabs_give_back): a read
+ * of them again faults them in from the page cache.  Such a table is in
+ * r->ptab until tab_free unmaps it. */
+
+#define TICK_EVENTS 65536u
+
+static int tab_paged(const pdt_replay *r, const void *p)
+{
+    for (int i = 0; p && i < r->nptab; i++)
+        if (r->ptab[i].p == p) return i;
+    return -1;
+}
+
+static void tab_free(pdt_replay *r, void *p)
+{
+    int i = tab_paged(r, p);
+    if (i < 0) {
+        free(p);
+        return;
+    }
+    munmap(p, r->ptab[i].bytes);
+    r->ptab[i] = r->ptab[--r->nptab];
+}
+
+/* A new table of `bytes` (zero-filled when paged; else malloc's, asking
+ * for huge pages), or NULL. */
+static void *tab_new(pdt_replay *r, size_t bytes)
+{
+    if (!r->tab_limit || bytes <= r->tab_limit || r->nptab == PDT_PTAB_MAX) {
+        void *p = malloc(bytes ? bytes : 1);
+        if (p) pdt_big_advise(p, bytes);
+        return p;
+    }
+    void *p = pdt_temp_zeros(bytes);
+    if (!p) return NULL;
+    r->ptab[r->nptab++] = (struct pdt_ptab){p, bytes};
+    return p;
+}
+
+/* grow() for a table of r: room for `need` entries of `elem` bytes, its
+ * entries [0, *cap) kept. */
+static int tab_grow(pdt_replay *r, void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap) return 1;
+    size_t c = *cap ? *cap : 64;
+    while (c < need) c *= 2;
+    if (!r->tab_limit || (c * elem <= r->tab_limit && tab_paged(r, *p) < 0))
+        return grow(p, cap, need, elem);
+    void *q = tab_new(r, c * elem);
+    if (!q) return 0;
+    for (size_t o = 0, all = *cap * elem; o < all; o += (size_t)16 << 20) { /* (paged: a step
+                                                 * at a time, its pages given back) */
+        size_t k = all - o < ((size_t)16 << 20) ? all - o : ((size_t)16 << 20);
+        memcpy((char *)q + o, (const char *)*p + o, k);
+        pdt_replay_tab_release(r, (char *)q + o, k);
+        pdt_replay_tab_release(r, (const char *)*p + o, k);
+    }
+    tab_free(r, *p);
+    *p = q;
+    *cap = c;
+    return 1;
+}
+
+static void tabs_give_back(const pdt_replay *r)
+{
+    for (int i = 0; i < r->nptab; i++) pdt_release_pages(r->ptab[i].p, r->ptab[i].bytes);
+}
+
+void pdt_replay_tab_release(const pdt_replay *r, const void *p, size_t len)
+{
+    for (int i = 0; i < r->nptab; i++) {
+        const char *b = r->ptab[i].p;
+        if ((const char *)p >= b && (const char *)p + len <= b + r->ptab[i].bytes) {
+            pdt_release_pages(p, len);
+            return;
+        }
+    }
 }
 
 /* ---- the replay ------------------------------------------------------------ */
@@ -437,7 +541,7 @@ static int set_slot(builder *b, uint32_t ev, int rank, int slot, int32_t val)
 {
     pdt_replay *r = b->r;
     size_t s = (size_t)rank * PDT_SLOT_PER_RANK + (size_t)slot;
-    if (!grow((void **)&r->ch, &r->cap_ch, r->nch + 1, sizeof *r->ch)) return 0;
+    if (!tab_grow(r, (void **)&r->ch, &r->cap_ch, r->nch + 1, sizeof *r->ch)) return 0;
     if (r->nch >= INT32_MAX) return 0;
     r->ch[r->nch] = (slot_change){ev, val, b->cur[s], (uint32_t)s};
     set_obj(b, ev, (int32_t)r->nch);  /* the change (its slot: ch[].slot) */
@@ -473,13 +577,13 @@ static void box_add(pdt_replay *r, uint32_t rank, pdt_point p)
 static int graham_tables(pdt_replay *r)
 {
     size_t n = r->n;
-    r->sort_ev = big_table(n * sizeof *r->sort_ev);
-    r->del_ev = big_table(n * sizeof *r->del_ev);
-    r->sort_pos = big_table(n * sizeof *r->sort_pos);
+    r->sort_ev = tab_new(r, n * sizeof *r->sort_ev);
+    r->del_ev = tab_new(r, n * sizeof *r->del_ev);
+    r->sort_pos = tab_new(r, n * sizeof *r->sort_pos);
     if (!r->sort_ev || !r->del_ev || !r->sort_pos) {
-        free(r->sort_ev);
-        free(r->del_ev);
-        free(r->sort_pos);
+        tab_free(r, r->sort_ev);
+        tab_free(r, r->del_ev);
+        tab_free(r, r->sort_pos);
         r->sort_ev = r->del_ev = NULL;
         r->sort_pos = NULL;
         return 0;
@@ -500,7 +604,7 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
     int32_t *cur = b->cur + (size_t)rank * PDT_SLOT_PER_RANK;
     switch (e->kind) {
     case PDT_EV_PHASE_BEGIN: {
-        if (!grow((void **)&r->phases, &r->cap_phase, r->nphase + 1, sizeof *r->phases)) return 0;
+        if (!tab_grow(r, (void **)&r->phases, &r->cap_phase, r->nphase + 1, sizeof *r->phases)) return 0;
         r->phases[r->nphase] = (pdt_rphase){rec->rank, e->sub, e->a, i, NONE32, cur[PDT_SLOT_PHASE], 0};
         r->nphase++;
         return set_slot(b, i, rank, PDT_SLOT_PHASE, (int32_t)(r->nphase - 1));
@@ -516,7 +620,7 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
         return set_slot(b, i, rank, PDT_SLOT_PHASE, r->phases[p].parent);
     }
     case PDT_EV_MERGE_BEGIN: {
-        if (!grow((void **)&r->merges, &r->cap_merge, r->nmerge + 1, sizeof *r->merges)) return 0;
+        if (!tab_grow(r, (void **)&r->merges, &r->cap_merge, r->nmerge + 1, sizeof *r->merges)) return 0;
         r->merges[r->nmerge] =
             (pdt_rmerge){rec->rank, e->sub, e->a, e->b, e->c, i, NONE32, 0, 0, 0, 0};
         r->nmerge++;
@@ -548,7 +652,7 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
         if (e->kind == PDT_EV_POP) return set_slot(b, i, rank, slot, node_at_depth(r, t, e->b));
         uint32_t d = e->b ? e->b : (t >= 0 ? r->nodes[t].depth + 1 : 1);
         int32_t parent = node_at_depth(r, t, d - 1);
-        if (!grow((void **)&r->nodes, &r->cap_node, r->nnode + 1, sizeof *r->nodes)) return 0;
+        if (!tab_grow(r, (void **)&r->nodes, &r->cap_node, r->nnode + 1, sizeof *r->nodes)) return 0;
         r->nodes[r->nnode] = (pdt_rnode){e->a, parent, d, NONE32};
         r->nnode++;
         if (!lifted_any[rank]) {
@@ -558,7 +662,7 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
         return set_slot(b, i, rank, slot, (int32_t)(r->nnode - 1));
     }
     case PDT_EV_HULL: {
-        if (!grow((void **)&r->hulls, &r->cap_hull, r->nhull + 1, sizeof *r->hulls)) return 0;
+        if (!tab_grow(r, (void **)&r->hulls, &r->cap_hull, r->nhull + 1, sizeof *r->hulls)) return 0;
         int st = b->lastst[rank];
         pdt_rhull h = {rec->rank, i, -1, -1, e->a, (uint8_t)(e->b != 0)};
         if (st == PDT_STACK_LOWER || st == PDT_STACK_UPPER) {
@@ -620,15 +724,15 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
         int32_t id;
         int have = km_get(&b->edge_map, rec->rank, k, &id) && id >= 0;
         if (e->kind == PDT_EV_EDGE_ADD) {
-            if (!grow((void **)&r->edges, &r->cap_edge, r->nedge + 1, sizeof *r->edges)) return 0;
+            if (!tab_grow(r, (void **)&r->edges, &r->cap_edge, r->nedge + 1, sizeof *r->edges)) return 0;
             r->edges[r->nedge] = (pdt_redge){e->a, e->b, rec->rank, i, NONE32};
-            if (!km_put(&b->edge_map, rec->rank, k, (int32_t)r->nedge)) return 0;
+            if (!km_put(&b->edge_map, rec->rank, k, (int32_t)r->nedge, r->tab_limit)) return 0;
             set_obj(b, i, (int32_t)r->nedge);
             r->nedge++;
         } else if (have) {
             r->edges[id].del_ev = i;
             set_obj(b, i, id);
-            if (!km_put(&b->edge_map, rec->rank, k, -1)) return 0;
+            if (!km_put(&b->edge_map, rec->rank, k, -1, r->tab_limit)) return 0;
         } else {
             r->skipped++;
         }
@@ -647,10 +751,10 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
         int32_t id;
         if (!km_get(&b->msg_map, hi, lo, &id) ||
             (send ? r->msgs[id].send_ev : r->msgs[id].recv_ev) != NONE32) {
-            if (!grow((void **)&r->msgs, &r->cap_msg, r->nmsg + 1, sizeof *r->msgs)) return 0;
+            if (!tab_grow(r, (void **)&r->msgs, &r->cap_msg, r->nmsg + 1, sizeof *r->msgs)) return 0;
             r->msgs[r->nmsg] = (pdt_rmsg){src, dst, e->sub, pdt_event_bytes(e), NONE32, NONE32};
             id = (int32_t)r->nmsg++;
-            if (!km_put(&b->msg_map, hi, lo, id)) return 0;
+            if (!km_put(&b->msg_map, hi, lo, id, r->tab_limit)) return 0;
         }
         if (send) r->msgs[id].send_ev = i;
         else r->msgs[id].recv_ev = i;
@@ -1346,6 +1450,7 @@ static int points_pass(builder *b, const uint8_t *lifted_any)
             }
         }
         ok = ok && pl->put(pl->ctx, r->lift_at + (uint64_t)p0 * sizeof *lift, lift, np * sizeof *lift);
+        if (pl->points_read) pl->points_read(pl->ctx);  /* (the window's pages go back) */
     }
     for (size_t q = 0; ok && q < q1; q++) {
         size_t k = lifted_any[q] ? q1 + q : q;
@@ -1442,10 +1547,10 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             b.spill = big_table(r->nhist * sizeof *b.spill);
             if (!r->hist || !r->tris || !b.spill) goto out;
         }
-        if (!km_alloc(&b.edge_map, cnt[PDT_EV_EDGE_ADD]) ||
-            !km_alloc(&b.msg_map, cnt[PDT_EV_SEND]) ||
-            !grow((void **)&r->edges, &r->cap_edge, cnt[PDT_EV_EDGE_ADD], sizeof *r->edges) ||
-            !grow((void **)&r->nodes, &r->cap_node, cnt[PDT_EV_PUSH], sizeof *r->nodes))
+        if (!km_alloc(&b.edge_map, cnt[PDT_EV_EDGE_ADD], r->tab_limit) ||
+            !km_alloc(&b.msg_map, cnt[PDT_EV_SEND], r->tab_limit) ||
+            !tab_grow(r, (void **)&r->edges, &r->cap_edge, cnt[PDT_EV_EDGE_ADD], sizeof *r->edges) ||
+            !tab_grow(r, (void **)&r->nodes, &r->cap_node, cnt[PDT_EV_PUSH], sizeof *r->nodes))
             goto out;
     }
 
@@ -1468,6 +1573,11 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         }
         if (rec->ev.kind < PDT_EV_KIND_COUNT) r->kind_count[rec->ev.kind]++;
         if (!index_event(&b, (uint32_t)i, rec, lifted_any)) goto out;
+        if (i % TICK_EVENTS == TICK_EVENTS - 1) { /* (paged tables: their pages go back) */
+            tabs_give_back(r);
+            km_give_back(&b.edge_map);
+            km_give_back(&b.msg_map);
+        }
     }
     if (pl) { /* the stream's end (it finishes its part: pl->src is ready) */
         pdt_rec extra;
@@ -1503,7 +1613,7 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             uint32_t e = ph->end_ev == NONE32 ? (uint32_t)INT32_MAX : ph->end_ev;
             ph->first = !have || (uint32_t)end < ph->begin_ev;
             if (!have || (uint32_t)end < e) {
-                if (!km_put(&last_end, ph->phase, ph->sub, (int32_t)(e > INT32_MAX ? INT32_MAX : e))) {
+                if (!km_put(&last_end, ph->phase, ph->sub, (int32_t)(e > INT32_MAX ? INT32_MAX : e), 0)) {
                     km_free(&last_end);
                     goto out;
                 }
@@ -1548,7 +1658,7 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
     }
     /* Slot changes grouped by slot (counting sort keeps event order). */
     r->slot_start = calloc(nslot + 1, sizeof *r->slot_start);
-    r->slot_ch = malloc((r->nch ? r->nch : 1) * sizeof *r->slot_ch);
+    r->slot_ch = tab_new(r, (r->nch ? r->nch : 1) * sizeof *r->slot_ch);
     if (!r->slot_start || !r->slot_ch) goto out;
     for (size_t c = 0; c < r->nch; c++) r->slot_start[r->ch[c].slot + 1]++;
     for (size_t s = 0; s < nslot; s++) r->slot_start[s + 1] += r->slot_start[s];
@@ -1556,8 +1666,12 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
         uint32_t *fill = malloc((nslot ? nslot : 1) * sizeof *fill);
         if (!fill) goto out;
         memcpy(fill, r->slot_start, nslot * sizeof *fill);
-        for (size_t c = 0; c < r->nch; c++) r->slot_ch[fill[r->ch[c].slot]++] = (uint32_t)c;
+        for (size_t c = 0; c < r->nch; c++) {
+            r->slot_ch[fill[r->ch[c].slot]++] = (uint32_t)c;
+            if (c % TICK_EVENTS == TICK_EVENTS - 1) tabs_give_back(r);
+        }
         free(fill);
+        tabs_give_back(r);
     }
     st = PDT_OK;
 out:
@@ -1621,6 +1735,8 @@ pdt_status pdt_replay_build(const pdt_point *pts, size_t n, const pdt_rec *recs,
     r->src = recs || !pl ? NULL : pl->src;
     r->m = m;
     r->nranks = nranks;
+    if (pl && pl->budget) /* (a sixteenth: some ten tables, and the build's own) */
+        r->tab_limit = pl->budget / 16 > 4096 ? pl->budget / 16 : 4096;
     size_t q1 = (size_t)nranks;
     if (!pl) { /* (streamed: none per event or point in memory) */
         r->ev_obj = big_table(m * sizeof *r->ev_obj);
@@ -1667,17 +1783,17 @@ void pdt_replay_free(pdt_replay *r)
     free(r->tris);
     free(r->hist);
     free(r->lift_ev);
-    free(r->sort_ev);
-    free(r->del_ev);
-    free(r->sort_pos);
-    free(r->edges);
-    free(r->nodes);
-    free(r->phases);
-    free(r->merges);
-    free(r->msgs);
-    free(r->hulls);
-    free(r->ch);
-    free(r->slot_ch);
+    tab_free(r, r->sort_ev);
+    tab_free(r, r->del_ev);
+    tab_free(r, r->sort_pos);
+    tab_free(r, r->edges);
+    tab_free(r, r->nodes);
+    tab_free(r, r->phases);
+    tab_free(r, r->merges);
+    tab_free(r, r->msgs);
+    tab_free(r, r->hulls);
+    tab_free(r, r->ch);
+    tab_free(r, r->slot_ch);
     free(r->slot_start);
     free(r->box_lo);
     free(r->box_hi);
@@ -1750,6 +1866,7 @@ int pdt_replay_bbox(const pdt_replay *r, pdt_point *lo, pdt_point *hi)
     if (!w->bbox_known) {
         pdt_point a = r->pts[0], b = r->pts[0];
         for (size_t p = 1; p < r->n; p++) {
+            if (p % ((size_t)1 << 21) == 0 && r->release_points) r->release_points(r->release_ctx);
             pdt_point q = r->pts[p];
             if (q.x < a.x) a.x = q.x;
             if (q.y < a.y) a.y = q.y;
@@ -2036,6 +2153,10 @@ int pdt_fwd_to(pdt_fwd *f, pdt_rstate *s, size_t k)
             f->n = n;
         }
         s->k++;
+        if (i % TICK_EVENTS == TICK_EVENTS - 1) { /* (paged tables and state) */
+            tabs_give_back(r);
+            if (r->state_paged) state_give_back(s);
+        }
         int32_t obj = f->obj[i - f->lo];
         int kind = f->kind[i - f->lo];
         if (obj < 0) continue;

@@ -58,6 +58,8 @@ void pdt_evsrc_clear(pdt_evsrc *s);
 /* 1 if the checksum of block b (its header and payload) matches. */
 int pdt_evsrc_block_ok(const pdt_evsrc *s, size_t b, uint32_t rank);
 
+#define PDT_PTAB_MAX 24  /* paged tables of a build at once (a keymap's two while it grows) */
+
 typedef struct slot_change {
     uint32_t ev;
     int32_t val, prev;
@@ -127,6 +129,13 @@ struct pdt_replay {
                             * (pdt_rstate_new) */
     uint64_t mem_budget;   /* pdt_replay_set_mem's budget */
     uint64_t state_held;   /* bytes of the states held in memory (a count) */
+    /* A streamed build's tables (edges, stacks, phases, merges, messages,
+     * hulls, slot changes, Graham's per-point tables) that outgrow tab_limit
+     * bytes live in temporary files' mappings (replay.c: tab_grow), their
+     * pages given back as the build goes on: freed by munmap (tab_free). */
+    struct pdt_ptab { void *p; size_t bytes; } ptab[PDT_PTAB_MAX];
+    int nptab;
+    uint64_t tab_limit;    /* 0: every table in memory (pdt_replay_new) */
     int bbox_known;        /* pdt_replay_bbox's answer, found once */
     pdt_point bbox_lo, bbox_hi;
     /* the run's points are read in place: give their resident pages back
@@ -169,9 +178,11 @@ enum {
  * reserve(ctx, bytes) gives a place for a table (e.g. a file offset;
  * UINT64_MAX: none), put and get write and read bytes there (1 on success).
  * budget: the build's working memory (0: no limit); what it holds besides
- * is the points (the caller's), the small tables (phases, merges, stacks,
- * edges, messages, slot changes) and for a run with Graham's sort 16 bytes
- * per point. */
+ * is the points (the caller's) and the tables of objects (phases, merges,
+ * stacks, edges, messages, slot changes, hulls; for a run with Graham's sort
+ * 16 bytes per point), each in memory up to budget / 16 bytes and beyond it
+ * in a temporary file's mapping whose pages are given back as the build
+ * goes on (tab_grow in replay.c). */
 typedef struct pdt_replay_place {
     uint64_t (*reserve)(void *ctx, uint64_t bytes);
     int (*put)(void *ctx, uint64_t at, const void *p, size_t bytes);
@@ -248,6 +259,11 @@ void pdt_rstate_blob_parts(const pdt_replay *r, const pdt_rstate *s, size_t born
  * of them again faults them in from the page cache.  Touched pages of a
  * shared mapping count as the process's memory until given back. */
 void pdt_index_release(const pdt_replay *r, const void *p, size_t len);
+
+/* Give back the resident pages of [p, p + len) when they belong to one of
+ * r's paged build tables (nothing otherwise: a table in memory keeps its
+ * pages). */
+void pdt_replay_tab_release(const pdt_replay *r, const void *p, size_t len);
 
 /* Unmap a replay's kept index (index.c). */
 void pdt_index_unmap(pdt_replay *r);

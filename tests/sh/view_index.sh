@@ -207,6 +207,24 @@ else fail hull_run_same_events "$(diff "$TMP/dhm.txt" "$TMP/dhi.txt" | head -3)"
 case "$("$V" "$RH" --check --mem 64K)" in *", 0 differ"*) ok hull_run_check ;;
     *) fail hull_run_check "$("$V" "$RH" --check --mem 64K)" ;; esac
 
+# a level-2 run (the kernel's edges: the edge table and its map) whose
+# tables outgrow a tiny budget's share: they live in temporary files'
+# mappings while the index is built (replay.c, tab_grow), and the replay is
+# the same as the one held in memory
+R2=$TMP/run2
+"$PDT" gen uniform 3000 --seed 21 > "$TMP/u2.txt"
+"$PDT" triangulate "$TMP/u2.txt" -o "$TMP/u2.tri" --trace "$R2" --trace-level 2 >/dev/null 2>&1 ||
+    fail level2_record
+"$V" "$R2" --describe --index off > "$TMP/d2m.txt"
+"$V" "$R2" --describe --mem 32K > "$TMP/d2i.txt"
+if [ -s "$R2/.pdtview-index" ] && [ -s "$TMP/d2m.txt" ] && cmp -s "$TMP/d2m.txt" "$TMP/d2i.txt"
+then ok level2_paged_tables_same_events
+else fail level2_paged_tables_same_events "$(diff "$TMP/d2m.txt" "$TMP/d2i.txt" | head -3)"; fi
+same_pictures "$R2" 32K 4000 20000 end && ok level2_paged_tables_same_pictures ||
+    fail level2_paged_tables_same_pictures
+case "$("$V" "$R2" --check --mem 32K)" in *", 0 differ"*) ok level2_paged_tables_check ;;
+    *) fail level2_paged_tables_check "$("$V" "$R2" --check --mem 32K)" ;; esac
+
 # the build holds no table per event or per point (they go to the index
 # and to scratch files a window at a time): its working memory, as it
 # counts it, stays within --mem and does not grow with the run (a run four
