@@ -2153,10 +2153,11 @@ int pdt_fwd_to(pdt_fwd *f, pdt_rstate *s, size_t k)
             f->n = n;
         }
         s->k++;
-        if (i % TICK_EVENTS == TICK_EVENTS - 1) { /* (paged tables and state) */
-            tabs_give_back(r);
-            if (r->state_paged) state_give_back(s);
-        }
+        /* (a paged build's tables go back as it goes; the state's pages, which
+         * the steps write at random, when a checkpoint of it has been written:
+         * a page of a file mapping written again costs a fault into the file
+         * system, and giving them back here made the build twice as slow) */
+        if (i % TICK_EVENTS == TICK_EVENTS - 1) tabs_give_back(r);
         int32_t obj = f->obj[i - f->lo];
         int kind = f->kind[i - f->lo];
         if (obj < 0) continue;
