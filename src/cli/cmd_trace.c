@@ -24,8 +24,9 @@ static const char help_main[] =
     "  dump    one line per event: rank, index in the rank, aligned time, event\n"
     "  check   verify the invariants of a correct run; exit 1 naming the first violation,\n"
     "          2 if DIR cannot be read as a run folder.  --mem BYTES (or $PDT_TRACE_MEM;\n"
-    "          e.g. 64M, default 1G): memory for sorting the final triangles; beyond it\n"
-    "          they are sorted in runs on temporary files ($TMPDIR)\n"
+    "          e.g. 64M, default 1G): its memory budget; beyond it the final triangles\n"
+    "          and the points are sorted on temporary files ($TMPDIR), and T* or a hull\n"
+    "          run's hull is certified instead of recomputed\n"
     "  export  Chrome trace-event JSON (chrome://tracing, ui.perfetto.dev): one row per\n"
     "          rank, phases and merge steps as slices, messages as flow arrows; or an\n"
     "          OTF2 archive (Vampir, otf2-print): ARCHIVE_DIR/run.otf2\n";

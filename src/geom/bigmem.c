@@ -134,7 +134,9 @@ void pdt_prefault_stop(pdt_prefault *pf)
     free(pf);
 }
 
-void *pdt_temp_zeros(size_t bytes)
+/* A new anonymous temporary file in $TMPDIR (else /tmp), open for reading
+ * and writing, or -1 (errno). */
+static int temp_fd(void)
 {
     const char *dir = getenv("TMPDIR");
     if (!dir || !*dir) dir = "/tmp";
@@ -142,9 +144,16 @@ void *pdt_temp_zeros(size_t bytes)
     if (fd < 0) {  /* a file system without O_TMPFILE: a named file, unlinked */
         char path[4096];
         snprintf(path, sizeof path, "%s/pdt-scratch.XXXXXX", dir);
-        if ((fd = mkstemp(path)) < 0) return NULL;
+        if ((fd = mkstemp(path)) < 0) return -1;
         unlink(path);
     }
+    return fd;
+}
+
+void *pdt_temp_zeros(size_t bytes)
+{
+    int fd = temp_fd();
+    if (fd < 0) return NULL;
     void *p = MAP_FAILED;
     if (ftruncate(fd, (off_t)(bytes ? bytes : 1)) == 0)
         p = mmap(NULL, bytes ? bytes : 1, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
@@ -152,4 +161,53 @@ void *pdt_temp_zeros(size_t bytes)
     close(fd);  /* the mapping keeps the file */
     errno = e;
     return p == MAP_FAILED ? NULL : p;
+}
+
+/* ---- a growable temporary file's mapping (bigmem.h) ---- */
+
+int pdt_temp_map_new(pdt_temp_map *m, size_t bytes)
+{
+    m->p = NULL;
+    m->bytes = 0;
+    if (!bytes) bytes = 1;
+    if ((m->fd = temp_fd()) < 0) return -1;
+    void *p = MAP_FAILED;
+    if (ftruncate(m->fd, (off_t)bytes) == 0)
+        p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, m->fd, 0);
+    if (p == MAP_FAILED) {
+        int e = errno;
+        close(m->fd);
+        m->fd = -1;
+        errno = e;
+        return -1;
+    }
+    m->p = p;
+    m->bytes = bytes;
+    return 0;
+}
+
+int pdt_temp_map_grow(pdt_temp_map *m, size_t bytes)
+{
+    if (bytes <= m->bytes) return 0;
+    if (ftruncate(m->fd, (off_t)bytes) != 0) return -1;
+    void *p = mremap(m->p, m->bytes, bytes, MREMAP_MAYMOVE);
+    if (p == MAP_FAILED) {
+        int e = errno;
+        (void)ftruncate(m->fd, (off_t)m->bytes);  /* as it was */
+        errno = e;
+        return -1;
+    }
+    m->p = p;
+    m->bytes = bytes;
+    return 0;
+}
+
+void pdt_temp_map_free(pdt_temp_map *m)
+{
+    if (!m->p) return;
+    munmap(m->p, m->bytes);
+    close(m->fd);
+    m->p = NULL;
+    m->bytes = 0;
+    m->fd = -1;
 }

@@ -27,6 +27,24 @@ void pdt_big_advise(void *p, size_t bytes);
  * set.  Unmap it with munmap(p, bytes). */
 void *pdt_temp_zeros(size_t bytes);
 
+/* A pdt_temp_zeros that can grow: `bytes` of zeros in a shared mapping of an
+ * anonymous temporary file, which stays open (one descriptor) so that
+ * pdt_temp_map_grow can lengthen it (ftruncate, then mremap: the mapping may
+ * move, the contents stay, the new part reads zeros).  The file costs disk
+ * only where it is written; pdt_release_pages gives its resident pages back
+ * without losing them.  m->p is NULL while nothing is mapped (a zeroed
+ * struct, or after pdt_temp_map_free).  new and grow return 0, or -1 with
+ * errno set (grow leaves m as it was). */
+typedef struct pdt_temp_map {
+    void *p;
+    size_t bytes;
+    int fd;
+} pdt_temp_map;
+int pdt_temp_map_new(pdt_temp_map *m, size_t bytes);
+int pdt_temp_map_grow(pdt_temp_map *m, size_t bytes);
+/* Unmap and close (nothing if m->p is NULL). */
+void pdt_temp_map_free(pdt_temp_map *m);
+
 /* The system's page size (sysconf), for code that gives pages back. */
 size_t pdt_page_size(void);
 

@@ -4,6 +4,7 @@
  * checked), then the cross-rank checks.  The first violation found is
  * reported as "rank R event #K (the event as text): what is wrong".  The
  * final triangles and what grows with the points are check_finals.c's. */
+#include <errno.h>
 #include <inttypes.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -14,6 +15,7 @@
 #include "pdt/predicates.h"
 #include "pdt/tracefile.h"
 #include "check_int.h"
+#include "hullcert.h"
 #include "xsort.h"
 #include "../geom/bigmem.h"
 
@@ -119,8 +121,70 @@ static void edge_del(edge_set *e, uint64_t key)
     }
 }
 
+/* ---- the stacks within the budget ----------------------------------------------
+ *
+ * A stack of one instance can hold every point (a Graham scan over points
+ * in convex position, a chain over collinear ones): the stacks are
+ * malloc'd while together they take at most an eighth of the budget; a
+ * stack that would take more grows on in a temporary file's mapping, whose
+ * resident pages are given back every GIVE_BACK_EVERY events. */
+
+/* Room for twice the entries of s.  0, or -1 (errno). */
+static int stack_grow(chk *c, chk_stack *s)
+{
+    size_t cap = s->cap ? 2 * s->cap : 64, old = s->cap * sizeof *s->v;
+    if (cap > SIZE_MAX / 2 / sizeof *s->v) {
+        errno = ENOMEM;
+        return -1;
+    }
+    size_t bytes = cap * sizeof *s->v;
+    if (s->map.p) {
+        if (pdt_temp_map_grow(&s->map, bytes)) return -1;
+        s->v = s->map.p;
+    } else if (c->stack_bytes - old + bytes <= c->budget / 8) {
+        uint32_t *v = realloc(s->v, bytes);
+        if (!v) return -1;
+        s->v = v;
+        c->stack_bytes += bytes - old;
+    } else {  /* over its share of the budget: on to a file, for good */
+        if (pdt_temp_map_new(&s->map, bytes)) return -1;
+        if (s->n) memcpy(s->map.p, s->v, s->n * sizeof *s->v);
+        free(s->v);
+        c->stack_bytes -= old;
+        s->v = s->map.p;
+    }
+    s->cap = cap;
+    return 0;
+}
+
+static pdt_status stack_push(chk *c, chk_stack *s, uint32_t x)
+{
+    if (s->n == s->cap && stack_grow(c, s)) return chk_tmp_fail(c, "a stack", "cannot grow");
+    s->v[s->n++] = x;
+    return PDT_OK;
+}
+
+static void stack_free(chk *c, chk_stack *s)
+{
+    if (s->map.p) {
+        pdt_temp_map_free(&s->map);
+    } else {
+        free(s->v);
+        c->stack_bytes -= s->cap * sizeof *s->v;
+    }
+    *s = (chk_stack){0};
+}
+
+/* The resident pages of the stacks in files given back (they stay in the
+ * file: the next push or pop reads its page again). */
+static void stacks_give_back(chk_stack *st, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (st[i].map.p) pdt_release_pages(st[i].map.p, st[i].map.bytes);
+}
+
 typedef struct rank_state {
-    u32vec stack[256];      /* by stack id */
+    chk_stack stack[256];   /* by stack id */
     u32vec phases;          /* open phases: (phase << 32 would not fit) ids */
     u32vec phase_seq_lo;    /* low 32 bits of the event index of each open phase */
     long open_merge;        /* index into c->mg, or -1 */
@@ -139,9 +203,9 @@ typedef struct rank_state {
     uint64_t spill_tris;    /* triangles reported in the spilled scope */
 } rank_state;
 
-static void rank_state_free(rank_state *s)
+static void rank_state_free(chk *c, rank_state *s)
 {
-    for (int i = 0; i < 256; i++) free(s->stack[i].v);
+    for (int i = 0; i < 256; i++) stack_free(c, &s->stack[i]);
     free(s->phases.v);
     free(s->phase_seq_lo.v);
     free(s->edges.k);
@@ -149,13 +213,14 @@ static void rank_state_free(rank_state *s)
     pdt_xsort_free(s->spill);
 }
 
-/* Graham's stack of rank 0 finished: remember its content. */
-static pdt_status graham_done(chk *c, const u32vec *s)
+/* Graham's stack of rank 0 finished: it becomes the final one (its storage
+ * moves there; the stack, emptied, takes the storage of the old final one). */
+static void graham_done(chk *c, chk_stack *s)
 {
-    c->graham_final.n = 0;
-    for (size_t i = 0; i < s->n; i++)
-        if (u32_push(&c->graham_final, s->v[i])) return chk_nomem(c);
-    return PDT_OK;
+    chk_stack old = c->graham_final;
+    c->graham_final = *s;
+    *s = old;
+    s->n = 0;
 }
 
 static void scope_open(rank_state *rs, uint64_t seq)
@@ -370,24 +435,23 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
             return chk_nomem(c);
         break;
     case PDT_EV_PUSH: {
-        u32vec *s = &rs->stack[e->sub];
+        chk_stack *s = &rs->stack[e->sub];
         if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
         if (e->b == 1) {  /* a new stack instance begins */
-            if (r == 0 && e->sub == PDT_STACK_GRAHAM && s->n && (st = graham_done(c, s)))
-                return st;
+            if (r == 0 && e->sub == PDT_STACK_GRAHAM && s->n) graham_done(c, s);
             s->n = 0;
             c->instances++;
         } else if (e->b != s->n + 1) {
             return chk_viol(c, r, seq, e, "depth after push should be %zu", s->n + 1);
         }
-        if (u32_push(s, e->a)) return chk_nomem(c);
+        if ((st = stack_push(c, s, e->a)) != PDT_OK) return st;
         c->pushes++;
         rs->last_stack = e->sub;
         if (e->sub == PDT_STACK_GRAHAM) c->mark[e->a] |= M_PUSHED;
         break;
     }
     case PDT_EV_POP: {
-        u32vec *s = &rs->stack[e->sub];
+        chk_stack *s = &rs->stack[e->sub];
         if (s->n == 0) return chk_viol(c, r, seq, e, "pop from an empty stack");
         if (s->v[s->n - 1] != e->a)
             return chk_viol(c, r, seq, e, "the top of the %s stack is pt %" PRIu32 ", not pt %" PRIu32,
@@ -474,7 +538,7 @@ static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, 
         int up = rs->last_stack;
         rs->last_stack = -1;
         if (e->b || (up != PDT_STACK_UPPER && up != PDT_STACK_MERGE_UPPER)) break;
-        const u32vec *lo = &rs->stack[up - 1], *hi = &rs->stack[up];
+        const chk_stack *lo = &rs->stack[up - 1], *hi = &rs->stack[up];
         if (lo->n < 2 || hi->n < 2 || lo->v[0] != hi->v[hi->n - 1] ||
             lo->v[lo->n - 1] != hi->v[0])
             return chk_viol(c, r, seq, e, "the %s and %s stacks do not form a closed chain",
@@ -579,6 +643,7 @@ static pdt_status check_rank(chk *c, uint32_t r)
         if (done == got) break;
         c->events++;
         chk_tick(c);
+        if (c->events % GIVE_BACK_EVERY == 0) stacks_give_back(rs->stack, 256);
         st = check_event(c, rs, r, seqs[done % CHECK_AHEAD], &ring[done % CHECK_AHEAD]);
         done++;
     }
@@ -593,9 +658,9 @@ static pdt_status check_rank(chk *c, uint32_t r)
         st = chk_viol(c, r, 0, NULL, "rank %" PRIu32 ": the merge step begun at event #%" PRIu64
                                  " never ends", r, c->mg[rs->open_merge].seq);
     if (st == PDT_OK && r == 0 && rs->stack[PDT_STACK_GRAHAM].n)
-        st = graham_done(c, &rs->stack[PDT_STACK_GRAHAM]);
+        graham_done(c, &rs->stack[PDT_STACK_GRAHAM]);
     pdt_cursor_close(cur);
-    rank_state_free(rs);
+    rank_state_free(c, rs);
     free(rs);
     return st;
 }
@@ -664,6 +729,66 @@ static pdt_status check_merges(chk *c)
     return PDT_OK;
 }
 
+/* ---- the hull of a hull run ------------------------------------------------------ */
+
+/* The final Graham stack compared with the hull recomputed in memory. */
+static pdt_status hull_recomputed(chk *c)
+{
+    const chk_stack *g = &c->graham_final;
+    uint32_t *hull = malloc((c->npts ? c->npts : 1) * sizeof *hull);
+    size_t nh = 0;
+    if (!hull) return chk_nomem(c);
+    pdt_status st = pdt_hull_graham(c->pts, c->npts, hull, &nh, NULL);
+    if (st != PDT_OK) pdt_err_set(c->err, st, "recomputing the hull failed: %s", pdt_status_str(st));
+    if (st == PDT_OK && (nh != g->n || (nh && memcmp(hull, g->v, nh * sizeof *hull) != 0))) {
+        size_t k = 0;
+        while (k < nh && k < g->n && hull[k] == g->v[k]) k++;
+        st = chk_viol(c, 0, 0, NULL, "the final Graham stack (%zu points) is not the hull of the "
+                                    "run's points (%zu points); first difference at position %zu",
+                      g->n, nh, k);
+    }
+    free(hull);
+    return st;
+}
+
+/* (pdt_hull_certify's release) */
+static void hull_give_back(void *ctx)
+{
+    chk *c = ctx;
+    pdt_run_release_points(c->run);
+    stacks_give_back(&c->graham_final, 1);
+}
+
+/* The final Graham stack certified in one pass over the points. */
+static pdt_status hull_certified(chk *c)
+{
+    const chk_stack *g = &c->graham_final;
+    pdt_err why = {0};
+    if (pdt_hull_certify(c->pts, c->npts, g->v, g->n, hull_give_back, c, &why) == PDT_OK)
+        return PDT_OK;
+    return chk_viol(c, 0, 0, NULL, "the final Graham stack (%zu points) is not the hull of the "
+                                  "run's points: %s", g->n, why.msg);
+}
+
+/* A hull run: every point sorted, each deleted or pushed, and the final
+ * Graham stack is the hull of the run's points, recomputed while that fits
+ * the budget (HULL_BYTES_PER_POINT), else certified (hullcert.h). */
+static pdt_status check_graham_hull(chk *c)
+{
+    pdt_status st = PDT_OK;
+    for (size_t i = 0; st == PDT_OK && i < c->npts; i++) {
+        chk_tick(c);
+        if (!(c->mark[i] & M_SORTED))
+            st = chk_viol(c, 0, 0, NULL, "pt %zu never appears in the angular order", i);
+        else if (!(c->mark[i] & (M_DELETED | M_PUSHED)))
+            st = chk_viol(c, 0, 0, NULL, "pt %zu was neither deleted nor pushed", i);
+        else if ((c->mark[i] & M_DELETED) && (c->mark[i] & M_PUSHED))
+            st = chk_viol(c, 0, 0, NULL, "pt %zu was deleted and also pushed", i);
+    }
+    if (st != PDT_OK) return st;
+    return c->hull_certify ? hull_certified(c) : hull_recomputed(c);
+}
+
 pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
 {
     return pdt_run_check_mem(run, PDT_TRACE_MEM_DEFAULT, summary, cap, err);
@@ -699,6 +824,7 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
     c.is_tri = !strcmp(m->command, "triangulate");
     c.is_hull = !strcmp(m->command, "hull");
     c.certify = (uint64_t)c.npts * TSTAR_BYTES_PER_POINT > budget;
+    c.hull_certify = (uint64_t)c.npts * HULL_BYTES_PER_POINT > budget;
     c.dedup_on_disk = (uint64_t)c.npts * DEDUP_BYTES_PER_POINT > budget;
     size_t nr = (size_t)pdt_run_nranks(run);
     c.kmin = calloc(nr, sizeof *c.kmin);
@@ -731,32 +857,7 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
         prev = r;
     }
     if (st == PDT_OK && c.is_tri) st = chk_finals(&c, nu);
-    if (st == PDT_OK && c.is_hull) {
-        /* every point sorted; each deleted or pushed; the final stack is the hull */
-        for (size_t i = 0; st == PDT_OK && i < c.npts; i++) {
-            if (!(c.mark[i] & M_SORTED))
-                st = chk_viol(&c, 0, 0, NULL, "pt %zu never appears in the angular order", i);
-            else if (!(c.mark[i] & (M_DELETED | M_PUSHED)))
-                st = chk_viol(&c, 0, 0, NULL, "pt %zu was neither deleted nor pushed", i);
-            else if ((c.mark[i] & M_DELETED) && (c.mark[i] & M_PUSHED))
-                st = chk_viol(&c, 0, 0, NULL, "pt %zu was deleted and also pushed", i);
-        }
-        uint32_t *hull = malloc((c.npts ? c.npts : 1) * sizeof *hull);
-        size_t nh = 0;
-        if (st == PDT_OK && !hull) st = chk_nomem(&c);
-        if (st == PDT_OK && (st = pdt_hull_graham(c.pts, c.npts, hull, &nh, NULL)) != PDT_OK)
-            pdt_err_set(err, st, "recomputing the hull failed: %s", pdt_status_str(st));
-        if (st == PDT_OK &&
-            (nh != c.graham_final.n ||
-             (nh && memcmp(hull, c.graham_final.v, nh * sizeof *hull) != 0))) {
-            size_t k = 0;
-            while (k < nh && k < c.graham_final.n && hull[k] == c.graham_final.v[k]) k++;
-            st = chk_viol(&c, 0, 0, NULL, "the final Graham stack (%zu points) is not the hull of the "
-                                      "run's points (%zu points); first difference at position %zu",
-                      c.graham_final.n, nh, k);
-        }
-        free(hull);
-    }
+    if (st == PDT_OK && c.is_hull) st = check_graham_hull(&c);
     if (st == PDT_OK) st = check_merges(&c);
     if (st == PDT_OK) st = check_messages(&c);
     if (st == PDT_OK && cap)
@@ -788,6 +889,11 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
         snprintf(summary + len, cap - len, " (T* certified side by side%s%s: recomputing it would "
                  "not fit the memory budget)", runs, dedup);
     }
+    if (st == PDT_OK && cap && c.hull_certify && c.is_hull) {
+        size_t len = strlen(summary);
+        snprintf(summary + len, cap - len, " (the hull certified point by point: recomputing it "
+                 "would not fit the memory budget)");
+    }
     if (st == PDT_OK && cap && c.spills) {
         size_t len = strlen(summary);
         snprintf(summary + len, cap - len, " (final triangles sorted on disk in %" PRIu64
@@ -802,6 +908,6 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
     free(c.runs);
     free(c.msg);
     free(c.mg);
-    free(c.graham_final.v);
+    stack_free(&c, &c.graham_final);
     return st;
 }

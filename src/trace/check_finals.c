@@ -433,15 +433,16 @@ pdt_status chk_finals(chk *c, size_t nu)
  *
  * What grows with the points is held in memory while it fits the budget:
  * the marks (a byte per point) up to a quarter of it, the sort that finds
- * the distinct points (DEDUP_BYTES_PER_POINT) and T* recomputed
- * (TSTAR_BYTES_PER_POINT) up to all of it.  Beyond, the marks live in a
+ * the distinct points (DEDUP_BYTES_PER_POINT), T* recomputed
+ * (TSTAR_BYTES_PER_POINT) and a hull run's hull recomputed
+ * (HULL_BYTES_PER_POINT) up to all of it.  Beyond, the marks live in a
  * mapping of an anonymous temporary file, the distinct points are found by
- * a sort on disk (xsort.h) and T* is certified on disk instead of
- * recomputed (certify.h); the resident pages of the marks and of the
- * points are then given back every GIVE_BACK_EVERY reads (they stay in the
- * page cache, or go to disk under pressure), so the check's memory is the
- * budget whatever the run's size. */
-#define GIVE_BACK_EVERY ((uint64_t)1 << 16)
+ * a sort on disk (xsort.h), T* is certified on disk instead of recomputed
+ * (certify.h) and the hull certified from the final Graham stack
+ * (hullcert.h; the stacks themselves: check.c); the resident pages of the
+ * marks and of the points are then given back every GIVE_BACK_EVERY reads
+ * (check_int.h; they stay in the page cache, or go to disk under
+ * pressure), so the check's memory is the budget whatever the run's size. */
 
 int chk_marks_new(chk *c)
 {

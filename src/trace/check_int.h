@@ -10,6 +10,7 @@
 
 #include "pdt/tracefile.h"
 #include "tf_internal.h"
+#include "../geom/bigmem.h"
 
 typedef struct fin {   /* a TRI_FINAL, rotated to start at its smallest index */
     pdt_tri t;
@@ -30,6 +31,17 @@ typedef struct merge {
     uint64_t seq, lifts, discards;
     int closed;
 } merge;
+
+/* A stack of point indices as the events build it (a rank's stack of one
+ * id, or the final Graham stack): malloc'd while all of them together fit
+ * an eighth of the budget, beyond it in a growable temporary file's
+ * mapping (v == map.p), whose resident pages are given back as the check
+ * goes (chk_stacks_tick in check.c). */
+typedef struct chk_stack {
+    uint32_t *v;
+    size_t n, cap;
+    pdt_temp_map map;       /* map.p NULL: v is malloc'd */
+} chk_stack;
 
 typedef struct chk {
     pdt_run *run;
@@ -59,7 +71,9 @@ typedef struct chk {
     size_t nmsg, capmsg;
     merge *mg;
     size_t nmg, capmg;
-    u32vec graham_final;    /* last finished Graham stack of rank 0 */
+    chk_stack graham_final; /* last finished Graham stack of rank 0 (moved, not copied) */
+    uint64_t stack_bytes;   /* malloc'd by the stacks (at most budget / 8) */
+    int hull_certify;       /* a hull run's hull certified, not recomputed (over budget) */
     uint64_t events, pushes, pops, instances, lifts_local, lifts_merge, sorts, hulls;
     uint64_t edge_scopes;   /* kernel runs whose level-2 edges were replayed */
     uint64_t edge_spills;   /* of them, replayed on disk (over a quarter of the budget) */
@@ -75,6 +89,12 @@ enum { M_SORTED = 1, M_DELETED = 2, M_PUSHED = 4, M_LIFTED = 8, M_REP = 16 };
  * finals go to disk before T* is recomputed. */
 #define TSTAR_BYTES_PER_POINT 96u
 #define DEDUP_BYTES_PER_POINT 36u  /* pdt_sort_unique: order 4, work 32 */
+/* What recomputing a hull run's hull takes per point: pdt_hull_graham's
+ * order and its sort's scratch (or its stack), and the hull written.  Over
+ * the budget the final Graham stack is certified instead (hullcert.h). */
+#define HULL_BYTES_PER_POINT 12u
+/* Calls between two givings-back of resident pages (chk_tick, the stacks). */
+#define GIVE_BACK_EVERY ((uint64_t)1 << 16)
 
 /* check.c */
 pdt_status chk_nomem(chk *c);

@@ -6,6 +6,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "pdt/hull.h"
 #include "pdt/tracefile.h"
 
 static void die(const char *what, const pdt_err *err)
@@ -87,6 +88,51 @@ static void meta(const char *dir, int nranks)
     if (pdt_run_write_meta(dir, &m, pts, 5, &err) != PDT_OK) die("meta", &err);
 }
 
+/* A hull run as `pdt hull --trace` records it: Graham's scan of pts[0..n). */
+static void record_hull(const char *dir, const pdt_point *pts, size_t n)
+{
+    pdt_trace_writer *w;
+    pdt_err err = {0};
+    if (pdt_tw_open(dir, 0, 1, &w, &err) != PDT_OK) die("pdt_tw_open", &err);
+    uint32_t out[16];
+    size_t nout;
+    if (n > 16 || pdt_hull_graham(pts, n, out, &nout, pdt_tw_hook(w)) != PDT_OK) die("hull", NULL);
+    if (pdt_tw_close(w, &err) != PDT_OK) die("pdt_tw_close", &err);
+    int64_t off = 0;
+    pdt_manifest m = {0};
+    m.format_version = PDT_TRACE_FORMAT_MAJOR;
+    snprintf(m.program_version, sizeof m.program_version, "%s", PDT_VERSION);
+    snprintf(m.command, sizeof m.command, "hull");
+    m.command_line = (char *)"pdt hull in.txt -o in.hull --trace run";
+    m.input_name = (char *)"in.txt";
+    m.input_checksum = pdt_points_checksum(pts, n);
+    m.n = n;
+    m.nranks = 1;
+    m.level = 1;
+    m.clock_offset_ns = &off;
+    m.wall_start_ns = 1700000000000000000ull;
+    if (pdt_run_write_meta(dir, &m, pts, n, &err) != PDT_OK) die("meta", &err);
+}
+
+/* trace_run's input for the one-rank run folder dir: manifest SEP points
+ * SEP rank-0000.trace, to out/trace_run/name. */
+static void put_run(const char *out, const char *name, const char *dir)
+{
+    char b[2100];
+    const char *sep = "\n==PDT==\n", *parts[3] = {"manifest", "points.bin", "rank-0000.trace"};
+    snprintf(b, sizeof b, "%s/trace_run/%s", out, name);
+    FILE *fp = fopen(b, "wb");
+    if (!fp) die(b, NULL);
+    for (int i = 0; i < 3; i++) {
+        size_t len;
+        snprintf(b, sizeof b, "%s/%s", dir, parts[i]);
+        unsigned char *d = slurp(b, &len);
+        if ((i && fputs(sep, fp) == EOF) || fwrite(d, 1, len, fp) != len) die(b, NULL);
+        free(d);
+    }
+    if (fclose(fp) != 0) die(name, NULL);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 3) {
@@ -141,6 +187,24 @@ int main(int argc, char **argv)
         free(cat);
         free(man);
         free(pts);
+    }
+    /* hull runs: Graham's scan of a square with points on its sides, copies of
+     * corners and of the origin, a point inside; of points on a line; of
+     * copies of one point (trace_run only) */
+    static const pdt_point square[] = {{0, 4}, {2, 0}, {4, 4}, {2, 4}, {4, 0}, {2, 2},
+                                       {4, 4}, {0, 0}, {4, 0}, {0, 2}, {1, 3}, {3, 1}};
+    static const pdt_point line[] = {{3, 3}, {1, 1}, {2, 2}, {3, 3}, {1, 1}, {0, 0}};
+    static const pdt_point one[] = {{7, -7}, {7, -7}, {7, -7}};
+    struct { const char *name; const pdt_point *pts; size_t n; } hulls[] = {
+        {"w-hull-square", square, sizeof square / sizeof *square},
+        {"w-hull-line", line, sizeof line / sizeof *line},
+        {"w-hull-one", one, sizeof one / sizeof *one},
+    };
+    for (size_t i = 0; i < sizeof hulls / sizeof hulls[0]; i++) {
+        snprintf(a, sizeof a, "%s/%s", tmp, hulls[i].name);
+        mkdir(a, 0777);
+        record_hull(a, hulls[i].pts, hulls[i].n);
+        put_run(out, hulls[i].name, a);
     }
     return 0;
 }

@@ -2,6 +2,7 @@
  * naming the problem on traces altered on purpose (an event removed, a block
  * truncated, a checksum flipped, a triangle made final twice, a lift with the
  * wrong height, a message without its receive). */
+#include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -57,17 +58,24 @@ static void record_tri(const char *dir, const pdt_point *pts, size_t n, int leve
     CHECK(pdt_tw_close(w, &err) == PDT_OK);
 }
 
-static void record_hull(const char *dir, const pdt_point *pts, size_t n)
+/* A traced Graham scan of pts, in a run folder whose points.bin holds
+ * `as` instead (pts: a true run). */
+static void record_hull_as(const char *dir, const pdt_point *pts, const pdt_point *as, size_t n)
 {
     pdt_trace_writer *w;
     pdt_err err = {0};
     CHECK(pdt_tw_open(dir, 0, 1, &w, &err) == PDT_OK);
-    meta(dir, "hull", pts, n, 1);
+    meta(dir, "hull", as, n, 1);
     uint32_t *out = malloc((n ? n : 1) * sizeof *out);
     size_t nout;
     CHECK(pdt_hull_graham(pts, n, out, &nout, pdt_tw_hook(w)) == PDT_OK);
     free(out);
     CHECK(pdt_tw_close(w, &err) == PDT_OK);
+}
+
+static void record_hull(const char *dir, const pdt_point *pts, size_t n)
+{
+    record_hull_as(dir, pts, pts, n);
 }
 
 /* Run the check; returns its status, the message in msg. */
@@ -598,6 +606,104 @@ TEST(certified_tstar)
     free(pts);
 }
 
+/* The check of a hull run in memory and in a budget of 1 byte (the hull
+ * certified unless the run is empty, the stacks in files): the same
+ * verdict; the summary the same but for what says it was certified.  When
+ * it fails, each names why. */
+static void hull_both(const char *name, const char *want_mem, const char *want_cert)
+{
+    char mem[1100], tiny[1100];
+    pdt_status a = check_dir(sub(name), mem, sizeof mem);
+    budget = 1;
+    pdt_status b = check_dir(sub(name), tiny, sizeof tiny);
+    budget = PDT_TRACE_MEM_DEFAULT;
+    CHECK_MSG(a == b, "%s: %d '%s' in memory, %d '%s' certified", name, a, mem, b, tiny);
+    if (!want_mem) {
+        const char *said = " (the hull certified point by point: recomputing it would not fit the "
+                           "memory budget)";
+        size_t len = strlen(mem);
+        CHECK_MSG(a == PDT_OK && !strstr(mem, "certified"), "%s: %s", name, mem);
+        if (strstr(mem, " 0 events")) said = "";  /* no points: nothing to certify */
+        CHECK_MSG(strncmp(tiny, mem, len) == 0 && strcmp(tiny + len, said) == 0, "%s: '%s' / '%s'",
+                  name, mem, tiny);
+        return;
+    }
+    CHECK_MSG(a == PDT_ERR_CHECK && strstr(mem, want_mem), "%s: '%s' lacks '%s'", name, mem, want_mem);
+    CHECK_MSG(strstr(tiny, want_cert), "%s: '%s' lacks '%s'", name, tiny, want_cert);
+}
+
+TEST(hull_certified_in_bounded_memory)
+{
+    const char *const *kinds = pdt_gen_kinds();
+    for (int i = 0; kinds[i]; i++) {
+        pdt_point *q;
+        pdt_err err = {0};
+        CHECK(pdt_gen(kinds[i], 900, 13, &q, &err) == PDT_OK);
+        record_hull(sub("hb-fam"), q, 900);
+        hull_both("hb-fam", NULL, NULL);
+        free(q);
+    }
+    /* n = 0..3, all at one point, all on a line (copies included) */
+    pdt_point few[3] = {{5, 5}, {-1, 7}, {9, 8}};
+    for (size_t n = 0; n <= 3; n++) {
+        record_hull(sub("hb-few"), few, n);
+        hull_both("hb-few", NULL, NULL);
+    }
+    pdt_point one[500], line[500];
+    for (int i = 0; i < 500; i++) {
+        one[i] = (pdt_point){-7, 3};
+        line[i] = (pdt_point){3 * (i % 97) - 100, -2 * (i % 97) + 40};
+    }
+    record_hull(sub("hb-one"), one, 500);
+    hull_both("hb-one", NULL, NULL);
+    record_hull(sub("hb-line"), line, 500);
+    hull_both("hb-line", NULL, NULL);
+
+    /* the points of the run are not the points scanned: the final stack
+     * is not their hull */
+    size_t n = 2000;
+    pdt_point *pts = uniform(n), *as = malloc(n * sizeof *as);
+    uint32_t *h = malloc(n * sizeof *h);
+    size_t nh;
+    CHECK(pdt_hull_graham(pts, n, h, &nh, NULL) == PDT_OK && nh >= 3);
+    uint32_t in = UINT32_MAX, hi = 0;  /* a point inside (the last), a corner before it */
+    for (uint32_t p = 0; p < n; p++) {
+        int corner = 0;
+        for (size_t k = 0; k < nh; k++) corner |= h[k] == p;
+        if (!corner) in = p;
+    }
+    for (size_t k = 1; k < nh; k++)
+        if (h[k] < in && h[k] > hi) hi = h[k];
+    CHECK(in != UINT32_MAX && hi > 0);
+    memcpy(as, pts, n * sizeof *as);
+    as[in] = (pdt_point){-5, -(1 << 30)};  /* far below */
+    record_hull_as(sub("hb-below"), pts, as, n);
+    hull_both("hb-below", "is not the hull of the run's points (", "is not the rightmost lowest point: pt");
+    memcpy(as, pts, n * sizeof *as);
+    as[in] = (pdt_point){pts[h[1]].x + 1, pts[h[1]].y};  /* beside a corner, outside */
+    record_hull_as(sub("hb-out"), pts, as, n);
+    char want[200];
+    snprintf(want, sizeof want, "pt %" PRIu32 " (%" PRId32 ", %" PRId32 ") lies outside it", in,
+             as[in].x, as[in].y);
+    hull_both("hb-out", "first difference at position", want);
+    memcpy(as, pts, n * sizeof *as);
+    as[in] = pts[hi];  /* a later copy of a corner */
+    record_hull_as(sub("hb-copy"), pts, as, n);
+    snprintf(want, sizeof want, "pt %" PRIu32 " is a later copy of its point pt %" PRIu32, in, hi);
+    hull_both("hb-copy", "first difference at position", want);
+    memcpy(as, pts, n * sizeof *as);
+    /* a corner moved inside the triangle of the origin and its neighbours */
+    as[h[2]] = (pdt_point){(int32_t)(((int64_t)pts[h[0]].x + pts[h[1]].x + pts[h[3 % nh]].x) / 3),
+                           (int32_t)(((int64_t)pts[h[0]].y + pts[h[1]].y + pts[h[3 % nh]].y) / 3)};
+    record_hull_as(sub("hb-dent"), pts, as, n);
+    snprintf(want, sizeof want, "no strict left turn at position 2 (pts %" PRIu32 " %" PRIu32
+             " %" PRIu32 ")", h[1], h[2], h[3 % nh]);
+    hull_both("hb-dent", "first difference at position", want);
+    free(h);
+    free(as);
+    free(pts);
+}
+
 static void del_to_add(pdt_event *e) { e->kind = PDT_EV_EDGE_ADD; }
 
 /* A level-2 kernel run whose edges outgrow a quarter of the budget is
@@ -640,6 +746,7 @@ int main(void)
     RUN(tiny_budget_spills);
     RUN(certified_tstar);
     RUN(level2_edges_on_disk);
+    RUN(hull_certified_in_bounded_memory);
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
     if (system(cmd) != 0) return 1;
