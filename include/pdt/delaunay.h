@@ -91,6 +91,12 @@ void pdt_tri_bucket_count(pdt_tri *t, size_t n, int shift, uint64_t *hist);
 
 /* Copy each of t[0, n) (rotated) to dst[at[b]++], b its bucket. */
 void pdt_tri_bucket_scatter(const pdt_tri *t, size_t n, int shift, uint64_t *at, pdt_tri *dst);
+/* The same for the triangles of the buckets b with in[b] = 1 only (an
+ * exchange in rounds, each with a grouped array of its own share): those of
+ * the others are written to dst[at[b]] without moving on, so at[b] must
+ * name one spare place past the round's for them. */
+void pdt_tri_bucket_scatter_round(const pdt_tri *t, size_t n, int shift, const uint8_t *in,
+                                  uint64_t *at, pdt_tri *dst);
 
 /* The ns runs src[k][0, len[k]) (rotated, each grouped by bucket in
  * increasing order, no triangle twice) into out in canonical order; out has

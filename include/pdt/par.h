@@ -195,8 +195,9 @@ typedef struct pdt_par_rank_stats {
     uint64_t hull;          /* vertices of the hull this rank holds */
     int32_t holds_final_hull, hull_degenerate;
     int32_t prefault;       /* 1: a second thread faulted memory in ahead */
-    int32_t strips;         /* plain run: strips triangulated one after the other
-                             * to save memory (0: one kernel run on all points) */
+    int32_t strips;         /* strips triangulated one after the other to save
+                             * memory: a plain run's, or each rank's of an MPI
+                             * run (0: one kernel run on the rank's points) */
     /* seconds per phase of the pipeline */
     double t_read, t_partition, t_local, t_merge, t_order, t_write;
     double critical_path;   /* seconds: longest chain of dependent compute ending here */

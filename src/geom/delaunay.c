@@ -587,7 +587,12 @@ static pdt_status kernel_on(uint32_t *id, pdt_point *q, size_t n, edge *e, size_
     c.ks = c.k + n;
     c.tp = (uint32_t *)(void *)(c.ks + n);
     c.tq = (pdt_point *)(void *)(c.tp + n);
-    cut_order(&c, 0, (uint32_t)n, 0);
+    /* the first cut across the longer side (then the sides alternate): a
+     * strip twice as tall as wide cut first by y, so that no merge seam runs
+     * its whole height (a strip taller than wide: y first); traced runs keep the x cut first (their events are
+     * the lessons') */
+    int axis = !tr && (int64_t)maxy - miny > (int64_t)maxx - minx ? 1 : 0;
+    cut_order(&c, 0, (uint32_t)n, axis);
     d.p = q;
 
     /* kernel vertex v is point id[v]; the trace names it tr->gid[id[v]] */
@@ -605,7 +610,8 @@ static pdt_status kernel_on(uint32_t *id, pdt_point *q, size_t n, edge *e, size_
         d.tr = &ktr;
     }
     uint32_t le, re;
-    int ok = build(&d, 0, (uint32_t)n, 0, &le, &re);
+    int ok = build(&d, 0, (uint32_t)n, axis, &le, &re);
+    if (ok && axis) frame_extremes(&d, le, 0, &le, &re); /* (the x frame's extremes) */
     if (ok && hull && n >= 3) ok = outer_hull(&d, le, n, by_vertex ? NULL : id, hull, nhull);
     if (ok) *ntri = by_vertex ? collect(&d, NULL, tid, run) : collect(&d, id, tid, run);
     free(tmap);
@@ -921,6 +927,17 @@ void pdt_tri_bucket_count(pdt_tri *t, size_t n, int shift, uint64_t *hist)
 void pdt_tri_bucket_scatter(const pdt_tri *t, size_t n, int shift, uint64_t *at, pdt_tri *dst)
 {
     for (size_t i = 0; i < n; i++) dst[at[t[i].v[0] >> shift]++] = t[i];
+}
+
+void pdt_tri_bucket_scatter_round(const pdt_tri *t, size_t n, int shift, const uint8_t *in,
+                                  uint64_t *at, pdt_tri *dst)
+{
+    for (size_t i = 0; i < n; i++) { /* (branch-free: which round is random) */
+        uint32_t b = t[i].v[0] >> shift;
+        uint64_t a = at[b];
+        dst[a] = t[i];
+        at[b] = a + in[b];
+    }
 }
 
 /* Each bucket in turn, the smallest at a run's head first: its part of every

@@ -14,7 +14,11 @@
  *
  * With one rank the sequential pipeline does all of it: pdt_triangulate_inplace,
  * or for a large untraced .tri run the same SRM on two strips one after the
- * other in one process (pdt_srm_plain, plain.c), to hold less memory. */
+ * other in one process (pdt_srm_plain, plain.c), to hold less memory.  By the
+ * same rule a rank of a large untraced .tri run holds two strips (rank_strips):
+ * the SRM then runs on 2P strips, rank r holding strips 2r and 2r + 1, which
+ * it triangulates one after the other in its block and merges first, at
+ * level 0, with no message; the levels above are the P ranks' own. */
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -49,9 +53,13 @@ typedef struct drv {
     uint64_t nrecv;
     uint64_t local_dups;           /* copies dropped before the exchange */
     uint64_t n_total;              /* points in the whole input */
-    srm_strip *strip;              /* p strip descriptors */
-    srm_rank s;
-    int s_init;
+    int k;                         /* strips this rank holds (every rank the same) */
+    size_t first[PDT_RANK_MAX_STRIPS + 1]; /* strip j: the block's points [first[j], first[j+1]) */
+    srm_strip *strip;              /* p * k strip descriptors */
+    srm_rank s[PDT_RANK_MAX_STRIPS];  /* strip k * rank + j */
+    int s_init[PDT_RANK_MAX_STRIPS];
+    pdt_tri *more;                 /* the order phase's finals besides the block's */
+    size_t nmore;
     pdt_par_rank_stats *me;
     pdt_err *err;
 } drv;
@@ -357,12 +365,39 @@ done:
 static pdt_status strips(drv *d, pdt_err *err)
 {
     size_t m = d->m;
-    d->strip = malloc((size_t)d->p * sizeof *d->strip);
+    int k = d->k;
+    d->strip = malloc((size_t)d->p * (size_t)k * sizeof *d->strip);
     if (!d->strip) return nomem(d, "partition");
-    srm_strip mine = pdt_srm_strip_of(block_pts(d), m);
-    pdt_status st = pdt_comm_allgather(d->c, &mine, sizeof mine, d->strip, err);
-    if (st == PDT_OK) note_all(d, TAG_STRIPS, sizeof mine);
+    srm_strip mine[PDT_RANK_MAX_STRIPS];
+    for (int j = 0; j <= k; j++) d->first[j] = m * (size_t)j / (size_t)k;
+    for (int j = 0; j < k; j++)
+        mine[j] = pdt_srm_strip_of(block_pts(d) + d->first[j], d->first[j + 1] - d->first[j]);
+    size_t bytes = (size_t)k * sizeof *mine;
+    pdt_status st = pdt_comm_allgather(d->c, mine, bytes, d->strip, err);
+    if (st == PDT_OK) note_all(d, TAG_STRIPS, bytes);
     return st;
+}
+
+/* How many strips each rank holds: 2 for an untraced run of at least 2^21
+ * points whose points may be spent (a .tri output), as a plain run's
+ * (strips_for), when every rank's sample says the merge pays
+ * (pdt_srm_plain_pays: one vote each, summed); else 1.
+ * $PDT_RANK_STRIPS=1|2 decides for every size (tests). */
+static pdt_status rank_strips(drv *d, const pdt_par_input *in, pdt_err *err)
+{
+    const char *t = getenv("PDT_RANK_STRIPS");
+    int want = t && *t ? atoi(t) : 0;
+    int k = want ? want : !d->tr && in->release_pts && d->n_total >= ((uint64_t)1 << 21) ? 2 : 1;
+    k = k >= 2 ? 2 : 1;
+    if (!want && k == 2) {
+        uint64_t votes = (uint64_t)pdt_srm_plain_pays(block_pts(d), d->m);
+        pdt_status st = pdt_comm_allreduce_u64(d->c, &votes, 1, PDT_COMM_SUM, err);
+        if (st != PDT_OK) return st;
+        note_all(d, TAG_STRIPS, sizeof votes);
+        if (votes < (uint64_t)d->p) k = 1;
+    }
+    d->k = k;
+    return PDT_OK;
 }
 
 /* Phases 1 and 2 on this rank's strip, in its block (which the SRM state
@@ -370,86 +405,179 @@ static pdt_status strips(drv *d, pdt_err *err)
  * second thread faults the kernel's part of the block in ahead of it. */
 static pdt_status local(drv *d, int prefault, pdt_err *err)
 {
-    pdt_status st = pdt_srm_init(&d->s, d->rank, d->p, d->strip, d->tr, err);
-    if (st != PDT_OK) return st;
-    d->s_init = 1;
-    d->s.clock = wclock;
-    d->s.clock_user = d->c;
+    int k = d->k;
+    pdt_status st = PDT_OK;
+    for (int j = 0; j < k && st == PDT_OK; j++) {
+        srm_rank *s = &d->s[j];
+        st = pdt_srm_init(s, d->rank * k + j, d->p * k, d->strip, d->tr, err);
+        if (st != PDT_OK) return st;
+        d->s_init[j] = 1;
+        pdt_srm_per_rank(s, k);
+        s->clock = wclock;
+        s->clock_user = d->c;
+    }
     pdt_point *pts = block_pts(d);
     uint32_t *gid = block_gid(d), *id = block_id(d);
     unsigned char *blk = d->blk;
     d->blk = NULL;
+    /* strip j's kernel right behind the final triangles of the strips before
+     * it (an even number: the edges stay 8-byte aligned; an odd one is set
+     * aside in d->more) */
+    size_t off = 0, need = 0;
+    for (int j = 0; j < k; j++) {
+        size_t mj = d->first[j + 1] - d->first[j];
+        size_t end = (j ? 24 * d->first[j] : 0) + PDT_DELAUNAY_WORK(mj);
+        need = end > need ? end : need;
+    }
     pdt_prefault *pf = NULL;
     if (prefault) { /* the kernel's edges grow past the partition's records, up to its
                      * bound for this strip's points (the block has room for more) */
-        size_t front = 2 * d->blk_cap * sizeof(srm_rec), work = PDT_DELAUNAY_WORK(d->m);
-        pdt_range edges = {blk + front, work > front ? work - front : 0};
+        size_t front = 2 * d->blk_cap * sizeof(srm_rec);
+        pdt_range edges = {blk + front, need > front ? need - front : 0};
         pf = pdt_prefault_start(&edges, 1);
         d->me->prefault = pf != NULL;
     }
-    st = pdt_srm_local(&d->s, blk, pts, gid, id, d->m, err);
+    size_t nfin = 0;
+    for (int j = 0; j < k && st == PDT_OK; j++) {
+        size_t a = d->first[j], mj = d->first[j + 1] - a;
+        srm_rank *s = &d->s[j];
+        st = pdt_srm_local(s, blk + off, pts + a, gid + a, id, mj, err);
+        if (st != PDT_OK) break;
+        if (j + 1 < k && s->nfin % 2) {
+            pdt_tri *more = realloc(d->more, (d->nmore + 1) * sizeof *more);
+            if (!more) {
+                st = nomem(d, "local");
+                break;
+            }
+            d->more = more;
+            d->more[d->nmore++] = s->fin[--s->nfin];
+        }
+        off += s->nfin * sizeof(pdt_tri);
+        nfin += s->nfin;
+        if (j) { /* (the block is strip 0's: its finals hold every strip's, in order) */
+            s->fin = NULL;
+            s->nfin = s->capfin = 0;
+        }
+    }
+    if (st == PDT_OK) {
+        d->s[0].nfin = nfin;
+        d->s[0].capfin = nfin;
+    }
     pdt_prefault_stop(pf); /* every page of the block has been touched */
     return st;
 }
 
 /* ---- merge --------------------------------------------------------------------- */
 
-/* At the merge rank of a level: receive the other ranks' messages of the pair
- * [gl, ge) (own = this rank's message, freed here) and merge them. */
-static pdt_status merge_at(drv *d, int level, int gl, int ge, void *own, size_t own_len,
+/* At the merge strip g of a level (this rank's strip j): the messages of the
+ * pair's strips [gl, ge): this rank's own (in own[], taken: freed here), the
+ * others received from their ranks, in strip order (a rank sends its strips'
+ * messages in that order, and messages from one rank with one tag arrive in
+ * the order sent); merged. */
+static pdt_status merge_at(drv *d, int level, int j, int gl, int ge, void **own, size_t *own_len,
                            pdt_err *err)
 {
-    int r = d->rank, nm = ge - gl;
-    test_sleep(r);
+    int k = d->k, nm = ge - gl;
+    test_sleep(d->rank);
     void **msg = calloc((size_t)nm, sizeof *msg);
     size_t *lens = calloc((size_t)nm, sizeof *lens);
-    pdt_status st = PDT_OK;
-    if (!msg || !lens) {
-        free(msg);
-        free(lens);
-        free(own);
-        return nomem(d, "merge");
-    }
-    msg[r - gl] = own;
-    lens[r - gl] = own_len;
+    pdt_status st = msg && lens ? PDT_OK : nomem(d, "merge");
     for (int q = gl; q < ge && st == PDT_OK; q++) {
-        if (q == r) continue;
-        st = pdt_comm_recv(d->c, q, TAG_MERGE + level, &msg[q - gl], &lens[q - gl], err);
-        if (st == PDT_OK) note_recv(d, TAG_MERGE + level, q, lens[q - gl]);
+        int from = q / k;
+        if (from == d->rank) {
+            msg[q - gl] = own[q % k];
+            lens[q - gl] = own_len[q % k];
+            own[q % k] = NULL;
+            continue;
+        }
+        st = pdt_comm_recv(d->c, from, TAG_MERGE + level, &msg[q - gl], &lens[q - gl], err);
+        if (st == PDT_OK) note_recv(d, TAG_MERGE + level, from, lens[q - gl]);
     }
-    if (st == PDT_OK) st = pdt_srm_merge(&d->s, level, msg, lens, err);
-    for (int i = 0; i < nm; i++) free(msg[i]);
+    if (st == PDT_OK) st = pdt_srm_merge(&d->s[j], level, msg, lens, err);
+    for (int i = 0; msg && i < nm; i++) free(msg[i]);
     free(msg);
     free(lens);
     return st;
 }
 
+/* One level of the merge tree on this rank: each of its strips whose group
+ * has a partner packs its message (in strip order) and sends it to the rank
+ * of the pair's merge strip, or keeps it when that strip is its own; then
+ * the merges at its own merge strips. */
+static pdt_status merge_level(drv *d, int level, pdt_err *err)
+{
+    int k = d->k, np = d->p * k;
+    void *own[PDT_RANK_MAX_STRIPS] = {0};
+    size_t own_len[PDT_RANK_MAX_STRIPS] = {0};
+    pdt_status st = PDT_OK;
+    for (int j = 0; j < k && st == PDT_OK; j++) {
+        int g = d->rank * k + j, gl, gr, ge;
+        if (!pdt_srm_pair(g, np, level, &gl, &gr, &ge)) continue;
+        st = pdt_srm_pack(&d->s[j], level, &own[j], &own_len[j], err);
+        if (st != PDT_OK || gr / k == d->rank) continue;
+        st = pdt_comm_send(d->c, gr / k, TAG_MERGE + level, own[j], own_len[j], err);
+        if (st == PDT_OK) note_send(d, TAG_MERGE + level, gr / k, own_len[j]);
+        free(own[j]);
+        own[j] = NULL;
+    }
+    for (int j = 0; j < k && st == PDT_OK; j++) {
+        int g = d->rank * k + j, gl, gr, ge;
+        if (pdt_srm_pair(g, np, level, &gl, &gr, &ge) && gr == g)
+            st = merge_at(d, level, j, gl, ge, own, own_len, err);
+    }
+    for (int j = 0; j < k; j++) free(own[j]);
+    return st;
+}
+
 /* Phase 3: the merge tree, level by level; this rank takes part in the
- * levels where its group has a partner. */
+ * levels where one of its strips' groups has a partner. */
 static pdt_status merge_tree(drv *d, pdt_err *err)
 {
     pdt_status st = PDT_OK;
-    for (int level = 0; level < d->s.levels && st == PDT_OK; level++) {
-        int gl, gr, ge;
-        if (!pdt_srm_pair(d->rank, d->p, level, &gl, &gr, &ge)) continue;
+    int k = d->k, np = d->p * k;
+    for (int level = 0; level < d->s[0].levels && st == PDT_OK; level++) {
+        int gl, gr, ge, any = 0;
+        for (int j = 0; j < k; j++) any |= pdt_srm_pair(d->rank * k + j, np, level, &gl, &gr, &ge);
+        if (!any) continue;
         PDT_TRACE(d->tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_MERGE, level, 0, 0, 0);
-        void *buf = NULL;
-        size_t len = 0;
-        st = pdt_srm_pack(&d->s, level, &buf, &len, err);
-        if (st != PDT_OK) return st;
-        if (d->rank != gr) {
-            st = pdt_comm_send(d->c, gr, TAG_MERGE + level, buf, len, err);
-            if (st == PDT_OK) note_send(d, TAG_MERGE + level, gr, len);
-            free(buf);
-        } else {
-            st = merge_at(d, level, gl, ge, buf, len, err);
-        }
+        st = merge_level(d, level, err);
         if (st == PDT_OK) PDT_TRACE(d->tr, 1, PDT_EV_PHASE_END, PDT_PH_MERGE, level, 0, 0, 0);
     }
-    if (st == PDT_OK && d->s.npend)
-        st = pdt_err_set(err, PDT_ERR_CHECK, "rank %d: %zu triangles still pending after the "
-                         "last merge", d->rank, d->s.npend);
+    for (int j = 0; j < k && st == PDT_OK; j++)
+        if (d->s[j].npend)
+            st = pdt_err_set(err, PDT_ERR_CHECK, "%s: %zu triangles still pending after the "
+                             "last merge", d->s[j].who, d->s[j].npend);
     return st;
+}
+
+/* After the merges: the finals besides the block's (the strips' merges' and
+ * those set aside) in one array, d->more. */
+static pdt_status gather_more(drv *d)
+{
+    size_t n = d->nmore;
+    for (int j = 0; j < d->k; j++) n += d->s[j].nmore;
+    pdt_tri *all = realloc(d->more, (n + 1) * sizeof *all);
+    if (!all) return nomem(d, "order");
+    for (int j = 0; j < d->k; j++) {
+        if (d->s[j].nmore) memcpy(all + d->nmore, d->s[j].more, d->s[j].nmore * sizeof *all);
+        d->nmore += d->s[j].nmore;
+        free(d->s[j].more);
+        d->s[j].more = NULL;
+        d->s[j].nmore = d->s[j].capmore = 0;
+    }
+    d->more = all;
+    return PDT_OK;
+}
+
+/* After the merges the strip's points and their names in the block are done
+ * with: their pages go back before the order phase (which may take that room
+ * again: it is the block's far end) -- 16 bytes a point of the peak. */
+static void release_points(drv *d)
+{
+    if (!d->s[0].fin) return;
+    unsigned char *blk = (unsigned char *)d->s[0].fin;
+    size_t at = PDT_DELAUNAY_WORK(d->blk_cap);
+    pdt_release_pages(blk + at, d->blk_bytes - at);
 }
 
 /* ---- canonical order across ranks ------------------------------------------------ */
@@ -486,13 +614,16 @@ static int order_shift(const drv *d)
     return sh;
 }
 
-/* The plan of the exchange: hist[b], this rank's triangles in bucket b; the
- * buckets' owners from the sum over the ranks (the rank whose share holds a
- * bucket's middle: nondecreasing in b); sc[q], how many this rank sends
- * rank q; at[b], where bucket b starts in the grouped array. */
+/* The plan of the exchange, in `rounds` rounds (bucket b goes in round
+ * b % rounds: a round's grouped array holds about 1/rounds of the finals):
+ * hist[b], this rank's triangles in bucket b; the buckets' owners from the
+ * sum over the ranks (the rank whose share holds a bucket's middle:
+ * nondecreasing in b); sc[q * rounds + r], how many this rank sends rank q in
+ * round r, rc the same received; at[b], where bucket b starts in its round's
+ * grouped array; most, the largest round's count. */
 typedef struct order_plan {
-    int shift;
-    size_t nb;
+    int shift, rounds;
+    size_t nb, most;
     uint64_t *hist, *at, *sc, *rc;
 } order_plan;
 
@@ -507,12 +638,13 @@ static void order_plan_free(order_plan *o)
 static pdt_status order_plan_make(drv *d, finals *f, order_plan *o, pdt_err *err)
 {
     int p = d->p;
+    int R = o->rounds = d->k > 1 ? 2 : 1; /* (two when the strips are, for memory) */
     o->shift = order_shift(d);
     o->nb = (size_t)((d->n_total ? d->n_total - 1 : 0) >> o->shift) + 1;
     o->hist = calloc(o->nb, sizeof *o->hist);
     o->at = calloc(o->nb, sizeof *o->at);
-    o->sc = calloc((size_t)p, sizeof *o->sc);
-    o->rc = calloc((size_t)p, sizeof *o->rc);
+    o->sc = calloc((size_t)p * (size_t)R, sizeof *o->sc);
+    o->rc = calloc((size_t)p * (size_t)R, sizeof *o->rc);
     uint64_t *sum = calloc(o->nb, sizeof *sum);
     if (!o->hist || !o->at || !o->sc || !o->rc || !sum) {
         free(sum);
@@ -523,17 +655,19 @@ static pdt_status order_plan_make(drv *d, finals *f, order_plan *o, pdt_err *err
     pdt_status st = pdt_comm_allreduce_u64(d->c, sum, o->nb, PDT_COMM_SUM, err);
     if (st == PDT_OK) {
         note_all(d, TAG_ORDER, o->nb * sizeof *sum);
-        uint64_t total = 0, before = 0, pos = 0;
+        uint64_t total = 0, before = 0, pos[2] = {0, 0};
         for (size_t b = 0; b < o->nb; b++) total += sum[b];
         for (size_t b = 0; b < o->nb; b++) {
             uint64_t q = total ? (before + sum[b] / 2) * (uint64_t)p / total : 0;
+            int r = (int)(b % (size_t)R);
             before += sum[b];
-            o->sc[q < (uint64_t)p ? q : (uint64_t)p - 1] += o->hist[b];
-            o->at[b] = pos;
-            pos += o->hist[b];
+            o->sc[(q < (uint64_t)p ? q : (uint64_t)p - 1) * (uint64_t)R + (uint64_t)r] += o->hist[b];
+            o->at[b] = pos[r];
+            pos[r] += o->hist[b];
         }
-        st = pdt_comm_alltoall(d->c, o->sc, sizeof *o->sc, o->rc, err);
-        if (st == PDT_OK) note_all(d, TAG_COUNTS, sizeof *o->sc);
+        o->most = (size_t)(pos[0] > pos[1] ? pos[0] : pos[1]);
+        st = pdt_comm_alltoall(d->c, o->sc, (size_t)R * sizeof *o->sc, o->rc, err);
+        if (st == PDT_OK) note_all(d, TAG_COUNTS, (size_t)R * sizeof *o->sc);
     }
     free(sum);
     return st;
@@ -574,13 +708,12 @@ static size_t test_order_room(size_t cap)
     return e && *e && !*end && v < cap ? (size_t)v : cap;
 }
 
-static pdt_status order_room_grp(drv *d, order_room *o, const finals *f)
+static pdt_status order_room_grp(drv *d, order_room *o, const finals *f, size_t mine)
 {
-    size_t mine = f->n[0] + f->n[1];
-    o->blk = d->s.fin;
+    o->blk = d->s[0].fin;
     o->cap = o->blk ? test_order_room(d->blk_bytes / sizeof(pdt_tri)) : 0; /* (the strip's
                                                                               points are done) */
-    if (o->blk && f->n[0] + mine <= o->cap) {
+    if (o->blk && f->n[0] + mine + 1 <= o->cap) { /* (+ 1: a round's spare place) */
         o->grp = o->blk + f->n[0];
         return PDT_OK;
     }
@@ -589,9 +722,10 @@ static pdt_status order_room_grp(drv *d, order_room *o, const finals *f)
     return o->grp ? PDT_OK : nomem(d, "order");
 }
 
-static pdt_status order_room_out(drv *d, order_room *o, const finals *f, size_t total)
+static pdt_status order_room_out(drv *d, order_room *o, const finals *f, size_t grp,
+                                 size_t total)
 {
-    size_t busy = o->grp_own ? 0 : 2 * f->n[0] + f->n[1]; /* grp, until it has been sent */
+    size_t busy = o->grp_own ? 0 : f->n[0] + grp + 1; /* grp, until it has been sent */
     size_t got_at = busy > total ? busy : total;
     if (o->blk && got_at <= o->cap && o->cap - got_at >= total) {
         o->got = o->blk + got_at;
@@ -614,40 +748,60 @@ static pdt_status order_room_out(drv *d, order_room *o, const finals *f, size_t 
 static pdt_status order(drv *d, pdt_par_output *out, pdt_err *err)
 {
     int p = d->p;
-    finals f = {{d->s.fin, d->s.more}, {d->s.nfin, d->s.nmore}};
+    finals f = {{d->s[0].fin, d->more}, {d->s[0].nfin, d->nmore}};
     order_plan o = {0};
     order_room room = {0};
     size_t *cnt = calloc((size_t)p, sizeof *cnt), *rcnt = calloc((size_t)p, sizeof *rcnt);
-    size_t *len = calloc((size_t)p, sizeof *len);
-    const pdt_tri **src = calloc((size_t)p, sizeof *src);
+    size_t *len = calloc(2 * (size_t)p, sizeof *len);
+    const pdt_tri **src = calloc(2 * (size_t)p, sizeof *src);
     pdt_status st = cnt && rcnt && len && src ? PDT_OK : nomem(d, "order");
     if (st == PDT_OK) st = order_plan_make(d, &f, &o, err);
-    if (st == PDT_OK) st = order_room_grp(d, &room, &f);
+    if (st == PDT_OK) st = order_room_grp(d, &room, &f, o.most);
     if (st != PDT_OK) goto done;
-    for (int k = 0; k < 2; k++) pdt_tri_bucket_scatter(f.t[k], f.n[k], o.shift, o.at, room.grp);
     size_t total = 0;
-    for (int q = 0; q < p; q++) {
-        cnt[q] = (size_t)o.sc[q] * sizeof(pdt_tri);
-        rcnt[q] = (size_t)o.rc[q] * sizeof(pdt_tri);
-        total += (size_t)o.rc[q];
+    for (size_t i = 0; i < (size_t)p * (size_t)o.rounds; i++) total += (size_t)o.rc[i];
+    st = order_room_out(d, &room, &f, o.most, total);
+    /* round r: the triangles of its buckets grouped, sent, received behind
+     * the rounds before; each source's run of a round is in bucket order */
+    size_t off = 0;
+    uint8_t *in = o.rounds > 1 ? malloc(o.nb) : NULL;
+    uint64_t *at = o.rounds > 1 ? malloc(o.nb * sizeof *at) : NULL;
+    if (o.rounds > 1 && (!in || !at)) st = nomem(d, "order");
+    for (int r = 0; r < o.rounds && st == PDT_OK; r++) {
+        if (o.rounds == 1) {
+            for (int k = 0; k < 2; k++) pdt_tri_bucket_scatter(f.t[k], f.n[k], o.shift, o.at, room.grp);
+        } else {
+            for (size_t b = 0; b < o.nb; b++) { /* (the others: to the spare place) */
+                in[b] = b % (size_t)o.rounds == (size_t)r;
+                at[b] = in[b] ? o.at[b] : o.most;
+            }
+            for (int k = 0; k < 2; k++)
+                pdt_tri_bucket_scatter_round(f.t[k], f.n[k], o.shift, in, at, room.grp);
+        }
+        pdt_tri *into = room.got + off;
+        for (int q = 0; q < p; q++) {
+            size_t i = (size_t)q * (size_t)o.rounds + (size_t)r, j = (size_t)r * (size_t)p + (size_t)q;
+            cnt[q] = (size_t)o.sc[i] * sizeof(pdt_tri);
+            rcnt[q] = (size_t)o.rc[i] * sizeof(pdt_tri);
+            src[j] = room.got + off;
+            len[j] = (size_t)o.rc[i];
+            off += len[j];
+        }
+        st = pdt_comm_alltoallv(d->c, room.grp, cnt, into, rcnt, err);
+        if (st == PDT_OK) note_v(d, TAG_ORDER, cnt, rcnt);
     }
-    st = order_room_out(d, &room, &f, total);
-    if (st == PDT_OK) st = pdt_comm_alltoallv(d->c, room.grp, cnt, room.got, rcnt, err);
+    free(in);
+    free(at);
     if (st != PDT_OK) goto done;
-    note_v(d, TAG_ORDER, cnt, rcnt);
-    for (size_t q = 0, at = 0; q < (size_t)p; at += len[q], q++) { /* rank q's run, by bucket */
-        src[q] = room.got + at;
-        len[q] = (size_t)o.rc[q];
-    }
-    if (pdt_tri_bucket_order(src, len, (size_t)p, o.shift, room.out) != PDT_OK) {
+    if (pdt_tri_bucket_order(src, len, (size_t)p * (size_t)o.rounds, o.shift, room.out) != PDT_OK) {
         st = nomem(d, "order");
         goto done;
     }
-    free(d->s.more); /* every triangle went somewhere (itself included) */
-    d->s.more = NULL;
-    d->s.nmore = d->s.capmore = 0;
-    d->s.fin = NULL; /* the block is room.blk */
-    d->s.nfin = d->s.capfin = 0;
+    free(d->more); /* every triangle went somewhere (itself included) */
+    d->more = NULL;
+    d->nmore = 0;
+    d->s[0].fin = NULL; /* the block is room.blk */
+    d->s[0].nfin = d->s[0].capfin = 0;
     if (room.out == room.blk) {
         pdt_tri *shrunk = realloc(room.out, (total + 1) * sizeof *room.out);
         room.out = shrunk ? shrunk : room.out;
@@ -680,28 +834,34 @@ done:
 static void figures(drv *d)
 {
     pdt_par_rank_stats *me = d->me;
-    const srm_rank *s = &d->s;
     me->points = d->m;
     me->received = d->nrecv + d->local_dups;
     me->n_dup = me->received - d->m;
-    me->local_tris = s->cnt.local_tris;
-    me->final_at_once = s->cnt.final_at_once;
-    me->deferred = s->cnt.deferred;
-    me->shipped = s->cnt.shipped;
-    me->merges = s->cnt.merges;
-    me->border_max = s->cnt.border_max;
-    me->kept = s->cnt.kept;
-    me->discarded = s->cnt.discarded;
-    me->final_merge = s->cnt.final_merge;
     me->bytes_sent = d->bytes_sent;
     me->bytes_recv = d->bytes_recv;
     me->merge_bytes_sent = d->merge_sent;
     me->merge_bytes_recv = d->merge_recv;
-    me->critical_path = s->cnt.critical_path;
-    me->critical_cpu = s->cnt.critical_cpu;
-    me->holds_final_hull = s->holds_hull && pdt_srm_holder(d->rank, d->p, s->levels) == d->rank;
-    me->hull = s->nhull;
-    me->hull_degenerate = s->hull_degenerate;
+    me->strips = d->k > 1 ? d->k : 0;
+    for (int j = 0; j < d->k; j++) { /* the strips' counts summed; the longest chain */
+        const srm_rank *s = &d->s[j];
+        me->local_tris += s->cnt.local_tris;
+        me->final_at_once += s->cnt.final_at_once;
+        me->deferred += s->cnt.deferred;
+        me->shipped += s->cnt.shipped;
+        me->merges += s->cnt.merges;
+        if (s->cnt.border_max > me->border_max) me->border_max = s->cnt.border_max;
+        me->kept += s->cnt.kept;
+        me->discarded += s->cnt.discarded;
+        me->final_merge += s->cnt.final_merge;
+        if (s->cnt.critical_path > me->critical_path) me->critical_path = s->cnt.critical_path;
+        if (s->cnt.critical_cpu > me->critical_cpu) me->critical_cpu = s->cnt.critical_cpu;
+        int g = d->rank * d->k + j;
+        if (s->holds_hull && pdt_srm_holder(g, d->p * d->k, s->levels) == g) {
+            me->holds_final_hull = 1;
+            me->hull = s->nhull;
+            me->hull_degenerate = s->hull_degenerate;
+        }
+    }
 }
 
 static double cpu_seconds(void)
@@ -851,6 +1011,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
     enter("partition");
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_PARTITION, 0, 0, 0, 0);
     st = partition(&d, in, err);
+    if (st == PDT_OK) st = rank_strips(&d, in, err);
     if (st == PDT_OK) st = strips(&d, err);
     if (st != PDT_OK) goto done;
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_PARTITION, 0, 0, 0, 0);
@@ -866,7 +1027,10 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
     if (st == PDT_OK) st = pdt_comm_quiet_barrier(c, err);
     if (st != PDT_OK) goto done;
     double t3 = pdt_comm_wtime(c);
-    me->emitted = d.s.nfin + d.s.nmore;
+    if (st == PDT_OK) st = gather_more(&d);
+    if (st != PDT_OK) goto done;
+    me->emitted = d.s[0].nfin + d.nmore;
+    release_points(&d);
     enter("order");
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_ORDER, 0, 0, 0, 0);
     st = order(&d, out, err);
@@ -881,7 +1045,9 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
 done:
     enter(NULL);
     if (tr) tr->gid = saved_gid;
-    if (d.s_init) pdt_srm_free(&d.s);
+    for (int j = 0; j < PDT_RANK_MAX_STRIPS; j++)
+        if (d.s_init[j]) pdt_srm_free(&d.s[j]);
+    free(d.more);
     free(d.blk);
     free(d.strip);
     free(d.seq_send);

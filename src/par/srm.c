@@ -186,7 +186,16 @@ srm_strip pdt_srm_strip_of(const pdt_point *pts, size_t m)
 void pdt_srm_name(const srm_rank *s, int r, char *buf, size_t cap)
 {
     if (s->as_strips) snprintf(buf, cap, "strip %d of %d", r + 1, s->p);
+    else if (s->per_rank > 1)
+        snprintf(buf, cap, "rank %d (strip %d of %d)", r / s->per_rank, r % s->per_rank + 1,
+                 s->per_rank);
     else snprintf(buf, cap, "rank %d", r);
+}
+
+void pdt_srm_per_rank(srm_rank *s, int k)
+{
+    s->per_rank = k;
+    pdt_srm_name(s, s->rank, s->who, sizeof s->who);
 }
 
 void pdt_srm_as_strips(srm_rank *s)

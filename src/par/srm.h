@@ -183,7 +183,8 @@ typedef struct srm_counts {
 typedef struct srm_rank {
     int rank, p, levels;          /* levels = ceil(log2 p) */
     int as_strips;                /* 1: the strips of one plain run (plain.c), 0: ranks */
-    char who[40];                 /* how messages name it (pdt_srm_name) */
+    int per_rank;                 /* strips per rank in an MPI run (0, 1: one) */
+    char who[64];                 /* how messages name it (pdt_srm_name) */
     const srm_strip *strip;       /* p descriptors (not owned) */
     int *nonempty;                /* ranks with points, in order (x-sorted boxes) */
     int nne;
@@ -212,6 +213,13 @@ srm_strip pdt_srm_strip_of(const pdt_point *pts, size_t m);
 /* How messages name participant r of s's run: "rank R", or "strip R+1 of
  * P" among the strips of a plain run (s->as_strips). */
 void pdt_srm_name(const srm_rank *s, int r, char *buf, size_t cap);
+
+/* The strips a rank of an MPI run holds (driver.c: rank_strips), at most: */
+#define PDT_RANK_MAX_STRIPS 2
+
+/* After pdt_srm_init in an MPI run whose ranks hold k strips each: s and the
+ * others are named by rank and strip ("rank 1 (strip 2 of 2)"). */
+void pdt_srm_per_rank(srm_rank *s, int k);
 
 /* After pdt_srm_init in a plain run: s and the others are named as strips. */
 void pdt_srm_as_strips(srm_rank *s);
