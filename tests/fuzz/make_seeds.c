@@ -68,24 +68,32 @@ static void record(const char *dir, int rank, int nranks, size_t nev, int close_
     }
 }
 
+/* The manifest and points.bin of a seed's run folder: command, its line,
+ * pts[0..n), nranks ranks (off: their clock offsets), trace level. */
+static void write_meta(const char *dir, const char *command, const char *line,
+                       const pdt_point *pts, size_t n, int nranks, int level, int64_t *off)
+{
+    pdt_manifest m = {0};
+    m.format_version = PDT_TRACE_FORMAT_MAJOR;
+    snprintf(m.program_version, sizeof m.program_version, "%s", PDT_VERSION);
+    snprintf(m.command, sizeof m.command, "%s", command);
+    m.command_line = (char *)(uintptr_t)line;
+    m.input_name = (char *)"in.txt";
+    m.input_checksum = pdt_points_checksum(pts, n);
+    m.n = n;
+    m.nranks = nranks;
+    m.level = level;
+    m.clock_offset_ns = off;
+    m.wall_start_ns = 1700000000000000000ull;
+    pdt_err err = {0};
+    if (pdt_run_write_meta(dir, &m, pts, n, &err) != PDT_OK) die("meta", &err);
+}
+
 static void meta(const char *dir, int nranks)
 {
     pdt_point pts[5] = {{0, 0}, {10, 0}, {0, 10}, {7, 7}, {-3, 4}};
     int64_t off[4] = {0, 150, -20, 7};
-    pdt_manifest m = {0};
-    m.format_version = PDT_TRACE_FORMAT_MAJOR;
-    snprintf(m.program_version, sizeof m.program_version, "%s", PDT_VERSION);
-    snprintf(m.command, sizeof m.command, "triangulate");
-    m.command_line = (char *)"pdt triangulate in.txt --trace run\\x";
-    m.input_name = (char *)"in.txt";
-    m.input_checksum = pdt_points_checksum(pts, 5);
-    m.n = 5;
-    m.nranks = nranks;
-    m.level = 2;
-    m.clock_offset_ns = off;
-    m.wall_start_ns = 1700000000000000000ull;
-    pdt_err err = {0};
-    if (pdt_run_write_meta(dir, &m, pts, 5, &err) != PDT_OK) die("meta", &err);
+    write_meta(dir, "triangulate", "pdt triangulate in.txt --trace run\\x", pts, 5, nranks, 2, off);
 }
 
 /* A hull run as `pdt hull --trace` records it: Graham's scan of pts[0..n). */
@@ -99,19 +107,7 @@ static void record_hull(const char *dir, const pdt_point *pts, size_t n)
     if (n > 16 || pdt_hull_graham(pts, n, out, &nout, pdt_tw_hook(w)) != PDT_OK) die("hull", NULL);
     if (pdt_tw_close(w, &err) != PDT_OK) die("pdt_tw_close", &err);
     int64_t off = 0;
-    pdt_manifest m = {0};
-    m.format_version = PDT_TRACE_FORMAT_MAJOR;
-    snprintf(m.program_version, sizeof m.program_version, "%s", PDT_VERSION);
-    snprintf(m.command, sizeof m.command, "hull");
-    m.command_line = (char *)"pdt hull in.txt -o in.hull --trace run";
-    m.input_name = (char *)"in.txt";
-    m.input_checksum = pdt_points_checksum(pts, n);
-    m.n = n;
-    m.nranks = 1;
-    m.level = 1;
-    m.clock_offset_ns = &off;
-    m.wall_start_ns = 1700000000000000000ull;
-    if (pdt_run_write_meta(dir, &m, pts, n, &err) != PDT_OK) die("meta", &err);
+    write_meta(dir, "hull", "pdt hull in.txt -o in.hull --trace run", pts, n, 1, 1, &off);
 }
 
 /* trace_run's input for the one-rank run folder dir: manifest SEP points
