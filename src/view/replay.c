@@ -135,10 +135,10 @@ static int km_put(keymap *km, uint64_t hi, uint64_t lo, int32_t v, uint64_t limi
 
  * A streamed build (a kept index) holds its tables of objects within a
  * share of its budget (r->tab_limit): a table that outgrows it moves to a
- * temporary file's mapping (pdt_temp_zeros), where the pages the build
- * touched are given back every TICK_EVENTS events (tabs_give_back): a read
- * of them again faults them in from the page cache.  Such a table is in
- * r->ptab until tab_free unmaps it. */
+ * temporary file's mapping (pdt_temp_map, lengthened in place as it grows),
+ * where the pages the build touched are given back every TICK_EVENTS events
+ * (tabs_give_back): a read of them again faults them in from the page
+ * cache.  Such a table is in r->ptab until tab_free unmaps it. */
 
 #define TICK_EVENTS 65536u
 
@@ -156,7 +156,7 @@ static void tab_free(pdt_replay *r, void *p)
         free(p);
         return;
     }
-    munmap(p, r->ptab[i].bytes);
+    pdt_temp_map_free(&r->ptab[i]);
     r->ptab[i] = r->ptab[--r->nptab];
 }
 
@@ -169,10 +169,10 @@ static void *tab_new(pdt_replay *r, size_t bytes)
         if (p) pdt_big_advise(p, bytes);
         return p;
     }
-    void *p = pdt_temp_zeros(bytes);
-    if (!p) return NULL;
-    r->ptab[r->nptab++] = (struct pdt_ptab){p, bytes};
-    return p;
+    pdt_temp_map m = {0};
+    if (pdt_temp_map_new(&m, bytes) != 0) return NULL;
+    r->ptab[r->nptab++] = m;
+    return m.p;
 }
 
 /* grow() for a table of r: room for `need` entries of `elem` bytes, its
@@ -182,8 +182,14 @@ static int tab_grow(pdt_replay *r, void **p, size_t *cap, size_t need, size_t el
     if (need <= *cap) return 1;
     size_t c = *cap ? *cap : 64;
     while (c < need) c *= 2;
-    if (!r->tab_limit || (c * elem <= r->tab_limit && tab_paged(r, *p) < 0))
-        return grow(p, cap, need, elem);
+    int i = tab_paged(r, *p);
+    if (!r->tab_limit || (c * elem <= r->tab_limit && i < 0)) return grow(p, cap, need, elem);
+    if (i >= 0) { /* (paged: the file lengthened, its mapping moved if need be) */
+        if (pdt_temp_map_grow(&r->ptab[i], c * elem) != 0) return 0;
+        *p = r->ptab[i].p;
+        *cap = c;
+        return 1;
+    }
     void *q = tab_new(r, c * elem);
     if (!q) return 0;
     for (size_t o = 0, all = *cap * elem; o < all; o += (size_t)16 << 20) { /* (paged: a step

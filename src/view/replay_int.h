@@ -4,6 +4,7 @@
 #define PDT_REPLAY_INT_H
 
 #include "pdt/replay.h"
+#include "../geom/bigmem.h"
 
 /* Checkpoints a kept index holds, at most (index.c makes 17 at most). */
 #define PDT_ICK_MAX 24
@@ -58,7 +59,7 @@ void pdt_evsrc_clear(pdt_evsrc *s);
 /* 1 if the checksum of block b (its header and payload) matches. */
 int pdt_evsrc_block_ok(const pdt_evsrc *s, size_t b, uint32_t rank);
 
-#define PDT_PTAB_MAX 24  /* paged tables of a build at once (a keymap's two while it grows) */
+#define PDT_PTAB_MAX 24  /* paged tables of a build at once */
 
 typedef struct slot_change {
     uint32_t ev;
@@ -133,7 +134,7 @@ struct pdt_replay {
      * hulls, slot changes, Graham's per-point tables) that outgrow tab_limit
      * bytes live in temporary files' mappings (replay.c: tab_grow), their
      * pages given back as the build goes on: freed by munmap (tab_free). */
-    struct pdt_ptab { void *p; size_t bytes; } ptab[PDT_PTAB_MAX];
+    pdt_temp_map ptab[PDT_PTAB_MAX];
     int nptab;
     uint64_t tab_limit;    /* 0: every table in memory (pdt_replay_new) */
     int bbox_known;        /* pdt_replay_bbox's answer, found once */
