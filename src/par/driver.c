@@ -382,12 +382,14 @@ static pdt_status strips(drv *d, pdt_err *err)
  * points whose points may be spent (a .tri output), as a plain run's
  * (strips_for), when every rank's sample says the merge pays
  * (pdt_srm_plain_pays: one vote each, summed); else 1.
- * $PDT_RANK_STRIPS=1|2 decides for every size (tests). */
+ * $PDT_RANK_STRIPS=1|2 decides for every size and output format of an
+ * untraced run (tests). */
 static pdt_status rank_strips(drv *d, const pdt_par_input *in, pdt_err *err)
 {
     const char *t = getenv("PDT_RANK_STRIPS");
     int want = t && *t ? atoi(t) : 0;
-    int k = want ? want : !d->tr && in->release_pts && d->n_total >= ((uint64_t)1 << 21) ? 2 : 1;
+    int k = d->tr ? 1 /* (a traced run's events are the lessons': one strip a rank) */
+            : want ? want : in->release_pts && d->n_total >= ((uint64_t)1 << 21) ? 2 : 1;
     k = k >= 2 ? 2 : 1;
     if (!want && k == 2) {
         uint64_t votes = (uint64_t)pdt_srm_plain_pays(block_pts(d), d->m);

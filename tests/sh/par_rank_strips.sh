@@ -30,9 +30,20 @@ done
 mpirun -np 2 -x PDT_RANK_STRIPS=2 "$PDT" triangulate uniform.txt -o s.tri --stats 2> stats.err > /dev/null
 case "$(grep '^{' stats.err)" in *'"strips": 2'*'"strips": 2'*) ok stats_say_two_strips ;;
     *) fail stats_say_two_strips "$(grep '^{' stats.err | head -c 300)" ;; esac
-# a traced run keeps one strip per rank (its events are the lessons')
-mpirun -np 2 -x PDT_RANK_STRIPS= "$PDT" triangulate uniform.txt -o t.tri --trace trun --stats \
+# a traced run keeps one strip per rank (its events are the lessons'), even
+# when asked for two
+mpirun -np 2 -x PDT_RANK_STRIPS=2 "$PDT" triangulate uniform.txt -o t.tri --trace trun --stats \
     2> tstats.err > /dev/null
 case "$(grep '^{' tstats.err)" in *'"strips": 2'*) fail traced_one_strip ;; *) ok traced_one_strip ;; esac
 cmp -s t.tri uniform.ref.tri && ok traced_same_output || fail traced_same_output
+"$PDT" trace check trun > tcheck.out 2>&1 && ok traced_run_checks || fail traced_run_checks "$(tail -2 tcheck.out)"
+# the other formats (the points written from each rank's input block)
+for fmt in ele off; do
+    "$PDT" triangulate uniform.txt -o ref.$fmt 2>/dev/null
+    mpirun -np 3 -x PDT_RANK_STRIPS=2 "$PDT" triangulate uniform.txt -o two.$fmt > /dev/null 2>&1
+    same=1
+    cmp -s ref.$fmt two.$fmt || same=0
+    [ $fmt = ele ] && { cmp -s ref.node two.node || same=0; }
+    [ $same = 1 ] && ok "format_${fmt}_two_strips" || fail "format_${fmt}_two_strips"
+done
 summary
