@@ -8,8 +8,19 @@
 #ifndef PDT_TEST_HARNESS_H
 #define PDT_TEST_HARNESS_H
 
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+
+/* One step of the xorshift64 generator the tests draw their random inputs
+ * from (each test program keeps its own state, seeded its own way). */
+static inline uint64_t th_xorshift(uint64_t *s)
+{
+    *s ^= *s << 13;
+    *s ^= *s >> 7;
+    *s ^= *s << 17;
+    return *s;
+}
 
 static int th_failed_checks;  /* in the current test case */
 static int th_cases_passed, th_cases_failed;

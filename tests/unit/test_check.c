@@ -15,13 +15,7 @@ static pdt_point P(int x, int y)
 }
 
 static uint64_t rs = 0xD1B54A32D192ED03u;
-static uint64_t xr(void)
-{
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
+static uint64_t xr(void) { return th_xorshift(&rs); }
 
 static pdt_status check(const pdt_point *p, size_t n, const pdt_tri *t, size_t nt, pdt_err *err)
 {

@@ -20,13 +20,7 @@ static pdt_point P(int x, int y)
 }
 
 static uint64_t rs = 0x9E3779B97F4A7C15u;
-static uint64_t xr(void)
-{
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
+static uint64_t xr(void) { return th_xorshift(&rs); }
 
 /* pdt_triangulate == pdt_brute_delaunay, and the checker accepts it; returns 1 if so.  *nt gets the
  * triangle count. */

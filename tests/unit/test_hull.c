@@ -13,13 +13,7 @@ static pdt_point P(int x, int y)
 }
 
 static uint64_t rs = 0x2545F4914F6CDD1Du;
-static uint64_t xr(void)
-{
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
+static uint64_t xr(void) { return th_xorshift(&rs); }
 
 static int same(pdt_point a, pdt_point b)
 {

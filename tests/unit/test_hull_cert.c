@@ -14,13 +14,7 @@
 #include "pdt/predicates.h"
 
 static uint64_t rs = 0x9E3779B97F4A7C15u;
-static uint64_t xr(void)
-{
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
+static uint64_t xr(void) { return th_xorshift(&rs); }
 
 /* n points on a (side x side) grid offset by (x0, y0): many copies and
  * collinear points when side is small. */

@@ -177,13 +177,7 @@ static int ref_sos(pdt_point a, pdt_point b, pdt_point c, pdt_point d)
 }
 
 static uint64_t rs = 88172645463325252u;
-static uint64_t xr(void)
-{
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
+static uint64_t xr(void) { return th_xorshift(&rs); }
 
 static int32_t extreme_coord(void)
 {
