@@ -587,10 +587,10 @@ static pdt_status kernel_on(uint32_t *id, pdt_point *q, size_t n, edge *e, size_
     c.ks = c.k + n;
     c.tp = (uint32_t *)(void *)(c.ks + n);
     c.tq = (pdt_point *)(void *)(c.tp + n);
-    /* the first cut across the longer side (then the sides alternate): a
-     * strip twice as tall as wide cut first by y, so that no merge seam runs
-     * its whole height (a strip taller than wide: y first); traced runs keep the x cut first (their events are
-     * the lessons') */
+    /* the first cut across the longer side of the points' box (then the
+     * sides alternate): a strip taller than wide is cut first by y, so that
+     * no merge seam runs its whole height; traced runs keep the x cut first
+     * (their events are the lessons') */
     int axis = !tr && (int64_t)maxy - miny > (int64_t)maxx - minx ? 1 : 0;
     cut_order(&c, 0, (uint32_t)n, axis);
     d.p = q;

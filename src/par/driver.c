@@ -409,7 +409,7 @@ static pdt_status local(drv *d, int prefault, pdt_err *err)
 {
     int k = d->k;
     pdt_status st = PDT_OK;
-    for (int j = 0; j < k && st == PDT_OK; j++) {
+    for (int j = 0; j < k; j++) {
         srm_rank *s = &d->s[j];
         st = pdt_srm_init(s, d->rank * k + j, d->p * k, d->strip, d->tr, err);
         if (st != PDT_OK) return st;
@@ -1029,7 +1029,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
     if (st == PDT_OK) st = pdt_comm_quiet_barrier(c, err);
     if (st != PDT_OK) goto done;
     double t3 = pdt_comm_wtime(c);
-    if (st == PDT_OK) st = gather_more(&d);
+    st = gather_more(&d);
     if (st != PDT_OK) goto done;
     me->emitted = d.s[0].nfin + d.nmore;
     release_points(&d);

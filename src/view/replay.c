@@ -190,15 +190,10 @@ static int tab_grow(pdt_replay *r, void **p, size_t *cap, size_t need, size_t el
         *cap = c;
         return 1;
     }
-    void *q = tab_new(r, c * elem);
+    void *q = tab_new(r, c * elem); /* (a table in memory outgrowing the limit: paged) */
     if (!q) return 0;
-    for (size_t o = 0, all = *cap * elem; o < all; o += (size_t)16 << 20) { /* (paged: a step
-                                                 * at a time, its pages given back) */
-        size_t k = all - o < ((size_t)16 << 20) ? all - o : ((size_t)16 << 20);
-        memcpy((char *)q + o, (const char *)*p + o, k);
-        pdt_replay_tab_release(r, (char *)q + o, k);
-        pdt_replay_tab_release(r, (const char *)*p + o, k);
-    }
+    memcpy(q, *p, *cap * elem); /* (at most tab_limit bytes) */
+    pdt_replay_tab_release(r, q, *cap * elem);
     tab_free(r, *p);
     *p = q;
     *cap = c;

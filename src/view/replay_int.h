@@ -133,7 +133,7 @@ struct pdt_replay {
     /* A streamed build's tables (edges, stacks, phases, merges, messages,
      * hulls, slot changes, Graham's per-point tables) that outgrow tab_limit
      * bytes live in temporary files' mappings (replay.c: tab_grow), their
-     * pages given back as the build goes on: freed by munmap (tab_free). */
+     * pages given back as the build goes on (freed by tab_free). */
     pdt_temp_map ptab[PDT_PTAB_MAX];
     int nptab;
     uint64_t tab_limit;    /* 0: every table in memory (pdt_replay_new) */
