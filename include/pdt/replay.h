@@ -284,6 +284,7 @@ typedef struct pdt_replay_open_info {
     uint64_t build_bytes;    /* the build's working memory at most (its buffers,
                               * and the state it steps for the checkpoints),
                               * besides the run's points and the small tables */
+    uint32_t build_buckets;  /* the buckets its triangle events were grouped in */
     char path[4096];         /* the index file */
     char why[160];           /* why an index found was not used ("stale: ...", "damaged: ...") */
     char write_error[1024];   /* why no index could be written (then: in memory) */

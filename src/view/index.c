@@ -1501,7 +1501,8 @@ static void clean_stale_temps(const char *path)
 
 /* Build the index of run at `path` (temporary file + rename). */
 static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks, uint64_t ident,
-                        const char *path, uint64_t budget, uint64_t *work, pdt_err *err)
+                        const char *path, uint64_t budget, uint64_t *work, uint32_t *buckets,
+                        pdt_err *err)
 {
     char tmp[PATH_MAX + 128];
     clean_stale_temps(path);
@@ -1566,6 +1567,7 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         pdt_run_release_points(run);  /* (written from them) */
         *work = r->build_peak + (r->state_paged ? 0 : pdt_replay_state_bytes(r)); /* (the
                                                             * checkpoints' state, when held) */
+        *buckets = r->build_buckets;
         r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
     }
     pdt_replay_free(r);
@@ -1684,7 +1686,8 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
                 if (!cache_dir(cdir, sizeof cdir) || !make_dirs(cdir)) continue;
             }
             pdt_err e2 = {0};
-            if (build(run, pts, n, nranks, ident, path, budget, &info->build_bytes, &e2) != PDT_OK) {
+            if (build(run, pts, n, nranks, ident, path, budget, &info->build_bytes,
+                      &info->build_buckets, &e2) != PDT_OK) {
                 snprintf(info->write_error, sizeof info->write_error, "%s", e2.msg);
                 pdt_err_clear(&e2);
                 continue;

@@ -817,8 +817,9 @@ int main(int argc, char **argv)
                "cpu %.3f s + %.3f s)\n", pdt_replay_count(r), L.n, L.nranks, pdt_seconds() - t0,
                t1 - t0, pdt_seconds() - t1, c1 - c0, cpu_s() - c1);
         if (info.indexed && info.built)
-            printf("index build: working memory %.1f MiB (budget %.1f MiB)\n",
-                   (double)info.build_bytes / 1048576.0, (double)o.mem / 1048576.0);
+            printf("index build: working memory %.1f MiB (budget %.1f MiB; triangle events "
+                   "grouped in %u buckets)\n", (double)info.build_bytes / 1048576.0,
+                   (double)o.mem / 1048576.0, (unsigned)info.build_buckets);
         if (info.indexed)
             printf("kept index %s: %s%s%s\n", info.path,
                    info.built ? "built at this opening" : "mapped", *info.why ? "; " : "", info.why);

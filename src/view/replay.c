@@ -315,7 +315,7 @@ static uint64_t key_hash(const uint32_t s[3])
     return mix(((uint64_t)s[0] << 32) | s[1], s[2]);
 }
 
-static size_t fine_of(const uint32_t s[3]) { return (size_t)(key_hash(s) >> (64 - FINE_BITS)); }
+static size_t fine_of(const uint32_t s[3], unsigned bits) { return (size_t)(key_hash(s) >> (64 - bits)); }
 
 size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks)
 {
@@ -325,7 +325,7 @@ size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks)
         return NFINE;
     uint32_t in[3] = {e->a, e->b, e->c}, s[3];
     sort3(s, in);
-    return fine_of(s);
+    return fine_of(s, FINE_BITS);
 }
 
 /* A chunk of a spill: where, whose (fine bucket, or window of points), how
@@ -348,10 +348,15 @@ typedef struct builder {
     int32_t *cur;   /* per rank * PDT_SLOT_PER_RANK */
     int32_t *lastst;     /* per rank: the stack touched last (HULL reports it) */
     keymap edge_map, msg_map;
+    /* the fine buckets: 2^fine_bits of them (FINE_BITS held in memory;
+     * streamed, bucket_plan), the records buffered per bucket in pass 1
+     * (fbuf_recs) and per cursor after it (cur_recs) */
+    unsigned fine_bits;
+    size_t nfine, fbuf_recs, cur_recs;
     size_t *fine_fill;    /* per fine bucket: the next free history entry (pass 1) */
-    size_t *fine_off;     /* per fine bucket: its first history entry; NFINE + 1 */
+    size_t *fine_off;     /* per fine bucket: its first history entry; nfine + 1 */
     const pdt_replay_place *pl;  /* streamed: the place, and per fine bucket a buffer */
-    tri_xrec *fbuf;       /* NFINE * FBUF records */
+    tri_xrec *fbuf;       /* nfine * fbuf_recs records */
     tri_rec *spill;       /* not streamed: the triangle events by fine bucket */
     /* streamed: the spill is written a buffer (a chunk) at a time, where it
      * ends; chunk k of fine bucket f is chunk[ck_start[f] + k] after pass 1 */
@@ -367,7 +372,7 @@ typedef struct builder {
     int32_t *wobj;
     uint8_t *wkind;
     size_t wlo;
-    size_t *tcount;       /* streamed: triangles per fine bucket (NFINE) */
+    size_t *tcount;       /* streamed: triangles per fine bucket (nfine) */
     /* streamed: what lifts and pushes do to points (pt_rec), spilled by
      * point window (PT_WINDOW points each) to PDT_SCR_POINTS in chunks */
     struct pt_rec *pbuf;  /* npw * PBUF records */
@@ -506,7 +511,7 @@ static int fine_flush(builder *b, size_t f)
 {
     size_t k = b->fbn[f];
     b->fbn[f] = 0;
-    return spill_put(b, PDT_SCR_SPILL, &b->tlog, b->fbuf + f * FBUF, k, sizeof(tri_xrec), f);
+    return spill_put(b, PDT_SCR_SPILL, &b->tlog, b->fbuf + f * b->fbuf_recs, k, sizeof(tri_xrec), f);
 }
 
 /* Streamed pass 1: have events i .. i + PREFETCH_AHEAD (or to the end) in
@@ -534,8 +539,8 @@ static int win_fill(builder *b, size_t i, pdt_err *err)
  * bucket's in the order written (its events' order). */
 static int chunks_by_bucket(builder *b)
 {
-    b->ck_start = calloc(NFINE + 1, sizeof *b->ck_start);
-    return b->ck_start && spill_group(&b->tlog, NFINE, b->ck_start);
+    b->ck_start = calloc(b->nfine + 1, sizeof *b->ck_start);
+    return b->ck_start && spill_group(&b->tlog, b->nfine, b->ck_start);
 }
 
 static int set_slot(builder *b, uint32_t ev, int rank, int slot, int32_t val)
@@ -773,7 +778,7 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
         sort3(t.s, in);
         t.ev = i;
         int border = e->kind == PDT_EV_TRI_NEW && e->sub == 1;
-        size_t f = fine_of(t.s);
+        size_t f = fine_of(t.s, b->fine_bits);
         if (!b->pl) { /* for hist_of, until the grouping writes these two */
             r->ev_ent[i] = e->sub;
             r->ev_obj[i] = border ? cur[PDT_SLOT_MERGE] : -1;
@@ -781,12 +786,12 @@ static int index_event(builder *b, uint32_t i, const pdt_rec *rec, uint8_t *lift
             return 1;
         }
         /* (streamed: fine_fill counts the bucket's events) */
-        b->fbuf[f * FBUF + b->fbn[f]++] =
+        b->fbuf[f * b->fbuf_recs + b->fbn[f]++] =
             (tri_xrec){{t.s[0], t.s[1], t.s[2]}, i,
                        border ? XREC_BORDER | (uint32_t)(cur[PDT_SLOT_MERGE] + 1)
                               : (uint32_t)e->kind | (uint32_t)e->sub << 8};
         b->fine_fill[f]++;
-        return b->fbn[f] < FBUF || fine_flush(b, f);
+        return b->fbn[f] < b->fbuf_recs || fine_flush(b, f);
     }
 }
 
@@ -1087,16 +1092,20 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
     size_t cap = budget ? (size_t)(budget / GROUP_BYTES_PER_EVENT / GROUP_THREADS) : SIZE_MAX;
     if (cap < 1024) cap = 1024;
     if (b->pl && cap > GROUP_RUN_MAX) cap = GROUP_RUN_MAX;
-    size_t run[NFINE + 1], nrun = 0, most = 0;  /* the runs' bounds; the largest run */
+    size_t *run = malloc((b->nfine + 1) * sizeof *run), nrun = 0, most = 0; /* the runs' bounds; the largest run */
+    if (!run) return 0;
     run[0] = 0;
-    for (size_t f = 0; f < NFINE;) {
+    for (size_t f = 0; f < b->nfine;) {
         size_t g = f + 1;
-        while (g < NFINE && b->fine_off[g + 1] - b->fine_off[f] <= cap) g++;
+        while (g < b->nfine && b->fine_off[g + 1] - b->fine_off[f] <= cap) g++;
         if (b->fine_off[g] - b->fine_off[f] > most) most = b->fine_off[g] - b->fine_off[f];
         run[++nrun] = g;
         f = g;
     }
-    if (!most) return 1;
+    if (!most) {
+        free(run);
+        return 1;
+    }
     group_job J = {.b = b, .run = run, .nrun = nrun, .most = most};
     pthread_t th[GROUP_THREADS];
     int started = 0;
@@ -1111,6 +1120,7 @@ static int tri_groups(builder *b, uint64_t budget, size_t *ntri)
     (b->pl ? group_worker_streamed : group_worker)(&J);
     for (int t = 1; t < GROUP_THREADS; t++)
         if (started & (1 << t)) pthread_join(th[t], NULL);
+    free(run);
     if (J.failed) {
         if (J.io) b->failed = 1;
         return 0;
@@ -1182,14 +1192,14 @@ static int tri_ids(builder *b)
  * the numbers of the largest bucket's triangles in tri_join). */
 
 #define NUM_WINDOW ((size_t)1 << 18)  /* events per window (tri_number, ev_tables) */
-#define CUR_RECS 512u                 /* records buffered per bucket */
+#define CUR_RECS 512u                 /* records buffered per cursor, at most */
 
 /* Records of `rec` bytes, read in order from `left` of them at `at` of
- * scratch file `file`, CUR_RECS at a time. */
+ * scratch file `file`, cap at a time (a bucket's: the builder's cur_recs). */
 typedef struct bcur {
     int file;
     uint64_t at;
-    size_t left, rec, n, i;
+    size_t left, rec, n, i, cap;  /* cap: records the buffer holds */
     unsigned char *buf;
 } bcur;
 
@@ -1198,7 +1208,7 @@ static const void *bcur_peek(builder *b, bcur *c)
 {
     if (c->i < c->n) return c->buf + c->i * c->rec;
     if (!c->left) return NULL;
-    size_t k = c->left < CUR_RECS ? c->left : CUR_RECS;
+    size_t k = c->left < c->cap ? c->left : c->cap;
     if (!b->pl->sget(b->pl->ctx, c->file, c->at, c->buf, k * c->rec)) {
         b->failed = 1;
         c->left = 0;
@@ -1212,7 +1222,7 @@ static const void *bcur_peek(builder *b, bcur *c)
 }
 
 /* Records appended at `at` of scratch file `file` (file < 0: of the place),
- * CUR_RECS at a time.  0 when a write failed. */
+ * cap at a time.  0 when a write failed. */
 static int bput_flush(builder *b, bcur *c)
 {
     if (!c->n) return 1;
@@ -1228,29 +1238,30 @@ static int bput_flush(builder *b, bcur *c)
 static int bput(builder *b, bcur *c, const void *p)
 {
     memcpy(c->buf + c->n * c->rec, p, c->rec);
-    return ++c->n < CUR_RECS || bput_flush(b, c);
+    return ++c->n < c->cap || bput_flush(b, c);
 }
 
-/* NFINE cursors over records of rec bytes with one buffer; NULL when out of memory. */
+/* nfine cursors over records of rec bytes with one buffer; NULL when out of memory. */
 static bcur *bcurs_new(builder *b, size_t rec)
 {
-    bcur *c = bmalloc(b, NFINE * sizeof *c);
-    unsigned char *buf = bmalloc(b, (size_t)NFINE * CUR_RECS * rec);
+    bcur *c = bmalloc(b, b->nfine * sizeof *c);
+    unsigned char *buf = bmalloc(b, (size_t)b->nfine * b->cur_recs * rec);
     if (!c || !buf) {
-        bfree(b, c, NFINE * sizeof *c);
-        bfree(b, buf, (size_t)NFINE * CUR_RECS * rec);
+        bfree(b, c, b->nfine * sizeof *c);
+        bfree(b, buf, (size_t)b->nfine * b->cur_recs * rec);
         return NULL;
     }
-    memset(c, 0, NFINE * sizeof *c);
-    for (size_t f = 0; f < NFINE; f++) c[f].buf = buf + f * CUR_RECS * rec, c[f].rec = rec;
+    memset(c, 0, b->nfine * sizeof *c);
+    for (size_t f = 0; f < b->nfine; f++)
+        c[f].buf = buf + f * b->cur_recs * rec, c[f].rec = rec, c[f].cap = b->cur_recs;
     return c;
 }
 
 static void bcurs_free(builder *b, bcur *c, size_t rec)
 {
     if (!c) return;
-    bfree(b, c[0].buf, (size_t)NFINE * CUR_RECS * rec);
-    bfree(b, c, NFINE * sizeof *c);
+    bfree(b, c[0].buf, (size_t)b->nfine * b->cur_recs * rec);
+    bfree(b, c, b->nfine * sizeof *c);
 }
 
 /* Number the triangles by their first events: the triangle table and the
@@ -1272,7 +1283,7 @@ static int tri_number(builder *b)
     hw.buf = bmalloc(b, CUR_RECS * sizeof(pdt_rtri_hist));
     int ok = tc && ic && hc && wn && wf && tw.buf && hw.buf;
     if (ok) {
-        for (size_t f = 0; f < NFINE; f++) {
+        for (size_t f = 0; f < b->nfine; f++) {
             tc[f].file = PDT_SCR_TRIS;
             tc[f].at = (uint64_t)b->fine_off[f] * sizeof(tri_first);
             tc[f].left = b->tcount[f];
@@ -1285,6 +1296,7 @@ static int tri_number(builder *b)
         tw.file = hw.file = -1;
         tw.at = r->tris_at;
         tw.rec = sizeof(pdt_rtri);
+    tw.cap = hw.cap = CUR_RECS;
         hw.at = r->hist_at;
         hw.rec = sizeof(pdt_rtri_hist);
     }
@@ -1293,7 +1305,7 @@ static int tri_number(builder *b)
     for (size_t lo = 0; ok && lo < r->m; lo += NUM_WINDOW) {
         size_t hi = r->m - lo < NUM_WINDOW ? r->m : lo + NUM_WINDOW;
         memset(wn, 0, (hi - lo) * sizeof *wn);
-        for (size_t f = 0; f < NFINE; f++) {
+        for (size_t f = 0; f < b->nfine; f++) {
             const tri_first *t;
             while ((t = bcur_peek(b, &tc[f])) && t->ev < hi) {
                 if (t->ev < lo || !t->n) { /* (not in event order: never written so) */
@@ -1320,7 +1332,7 @@ static int tri_number(builder *b)
         }
         ok = ok && !b->failed;
     }
-    for (size_t f = 0; ok && f < NFINE; f++) ok = bput_flush(b, &ic[f]);
+    for (size_t f = 0; ok && f < b->nfine; f++) ok = bput_flush(b, &ic[f]);
     ok = ok && bput_flush(b, &tw) && bput_flush(b, &hw) && h0 == r->nhist;
     bfree(b, tw.buf, CUR_RECS * sizeof(pdt_rtri));
     bfree(b, hw.buf, CUR_RECS * sizeof(pdt_rtri_hist));
@@ -1338,13 +1350,13 @@ static int tri_number(builder *b)
 static int tri_join(builder *b)
 {
     size_t most = 0;
-    for (size_t f = 0; f < NFINE; f++)
+    for (size_t f = 0; f < b->nfine; f++)
         if (b->tcount[f] > most) most = b->tcount[f];
     enum { JOIN_RECS = 1 << 16 };
     uint32_t *ids = bmalloc(b, most * sizeof *ids);
     tri_ev *ev = bmalloc(b, JOIN_RECS * sizeof *ev);
     int ok = ids && ev;
-    for (size_t f = 0; ok && f < NFINE; f++) {
+    for (size_t f = 0; ok && f < b->nfine; f++) {
         ok = !b->tcount[f] || b->pl->sget(b->pl->ctx, PDT_SCR_IDS, (uint64_t)b->fine_off[f] * sizeof *ids,
                                          ids, b->tcount[f] * sizeof *ids);
         for (size_t j = b->fine_off[f]; ok && j < b->fine_off[f + 1]; j += JOIN_RECS) {
@@ -1379,7 +1391,7 @@ static int ev_tables(builder *b)
     int32_t *obj = bmalloc(b, NUM_WINDOW * sizeof *obj);
     uint8_t *kind = bmalloc(b, NUM_WINDOW);
     int ok = ec && obj && kind;
-    for (size_t f = 0; ok && f < NFINE; f++) {
+    for (size_t f = 0; ok && f < b->nfine; f++) {
         ec[f].file = PDT_SCR_TRIEV;
         ec[f].at = (uint64_t)b->fine_off[f] * sizeof(tri_ev);
         ec[f].left = b->fine_off[f + 1] - b->fine_off[f];
@@ -1388,7 +1400,7 @@ static int ev_tables(builder *b)
         size_t hi = r->m - lo < NUM_WINDOW ? r->m : lo + NUM_WINDOW, k = hi - lo;
         ok = pl->get(pl->ctx, r->evobj_at + (uint64_t)lo * sizeof *obj, obj, k * sizeof *obj) &&
              pl->get(pl->ctx, r->evkind_at + lo, kind, k);
-        for (size_t f = 0; ok && f < NFINE; f++) {
+        for (size_t f = 0; ok && f < b->nfine; f++) {
             const tri_ev *t;
             while ((t = bcur_peek(b, &ec[f])) && t->ev < hi) {
                 if (t->ev < lo) {
@@ -1492,6 +1504,79 @@ static uint64_t held_bytes(size_t n)
     return (uint64_t)n * sizeof(pdt_point) + ((uint64_t)16 << 20);
 }
 
+/* tri_groups' share of a streamed build's budget: what the replay does not hold. */
+static uint64_t group_work(const pdt_replay *r, uint64_t budget)
+{
+    uint64_t held = held_bytes(r->n);
+    return budget > held + budget / 4 ? budget - held : budget / 4;
+}
+
+/* Fine bits a streamed build may use at most (tri_number keeps a bucket's
+ * number in 16 bits). */
+#define FINE_BITS_MAX 16u
+/* What the streamed grouping holds per event of its bucket, with a margin
+ * (it measures under 70 bytes per event of the run: a bucket's triangle
+ * events, their hash table, groups and entries). */
+#define GROUP_EVENT_EST PDT_REPLAY_GROUP_EVENT_EST
+/* The least room planned for the grouping, whatever the budget (below it,
+ * more and smaller buckets only make the build slower: 2^11 buckets made
+ * the 10^7-point run's build 15-20 % slower than 2^8). */
+#define PLAN_ROOM_MIN ((uint64_t)64 << 20)
+
+/* What a plan holds: one bucket's grouping, the buckets' buffers (pass 1's
+ * records, the cursors' three records) and what a bucket costs besides,
+ * and the spill's chunk table (a chunk per fbuf records). */
+static uint64_t plan_bytes(uint64_t m, unsigned bits, uint64_t fbuf, uint64_t cur)
+{
+    uint64_t nf = (uint64_t)1 << bits;
+    return ((m >> bits) + 1) * GROUP_EVENT_EST +
+           nf * (fbuf * sizeof(tri_xrec) + cur * (sizeof(tri_first) + 4 + sizeof(pdt_rtri_hist)) + 160) +
+           (m / fbuf + nf) * sizeof(spill_chunk);
+}
+
+/* The fine buckets of a streamed build (the kept index; replay_int.h):
+ * the grouping holds at least one whole bucket, and more buckets make the
+ * build slower, so the fewest (from 2^8, doubling; the largest buffers
+ * first) whose plan_bytes fit half the budget (or PLAN_ROOM_MIN: 2^8 with
+ * full buffers for every run up to 1.3·10^9 events at the default budget,
+ * 1.5·10^8 under any); when none does, the plan that holds least (2^8 to
+ * 2^16 buckets, buffers of 32 to 1024 records). */
+unsigned pdt_replay_plan_buckets(uint64_t m, uint64_t budget, size_t *fbuf_recs, size_t *cur_recs,
+                                 uint64_t *bytes)
+{
+    uint64_t room = budget / 2 > PLAN_ROOM_MIN ? budget / 2 : PLAN_ROOM_MIN;
+    unsigned best_bits = FINE_BITS;
+    uint64_t best_f = FBUF, best_c = CUR_RECS, best = UINT64_MAX;
+    for (unsigned bits = FINE_BITS; bits <= FINE_BITS_MAX && best > room; bits++)
+        for (uint64_t f = FBUF; f >= 32 && best > room; f /= 2) {
+            uint64_t c = f < CUR_RECS ? f : CUR_RECS, got = plan_bytes(m, bits, f, c);
+            if (got < best) best = got, best_bits = bits, best_f = f, best_c = c;
+        }
+    *fbuf_recs = (size_t)best_f;
+    *cur_recs = (size_t)best_c;
+    if (bytes) *bytes = best;
+    return best_bits;
+}
+
+/* The builder's fine buckets (fine_bits, nfine) and buffers (fbuf_recs,
+ * cur_recs): held in memory, 2^FINE_BITS; streamed, as planned, or as
+ * $PDTVIEW_BUCKETS says (a power of two from 2^8 to 2^16: the tests' runs
+ * are far below where the plan changes). */
+static void bucket_plan(builder *b, uint64_t m, uint64_t budget)
+{
+    b->fine_bits = FINE_BITS;
+    b->fbuf_recs = FBUF;
+    b->cur_recs = CUR_RECS;
+    if (b->pl) {
+        b->fine_bits = pdt_replay_plan_buckets(m, budget, &b->fbuf_recs, &b->cur_recs, NULL);
+        const char *env = getenv("PDTVIEW_BUCKETS");
+        unsigned long want = env ? strtoul(env, NULL, 10) : 0;
+        for (unsigned bits = FINE_BITS; bits <= FINE_BITS_MAX; bits++)
+            if (want == 1ul << bits) b->fine_bits = bits;
+    }
+    b->nfine = (size_t)1 << b->fine_bits;
+}
+
 static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
 {
     builder b;
@@ -1501,8 +1586,9 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
     b.cur = malloc((nslot ? nslot : 1) * sizeof *b.cur);
     b.lastst = calloc((size_t)r->nranks + 1, sizeof *b.lastst);
-    b.fine_fill = calloc(NFINE, sizeof *b.fine_fill);
-    b.fine_off = calloc(NFINE + 1, sizeof *b.fine_off);
+    bucket_plan(&b, r->m, pl ? pl->budget : 0);
+    b.fine_fill = calloc(b.nfine, sizeof *b.fine_fill);
+    b.fine_off = calloc(b.nfine + 1, sizeof *b.fine_off);
     uint8_t *lifted_any = calloc((size_t)r->nranks + 1, 1);
     pdt_status st = PDT_ERR_NOMEM;
     if (!b.cur || !b.lastst || !lifted_any || !b.fine_fill || !b.fine_off) goto out;
@@ -1518,27 +1604,27 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
             const pdt_rec *rec = rec_at(r, i);
             if (rec->ev.kind < PDT_EV_KIND_COUNT) cnt[rec->ev.kind]++;
             size_t f = pdt_replay_fine_of(rec, r->n, r->nranks);
-            if (f < NFINE) b.fine_off[f + 1]++;
+            if (f < b.nfine) b.fine_off[f + 1]++;
         }
-        for (size_t f = 0; f < NFINE; f++) b.fine_off[f + 1] += b.fine_off[f];
-        memcpy(b.fine_fill, b.fine_off, NFINE * sizeof *b.fine_fill);
-        r->nhist = b.fine_off[NFINE];
+        for (size_t f = 0; f < b.nfine; f++) b.fine_off[f + 1] += b.fine_off[f];
+        memcpy(b.fine_fill, b.fine_off, b.nfine * sizeof *b.fine_fill);
+        r->nhist = b.fine_off[b.nfine];
         if (pl) {
             r->streamed = 1;
             r->evobj_at = pl->evobj_at;
             r->evkind_at = pl->evkind_at;
-            b.fbuf = bmalloc(&b, NFINE * FBUF * sizeof *b.fbuf);
-            b.fbn = calloc(NFINE, sizeof *b.fbn);
+            b.fbuf = bmalloc(&b, b.nfine * b.fbuf_recs * sizeof *b.fbuf);
+            b.fbn = calloc(b.nfine, sizeof *b.fbn);
             b.win = bmalloc(&b, WIN * sizeof *b.win);
             b.wobj = bmalloc(&b, EVW * sizeof *b.wobj);
             b.wkind = bmalloc(&b, EVW);
-            b.tcount = calloc(NFINE, sizeof *b.tcount);
+            b.tcount = calloc(b.nfine, sizeof *b.tcount);
             b.npw = (r->n + PT_WINDOW - 1) / PT_WINDOW;
             b.pbuf = bmalloc(&b, (b.npw ? b.npw : 1) * PBUF * sizeof *b.pbuf);
             b.pbn = calloc(b.npw + 1, sizeof *b.pbn);
             if (!b.fbuf || !b.fbn || !b.win || !b.wobj || !b.wkind || !b.tcount || !b.pbuf || !b.pbn)
                 goto out;
-            pdt_big_advise(b.fbuf, NFINE * FBUF * sizeof *b.fbuf);
+            pdt_big_advise(b.fbuf, b.nfine * b.fbuf_recs * sizeof *b.fbuf);
         } else {
             b.wobj = r->ev_obj;
             b.wkind = r->ev_kind;
@@ -1624,24 +1710,19 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
     }
     /* Triangle histories: grouped by triangle, then the triangles numbered. */
     if (pl) { /* the last chunks; the buckets' places in the history table */
-        for (size_t f = 0; f < NFINE; f++)
+        for (size_t f = 0; f < b.nfine; f++)
             if (!fine_flush(&b, f)) goto out;
         if (!chunks_by_bucket(&b)) goto out;
-        for (size_t f = 0; f < NFINE; f++) b.fine_off[f + 1] = b.fine_off[f] + b.fine_fill[f];
-        r->nhist = b.fine_off[NFINE];
+        for (size_t f = 0; f < b.nfine; f++) b.fine_off[f + 1] = b.fine_off[f] + b.fine_fill[f];
+        r->nhist = b.fine_off[b.nfine];
         if ((r->hist_at = pl->reserve(pl->ctx, (uint64_t)r->nhist * sizeof *r->hist)) == UINT64_MAX)
             goto out;
     }
-    if (pl) bfree(&b, b.fbuf, NFINE * FBUF * sizeof *b.fbuf);
+    if (pl) bfree(&b, b.fbuf, b.nfine * b.fbuf_recs * sizeof *b.fbuf);
     else free(b.fbuf);
     b.fbuf = NULL;
     size_t ntri;
-    uint64_t work = 0; /* tri_groups' share of the budget: what the replay does not hold */
-    if (pl) {
-        uint64_t held = held_bytes(r->n);
-        work = pl->budget > held + pl->budget / 4 ? pl->budget - held : pl->budget / 4;
-    }
-    if (!tri_groups(&b, work, &ntri)) goto out;
+    if (!tri_groups(&b, pl ? group_work(r, pl->budget) : 0, &ntri)) goto out;
     free(b.spill);
     b.spill = NULL;
     if (pl) { /* number the triangles, then the per-event tables (none in memory) */
@@ -1682,13 +1763,14 @@ out:
     free(b.fine_fill);
     free(b.fine_off);
     if (pl) {
-        bfree(&b, b.fbuf, NFINE * FBUF * sizeof *b.fbuf);
+        bfree(&b, b.fbuf, b.nfine * b.fbuf_recs * sizeof *b.fbuf);
         bfree(&b, b.win, WIN * sizeof *b.win);
         bfree(&b, b.wobj, EVW * sizeof *b.wobj);
         bfree(&b, b.wkind, EVW);
         bfree(&b, b.pbuf, (b.npw ? b.npw : 1) * PBUF * sizeof *b.pbuf);
         b.win = NULL;
         r->build_peak = atomic_load(&b.peak);
+        r->build_buckets = (uint32_t)b.nfine;
     } else {
         free(b.fbuf);
     }

@@ -123,6 +123,7 @@ struct pdt_replay {
     int streamed;
     uint64_t tris_at, hist_at, evobj_at, evkind_at, lift_at;
     uint64_t build_peak;   /* the build's own working memory, at most (bytes) */
+    uint32_t build_buckets; /* the fine buckets its triangle events were grouped in */
     struct lazy *lazy;     /* the map is verified chunk by chunk as it is read (index.c) */
     const char *warnings;  /* the reader's warnings about the run (kept index), or NULL */
     int state_paged;       /* a big run's state: pages given back after seeks and
@@ -218,6 +219,16 @@ typedef struct pdt_replay_place {
  * run's). */
 #define PDT_REPLAY_NFINE 256
 size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks);
+/* A streamed build (the kept index) of m events under budget bytes groups
+ * its triangle events in 2^(the result) buckets instead, from 8 to 16 bits,
+ * buffering *fbuf_recs records a bucket in its first pass and *cur_recs a
+ * cursor after it; *bytes (when not NULL): what that holds at most, by
+ * PDT_REPLAY_GROUP_EVENT_EST bytes per event of a bucket.  At most half the
+ * budget (or 64 MiB) when a plan does it, else the least a plan holds (289
+ * MiB for a run of 2^32 events). */
+#define PDT_REPLAY_GROUP_EVENT_EST 96u
+unsigned pdt_replay_plan_buckets(uint64_t m, uint64_t budget, size_t *fbuf_recs, size_t *cur_recs,
+                                 uint64_t *bytes);
 
 /* pdt_replay_new, with the triangles and histories streamed to pl (NULL:
  * held in memory, no budget: pdt_replay_new); recs NULL: the events are

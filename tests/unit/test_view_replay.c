@@ -390,6 +390,41 @@ TEST(code_listings)
     CHECK(pdt_code_title(PDT_CODE_COUNT) == NULL && pdt_code_count(-1) == 0);
 }
 
+/* The kept index's build groups a run's triangle events in buckets, and
+ * holds at least one whole bucket: their count grows with the run so that
+ * what the grouping holds (one bucket, the buckets' buffers, the spill's
+ * chunk table) stays within the budget for every run the format allows (up
+ * to 2^32 events), or within 300 MiB under a budget too small for that.
+ * With 2^8 buckets always, a run of 2^32 events held 1.6 GB in one bucket. */
+TEST(bucket_plan_bounded)
+{
+    const uint64_t ms[] = {1000, 500000, 50000000, 500000000, 1400000000, 2000000000, 4294967295u};
+    const uint64_t budgets[] = {64 << 10, 16 << 20, 64 << 20, 256 << 20, (uint64_t)1 << 30, (uint64_t)8 << 30};
+    for (size_t i = 0; i < sizeof ms / sizeof *ms; i++)
+        for (size_t k = 0; k < sizeof budgets / sizeof *budgets; k++) {
+            size_t fb, cr;
+            uint64_t bytes;
+            unsigned bits = pdt_replay_plan_buckets(ms[i], budgets[k], &fb, &cr, &bytes);
+            uint64_t nf = (uint64_t)1 << bits;
+            uint64_t bucket = ((ms[i] >> bits) + 1) * PDT_REPLAY_GROUP_EVENT_EST;
+            uint64_t buffers = nf * ((uint64_t)fb * 20 + (uint64_t)cr * 24);  /* tri_xrec; tri_first, id, entry */
+            uint64_t chunks = (ms[i] / fb + nf) * 16;
+            uint64_t bound = budgets[k] > ((uint64_t)300 << 20) ? budgets[k] : (uint64_t)300 << 20;
+            CHECK_MSG(bits >= 8 && bits <= 16 && fb >= 32 && fb <= 1024 && cr >= 32 && cr <= 512 &&
+                          bucket + buffers + chunks <= bytes && bytes <= bound,
+                      "m %llu budget %llu: 2^%u buckets of %llu bytes, buffers %llu, chunks %llu, "
+                      "planned %llu", (unsigned long long)ms[i], (unsigned long long)budgets[k], bits,
+                      (unsigned long long)bucket, (unsigned long long)buffers,
+                      (unsigned long long)chunks, (unsigned long long)bytes);
+        }
+    /* what the runs made so far get: 2^8 buckets and full buffers */
+    size_t fb, cr;
+    CHECK(pdt_replay_plan_buckets(50000000, 16 << 20, &fb, &cr, NULL) == 8 && fb == 1024 && cr == 512);
+    CHECK(pdt_replay_plan_buckets(500000000, (uint64_t)1 << 30, &fb, &cr, NULL) == 8 && fb == 1024);
+    /* and the largest: more buckets */
+    CHECK(pdt_replay_plan_buckets(4294967295u, (uint64_t)1 << 30, &fb, &cr, NULL) > 8);
+}
+
 int main(void)
 {
     RUN(seek_equals_step_srm_4_ranks);
@@ -401,5 +436,6 @@ int main(void)
     RUN(malformed_events_skipped);
     RUN(code_listings);
     RUN(graham_words);
+    RUN(bucket_plan_bounded);
     return test_summary();
 }
