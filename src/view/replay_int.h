@@ -217,6 +217,10 @@ typedef struct pdt_replay_place {
  * run of n points and nranks ranks, or PDT_REPLAY_NFINE when the build does
  * not group it (not a triangle event, or naming a point or rank beyond the
  * run's). */
+/* pdt_replay_coverage shares its pass between two threads from this many
+ * triangles on (default 2^20; the tests set 1 and SIZE_MAX to compare). */
+void pdt_replay_set_cov_split(size_t tris);
+
 #define PDT_REPLAY_NFINE 256
 size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks);
 /* A streamed build (the kept index) of m events under budget bytes groups

@@ -4,11 +4,13 @@
  * outside the box.  A synthetic multi-rank run: every triangle counted once. */
 #include "../harness.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "pdt/replay.h"
 #include "pdt/viewsynth.h"
+#include "../../src/view/replay_int.h"
 
 static pdt_rec rec(int rank, int kind, uint32_t a, uint32_t b, uint32_t c, int64_t v)
 {
@@ -123,9 +125,52 @@ TEST(synthetic_run_counts_add_up)
     pdt_synth_free(&L);
 }
 
+/* The pass shared between two threads (a frame of millions of triangles)
+ * gives the cells one pass gives, cell for cell: counts added, a cell mixed
+ * when either share's is or their makers differ. */
+TEST(two_threads_same_cells)
+{
+    pdt_synth L;
+    pdt_err err = {0};
+    CHECK(pdt_synth_srm(40, 40, 8, 1, &L, &err) == PDT_OK);
+    if (err.code) return;
+    pdt_replay *r;
+    CHECK(pdt_replay_new(L.pts, L.n, L.recs, L.m, L.nranks, &r, &err) == PDT_OK);
+    if (!r) {
+        pdt_synth_free(&L);
+        return;
+    }
+    pdt_rstate *s = pdt_rstate_new(r);
+    pdt_point lo, hi;
+    CHECK(pdt_replay_bbox(r, &lo, &hi));
+    enum { C = 61, R = 47 };
+    pdt_cov_cell *one = calloc(C * R, sizeof *one), *two = calloc(C * R, sizeof *two);
+    const size_t at[] = {L.m / 3, L.m / 2, L.m};
+    for (size_t k = 0; k < sizeof at / sizeof *at; k++) {
+        pdt_replay_seek(r, s, at[k]);
+        pdt_replay_set_cov_split(SIZE_MAX);
+        size_t b1 = pdt_replay_coverage(r, s, lo.x, lo.y, hi.x + 1e-9, hi.y + 1e-9, C, R, NULL, one);
+        pdt_replay_set_cov_split(1);
+        size_t b2 = pdt_replay_coverage(r, s, lo.x, lo.y, hi.x + 1e-9, hi.y + 1e-9, C, R, NULL, two);
+        size_t mixed = 0;
+        for (int i = 0; i < C * R; i++) mixed += one[i].n && one[i].rank == PDT_COV_MIXED;
+        CHECK_MSG(b1 > 100 && b1 == b2 && memcmp(one, two, C * R * sizeof *one) == 0 &&
+                      (at[k] < L.m || mixed > 0),
+                  "cursor %zu: binned %zu and %zu, cells %s (%zu mixed)", at[k], b1, b2,
+                  memcmp(one, two, C * R * sizeof *one) ? "differ" : "same", mixed);
+    }
+    pdt_replay_set_cov_split((size_t)1 << 20);
+    free(one);
+    free(two);
+    pdt_rstate_free(s);
+    pdt_replay_free(r);
+    pdt_synth_free(&L);
+}
+
 int main(void)
 {
     RUN(cells_by_status_and_rank);
     RUN(synthetic_run_counts_add_up);
+    RUN(two_threads_same_cells);
     return test_summary();
 }
