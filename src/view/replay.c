@@ -1572,7 +1572,10 @@ static void bucket_plan(builder *b, uint64_t m, uint64_t budget)
         const char *env = getenv("PDTVIEW_BUCKETS");
         unsigned long want = env ? strtoul(env, NULL, 10) : 0;
         for (unsigned bits = FINE_BITS; bits <= FINE_BITS_MAX; bits++)
-            if (want == 1ul << bits) b->fine_bits = bits;
+            if (want == 1ul << bits) { /* (with small buffers, as the plan would) */
+                b->fine_bits = bits;
+                b->fbuf_recs = b->cur_recs = 64;
+            }
     }
     b->nfine = (size_t)1 << b->fine_bits;
 }
