@@ -378,6 +378,7 @@ typedef struct builder {
     uint32_t *pbn;
     size_t npw;
     spill_log plog;
+    uint8_t *lifted_any;  /* per rank: it lifted a point outside a merge */
     _Atomic uint64_t held, peak;  /* streamed: working memory (bytes) */
 } builder;
 
@@ -1579,217 +1580,256 @@ static void bucket_plan(builder *b, uint64_t m, uint64_t budget)
     b->nfine = (size_t)1 << b->fine_bits;
 }
 
-static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
+/* The builder for replay r (streamed to pl, or held in memory): the
+ * buckets planned, and the tables sized (in memory: once, from counts of
+ * the events that create objects and of the triangle events per bucket;
+ * streamed: the events come once, the buckets are spilled in chunks,
+ * counted as they come, and the small tables grow).  0 when out of memory. */
+static int builder_open(builder *b, pdt_replay *r, const pdt_replay_place *pl)
 {
-    builder b;
-    memset(&b, 0, sizeof b);
-    b.r = r;
-    b.pl = pl;
+    memset(b, 0, sizeof *b);
+    b->r = r;
+    b->pl = pl;
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
-    b.cur = malloc((nslot ? nslot : 1) * sizeof *b.cur);
-    b.lastst = calloc((size_t)r->nranks + 1, sizeof *b.lastst);
-    bucket_plan(&b, r->m, pl ? pl->budget : 0);
-    b.fine_fill = calloc(b.nfine, sizeof *b.fine_fill);
-    b.fine_off = calloc(b.nfine + 1, sizeof *b.fine_off);
-    uint8_t *lifted_any = calloc((size_t)r->nranks + 1, 1);
-    pdt_status st = PDT_ERR_NOMEM;
-    if (!b.cur || !b.lastst || !lifted_any || !b.fine_fill || !b.fine_off) goto out;
-    for (size_t s = 0; s < nslot; s++) b.cur[s] = -1;
-    for (int q = 0; q < r->nranks; q++) b.lastst[q] = -1;
-    /* in memory, size the tables once: counts of the events that create
-     * objects, and of the triangle events per fine bucket (streamed: the
-     * events come once, the fine buckets are spilled in chunks, counted as
-     * they come, and the small tables grow) */
-    {
-        size_t cnt[PDT_EV_KIND_COUNT] = {0};
-        for (size_t i = 0; !pl && i < r->m; i++) {
-            const pdt_rec *rec = rec_at(r, i);
-            if (rec->ev.kind < PDT_EV_KIND_COUNT) cnt[rec->ev.kind]++;
-            size_t f = pdt_replay_fine_of(rec, r->n, r->nranks);
-            if (f < b.nfine) b.fine_off[f + 1]++;
-        }
-        for (size_t f = 0; f < b.nfine; f++) b.fine_off[f + 1] += b.fine_off[f];
-        memcpy(b.fine_fill, b.fine_off, b.nfine * sizeof *b.fine_fill);
-        r->nhist = b.fine_off[b.nfine];
-        if (pl) {
-            r->streamed = 1;
-            r->evobj_at = pl->evobj_at;
-            r->evkind_at = pl->evkind_at;
-            b.fbuf = bmalloc(&b, b.nfine * b.fbuf_recs * sizeof *b.fbuf);
-            b.fbn = calloc(b.nfine, sizeof *b.fbn);
-            b.win = bmalloc(&b, WIN * sizeof *b.win);
-            b.wobj = bmalloc(&b, EVW * sizeof *b.wobj);
-            b.wkind = bmalloc(&b, EVW);
-            b.tcount = calloc(b.nfine, sizeof *b.tcount);
-            b.npw = (r->n + PT_WINDOW - 1) / PT_WINDOW;
-            b.pbuf = bmalloc(&b, (b.npw ? b.npw : 1) * PBUF * sizeof *b.pbuf);
-            b.pbn = calloc(b.npw + 1, sizeof *b.pbn);
-            if (!b.fbuf || !b.fbn || !b.win || !b.wobj || !b.wkind || !b.tcount || !b.pbuf || !b.pbn)
-                goto out;
-            pdt_big_advise(b.fbuf, b.nfine * b.fbuf_recs * sizeof *b.fbuf);
-        } else {
-            b.wobj = r->ev_obj;
-            b.wkind = r->ev_kind;
-            r->hist = big_table(r->nhist * sizeof *r->hist);
-            r->tris = big_table(r->nhist * sizeof *r->tris); /* at most one per event */
-            r->cap_tri = r->nhist;
-            b.spill = big_table(r->nhist * sizeof *b.spill);
-            if (!r->hist || !r->tris || !b.spill) goto out;
-        }
-        if (!km_alloc(&b.edge_map, cnt[PDT_EV_EDGE_ADD], r->tab_limit) ||
-            !km_alloc(&b.msg_map, cnt[PDT_EV_SEND], r->tab_limit) ||
-            !tab_grow(r, (void **)&r->edges, &r->cap_edge, cnt[PDT_EV_EDGE_ADD], sizeof *r->edges) ||
-            !tab_grow(r, (void **)&r->nodes, &r->cap_node, cnt[PDT_EV_PUSH], sizeof *r->nodes))
-            goto out;
+    b->cur = malloc((nslot ? nslot : 1) * sizeof *b->cur);
+    b->lastst = calloc((size_t)r->nranks + 1, sizeof *b->lastst);
+    bucket_plan(b, r->m, pl ? pl->budget : 0);
+    b->fine_fill = calloc(b->nfine, sizeof *b->fine_fill);
+    b->fine_off = calloc(b->nfine + 1, sizeof *b->fine_off);
+    b->lifted_any = calloc((size_t)r->nranks + 1, 1);
+    if (!b->cur || !b->lastst || !b->lifted_any || !b->fine_fill || !b->fine_off) return 0;
+    for (size_t s = 0; s < nslot; s++) b->cur[s] = -1;
+    for (int q = 0; q < r->nranks; q++) b->lastst[q] = -1;
+    size_t cnt[PDT_EV_KIND_COUNT] = {0};
+    for (size_t i = 0; !pl && i < r->m; i++) {
+        const pdt_rec *rec = rec_at(r, i);
+        if (rec->ev.kind < PDT_EV_KIND_COUNT) cnt[rec->ev.kind]++;
+        size_t f = pdt_replay_fine_of(rec, r->n, r->nranks);
+        if (f < b->nfine) b->fine_off[f + 1]++;
     }
+    for (size_t f = 0; f < b->nfine; f++) b->fine_off[f + 1] += b->fine_off[f];
+    memcpy(b->fine_fill, b->fine_off, b->nfine * sizeof *b->fine_fill);
+    r->nhist = b->fine_off[b->nfine];
+    if (pl) {
+        r->streamed = 1;
+        r->evobj_at = pl->evobj_at;
+        r->evkind_at = pl->evkind_at;
+        b->fbuf = bmalloc(b, b->nfine * b->fbuf_recs * sizeof *b->fbuf);
+        b->fbn = calloc(b->nfine, sizeof *b->fbn);
+        b->win = bmalloc(b, WIN * sizeof *b->win);
+        b->wobj = bmalloc(b, EVW * sizeof *b->wobj);
+        b->wkind = bmalloc(b, EVW);
+        b->tcount = calloc(b->nfine, sizeof *b->tcount);
+        b->npw = (r->n + PT_WINDOW - 1) / PT_WINDOW;
+        b->pbuf = bmalloc(b, (b->npw ? b->npw : 1) * PBUF * sizeof *b->pbuf);
+        b->pbn = calloc(b->npw + 1, sizeof *b->pbn);
+        if (!b->fbuf || !b->fbn || !b->win || !b->wobj || !b->wkind || !b->tcount || !b->pbuf || !b->pbn)
+            return 0;
+        pdt_big_advise(b->fbuf, b->nfine * b->fbuf_recs * sizeof *b->fbuf);
+    } else {
+        b->wobj = r->ev_obj;
+        b->wkind = r->ev_kind;
+        r->hist = big_table(r->nhist * sizeof *r->hist);
+        r->tris = big_table(r->nhist * sizeof *r->tris); /* at most one per event */
+        r->cap_tri = r->nhist;
+        b->spill = big_table(r->nhist * sizeof *b->spill);
+        if (!r->hist || !r->tris || !b->spill) return 0;
+    }
+    return km_alloc(&b->edge_map, cnt[PDT_EV_EDGE_ADD], r->tab_limit) &&
+           km_alloc(&b->msg_map, cnt[PDT_EV_SEND], r->tab_limit) &&
+           tab_grow(r, (void **)&r->edges, &r->cap_edge, cnt[PDT_EV_EDGE_ADD], sizeof *r->edges) &&
+           tab_grow(r, (void **)&r->nodes, &r->cap_node, cnt[PDT_EV_PUSH], sizeof *r->nodes);
+}
 
+/* Pass 1: every event once, in order (streamed: from pl's stream, a window
+ * at a time, the per-event tables written out a window at a time). */
+static int first_pass(builder *b, pdt_err *err)
+{
+    pdt_replay *r = b->r;
+    const pdt_replay_place *pl = b->pl;
     for (size_t i = 0; i < r->m; i++) {
-        drop_recs(&b, i);
-        if (pl && (!win_fill(&b, i, err) || (i - b.wlo == EVW && !ev_window(&b, i)))) goto out;
-        set_obj(&b, i, -1);
+        drop_recs(b, i);
+        if (pl && (!win_fill(b, i, err) || (i - b->wlo == EVW && !ev_window(b, i)))) return 0;
+        set_obj(b, i, -1);
         if (r->ev_ent) r->ev_ent[i] = 0;
-        const pdt_rec *rec = pl ? &b.win[i - b.win_lo] : rec_at(r, i);
-        b.wkind[i - b.wlo] = rec->ev.kind < KIND_UNKNOWN ? rec->ev.kind : KIND_UNKNOWN;
+        const pdt_rec *rec = pl ? &b->win[i - b->win_lo] : rec_at(r, i);
+        b->wkind[i - b->wlo] = rec->ev.kind < KIND_UNKNOWN ? rec->ev.kind : KIND_UNKNOWN;
         if (rec->rank >= (uint32_t)r->nranks) {
             r->skipped++;
             continue;
         }
-        if (pl ? i + PREFETCH_AHEAD < b.win_lo + b.win_n : i + PREFETCH_AHEAD < r->m) {
-            const pdt_rec *ahead = pl ? &b.win[i + PREFETCH_AHEAD - b.win_lo] : rec_at(r, i + PREFETCH_AHEAD);
-            const void *also, *p = probe_addr(&b, ahead, &also);
+        if (pl ? i + PREFETCH_AHEAD < b->win_lo + b->win_n : i + PREFETCH_AHEAD < r->m) {
+            const pdt_rec *ahead = pl ? &b->win[i + PREFETCH_AHEAD - b->win_lo] : rec_at(r, i + PREFETCH_AHEAD);
+            const void *also, *p = probe_addr(b, ahead, &also);
             if (p) __builtin_prefetch(p);
             if (also) __builtin_prefetch(also);
         }
         if (rec->ev.kind < PDT_EV_KIND_COUNT) r->kind_count[rec->ev.kind]++;
-        if (!index_event(&b, (uint32_t)i, rec, lifted_any)) goto out;
+        if (!index_event(b, (uint32_t)i, rec, b->lifted_any)) return 0;
         if (i % TICK_EVENTS == TICK_EVENTS - 1) { /* (paged tables: their pages go back) */
             tabs_give_back(r);
-            km_give_back(&b.edge_map);
-            km_give_back(&b.msg_map);
+            km_give_back(&b->edge_map);
+            km_give_back(&b->msg_map);
         }
     }
-    if (pl) { /* the stream's end (it finishes its part: pl->src is ready) */
-        pdt_rec extra;
-        int more = pl->next(pl->ctx, &extra, 1, err);
-        if (more != 0) {
-            if (more > 0) pdt_err_set(err, PDT_ERR_FORMAT, "the run has more events than counted");
-            b.stream_failed = 1;
-            goto out;
-        }
-        bfree(&b, b.win, WIN * sizeof *b.win);
-        b.win = NULL;
-        if (!ev_window(&b, r->m)) goto out;
-        bfree(&b, b.wobj, EVW * sizeof *b.wobj);
-        bfree(&b, b.wkind, EVW);
-        b.wobj = NULL;
-        b.wkind = NULL;
-        if ((r->lift_at = pl->reserve(pl->ctx, (uint64_t)r->n * sizeof(uint32_t))) == UINT64_MAX ||
-            !points_pass(&b, lifted_any))
-            goto out;
-        pl->sdrop(pl->ctx, PDT_SCR_POINTS);
-        if (pl->points_read) pl->points_read(pl->ctx);
-        bfree(&b, b.pbuf, (b.npw ? b.npw : 1) * PBUF * sizeof *b.pbuf);
-        b.pbuf = NULL;
+    return 1;
+}
+
+/* After pass 1 (streamed): the stream's end (it finishes its part: pl->src
+ * is ready), the last window of the per-event tables, and the points' first
+ * lifts and the ranks' boxes (points_pass). */
+static int stream_end(builder *b, pdt_err *err)
+{
+    pdt_replay *r = b->r;
+    const pdt_replay_place *pl = b->pl;
+    pdt_rec extra;
+    int more = pl->next(pl->ctx, &extra, 1, err);
+    if (more != 0) {
+        if (more > 0) pdt_err_set(err, PDT_ERR_FORMAT, "the run has more events than counted");
+        b->stream_failed = 1;
+        return 0;
     }
-    /* Phases that open a cluster of overlapping same phases (any rank). */
-    {
-        keymap last_end;
-        memset(&last_end, 0, sizeof last_end);
-        for (size_t p = 0; p < r->nphase; p++) {
-            pdt_rphase *ph = &r->phases[p];
-            int32_t end;
-            int have = km_get(&last_end, ph->phase, ph->sub, &end);
-            uint32_t e = ph->end_ev == NONE32 ? (uint32_t)INT32_MAX : ph->end_ev;
-            ph->first = !have || (uint32_t)end < ph->begin_ev;
-            if (!have || (uint32_t)end < e) {
-                if (!km_put(&last_end, ph->phase, ph->sub, (int32_t)(e > INT32_MAX ? INT32_MAX : e), 0)) {
-                    km_free(&last_end);
-                    goto out;
-                }
-            }
-        }
-        km_free(&last_end);
+    bfree(b, b->win, WIN * sizeof *b->win);
+    b->win = NULL;
+    if (!ev_window(b, r->m)) return 0;
+    bfree(b, b->wobj, EVW * sizeof *b->wobj);
+    bfree(b, b->wkind, EVW);
+    b->wobj = NULL;
+    b->wkind = NULL;
+    if ((r->lift_at = pl->reserve(pl->ctx, (uint64_t)r->n * sizeof(uint32_t))) == UINT64_MAX ||
+        !points_pass(b, b->lifted_any))
+        return 0;
+    pl->sdrop(pl->ctx, PDT_SCR_POINTS);
+    if (pl->points_read) pl->points_read(pl->ctx);
+    bfree(b, b->pbuf, (b->npw ? b->npw : 1) * PBUF * sizeof *b->pbuf);
+    b->pbuf = NULL;
+    return 1;
+}
+
+/* The phases that open a cluster of overlapping same phases (any rank). */
+static int phase_clusters(pdt_replay *r)
+{
+    keymap last_end;
+    memset(&last_end, 0, sizeof last_end);
+    int ok = 1;
+    for (size_t p = 0; ok && p < r->nphase; p++) {
+        pdt_rphase *ph = &r->phases[p];
+        int32_t end;
+        int have = km_get(&last_end, ph->phase, ph->sub, &end);
+        uint32_t e = ph->end_ev == NONE32 ? (uint32_t)INT32_MAX : ph->end_ev;
+        ph->first = !have || (uint32_t)end < ph->begin_ev;
+        if (!have || (uint32_t)end < e)
+            ok = km_put(&last_end, ph->phase, ph->sub, (int32_t)(e > INT32_MAX ? INT32_MAX : e), 0);
     }
-    /* Triangle histories: grouped by triangle, then the triangles numbered. */
+    km_free(&last_end);
+    return ok;
+}
+
+/* The triangles' histories: grouped by triangle (tri_groups), then the
+ * triangles numbered by their first event (streamed: tri_number, tri_join,
+ * ev_tables, through scratch files; in memory: tri_ids). */
+static int tri_histories(builder *b)
+{
+    pdt_replay *r = b->r;
+    const pdt_replay_place *pl = b->pl;
     if (pl) { /* the last chunks; the buckets' places in the history table */
-        for (size_t f = 0; f < b.nfine; f++)
-            if (!fine_flush(&b, f)) goto out;
-        if (!chunks_by_bucket(&b)) goto out;
-        for (size_t f = 0; f < b.nfine; f++) b.fine_off[f + 1] = b.fine_off[f] + b.fine_fill[f];
-        r->nhist = b.fine_off[b.nfine];
+        for (size_t f = 0; f < b->nfine; f++)
+            if (!fine_flush(b, f)) return 0;
+        if (!chunks_by_bucket(b)) return 0;
+        for (size_t f = 0; f < b->nfine; f++) b->fine_off[f + 1] = b->fine_off[f] + b->fine_fill[f];
+        r->nhist = b->fine_off[b->nfine];
         if ((r->hist_at = pl->reserve(pl->ctx, (uint64_t)r->nhist * sizeof *r->hist)) == UINT64_MAX)
-            goto out;
+            return 0;
+        bfree(b, b->fbuf, b->nfine * b->fbuf_recs * sizeof *b->fbuf);
+        b->fbuf = NULL;
     }
-    if (pl) bfree(&b, b.fbuf, b.nfine * b.fbuf_recs * sizeof *b.fbuf);
-    else free(b.fbuf);
-    b.fbuf = NULL;
     size_t ntri;
-    if (!tri_groups(&b, pl ? group_work(r, pl->budget) : 0, &ntri)) goto out;
-    free(b.spill);
-    b.spill = NULL;
-    if (pl) { /* number the triangles, then the per-event tables (none in memory) */
-        pl->sdrop(pl->ctx, PDT_SCR_SPILL);
-        if ((r->tris_at = pl->reserve(pl->ctx, (uint64_t)ntri * sizeof *r->tris)) == UINT64_MAX ||
-            !tri_number(&b) || !tri_join(&b))
-            goto out;
-        pl->sdrop(pl->ctx, PDT_SCR_TRIS);
-        pl->sdrop(pl->ctx, PDT_SCR_IDS);
-        pl->sdrop(pl->ctx, PDT_SCR_HIST);
-        if (!ev_tables(&b)) goto out;
-        pl->sdrop(pl->ctx, PDT_SCR_TRIEV);
-    } else if (!tri_ids(&b)) {
-        goto out;
-    }
-    /* Slot changes grouped by slot (counting sort keeps event order). */
+    if (!tri_groups(b, pl ? group_work(r, pl->budget) : 0, &ntri)) return 0;
+    free(b->spill);
+    b->spill = NULL;
+    if (!pl) return tri_ids(b);
+    pl->sdrop(pl->ctx, PDT_SCR_SPILL);
+    if ((r->tris_at = pl->reserve(pl->ctx, (uint64_t)ntri * sizeof *r->tris)) == UINT64_MAX ||
+        !tri_number(b) || !tri_join(b))
+        return 0;
+    pl->sdrop(pl->ctx, PDT_SCR_TRIS);
+    pl->sdrop(pl->ctx, PDT_SCR_IDS);
+    pl->sdrop(pl->ctx, PDT_SCR_HIST);
+    if (!ev_tables(b)) return 0;
+    pl->sdrop(pl->ctx, PDT_SCR_TRIEV);
+    return 1;
+}
+
+/* The slot changes grouped by slot (a counting sort: event order kept). */
+static int slot_index(pdt_replay *r)
+{
+    size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
     r->slot_start = calloc(nslot + 1, sizeof *r->slot_start);
     r->slot_ch = tab_new(r, (r->nch ? r->nch : 1) * sizeof *r->slot_ch);
-    if (!r->slot_start || !r->slot_ch) goto out;
+    uint32_t *fill = malloc((nslot ? nslot : 1) * sizeof *fill);
+    if (!r->slot_start || !r->slot_ch || !fill) {
+        free(fill);
+        return 0;
+    }
     for (size_t c = 0; c < r->nch; c++) r->slot_start[r->ch[c].slot + 1]++;
     for (size_t s = 0; s < nslot; s++) r->slot_start[s + 1] += r->slot_start[s];
-    {
-        uint32_t *fill = malloc((nslot ? nslot : 1) * sizeof *fill);
-        if (!fill) goto out;
-        memcpy(fill, r->slot_start, nslot * sizeof *fill);
-        for (size_t c = 0; c < r->nch; c++) {
-            r->slot_ch[fill[r->ch[c].slot]++] = (uint32_t)c;
-            if (c % TICK_EVENTS == TICK_EVENTS - 1) tabs_give_back(r);
-        }
-        free(fill);
-        tabs_give_back(r);
+    memcpy(fill, r->slot_start, nslot * sizeof *fill);
+    for (size_t c = 0; c < r->nch; c++) {
+        r->slot_ch[fill[r->ch[c].slot]++] = (uint32_t)c;
+        if (c % TICK_EVENTS == TICK_EVENTS - 1) tabs_give_back(r);
     }
-    st = PDT_OK;
-out:
-    free(b.cur);
-    free(b.lastst);
-    free(lifted_any);
-    free(b.fine_fill);
-    free(b.fine_off);
-    if (pl) {
-        bfree(&b, b.fbuf, b.nfine * b.fbuf_recs * sizeof *b.fbuf);
-        bfree(&b, b.win, WIN * sizeof *b.win);
-        bfree(&b, b.wobj, EVW * sizeof *b.wobj);
-        bfree(&b, b.wkind, EVW);
-        bfree(&b, b.pbuf, (b.npw ? b.npw : 1) * PBUF * sizeof *b.pbuf);
-        b.win = NULL;
-        r->build_peak = atomic_load(&b.peak);
-        r->build_buckets = (uint32_t)b.nfine;
+    free(fill);
+    tabs_give_back(r);
+    return 1;
+}
+
+/* Free the builder; the build's status from ok and what failed. */
+static pdt_status builder_close(builder *b, int ok, pdt_err *err)
+{
+    pdt_replay *r = b->r;
+    free(b->cur);
+    free(b->lastst);
+    free(b->lifted_any);
+    free(b->fine_fill);
+    free(b->fine_off);
+    if (b->pl) {
+        bfree(b, b->fbuf, b->nfine * b->fbuf_recs * sizeof *b->fbuf);
+        bfree(b, b->win, WIN * sizeof *b->win);
+        bfree(b, b->wobj, EVW * sizeof *b->wobj);
+        bfree(b, b->wkind, EVW);
+        bfree(b, b->pbuf, (b->npw ? b->npw : 1) * PBUF * sizeof *b->pbuf);
+        r->build_peak = atomic_load(&b->peak);
+        r->build_buckets = (uint32_t)b->nfine;
     } else {
-        free(b.fbuf);
+        free(b->fbuf);
+        free(b->win);
     }
-    free(b.pbn);
-    free(b.plog.chunk);
-    free(b.tcount);
-    free(b.fbn);
-    free(b.spill);
-    free(b.tlog.chunk);
-    free(b.ck_start);
-    free(b.win);
-    km_free(&b.edge_map);
-    km_free(&b.msg_map);
-    if (st != PDT_OK && b.stream_failed) st = err->code ? err->code : PDT_ERR_IO;
-    else if (st != PDT_OK && b.failed) pdt_err_set(err, PDT_ERR_IO, "the index file: %s", strerror(errno));
-    else if (st != PDT_OK) pdt_err_set(err, st, "out of memory indexing %zu events", r->m);
-    return st;
+    free(b->pbn);
+    free(b->plog.chunk);
+    free(b->tcount);
+    free(b->fbn);
+    free(b->spill);
+    free(b->tlog.chunk);
+    free(b->ck_start);
+    km_free(&b->edge_map);
+    km_free(&b->msg_map);
+    if (ok) return PDT_OK;
+    if (b->stream_failed) return err->code ? err->code : PDT_ERR_IO;
+    if (b->failed) return pdt_err_set(err, PDT_ERR_IO, "the index file: %s", strerror(errno));
+    return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory indexing %zu events", r->m);
+}
+
+/* Build replay r: its tables, in memory or streamed to pl (the kept index). */
+static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
+{
+    builder b;
+    int ok = builder_open(&b, r, pl) &&     /* the buckets planned, the tables sized */
+             first_pass(&b, err) &&          /* every event once */
+             (!pl || stream_end(&b, err)) && /* the points' first lifts, the ranks' boxes */
+             phase_clusters(r) &&
+             tri_histories(&b) &&            /* grouped by triangle, numbered */
+             slot_index(r);
+    return builder_close(&b, ok, err);
 }
 
 pdt_status pdt_replay_new(const pdt_point *pts, size_t n, const pdt_rec *recs, size_t m,
