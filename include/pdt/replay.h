@@ -125,12 +125,21 @@ typedef struct pdt_rhull {
 
 typedef struct pdt_replay pdt_replay;
 
+/* A triangle's state names its history entry in 16 bits: a triangle has at
+ * most PDT_TRI_HIST_MAX entries (a vertex set with more events in a run,
+ * which only a damaged or made-up trace has, is several triangles, each of
+ * that many events but the last). */
+#define PDT_TCUR_NONE UINT16_MAX
+#define PDT_TRI_HIST_MAX 65535u
+
 /* The state at one cursor position.  Arrays are sized by the replay and
  * owned by the state (pdt_rstate_new / pdt_rstate_free). */
 typedef struct pdt_rstate {
     size_t k;            /* events applied: 0 .. k-1 */
     uint8_t *pflags;     /* per point: PDT_PF_* */
-    uint32_t *tcur;      /* per triangle: history entry in effect, UINT32_MAX = none */
+    uint16_t *tcur;      /* per triangle t: its history entry in effect, as an offset
+                          * from its first (tris' h0: entry h0 + tcur[t]);
+                          * PDT_TCUR_NONE = none (2 bytes a triangle) */
     uint8_t *ealive;     /* per kernel edge: 1 while it exists */
     uint8_t *mflight;    /* per message: 1 sent and not yet received */
     int32_t *slot;       /* per rank * PDT_SLOT_PER_RANK: current value or -1 */

@@ -92,10 +92,10 @@ static void cov_range(cov_job *J)
         }
         /* the corners' points and the history entry of a triangle a few
          * ahead: random places in tables of 10^8 bytes (a hint only) */
-        if (t + COV_AHEAD < nt && s->tcur[t + COV_AHEAD] != NONE32) {
+        if (t + COV_AHEAD < nt && s->tcur[t + COV_AHEAD] != PDT_TCUR_NONE) {
             const pdt_rtri *ahead = &r->tris[t + COV_AHEAD];
             for (int k = 0; k < 3; k++) __builtin_prefetch(&r->pts[ahead->v[k]]);
-            __builtin_prefetch(&r->hist[s->tcur[t + COV_AHEAD]]);
+            __builtin_prefetch(&r->hist[ahead->h0 + s->tcur[t + COV_AHEAD]]);
         }
         uint32_t h = pdt_rstate_tri_entry(r, s, t);
         if (h == NONE32) continue;

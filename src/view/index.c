@@ -47,7 +47,8 @@
 #include <unistd.h>
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 8u /* 8: the histories in the triangles' order */
+#define INDEX_VERSION 9u /* 8: the histories in the triangles' order; 9: a triangle's state
+                            * in 16 bits (an offset from its first entry) */
 #define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/8 events, at least this */
 #define ICK_PARTS 8u
 /* ... and at most every ICK_MAX_EVERY events while ICK_MAX_PARTS allow (a

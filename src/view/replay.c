@@ -943,7 +943,8 @@ static uint32_t group_keys(const void *buf, size_t stride, size_t nb, gslot *slo
         while (slot[q].g != NONE32 &&
                (slot[q].s[0] != s[0] || slot[q].s[1] != s[1] || slot[q].s[2] != s[2]))
             q = (q + 1) & mask;
-        if (slot[q].g == NONE32) {
+        if (slot[q].g == NONE32 || gn[slot[q].g] == PDT_TRI_HIST_MAX) { /* (a new triangle,
+                                                  * or the next of a vertex set's) */
             slot[q] = (gslot){{s[0], s[1], s[2]}, ng};
             gfirst[ng] = KREC(j)->ev;
             gn[ng++] = 0;
@@ -2191,8 +2192,8 @@ void pdt_replay_seek_direct(const pdt_replay *r, pdt_rstate *s, size_t k)
     for (size_t p = 0; p < r->n; p++) s->pflags[p] = point_flags(r, p, k);
     for (size_t t = 0; t < r->ntri; t++) {
         const pdt_rtri *tr = &r->tris[t];
-        uint32_t c = NONE32;
-        for (uint32_t h = tr->h0; h < tr->h0 + tr->hn && r->hist[h].ev < k; h++) c = h;
+        uint16_t c = PDT_TCUR_NONE;
+        for (uint32_t h = tr->h0; h < tr->h0 + tr->hn && r->hist[h].ev < k; h++) c = (uint16_t)(h - tr->h0);
         s->tcur[t] = c;
     }
     for (size_t e = 0; e < r->nedge; e++) s->ealive[e] = alive(r->edges[e].add_ev, r->edges[e].del_ev, k);
@@ -2211,9 +2212,9 @@ void pdt_replay_seek_direct(const pdt_replay *r, pdt_rstate *s, size_t k)
 }
 
 /* Apply (fwd) or undo (!fwd) an event of object obj (>= 0) and kind (with
- * its mark); s->k is already the new cursor.  h0: for a triangle's first
- * event, the triangle's first entry. */
-static void apply_obj(const pdt_replay *r, pdt_rstate *s, int32_t obj, int kind, int fwd, uint32_t h0)
+ * its mark); s->k is already the new cursor.  A triangle's event moves its
+ * entry one on or back; its first event, from none to its first or back. */
+static void apply_obj(const pdt_replay *r, pdt_rstate *s, int32_t obj, int kind, int fwd)
 {
     switch (kind & KIND_MASK) {
     case PDT_EV_LIFT:
@@ -2231,9 +2232,9 @@ static void apply_obj(const pdt_replay *r, pdt_rstate *s, int32_t obj, int kind,
         return;
     default:
         if (is_tri_kind(kind & KIND_MASK)) {
-            uint32_t *t = &s->tcur[obj];
-            if (!(kind & KIND_FIRST)) *t = fwd ? *t + 1 : *t - 1;
-            else *t = fwd ? h0 : NONE32;
+            uint16_t *t = &s->tcur[obj];
+            if (!(kind & KIND_FIRST)) *t = (uint16_t)(fwd ? *t + 1 : *t - 1);
+            else *t = fwd ? 0 : PDT_TCUR_NONE;
             return;
         }
         /* a slot change */
@@ -2248,10 +2249,7 @@ static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
 {
     int32_t obj = r->ev_obj[i];
     if (obj < 0) return;
-    int kind = r->ev_kind[i];
-    uint32_t h0 = NONE32;
-    if ((kind & KIND_FIRST) && fwd) h0 = r->ev_ent ? r->ev_ent[i] : r->tris[obj].h0;
-    apply_obj(r, s, obj, kind, fwd, h0);
+    apply_obj(r, s, obj, r->ev_kind[i], fwd);
 }
 
 int pdt_replay_step(const pdt_replay *r, pdt_rstate *s, int dir)
@@ -2274,7 +2272,6 @@ int pdt_replay_step(const pdt_replay *r, pdt_rstate *s, int dir)
 /* ---- a forward pass over a streamed replay ------------------------------------------ */
 
 #define FWD_EVENTS 65536u  /* events per window of the per-event tables */
-#define FWD_TRIS 4096u     /* triangles per window of the triangle table */
 
 struct pdt_fwd {
     const pdt_replay *r;
@@ -2283,8 +2280,6 @@ struct pdt_fwd {
     int32_t *obj;
     uint8_t *kind;
     size_t lo, n;      /* the window of events: lo .. lo + n - 1 */
-    pdt_rtri *tri;
-    size_t tlo, tn;    /* the window of triangles */
 };
 
 pdt_fwd *pdt_fwd_new(const pdt_replay *r, int (*get)(void *ctx, uint64_t at, void *p, size_t bytes),
@@ -2297,8 +2292,7 @@ pdt_fwd *pdt_fwd_new(const pdt_replay *r, int (*get)(void *ctx, uint64_t at, voi
     f->ctx = ctx;
     f->obj = malloc(FWD_EVENTS * sizeof *f->obj);
     f->kind = malloc(FWD_EVENTS);
-    f->tri = malloc(FWD_TRIS * sizeof *f->tri);
-    if (!f->obj || !f->kind || !f->tri) {
+    if (!f->obj || !f->kind) {
         pdt_fwd_free(f);
         return NULL;
     }
@@ -2310,25 +2304,7 @@ void pdt_fwd_free(pdt_fwd *f)
     if (!f) return;
     free(f->obj);
     free(f->kind);
-    free(f->tri);
     free(f);
-}
-
-/* The first history entry of triangle t (the triangles are born in order:
- * the window moves forwards). */
-static int fwd_h0(pdt_fwd *f, size_t t, uint32_t *h0)
-{
-    const pdt_replay *r = f->r;
-    if (t >= r->ntri) return 0;
-    if (t < f->tlo || t >= f->tlo + f->tn) {
-        size_t k = r->ntri - t < FWD_TRIS ? r->ntri - t : FWD_TRIS;
-        if (!f->get(f->ctx, r->tris_at + (uint64_t)t * sizeof *f->tri, f->tri, k * sizeof *f->tri))
-            return 0;
-        f->tlo = t;
-        f->tn = k;
-    }
-    *h0 = f->tri[t - f->tlo].h0;
-    return 1;
 }
 
 int pdt_fwd_to(pdt_fwd *f, pdt_rstate *s, size_t k)
@@ -2354,18 +2330,12 @@ int pdt_fwd_to(pdt_fwd *f, pdt_rstate *s, size_t k)
         int32_t obj = f->obj[i - f->lo];
         int kind = f->kind[i - f->lo];
         if (obj < 0) continue;
-        if (is_tri_kind(kind & KIND_MASK) && (kind & KIND_FIRST)) {
-            uint32_t h0;
-            if (!fwd_h0(f, (size_t)obj, &h0)) return 0;
-            s->tcur[obj] = h0;
-            continue;
-        }
         switch (kind & KIND_MASK) { /* (streamed: no table per point; forwards the
                                      * flags only gather: what point_flags gives) */
         case PDT_EV_LIFT: s->pflags[obj] |= PDT_PF_LIFTED; continue;
         case PDT_EV_SORT: s->pflags[obj] |= PDT_PF_SORTED; continue;
         case PDT_EV_DELETE: s->pflags[obj] |= PDT_PF_DELETED; continue;
-        default: apply_obj(r, s, obj, kind, 1, NONE32);
+        default: apply_obj(r, s, obj, kind, 1);
         }
     }
     return 1;
@@ -2383,7 +2353,7 @@ int pdt_fwd_to(pdt_fwd *f, pdt_rstate *s, size_t k)
 
 size_t pdt_replay_state_bytes(const pdt_replay *r)
 {
-    return sizeof(pdt_rstate) + r->n + r->ntri * sizeof(uint32_t) + r->nedge + r->nmsg +
+    return sizeof(pdt_rstate) + r->n + r->ntri * sizeof(uint16_t) + r->nedge + r->nmsg +
            (size_t)r->nranks * PDT_SLOT_PER_RANK * sizeof(int32_t);
 }
 
@@ -2450,13 +2420,13 @@ static size_t up8(size_t x) { return (x + 7) & ~(size_t)7; }
 size_t pdt_rstate_blob_bytes(const pdt_replay *r, size_t born)
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
-    return up8(r->n) + up8(born * 4) + up8(r->nedge) + up8(r->nmsg) + up8(nslot * 4);
+    return up8(r->n) + up8(born * sizeof(uint16_t)) + up8(r->nedge) + up8(r->nmsg) + up8(nslot * 4);
 }
 
 size_t pdt_rstate_born(const pdt_replay *r, const pdt_rstate *s)
 {
     size_t t = r->ntri;
-    while (t > 0 && s->tcur[t - 1] == NONE32) t--;
+    while (t > 0 && s->tcur[t - 1] == PDT_TCUR_NONE) t--;
     return t;
 }
 
@@ -2466,8 +2436,8 @@ void pdt_rstate_to_blob(const pdt_replay *r, const pdt_rstate *s, size_t born, u
     memset(out, 0, pdt_rstate_blob_bytes(r, born));
     memcpy(out, s->pflags, r->n);
     out += up8(r->n);
-    memcpy(out, s->tcur, born * 4);
-    out += up8(born * 4);
+    memcpy(out, s->tcur, born * sizeof *s->tcur);
+    out += up8(born * sizeof *s->tcur);
     memcpy(out, s->ealive, r->nedge);
     out += up8(r->nedge);
     memcpy(out, s->mflight, r->nmsg);
@@ -2480,7 +2450,7 @@ void pdt_rstate_blob_parts(const pdt_replay *r, const pdt_rstate *s, size_t born
 {
     size_t nslot = (size_t)r->nranks * PDT_SLOT_PER_RANK;
     const void *p[5] = {s->pflags, s->tcur, s->ealive, s->mflight, s->slot};
-    size_t l[5] = {r->n, born * 4, r->nedge, r->nmsg, nslot * 4};
+    size_t l[5] = {r->n, born * sizeof *s->tcur, r->nedge, r->nmsg, nslot * 4};
     for (int j = 0; j < 5; j++) part[j] = p[j], len[j] = l[j], pad[j] = up8(l[j]) - l[j];
 }
 
@@ -2542,9 +2512,9 @@ void pdt_rstate_from_blob(const pdt_replay *r, pdt_rstate *s, const uint8_t *in,
     s->k = k;
     copy_out(r, s->pflags, in, r->n, s->paged[0]);
     in += up8(r->n);
-    copy_out(r, s->tcur, in, born * 4, s->paged[1]);
+    copy_out(r, s->tcur, in, born * sizeof *s->tcur, s->paged[1]);
     fill_out(s->tcur + born, 0xff, (r->ntri - born) * sizeof *s->tcur, s->paged[1]);
-    in += up8(born * 4);
+    in += up8(born * sizeof *s->tcur);
     copy_out(r, s->ealive, in, r->nedge, s->paged[2]);
     in += up8(r->nedge);
     copy_out(r, s->mflight, in, r->nmsg, 0);
@@ -2564,7 +2534,6 @@ static void step_prefetch(const pdt_replay *r, const pdt_rstate *s, size_t i)
     int kind = r->ev_kind[i];
     if (is_tri_kind(kind & KIND_MASK)) {
         __builtin_prefetch(&s->tcur[obj], 1);
-        if (kind & KIND_FIRST) __builtin_prefetch(&r->tris[obj]);
     } else if ((kind & KIND_MASK) == PDT_EV_LIFT && r->lift_ev) {
         __builtin_prefetch(&s->pflags[obj], 1);
         __builtin_prefetch(&r->lift_ev[obj]);
@@ -2664,14 +2633,14 @@ int32_t pdt_rstate_slot(const pdt_replay *r, const pdt_rstate *s, int rank, int 
 
 pdt_tri_status pdt_rstate_tri_status(const pdt_replay *r, const pdt_rstate *s, size_t t)
 {
-    if (t >= r->ntri || s->tcur[t] == NONE32) return PDT_TS_NONE;
-    return (pdt_tri_status)r->hist[s->tcur[t]].status;
+    if (t >= r->ntri || s->tcur[t] == PDT_TCUR_NONE) return PDT_TS_NONE;
+    return (pdt_tri_status)r->hist[r->tris[t].h0 + s->tcur[t]].status;
 }
 
 uint32_t pdt_rstate_tri_entry(const pdt_replay *r, const pdt_rstate *s, size_t t)
 {
-    if (t >= r->ntri || s->tcur[t] == NONE32) return NONE32;
-    uint32_t h = s->tcur[t];
+    if (t >= r->ntri || s->tcur[t] == PDT_TCUR_NONE) return NONE32;
+    uint32_t h = r->tris[t].h0 + s->tcur[t];
     while (r->hist[h].status == PDT_TS_CANDIDATE && r->hist[h].until < s->k) {
         if (h == r->tris[t].h0) return NONE32;
         h--;

@@ -68,10 +68,10 @@ done
 # a state over a quarter of the budget lives in a temporary file's mapping
 # (paged, its pages given back after each seek and frame): the same replay
 # and the same pictures as in memory
-case "$("$V" "$R" --check --mem 32K)" in *", 0 differ"*"(states paged"*) ok paged_state_check ;;
-    *) fail paged_state_check "$("$V" "$R" --check --mem 32K)" ;; esac
+case "$("$V" "$R" --check --mem 16K)" in *", 0 differ"*"(states paged"*) ok paged_state_check ;;
+    *) fail paged_state_check "$("$V" "$R" --check --mem 16K)" ;; esac
 case "$("$V" "$R" --check --mem 1M)" in *"paged"*) fail small_state_not_paged ;; *) ok small_state_not_paged ;; esac
-same_pictures "$R" 32K 0 2345 end && ok paged_state_same_pictures || fail paged_state_same_pictures
+same_pictures "$R" 16K 0 2345 end && ok paged_state_same_pictures || fail paged_state_same_pictures
 case "$("$V" "$R" --check --mem 1M)" in *"checkpoints every"*) ok checkpoints_made ;;
     *) fail checkpoints_made "no checkpoints under --mem 1M" ;; esac
 

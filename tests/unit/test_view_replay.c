@@ -317,6 +317,36 @@ TEST(malformed_events_skipped)
     pdt_replay_free(r);
 }
 
+/* A triangle's state names its history entry in 16 bits: a vertex set with
+ * more than PDT_TRI_HIST_MAX events (only a made-up trace has one) is two
+ * triangles, and every route (stepping both ways, seeking) agrees. */
+TEST(long_history_split)
+{
+    pdt_point pts[3] = {{0, 0}, {4, 0}, {0, 4}};
+    const size_t m = PDT_TRI_HIST_MAX + 4465;
+    pdt_rec *ev = malloc(m * sizeof *ev);
+    if (!ev) return;
+    for (size_t i = 0; i < m; i++)
+        ev[i] = rec(0, i % 2 ? PDT_EV_TRI_FINAL : PDT_EV_TRI_NEW, 0, (uint32_t)(i % 3),
+                    (uint32_t)((i + 1) % 3), (uint32_t)((i + 2) % 3), 0);
+    pdt_replay *r = NULL;
+    pdt_err err = {0};
+    CHECK(pdt_replay_new(pts, 3, ev, m, 1, &r, &err) == PDT_OK);
+    free(ev);
+    if (!r) return;
+    size_t nt;
+    const pdt_rtri *t = pdt_replay_tris(r, &nt);
+    CHECK_MSG(nt == 2 && t[0].hn == PDT_TRI_HIST_MAX && t[1].hn == 4465 && t[1].h0 == PDT_TRI_HIST_MAX,
+              "%zu triangles, %u and %u entries", nt, t[0].hn, nt > 1 ? t[1].hn : 0);
+    pdt_rstate *s = pdt_rstate_new(r);
+    pdt_replay_seek(r, s, m);
+    CHECK(s && pdt_rstate_tri_entry(r, s, 0) == PDT_TRI_HIST_MAX - 1 &&
+          pdt_rstate_tri_entry(r, s, 1) == (uint32_t)(m - 1));
+    pdt_rstate_free(s);
+    CHECK(check_routes(r, 997) == 0);
+    pdt_replay_free(r);
+}
+
 /* Graham's words: the sort says which point becomes which p_k, a pop gives
  * Area2 of (below, popped, new) and tells collinear from a right turn
  * (the points of lesson 1, already in angular order). */
@@ -434,6 +464,7 @@ int main(void)
     RUN(checkpoint_blob_born_triangles);
     RUN(hand_made_story);
     RUN(malformed_events_skipped);
+    RUN(long_history_split);
     RUN(code_listings);
     RUN(graham_words);
     RUN(bucket_plan_bounded);
