@@ -374,234 +374,300 @@ static pdt_status spill_replay(chk *c, rank_state *rs, uint32_t r)
     return st;
 }
 
-static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, const pdt_event *e)
+/* The checks of one event, one handler per kind: each returns PDT_OK, or
+ * the violation it found (chk_viol) or what failed (out of memory, the
+ * scratch file). */
+#define CK_ARGS chk *c, rank_state *rs CK_MAYBE, uint32_t r CK_MAYBE, uint64_t seq CK_MAYBE, \
+    const pdt_event *e CK_MAYBE
+#define CK_MAYBE __attribute__((unused)) /* (not every check needs every argument) */
+
+static pdt_status ck_phase_begin(CK_ARGS)
 {
-    pdt_status st = PDT_OK;
-    switch (e->kind) {
-    case PDT_EV_PHASE_BEGIN:
-        if (e->sub == PDT_PH_KERNEL) scope_open(rs, seq);
-        if (u32_push(&rs->phases, e->sub) || u32_push(&rs->phase_seq_lo, (uint32_t)seq))
-            return chk_nomem(c);
-        break;
-    case PDT_EV_PHASE_END:
-        if (rs->phases.n == 0 || rs->phases.v[rs->phases.n - 1] != e->sub) {
-            const char *open = rs->phases.n ? pdt_phase_name((int)rs->phases.v[rs->phases.n - 1])
-                                            : NULL;
-            return chk_viol(c, r, seq, e, "ends a phase that is not the innermost open one (%s)",
-                        rs->phases.n ? (open ? open : "?") : "none open");
-        }
-        rs->phases.n--;
-        rs->phase_seq_lo.n--;
-        if (e->sub == PDT_PH_KERNEL) return scope_close(c, rs, r, seq, e);
-        break;
-    case PDT_EV_EDGE_ADD:
-    case PDT_EV_EDGE_DEL: {
-        if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
-        if ((st = need_pt(c, r, seq, e, e->b)) != PDT_OK) return st;
-        if (e->a == e->b) return chk_viol(c, r, seq, e, "an edge from a point to itself");
-        uint64_t key = edge_key(e->a, e->b);
-        rs->edge_events++;
-        if (!rs->spill && edges_held(rs) > c->budget / 4 && (st = spill_start(c, rs)) != PDT_OK)
-            return st;
-        if (rs->spill) {
-            if (pdt_xsort_put(rs->spill, key, seq << 2 | (e->kind == PDT_EV_EDGE_ADD ? SP_ADD : SP_DEL)))
-                return chk_tmp_fail(c, "the kernel's edges", "cannot write");
-            break;
-        }
-        int alive = edge_has(&rs->edges, key);
-        if (e->kind == PDT_EV_EDGE_ADD) {
-            if (alive) return chk_viol(c, r, seq, e, "the edge already exists");
-            if (edge_add(&rs->edges, key)) return chk_nomem(c);
-        } else {
-            if (!alive) return chk_viol(c, r, seq, e, "the edge does not exist");
-            edge_del(&rs->edges, key);
-        }
-        break;
+    if (e->sub == PDT_PH_KERNEL) scope_open(rs, seq);
+    if (u32_push(&rs->phases, e->sub) || u32_push(&rs->phase_seq_lo, (uint32_t)seq))
+        return chk_nomem(c);
+    return PDT_OK;
+}
+
+static pdt_status ck_phase_end(CK_ARGS)
+{
+    if (rs->phases.n == 0 || rs->phases.v[rs->phases.n - 1] != e->sub) {
+        const char *open = rs->phases.n ? pdt_phase_name((int)rs->phases.v[rs->phases.n - 1])
+                                        : NULL;
+        return chk_viol(c, r, seq, e, "ends a phase that is not the innermost open one (%s)",
+                    rs->phases.n ? (open ? open : "?") : "none open");
     }
-    case PDT_EV_TRI_NEW:
-        /* kept for the edges' replay only (a level-1 trace has none: its
-         * kernel's triangles would take 12 bytes each for nothing) */
-        if (!rs->edges_traced) break;
-        if (!rs->spill && edges_held(rs) > c->budget / 4 && (st = spill_start(c, rs)) != PDT_OK)
-            return st;
-        if (rs->spill) {
-            rs->spill_tris++;
-            if (spill_tri(rs->spill, e->a, e->b, e->c))
-                return chk_tmp_fail(c, "the kernel's edges", "cannot write");
-            break;
-        }
-        if (u32_push(&rs->scope_tris, e->a) || u32_push(&rs->scope_tris, e->b) ||
-            u32_push(&rs->scope_tris, e->c))
-            return chk_nomem(c);
-        break;
-    case PDT_EV_PUSH: {
-        chk_stack *s = &rs->stack[e->sub];
-        if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
-        if (e->b == 1) {  /* a new stack instance begins */
-            if (r == 0 && e->sub == PDT_STACK_GRAHAM && s->n) graham_done(c, s);
-            s->n = 0;
-            c->instances++;
-        } else if (e->b != s->n + 1) {
-            return chk_viol(c, r, seq, e, "depth after push should be %zu", s->n + 1);
-        }
-        if ((st = stack_push(c, s, e->a)) != PDT_OK) return st;
-        c->pushes++;
-        rs->last_stack = e->sub;
-        if (e->sub == PDT_STACK_GRAHAM) c->mark[e->a] |= M_PUSHED;
-        break;
+    rs->phases.n--;
+    rs->phase_seq_lo.n--;
+    if (e->sub == PDT_PH_KERNEL) return scope_close(c, rs, r, seq, e);
+    return PDT_OK;
+}
+
+static pdt_status ck_edge(CK_ARGS)
+{
+    pdt_status st;
+    if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
+    if ((st = need_pt(c, r, seq, e, e->b)) != PDT_OK) return st;
+    if (e->a == e->b) return chk_viol(c, r, seq, e, "an edge from a point to itself");
+    uint64_t key = edge_key(e->a, e->b);
+    rs->edge_events++;
+    if (!rs->spill && edges_held(rs) > c->budget / 4 && (st = spill_start(c, rs)) != PDT_OK)
+        return st;
+    if (rs->spill) {
+        if (pdt_xsort_put(rs->spill, key, seq << 2 | (e->kind == PDT_EV_EDGE_ADD ? SP_ADD : SP_DEL)))
+            return chk_tmp_fail(c, "the kernel's edges", "cannot write");
+        return PDT_OK;
     }
-    case PDT_EV_POP: {
-        chk_stack *s = &rs->stack[e->sub];
-        if (s->n == 0) return chk_viol(c, r, seq, e, "pop from an empty stack");
-        if (s->v[s->n - 1] != e->a)
-            return chk_viol(c, r, seq, e, "the top of the %s stack is pt %" PRIu32 ", not pt %" PRIu32,
-                        pdt_stack_name(e->sub) ? pdt_stack_name(e->sub) : "?",
-                        s->v[s->n - 1], e->a);
-        if (e->b != s->n - 1)
-            return chk_viol(c, r, seq, e, "depth after pop should be %zu", s->n - 1);
-        s->n--;
-        c->pops++;
-        rs->last_stack = e->sub;
-        break;
-    }
-    case PDT_EV_LIFT: {
-        if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
-        pdt_point p = c->pts[e->a];
-        uint64_t z = (uint64_t)((int64_t)p.x * p.x) + (uint64_t)((int64_t)p.y * p.y);
-        if ((uint64_t)e->v != z)
-            return chk_viol(c, r, seq, e, "z should be x*x + y*y = %" PRIu64, z);
-        if (rs->open_merge >= 0) {
-            c->mg[rs->open_merge].lifts++;
-            c->lifts_merge++;
-            break;
-        }
-        c->lifts_local++;
-        uint64_t key = pdt_key(p);
-        if (!c->nlocal[r] || key < c->kmin[r]) c->kmin[r] = key;
-        if (!c->nlocal[r] || key > c->kmax[r]) c->kmax[r] = key;
-        c->nlocal[r]++;
-        if (!(c->mark[e->a] & M_REP))
-            return chk_viol(c, r, seq, e, "pt %" PRIu32 " is a duplicate of an earlier input point "
-                                      "and should not be lifted", e->a);
-        if (c->mark[e->a] & M_LIFTED)
-            return chk_viol(c, r, seq, e, "pt %" PRIu32 " was already lifted (local lift-ups must "
-                                      "cover each distinct point once)", e->a);
-        c->mark[e->a] |= M_LIFTED;
-        break;
-    }
-    case PDT_EV_SORT:
-        if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
-        c->mark[e->a] |= M_SORTED;
-        c->sorts++;
-        break;
-    case PDT_EV_DELETE:
-        if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
-        if ((st = need_pt(c, r, seq, e, e->b)) != PDT_OK) return st;
-        c->mark[e->a] |= M_DELETED;
-        break;
-    case PDT_EV_TRI_FINAL: {
-        uint32_t v[3] = {e->a, e->b, e->c};
-        for (int i = 0; i < 3; i++)
-            if ((st = need_pt(c, r, seq, e, v[i])) != PDT_OK) return st;
-        if (pdt_orient(c->pts[v[0]], c->pts[v[1]], c->pts[v[2]]) <= 0)
-            return chk_viol(c, r, seq, e, "the triangle is not counter-clockwise");
-        for (int i = 0; i < 3; i++)
-            if (!(c->mark[v[i]] & M_REP))
-                return chk_viol(c, r, seq, e, "pt %" PRIu32 " is a copy of an earlier input point and "
-                                          "cannot be a corner of T*", v[i]);
-        int k = v[0] < v[1] ? (v[0] < v[2] ? 0 : 2) : (v[1] < v[2] ? 1 : 2);
-        if (c->nfin == c->maxfin && (st = chk_spill_finals(c)) != PDT_OK) return st;
-        if (c->nfin == c->capfin && c->capfin == 0) {
-            /* room for T*'s triangles (at most 2n) at once, within the
-             * budget: growing by doubling held the old and the new buffer
-             * together for a moment (the peak of the whole check) */
-            size_t want = 2 * c->npts + 64 < c->maxfin ? 2 * c->npts + 64 : c->maxfin;
-            if (!(c->fin = malloc(want * sizeof *c->fin))) return chk_nomem(c);
-            c->capfin = want;
-            pdt_big_advise(c->fin, c->capfin * sizeof *c->fin);
-        }
-        if (c->nfin == c->capfin) {
-            if (chk_grow((void **)&c->fin, &c->capfin, c->nfin, sizeof *c->fin)) return chk_nomem(c);
-            /* up to half the budget, filled once: huge pages spare most page faults */
-            pdt_big_advise(c->fin, c->capfin * sizeof *c->fin);
-        }
-        c->totfin++;
-        fin *f = &c->fin[c->nfin++];
-        for (int i = 0; i < 3; i++) f->t.v[i] = v[(k + i) % 3];
-        f->rank = r;
-        f->seq = seq;
-        break;
-    }
-    case PDT_EV_HULL: {
-        /* after a monotone chain (lower stack, then upper stack): the hull is
-         * the lower chain plus the upper chain without its two ends */
-        int up = rs->last_stack;
-        rs->last_stack = -1;
-        if (e->b || (up != PDT_STACK_UPPER && up != PDT_STACK_MERGE_UPPER)) break;
-        const chk_stack *lo = &rs->stack[up - 1], *hi = &rs->stack[up];
-        if (lo->n < 2 || hi->n < 2 || lo->v[0] != hi->v[hi->n - 1] ||
-            lo->v[lo->n - 1] != hi->v[0])
-            return chk_viol(c, r, seq, e, "the %s and %s stacks do not form a closed chain",
-                        pdt_stack_name(up - 1), pdt_stack_name(up));
-        if (e->a != lo->n + hi->n - 2)
-            return chk_viol(c, r, seq, e, "the %s and %s stacks hold %zu hull vertices",
-                        pdt_stack_name(up - 1), pdt_stack_name(up), lo->n + hi->n - 2);
-        c->hulls++;
-        break;
-    }
-    case PDT_EV_DISCARD:
-        if (rs->open_merge >= 0) c->mg[rs->open_merge].discards++;
-        break;
-    case PDT_EV_MERGE_BEGIN:
-        if (rs->open_merge >= 0)
-            return chk_viol(c, r, seq, e, "the merge begun at event #%" PRIu64 " has not ended",
-                        c->mg[rs->open_merge].seq);
-        if (!(e->a < e->b && e->b < e->c && e->c <= (uint32_t)pdt_run_nranks(c->run)))
-            return chk_viol(c, r, seq, e, "groups must be ranks [left, right) and [right, end) "
-                                      "with left < right < end <= %d", pdt_run_nranks(c->run));
-        if (e->v != (int64_t)r || e->b != r)
-            return chk_viol(c, r, seq, e, "the merge rank must be the first rank of the right "
-                                      "group (%" PRIu32 ") and the rank recording it", e->b);
-        if (chk_grow((void **)&c->mg, &c->capmg, c->nmg, sizeof *c->mg)) return chk_nomem(c);
-        c->mg[c->nmg] = (merge){e->sub, e->a, e->b, e->c, r, seq, 0, 0, 0};
-        rs->open_merge = (long)c->nmg++;
-        scope_open(rs, seq);
-        break;
-    case PDT_EV_MERGE_END: {
-        if (rs->open_merge < 0) return chk_viol(c, r, seq, e, "no merge step is open");
-        merge *m = &c->mg[rs->open_merge];
-        if (e->sub != m->level)
-            return chk_viol(c, r, seq, e, "the open merge (event #%" PRIu64 ") is at level %" PRIu32,
-                        m->seq, m->level);
-        if (m->lifts != e->b)
-            return chk_viol(c, r, seq, e, "the merge lifted %" PRIu64 " points, its border set has %"
-                                      PRIu32, m->lifts, e->b);
-        if (m->discards != (uint64_t)e->v)
-            return chk_viol(c, r, seq, e, "%" PRIu64 " discard events were recorded in this merge",
-                        m->discards);
-        m->closed = 1;
-        rs->open_merge = -1;
-        return scope_close(c, rs, r, seq, e);
-    }
-    case PDT_EV_SEND:
-    case PDT_EV_RECV: {
-        if (chk_grow((void **)&c->msg, &c->capmsg, c->nmsg, sizeof *c->msg)) return chk_nomem(c);
-        msg *m = &c->msg[c->nmsg++];
-        int send = e->kind == PDT_EV_SEND;
-        m->src = send ? r : e->a;
-        m->dst = send ? e->a : r;
-        m->tag = e->sub;
-        m->seq_no = e->v;
-        m->bytes = pdt_event_bytes(e);
-        m->rank = r;
-        m->seq = seq;
-        m->ev = *e;
-        break;
-    }
-    default:
-        break;
+    int alive = edge_has(&rs->edges, key);
+    if (e->kind == PDT_EV_EDGE_ADD) {
+        if (alive) return chk_viol(c, r, seq, e, "the edge already exists");
+        if (edge_add(&rs->edges, key)) return chk_nomem(c);
+    } else {
+        if (!alive) return chk_viol(c, r, seq, e, "the edge does not exist");
+        edge_del(&rs->edges, key);
     }
     return PDT_OK;
+}
+
+static pdt_status ck_tri_new(CK_ARGS)
+{
+    pdt_status st;
+    /* kept for the edges' replay only (a level-1 trace has none: its
+     * kernel's triangles would take 12 bytes each for nothing) */
+    if (!rs->edges_traced) return PDT_OK;
+    if (!rs->spill && edges_held(rs) > c->budget / 4 && (st = spill_start(c, rs)) != PDT_OK)
+        return st;
+    if (rs->spill) {
+        rs->spill_tris++;
+        if (spill_tri(rs->spill, e->a, e->b, e->c))
+            return chk_tmp_fail(c, "the kernel's edges", "cannot write");
+        return PDT_OK;
+    }
+    if (u32_push(&rs->scope_tris, e->a) || u32_push(&rs->scope_tris, e->b) ||
+        u32_push(&rs->scope_tris, e->c))
+        return chk_nomem(c);
+    return PDT_OK;
+}
+
+static pdt_status ck_push(CK_ARGS)
+{
+    pdt_status st;
+    chk_stack *s = &rs->stack[e->sub];
+    if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
+    if (e->b == 1) {  /* a new stack instance begins */
+        if (r == 0 && e->sub == PDT_STACK_GRAHAM && s->n) graham_done(c, s);
+        s->n = 0;
+        c->instances++;
+    } else if (e->b != s->n + 1) {
+        return chk_viol(c, r, seq, e, "depth after push should be %zu", s->n + 1);
+    }
+    if ((st = stack_push(c, s, e->a)) != PDT_OK) return st;
+    c->pushes++;
+    rs->last_stack = e->sub;
+    if (e->sub == PDT_STACK_GRAHAM) c->mark[e->a] |= M_PUSHED;
+    return PDT_OK;
+}
+
+static pdt_status ck_pop(CK_ARGS)
+{
+    chk_stack *s = &rs->stack[e->sub];
+    if (s->n == 0) return chk_viol(c, r, seq, e, "pop from an empty stack");
+    if (s->v[s->n - 1] != e->a)
+        return chk_viol(c, r, seq, e, "the top of the %s stack is pt %" PRIu32 ", not pt %" PRIu32,
+                    pdt_stack_name(e->sub) ? pdt_stack_name(e->sub) : "?",
+                    s->v[s->n - 1], e->a);
+    if (e->b != s->n - 1)
+        return chk_viol(c, r, seq, e, "depth after pop should be %zu", s->n - 1);
+    s->n--;
+    c->pops++;
+    rs->last_stack = e->sub;
+    return PDT_OK;
+}
+
+static pdt_status ck_lift(CK_ARGS)
+{
+    pdt_status st;
+    if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
+    pdt_point p = c->pts[e->a];
+    uint64_t z = (uint64_t)((int64_t)p.x * p.x) + (uint64_t)((int64_t)p.y * p.y);
+    if ((uint64_t)e->v != z)
+        return chk_viol(c, r, seq, e, "z should be x*x + y*y = %" PRIu64, z);
+    if (rs->open_merge >= 0) {
+        c->mg[rs->open_merge].lifts++;
+        c->lifts_merge++;
+        return PDT_OK;
+    }
+    c->lifts_local++;
+    uint64_t key = pdt_key(p);
+    if (!c->nlocal[r] || key < c->kmin[r]) c->kmin[r] = key;
+    if (!c->nlocal[r] || key > c->kmax[r]) c->kmax[r] = key;
+    c->nlocal[r]++;
+    if (!(c->mark[e->a] & M_REP))
+        return chk_viol(c, r, seq, e, "pt %" PRIu32 " is a duplicate of an earlier input point "
+                                  "and should not be lifted", e->a);
+    if (c->mark[e->a] & M_LIFTED)
+        return chk_viol(c, r, seq, e, "pt %" PRIu32 " was already lifted (local lift-ups must "
+                                  "cover each distinct point once)", e->a);
+    c->mark[e->a] |= M_LIFTED;
+    return PDT_OK;
+}
+
+static pdt_status ck_sort(CK_ARGS)
+{
+    pdt_status st;
+    if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
+    c->mark[e->a] |= M_SORTED;
+    c->sorts++;
+    return PDT_OK;
+}
+
+static pdt_status ck_delete(CK_ARGS)
+{
+    pdt_status st;
+    if ((st = need_pt(c, r, seq, e, e->a)) != PDT_OK) return st;
+    if ((st = need_pt(c, r, seq, e, e->b)) != PDT_OK) return st;
+    c->mark[e->a] |= M_DELETED;
+    return PDT_OK;
+}
+
+static pdt_status ck_tri_final(CK_ARGS)
+{
+    pdt_status st;
+    uint32_t v[3] = {e->a, e->b, e->c};
+    for (int i = 0; i < 3; i++)
+        if ((st = need_pt(c, r, seq, e, v[i])) != PDT_OK) return st;
+    if (pdt_orient(c->pts[v[0]], c->pts[v[1]], c->pts[v[2]]) <= 0)
+        return chk_viol(c, r, seq, e, "the triangle is not counter-clockwise");
+    for (int i = 0; i < 3; i++)
+        if (!(c->mark[v[i]] & M_REP))
+            return chk_viol(c, r, seq, e, "pt %" PRIu32 " is a copy of an earlier input point and "
+                                      "cannot be a corner of T*", v[i]);
+    int k = v[0] < v[1] ? (v[0] < v[2] ? 0 : 2) : (v[1] < v[2] ? 1 : 2);
+    if (c->nfin == c->maxfin && (st = chk_spill_finals(c)) != PDT_OK) return st;
+    if (c->nfin == c->capfin && c->capfin == 0) {
+        /* room for T*'s triangles (at most 2n) at once, within the
+         * budget: growing by doubling held the old and the new buffer
+         * together for a moment (the peak of the whole check) */
+        size_t want = 2 * c->npts + 64 < c->maxfin ? 2 * c->npts + 64 : c->maxfin;
+        if (!(c->fin = malloc(want * sizeof *c->fin))) return chk_nomem(c);
+        c->capfin = want;
+        pdt_big_advise(c->fin, c->capfin * sizeof *c->fin);
+    }
+    if (c->nfin == c->capfin) {
+        if (chk_grow((void **)&c->fin, &c->capfin, c->nfin, sizeof *c->fin)) return chk_nomem(c);
+        /* up to half the budget, filled once: huge pages spare most page faults */
+        pdt_big_advise(c->fin, c->capfin * sizeof *c->fin);
+    }
+    c->totfin++;
+    fin *f = &c->fin[c->nfin++];
+    for (int i = 0; i < 3; i++) f->t.v[i] = v[(k + i) % 3];
+    f->rank = r;
+    f->seq = seq;
+    return PDT_OK;
+}
+
+static pdt_status ck_hull(CK_ARGS)
+{
+    /* after a monotone chain (lower stack, then upper stack): the hull is
+     * the lower chain plus the upper chain without its two ends */
+    int up = rs->last_stack;
+    rs->last_stack = -1;
+    if (e->b || (up != PDT_STACK_UPPER && up != PDT_STACK_MERGE_UPPER)) return PDT_OK;
+    const chk_stack *lo = &rs->stack[up - 1], *hi = &rs->stack[up];
+    if (lo->n < 2 || hi->n < 2 || lo->v[0] != hi->v[hi->n - 1] ||
+        lo->v[lo->n - 1] != hi->v[0])
+        return chk_viol(c, r, seq, e, "the %s and %s stacks do not form a closed chain",
+                    pdt_stack_name(up - 1), pdt_stack_name(up));
+    if (e->a != lo->n + hi->n - 2)
+        return chk_viol(c, r, seq, e, "the %s and %s stacks hold %zu hull vertices",
+                    pdt_stack_name(up - 1), pdt_stack_name(up), lo->n + hi->n - 2);
+    c->hulls++;
+    return PDT_OK;
+}
+
+static pdt_status ck_discard(CK_ARGS)
+{
+    if (rs->open_merge >= 0) c->mg[rs->open_merge].discards++;
+    return PDT_OK;
+}
+
+static pdt_status ck_merge_begin(CK_ARGS)
+{
+    if (rs->open_merge >= 0)
+        return chk_viol(c, r, seq, e, "the merge begun at event #%" PRIu64 " has not ended",
+                    c->mg[rs->open_merge].seq);
+    if (!(e->a < e->b && e->b < e->c && e->c <= (uint32_t)pdt_run_nranks(c->run)))
+        return chk_viol(c, r, seq, e, "groups must be ranks [left, right) and [right, end) "
+                                  "with left < right < end <= %d", pdt_run_nranks(c->run));
+    if (e->v != (int64_t)r || e->b != r)
+        return chk_viol(c, r, seq, e, "the merge rank must be the first rank of the right "
+                                  "group (%" PRIu32 ") and the rank recording it", e->b);
+    if (chk_grow((void **)&c->mg, &c->capmg, c->nmg, sizeof *c->mg)) return chk_nomem(c);
+    c->mg[c->nmg] = (merge){e->sub, e->a, e->b, e->c, r, seq, 0, 0, 0};
+    rs->open_merge = (long)c->nmg++;
+    scope_open(rs, seq);
+    return PDT_OK;
+}
+
+static pdt_status ck_merge_end(CK_ARGS)
+{
+    if (rs->open_merge < 0) return chk_viol(c, r, seq, e, "no merge step is open");
+    merge *m = &c->mg[rs->open_merge];
+    if (e->sub != m->level)
+        return chk_viol(c, r, seq, e, "the open merge (event #%" PRIu64 ") is at level %" PRIu32,
+                    m->seq, m->level);
+    if (m->lifts != e->b)
+        return chk_viol(c, r, seq, e, "the merge lifted %" PRIu64 " points, its border set has %"
+                                  PRIu32, m->lifts, e->b);
+    if (m->discards != (uint64_t)e->v)
+        return chk_viol(c, r, seq, e, "%" PRIu64 " discard events were recorded in this merge",
+                    m->discards);
+    m->closed = 1;
+    rs->open_merge = -1;
+    return scope_close(c, rs, r, seq, e);
+}
+
+static pdt_status ck_msg(CK_ARGS)
+{
+    if (chk_grow((void **)&c->msg, &c->capmsg, c->nmsg, sizeof *c->msg)) return chk_nomem(c);
+    msg *m = &c->msg[c->nmsg++];
+    int send = e->kind == PDT_EV_SEND;
+    m->src = send ? r : e->a;
+    m->dst = send ? e->a : r;
+    m->tag = e->sub;
+    m->seq_no = e->v;
+    m->bytes = pdt_event_bytes(e);
+    m->rank = r;
+    m->seq = seq;
+    m->ev = *e;
+    return PDT_OK;
+}
+
+#undef CK_ARGS
+#undef CK_MAYBE
+
+static pdt_status check_event(chk *c, rank_state *rs, uint32_t r, uint64_t seq, const pdt_event *e)
+{
+    switch (e->kind) {
+    case PDT_EV_PHASE_BEGIN: return ck_phase_begin(c, rs, r, seq, e);
+    case PDT_EV_PHASE_END: return ck_phase_end(c, rs, r, seq, e);
+    case PDT_EV_EDGE_ADD: return ck_edge(c, rs, r, seq, e);
+    case PDT_EV_EDGE_DEL: return ck_edge(c, rs, r, seq, e);
+    case PDT_EV_TRI_NEW: return ck_tri_new(c, rs, r, seq, e);
+    case PDT_EV_PUSH: return ck_push(c, rs, r, seq, e);
+    case PDT_EV_POP: return ck_pop(c, rs, r, seq, e);
+    case PDT_EV_LIFT: return ck_lift(c, rs, r, seq, e);
+    case PDT_EV_SORT: return ck_sort(c, rs, r, seq, e);
+    case PDT_EV_DELETE: return ck_delete(c, rs, r, seq, e);
+    case PDT_EV_TRI_FINAL: return ck_tri_final(c, rs, r, seq, e);
+    case PDT_EV_HULL: return ck_hull(c, rs, r, seq, e);
+    case PDT_EV_DISCARD: return ck_discard(c, rs, r, seq, e);
+    case PDT_EV_MERGE_BEGIN: return ck_merge_begin(c, rs, r, seq, e);
+    case PDT_EV_MERGE_END: return ck_merge_end(c, rs, r, seq, e);
+    case PDT_EV_SEND: return ck_msg(c, rs, r, seq, e);
+    case PDT_EV_RECV: return ck_msg(c, rs, r, seq, e);
+    default: return PDT_OK;
+    }
 }
 
 #define CHECK_AHEAD 16
