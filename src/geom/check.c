@@ -243,192 +243,221 @@ static pdt_status fail(pdt_err *err, const char *fmt, ...)
     return pdt_err_set(err, PDT_ERR_CHECK, "%s", msg);
 }
 
-pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tris, size_t ntri,
-                              pdt_err *err)
-{
-    pdt_status st = PDT_OK;
-    if (n > UINT32_MAX || ntri > (size_t)UINT32_MAX / 3)
-        return pdt_err_set(err, PDT_ERR_ARG, "input too large");
-    pidx *s = malloc((n ? n : 1) * sizeof *s);
-    uint32_t *rep = malloc((n ? n : 1) * sizeof *rep);
-    uint32_t *hull = malloc((2 * n + 2) * sizeof *hull); /* the chains may overshoot */
-    uint32_t *nxt = malloc((n ? n : 1) * sizeof *nxt);
-    uint8_t *usedv = calloc(n ? n : 1, 1);
-    dedge *ed = malloc((ntri ? 3 * ntri : 1) * sizeof *ed);
-    if (!s || !rep || !hull || !nxt || !usedv || !ed) {
-        st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-        goto done;
-    }
+/* pdt_check_delaunay's state: the input, its distinct points (s[0..m):
+ * sorted, each its smallest index; rep: every index's representative), our
+ * own hull (h vertices, collinear boundary points included), and the
+ * triangles' directed edges (ed) with the boundary's successor of each
+ * vertex (nxt, nb edges). */
+typedef struct dcheck {
+    const pdt_point *pts;
+    const pdt_tri *tris;
+    size_t n, ntri, m, h, nb;
+    pidx *s;
+    uint32_t *rep, *hull, *nxt;
+    uint8_t *usedv;
+    dedge *ed;
+    pdt_err *err;
+} dcheck;
 
-    /* representatives: the smallest index of each location */
-    for (size_t i = 0; i < n; i++) {
-        s[i].p = pts[i];
-        s[i].i = (uint32_t)i;
+/* The representatives: the smallest index of each location. */
+static void distinct_points(dcheck *d)
+{
+    for (size_t i = 0; i < d->n; i++) {
+        d->s[i].p = d->pts[i];
+        d->s[i].i = (uint32_t)i;
     }
-    qsort(s, n, sizeof *s, pidx_cmp);
+    qsort(d->s, d->n, sizeof *d->s, pidx_cmp);
     size_t m = 0; /* distinct points, in s[0..m) after compaction */
-    for (size_t i = 0; i < n; i++) {
-        if (i > 0 && pdt_lex_cmp(s[i].p, s[m - 1].p) == 0) {
-            rep[s[i].i] = s[m - 1].i;
+    for (size_t i = 0; i < d->n; i++) {
+        if (i > 0 && pdt_lex_cmp(d->s[i].p, d->s[m - 1].p) == 0) {
+            d->rep[d->s[i].i] = d->s[m - 1].i;
             continue;
         }
-        rep[s[i].i] = s[i].i;
-        s[m++] = s[i];
+        d->rep[d->s[i].i] = d->s[i].i;
+        d->s[m++] = d->s[i];
     }
+    d->m = m;
+}
 
-    /* own monotone chain over the distinct points, collinear points kept */
-    size_t h = 0;
+/* Our own monotone chain over the distinct points, collinear points kept
+ * (d->h vertices).  0 when they are all collinear (or fewer than 3). */
+static int own_hull(dcheck *d)
+{
+    const pidx *s = d->s;
+    const pdt_point *pts = d->pts;
+    uint32_t *hull = d->hull;
+    size_t m = d->m, h = 0;
     int collinear = 1;
-    for (size_t i = 2; i < m && collinear; i++)
-        collinear = ck_orient(s[0].p, s[1].p, s[i].p) == 0;
-    if (!collinear) {
-        for (size_t i = 0; i < m; i++) {
-            while (h >= 2 && ck_orient(pts[hull[h - 2]], pts[hull[h - 1]], s[i].p) < 0) h--;
-            hull[h++] = s[i].i;
-        }
-        size_t low = h;
-        for (size_t i = m - 1; i-- > 0;) {
-            while (h > low && ck_orient(pts[hull[h - 2]], pts[hull[h - 1]], s[i].p) < 0) h--;
-            hull[h++] = s[i].i;
-        }
-        h--; /* the start point came back */
+    for (size_t i = 2; i < m && collinear; i++) collinear = ck_orient(s[0].p, s[1].p, s[i].p) == 0;
+    if (collinear) return 0;
+    for (size_t i = 0; i < m; i++) {
+        while (h >= 2 && ck_orient(pts[hull[h - 2]], pts[hull[h - 1]], s[i].p) < 0) h--;
+        hull[h++] = s[i].i;
     }
+    size_t low = h;
+    for (size_t i = m - 1; i-- > 0;) {
+        while (h > low && ck_orient(pts[hull[h - 2]], pts[hull[h - 1]], s[i].p) < 0) h--;
+        hull[h++] = s[i].i;
+    }
+    d->h = h - 1; /* the start point came back */
+    return 1;
+}
 
-    if (collinear) {
-        if (ntri)
-            st = fail(err, "%zu triangles for %s input (expected none)", ntri,
-                 m < 3 ? "fewer than 3 distinct points" : "all-collinear");
-        goto done;
-    }
-    if (ntri == 0) {
-        st = fail(err, "no triangles, but the %zu distinct points are not collinear", m);
-        goto done;
-    }
-
-    /* 1: triangles: valid representatives, counter-clockwise */
-    for (size_t t = 0; t < ntri && st == PDT_OK; t++) {
-        const uint32_t *v = tris[t].v;
-        for (int k = 0; k < 3 && st == PDT_OK; k++) {
-            if (v[k] >= n)
-                st = fail(err,
-                          "triangle %zu (%u %u %u): index %u out of range (n = %zu)", t, v[0],
-                          v[1], v[2], v[k], n);
-            else if (rep[v[k]] != v[k])
-                st = fail(err,
-                          "triangle %zu (%u %u %u) uses %u, a duplicate of point %u "
-                          "(the smallest index must represent it)",
-                          t, v[0], v[1], v[2], v[k], rep[v[k]]);
+/* 1: every triangle names representatives, three of them, counter-
+ * clockwise; its directed edges go to d->ed and its corners are marked used. */
+static pdt_status check_triangles(dcheck *d)
+{
+    for (size_t t = 0; t < d->ntri; t++) {
+        const uint32_t *v = d->tris[t].v;
+        for (int k = 0; k < 3; k++) {
+            if (v[k] >= d->n)
+                return fail(d->err, "triangle %zu (%u %u %u): index %u out of range (n = %zu)", t, v[0],
+                            v[1], v[2], v[k], d->n);
+            if (d->rep[v[k]] != v[k])
+                return fail(d->err,
+                            "triangle %zu (%u %u %u) uses %u, a duplicate of point %u "
+                            "(the smallest index must represent it)",
+                            t, v[0], v[1], v[2], v[k], d->rep[v[k]]);
         }
-        if (st != PDT_OK) break;
         if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2])
-            st = fail(err, "triangle %zu (%u %u %u) repeats a vertex", t,
-                      v[0], v[1], v[2]);
-        else if (ck_orient(pts[v[0]], pts[v[1]], pts[v[2]]) <= 0)
-            st = fail(err, "triangle %zu (%u %u %u) is not counter-clockwise",
-                      t, v[0], v[1], v[2]);
+            return fail(d->err, "triangle %zu (%u %u %u) repeats a vertex", t, v[0], v[1], v[2]);
+        if (ck_orient(d->pts[v[0]], d->pts[v[1]], d->pts[v[2]]) <= 0)
+            return fail(d->err, "triangle %zu (%u %u %u) is not counter-clockwise", t, v[0], v[1], v[2]);
         for (int k = 0; k < 3; k++) {
             uint32_t a = v[k], b = v[(k + 1) % 3];
-            dedge *e = &ed[3 * t + (size_t)k];
+            dedge *e = &d->ed[3 * t + (size_t)k];
             e->lo = a < b ? a : b;
             e->hi = a < b ? b : a;
             e->fwd = a < b;
             e->tri = (uint32_t)t;
             e->k = (uint8_t)k;
-            usedv[a] = 1;
+            d->usedv[a] = 1;
         }
     }
-    if (st != PDT_OK) goto done;
+    return PDT_OK;
+}
 
-    /* 3: every distinct point used */
-    for (size_t i = 0; i < m && st == PDT_OK; i++)
-        if (!usedv[s[i].i])
-            st = fail(err, "point %u (%d, %d) is in no triangle", s[i].i,
-                      s[i].p.x, s[i].p.y);
-    if (st != PDT_OK) goto done;
+/* 3: every distinct point is a corner. */
+static pdt_status check_points_used(dcheck *d)
+{
+    for (size_t i = 0; i < d->m; i++)
+        if (!d->usedv[d->s[i].i])
+            return fail(d->err, "point %u (%d, %d) is in no triangle", d->s[i].i, d->s[i].p.x,
+                        d->s[i].p.y);
+    return PDT_OK;
+}
 
-    /* 2: edge multiplicities; collect the boundary */
-    size_t ne = 3 * ntri, nb = 0;
-    if (!sort_edges(ed, ne, n)) {
-        st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-        goto done;
-    }
-    for (size_t i = 0; i < n; i++)
-        nxt[i] = UINT32_MAX;
-    for (size_t i = 0; i < ne && st == PDT_OK;) {
+/* 2: every edge in at most two triangles, on both sides when two; the
+ * edges of one triangle are the boundary (d->nxt, d->nb). */
+static pdt_status check_edge_multiplicity(dcheck *d)
+{
+    size_t ne = 3 * d->ntri;
+    const dedge *ed = d->ed;
+    if (!sort_edges(d->ed, ne, d->n)) return pdt_err_set(d->err, PDT_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < d->n; i++) d->nxt[i] = UINT32_MAX;
+    for (size_t i = 0; i < ne;) {
         size_t j = i + 1;
-        while (j < ne && ed[j].lo == ed[i].lo && ed[j].hi == ed[i].hi)
-            j++;
+        while (j < ne && ed[j].lo == ed[i].lo && ed[j].hi == ed[i].hi) j++;
         if (j - i > 2 || (j - i == 2 && ed[i].fwd == ed[i + 1].fwd)) {
-            const pdt_tri *a = &tris[ed[i].tri], *b = &tris[ed[i + 1].tri];
-            st = fail(err,
-                      "edge %u-%u is used by %zu triangles (%u %u %u), (%u %u %u)%s",
-                      ed[i].lo, ed[i].hi, j - i, a->v[0], a->v[1], a->v[2], b->v[0],
-                      b->v[1], b->v[2], j - i == 2 ? " on the same side" : ", ...");
-        } else if (j - i == 1) { /* boundary edge, directed as in its triangle */
+            const pdt_tri *a = &d->tris[ed[i].tri], *b = &d->tris[ed[i + 1].tri];
+            return fail(d->err, "edge %u-%u is used by %zu triangles (%u %u %u), (%u %u %u)%s", ed[i].lo,
+                        ed[i].hi, j - i, a->v[0], a->v[1], a->v[2], b->v[0], b->v[1], b->v[2],
+                        j - i == 2 ? " on the same side" : ", ...");
+        }
+        if (j - i == 1) { /* boundary edge, directed as in its triangle */
             uint32_t from = ed[i].fwd ? ed[i].lo : ed[i].hi, to = ed[i].fwd ? ed[i].hi : ed[i].lo;
-            if (nxt[from] != UINT32_MAX)
-                st = fail(err,
-                          "boundary vertex %u has two outgoing boundary edges (to %u "
-                          "and %u)", from, nxt[from], to);
-            nxt[from] = to;
-            nb++;
+            if (d->nxt[from] != UINT32_MAX)
+                return fail(d->err,
+                            "boundary vertex %u has two outgoing boundary edges (to %u "
+                            "and %u)", from, d->nxt[from], to);
+            d->nxt[from] = to;
+            d->nb++;
         }
         i = j;
     }
-    if (st != PDT_OK) goto done;
+    return PDT_OK;
+}
 
-    /* the boundary is exactly the hull cycle */
-    if (nb != h) {
-        st = fail(err,
-                  "%zu boundary edges, but the convex hull has %zu vertices "
-                  "(collinear boundary points included)", nb, h);
-        goto done;
-    }
+/* The boundary is exactly the hull cycle, and Euler's count (thesis D5)
+ * holds. */
+static pdt_status check_boundary(dcheck *d)
+{
+    size_t h = d->h, m = d->m;
+    if (d->nb != h)
+        return fail(d->err,
+                    "%zu boundary edges, but the convex hull has %zu vertices "
+                    "(collinear boundary points included)", d->nb, h);
     for (size_t k = 0; k < h; k++) {
-        uint32_t a = hull[k], b = hull[(k + 1) % h];
-        if (nxt[a] != b) {
-            if (nxt[a] == UINT32_MAX)
-                st = fail(err,
-                          "hull edge %u-%u is not a boundary edge (hull vertex %u has "
-                          "no outgoing boundary edge)", a, b, a);
-            else
-                st = fail(err, "boundary edge %u-%u is not the hull edge %u-%u", a, nxt[a], a, b);
-            goto done;
-        }
+        uint32_t a = d->hull[k], b = d->hull[(k + 1) % h];
+        if (d->nxt[a] == b) continue;
+        if (d->nxt[a] == UINT32_MAX)
+            return fail(d->err,
+                        "hull edge %u-%u is not a boundary edge (hull vertex %u has "
+                        "no outgoing boundary edge)", a, b, a);
+        return fail(d->err, "boundary edge %u-%u is not the hull edge %u-%u", a, d->nxt[a], a, b);
     }
+    if (d->ntri != 2 * m - h - 2)
+        return fail(d->err, "%zu triangles, Euler count 2n - h - 2 = %zu (n = %zu, h = %zu)", d->ntri,
+                    2 * m - h - 2, m, h);
+    return PDT_OK;
+}
 
-    /* Euler (thesis D5) */
-    if (ntri != 2 * m - h - 2) {
-        st = fail(err, "%zu triangles, Euler count 2n - h - 2 = %zu (n = %zu, h = %zu)", ntri,
-                  2 * m - h - 2, m, h);
-        goto done;
-    }
-
-    /* 4: every interior edge locally Delaunay under the tie rule */
-    for (size_t i = 0; i + 1 < ne && st == PDT_OK; i++) {
+/* 4: every interior edge locally Delaunay under the tie rule. */
+static pdt_status check_locally_delaunay(dcheck *d)
+{
+    const dedge *ed = d->ed;
+    const pdt_point *pts = d->pts;
+    for (size_t i = 0; i + 1 < 3 * d->ntri; i++) {
         if (ed[i].lo != ed[i + 1].lo || ed[i].hi != ed[i + 1].hi) continue;
-        const pdt_tri *t1 = &tris[ed[i].tri], *t2 = &tris[ed[i + 1].tri];
+        const pdt_tri *t1 = &d->tris[ed[i].tri], *t2 = &d->tris[ed[i + 1].tri];
         uint32_t a = t1->v[ed[i].k], b = t1->v[(ed[i].k + 1) % 3], c = t1->v[(ed[i].k + 2) % 3];
-        uint32_t d = t2->v[(ed[i + 1].k + 2) % 3];
-        int r = ck_incircle_sos(pts[a], pts[b], pts[c], pts[d]);
-        if (r >= 0)
-            st = fail(
-                err,
-                "edge %u-%u is not locally Delaunay: point %u is %s the circle of "
-                "triangle (%u %u %u), the file's triangle %zu%s", ed[i].lo, ed[i].hi, d,
-                ck_incircle(pts[a], pts[b], pts[c], pts[d]) > 0 ? "inside" : "on", a, b, c,
-                (size_t)ed[i].tri + 1,
-                ck_incircle(pts[a], pts[b], pts[c], pts[d]) > 0 ? ""
-                                                                : " and the tie rule says inside");
+        uint32_t x = t2->v[(ed[i + 1].k + 2) % 3];
+        if (ck_incircle_sos(pts[a], pts[b], pts[c], pts[x]) >= 0) {
+            int inside = ck_incircle(pts[a], pts[b], pts[c], pts[x]) > 0;
+            return fail(d->err,
+                        "edge %u-%u is not locally Delaunay: point %u is %s the circle of "
+                        "triangle (%u %u %u), the file's triangle %zu%s", ed[i].lo, ed[i].hi, x,
+                        inside ? "inside" : "on", a, b, c, (size_t)ed[i].tri + 1,
+                        inside ? "" : " and the tie rule says inside");
+        }
         i++;
     }
+    return PDT_OK;
+}
 
-done:
-    free(s);
-    free(rep);
-    free(hull);
-    free(nxt);
-    free(usedv);
-    free(ed);
+pdt_status pdt_check_delaunay(const pdt_point *pts, size_t n, const pdt_tri *tris, size_t ntri,
+                              pdt_err *err)
+{
+    if (n > UINT32_MAX || ntri > (size_t)UINT32_MAX / 3)
+        return pdt_err_set(err, PDT_ERR_ARG, "input too large");
+    dcheck d = {.pts = pts, .tris = tris, .n = n, .ntri = ntri, .err = err};
+    d.s = malloc((n ? n : 1) * sizeof *d.s);
+    d.rep = malloc((n ? n : 1) * sizeof *d.rep);
+    d.hull = malloc((2 * n + 2) * sizeof *d.hull); /* the chains may overshoot */
+    d.nxt = malloc((n ? n : 1) * sizeof *d.nxt);
+    d.usedv = calloc(n ? n : 1, 1);
+    d.ed = malloc((ntri ? 3 * ntri : 1) * sizeof *d.ed);
+    pdt_status st = PDT_OK;
+    if (!d.s || !d.rep || !d.hull || !d.nxt || !d.usedv || !d.ed) {
+        st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    } else {
+        distinct_points(&d);
+        if (!own_hull(&d)) { /* fewer than 3 distinct points, or all collinear */
+            if (ntri)
+                st = fail(err, "%zu triangles for %s input (expected none)", ntri,
+                          d.m < 3 ? "fewer than 3 distinct points" : "all-collinear");
+        } else if (ntri == 0) {
+            st = fail(err, "no triangles, but the %zu distinct points are not collinear", d.m);
+        } else if ((st = check_triangles(&d)) == PDT_OK && (st = check_points_used(&d)) == PDT_OK &&
+                   (st = check_edge_multiplicity(&d)) == PDT_OK && (st = check_boundary(&d)) == PDT_OK) {
+            st = check_locally_delaunay(&d);
+        }
+    }
+    free(d.s);
+    free(d.rep);
+    free(d.hull);
+    free(d.nxt);
+    free(d.usedv);
+    free(d.ed);
     return st;
 }
