@@ -81,22 +81,28 @@ TEST(cells_by_status_and_rank)
     pdt_replay_free(r);
 }
 
+/* A synthetic 8-rank SRM run on a 40x40 grid (level 1) and its replay;
+ * NULL (L freed, the failure counted) when either cannot be made. */
+static pdt_replay *synth_replay(pdt_synth *L)
+{
+    pdt_err err = {0};
+    pdt_replay *r = NULL;
+    CHECK(pdt_synth_srm(40, 40, 8, 1, L, &err) == PDT_OK);
+    if (err.code) return NULL;
+    CHECK(pdt_replay_new(L->pts, L->n, L->recs, L->m, L->nranks, &r, &err) == PDT_OK);
+    if (!r) pdt_synth_free(L);
+    return r;
+}
+
 /* A synthetic 8-rank run at its end: every visible triangle touches the grid
  * over the bounding box; with cells smaller than the triangles, a cell is
  * empty only where no triangle is (none here: the grid is triangulated). */
 TEST(synthetic_run_counts_add_up)
 {
     pdt_synth L;
-    pdt_err err = {0};
-    CHECK(pdt_synth_srm(40, 40, 8, 1, &L, &err) == PDT_OK);
-    if (err.code) return;
+    pdt_replay *r = synth_replay(&L);
+    if (!r) return;
     size_t m = L.m;
-    pdt_replay *r;
-    CHECK(pdt_replay_new(L.pts, L.n, L.recs, L.m, L.nranks, &r, &err) == PDT_OK);
-    if (!r) {
-        pdt_synth_free(&L);
-        return;
-    }
     pdt_rstate *s = pdt_rstate_new(r);
     pdt_replay_seek(r, s, m);
     size_t nt, visible = 0;
@@ -131,15 +137,8 @@ TEST(synthetic_run_counts_add_up)
 TEST(two_threads_same_cells)
 {
     pdt_synth L;
-    pdt_err err = {0};
-    CHECK(pdt_synth_srm(40, 40, 8, 1, &L, &err) == PDT_OK);
-    if (err.code) return;
-    pdt_replay *r;
-    CHECK(pdt_replay_new(L.pts, L.n, L.recs, L.m, L.nranks, &r, &err) == PDT_OK);
-    if (!r) {
-        pdt_synth_free(&L);
-        return;
-    }
+    pdt_replay *r = synth_replay(&L);
+    if (!r) return;
     pdt_rstate *s = pdt_rstate_new(r);
     pdt_point lo, hi;
     CHECK(pdt_replay_bbox(r, &lo, &hi));
