@@ -18,7 +18,13 @@ done
 D=$TMP/slurm
 mkdir -p "$D/state" "$D/spool" "$D/log" "$D/munge"
 chmod 700 "$D/munge"
+# two free ports (nothing listening on either): slurmctld's and slurmd's
+listening() { (exec 3<> "/dev/tcp/127.0.0.1/$1") 2> /dev/null; }
 PORT=$((20000 + $$ % 20000))
+for _ in $(seq 1 50); do
+    listening "$PORT" || listening $((PORT + 1)) || break
+    PORT=$((20000 + (PORT + 7) % 20000))
+done
 
 stop_daemons() {
     local f pid
@@ -69,13 +75,16 @@ PartitionName=debug Nodes=localhost Default=YES MaxTime=10 State=UP
 CONF
 export SLURM_CONF=$D/slurm.conf
 slurmctld -c -f "$SLURM_CONF" && slurmd -f "$SLURM_CONF"
+# the node registers in about a second on a quiet machine; under load (the
+# rest of the suite, a benchmark) it took over 20 s once: wait up to 90 s
 up=0
-for _ in $(seq 1 40); do
+for _ in $(seq 1 180); do
     if timeout 5 sinfo -h -o %t 2> /dev/null | grep -qx idle; then up=1; break; fi
     sleep 0.5
 done
 if [ "$up" -ne 1 ]; then
-    fail slurm_up "the node did not become idle: $(tail -3 "$D/log/slurmctld.log" "$D/log/slurmd.log" 2>&1)"
+    fail slurm_up "the node did not become idle (state: $(timeout 5 sinfo -h -o %t 2>&1)):" \
+        "$(tail -n 4 "$D/log/slurmctld.log" "$D/log/slurmd.log" 2>&1)"
     summary; exit
 fi
 ok slurm_up
