@@ -273,16 +273,20 @@ static void sort3(uint32_t v[3], const uint32_t in[3])
  *
  * The first pass writes every triangle event as its triangle's key (the
  * corners sorted) and its event index into a spill (memory, or the place's
- * spill file), sorted by a hash of the key into NFINE fine buckets, each in
- * event order; what its history entry needs besides (its sub field, and for
+ * spill file), sorted by a hash of the key into fine buckets (NFINE held
+ * in memory; a streamed build plans their number from the run and its
+ * budget, pdt_replay_plan_buckets), each in event order; what its history
+ * entry needs besides (its sub field, and for
  * a border kernel's candidate the merge step open on its rank) waits in
  * ev_ent and ev_obj, which the grouping overwrites.  Then runs of
  * consecutive fine buckets that fit the working budget are grouped one
  * after the other with a hash table of their own size (tri_groups): the
  * events of one triangle are all in one fine bucket, so each run's
  * triangles are whole, and their history entries take the run's place in
- * the history table.  A last pass in event order numbers the triangles by
- * their first event (tri_ids).  Memory: the tables themselves (which may be
+ * the history table; a vertex set of more than PDT_TRI_HIST_MAX events is
+ * grouped as several triangles (a state names a triangle's entry in 16
+ * bits).  A last pass in event order numbers the triangles by their first
+ * event (tri_ids; streamed: tri_number).  Memory: the tables themselves (which may be
  * the caller's, e.g. a mapping of the index file) and a working set bounded
  * by the budget. */
 
