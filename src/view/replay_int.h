@@ -7,7 +7,7 @@
 #include "../geom/bigmem.h"
 
 /* Checkpoints a kept index holds, at most (index.c makes 17 at most). */
-#define PDT_ICK_MAX 24
+#define PDT_ICK_MAX 48
 
 /* ---- the merged events of a kept index, decoded on demand (evsrc.c) ----------
  *
