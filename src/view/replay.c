@@ -307,7 +307,8 @@ typedef struct tri_xrec {
 #define FINE_BITS 8
 #define NFINE ((size_t)1 << FINE_BITS)
 _Static_assert(NFINE == PDT_REPLAY_NFINE, "replay_int.h says how many fine buckets");
-#define GROUP_BYTES_PER_EVENT 128u /* tri_groups' working memory per event, at most */
+#define GROUP_BYTES_PER_EVENT PDT_REPLAY_GROUP_BYTES_PER_EVENT /* tri_groups' working memory
+                                                              * per event, at most */
 /* Events per run, at most (unless one fine bucket holds more): a working set
  * of some 60 MiB, reused from run to run (fresh pages are dear on virtual
  * machines, and a smaller hash table misses the caches less). */
@@ -1587,10 +1588,6 @@ static uint64_t group_work(const pdt_replay *r, uint64_t budget)
 /* Fine bits a streamed build may use at most (tri_number keeps a bucket's
  * number in 16 bits). */
 #define FINE_BITS_MAX 16u
-/* What the streamed grouping holds per event of its bucket, with a margin
- * (it measures under 70 bytes per event of the run: a bucket's triangle
- * events, their hash table, groups and entries). */
-#define GROUP_EVENT_EST PDT_REPLAY_GROUP_EVENT_EST
 /* The least room planned for the grouping, whatever the budget (below it,
  * more and smaller buckets only make the build slower: 2^11 buckets made
  * the 10^7-point run's build 15-20 % slower than 2^8). */
@@ -1602,7 +1599,7 @@ static uint64_t group_work(const pdt_replay *r, uint64_t budget)
 static uint64_t plan_bytes(uint64_t m, unsigned bits, uint64_t fbuf, uint64_t cur)
 {
     uint64_t nf = (uint64_t)1 << bits;
-    return ((m >> bits) + 1) * GROUP_EVENT_EST +
+    return ((m >> bits) + 1) * GROUP_BYTES_PER_EVENT + /* (every event of the run, as if a triangle's) */
            nf * (fbuf * sizeof(tri_xrec) + cur * (sizeof(tri_first) + 4 + sizeof(pdt_rtri_hist)) + 160) +
            (m / fbuf + nf) * sizeof(spill_chunk);
 }
@@ -1611,8 +1608,8 @@ static uint64_t plan_bytes(uint64_t m, unsigned bits, uint64_t fbuf, uint64_t cu
  * the grouping holds at least one whole bucket, and more buckets make the
  * build slower, so the fewest (from 2^8, doubling; the largest buffers
  * first) whose plan_bytes fit half the budget (or PLAN_ROOM_MIN: 2^8 with
- * full buffers for every run up to 1.3·10^9 events at the default budget,
- * 1.5·10^8 under any); when none does, the plan that holds least (2^8 to
+ * full buffers for every run up to 10^9 events at the default budget,
+ * 1.1·10^8 under any); when none does, the plan that holds least (2^8 to
  * 2^16 buckets, buffers of 32 to 1024 records). */
 unsigned pdt_replay_plan_buckets(uint64_t m, uint64_t budget, size_t *fbuf_recs, size_t *cur_recs,
                                  uint64_t *bytes)

@@ -227,10 +227,11 @@ size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks);
  * its triangle events in 2^(the result) buckets instead, from 8 to 16 bits,
  * buffering *fbuf_recs records a bucket in its first pass and *cur_recs a
  * cursor after it; *bytes (when not NULL): what that holds at most, by
- * PDT_REPLAY_GROUP_EVENT_EST bytes per event of a bucket.  At most half the
- * budget (or 64 MiB) when a plan does it, else the least a plan holds (289
+ * PDT_REPLAY_GROUP_BYTES_PER_EVENT bytes per event of a bucket (what the
+ * grouping holds per triangle event at most; the plan counts every
+ * event).  At most half the budget (or 64 MiB) when a plan does it, else the least a plan holds (321
  * MiB for a run of 2^32 events). */
-#define PDT_REPLAY_GROUP_EVENT_EST 96u
+#define PDT_REPLAY_GROUP_BYTES_PER_EVENT 128u
 unsigned pdt_replay_plan_buckets(uint64_t m, uint64_t budget, size_t *fbuf_recs, size_t *cur_recs,
                                  uint64_t *bytes);
 

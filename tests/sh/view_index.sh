@@ -247,7 +247,7 @@ RB=$TMP/runb40000
 same_pictures "$RB" 16M 123457 end && ok build_bounded_same_pictures || fail build_bounded_same_pictures
 
 # the triangle events grouped in more buckets (what a run of more than
-# 1.3*10^9 events gets at the default budget, forced here): the same replay
+# 10^9 events gets at the default budget, forced here): the same replay
 RS=$TMP/runb10000
 rm -f "$RS/.pdtview-index"
 nb=$(PDTVIEW_BUCKETS=4096 "$V" "$RS" --bench --mem 1M | sed -n 's/.*grouped in \([0-9]*\) buckets.*/\1/p')
