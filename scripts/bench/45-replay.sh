@@ -51,7 +51,7 @@ one_run() {
     local dir=$1
     local ev
     ev=$(bin/pdt trace info "$dir" | awk '$1 == "all" {print $2; f = 1} $1 == "0" && NF >= 5 && !f {e = $2} END {if (!f) print e}')
-    echo "-- $dir: $ev events, $(du -sh "$dir" | cut -f1) on disk (load: $(cut -d' ' -f1-3 /proc/loadavg))"
+    echo "-- $dir: $ev events, $(du -sh --exclude=.pdtview-index "$dir" | cut -f1) on disk, its kept index aside (load: $(cut -d' ' -f1-3 /proc/loadavg))"
     measure "pdt trace check" bin/pdt trace check "$dir"
     measure "pdt trace check --mem 64M" bin/pdt trace check "$dir" --mem 64M
     grep -o 'sorted on disk in [0-9]* runs\|T\* certified[^)]*' "$OUT/cmd.out" | sed 's/^/    /'
