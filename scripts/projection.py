@@ -6,7 +6,7 @@ Usage: pdt triangulate IN -o OUT --stats 2> run.json   (under mpirun -np P, P >=
        scripts/projection.py run.json [--alpha SECONDS] [--beta BYTES_PER_S]
 
 Model (docs/parallel.md; the merge tree and border sets of
-../shared/design/algorithm.md §3.5 and §3.10), for uniform points:
+docs/algorithm.md §3.5 and §3.10), for uniform points:
   * each rank holds m = n/P points; read, partition, order and write cost a
     measured time per point of the rank's share (the slowest rank's phase
     time / its share), the local kernel a measured time per m*log2(m);

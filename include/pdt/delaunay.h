@@ -2,7 +2,7 @@
  * Guibas–Stolfi divide and conquer) and the sequential pipeline around it.
  *
  * The answer is always T*(P), the canonical Delaunay triangulation of
- * algorithm.md §2.3 (simulation of simplicity on the lifted heights). */
+ * docs/algorithm.md §2.3 (simulation of simplicity on the lifted heights). */
 #ifndef PDT_DELAUNAY_H
 #define PDT_DELAUNAY_H
 

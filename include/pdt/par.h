@@ -1,5 +1,5 @@
 /* pdt — the parallel triangulation (SRM: strips, restricted areas, merge
- * tree; design in ../shared/design/algorithm.md §3) and the thin
+ * tree; design in docs/algorithm.md §3) and the thin
  * communication layer it runs on.
  *
  * Only src/par/comm_mpi.c includes mpi.h.  Everything else talks to a

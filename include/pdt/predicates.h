@@ -1,7 +1,7 @@
 /* pdt — exact geometric predicates on int32 points, and the lift-up.
  *
  * All predicates are exact over the whole int32 range and return a sign
- * (-1, 0, +1).  See ../shared/design/algorithm.md §2.2 for the bit budget:
+ * (-1, 0, +1).  See docs/algorithm.md §2.2 for the bit budget:
  * orient needs 65 bits (int128), incircle 133 bits (wider than int128), so
  * incircle has a fast path (floating-point filter / int128 when coordinate
  * differences are small) and an exact multi-limb fallback. */
@@ -22,7 +22,7 @@ int pdt_orient(pdt_point a, pdt_point b, pdt_point c);
 int pdt_incircle0(pdt_point a, pdt_point b, pdt_point c, pdt_point d);
 
 /* In-circle with simulation of simplicity on the lifted heights
- * (algorithm.md §2.3): if pdt_incircle0 is 0, the answer is the sign of the
+ * (docs/algorithm.md §2.3): if pdt_incircle0 is 0, the answer is the sign of the
  * cofactor of the lexicographically smallest of the four points.  Never 0
  * unless all four points are collinear.  The four points must be distinct.
  * This is the only in-circle test any triangulation code may use. */

@@ -1,7 +1,7 @@
 /* pdt — the sequential Delaunay kernel: Guibas–Stolfi divide and conquer
  * with Dwyer's alternating cuts, with the exact pdt_orient and the
  * simulation-of-simplicity pdt_incircle_sos for every in-circle decision, so
- * the result is T*(P) (algorithm.md §2.3) — the projection of the lower hull
+ * the result is T*(P) (docs/algorithm.md §2.3) — the projection of the lower hull
  * of the (perturbed) lifted points.
  *
  * Cuts: the root splits the lexicographically sorted points at the median

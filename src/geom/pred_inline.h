@@ -4,7 +4,7 @@
  * same bit for bit; only the call overhead goes: at 10^6 points the kernel
  * makes ~8 M in-circle and ~20 M orientation tests.  The exact stages and the
  * tie rule stay out of line in predicates.c (they run on a tiny fraction of
- * the calls).  Bit budget: see predicates.c and algorithm.md §2.2. */
+ * the calls).  Bit budget: see predicates.c and docs/algorithm.md §2.2. */
 #ifndef PDT_GEOM_PRED_INLINE_H
 #define PDT_GEOM_PRED_INLINE_H
 
@@ -15,7 +15,7 @@
 int pdt_incircle_exact(int64_t adx, int64_t ady, int64_t bdx, int64_t bdy, int64_t cdx,
                        int64_t cdy);
 
-/* The tie rule of pdt_incircle_sos (algorithm.md §2.3), for incircle0 == 0. */
+/* The tie rule of pdt_incircle_sos (docs/algorithm.md §2.3), for incircle0 == 0. */
 int pdt_incircle_ties(pdt_point a, pdt_point b, pdt_point c, pdt_point d);
 
 /* pdt_orient: the sign of (b-a) x (c-a), exact (int128). */

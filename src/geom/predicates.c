@@ -1,6 +1,6 @@
 /* pdt — exact orientation and in-circle predicates on int32 points.
  *
- * Bit budget (algorithm.md §2.2): a coordinate difference is < 2^32 in
+ * Bit budget (docs/algorithm.md §2.2): a coordinate difference is < 2^32 in
  * magnitude (int64), orient < 2^65 (int128), incircle0 < 3 * 2^130 (133 bits,
  * wider than int128).
  *

@@ -1,4 +1,4 @@
-/* pdt — Phase 0 of SRM: sorting keys, splitters, duplicates (algorithm.md §3.2).
+/* pdt — Phase 0 of SRM: sorting keys, splitters, duplicates (docs/algorithm.md §3.2).
  *
  * The collective part (scatter, sample exchange, all-to-all) is in driver.c;
  * here are the local building blocks. */

@@ -6,7 +6,7 @@
  * its end (docs/geometry.md); with the points (8) and their input indices
  * (4) the plain run peaked at 84 bytes per point.  Here the sorted points
  * are cut into k strips by count, as k ranks would hold them, and SRM
- * (algorithm.md §3) runs on one strip after the other in one block R:
+ * (docs/algorithm.md §3) runs on one strip after the other in one block R:
  *
  *   R[0, 48n)   the sort's records and sorted points (pdt_sort_unique_on);
  *   then        strip 0's kernel at R's front: its final triangles stay at

@@ -1,4 +1,4 @@
-/* pdt — the merge schedule of SRM (algorithm.md §3.5).
+/* pdt — the merge schedule of SRM (docs/algorithm.md §3.5).
  *
  * Level-l groups are the rank blocks [j 2^l, (j+1) 2^l) ∩ [0, p).  At level l
  * the groups 2i and 2i+1 merge; the merge rank is the first rank of the right

@@ -1,5 +1,5 @@
 /* pdt — SRM per rank: local phase, classification, merge steps
- * (algorithm.md §3.3–3.8).  No MPI here: messages are byte buffers that the
+ * (docs/algorithm.md §3.3–3.8).  No MPI here: messages are byte buffers that the
  * driver moves.
  *
  * Correctness rests on the Merge Lemma (§3.8): at the merge of G_L and G_R the

@@ -4,7 +4,7 @@
  * buffers these functions produce and consume with the pdt_comm wrappers,
  * and a unit test can move them in-process to simulate any number of ranks.
  *
- * Vocabulary (algorithm.md §3): a strip is the lexicographic block of points
+ * Vocabulary (docs/algorithm.md §3): a strip is the lexicographic block of points
  * owned by one rank; a level-l group is the rank block [j 2^l, (j+1) 2^l);
  * the merge rank of a pair (G_L, G_R) is the first rank of G_R; the holder of
  * a group keeps its hull; a pending triangle waits at one rank until the

@@ -1,4 +1,4 @@
-/* pdt — restricted-area tests of SRM (algorithm.md §3.4, Proposition R).
+/* pdt — restricted-area tests of SRM (docs/algorithm.md §3.4, Proposition R).
  *
  * The restricted area of a triangle t is the set of plane points whose lift
  * lies on or below the plane through the lifted vertices of t: its closed

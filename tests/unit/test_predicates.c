@@ -290,7 +290,7 @@ TEST(incircle_is_lifted_orientation)
 
 TEST(sos_unit_square)
 {
-    /* algorithm.md §2.3: t = ((0,0),(1,0),(1,1)), d = (0,1): lex-min a has
+    /* docs/algorithm.md §2.3: t = ((0,0),(1,0),(1,1)), d = (0,1): lex-min a has
      * cofactor orient(b,c,d) = 1 > 0, so d counts as inside: t is rejected;
      * the square is split by the anti-diagonal (1,0)-(0,1). */
     pdt_point a = P(0, 0), b = P(1, 0), c = P(1, 1), d = P(0, 1);
