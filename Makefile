@@ -4,9 +4,11 @@
 #   make            build bin/ (release) — pdt, pdtview
 #   make test       install missing Debian packages, build release + sanitizer
 #                   builds, run the whole suite (tests/run.sh)
-#   make demo       install missing packages, build, run the classroom demo
+#   make demo       install missing build packages (none: no apt-get), build,
+#                   run the classroom demo
 #   make lesson L=NN  record lesson NN (lessons/NN-*) and open the viewer on it
-#                   (no display: render its key frames into build/lessons/NN)
+#                   (no display: render its key frames into build/lessons/NN);
+#                   installs only missing build packages, like make demo
 #   make bench      benchmarks against other tools (prints figures; no asserts)
 #   make table1     the thesis' Table 1 (speedup) reproduced
 #   make fuzz       build the libFuzzer targets (clang, bin/fuzz/) and run each
@@ -27,6 +29,8 @@
 #   NP        ranks for demo runs                (default: 4)
 #   POINTS    your own point file for make demo / make lesson (default: the
 #             bundled points; a lesson's checked facts hold for its own only)
+#   VIEW      pdtview options for make demo / make lesson, e.g.
+#             VIEW="--theme dark --font-scale 1.5" (pdtview --help)
 #   TRACE=0   compile tracing out entirely (-DPDT_NO_TRACE)
 #   PREFIX    install prefix                     (default: /usr/local)
 #   DESTDIR   staging root for packaging         (default: empty)
@@ -139,7 +143,7 @@ endef
 $(eval $(call variant,rel,$(OPT),bin))
 $(eval $(call variant,san,$(SAN),bin/san))
 
-.PHONY: all deps test demo lesson bench table1 clean rel-all san-all check-deps fuzz fuzz-build fuzz-seeds
+.PHONY: all deps deps-lesson test demo lesson bench table1 clean rel-all san-all check-deps fuzz fuzz-build fuzz-seeds
 .DEFAULT_GOAL := all
 
 all: rel-all
@@ -149,6 +153,11 @@ all: rel-all
 deps:
 	@scripts/deps.sh $(DEB_BUILD) $(DEB_TEST)
 
+# what make lesson / make demo need: the build, and python3 for the lesson
+# checks (no test tools: nothing is installed when these are present)
+deps-lesson:
+	@scripts/deps.sh $(DEB_BUILD) python3
+
 deps-bench:
 	@scripts/deps.sh $(DEB_BUILD) $(DEB_TEST) $(DEB_BENCH)
 
@@ -156,14 +165,14 @@ test: deps
 	$(MAKE) rel-all san-all
 	tests/run.sh
 
-demo: deps
+demo: deps-lesson
 	$(MAKE) rel-all
-	scripts/demo.sh $(if $(POINTS),$(abspath $(POINTS)))
+	scripts/demo.sh $(if $(VIEW),--view '$(VIEW)') $(if $(POINTS),$(abspath $(POINTS)))
 
-lesson: deps
+lesson: deps-lesson
 	@test -n "$(L)" || { echo "usage: make lesson L=NN   (lessons: $(notdir $(wildcard lessons/[0-9]*)))"; exit 2; }
 	$(MAKE) rel-all
-	scripts/lesson.sh $(if $(POINTS),--points $(abspath $(POINTS))) $(L)
+	scripts/lesson.sh $(if $(VIEW),--view '$(VIEW)') $(if $(POINTS),--points $(abspath $(POINTS))) $(L)
 
 bench: deps-bench
 	$(MAKE) rel-all

@@ -5,7 +5,8 @@
 # bundled point set, checks it, and opens the viewer on it.  With no display it
 # draws the key moments into out/demo/frames/ instead, says where, and exits 0.
 #
-#   scripts/demo.sh [--headless] [POINTS]
+#   scripts/demo.sh [--headless] [--view OPTS] [POINTS]
+#   --view OPTS: more pdtview options (`make demo VIEW="--theme dark --font-scale 1.5"`)
 #   environment: NP (ranks, default 4), OUT (default out/demo), BIN (default bin)
 set -u
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
@@ -18,10 +19,12 @@ OUT=${OUT:-$ROOT/out/demo}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 
 headless=0
+view=""
 points=$ROOT/assets/points/demo-48.txt
 while [ $# -gt 0 ]; do
     case $1 in
         --headless) headless=1 ;;
+        --view) view=$2; shift ;;
         -h|--help) sed -n '2,/^set -u/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
         *) points=$1 ;;
     esac
@@ -96,7 +99,8 @@ fi
 if [ "$headless" = 0 ]; then
     echo "3. Opening the viewer.  Space plays and pauses, the arrow keys step, h lists every"
     echo "   key, q quits.  Re-open it any time with: $BIN/pdtview $run"
-    exec "$BIN/pdtview" "$run"
+    # shellcheck disable=SC2086
+    exec "$BIN/pdtview" "$run" $view
 fi
 
 # No display: draw the key moments instead.
@@ -133,7 +137,7 @@ for s in "${shots[@]}"; do
            args=${k:+--at $k} ;;
     esac
     # shellcheck disable=SC2086
-    if [ -n "$args" ] && "$BIN/pdtview" --headless "$run" $args -o "$frames/$name.png" >>"$OUT/log.txt" 2>&1; then
+    if [ -n "$args" ] && "$BIN/pdtview" --headless "$run" $args $view -o "$frames/$name.png" >>"$OUT/log.txt" 2>&1; then
         echo "   $frames/$name.png"
         echo "$what" | fold -s -w 70 | sed 's/^/       /'
     else

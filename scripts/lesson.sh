@@ -24,6 +24,8 @@
 #   --quiet        print only where things are
 #   --points FILE  record every run on FILE instead of the lesson's points (a
 #                  teacher's own; the lesson's checked facts are about its own)
+#   --view OPTS    more pdtview options for the window and the frames, after the
+#                  lesson's own (`make lesson L=NN VIEW="--theme dark --font-scale 1.5"`)
 #
 # lesson.conf: `key = value` lines, `#` comments; optional `[NAME]` sections, one
 # per run (keys before the first section apply to every run).  Keys:
@@ -63,7 +65,7 @@ PDT=${PDT:-$BIN/pdt}
 PDTVIEW=${PDTVIEW:-$BIN/pdtview}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 
-headless=0; record_only=0; out=""; quiet=0; lesson=""; own_points=""
+headless=0; record_only=0; out=""; quiet=0; lesson=""; own_points=""; user_view=""
 while [ $# -gt 0 ]; do
     case $1 in
         --headless) headless=1 ;;
@@ -71,6 +73,7 @@ while [ $# -gt 0 ]; do
         --out) out=$2; shift ;;
         --quiet) quiet=1 ;;
         --points) own_points=$2; shift ;;
+        --view) user_view=$2; shift ;;
         -h|--help) sed -n '2,/^set -u/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
         -*) echo "lesson: unknown option $1 (see --help)" >&2; exit 2 ;;
         *) lesson=$1 ;;
@@ -173,7 +176,7 @@ for run in "${RUNS[@]}"; do
     level=$(conf "$run" level 1)
     start=$(conf "$run" start end)
     frames=$(conf "$run" frames "")
-    view=$(conf "$run" view "")
+    view="$(conf "$run" view "") $user_view"
     recorded=$(conf "$run" recorded "")
     [ -n "$own_points" ] && recorded=""
     mkdir -p "$rdir"

@@ -60,13 +60,17 @@ pdt_status pdt_anim_close(pdt_anim *a, pdt_err *err);
 /* Free a and remove the temporary file (a may be NULL). */
 void pdt_anim_abort(pdt_anim *a);
 
+/* Seconds a GIF rests on its last frame before it loops, by default. */
+#define PDT_ANIM_GIF_HOLD 2.0
+
 /* What part of a replay to animate, and how. */
 typedef struct pdt_anim_opts {
     int w, h;           /* frame size in pixels */
     double fps;         /* frames per second */
     size_t from, to;    /* cursors: from <= to <= pdt_replay_count(r) */
     size_t every;       /* events per frame (>= 1) */
-    double hold;        /* seconds the last frame stays (0: one frame) */
+    double hold;        /* seconds the last frame stays (0: one frame; < 0: the
+                         * default, PDT_ANIM_GIF_HOLD for a GIF, 0 for a video) */
 } pdt_anim_opts;
 
 /* Write the replay from cursor o->from to o->to, one frame every o->every

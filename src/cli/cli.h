@@ -36,7 +36,8 @@ typedef enum pdt_cli_optkind {
     PDT_OPT_STR,    /* const char **: the next argument */
     PDT_OPT_POSNUM, /* double *: a finite number > 0 */
     PDT_OPT_LEVEL,  /* int *: 0, 1 or 2 */
-    PDT_OPT_U64     /* uint64_t *: a whole number >= 0 */
+    PDT_OPT_U64,    /* uint64_t *: a whole number >= 0 */
+    PDT_OPT_NUM     /* double *: a finite number >= 0 */
 } pdt_cli_optkind;
 
 /* An option: long name ("--scale"), optional short name ("-o"), where to

@@ -57,11 +57,14 @@ static int store(const char *cmd, const pdt_cli_opt *o, const char *v)
     case PDT_OPT_STR:
         *(const char **)o->dst = v;
         return 0;
-    case PDT_OPT_POSNUM: {
+    case PDT_OPT_POSNUM:
+    case PDT_OPT_NUM: {
         errno = 0;
         double x = strtod(v, &end);
-        if (end == v || *end || errno || !isfinite(x) || x <= 0) {
-            pdt_cli_usage(cmd, "%s needs a positive number, not '%s'", o->name, v);
+        int pos = o->kind == PDT_OPT_POSNUM;
+        if (end == v || *end || errno || !isfinite(x) || x < 0 || (pos && x == 0)) {
+            pdt_cli_usage(cmd, "%s needs a %s number, not '%s'", o->name,
+                          pos ? "positive" : "non-negative", v);
             return 1;
         }
         *(double *)o->dst = x;

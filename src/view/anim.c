@@ -771,7 +771,9 @@ pdt_status pdt_anim_replay(const char *path, const pdt_anim_opts *o, const pdt_r
         st = draw(img, o, r, s, v, k, err);
         if (st == PDT_OK) st = pdt_anim_frame(a, img, err);
     }
-    long hold = o->hold > 0 ? lround(o->hold * o->fps) : 0;
+    /* a GIF loops: it rests PDT_ANIM_GIF_HOLD s on its end unless told */
+    double hs = o->hold >= 0 ? o->hold : pdt_anim_format_of(path) == PDT_ANIM_GIF ? PDT_ANIM_GIF_HOLD : 0;
+    long hold = hs > 0 ? lround(hs * o->fps) : 0;
     for (long i = 0; i < hold && st == PDT_OK; i++) st = pdt_anim_frame(a, img, err);
     cairo_surface_destroy(img);
     size_t written = st == PDT_OK ? pdt_anim_frames(a) : 0;

@@ -14,6 +14,8 @@
  * RUN is a run folder (pdt triangulate/hull --trace DIR), or a synthetic run
  * "synth:srm:COLS:ROWS:RANKS" / "synth:graham:N" (for tests and demos). */
 #include <errno.h>
+#include <langinfo.h>
+#include <locale.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -68,7 +70,8 @@ static const char help_text[] =
     "       pdtview --headless RUN --frames DIR --every K [--size WxH]\n"
     "       pdtview --headless RUN --gif OUT.gif | --video OUT.mp4|OUT.webm\n"
     "               [--phase P | --from N --to M] [--every K] [--fps F] [--hold S]\n"
-    "               [--size WxH]   (an animation: all events, a phase, or N..M)\n"
+    "               [--size WxH]   (an animation: all events, a phase, or N..M; the last\n"
+    "               frame stays S seconds, a GIF's 2 by default: --hold 0 for none)\n"
     "       pdtview --edit FILE [--ranks P] [--hull] [--size WxH]   (click points in;\n"
     "               P simulated ranks run the parallel code; keys 1..8 and x switch)\n"
     "       pdtview --edit FILE [--ranks P] [--hull] --write-run DIR   (the live run as a\n"
@@ -128,7 +131,7 @@ static int parse_args(int argc, char **argv, opts *o)
     o->font_scale = 1;
     uint64_t at = UINT64_MAX, every = UINT64_MAX, from = UINT64_MAX, to = UINT64_MAX,
              ranks = 1;
-    double hold = 0;
+    double hold = -1; /* not given: the animation's default (a GIF rests on its end) */
     const pdt_cli_opt table[] = {
         {"--headless", NULL, PDT_OPT_FLAG, &o->headless},
         {"--bench", NULL, PDT_OPT_FLAG, &o->bench},
@@ -153,7 +156,7 @@ static int parse_args(int argc, char **argv, opts *o)
         {"--video", NULL, PDT_OPT_STR, &o->video},
         {"--record", NULL, PDT_OPT_STR, &o->record},
         {"--fps", NULL, PDT_OPT_POSNUM, &o->fps},
-        {"--hold", NULL, PDT_OPT_POSNUM, &hold},
+        {"--hold", NULL, PDT_OPT_NUM, &hold},
         {"--from", NULL, PDT_OPT_U64, &from},
         {"--to", NULL, PDT_OPT_U64, &to},
         {"--edit", NULL, PDT_OPT_STR, &o->edit},
@@ -768,9 +771,19 @@ static void index_damaged(const char *msg)
  * read ($PDTVIEW_VERIFY=lazy: all of them; =eager: none, whole at opening). */
 #define LAZY_VERIFY_MIN ((uint64_t)64 << 20)
 
+/* SDL hands the window title (UTF-8) to X11 through the C library's
+ * character type: under the "C" locale "pdtview — run" reaches the title
+ * bar as "pdtview â".  Take the user's locale, else C.UTF-8. */
+static void utf8_ctype(void)
+{
+    const char *cs = setlocale(LC_CTYPE, "") ? nl_langinfo(CODESET) : "";
+    if (strcmp(cs, "UTF-8") && !setlocale(LC_CTYPE, "C.UTF-8")) setlocale(LC_CTYPE, "C");
+}
+
 int main(int argc, char **argv)
 {
     opts o;
+    utf8_ctype();
     int prc = parse_args(argc, argv, &o);
     if (prc >= 0) return prc;
     if (o.bench_live) return bench_live(&o);

@@ -101,7 +101,7 @@ static void record(shell *sh)
     }
     size_t a = sh->s->k, b = sh->mark == SIZE_MAX ? pdt_replay_count(sh->r) : sh->mark;
     pdt_anim_opts ao = {sh->tw & ~1, sh->th & ~1, sh->o->fps > 0 ? sh->o->fps : 10,
-                        a < b ? a : b, a < b ? b : a, sh->o->every > 0 ? (size_t)sh->o->every : 1, 0};
+                        a < b ? a : b, a < b ? b : a, sh->o->every > 0 ? (size_t)sh->o->every : 1, -1};
     pdt_view v = *sh->v;
     v.status = NULL;
     v.help = 0;

@@ -2,7 +2,7 @@
 # pdtview animation export: --gif / --video (mp4, webm) read back with the
 # tools users have (ImageMagick's identify and compare, FFmpeg's ffprobe):
 # frame count, size, duration, the picture itself; ranges (--from/--to,
-# --phase, --every, --hold); bad output paths (exit 2, a message, nothing
+# --phase, --every, --hold and its 2 s default for a GIF); bad output paths (exit 2, a message, nothing
 # left behind); the window's m / r keys under Xvfb.
 # san: yes
 . "$(dirname "$0")/lib.sh"
@@ -16,9 +16,10 @@ m=$("$V" --headless "$RUN" --end -o "$TMP/x.png" --size 320x200 | sed -n 's/.*ev
 # ---- GIF: every 100 events at 8 frames/s -------------------------------------------------
 if "$V" --headless "$RUN" --gif "$TMP/a.gif" --every 100 --fps 8 --size 640x400 --quiet; then
     ok gif_written; else fail gif_written; fi
-want=$(( (m + 99) / 100 + 1 ))
+# a GIF rests 2 s on its last frame unless told (--hold): 16 more frames at 8/s
+want=$(( (m + 99) / 100 + 1 + 16 ))
 got=$(identify "$TMP/a.gif" 2>/dev/null | wc -l)
-if [ "$got" -eq "$want" ]; then ok gif_frame_count; else fail gif_frame_count "want $want, got $got (m=$m)"; fi
+if [ "$got" -eq "$want" ]; then ok gif_frame_count_holds_2s; else fail gif_frame_count_holds_2s "want $want, got $got (m=$m)"; fi
 size=$(identify -format '%W %H\n' "$TMP/a.gif" | sort -u)
 if [ "$size" = "640 400" ]; then ok gif_size; else fail gif_size "page sizes: $size"; fi
 # delays in 1/100 s add up to frames / fps
@@ -38,12 +39,16 @@ echo "# last GIF frame vs headless PNG: $share % of the pixels differ by more th
 if python3 -c "import sys; sys.exit(0 if float('$share') < 1.0 else 1)"; then ok gif_last_frame_equals_png
 else fail gif_last_frame_equals_png "$share % differ"; fi
 
-# ---- --from/--to, --hold, --phase --------------------------------------------------------
+# ---- --hold 0, --from/--to, --hold, --phase -------------------------------------------------
+"$V" --headless "$RUN" --gif "$TMP/h0.gif" --every 100 --fps 8 --size 320x200 --hold 0 --quiet
+got=$(identify "$TMP/h0.gif" 2>/dev/null | wc -l)
+if [ "$got" -eq $(( (m + 99) / 100 + 1 )) ]; then ok gif_hold_0_no_rest
+else fail gif_hold_0_no_rest "got $got frames"; fi
 "$V" --headless "$RUN" --gif "$TMP/r.gif" --from 100 --to 130 --every 10 --hold 0.5 --fps 10 \
      --size 320x200 --quiet
 got=$(identify "$TMP/r.gif" 2>/dev/null | wc -l)
 if [ "$got" -eq 9 ]; then ok gif_from_to_hold; else fail gif_from_to_hold "want 4 + 5 frames, got $got"; fi
-out=$("$V" --headless "$RUN" --gif "$TMP/p.gif" --phase merge:1 --every 50 --size 320x200)
+out=$("$V" --headless "$RUN" --gif "$TMP/p.gif" --phase merge:1 --every 50 --size 320x200 --hold 0)
 from=$(echo "$out" | sed -n 's/.*events \([0-9]*\) to \([0-9]*\).*/\1/p')
 to=$(echo "$out" | sed -n 's/.*events \([0-9]*\) to \([0-9]*\).*/\2/p')
 if [ -n "$from" ] && [ "$from" -gt 0 ] && [ "$to" -gt "$from" ] && [ "$to" -le "$m" ] &&
@@ -102,7 +107,8 @@ if command -v Xvfb >/dev/null && [ -z "${SKIP_WINDOW:-}" ]; then
         --script "right right m right right right right right r wait:2 q" 2>"$TMP/win.err"
     kill "$XPID" 2>/dev/null; wait "$XPID" 2>/dev/null
     got=$(identify "$TMP/win.gif" 2>/dev/null | wc -l)
-    if grep -q 'recorded .*win.gif (6 frames, events 2 to 7)' "$TMP/win.err" && [ "$got" -eq 6 ]; then
+    # 6 frames, then 2 s (10 frames at 5/s) on the last: a GIF rests on its end
+    if grep -q 'recorded .*win.gif (16 frames, events 2 to 7)' "$TMP/win.err" && [ "$got" -eq 16 ]; then
         ok window_record_key; else fail window_record_key "$got frames; $(cat "$TMP/win.err")"; fi
 fi
 summary
