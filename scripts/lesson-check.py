@@ -53,6 +53,13 @@ scripts/lesson.sh into RUNS_DIR/RUN/describe.txt: the window's own functions):
     line POS ~ "TEXT"           the event line at POS contains TEXT
     code POS = N                the code panel lights line N (as numbered on screen)
     code POS = LISTING N        ... of listing LISTING (graham or srm)
+    code K..M = [LISTING] N     ... at every counter from K to M
+    code each KIND [W..] [F=V..] = [LISTING] N
+                                ... at every event of that kind ("a pop lights line 9")
+    phases RANK = A B C ...     the phases rank RANK begins, in order, are A, B, C
+                                (each name once, at its first begin; `run` left out;
+                                RANK `*`: every rank, the same list; `any`: the phases
+                                any rank begins, in the order they first begin)
     start = K                   the lesson's start position (lesson.conf) is cursor K
     listing LISTING             the text holds the panel's pseudo-code LISTING line for line
                                 (an indented block, numbers and all)
@@ -302,6 +309,52 @@ def resolve_pos(toks, events, order, start):
     return int(toks[0])
 
 
+def lit(want, listing, cl):
+    """Does the panel state (listing, line cl) match the wanted [LISTING] N?"""
+    got = '%s %s' % (listing, cl if cl else '-')
+    return (len(want) == 1 and str(cl if cl else '-') == want[0]) or \
+        (len(want) == 2 and got == ' '.join(want))
+
+
+def check_code_all(lt, want, dev, events, order):
+    """`code K..M = [LISTING] N` or `code each KIND ... = [LISTING] N`: the
+    panel lights that line at every such cursor; raise naming the others."""
+    if lt[0] == 'each':
+        spec = parse_fields(lt[2:])
+        ks = [i + 1 - DUMP_FIRST for i in order if match(events[i][0], events[i][1], lt[1], spec)]
+        if not ks:
+            raise AssertionError('no event %s' % ' '.join(lt[1:]))
+    else:
+        a, b = lt[0].split('..')
+        ks = list(range(int(a), int(b) + 1))
+    bad = []
+    for k in ks:
+        if k not in dev:
+            raise AssertionError('the viewer has no event %d' % k)
+        listing, cl, _ = dev[k]
+        if not lit(want, listing, cl):
+            bad.append('%d: %s line %s' % (k, listing, cl if cl else '(none)'))
+    if bad:
+        raise AssertionError('%d of %d cursors light another line: %s' % (
+            len(bad), len(ks), ', '.join(bad[:8])))
+
+
+def phases_begun(events, order, rank):
+    """Phase names in the order rank `rank` first begins them ('main': every
+    phase any rank begins, in the order they first begin; run left out)."""
+    seen = []
+    for i in order:
+        kind, f, _ = events[i]
+        if kind != 'phase-begin' or not f['_words']:
+            continue
+        name = f['_words'][0]
+        if name == 'run' or name in seen:
+            continue
+        if rank == 'any' or f['@rank'] == rank:
+            seen.append(name)
+    return seen
+
+
 def quoted(rhs):
     rhs = rhs.strip()
     if len(rhs) < 2 or rhs[0] != '"' or rhs[-1] != '"':
@@ -383,6 +436,9 @@ def main():
                 op = ' ~ ' if ' ~ ' in line and toks[0] == 'line' else ' = '
                 lhs, _, rhs = line.partition(op)
                 lt = lhs.split()
+                if toks[0] == 'code' and (lt[1] == 'each' or '..' in lt[1]):
+                    check_code_all(lt[1:], rhs.split(), dev, events, order)
+                    continue
                 k = dstart if toks[0] == 'start' else resolve_pos(lt[1:], events, order, dstart)
                 if toks[0] == 'start':
                     if k != int(rhs):
@@ -440,6 +496,15 @@ def main():
                 got = max(vals) if vals else None
                 if got is None or got != int(rhs):
                     raise AssertionError('the largest %s is %s' % (ltoks[2], got))
+            elif toks[0] == 'phases':
+                want = rhs.split()
+                ranks = sorted({events[i][1]['@rank'] for i in order}, key=int) \
+                    if ltoks[1] == '*' else [ltoks[1]]
+                for rk in ranks:
+                    got = phases_begun(events, order, rk)
+                    if got != want:
+                        raise AssertionError('rank %s begins: %s' % (rk, ' '.join(got) or 'none')
+                                             if rk != 'any' else 'the phases are: %s' % ' '.join(got))
             elif toks[0] == 'output-lines':
                 if len(out) != int(rhs):
                     raise AssertionError('the program printed %d lines' % len(out))

@@ -3,8 +3,9 @@
 # frame and key frames render headless, and every line of its `checks` file
 # (the facts its text states) holds against the recorded trace and against
 # what the viewer itself shows (`pdtview --describe`: event lines, lit code
-# lines, the start); every counter and every event line the text quotes is
-# one of those checks.
+# lines, the start); every counter, every event line, every "lights line N"
+# and every phase the text has PgDn visit (or quotes as a phase) is one of
+# those checks.
 . "$(dirname "$0")/lib.sh"
 unset DISPLAY WAYLAND_DISPLAY
 have_view=0
@@ -69,6 +70,21 @@ for ldir in "$ROOT"/lessons/[0-9][0-9]-*/; do
         grep -qF -- "$q" "$ldir/checks" || missing="$missing [$q]"
     done < <(grep -oE '"rank [0-9]+: [^"]*"' "$ldir/README.md")
     if grep -qE '"rank [0-9]+: [^"]*$' "$ldir/README.md"; then missing="$missing [a quoted event line broken over two lines]"; fi
+    # every "lights line N" of the text is a `code` check of line N (at a counter,
+    # a range K..M or `each` event of a kind), and every phase the text has
+    # PgDn go through, or quotes as a phase ("output"), is in a check (`phases`,
+    # `at K phase-begin NAME`, `@phase=NAME`, ...)
+    flat=$(tr '\n' ' ' <"$ldir/README.md")
+    for n in $(echo "$flat" | grep -oE 'lights line [0-9]+' | awk '{print $3}' | sort -u); do
+        grep -qE "^code .* = ([a-z]+ )?$n\$" "$ldir/checks" || missing="$missing [lights line $n]"
+    done
+    phnames='read|partition|lift|kernel|hull|classify|merge|order|write|output|graham-sort|graham-scan'
+    for ph in $( { echo "$flat" | grep -oE '[^.]*PgDn[^.]*' | grep -owE "$phnames"
+                   echo "$flat" | grep -oE "phase [\"\`]($phnames)[\"\`]|[\"\`]($phnames)[\"\`] phases?" |
+                       grep -oE "[\"\`]($phnames)[\"\`]" | tr -d '"\`'; } | sort -u); do
+        grep -qE "^phases .*= (.* )?$ph( |\$)|phase-(begin|end) $ph( |\$)|@phase=$ph( |\$)" "$ldir/checks" ||
+            missing="$missing [phase $ph]"
+    done
     if [ -z "$missing" ] && ! grep -qE 'TODO|FACTS|ANSWERS|ANSWER[0-9_]|RECORDED|CLUSTER|EXAMPLE$' "$ldir/README.md"; then
         ok "$name: every event the text names is checked; no placeholders left"
     else
