@@ -92,6 +92,23 @@ for ldir in "$ROOT"/lessons/[0-9][0-9]-*/; do
     fi
 done
 
+# the class plan (lessons/README.md): every counter a row names ("14 / 20")
+# is a checked fact of the lesson the row opens (`make lesson L=NN`)
+missing=""
+while IFS= read -r row; do
+    nn=$(echo "$row" | grep -oE 'make lesson L=[0-9]+' | head -1 | grep -oE '[0-9]+$')
+    cf=$(ls "$ROOT"/lessons/"$nn"-*/checks 2>/dev/null | head -1)
+    [ -n "$cf" ] || { missing="$missing [no lesson $nn]"; continue; }
+    for km in $(echo "$row" | grep -oE '[0-9]+ / [0-9]+' | tr -d ' ' | sort -u); do
+        k=${km%/*}; m=${km#*/}
+        grep -qE "^count \* = $m( |$)" "$cf" || missing="$missing $nn:total-$m"
+        [ "$k" = 0 ] || [ "$k" = "$m" ] || grep -qE "^(at $k |line $k |code $k |first .* = $k$|start = $k$)" "$cf" ||
+            missing="$missing $nn:$k/$m"
+    done
+done < <(grep -E '^\| [0-9]+–[0-9]+ \| `make lesson L=' "$ROOT/lessons/README.md")
+if [ -z "$missing" ]; then ok "class plan: every counter it names is checked"
+else fail "class plan" "not in the lessons' checks:$missing"; fi
+
 # lesson 9: the Chrome/Perfetto export of the recorded run: valid JSON, one
 # row per rank, one flow arrow per message
 run9=$ROOT/assets/runs/uniform-300-p8
