@@ -18,7 +18,8 @@
 #   path (the longest chain of one rank's compute and waits from the
 #   partition to the order, simulated), merge bytes (all merge steps), the
 #   largest border set (points in the largest merge), and the simulation's
-#   own wall seconds and peak memory (GNU time: the one process of all ranks).
+#   own wall seconds, CPU seconds (user + system: what the wall would be on
+#   an idle core) and peak memory (GNU time: the one process of all ranks).
 # --partition is passed to pdt as is.  Inputs and outputs live in a temporary
 # folder (--keep DIR keeps them there).  The platform and the load of the
 # machine (uptime) head the output.
@@ -62,7 +63,7 @@ echo "Load before: $(uptime | sed 's/.*load/load/')"
 run() {
     local n=$1 p=$2 name=$3 in="$W/uniform-$1.txt"
     [ -s "$in" ] || "$PDT" gen uniform "$n" -o "$in" || return 1
-    /usr/bin/time -f "%e %M" -o "$W/$name.time" "$ROOT/scripts/simulate.sh" -np "$p" \
+    /usr/bin/time -f "%e %M %U %S" -o "$W/$name.time" "$ROOT/scripts/simulate.sh" -np "$p" \
         --platform "$platform" -- triangulate "$in" -o "$W/$name.tri" --stats "${popt[@]}" \
         2> "$W/$name.err" > /dev/null
     local rc=$?
@@ -79,15 +80,17 @@ w, title, kind, names = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
 print(f"\n{title}\n")
 print("| P | n | read | partition | local | merge | order | write | total | "
       + ("speedup | efficiency" if kind == "strong" else "weak efficiency | time / time(P=first)")
-      + " | critical path | merge bytes | largest border set | sim wall s | sim MiB |")
-print("|" + "---|" * 16)
+      + " | critical path | merge bytes | largest border set | sim wall s | sim CPU s | sim MiB |")
+print("|" + "---|" * 17)
 base = None
 for name in names:
     try:
         j = json.load(open(f"{w}/{name}.json"))
-        wall, rss = open(f"{w}/{name}.time").read().split()[-2:]
+        t = open(f"{w}/{name}.time").read().split()
+        wall, rss = t[0], t[1]
+        cpu = float(t[2]) + float(t[3]) if len(t) >= 4 else float("nan")
     except Exception:
-        print(f"| {name} | failed |" + " |" * 15)
+        print(f"| {name} | failed |" + " |" * 16)
         continue
     s, par = j["seconds"], j.get("parallel", {})
     tot = s["total"]
@@ -101,7 +104,7 @@ for name in names:
     print(f"| {p} | {j['n']} | " + " | ".join(f"{s[k]:.4f}" for k in
           ("read", "partition", "local", "merge", "order", "write"))
           + f" | {tot:.4f} | {a} | {b} | {crit:.4f} | {par.get('merge_bytes', 0)} | "
-          f"{par.get('largest_border_set', 0)} | {float(wall):.1f} | {int(rss) // 1024} |")
+          f"{par.get('largest_border_set', 0)} | {float(wall):.1f} | {cpu:.1f} | {int(rss) // 1024} |")
 EOF
 }
 
