@@ -114,6 +114,36 @@ static void launcher_nodelay(void)
     closedir(dir);
 }
 
+/* The context's communicators: duplicates of the world one (the caller's
+ * messages and the exchanges' cannot meet anybody else's), and the ranks on
+ * this rank's node.  Under SMPI the world communicator itself and one rank
+ * per node: SMPI sets up a new communicator with O(P^2) simulated messages
+ * (at P = 1024 the start-up alone ran for over 20 minutes); the exchanges'
+ * tag 0 is one the driver's messages never use. */
+static pdt_status private_comms(pdt_comm *c, mpi_be *m, pdt_err *err)
+{
+    pdt_status s = PDT_OK;
+    if (PDT_SMPI) {
+        m->comm = m->xcomm = MPI_COMM_WORLD;
+    } else {
+        s = mpi_check(MPI_Comm_dup(MPI_COMM_WORLD, &m->comm), "MPI_Comm_dup", c, err);
+        if (s == PDT_OK)
+            s = mpi_check(MPI_Comm_set_errhandler(m->comm, MPI_ERRORS_RETURN),
+                          "MPI_Comm_set_errhandler", c, err);
+        if (s == PDT_OK) s = mpi_check(MPI_Comm_dup(m->comm, &m->xcomm), "MPI_Comm_dup", c, err);
+    }
+    if (s == PDT_OK) s = mpi_check(MPI_Comm_rank(m->comm, &c->rank), "MPI_Comm_rank", c, err);
+    if (s == PDT_OK) s = mpi_check(MPI_Comm_size(m->comm, &c->size), "MPI_Comm_size", c, err);
+    c->node_size = PDT_SMPI ? 1 : c->size;
+    if (PDT_SMPI || s != PDT_OK) return s;
+    MPI_Comm node = MPI_COMM_NULL;
+    s = mpi_check(MPI_Comm_split_type(m->comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node),
+                  "MPI_Comm_split_type", c, err);
+    if (s == PDT_OK) s = mpi_check(MPI_Comm_size(node, &c->node_size), "MPI_Comm_size", c, err);
+    if (node != MPI_COMM_NULL) MPI_Comm_free(&node);
+    return s;
+}
+
 pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out, pdt_err *err)
 {
     *out = NULL;
@@ -142,20 +172,7 @@ pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out,
     /* From here on errors come back as codes instead of aborting. */
     pdt_status s = mpi_check(MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN),
                              "MPI_Comm_set_errhandler", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_dup(MPI_COMM_WORLD, &m->comm), "MPI_Comm_dup", c, err);
-    if (s == PDT_OK)
-        s = mpi_check(MPI_Comm_set_errhandler(m->comm, MPI_ERRORS_RETURN),
-                      "MPI_Comm_set_errhandler", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_rank(m->comm, &c->rank), "MPI_Comm_rank", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_size(m->comm, &c->size), "MPI_Comm_size", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_dup(m->comm, &m->xcomm), "MPI_Comm_dup", c, err);
-    MPI_Comm node = MPI_COMM_NULL;
-    c->node_size = c->size;
-    if (s == PDT_OK)
-        s = mpi_check(MPI_Comm_split_type(m->comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node),
-                      "MPI_Comm_split_type", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_size(node, &c->node_size), "MPI_Comm_size", c, err);
-    if (node != MPI_COMM_NULL) MPI_Comm_free(&node);
+    if (s == PDT_OK) s = private_comms(c, m, err);
     /* Every rank must cut transfers the same way: rank 0's chunk size wins. */
     unsigned long long chunk = c->chunk;
     if (s == PDT_OK)
@@ -175,8 +192,10 @@ pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out,
 static void mpi_finalize(pdt_comm *c)
 {
     mpi_be *m = c->be;
-    MPI_Comm_free(&m->xcomm);
-    MPI_Comm_free(&m->comm);
+    if (!PDT_SMPI) { /* (under SMPI both are the world communicator) */
+        MPI_Comm_free(&m->xcomm);
+        MPI_Comm_free(&m->comm);
+    }
     MPI_Finalize();
     free(m);
 }
