@@ -14,11 +14,14 @@
  * int displacement is ever needed.
  *
  * Under SimGrid's SMPI (bin/smpi/pdt: this file compiled by smpicc with
- * PDT_SMPI=1) three things differ, each marked PDT_SMPI below: waiting ranks
- * block in MPI instead of polling (a poll there is a simulated step that
- * costs real time for every waiting rank, and nanosleep is simulated time);
- * the output file is written with pwrite (SMPI's MPI-IO opens files on
- * simulated disks only); the launcher tweaks for Open MPI are skipped. */
+ * PDT_SMPI=1) a few things differ, each marked PDT_SMPI below, none in what
+ * is computed: waiting ranks block in MPI instead of polling (a poll there
+ * is a step of the simulator for every waiting rank, and nanosleep is
+ * simulated time); the world communicator is used as it is (SMPI sets up a
+ * new one with O(P^2) simulated messages); exscan and waitall avoid SMPI's
+ * O(P^2)-per-rank versions; the output file is written with pwrite (SMPI's
+ * MPI-IO opens files on simulated disks only); the launcher tweaks for Open
+ * MPI are skipped (docs/simulation.md). */
 #include "comm_int.h"
 
 #include <arpa/inet.h>
