@@ -19,6 +19,10 @@
 #   make fuzz-seeds rewrite the binary trace seeds of tests/fuzz/corpus/
 #   make install    install into $(DESTDIR)$(PREFIX) (see "install" below)
 #   make uninstall  remove what make install put there
+#   make smpi       install libsimgrid-dev if missing and build bin/smpi/pdt,
+#                   the same program for SimGrid's SMPI (scripts/simulate.sh)
+#   make simulate   simulated strong and weak scaling on a 1024-node cluster
+#                   (scripts/simulate-scaling.sh; docs/simulation.md)
 #   make deps       only install missing Debian packages
 #   make clean
 #
@@ -27,6 +31,8 @@
 #   OPT       optimisation flags, release build  (default: -O2 -g)
 #   SAN       sanitizer flags, sanitizer build   (default: ASan + UBSan)
 #   NP        ranks for demo runs                (default: 4)
+#   SMPICC    SimGrid's compiler wrapper          (default: smpicc)
+#   SIM_ARGS  arguments of make simulate (e.g. --sizes 1e6 --partition strips)
 #   POINTS    your own point file for make demo / make lesson (default: the
 #             bundled points; a lesson's checked facts hold for its own only)
 #   VIEW      pdtview options for make demo / make lesson, e.g.
@@ -39,7 +45,8 @@
 #   FUZZ_JOBS     targets fuzzed at once      (default: 1)
 #
 # Layout: build/rel/... and build/san/... hold objects; bin/ the release
-# programs; bin/san/ the sanitizer programs.  Sources are picked up by
+# programs; bin/san/ the sanitizer programs; build/smpi/ and bin/smpi/pdt
+# the simulated build.  Sources are picked up by
 # wildcard: src/geom (predicates, hull, kernel, checker), src/io (files,
 # generators), src/trace (hook, writer, reader), src/par (parallel driver:
 # every file but comm_mpi.c goes into libpdtpar.a, which unit tests link; the
@@ -87,7 +94,8 @@ LIBS        := -lm -pthread
 # Debian packages the build, the tests and the demo need.
 DEB_BUILD := build-essential pkg-config libopenmpi-dev openmpi-bin libsdl2-dev libcairo2-dev fonts-dejavu-core \
              libgif-dev libavcodec-dev libavformat-dev libswscale-dev libavutil-dev libopen-trace-format2-dev
-DEB_TEST  := time otf2-tools mandoc bash-completion qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps slurmctld slurmd slurm-client munge ffmpeg
+DEB_SMPI  := libsimgrid-dev
+DEB_TEST  := $(DEB_SMPI) time otf2-tools mandoc bash-completion qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps slurmctld slurmd slurm-client munge ffmpeg
 DEB_BENCH := hyperfine libcgal-dev g++ nodejs npm valgrind time
 DEB_FUZZ  := clang libclang-rt-dev
 
@@ -143,7 +151,8 @@ endef
 $(eval $(call variant,rel,$(OPT),bin))
 $(eval $(call variant,san,$(SAN),bin/san))
 
-.PHONY: all deps deps-lesson test demo lesson bench table1 clean rel-all san-all check-deps fuzz fuzz-build fuzz-seeds
+.PHONY: all deps deps-lesson test demo lesson bench table1 clean rel-all san-all check-deps fuzz fuzz-build fuzz-seeds \
+        smpi smpi-build simulate
 .DEFAULT_GOAL := all
 
 all: rel-all
@@ -162,7 +171,7 @@ deps-bench:
 	@scripts/deps.sh $(DEB_BUILD) $(DEB_TEST) $(DEB_BENCH)
 
 test: deps
-	$(MAKE) rel-all san-all
+	$(MAKE) rel-all san-all smpi-build
 	tests/run.sh
 
 demo: deps-lesson
@@ -181,6 +190,40 @@ bench: deps-bench
 table1: deps-bench
 	$(MAKE) rel-all
 	scripts/table1.sh
+
+# ---- the simulated build (SimGrid's SMPI) ------------------------------------
+# bin/smpi/pdt is the same program for smpirun: smpicc links a shared object
+# that SimGrid's loader copies once per rank (each rank gets its own globals),
+# so every object is position independent, and comm_mpi.c alone is compiled
+# by smpicc (SMPI's mpi.h; PDT_SMPI selects the few calls that differ there).
+# No debug information: the object is copied P times into the temporary folder.
+SMPICC    ?= smpicc
+SMPI_OPT  := $(filter-out -g,$(OPT)) -fPIC
+SMPI_OBJ  := $(patsubst %.c,build/smpi/%.o,$(LIB_SRC) $(PAR_SRC) $(CLI_SRC) src/par/comm_mpi.c)
+
+build/smpi/%.o: %.c $(wildcard include/pdt/*.h src/*/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(CSTD) $(SMPI_OPT) $(WARN) $(INC) -c $< -o $@
+
+build/smpi/src/par/comm_mpi.o: src/par/comm_mpi.c $(wildcard include/pdt/*.h src/*/*.h)
+	@mkdir -p $(dir $@)
+	$(SMPICC) $(CSTD) $(SMPI_OPT) $(WARN) $(INC) -DPDT_SMPI=1 -c $< -o $@
+
+bin/smpi/pdt: $(SMPI_OBJ)
+	@mkdir -p $(dir $@)
+	$(SMPICC) $(SMPI_OPT) -o $@ $^ $(OTF2_LIBS) $(LIBS)
+
+deps-smpi:
+	@scripts/deps.sh $(DEB_SMPI)
+
+smpi-build: bin/smpi/pdt
+
+smpi: deps-smpi
+	$(MAKE) smpi-build
+
+simulate: deps-smpi
+	$(MAKE) rel-all smpi-build
+	scripts/simulate-scaling.sh $(SIM_ARGS)
 
 # ---- fuzzing (clang + libFuzzer; see tests/fuzz/fuzz_common.h) ----------------
 FUZZ_CC      ?= clang

@@ -42,11 +42,17 @@ void pdt_comm_abort(pdt_comm *c, int code);
 int pdt_comm_rank(const pdt_comm *c);
 int pdt_comm_size(const pdt_comm *c);
 int pdt_comm_is_mpi(const pdt_comm *c);
+/* 1 when the ranks are simulated (bin/smpi/pdt under SimGrid's smpirun: all
+ * ranks are threads of one process, pdt_comm_wtime is the simulated clock and
+ * a rank's computing time is measured on its own thread's CPU clock, so a
+ * rank must not start helper threads), 0 otherwise. */
+int pdt_comm_is_simulated(const pdt_comm *c);
 /* How many ranks of the job run on this rank's machine (this one included). */
 int pdt_comm_node_size(const pdt_comm *c);
 /* Name of the host this rank runs on (owned by c). */
 const char *pdt_comm_host(const pdt_comm *c);
-/* Wall clock in seconds (MPI_Wtime, or CLOCK_MONOTONIC in serial mode). */
+/* Wall clock in seconds (MPI_Wtime, or CLOCK_MONOTONIC in serial mode;
+ * simulated seconds under SMPI). */
 double pdt_comm_wtime(const pdt_comm *c);
 
 /* Collectives.  Byte counts are size_t with no 32-bit limit: a transfer

@@ -121,6 +121,11 @@ pdt_trace *pdt_tw_hook(pdt_trace_writer *w);
 /* Current time on the writer's clock (CLOCK_MONOTONIC ns since pdt_tw_open):
  * the value event times are measured in; for clock-offset measurement. */
 uint64_t pdt_tw_now(const pdt_trace_writer *w);
+/* Read the writer's clock from clock_ns(user) (nanoseconds) instead of
+ * CLOCK_MONOTONIC, from now on; its origin becomes that clock's reading now.
+ * For runs whose time is not this machine's (simulated ranks: the simulated
+ * clock).  Call before the first event. */
+void pdt_tw_set_clock(pdt_trace_writer *w, uint64_t (*clock_ns)(void *user), void *user);
 /* Events recorded so far (written or buffered). */
 uint64_t pdt_tw_events(const pdt_trace_writer *w);
 /* Write the buffered events, the end marker, close the file and free the

@@ -236,10 +236,20 @@ static pdt_status check_size(run *R, pdt_err *err)
  * it off). */
 static int prefault_wanted(const run *R)
 {
+    if (pdt_comm_is_simulated(R->c)) return 0; /* see no_helpers */
     const char *pf = getenv("PDT_PREFAULT");
     long cpus = sysconf(_SC_NPROCESSORS_ONLN);
     int node = pdt_comm_node_size(R->c);
     return !(pf && strcmp(pf, "0") == 0) && (R->p == 1 ? cpus > 1 : (long)node <= cpus);
+}
+
+/* Under SMPI a rank's computing time is its own thread's CPU time: a helper
+ * thread's work would be free and its concurrency unsimulated.  The prefault
+ * threads are off (prefault_wanted) and so are the writer's (one process for
+ * all ranks: every rank sets the same value). */
+static void no_helpers(const run *R)
+{
+    if (pdt_comm_is_simulated(R->c)) setenv("PDT_WRITE_THREADS", "1", 1);
 }
 
 static pdt_status read_input(run *R, pdt_err *err)
@@ -396,6 +406,7 @@ static void json_stats(const run *R, const pdt_par_stats *s, double total)
             (long long)mx.peak_rss_kib);
     for (int q = 0; q < s->nranks; q++) json_rank(q, &s->rank[q]);
     fprintf(stderr, "]");
+    if (pdt_comm_is_simulated(R->c)) fprintf(stderr, ", \"simulated\": true");
     if (pdt_comm_is_mpi(R->c)) json_parallel(s);
     fprintf(stderr, "}\n");
 }
@@ -449,6 +460,7 @@ int pdt_cmd_triangulate(int argc, char **argv)
     if (R.p > 1) mallopt(M_MMAP_THRESHOLD, 4 << 20);
     if (R.p > 1 && pdt_comm_is_mpi(R.c)) catch_stop(&R);
     R.t_start = pdt_comm_wtime(R.c);
+    no_helpers(&R);
 
     pdt_status st = check_output(&R, &err);
     if (st == PDT_OK) st = open_trace(&R, &err);

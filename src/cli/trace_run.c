@@ -150,6 +150,12 @@ static pdt_status clock_offsets(pdt_comm *c, const pdt_trace_writer *w, int64_t 
     return st;
 }
 
+/* The simulated clock in nanoseconds (SMPI: user is the pdt_comm). */
+static uint64_t simulated_ns(void *user)
+{
+    return (uint64_t)(pdt_comm_wtime(user) * 1e9);
+}
+
 pdt_status pdt_cli_trace_open_ranks(const pdt_run_opts *o, pdt_comm *c, pdt_cli_trace **t,
                                     pdt_err *err)
 {
@@ -164,6 +170,7 @@ pdt_status pdt_cli_trace_open_ranks(const pdt_run_opts *o, pdt_comm *c, pdt_cli_
     st = pdt_par_agree(c, st, NULL, err);
     if (st == PDT_OK && r != 0) st = pdt_tw_open(o->trace_dir, r, o->trace_level, &ct->w, err);
     st = pdt_par_agree(c, st, NULL, err);
+    if (st == PDT_OK && pdt_comm_is_simulated(c)) pdt_tw_set_clock(ct->w, simulated_ns, c);
     if (st == PDT_OK && p > 1) st = clock_offsets(c, ct->w, off, err);
     st = pdt_par_agree(c, st, NULL, err);
     if (st != PDT_OK) {

@@ -14,8 +14,10 @@ int pdt_comm_launched(void)
 {
     const char *force = getenv("PDT_MPI");
     if (force && *force) return strcmp(force, "0") != 0;
+    /* SMPI_GLOBAL_SIZE: SimGrid's smpirun (bin/smpi/pdt) */
     static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_SIZE",
-                                       "PMI_RANK", "MPI_LOCALNRANKS", "MV2_COMM_WORLD_SIZE"};
+                                       "PMI_RANK", "MPI_LOCALNRANKS", "MV2_COMM_WORLD_SIZE",
+                                       "SMPI_GLOBAL_SIZE"};
     for (size_t i = 0; i < sizeof vars / sizeof *vars; i++)
         if (getenv(vars[i])) return 1;
     return 0;
@@ -45,6 +47,7 @@ pdt_status pdt_comm_finalize(pdt_comm *c, pdt_err *err)
 int pdt_comm_rank(const pdt_comm *c) { return c->rank; }
 int pdt_comm_size(const pdt_comm *c) { return c->size; }
 int pdt_comm_is_mpi(const pdt_comm *c) { return c->ops->is_mpi; }
+int pdt_comm_is_simulated(const pdt_comm *c) { return c->ops->simulated; }
 int pdt_comm_node_size(const pdt_comm *c) { return c->node_size; }
 const char *pdt_comm_host(const pdt_comm *c) { return c->host; }
 double pdt_comm_wtime(const pdt_comm *c) { return c->ops->wtime(c); }

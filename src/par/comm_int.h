@@ -9,6 +9,7 @@
 
 typedef struct pdt_comm_ops {
     int is_mpi;
+    int simulated; /* SMPI: see pdt_comm_is_simulated */
     void (*finalize)(pdt_comm *c); /* free c->be (not c) */
     double (*wtime)(const pdt_comm *c);
     pdt_status (*barrier)(pdt_comm *c, pdt_err *err);

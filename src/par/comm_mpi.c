@@ -11,7 +11,17 @@
  * calls), so every transfer goes in chunks of at most c->chunk bytes.  The
  * v-collectives and the large uniform ones run on point-to-point messages of
  * a second private communicator (xcomm_of(c)), chunk by chunk in rounds, so no
- * int displacement is ever needed. */
+ * int displacement is ever needed.
+ *
+ * Under SimGrid's SMPI (bin/smpi/pdt: this file compiled by smpicc with
+ * PDT_SMPI=1) a few things differ, each marked PDT_SMPI below, none in what
+ * is computed: waiting ranks block in MPI instead of polling (a poll there
+ * is a step of the simulator for every waiting rank, and nanosleep is
+ * simulated time); the world communicator is used as it is (SMPI sets up a
+ * new one with O(P^2) simulated messages); exscan and waitall avoid SMPI's
+ * O(P^2)-per-rank versions; the output file is written with pwrite (SMPI's
+ * MPI-IO opens files on simulated disks only); the launcher tweaks for Open
+ * MPI are skipped (docs/simulation.md). */
 #include "comm_int.h"
 
 #include <arpa/inet.h>
@@ -28,6 +38,10 @@
 #include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
+
+#ifndef PDT_SMPI
+#define PDT_SMPI 0 /* 1: compiled by smpicc for SimGrid (Makefile, bin/smpi/pdt) */
+#endif
 
 typedef struct mpi_be {
     MPI_Comm comm;  /* collectives and the caller's point-to-point messages */
@@ -103,6 +117,36 @@ static void launcher_nodelay(void)
     closedir(dir);
 }
 
+/* The context's communicators: duplicates of the world one (the caller's
+ * messages and the exchanges' cannot meet anybody else's), and the ranks on
+ * this rank's node.  Under SMPI the world communicator itself and one rank
+ * per node: SMPI sets up a new communicator with O(P^2) simulated messages
+ * (at P = 1024 the start-up alone ran for over 20 minutes); the exchanges'
+ * tag 0 is one the driver's messages never use. */
+static pdt_status private_comms(pdt_comm *c, mpi_be *m, pdt_err *err)
+{
+    pdt_status s = PDT_OK;
+    if (PDT_SMPI) {
+        m->comm = m->xcomm = MPI_COMM_WORLD;
+    } else {
+        s = mpi_check(MPI_Comm_dup(MPI_COMM_WORLD, &m->comm), "MPI_Comm_dup", c, err);
+        if (s == PDT_OK)
+            s = mpi_check(MPI_Comm_set_errhandler(m->comm, MPI_ERRORS_RETURN),
+                          "MPI_Comm_set_errhandler", c, err);
+        if (s == PDT_OK) s = mpi_check(MPI_Comm_dup(m->comm, &m->xcomm), "MPI_Comm_dup", c, err);
+    }
+    if (s == PDT_OK) s = mpi_check(MPI_Comm_rank(m->comm, &c->rank), "MPI_Comm_rank", c, err);
+    if (s == PDT_OK) s = mpi_check(MPI_Comm_size(m->comm, &c->size), "MPI_Comm_size", c, err);
+    c->node_size = PDT_SMPI ? 1 : c->size;
+    if (PDT_SMPI || s != PDT_OK) return s;
+    MPI_Comm node = MPI_COMM_NULL;
+    s = mpi_check(MPI_Comm_split_type(m->comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node),
+                  "MPI_Comm_split_type", c, err);
+    if (s == PDT_OK) s = mpi_check(MPI_Comm_size(node, &c->node_size), "MPI_Comm_size", c, err);
+    if (node != MPI_COMM_NULL) MPI_Comm_free(&node);
+    return s;
+}
+
 pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out, pdt_err *err)
 {
     *out = NULL;
@@ -120,31 +164,18 @@ pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out,
     c->node_size = 1;
     c->chunk = pdt_comm_chunk_from_env();
     if (gethostname(c->host, sizeof c->host - 1) != 0) strcpy(c->host, "?");
-    one_node_defaults();
+    if (!PDT_SMPI) one_node_defaults();
     int rc = MPI_Init(argc, argv);
     if (rc != MPI_SUCCESS) {
         free(m);
         free(c);
         return pdt_err_set(err, PDT_ERR_MPI, "MPI_Init failed (code %d)", rc);
     }
-    launcher_nodelay();
+    if (!PDT_SMPI) launcher_nodelay();
     /* From here on errors come back as codes instead of aborting. */
     pdt_status s = mpi_check(MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN),
                              "MPI_Comm_set_errhandler", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_dup(MPI_COMM_WORLD, &m->comm), "MPI_Comm_dup", c, err);
-    if (s == PDT_OK)
-        s = mpi_check(MPI_Comm_set_errhandler(m->comm, MPI_ERRORS_RETURN),
-                      "MPI_Comm_set_errhandler", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_rank(m->comm, &c->rank), "MPI_Comm_rank", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_size(m->comm, &c->size), "MPI_Comm_size", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_dup(m->comm, &m->xcomm), "MPI_Comm_dup", c, err);
-    MPI_Comm node = MPI_COMM_NULL;
-    c->node_size = c->size;
-    if (s == PDT_OK)
-        s = mpi_check(MPI_Comm_split_type(m->comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node),
-                      "MPI_Comm_split_type", c, err);
-    if (s == PDT_OK) s = mpi_check(MPI_Comm_size(node, &c->node_size), "MPI_Comm_size", c, err);
-    if (node != MPI_COMM_NULL) MPI_Comm_free(&node);
+    if (s == PDT_OK) s = private_comms(c, m, err);
     /* Every rank must cut transfers the same way: rank 0's chunk size wins. */
     unsigned long long chunk = c->chunk;
     if (s == PDT_OK)
@@ -164,8 +195,10 @@ pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out,
 static void mpi_finalize(pdt_comm *c)
 {
     mpi_be *m = c->be;
-    MPI_Comm_free(&m->xcomm);
-    MPI_Comm_free(&m->comm);
+    if (!PDT_SMPI) { /* (under SMPI both are the world communicator) */
+        MPI_Comm_free(&m->xcomm);
+        MPI_Comm_free(&m->comm);
+    }
     MPI_Finalize();
     free(m);
 }
@@ -198,6 +231,8 @@ static void nap(void)
 
 static pdt_status mpi_quiet_barrier(pdt_comm *c, pdt_err *err)
 {
+    if (PDT_SMPI) /* a blocked simulated rank costs nothing */
+        return mpi_check(MPI_Barrier(comm_of(c)), "MPI_Barrier", c, err);
     MPI_Request rq;
     pdt_status s = mpi_check(MPI_Ibarrier(comm_of(c), &rq), "MPI_Ibarrier", c, err);
     int done = 0;
@@ -243,6 +278,22 @@ static void xchg_free(xchg *x)
 
 static size_t min_size(size_t a, size_t b) { return a < b ? a : b; }
 
+/* SMPI's MPI_Waitall is a loop of MPI_Waitany, each a pass over all the
+ * requests: O(P^2) steps of the simulator per rank in an exchange with
+ * every rank.  Under SMPI the requests are waited for one by one instead
+ * (the same completion, in linear time). */
+static pdt_status wait_all(pdt_comm *c, int nrq, MPI_Request *rq, pdt_err *err)
+{
+    if (!PDT_SMPI)
+        return mpi_check(MPI_Waitall(nrq, rq, MPI_STATUSES_IGNORE), "MPI_Waitall", c, err);
+    pdt_status s = PDT_OK;
+    for (int i = 0; i < nrq; i++) {
+        pdt_status w = mpi_check(MPI_Wait(&rq[i], MPI_STATUS_IGNORE), "MPI_Wait", c, err);
+        if (s == PDT_OK) s = w;
+    }
+    return s;
+}
+
 static pdt_status xchg_run(pdt_comm *c, const xchg *x, const char *what, pdt_err *err)
 {
     int P = c->size, me = c->rank;
@@ -267,7 +318,7 @@ static pdt_status xchg_run(pdt_comm *c, const xchg *x, const char *what, pdt_err
                           "MPI_Isend", c, err);
         }
         if (nrq == 0) break;
-        pdt_status w = mpi_check(MPI_Waitall(nrq, rq, MPI_STATUSES_IGNORE), "MPI_Waitall", c, err);
+        pdt_status w = wait_all(c, nrq, rq, err);
         if (s == PDT_OK) s = w;
     }
     free(rq);
@@ -405,9 +456,27 @@ static pdt_status mpi_allreduce_u64(pdt_comm *c, uint64_t *v, size_t n, pdt_comm
     return s;
 }
 
+/* SMPI's MPI_Exscan is linear: every rank sends to every later rank and
+ * waits on them one MPI_Waitany at a time, O(P^3) steps of the simulator (at
+ * P = 256 a single call ran for minutes).  Under SMPI the prefix comes from
+ * an allgather of the P values instead. */
+static pdt_status smpi_exscan_u64(pdt_comm *c, uint64_t v, uint64_t *out, pdt_err *err)
+{
+    uint64_t *all = malloc((size_t)c->size * sizeof *all);
+    if (!all) return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: exscan: out of memory", c->rank);
+    pdt_status s = mpi_check(MPI_Allgather(&v, 1, MPI_UINT64_T, all, 1, MPI_UINT64_T, comm_of(c)),
+                             "MPI_Allgather", c, err);
+    uint64_t sum = 0;
+    for (int q = 0; s == PDT_OK && q < c->rank; q++) sum += all[q];
+    free(all);
+    *out = sum;
+    return s;
+}
+
 static pdt_status mpi_exscan_u64(pdt_comm *c, uint64_t v, uint64_t *out, pdt_err *err)
 {
     *out = 0;
+    if (PDT_SMPI) return smpi_exscan_u64(c, v, out, err);
     uint64_t r = 0;
     pdt_status s = mpi_check(MPI_Exscan(&v, &r, 1, MPI_UINT64_T, MPI_SUM, comm_of(c)), "MPI_Exscan",
                              c, err);
@@ -423,7 +492,7 @@ static pdt_status mpi_exscan_u64(pdt_comm *c, uint64_t v, uint64_t *out, pdt_err
 static pdt_status mpi_send(pdt_comm *c, int peer, int tag, const void *buf, size_t bytes,
                          pdt_err *err)
 {
-        uint64_t head = bytes;
+    uint64_t head = bytes;
     pdt_status s = mpi_check(MPI_Send(&head, 1, MPI_UINT64_T, peer, tag, comm_of(c)), "MPI_Send", c,
                              err);
     for (size_t off = 0; off < bytes && s == PDT_OK; off += c->chunk)
@@ -437,7 +506,7 @@ static pdt_status mpi_recv(pdt_comm *c, int peer, int tag, void **buf, size_t *b
 {
     *buf = NULL;
     *bytes = 0;
-        int flag = 0;
+    int flag = PDT_SMPI; /* a simulated rank blocks in MPI_Recv: that costs nothing */
     pdt_status s = PDT_OK;
     while (s == PDT_OK && !flag) {
         s = mpi_check(MPI_Iprobe(peer, tag, comm_of(c), &flag, MPI_STATUS_IGNORE), "MPI_Iprobe", c,
@@ -466,10 +535,9 @@ static pdt_status mpi_recv(pdt_comm *c, int peer, int tag, void **buf, size_t *b
     return PDT_OK;
 }
 
-/* ---- one file written by all ranks ----------------------------------------- */
-
 /* ---- one file written by all ranks (MPI-IO) --------------------------------- */
 
+#if !PDT_SMPI
 static pdt_status mpi_io_check(int rc, const pdt_comm *c, const char *path, const char *what,
                                pdt_err *err)
 {
@@ -539,8 +607,71 @@ static pdt_status mpi_file_close(pdt_comm_file *f, pdt_err *err)
     return s;
 }
 
+#endif
+
+/* ---- one file written by all ranks (SMPI: pwrite) ---------------------------
+ * SMPI's MPI-IO writes to the simulated hosts' disks only.  Under it every
+ * rank is a thread of this one process: rank 0 creates the file at its final
+ * size, then every rank opens it and writes its range with pwrite at the same
+ * offsets MPI-IO would use.  The write's simulated time is the formatting
+ * and the system calls, with no disk or file-system model. */
+#if PDT_SMPI
+static pdt_status smpi_file_open(pdt_comm *c, pdt_comm_file *f, pdt_err *err)
+{
+    int *fd = malloc(sizeof *fd);
+    pdt_status s = fd ? PDT_OK
+                      : pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", c->rank,
+                                    f->path);
+    if (s == PDT_OK && c->rank == 0) {
+        int h = open(f->path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+        if (h < 0 || ftruncate(h, (off_t)f->size) != 0)
+            s = pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: %s", f->path, strerror(errno));
+        if (h >= 0) close(h);
+    }
+    s = pdt_comm_agree(c, s, f->path, "create", err);
+    if (s == PDT_OK && (*fd = open(f->path, O_WRONLY | O_CLOEXEC)) < 0)
+        s = pdt_err_set(err, PDT_ERR_IO, "%s: cannot open at rank %d: %s", f->path, c->rank,
+                        strerror(errno));
+    s = pdt_comm_agree(c, s, f->path, "open", err);
+    if (s != PDT_OK) {
+        if (fd && *fd >= 0) close(*fd);
+        free(fd);
+        return s;
+    }
+    f->be = fd;
+    return PDT_OK;
+}
+
+static pdt_status smpi_file_write_at(pdt_comm_file *f, uint64_t offset, const void *buf,
+                                     size_t bytes, pdt_err *err)
+{
+    int fd = *(int *)f->be;
+    for (size_t off = 0; off < bytes;) {
+        ssize_t k = pwrite(fd, (const char *)buf + off, bytes - off, (off_t)(offset + off));
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0)
+            return pdt_err_set(err, PDT_ERR_IO, "%s: write failed at rank %d: %s", f->path,
+                               f->c->rank, k < 0 ? strerror(errno) : "no progress");
+        off += (size_t)k;
+    }
+    return PDT_OK;
+}
+
+static pdt_status smpi_file_close(pdt_comm_file *f, pdt_err *err)
+{
+    int *fd = f->be;
+    pdt_status s = PDT_OK;
+    if (close(*fd) != 0)
+        s = pdt_err_set(err, PDT_ERR_IO, "%s: close failed at rank %d: %s", f->path, f->c->rank,
+                        strerror(errno));
+    free(fd);
+    return s;
+}
+#endif
+
 static const pdt_comm_ops mpi_ops = {
     .is_mpi = 1,
+    .simulated = PDT_SMPI,
     .finalize = mpi_finalize,
     .wtime = mpi_wtime,
     .barrier = mpi_barrier,
@@ -556,7 +687,13 @@ static const pdt_comm_ops mpi_ops = {
     .exscan_u64 = mpi_exscan_u64,
     .send = mpi_send,
     .recv = mpi_recv,
+#if PDT_SMPI
+    .file_open = smpi_file_open,
+    .file_write_at = smpi_file_write_at,
+    .file_close = smpi_file_close,
+#else
     .file_open = mpi_file_open,
     .file_write_at = mpi_file_write_at,
     .file_close = mpi_file_close,
+#endif
 };

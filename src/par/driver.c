@@ -915,6 +915,18 @@ pdt_status pdt_par_tstar(const pdt_point *pts, size_t n, pdt_tri **tris, size_t 
     return st;
 }
 
+/* Under SMPI the kernel's own phase clock is this machine's, not the
+ * simulated one: its three phases are scaled to the simulated span they
+ * fill (critical_path, which then holds nothing else). */
+static void simulated_phases(pdt_par_rank_stats *me)
+{
+    double sum = me->t_partition + me->t_local + me->t_order;
+    double f = sum > 0 ? me->critical_path / sum : 0;
+    me->t_partition *= f;
+    me->t_local *= f;
+    me->t_order *= f;
+}
+
 /* One rank: the sequential pipeline on the whole input (the whole kernel, or
  * plain_strips strips one after the other), its figures in the same shape;
  * the trace gets the final triangles as a parallel run does. */
@@ -959,6 +971,7 @@ static pdt_status sequential(pdt_comm *c, pdt_par_input *in, pdt_par_output *out
     me->t_local = ts.t_kernel;
     me->t_order = ts.t_canon;
     me->critical_path = pdt_comm_wtime(c) - w0;
+    if (pdt_comm_is_simulated(c)) simulated_phases(me);
     me->critical_cpu = cpu_seconds() - c0;
     return PDT_OK;
 }

@@ -18,7 +18,9 @@ struct pdt_trace_writer {
     pdt_trace hook;
     int fd;
     char *path;
-    uint64_t origin_ns;  /* CLOCK_MONOTONIC at open */
+    uint64_t origin_ns;  /* the clock at open (CLOCK_MONOTONIC unless clock_ns) */
+    uint64_t (*clock_ns)(void *user); /* pdt_tw_set_clock, or NULL */
+    void *clock_user;
     uint64_t last_t;     /* latest clock reading (ns since origin) */
     pdt_event *buf;      /* TF_BLOCK_EVENTS */
     size_t nbuf;
@@ -32,6 +34,11 @@ static uint64_t mono_ns(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+static uint64_t clock_of(const pdt_trace_writer *w)
+{
+    return w->clock_ns ? w->clock_ns(w->clock_user) : mono_ns();
 }
 
 uint64_t pdt_wall_ns(void)
@@ -89,7 +96,7 @@ static void tw_sink(pdt_trace *tr, const pdt_event *ev)
     pdt_event *d = &w->buf[w->nbuf];
     *d = *ev;
     if ((ev->kind < 32 && (TF_CLOCK_KINDS >> ev->kind) & 1u) || w->nbuf % TF_CLOCK_EVERY == 0)
-        w->last_t = mono_ns() - w->origin_ns;
+        w->last_t = clock_of(w) - w->origin_ns;
     d->t = w->last_t;
     if (++w->nbuf == TF_BLOCK_EVENTS) tw_flush(w);
 }
@@ -173,7 +180,15 @@ pdt_trace *pdt_tw_hook(pdt_trace_writer *w)
 
 uint64_t pdt_tw_now(const pdt_trace_writer *w)
 {
-    return mono_ns() - w->origin_ns;
+    return clock_of(w) - w->origin_ns;
+}
+
+void pdt_tw_set_clock(pdt_trace_writer *w, uint64_t (*clock_ns)(void *user), void *user)
+{
+    w->clock_ns = clock_ns;
+    w->clock_user = user;
+    w->origin_ns = clock_of(w);
+    w->last_t = 0;
 }
 
 uint64_t pdt_tw_events(const pdt_trace_writer *w)

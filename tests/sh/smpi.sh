@@ -1,0 +1,72 @@
+#!/bin/bash
+# pdt on a simulated cluster (scripts/simulate.sh: bin/smpi/pdt under
+# SimGrid's smpirun, docs/simulation.md): 256 simulated ranks on a small
+# input write the plain run's bytes (every rank pwrites its block into the
+# one process's file), without PDT_MPI=1 (pdt sees smpirun by itself), with
+# --stats saying "simulated": true and 256 ranks; more ranks than points
+# work; --trace writes one file per rank that `pdt trace check` accepts.
+# Builds bin/smpi/pdt if it is missing.
+source "$(dirname "$0")/lib.sh"
+SIM=$ROOT/scripts/simulate.sh
+if ! command -v smpirun > /dev/null; then
+    fail smpirun_available "smpirun not found (make deps installs libsimgrid-dev)"
+    summary; exit
+fi
+if [ ! -f "$ROOT/bin/smpi/pdt" ]; then
+    make -C "$ROOT" -s smpi-build > "$TMP/make.log" 2>&1 ||
+        { fail smpi_build "$(tail -3 "$TMP/make.log")"; summary; exit; }
+fi
+cd "$TMP"
+unset PDT_MPI
+
+# sim NAME P OUT-FILE ARGS...: simulate.sh -np P -- triangulate ARGS (3 minutes at most)
+sim() {
+    local name=$1 np=$2
+    shift 2
+    timeout 300 "$SIM" -np "$np" -- triangulate "$@" > "$name.out" 2> "$name.err"
+}
+
+"$PDT" gen uniform 1200 -o u.txt
+"$PDT" triangulate u.txt -o plain.ele
+if sim p256 256 u.txt -o sim.ele --stats; then
+    if cmp -s plain.ele sim.ele; then ok smpi_256_ranks_same_bytes_as_plain
+    else fail smpi_256_ranks_same_bytes_as_plain "output differs from the plain run"; fi
+    if grep -q '"ranks": 256,' p256.err && grep -q '"simulated": true' p256.err; then
+        ok smpi_stats_say_simulated_256_ranks
+    else
+        fail smpi_stats_say_simulated_256_ranks "$(head -c 300 p256.err)"
+    fi
+    if ! grep -q '"write": 0.000000' p256.err && grep -q '"merge_bytes"' p256.err; then
+        ok smpi_stats_have_parallel_figures
+    else
+        fail smpi_stats_have_parallel_figures "$(head -c 300 p256.err)"
+    fi
+else
+    fail smpi_256_ranks_same_bytes_as_plain "exit $?: $(head -3 p256.err)"
+fi
+
+# more ranks than points: 64 ranks, 20 points (most ranks get none)
+"$PDT" gen uniform 20 --seed 7 -o few.txt
+"$PDT" triangulate few.txt -o few.ele
+if sim few 64 few.txt -o few-sim.ele && cmp -s few.ele few-sim.ele; then
+    ok smpi_more_ranks_than_points
+else
+    fail smpi_more_ranks_than_points "$(head -3 few.err)"
+fi
+
+# a simulated trace: one file per rank, simulated clock, accepted by the checker
+"$PDT" gen clusters 600 -o c.txt
+"$PDT" triangulate c.txt -o c.ele
+if sim tr 64 c.txt -o c-sim.ele --trace run && cmp -s c.ele c-sim.ele &&
+    [ "$(ls run/rank-*.trace | wc -l)" = 64 ] && "$PDT" trace check run > check.out 2>&1; then
+    ok smpi_trace_64_ranks_checks
+else
+    fail smpi_trace_64_ranks_checks "$(head -3 tr.err) $(tail -3 check.out 2>/dev/null)"
+fi
+
+# a wrong platform is a usage error
+"$SIM" -np 2 --platform no-such-platform -- triangulate u.txt -o x.ele 2> bad.err
+rc=$?
+if [ "$rc" = 2 ] && grep -q "no such platform" bad.err; then ok smpi_unknown_platform_usage_error
+else fail smpi_unknown_platform_usage_error "exit $rc: $(cat bad.err)"; fi
+summary
