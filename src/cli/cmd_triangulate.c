@@ -76,7 +76,7 @@ typedef struct run {
  * the ranks still finishing when one has exited with a failure status.  (Set by the pipeline,
  * read by the handler: plain values, the step a string constant.) */
 static const char *volatile stop_phase = "start";
-static volatile sig_atomic_t stop_rank, stop_size;
+static volatile sig_atomic_t stop_rank, stop_size, stop_written;
 
 static size_t put_str(char *b, size_t at, const char *s)
 {
@@ -112,7 +112,9 @@ static void on_stop(int sig)
         n = put_str(b, n, ": another of the ");
         n = put_uint(b, n, (unsigned)stop_size);
         n = put_str(b, n, " ranks ended first (the launcher names it) or the job was "
-                          "interrupted; no output written\n");
+                          "interrupted; ");
+        n = put_str(b, n, stop_written ? "the output had been written whole before\n"
+                                       : "no output written\n");
         ssize_t w = write(STDERR_FILENO, b, n);
         (void)w;
     }
@@ -495,6 +497,7 @@ int pdt_cmd_triangulate(int argc, char **argv)
     if (st == PDT_OK) st = read_input(&R, &err);
     if (st == PDT_OK) st = compute(&R, &err);
     if (st == PDT_OK) st = write_output(&R, &err);
+    stop_written = st == PDT_OK; /* (committed: a stop after this must not deny it) */
     if (st == PDT_OK) st = report(&R, &err);
     stop_phase = NULL;
 
