@@ -125,7 +125,9 @@ if ! command -v mpirun > /dev/null; then summary; exit; fi
 # stop_job NAME SIGNAL: mpirun -np 2 with rank 0 asleep in its write (the
 # test hook; a caught signal ends the sleep early) gets SIGNAL once the sleep
 # has begun.  The sleep is short: without the commit check, rank 0 would
-# finish and rename before mpirun's SIGTERM (a second after its SIGCONT).
+# finish and rename before mpirun's SIGTERM (a second after its SIGCONT);
+# with it, the SIGCONT (sent at once) ends the sleep and rank 0 waits at the
+# commit until the SIGTERM ends it.
 stop_job() {
     local name=$1 sig=$2 sleep=$3 rc kids alive
     rm -f "mark-$name"
@@ -149,8 +151,8 @@ stop_job() {
     if [ $rc -ne 0 ] && [ $alive -eq 0 ] && [ "$left" -eq 0 ]; then ok "$name"
     else fail "$name" "rc=$rc ranks alive=$alive files=$(ls -A | grep "out-$name") $(grep pdt "log-$name.err" | head -3)"; fi
 }
-stop_job sigint_to_mpirun_leaves_no_output INT 0.6
-stop_job sigterm_to_mpirun_leaves_no_output TERM 0.6
+stop_job sigint_to_mpirun_leaves_no_output INT 0.8
+stop_job sigterm_to_mpirun_leaves_no_output TERM 0.8
 stop_job sigkill_to_mpirun_orphans_do_not_commit KILL 3
 # a run that is not stopped still writes (the stop check costs nothing then)
 mpirun -np 2 "$PDT" triangulate u.txt -o whole.tri > /dev/null 2> w.err; rc=$?
