@@ -37,6 +37,28 @@ void pdt_out_abort(pdt_outfile *o);
  * 10^7 points); the exchange does not.  0, or -1 with errno set. */
 int pdt_replace_file(const char *tmp, const char *path);
 
+/* ---- opening a file to read ---------------------------------------------- */
+
+/* Open `path` read only for a reader of the user's files (points, triangles,
+ * run folders, indexes) without blocking (a FIFO with no writer does not
+ * hang the open) and only if, once open, it is a regular file: a folder, a
+ * FIFO, a socket or a device (also through a symbolic link: /dev/zero) is
+ * refused.  Returns the descriptor (close-on-exec, blocking), or -1 with
+ * errno set (open's own; EISDIR for a folder, EINVAL for anything else that
+ * is not a regular file) and a phrase for the message "PATH: WHY" in why
+ * ("cannot open: REASON", "is a FIFO (named pipe), not a regular file ...").
+ * Not for standard input ("-": the caller reads it as it is). */
+int pdt_open_input(const char *path, char *why, size_t cap);
+/* What a file of mode `mode` (st_mode) is, for messages: "a FIFO (named
+ * pipe)", "a character device", ... (a string constant). */
+const char *pdt_file_kind(unsigned mode);
+
+/* The longest line a text reader accepts from a stream (standard input):
+ * a stream with no end of line in this many bytes is refused at once,
+ * "NAME:LINE: no end of line in N bytes", rather than read on into memory
+ * without bound (`pdt triangulate - < /dev/zero`). */
+#define PDT_IO_LINE_SPAN ((size_t)1 << 20)
+
 /* ---- points ------------------------------------------------------------ */
 
 /* Read points.  Format by extension: ".node" is Triangle's node format,

@@ -39,6 +39,22 @@ pdt_status pdt_comm_finalize(pdt_comm *c, pdt_err *err);
  * For the program's main only, after an unrecoverable error on one rank. */
 void pdt_comm_abort(pdt_comm *c, int code);
 
+/* ---- stopping a job before it commits ----------------------------------------
+ * The library never catches a signal; the program does, and tells the
+ * library through a query it sets here: 1 when the job is being stopped
+ * (interrupted, terminated, its launcher gone), else 0.  The query may
+ * wait (a program that is told of a stop in two steps, as mpirun's SIGCONT
+ * and, a second later, SIGTERM).  A commit point (the rename of a parallel
+ * run's output) asks it of every rank just before it acts. */
+typedef int (*pdt_stop_query)(void *ctx);
+void pdt_comm_set_stop_query(pdt_comm *c, pdt_stop_query q, void *ctx);
+/* Collective, at a commit point: every rank asks its query, then rank 0,
+ * which renames, asks again after the others have answered.  PDT_OK when
+ * no rank is being stopped; else PDT_ERR_IO "PATH: not written: the job
+ * was stopped" at the ranks that were (rank 0's is its own status: the
+ * caller agrees on it with the others after it has decided not to act). */
+pdt_status pdt_comm_commit_ok(pdt_comm *c, const char *path, pdt_err *err);
+
 int pdt_comm_rank(const pdt_comm *c);
 int pdt_comm_size(const pdt_comm *c);
 int pdt_comm_is_mpi(const pdt_comm *c);

@@ -10,6 +10,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "cli.h"
@@ -74,7 +76,7 @@ typedef struct run {
  * the ranks still finishing when one has exited with a failure status.  (Set by the pipeline,
  * read by the handler: plain values, the step a string constant.) */
 static const char *volatile stop_phase = "start";
-static volatile sig_atomic_t stop_rank, stop_size;
+static volatile sig_atomic_t stop_rank, stop_size, stop_written;
 
 static size_t put_str(char *b, size_t at, const char *s)
 {
@@ -110,11 +112,44 @@ static void on_stop(int sig)
         n = put_str(b, n, ": another of the ");
         n = put_uint(b, n, (unsigned)stop_size);
         n = put_str(b, n, " ranks ended first (the launcher names it) or the job was "
-                          "interrupted; no output written\n");
+                          "interrupted; ");
+        n = put_str(b, n, stop_written ? "the output had been written whole before\n"
+                                       : "no output written\n");
         ssize_t w = write(STDERR_FILENO, b, n);
         (void)w;
     }
     _exit(PDT_EXIT_USAGE);
+}
+
+/* A job told to stop (mpirun interrupted, or a rank died) hears it in two
+ * steps: mpirun sends every rank SIGCONT at once, SIGTERM a second later
+ * (Open MPI's odls_base_sigkill_timeout).  A rank that finished in between
+ * would commit a new output behind the failure status mpirun then reports.
+ * So a rank remembers a SIGCONT, and at the commit point (stop_query) a
+ * rank that saw one waits for the SIGTERM (on_stop ends it) before it lets
+ * the commit go on; a SIGCONT of job control (fg after Ctrl-Z) costs that
+ * wait and nothing else.  A launcher that is gone (SIGKILL) is seen by the
+ * parent's death signal (SIGTERM: on_stop) and, at the commit, by a changed
+ * parent. */
+enum { CONT_WAIT_MS = 5000 };
+static volatile sig_atomic_t cont_seen;
+static pid_t launcher;
+
+static void on_cont(int sig)
+{
+    (void)sig;
+    cont_seen = 1;
+}
+
+static int stop_query(void *ctx)
+{
+    (void)ctx;
+    for (int ms = 0; cont_seen && ms < CONT_WAIT_MS; ms += 10) {
+        struct timespec ts = {0, 10 * 1000000L};
+        nanosleep(&ts, NULL);
+    }
+    cont_seen = 0; /* (no SIGTERM came: job control; the next question waits no more) */
+    return getppid() != launcher;
 }
 
 static void catch_stop(const run *R)
@@ -128,6 +163,13 @@ static void catch_stop(const run *R)
     sigaction(SIGTERM, &sa, NULL);
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGHUP, &sa, NULL);
+    sa.sa_handler = on_cont;
+    sa.sa_flags = SA_RESTART; /* (reads and writes go on; a sleep ends) */
+    sigaction(SIGCONT, &sa, NULL);
+    launcher = getppid();
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != launcher) raise(SIGTERM); /* (gone before the line above) */
+    pdt_comm_set_stop_query(R->c, stop_query, NULL);
 }
 
 static void set_phase(run *R, const char *phase)
@@ -467,6 +509,7 @@ int pdt_cmd_triangulate(int argc, char **argv)
     if (st == PDT_OK) st = read_input(&R, &err);
     if (st == PDT_OK) st = compute(&R, &err);
     if (st == PDT_OK) st = write_output(&R, &err);
+    stop_written = st == PDT_OK; /* (committed: a stop after this must not deny it) */
     if (st == PDT_OK) st = report(&R, &err);
     stop_phase = NULL;
 

@@ -21,7 +21,10 @@ typedef struct pdt_io_text {
 } pdt_io_text;
 
 /* Read the file `path` ("-" = standard input) into t.  Errors name the file:
- * "FILE: cannot open: REASON", "FILE: is a directory", "FILE: read error: REASON".
+ * "FILE: cannot open: REASON", "FILE: is a directory", "FILE: read error: REASON",
+ * "FILE: is a FIFO (named pipe), not a regular file ..." (pdt_open_input:
+ * only standard input may be something else), "FILE:LINE: no end of line in
+ * N bytes ..." (PDT_IO_LINE_SPAN: what is read is not a text at all).
  * A regular file of 1 MiB or more is mapped (read only: its page-cache pages
  * are used as they are, no fresh memory; the file must not shrink while it
  * is read), anything else is read into a malloc'd buffer.  Free t with

@@ -534,8 +534,9 @@ static pdt_status pread_full(int fd, char *buf, size_t len, uint64_t off, const 
 
 static pdt_status open_input(const char *path, int *fd, pdt_err *err)
 {
-    *fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (*fd < 0) return pdt_err_set(err, PDT_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    char why[160];
+    *fd = pdt_open_input(path, why, sizeof why);
+    if (*fd < 0) return pdt_err_set(err, PDT_ERR_IO, "%s: %s", path, why);
     return PDT_OK;
 }
 
@@ -616,6 +617,13 @@ pdt_status pdt_points_head_read(const char *path, double scale, pdt_points_head 
                 h->body = 3;
             h->body_nl = count_nl(buf, (size_t)h->body);
             h->last_nl = buf[len - 1] == '\n';
+            break;
+        }
+        if (len >= PDT_IO_LINE_SPAN && /* (a line of garbage: not read on to the end) */
+            !memchr(buf + len - PDT_IO_LINE_SPAN, '\n', PDT_IO_LINE_SPAN)) {
+            st = pdt_err_set(err, PDT_ERR_PARSE, "%s:%zu: no end of line in %zu bytes: not a "
+                             "text file of pdt's", path, (size_t)count_nl(buf, len) + 1,
+                             PDT_IO_LINE_SPAN);
             break;
         }
         len = h->size - len < len ? (size_t)h->size : 2 * len;

@@ -2,6 +2,7 @@
 #include "io_internal.h"
 
 #include "../geom/bigmem.h"
+#include "pdt/io.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -16,6 +17,64 @@
 
 enum { MAP_MIN = 1 << 20 };
 
+/* The line number of byte `at` of buf (1 + the newlines before it). */
+static size_t line_of(const char *buf, size_t at)
+{
+    size_t line = 1;
+    for (const char *p = buf, *e = buf + at; (p = memchr(p, '\n', (size_t)(e - p))); p++) line++;
+    return line;
+}
+
+/* Read fd to its end into a malloc'd buffer (room for a '\0' after it):
+ * cap bytes to start with, grown by doubling.  A stretch of more than
+ * PDT_IO_LINE_SPAN bytes with no '\n' stops the read with an error naming
+ * the line (a stream of /dev/zero or of garbage would otherwise be read
+ * into memory without bound). */
+static pdt_status read_stream(int fd, const char *name, size_t cap, pdt_io_text *t, pdt_err *err)
+{
+    char *buf = malloc(cap);
+    if (!buf) return pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory (%zu bytes)", name, cap);
+    pdt_big_advise(buf, cap); /* huge pages: a fresh 4 KiB page costs a fault */
+    size_t len = 0, ls = 0; /* ls: where the last line seen starts */
+    pdt_status st = PDT_OK;
+    for (;;) {
+        if (cap - len < 2) {
+            size_t ncap = cap * 2;
+            char *nb = ncap > cap ? realloc(buf, ncap) : NULL;
+            if (!nb) {
+                st = pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory", name);
+                break;
+            }
+            buf = nb;
+            cap = ncap;
+            pdt_big_advise(buf, cap);
+        }
+        ssize_t r = read(fd, buf + len, cap - len - 1);
+        if (r < 0 && errno == EINTR) continue;
+        if (r < 0) {
+            st = pdt_err_set(err, PDT_ERR_IO, "%s: read error: %s", name, strerror(errno));
+            break;
+        }
+        if (r == 0) break;
+        const char *nl = memrchr(buf + len, '\n', (size_t)r);
+        len += (size_t)r;
+        if (nl) ls = (size_t)(nl - buf) + 1;
+        if (len - ls > PDT_IO_LINE_SPAN) {
+            st = pdt_err_set(err, PDT_ERR_PARSE, "%s:%zu: no end of line in %zu bytes: not a "
+                             "text file of pdt's", name, line_of(buf, ls), PDT_IO_LINE_SPAN);
+            break;
+        }
+    }
+    if (st != PDT_OK) {
+        free(buf);
+        return st;
+    }
+    buf[len] = '\0';
+    t->buf = buf;
+    t->len = len;
+    return PDT_OK;
+}
+
 pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
 {
     t->buf = NULL;
@@ -24,8 +83,9 @@ pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
     t->map_base = NULL;
     int is_stdin = strcmp(path, "-") == 0;
     const char *name = is_stdin ? "standard input" : path;
-    int fd = is_stdin ? STDIN_FILENO : open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return pdt_err_set(err, PDT_ERR_IO, "%s: cannot open: %s", name, strerror(errno));
+    char why[160];
+    int fd = is_stdin ? STDIN_FILENO : pdt_open_input(path, why, sizeof why);
+    if (fd < 0) return pdt_err_set(err, PDT_ERR_IO, "%s: %s", name, why);
     struct stat sb;
     if (fstat(fd, &sb) != 0) {
         int e = errno;
@@ -40,48 +100,14 @@ pdt_status pdt_io_load(const char *path, pdt_io_text *t, pdt_err *err)
      * much fresh memory, whose first touch is dear: 0.2-0.3 s at 10^7
      * points on this project's VM).  Other regular files: one allocation
      * of the right size (room for the byte the read that finds the end asks
-     * for, and the '\0'); pipes: grow. */
-    if (S_ISREG(sb.st_mode) && pdt_io_map_part(fd, 0, (uint64_t)sb.st_size, t) == 0) {
-        if (!is_stdin) close(fd);
-        return PDT_OK;
-    }
-    size_t cap = S_ISREG(sb.st_mode) && sb.st_size > 0 ? (size_t)sb.st_size + 2 : 65536;
-    char *buf = malloc(cap);
-    if (!buf) {
-        if (!is_stdin) close(fd);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory (%zu bytes)", name, cap);
-    }
-    pdt_big_advise(buf, cap); /* huge pages: a fresh 4 KiB page costs a fault */
-    size_t len = 0;
-    for (;;) {
-        if (cap - len < 2) {
-            size_t ncap = cap * 2;
-            char *nb = ncap > cap ? realloc(buf, ncap) : NULL;
-            if (!nb) {
-                free(buf);
-                if (!is_stdin) close(fd);
-                return pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory", name);
-            }
-            buf = nb;
-            cap = ncap;
-            pdt_big_advise(buf, cap);
-        }
-        ssize_t r = read(fd, buf + len, cap - len - 1);
-        if (r < 0) {
-            if (errno == EINTR) continue;
-            int e = errno;
-            free(buf);
-            if (!is_stdin) close(fd);
-            return pdt_err_set(err, PDT_ERR_IO, "%s: read error: %s", name, strerror(e));
-        }
-        if (r == 0) break;
-        len += (size_t)r;
-    }
+     * for, and the '\0'); standard input from a pipe or device: grow. */
+    pdt_status st = PDT_OK;
+    if (!(S_ISREG(sb.st_mode) && pdt_io_map_part(fd, 0, (uint64_t)sb.st_size, t) == 0))
+        st = read_stream(fd, name,
+                         S_ISREG(sb.st_mode) && sb.st_size > 0 ? (size_t)sb.st_size + 2 : 65536,
+                         t, err);
     if (!is_stdin) close(fd);
-    buf[len] = '\0';
-    t->buf = buf;
-    t->len = len;
-    return PDT_OK;
+    return st;
 }
 
 /* (Also the whole file: lo = 0, hi = its size; the byte after its end is a

@@ -44,6 +44,28 @@ pdt_status pdt_comm_finalize(pdt_comm *c, pdt_err *err)
     return PDT_OK;
 }
 
+void pdt_comm_set_stop_query(pdt_comm *c, pdt_stop_query q, void *ctx)
+{
+    c->stop = q;
+    c->stop_ctx = ctx;
+}
+
+static int stopping(pdt_comm *c)
+{
+    return c->stop && c->stop(c->stop_ctx);
+}
+
+pdt_status pdt_comm_commit_ok(pdt_comm *c, const char *path, pdt_err *err)
+{
+    pdt_status st = stopping(c) ? PDT_ERR_IO : PDT_OK;
+    if (st != PDT_OK)
+        pdt_err_set(err, st, "%s: not written: the job was stopped (rank %d)", path, c->rank);
+    st = pdt_comm_agree(c, st, path, "the commit (the job was stopped)", err);
+    if (st == PDT_OK && c->rank == 0 && stopping(c)) /* (the last word: rank 0 renames) */
+        st = pdt_err_set(err, PDT_ERR_IO, "%s: not written: the job was stopped (rank 0)", path);
+    return st;
+}
+
 int pdt_comm_rank(const pdt_comm *c) { return c->rank; }
 int pdt_comm_size(const pdt_comm *c) { return c->size; }
 int pdt_comm_is_mpi(const pdt_comm *c) { return c->ops->is_mpi; }

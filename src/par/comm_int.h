@@ -47,6 +47,8 @@ struct pdt_comm {
     size_t chunk;   /* largest single message, bytes (<= INT_MAX) */
     char host[256];
     void *be;       /* the backend's state */
+    pdt_stop_query stop; /* the program's "is the job being stopped?" (NULL: never) */
+    void *stop_ctx;
 };
 
 struct pdt_comm_file {

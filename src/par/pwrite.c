@@ -250,6 +250,7 @@ static pdt_status write_files(pdt_comm *c, outfile *o, int nfile, pdt_err *err)
         }
         st = write_file(c, &o[made], err);
     }
+    if (st == PDT_OK) st = pdt_comm_commit_ok(c, o[0].path, err); /* (not if stopped) */
     for (int k = 0; k < nfile && st == PDT_OK && r == 0; k++)
         if (pdt_replace_file(o[k].tmp, o[k].path) != 0)
             st = pdt_err_set(err, PDT_ERR_IO, "%s: cannot rename into place: %s", o[k].path,

@@ -1,5 +1,6 @@
 /* pdt — the reader library: open a run folder, validate, decode, merge. */
 #include "tf_internal.h"
+#include "pdt/io.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -70,18 +71,21 @@ static void rank_name(char *buf, size_t cap, int r)
     snprintf(buf, cap, "rank-%04d.trace", r);
 }
 
-/* Map a whole file read-only.  Returns 0, or errno (ENOENT if missing).
- * An empty file gives map = NULL, size = 0. */
-static int map_file(const char *path, uint8_t **map, size_t *size)
+/* Map a whole file read-only.  Returns 0, or errno (ENOENT if missing)
+ * with the reason in why (pdt_open_input: a FIFO, a device, a folder are
+ * refused, never waited on or read).  An empty file gives map = NULL,
+ * size = 0. */
+static int map_file(const char *path, uint8_t **map, size_t *size, char *why, size_t wcap)
 {
     *map = NULL;
     *size = 0;
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return errno;
+    int fd = pdt_open_input(path, why, wcap);
+    if (fd < 0) return errno ? errno : EIO;
     struct stat st;
     if (fstat(fd, &st) != 0) {
         int e = errno;
         close(fd);
+        snprintf(why, wcap, "%s", strerror(e));
         return e;
     }
     if (st.st_size > 0) {
@@ -89,6 +93,7 @@ static int map_file(const char *path, uint8_t **map, size_t *size)
         if (p == MAP_FAILED) {
             int e = errno;
             close(fd);
+            snprintf(why, wcap, "%s", strerror(e));
             return e;
         }
         *map = p;
@@ -156,14 +161,15 @@ static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
     rank_name(name, sizeof name, r);
     char *path = pdt_tf_path_join(run->dir, name);
     if (!path) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    int e = map_file(path, &rk->map, &rk->size);
+    char why[160];
+    int e = map_file(path, &rk->map, &rk->size, why, sizeof why);
     free(path);
     if (e == ENOENT) {
         rk->absent = 1;
         return PDT_OK;
     }
     if (e) {
-        warnf(run, "%s: %s: no events for rank %d", name, strerror(e), r);
+        warnf(run, "%s: %s: no events for rank %d", name, why, r);
         return PDT_OK;
     }
     const uint8_t *p = rk->map;
@@ -270,11 +276,11 @@ static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
     return PDT_OK;
 }
 
-static char *read_text(const char *path, int *errnum)
+static char *read_text(const char *path, int *errnum, char *why, size_t wcap)
 {
     uint8_t *map;
     size_t size;
-    *errnum = map_file(path, &map, &size);
+    *errnum = map_file(path, &map, &size, why, wcap);
     if (*errnum) return NULL;
     char *s = malloc(size + 1);
     if (!s) {
@@ -323,6 +329,30 @@ static uint64_t points_sum(const pdt_manifest *m, const pdt_point *pts, size_t n
                                                           : pdt_points_checksum(pts, n);
 }
 
+/* The largest clock offset taken as one (10^18 ns, about 31 years): the
+ * differences of offsets in this range, and times shifted by them, are
+ * computed without overflow. */
+#define CLOCK_OFFSET_MAX INT64_C(1000000000000000000)
+
+/* The smallest of 0 and the manifest's clock offsets (each rank's shift is
+ * its offset minus this).  An offset beyond +-CLOCK_OFFSET_MAX is no clock
+ * offset (a damaged or hostile manifest): then the ranks' clocks are left
+ * unaligned (every offset 0), with a warning naming it. */
+static int64_t clock_base(pdt_run *run)
+{
+    int64_t *off = run->m.clock_offset_ns, minoff = 0;
+    for (int r = 0; r < run->nranks; r++) {
+        if (off[r] < -CLOCK_OFFSET_MAX || off[r] > CLOCK_OFFSET_MAX) {
+            warnf(run, "manifest: clock_offset_ns of rank %d is %" PRId64 " ns, beyond +-%" PRId64
+                       " ns: clocks not aligned", r, off[r], CLOCK_OFFSET_MAX);
+            memset(off, 0, (size_t)run->nranks * sizeof *off);
+            return 0;
+        }
+        if (off[r] < minoff) minoff = off[r];
+    }
+    return minoff;
+}
+
 pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
 {
     *out = NULL;
@@ -338,14 +368,17 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
     }
     run->dir[strlen(dir)] = '\0';  /* join added a '/' */
     int e;
-    char *text = read_text(mpath, &e);
+    char why[160];
+    char *text = read_text(mpath, &e, why, sizeof why);
     if (text) {
         st = pdt_tf_manifest_parse(mpath, text, &run->m, err);
         free(text);
     } else if (e == ENOENT) {
         st = guess_manifest(run, err);
+    } else if (e == ENOMEM) {
+        st = pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory", mpath);
     } else {
-        st = pdt_err_set(err, PDT_ERR_IO, "%s: cannot read: %s", mpath, strerror(e));
+        st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", mpath, why);
     }
     free(mpath);
     if (st != PDT_OK) {
@@ -360,8 +393,8 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
         uint8_t *map = NULL;
         size_t size = 0;
         if (!ppath) st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-        else if ((e = map_file(ppath, &map, &size)) != 0)
-            warnf(run, "points.bin: %s: the run cannot be replayed or checked", strerror(e));
+        else if ((e = map_file(ppath, &map, &size, why, sizeof why)) != 0)
+            warnf(run, "points.bin: %s: the run cannot be replayed or checked", why);
         else {
             pdt_err perr = {0};
             if (points_in_place(map, size, &run->pts, &run->npts)) {
@@ -393,9 +426,7 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
         pdt_run_close(run);
         return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     }
-    int64_t minoff = 0;
-    for (int r = 0; r < run->nranks; r++)
-        if (run->m.clock_offset_ns[r] < minoff) minoff = run->m.clock_offset_ns[r];
+    int64_t minoff = clock_base(run);
     /* Missing rank files are reported as ranges: a damaged manifest may
      * announce up to 2^20 ranks, and one line per absent file would bury the
      * other warnings. */

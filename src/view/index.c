@@ -610,12 +610,13 @@ static pdt_status run_ident(const char *dir, uint64_t *id, pdt_err *err)
         for (size_t i = 0; i < nf; i++) h = fnv(h, &f[i], sizeof f[i]);
         char path[PATH_MAX];
         snprintf(path, sizeof path, "%s/manifest", dir);
-        FILE *mf = fopen(path, "rb");
-        if (mf) {
+        char why[160];
+        int mfd = pdt_open_input(path, why, sizeof why); /* (not a file: the run's open says so) */
+        if (mfd >= 0) {
             char buf[4096];
-            size_t got;
-            while ((got = fread(buf, 1, sizeof buf, mf)) > 0) h = fnv(h, buf, got);
-            fclose(mf);
+            ssize_t got;
+            while ((got = read(mfd, buf, sizeof buf)) > 0) h = fnv(h, buf, (size_t)got);
+            close(mfd);
         }
         *id = h;
     }
@@ -709,7 +710,8 @@ static int map_ranks(pdt_replay *r, const char *dir, lazy *L, char *why, size_t 
         if (src->rank_blk[q] == src->rank_blk[q + 1]) continue;
         char p[PATH_MAX + 32];
         snprintf(p, sizeof p, "%s/rank-%04zu.trace", dir, q);
-        int fd = open(p, O_RDONLY | O_CLOEXEC);
+        char whyopen[160];
+        int fd = pdt_open_input(p, whyopen, sizeof whyopen);
         struct stat sb;
         void *m = MAP_FAILED;
         if (fd >= 0 && fstat(fd, &sb) == 0 && sb.st_size > 0)
@@ -760,9 +762,10 @@ static void unmap_ranks(pdt_replay *r)
 static pdt_replay *load(const char *path, const char *dir, uint64_t ident, const pdt_point *pts,
                         size_t n, int verify, char *why, size_t wcap)
 {
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    char whyopen[160];
+    int fd = pdt_open_input(path, whyopen, sizeof whyopen);
     if (fd < 0) {
-        snprintf(why, wcap, "%s", errno == ENOENT ? "no index yet" : strerror(errno));
+        snprintf(why, wcap, "%s", errno == ENOENT ? "no index yet" : whyopen);
         return NULL;
     }
     struct stat sb;

@@ -230,6 +230,54 @@ TEST(failing_rank_ends_the_run)
     }
 }
 
+/* The commit point's stop question (pdt_comm_commit_ok): arg says which
+ * rank is being stopped (-1: none; 0 late: rank 0 only at its last word,
+ * after the others answered).  Every rank checks the status it gets. */
+typedef struct stop_case {
+    int who, late;
+} stop_case;
+
+static int stop_calls[8];
+
+typedef struct stop_ctx {
+    int rank;
+    stop_case sc;
+} stop_ctx;
+
+static int stop_query(void *ctx)
+{
+    stop_ctx *x = ctx;
+    int n = ++stop_calls[x->rank];
+    if (x->sc.late) return x->rank == 0 && n == 2;
+    return x->rank == x->sc.who;
+}
+
+static pdt_status rank_commit(pdt_comm *c, void *arg, pdt_err *err)
+{
+    stop_ctx x = {pdt_comm_rank(c), *(const stop_case *)arg};
+    stop_calls[x.rank] = 0;
+    pdt_comm_set_stop_query(c, stop_query, &x);
+    pdt_err e = {0};
+    pdt_status st = pdt_comm_commit_ok(c, "out.tri", &e);
+    int want_fail = x.sc.late ? x.rank == 0 : x.sc.who >= 0;
+    pdt_comm_set_stop_query(c, NULL, NULL);
+    if ((st != PDT_OK) != want_fail)
+        return pdt_err_set(err, PDT_ERR_CHECK, "rank %d: status %d (%s)", x.rank, (int)st, e.msg);
+    if (want_fail && !strstr(e.msg, "out.tri: "))
+        return pdt_err_set(err, PDT_ERR_CHECK, "rank %d: message '%s'", x.rank, e.msg);
+    return PDT_OK;
+}
+
+TEST(commit_refused_when_any_rank_is_stopped)
+{
+    const stop_case cases[] = {{-1, 0}, {0, 0}, {1, 0}, {2, 0}, {-1, 1}};
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        pdt_err err = {0};
+        pdt_status s = pdt_comm_local_run(3, rank_commit, (void *)&cases[k], &err);
+        CHECK_MSG(s == PDT_OK, "case who=%d late=%d: %s", cases[k].who, cases[k].late, err.msg);
+    }
+}
+
 /* The partition of pdt_par_triangulate: the input (job->n points, point i
  * at job->pt(i)) dealt in consecutive blocks; every rank checks it got
  * exactly its share of the records when keys are distinct, and the distinct
@@ -294,6 +342,7 @@ int main(void)
     RUN(messages_by_tag_p1_to_p5);
     RUN(one_file_written_by_all_ranks);
     RUN(failing_rank_ends_the_run);
+    RUN(commit_refused_when_any_rank_is_stopped);
     RUN(partition_exact_shares_p2_to_p7);
     return test_summary();
 }

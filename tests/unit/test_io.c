@@ -1,6 +1,7 @@
 /* Unit tests of src/io: point and triangle parsers (every bad input with its
  * message), --scale rounding and collisions, writers, atomic output. */
 #include <dirent.h>
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -250,6 +251,61 @@ TEST(file_errors)
         CHECK(pdt_read_points(path("noread.txt"), 0, &p, &n, NULL, &err) == PDT_ERR_IO);
         CHECK(strstr(err.msg, "cannot open: Permission denied") != NULL);
     }
+}
+
+/* A FIFO, a device and a link to /dev/zero are refused by name, at once (a
+ * regression would block in open() or read without end: the alarm turns
+ * that into a failed run). */
+TEST(not_regular_files_refused)
+{
+    pdt_point *p = NULL;
+    size_t n;
+    pdt_err err;
+    pdt_points_head h;
+    char want[512];
+    alarm(30);
+    CHECK(mkfifo(path("fifo.txt"), 0600) == 0);
+    pdt_err_clear(&err);
+    CHECK(pdt_read_points(path("fifo.txt"), 0, &p, &n, NULL, &err) == PDT_ERR_IO);
+    snprintf(want, sizeof want, "%s: is a FIFO (named pipe), not a regular file", path("fifo.txt"));
+    CHECK_MSG(strncmp(err.msg, want, strlen(want)) == 0, "%s", err.msg);
+    pdt_err_clear(&err);
+    CHECK(pdt_points_head_read(path("fifo.txt"), 0, &h, &err) == PDT_ERR_IO);
+    CHECK_MSG(strncmp(err.msg, want, strlen(want)) == 0, "%s", err.msg);
+    pdt_err_clear(&err);
+    CHECK(pdt_read_points("/dev/zero", 0, &p, &n, NULL, &err) == PDT_ERR_IO);
+    CHECK_MSG(strstr(err.msg, "/dev/zero: is a character device") == err.msg, "%s", err.msg);
+    CHECK(symlink("/dev/zero", path("zero.txt")) == 0);
+    pdt_err_clear(&err);
+    CHECK(pdt_read_points(path("zero.txt"), 0, &p, &n, NULL, &err) == PDT_ERR_IO);
+    CHECK_MSG(strstr(err.msg, "is a character device") != NULL, "%s", err.msg);
+    char why[160];
+    CHECK(pdt_open_input(path("fifo.txt"), why, sizeof why) < 0 && errno == EINVAL);
+    int fd = pdt_open_input(path("missing"), why, sizeof why);
+    CHECK(fd < 0 && errno == ENOENT && strcmp(why, "cannot open: No such file or directory") == 0);
+    alarm(0);
+}
+
+/* A file whose first line never ends: the reader that finds where the
+ * header ends stops after PDT_IO_LINE_SPAN bytes and names the line. */
+TEST(head_read_endless_line_refused)
+{
+    size_t big = 3 * PDT_IO_LINE_SPAN;
+    char *b = malloc(big + 1);
+    if (!b) return;
+    memcpy(b, "# points\n", 9);
+    memset(b + 9, 'x', big - 9);
+    b[big] = 0;
+    put("endless.txt", b);
+    free(b);
+    pdt_points_head h;
+    pdt_err err;
+    pdt_err_clear(&err);
+    CHECK(pdt_points_head_read(path("endless.txt"), 0, &h, &err) == PDT_ERR_PARSE);
+    char want[512];
+    snprintf(want, sizeof want, "%s:2: no end of line in %zu bytes", path("endless.txt"),
+             PDT_IO_LINE_SPAN);
+    CHECK_MSG(strncmp(err.msg, want, strlen(want)) == 0, "%s", err.msg);
 }
 
 TEST(node_format)
@@ -847,6 +903,8 @@ int main(void)
     RUN(text_bad_inputs);
     RUN(text_csv);
     RUN(file_errors);
+    RUN(not_regular_files_refused);
+    RUN(head_read_endless_line_refused);
     RUN(node_format);
     RUN(scale_rounding);
     RUN(scale_collisions);
