@@ -241,6 +241,7 @@ typedef struct bis_range {
     int64_t x0, x1, y0, y1;  /* its cell (closed; the input's box at the root), in
                               * coordinates biased by 2^31 as in the key */
     size_t s, e;             /* its records here: w[s, e) */
+    int inorder;             /* w[s, e) is in rec's order (the (x, y) key's) */
 } bis_range;
 
 /* The input's box, (x0, y0) and (x1, y1), over all ranks (rec key-sorted). */
@@ -258,24 +259,31 @@ static pdt_status bis_root(drv *d, const srm_rec *rec, size_t n, bis_range *root
     if (st != PDT_OK) return st;
     note_all(d, TAG_SAMPLES, sizeof v);
     *root = (bis_range){0, d->p, 0, (int64_t)v[0], (int64_t)(uint32_t)~v[1], (int64_t)v[2],
-                        (int64_t)(uint32_t)~v[3], 0, n};
+                        (int64_t)(uint32_t)~v[3], 0, n, 1};
     return PDT_OK;
 }
 
 /* The axis of every range (its cell's longer side; x on a tie) and its run
- * of w sorted by that axis' key. */
-static void bis_sort(drv *d, const srm_rec *rec, srm_rec *w, srm_rec *scratch, bis_range *r,
-                     int nr)
+ * of w sorted by that axis' key (a run already in rec's order needs no sort
+ * for an x-cut: the first cut of a wide input, every cut of strips-like
+ * ones).  *scratch: n records, allocated at the first sort. */
+static pdt_status bis_sort(drv *d, const srm_rec *rec, srm_rec *w, size_t n, srm_rec **scratch,
+                           bis_range *r, int nr)
 {
     for (int i = 0; i < nr; i++) {
         int axis = r[i].x1 - r[i].x0 >= r[i].y1 - r[i].y0 ? 0 : 1;
         d->tree.cut[r[i].at].axis = axis;
+        if (axis == 0 && r[i].inorder) continue;
+        if (!*scratch && !(*scratch = srm_big((n + 1) * sizeof **scratch)))
+            return nomem(d, "partition");
         for (size_t k = r[i].s; k < r[i].e; k++) {
             pdt_point q = srm_key_point(rec[w[k].idx].key);
             w[k].key = srm_axis_key(axis, q.x, q.y);
         }
-        pdt_srm_radix_sort(w + r[i].s, scratch, r[i].e - r[i].s);
+        pdt_srm_radix_sort(w + r[i].s, *scratch, r[i].e - r[i].s);
+        r[i].inorder = axis == 0; /* (rec's keys are distinct: x order is rec's) */
     }
+    return PDT_OK;
 }
 
 /* The cuts of the nr ranges of one depth (every rank the same). */
@@ -315,9 +323,10 @@ static pdt_status bis_select(drv *d, const srm_rec *w, const bis_range *r, int n
 }
 
 /* Each range cut in two at its split: halves of two ranks or more into
- * next[] (their number returned), a single rank's run counted in sc[]. */
+ * next[] (their number returned), a single rank's run counted in sc[] (and
+ * whether it is in rec's order in inorder[]). */
 static int bis_split(drv *d, const srm_rec *w, const bis_range *r, int nr, bis_range *next,
-                     uint64_t *sc)
+                     uint64_t *sc, unsigned char *inorder)
 {
     int nn = 0;
     for (int i = 0; i < nr; i++) {
@@ -334,7 +343,10 @@ static int bis_split(drv *d, const srm_rec *w, const bis_range *r, int nr, bis_r
         else h[0].x1 = h[1].x0 = v;
         for (int k = 0; k < 2; k++) {
             if (h[k].hi - h[k].lo >= 2) next[nn++] = h[k];
-            else sc[h[k].lo] = h[k].e - h[k].s;
+            else {
+                sc[h[k].lo] = h[k].e - h[k].s;
+                inorder[h[k].lo] = (unsigned char)h[k].inorder;
+            }
         }
     }
     return nn;
@@ -353,28 +365,32 @@ static pdt_status bisect(drv *d, const srm_rec *rec, srm_rec *w, size_t n, uint6
     d->tree.levels_p = pdt_srm_ceil_log2(p);
     d->tree.cut = calloc((size_t)p, sizeof *d->tree.cut);
     bis_range *cur = malloc((size_t)p * sizeof *cur), *next = malloc((size_t)p * sizeof *next);
-    srm_rec *scratch = srm_big((n + 1) * sizeof *scratch);
-    pdt_status st = d->tree.cut && cur && next && scratch ? PDT_OK : nomem(d, "partition");
+    unsigned char *inorder = malloc((size_t)p);
+    srm_rec *scratch = NULL;
+    pdt_status st = d->tree.cut && cur && next && inorder ? PDT_OK : nomem(d, "partition");
     for (size_t i = 0; i < n; i++) w[i] = (srm_rec){rec[i].key, (uint32_t)i, 0};
     int nr = 1;
     if (st == PDT_OK) st = bis_root(d, rec, n, &cur[0], err);
     while (st == PDT_OK && nr > 0) {
-        bis_sort(d, rec, w, scratch, cur, nr);
-        st = bis_select(d, w, cur, nr, err);
+        st = bis_sort(d, rec, w, n, &scratch, cur, nr);
+        if (st == PDT_OK) st = bis_select(d, w, cur, nr, err);
         if (st != PDT_OK) break;
-        nr = bis_split(d, w, cur, nr, next, sc);
+        nr = bis_split(d, w, cur, nr, next, sc, inorder);
         bis_range *t = cur;
         cur = next;
         next = t;
     }
-    /* each rank's run back in key order, as records */
+    /* each rank's run back in key order (if a y-cut moved it), as records */
     for (size_t q = 0, at = 0; st == PDT_OK && q < (size_t)p; at += sc[q++]) {
-        for (size_t i = at; i < at + sc[q]; i++) w[i].key = w[i].idx;
-        pdt_srm_radix_sort(w + at, scratch, sc[q]);
+        if (!inorder[q]) {
+            for (size_t i = at; i < at + sc[q]; i++) w[i].key = w[i].idx;
+            pdt_srm_radix_sort(w + at, scratch, sc[q]);
+        }
         for (size_t i = at; i < at + sc[q]; i++) w[i] = rec[w[i].idx];
     }
     free(cur);
     free(next);
+    free(inorder);
     free(scratch);
     return st;
 }
