@@ -179,6 +179,8 @@ typedef struct pdt_par_input {
                           * memory in ahead of use (PDT_TRI_PREFAULT with one
                           * rank, the partition's block with more): for
                           * ranks not sharing a CPU with another rank */
+    int partition;       /* pdt_par_partition: how the ranks' regions are cut
+                          * (0: strips) */
 } pdt_par_input;
 
 /* This rank's share of T*: triangles first .. first + ntri - 1 of the
@@ -196,6 +198,18 @@ typedef struct pdt_par_output {
 void pdt_par_input_free(pdt_par_input *in);
 void pdt_par_output_free(pdt_par_output *out);
 
+/* Merge levels the figures count one by one (2^24 ranks). */
+#define PDT_PAR_MAX_LEVELS 24
+
+/* How the ranks' regions are cut (algorithm.md §3.2, §3.12). */
+typedef enum pdt_par_partition {
+    PDT_PART_STRIPS = 0, /* lexicographic blocks: every seam as tall as the input */
+    PDT_PART_BISECT = 1  /* boxes by recursive bisection across the longer side */
+} pdt_par_partition;
+
+/* The partition a run uses when none is asked for. */
+#define PDT_PART_DEFAULT PDT_PART_STRIPS
+
 /* Figures of one rank. */
 typedef struct pdt_par_rank_stats {
     uint64_t points;        /* distinct points in this rank's strip */
@@ -206,6 +220,7 @@ typedef struct pdt_par_rank_stats {
     uint64_t shipped;       /* pending triangles sent to a merge rank */
     uint64_t merges;        /* merge steps done at this rank */
     uint64_t border_max;    /* largest border set |B| of a merge done here */
+    uint64_t border_level[PDT_PAR_MAX_LEVELS]; /* the same, per merge level */
     uint64_t kept;          /* triangles kept by merges done here */
     uint64_t discarded;     /* shipped triangles discarded (non-Delaunay) here */
     uint64_t final_merge;   /* triangles made final by merges done here */
@@ -216,6 +231,8 @@ typedef struct pdt_par_rank_stats {
     uint64_t n_dup;         /* duplicates dropped in this rank's strip */
     uint64_t hull;          /* vertices of the hull this rank holds */
     int32_t holds_final_hull, hull_degenerate;
+    int32_t levels;         /* merge levels of the run (0 with one rank) */
+    int32_t partition;      /* pdt_par_partition of the run */
     int32_t prefault;       /* 1: a second thread faulted memory in ahead */
     int32_t strips;         /* strips triangulated one after the other to save
                              * memory: a plain run's, or each rank's of an MPI
@@ -234,6 +251,9 @@ typedef struct pdt_par_stats {
     int collinear;            /* 1 if < 3 distinct points or all collinear */
     uint64_t hull;            /* vertices of the final hull (collinear ones kept) */
     uint64_t border_max;      /* largest border set of any merge */
+    uint64_t border_level[PDT_PAR_MAX_LEVELS]; /* the same, per merge level */
+    int levels;               /* merge levels of the run */
+    int partition;            /* pdt_par_partition of the run */
     uint64_t bytes_total;     /* sum of bytes sent by all ranks */
     uint64_t merge_bytes;     /* sum of merge-step bytes sent */
     double critical_path;     /* seconds, max over ranks */

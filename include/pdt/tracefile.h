@@ -66,6 +66,8 @@ typedef struct pdt_manifest {
     int format_minor;        /* minor version (reader: as found in the file) */
     int input_checksum_kind; /* PDT_CHECKSUM_CRC64 (0: what writers write) or
                               * PDT_CHECKSUM_FNV1A64 (format 1 runs) */
+    int partition;           /* a triangulate run's regions: 0 strips (no
+                              * 'partition' line), 1 bisect (pdt_par_partition) */
 } pdt_manifest;
 
 enum { PDT_CHECKSUM_CRC64 = 0, PDT_CHECKSUM_FNV1A64 = 1 };

@@ -37,14 +37,18 @@ int pdt_cli_parse_run_opts(const char *cmd, const char *help, int argc, char **a
     memset(o, 0, sizeof *o);
     o->command = cmd;
     o->trace_level = 1;
+    o->partition = PDT_PART_DEFAULT;
     o->argc = argc;
     o->argv = argv;
+    const char *part = NULL;
     const pdt_cli_opt opts[] = {
         { "--output", "-o", PDT_OPT_STR, &o->output },
         { "--scale", NULL, PDT_OPT_POSNUM, &o->scale },
         { "--stats", NULL, PDT_OPT_FLAG, &o->stats },
         { "--trace", NULL, PDT_OPT_STR, &o->trace_dir },
         { "--trace-level", NULL, PDT_OPT_LEVEL, &o->trace_level },
+        /* last: for hull, the end of the list (a hull has no partition) */
+        { strcmp(cmd, "triangulate") == 0 ? "--partition" : NULL, NULL, PDT_OPT_STR, &part },
         { NULL, NULL, PDT_OPT_FLAG, NULL },
     };
     const char *pos[1];
@@ -53,6 +57,9 @@ int pdt_cli_parse_run_opts(const char *cmd, const char *help, int argc, char **a
     if (rc == 1) return PDT_EXIT_OK;
     if (rc) return PDT_EXIT_USAGE;
     if (npos != 1) return pdt_cli_usage(cmd, "needs one INPUT file");
+    if (part && !strcmp(part, "strips")) o->partition = PDT_PART_STRIPS;
+    else if (part && !strcmp(part, "bisect")) o->partition = PDT_PART_BISECT;
+    else if (part) return pdt_cli_usage(cmd, "--partition needs strips or bisect, not '%s'", part);
     o->input = pos[0];
     return -1;
 }

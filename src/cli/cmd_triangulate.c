@@ -23,6 +23,7 @@
 static const char help[] =
     "usage: pdt triangulate INPUT [-o OUT] [--scale K] [--stats]\n"
     "                             [--trace DIR] [--trace-level N]\n"
+    "                             [--partition strips|bisect]\n"
     "\n"
     "Compute T*, the Delaunay triangulation of the points in INPUT (exact; ties\n"
     "broken by the lexicographic rule, so the answer is unique).\n"
@@ -42,6 +43,12 @@ static const char help[] =
     "                to standard error.\n"
     "--trace DIR     record every step into the run folder DIR (for pdtview).\n"
     "--trace-level N 1 (default) or 2 (also every edge the kernel makes).\n"
+    "--partition strips|bisect\n"
+    "                how the ranks of a parallel run cut the plane: strips\n"
+    "                (the default; lexicographic blocks, every seam as tall as\n"
+    "                the input) or bisect (boxes by recursive bisection across\n"
+    "                the longer side: deeper seams are shorter).  The output\n"
+    "                is the same bytes either way.\n"
     "\n"
     "Output (.tri): one triangle per line, 'i j k', 0-based input indices,\n"
     "counter-clockwise, rotated to start at the smallest index, lines sorted.\n"
@@ -321,6 +328,7 @@ static pdt_status compute(run *R, pdt_err *err)
      * partitioned (the other formats write them; a trace keeps them) */
     R->in.release_pts = pdt_tri_format_of(R->o->output) == PDT_FMT_TRI && !R->trace;
     R->in.prefault = prefault_wanted(R);
+    R->in.partition = R->o->partition;
     pdt_status st = pdt_par_triangulate(R->c, &R->in, &R->out, &R->me,
                                         pdt_cli_trace_hook(R->trace), err);
     if (st != PDT_OK && R->p > 1) {
@@ -407,6 +415,11 @@ static void json_parallel(const pdt_par_stats *s)
             (unsigned long long)s->bytes_total, (unsigned long long)s->merge_bytes,
             s->n_in ? (double)s->merge_bytes / (8.0 * (double)s->n_in) : 0.0, s->critical_path,
             s->critical_cpu, s->t_compute);
+    fprintf(stderr, ", \"partition\": \"%s\", \"largest_border_set_by_level\": [",
+            s->partition == PDT_PART_BISECT ? "bisect" : "strips");
+    for (int l = 0; l < s->levels && l < PDT_PAR_MAX_LEVELS; l++)
+        fprintf(stderr, "%s%llu", l ? ", " : "", (unsigned long long)s->border_level[l]);
+    fprintf(stderr, "]");
     fprintf(stderr, ", \"per_rank\": [");
     for (int q = 0; q < s->nranks; q++) json_rank(q, &s->rank[q]);
     fprintf(stderr, "]}");

@@ -22,12 +22,15 @@ typedef struct pdt_run_opts {
     int stats;               /* --stats: JSON figures on stderr */
     const char *trace_dir;   /* --trace DIR; NULL = no trace */
     int trace_level;         /* --trace-level N (1 or 2; default 1) */
+    int partition;           /* --partition strips|bisect (triangulate only):
+                              * pdt_par_partition, PDT_PART_DEFAULT if not given */
     int argc;                /* the whole command line, for trace manifests */
     char **argv;
 } pdt_run_opts;
 
 /* Parse the options shared by `pdt triangulate` and `pdt hull` (INPUT, -o,
- * --scale, --stats, --trace, --trace-level) for command `cmd` into o.
+ * --scale, --stats, --trace, --trace-level; --partition for triangulate)
+ * for command `cmd` into o.
  * Returns -1 to go on, else the exit status to return (help printed, or a
  * usage error already reported). */
 int pdt_cli_parse_run_opts(const char *cmd, const char *help, int argc, char **argv,

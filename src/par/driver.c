@@ -56,6 +56,7 @@ typedef struct drv {
     int k;                         /* strips this rank holds (every rank the same) */
     size_t first[PDT_RANK_MAX_STRIPS + 1]; /* strip j: the block's points [first[j], first[j+1]) */
     srm_strip *strip;              /* p * k strip descriptors */
+    srm_tree tree;                 /* a bisection run's regions (tree.cut NULL: strips) */
     srm_rank s[PDT_RANK_MAX_STRIPS];  /* strip k * rank + j */
     int s_init[PDT_RANK_MAX_STRIPS];
     pdt_tri *more;                 /* the order phase's finals besides the block's */
@@ -159,56 +160,238 @@ static uint64_t sel_cut(uint64_t lo, uint64_t hi, uint64_t step, int j)
     return off >= hi - lo ? hi : lo + off;
 }
 
-static pdt_status splitters(drv *d, const srm_rec *rec, size_t n, uint64_t *split, pdt_err *err)
+/* The exact selection behind the splitters and the bisection's cuts: for
+ * each of ns searches, the smallest key v with more than t[i] keys <= v
+ * among the key-sorted runs arr[i][0..len[i]) of all ranks, known to lie in
+ * [lo[i], hi[i]] (every rank the same bounds); the answer in lo[i]. */
+static pdt_status select_keys(drv *d, int ns, const srm_rec *const *arr, const size_t *len,
+                              const uint64_t *t, uint64_t *lo, uint64_t *hi, pdt_err *err)
 {
-    int p = d->p, q1 = p - 1, nc = SEL_WAYS - 1;
-    uint64_t ext[2] = {n ? rec[0].key : UINT64_MAX, n ? ~rec[n - 1].key : UINT64_MAX};
-    pdt_status st = pdt_comm_allreduce_u64(d->c, ext, 2, PDT_COMM_MIN, err);
-    if (st != PDT_OK) return st;
-    note_all(d, TAG_SAMPLES, sizeof ext);
-    uint64_t N = d->n_total;
-    uint64_t *lo = malloc((size_t)q1 * sizeof *lo), *hi = malloc((size_t)q1 * sizeof *hi);
-    uint64_t *cnt = malloc((size_t)q1 * (size_t)nc * sizeof *cnt);
-    if (!lo || !hi || !cnt) {
-        free(lo);
-        free(hi);
-        free(cnt);
-        return nomem(d, "partition");
-    }
-    for (int q = 0; q < q1; q++) { /* an empty input: every key to rank 0 */
-        lo[q] = N ? ext[0] : UINT64_MAX;
-        hi[q] = N ? ~ext[1] : UINT64_MAX;
-    }
+    int nc = SEL_WAYS - 1;
+    pdt_status st = PDT_OK;
+    uint64_t *cnt = malloc(((size_t)ns * (size_t)nc + 1) * sizeof *cnt);
+    if (!cnt) return nomem(d, "partition");
     for (;;) {
         int open = 0;
-        for (int q = 0; q < q1; q++) {
+        for (int q = 0; q < ns; q++) {
             uint64_t step = (hi[q] - lo[q]) / SEL_WAYS + 1;
             for (int j = 0; j < nc; j++) {
                 uint64_t *c = &cnt[(size_t)q * (size_t)nc + (size_t)j];
                 if (lo[q] == hi[q]) *c = 0;
-                else *c = pdt_srm_count_lt(rec, n, sel_cut(lo[q], hi[q], step, j) + 1);
+                else *c = pdt_srm_count_lt(arr[q], len[q], sel_cut(lo[q], hi[q], step, j) + 1);
             }
             open |= lo[q] != hi[q];
         }
         if (!open) break;
-        st = pdt_comm_allreduce_u64(d->c, cnt, (size_t)q1 * (size_t)nc, PDT_COMM_SUM, err);
+        st = pdt_comm_allreduce_u64(d->c, cnt, (size_t)ns * (size_t)nc, PDT_COMM_SUM, err);
         if (st != PDT_OK) break;
-        note_all(d, TAG_SAMPLES, (size_t)q1 * (size_t)nc * sizeof *cnt);
-        for (int q = 0; q < q1; q++) {
+        note_all(d, TAG_SAMPLES, (size_t)ns * (size_t)nc * sizeof *cnt);
+        for (int q = 0; q < ns; q++) {
             if (lo[q] == hi[q]) continue;
-            /* the splitter: the smallest key v with more than t keys <= v */
-            uint64_t t = N * (uint64_t)(q + 1) / (uint64_t)p, step = (hi[q] - lo[q]) / SEL_WAYS + 1;
+            /* the key: the smallest v with more than t keys <= v */
+            uint64_t step = (hi[q] - lo[q]) / SEL_WAYS + 1;
             int j = 0;
-            while (j < nc && cnt[(size_t)q * (size_t)nc + (size_t)j] <= t) j++;
+            while (j < nc && cnt[(size_t)q * (size_t)nc + (size_t)j] <= t[q]) j++;
             uint64_t nlo = j ? sel_cut(lo[q], hi[q], step, j - 1) + 1 : lo[q];
             if (j < nc) hi[q] = sel_cut(lo[q], hi[q], step, j);
             lo[q] = nlo;
         }
     }
-    for (int q = 0; q < q1; q++) split[q] = lo[q];
-    free(lo);
-    free(hi);
     free(cnt);
+    return st;
+}
+
+static pdt_status splitters(drv *d, const srm_rec *rec, size_t n, uint64_t *split, pdt_err *err)
+{
+    int p = d->p, q1 = p - 1;
+    uint64_t ext[2] = {n ? rec[0].key : UINT64_MAX, n ? ~rec[n - 1].key : UINT64_MAX};
+    pdt_status st = pdt_comm_allreduce_u64(d->c, ext, 2, PDT_COMM_MIN, err);
+    if (st != PDT_OK) return st;
+    note_all(d, TAG_SAMPLES, sizeof ext);
+    uint64_t N = d->n_total;
+    uint64_t *hi = malloc(((size_t)q1 + 1) * sizeof *hi), *t = malloc(((size_t)q1 + 1) * sizeof *t);
+    size_t *len = malloc(((size_t)q1 + 1) * sizeof *len);
+    const srm_rec **arr = malloc(((size_t)q1 + 1) * sizeof *arr);
+    if (!hi || !t || !len || !arr) st = nomem(d, "partition");
+    for (int q = 0; st == PDT_OK && q < q1; q++) { /* an empty input: every key to rank 0 */
+        split[q] = N ? ext[0] : UINT64_MAX;
+        hi[q] = N ? ~ext[1] : UINT64_MAX;
+        t[q] = N * (uint64_t)(q + 1) / (uint64_t)p;
+        arr[q] = rec;
+        len[q] = n;
+    }
+    if (st == PDT_OK) st = select_keys(d, q1, arr, len, t, split, hi, err);
+    free(hi);
+    free(t);
+    free(len);
+    free((void *)arr);
+    return st;
+}
+
+/* ---- the bisection partition (algorithm.md §3.12) -------------------------------
+ *
+ * Every rank range of the tree cuts its points at the exact key that leaves
+ * ceil(s/2)/s of them (s ranks) on the left, along the longer side of its
+ * cell.  The ranges of one depth are cut together: each rank holds its
+ * records of a range as one run of w (sorted by the range's axis key, its
+ * index in rec alongside), the searches share the rounds of select_keys,
+ * and a cut splits each run in two in place. */
+typedef struct bis_range {
+    int lo, hi, at;          /* ranks [lo, hi), the preorder number of its cut */
+    int64_t x0, x1, y0, y1;  /* its cell (closed; the input's box at the root), in
+                              * coordinates biased by 2^31 as in the key */
+    size_t s, e;             /* its records here: w[s, e) */
+    int inorder;             /* w[s, e) is in rec's order (the (x, y) key's) */
+} bis_range;
+
+/* The input's box, (x0, y0) and (x1, y1), over all ranks (rec key-sorted). */
+static pdt_status bis_root(drv *d, const srm_rec *rec, size_t n, bis_range *root, pdt_err *err)
+{
+    uint64_t v[4] = {UINT64_MAX, UINT64_MAX, UINT64_MAX, UINT64_MAX};
+    for (size_t i = 0; i < n; i++) {
+        uint64_t x = rec[i].key >> 32, y = rec[i].key & 0xffffffffu;
+        if (x < v[0]) v[0] = x;
+        if (~x < v[1]) v[1] = ~x;
+        if (y < v[2]) v[2] = y;
+        if (~y < v[3]) v[3] = ~y;
+    }
+    pdt_status st = pdt_comm_allreduce_u64(d->c, v, 4, PDT_COMM_MIN, err);
+    if (st != PDT_OK) return st;
+    note_all(d, TAG_SAMPLES, sizeof v);
+    *root = (bis_range){0, d->p, 0, (int64_t)v[0], (int64_t)(uint32_t)~v[1], (int64_t)v[2],
+                        (int64_t)(uint32_t)~v[3], 0, n, 1};
+    return PDT_OK;
+}
+
+/* The axis of every range (its cell's longer side; x on a tie) and its run
+ * of w sorted by that axis' key (a run already in rec's order needs no sort
+ * for an x-cut: the first cut of a wide input, every cut of strips-like
+ * ones).  *scratch: n records, allocated at the first sort. */
+static pdt_status bis_sort(drv *d, const srm_rec *rec, srm_rec *w, size_t n, srm_rec **scratch,
+                           bis_range *r, int nr)
+{
+    for (int i = 0; i < nr; i++) {
+        int axis = r[i].x1 - r[i].x0 >= r[i].y1 - r[i].y0 ? 0 : 1;
+        d->tree.cut[r[i].at].axis = axis;
+        if (axis == 0 && r[i].inorder) continue;
+        if (!*scratch && !(*scratch = srm_big((n + 1) * sizeof **scratch)))
+            return nomem(d, "partition");
+        for (size_t k = r[i].s; k < r[i].e; k++) {
+            pdt_point q = srm_key_point(rec[w[k].idx].key);
+            w[k].key = srm_axis_key(axis, q.x, q.y);
+        }
+        pdt_srm_radix_sort(w + r[i].s, *scratch, r[i].e - r[i].s);
+        r[i].inorder = axis == 0; /* (rec's keys are distinct: x order is rec's) */
+    }
+    return PDT_OK;
+}
+
+/* The cuts of the nr ranges of one depth (every rank the same). */
+static pdt_status bis_select(drv *d, const srm_rec *w, const bis_range *r, int nr, pdt_err *err)
+{
+    size_t z = (size_t)nr; /* (lo and hi side by side: one allreduce) */
+    uint64_t *v = malloc(3 * z * sizeof *v), *t = malloc(z * sizeof *t);
+    const srm_rec **arr = malloc(z * sizeof *arr);
+    size_t *len = malloc(z * sizeof *len);
+    pdt_status st = v && t && arr && len ? PDT_OK : nomem(d, "partition");
+    uint64_t *cntr = v, *lo = v + z, *hi = v + 2 * z; /* hi: ~ of the largest key first */
+    for (int i = 0; st == PDT_OK && i < nr; i++) {
+        arr[i] = w + r[i].s;
+        len[i] = r[i].e - r[i].s;
+        cntr[i] = len[i];
+        lo[i] = len[i] ? arr[i][0].key : UINT64_MAX;
+        hi[i] = len[i] ? ~arr[i][len[i] - 1].key : UINT64_MAX;
+    }
+    if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, cntr, (size_t)nr, PDT_COMM_SUM, err);
+    if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, lo, 2 * (size_t)nr, PDT_COMM_MIN, err);
+    if (st == PDT_OK) {
+        note_all(d, TAG_SAMPLES, 3 * (size_t)nr * sizeof *v);
+        for (int i = 0; i < nr; i++) {
+            uint64_t s = (uint64_t)(r[i].hi - r[i].lo), left = (uint64_t)(srm_bis_mid(r[i].lo, r[i].hi) - r[i].lo);
+            t[i] = cntr[i] * left / s;
+            hi[i] = cntr[i] ? ~hi[i] : 0;
+            if (!cntr[i]) lo[i] = 0; /* no points: any cut */
+        }
+        st = select_keys(d, nr, arr, len, t, lo, hi, err);
+    }
+    for (int i = 0; st == PDT_OK && i < nr; i++) d->tree.cut[r[i].at].split = lo[i];
+    free(v);
+    free(t);
+    free((void *)arr);
+    free(len);
+    return st;
+}
+
+/* Each range cut in two at its split: halves of two ranks or more into
+ * next[] (their number returned), a single rank's run counted in sc[] (and
+ * whether it is in rec's order in inorder[]). */
+static int bis_split(drv *d, const srm_rec *w, const bis_range *r, int nr, bis_range *next,
+                     uint64_t *sc, unsigned char *inorder)
+{
+    int nn = 0;
+    for (int i = 0; i < nr; i++) {
+        srm_cut c = d->tree.cut[r[i].at];
+        int mid = srm_bis_mid(r[i].lo, r[i].hi);
+        size_t at = r[i].s + pdt_srm_count_lt(w + r[i].s, r[i].e - r[i].s, c.split);
+        int64_t v = (int64_t)(c.split >> 32); /* the cut's own coordinate (biased) */
+        bis_range h[2] = {r[i], r[i]};
+        h[0].hi = h[1].lo = mid;
+        h[0].at = r[i].at + 1;
+        h[1].at = r[i].at + mid - r[i].lo;
+        h[0].e = h[1].s = at;
+        if (c.axis) h[0].y1 = h[1].y0 = v;
+        else h[0].x1 = h[1].x0 = v;
+        for (int k = 0; k < 2; k++) {
+            if (h[k].hi - h[k].lo >= 2) next[nn++] = h[k];
+            else {
+                sc[h[k].lo] = h[k].e - h[k].s;
+                inorder[h[k].lo] = (unsigned char)h[k].inorder;
+            }
+        }
+    }
+    return nn;
+}
+
+/* The bisection of the key-sorted rec[0..n) into the ranks' regions: the
+ * cuts in d->tree (every rank the same), sc[q] the records for rank q, and
+ * w[0..n) the records grouped by rank, key-sorted within each group (the
+ * send buffer).  scratch: n records. */
+static pdt_status bisect(drv *d, const srm_rec *rec, srm_rec *w, size_t n, uint64_t *sc,
+                         pdt_err *err)
+{
+    int p = d->p;
+    d->tree.p = p;
+    d->tree.k = 1;
+    d->tree.levels_p = pdt_srm_ceil_log2(p);
+    d->tree.cut = calloc((size_t)p, sizeof *d->tree.cut);
+    bis_range *cur = malloc((size_t)p * sizeof *cur), *next = malloc((size_t)p * sizeof *next);
+    unsigned char *inorder = malloc((size_t)p);
+    srm_rec *scratch = NULL;
+    pdt_status st = d->tree.cut && cur && next && inorder ? PDT_OK : nomem(d, "partition");
+    for (size_t i = 0; i < n; i++) w[i] = (srm_rec){rec[i].key, (uint32_t)i, 0};
+    int nr = 1;
+    if (st == PDT_OK) st = bis_root(d, rec, n, &cur[0], err);
+    while (st == PDT_OK && nr > 0) {
+        st = bis_sort(d, rec, w, n, &scratch, cur, nr);
+        if (st == PDT_OK) st = bis_select(d, w, cur, nr, err);
+        if (st != PDT_OK) break;
+        nr = bis_split(d, w, cur, nr, next, sc, inorder);
+        bis_range *t = cur;
+        cur = next;
+        next = t;
+    }
+    /* each rank's run back in key order (if a y-cut moved it), as records */
+    for (size_t q = 0, at = 0; st == PDT_OK && q < (size_t)p; at += sc[q++]) {
+        if (!inorder[q]) {
+            for (size_t i = at; i < at + sc[q]; i++) w[i].key = w[i].idx;
+            pdt_srm_radix_sort(w + at, scratch, sc[q]);
+        }
+        for (size_t i = at; i < at + sc[q]; i++) w[i] = rec[w[i].idx];
+    }
+    free(cur);
+    free(next);
+    free(inorder);
+    free(scratch);
     return st;
 }
 
@@ -295,16 +478,21 @@ static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
         free(in->pts);
         in->pts = NULL;
     }
-    st = splitters(d, rec, n, split, err);
-    if (st != PDT_OK) goto done;
-    /* rank q's records are a consecutive block of the sorted ones */
-    size_t at = 0;
-    for (int q = 0; q < p; q++) {
-        size_t end = q < p - 1 ? pdt_srm_count_lt(rec, n, split[q]) : n;
-        if (end < at) end = at;
-        sc[q] = end - at;
-        at = end;
+    const srm_rec *send = rec;
+    if (in->partition == PDT_PART_BISECT) { /* the records regrouped by rank, in tmp */
+        st = bisect(d, rec, tmp, n, sc, err);
+        send = tmp;
+    } else {
+        st = splitters(d, rec, n, split, err);
+        /* rank q's records are a consecutive block of the sorted ones */
+        for (size_t q = 0, at = 0; st == PDT_OK && q < (size_t)p; q++) {
+            size_t end = q < (size_t)p - 1 ? pdt_srm_count_lt(rec, n, split[q]) : n;
+            if (end < at) end = at;
+            sc[q] = end - at;
+            at = end;
+        }
     }
+    if (st != PDT_OK) goto done;
     st = pdt_comm_alltoall(d->c, sc, sizeof *sc, rc, err);
     if (st != PDT_OK) goto done;
     note_all(d, TAG_COUNTS, sizeof *sc);
@@ -316,9 +504,9 @@ static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
         total += (size_t)rc[q];
     }
     start[p] = total;
-    if (total < cap) { /* received over the sorted input's scratch; merged back */
-        got = tmp;
-        scratch = rec;
+    if (total < cap) { /* received over the scratch the send leaves; merged back */
+        got = send == rec ? tmp : rec;
+        scratch = send == rec ? rec : tmp;
     } else { /* more than the room (many equal keys): a larger block */
         size_t M = total + 1;
         more = srm_big(block_bytes(M));
@@ -327,7 +515,7 @@ static pdt_status partition(drv *d, pdt_par_input *in, pdt_err *err)
         scratch = got + M;
         cap = M;
     }
-    st = pdt_comm_alltoallv(d->c, rec, cnt, got, rcnt, err);
+    st = pdt_comm_alltoallv(d->c, send, cnt, got, rcnt, err);
     if (st != PDT_OK) goto done;
     note_v(d, TAG_RECORDS, cnt, rcnt);
     if (more) {
@@ -415,6 +603,11 @@ static pdt_status local(drv *d, int prefault, pdt_err *err)
         if (st != PDT_OK) return st;
         d->s_init[j] = 1;
         pdt_srm_per_rank(s, k);
+        if (d->tree.cut) {
+            d->tree.k = k;
+            st = pdt_srm_use_tree(s, &d->tree, err);
+            if (st != PDT_OK) return st;
+        }
         s->clock = wclock;
         s->clock_user = d->c;
     }
@@ -471,6 +664,12 @@ static pdt_status local(drv *d, int prefault, pdt_err *err)
 
 /* ---- merge --------------------------------------------------------------------- */
 
+/* The merge tree's schedule: the bisection tree, or NULL for strips. */
+static const srm_tree *sched(const drv *d)
+{
+    return d->tree.cut ? &d->tree : NULL;
+}
+
 /* At the merge strip g of a level (this rank's strip j): the messages of the
  * pair's strips [gl, ge): this rank's own (in own[], taken: freed here), the
  * others received from their ranks, in strip order (a rank sends its strips'
@@ -514,7 +713,7 @@ static pdt_status merge_level(drv *d, int level, pdt_err *err)
     pdt_status st = PDT_OK;
     for (int j = 0; j < k && st == PDT_OK; j++) {
         int g = d->rank * k + j, gl, gr, ge;
-        if (!pdt_srm_pair(g, np, level, &gl, &gr, &ge)) continue;
+        if (!pdt_srm_pair_of(sched(d), g, np, level, &gl, &gr, &ge)) continue;
         st = pdt_srm_pack(&d->s[j], level, &own[j], &own_len[j], err);
         if (st != PDT_OK || gr / k == d->rank) continue;
         st = pdt_comm_send(d->c, gr / k, TAG_MERGE + level, own[j], own_len[j], err);
@@ -524,7 +723,7 @@ static pdt_status merge_level(drv *d, int level, pdt_err *err)
     }
     for (int j = 0; j < k && st == PDT_OK; j++) {
         int g = d->rank * k + j, gl, gr, ge;
-        if (pdt_srm_pair(g, np, level, &gl, &gr, &ge) && gr == g)
+        if (pdt_srm_pair_of(sched(d), g, np, level, &gl, &gr, &ge) && gr == g)
             st = merge_at(d, level, j, gl, ge, own, own_len, err);
     }
     for (int j = 0; j < k; j++) free(own[j]);
@@ -539,7 +738,8 @@ static pdt_status merge_tree(drv *d, pdt_err *err)
     int k = d->k, np = d->p * k;
     for (int level = 0; level < d->s[0].levels && st == PDT_OK; level++) {
         int gl, gr, ge, any = 0;
-        for (int j = 0; j < k; j++) any |= pdt_srm_pair(d->rank * k + j, np, level, &gl, &gr, &ge);
+        for (int j = 0; j < k; j++)
+            any |= pdt_srm_pair_of(sched(d), d->rank * k + j, np, level, &gl, &gr, &ge);
         if (!any) continue;
         PDT_TRACE(d->tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_MERGE, level, 0, 0, 0);
         st = merge_level(d, level, err);
@@ -844,6 +1044,8 @@ static void figures(drv *d)
     me->merge_bytes_sent = d->merge_sent;
     me->merge_bytes_recv = d->merge_recv;
     me->strips = d->k > 1 ? d->k : 0;
+    me->levels = d->s[0].levels;
+    me->partition = d->tree.cut ? PDT_PART_BISECT : PDT_PART_STRIPS;
     for (int j = 0; j < d->k; j++) { /* the strips' counts summed; the longest chain */
         const srm_rank *s = &d->s[j];
         me->local_tris += s->cnt.local_tris;
@@ -852,13 +1054,16 @@ static void figures(drv *d)
         me->shipped += s->cnt.shipped;
         me->merges += s->cnt.merges;
         if (s->cnt.border_max > me->border_max) me->border_max = s->cnt.border_max;
+        for (int l = 0; l < PDT_PAR_MAX_LEVELS; l++)
+            if (s->cnt.border_level[l] > me->border_level[l])
+                me->border_level[l] = s->cnt.border_level[l];
         me->kept += s->cnt.kept;
         me->discarded += s->cnt.discarded;
         me->final_merge += s->cnt.final_merge;
         if (s->cnt.critical_path > me->critical_path) me->critical_path = s->cnt.critical_path;
         if (s->cnt.critical_cpu > me->critical_cpu) me->critical_cpu = s->cnt.critical_cpu;
         int g = d->rank * d->k + j;
-        if (s->holds_hull && pdt_srm_holder(g, d->p * d->k, s->levels) == g) {
+        if (s->holds_hull && pdt_srm_holder_of(sched(d), g, d->p * d->k, s->levels) == g) {
             me->holds_final_hull = 1;
             me->hull = s->nhull;
             me->hull_degenerate = s->hull_degenerate;
@@ -1065,6 +1270,7 @@ done:
     free(d.more);
     free(d.blk);
     free(d.strip);
+    free(d.tree.cut);
     free(d.seq_send);
     free(d.seq_recv);
     return st;
@@ -1104,6 +1310,11 @@ pdt_status pdt_par_stats_collect(pdt_comm *c, const pdt_par_rank_stats *me, uint
         if (rp->critical_path > all->critical_path) all->critical_path = rp->critical_path;
         if (rp->critical_cpu > all->critical_cpu) all->critical_cpu = rp->critical_cpu;
         if (rp->border_max > all->border_max) all->border_max = rp->border_max;
+        for (int l = 0; l < PDT_PAR_MAX_LEVELS; l++)
+            if (rp->border_level[l] > all->border_level[l])
+                all->border_level[l] = rp->border_level[l];
+        if (rp->levels > all->levels) all->levels = rp->levels;
+        all->partition = rp->partition;
         double tc = rp->t_partition + rp->t_local + rp->t_merge + rp->t_order;
         if (tc > all->t_compute) all->t_compute = tc;
         if (rp->holds_final_hull) {

@@ -166,7 +166,8 @@ int pdt_srm_plain_pays(const pdt_point *pts, size_t n)
     int pays = 1;
     if (m >= 64 && pdt_delaunay(s, m, &t, &nt, 0, NULL) == PDT_OK && nt > 0) {
         /* the two strips' slabs, as pdt_srm_slab_of makes them */
-        srm_slab left = {-INFINITY, (double)s[m / 2].x}, right = {(double)s[m / 2 - 1].x, INFINITY};
+        srm_slab left = {-INFINITY, (double)s[m / 2].x, -INFINITY, INFINITY},
+                 right = {(double)s[m / 2 - 1].x, INFINITY, -INFINITY, INFINITY};
         for (size_t i = 0; i < nt; i++) {
             srm_pt v[3];
             for (int e = 0; e < 3; e++) v[e] = (srm_pt){s[t[i].v[e]].x, s[t[i].v[e]].y, 0};

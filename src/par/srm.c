@@ -133,10 +133,13 @@ static pdt_status add_pending(srm_rank *s, srm_pt a, srm_pt b, srm_pt c, int lev
  * `from`: -1 if its restricted area misses every box outside that group
  * (final), else the first merge level whose partner group holds a box it
  * touches (*who = that rank). */
+static int send_level_tree(const srm_rank *s, int h, int from, const srm_disk *d, int *who);
+
 static int send_level(const srm_rank *s, int h, int from, srm_pt a, srm_pt b, srm_pt c, int *who)
 {
     srm_disk d;
     pdt_srm_disk_of(&d, a, b, c);
+    if (s->tree) return send_level_tree(s, h, from, &d, who);
     double lo, hi;
     pdt_srm_disk_xrange(&d, &lo, &hi);
     /* boxes of non-empty strips are ordered in x: binary search the first
@@ -163,6 +166,60 @@ static int send_level(const srm_rank *s, int h, int from, srm_pt a, srm_pt b, sr
         }
     }
     return best;
+}
+
+/* With a bisection tree: whether the disk touches a box of a strip of
+ * the ranks [lo, hi) (the range's preorder cut `at`; *who = that strip),
+ * ranges whose box it misses skipped whole. */
+static int range_touch(const srm_rank *s, const srm_disk *d, int lo, int hi, int at, int *who)
+{
+    int k = s->tree->k;
+    if (hi - lo == 1) {
+        for (int q = lo * k; q < lo * k + k; q++)
+            if (s->strip[q].count && pdt_srm_disk_touch(d, &s->strip[q])) {
+                *who = q;
+                return 1;
+            }
+        return 0;
+    }
+    if (!s->nbox[at].count || !pdt_srm_disk_touch(d, &s->nbox[at])) return 0;
+    int mid = srm_bis_mid(lo, hi);
+    return range_touch(s, d, lo, mid, at + 1, who) ||
+           range_touch(s, d, mid, hi, at + mid - lo, who);
+}
+
+/* send_level on the bisection tree: the ranges met on the way down to h's
+ * rank each have a sibling that joins h's group at the range's level; the
+ * lowest level from `from` on whose sibling holds a touched box. */
+static int send_level_tree(const srm_rank *s, int h, int from, const srm_disk *d, int *who)
+{
+    const srm_tree *t = s->tree;
+    int k = t->k, off = k > 1, r = h / k, lo = 0, hi = t->p, at = 0, n = 0;
+    int lev[32], slo[32], shi[32], sat[32];
+    *who = -1;
+    for (int dep = 0; hi - lo >= 2; dep++, n++) {
+        int mid = srm_bis_mid(lo, hi);
+        lev[n] = t->levels_p - 1 - dep + off;
+        if (r < mid) {
+            slo[n] = mid, shi[n] = hi, sat[n] = at + mid - lo;
+            hi = mid;
+            at += 1;
+        } else {
+            slo[n] = lo, shi[n] = mid, sat[n] = at + 1;
+            at += mid - lo;
+            lo = mid;
+        }
+    }
+    if (off && from <= 0) { /* the rank's other strip joins at level 0 */
+        const srm_strip *o = &s->strip[h ^ 1];
+        if (o->count && pdt_srm_disk_touch(d, o)) {
+            *who = h ^ 1;
+            return 0;
+        }
+    }
+    for (int i = n - 1; i >= 0; i--)
+        if (lev[i] >= from && range_touch(s, d, slo[i], shi[i], sat[i], who)) return lev[i];
+    return -1;
 }
 
 /* ---- set-up ---------------------------------------------------------------- */
@@ -221,8 +278,47 @@ pdt_status pdt_srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pd
     return PDT_OK;
 }
 
+/* The box of every rank range of the tree with two ranks or more (its
+ * preorder cut `at`), from the strips' boxes; returns the range's. */
+static srm_strip box_build(srm_rank *s, int lo, int hi, int at)
+{
+    int k = s->tree->k;
+    srm_strip b = {0, 0, 0, 0, 0, 0, 0}, part[2];
+    int nparts = 0;
+    if (hi - lo == 1) {
+        for (int q = lo * k; q < lo * k + k; q++) part[nparts++] = s->strip[q];
+    } else {
+        int mid = srm_bis_mid(lo, hi);
+        part[nparts++] = box_build(s, lo, mid, at + 1);
+        part[nparts++] = box_build(s, mid, hi, at + mid - lo);
+    }
+    for (int i = 0; i < nparts; i++) {
+        const srm_strip *x = &part[i];
+        if (!x->count) continue;
+        if (!b.count || x->xmin < b.xmin) b.xmin = x->xmin;
+        if (!b.count || x->xmax > b.xmax) b.xmax = x->xmax;
+        if (!b.count || x->ymin < b.ymin) b.ymin = x->ymin;
+        if (!b.count || x->ymax > b.ymax) b.ymax = x->ymax;
+        b.count += x->count;
+    }
+    if (hi - lo >= 2) s->nbox[at] = b;
+    return b;
+}
+
+pdt_status pdt_srm_use_tree(srm_rank *s, const srm_tree *t, pdt_err *err)
+{
+    s->tree = t;
+    s->levels = pdt_srm_levels_of(t, s->p);
+    free(s->nbox);
+    s->nbox = malloc((size_t)t->p * sizeof *s->nbox);
+    if (!s->nbox) return nomem(err, s->who, "init");
+    box_build(s, 0, t->p, 0);
+    return PDT_OK;
+}
+
 void pdt_srm_free(srm_rank *s)
 {
+    free(s->nbox);
     free(s->nonempty);
     free(s->fin);
     free(s->more);
@@ -337,7 +433,8 @@ static pdt_status classify(srm_rank *s, pdt_tri *tris, const strip_pts *sp, pdt_
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_CLASSIFY, 0, 0, 0, 0);
     int alone = s->nne == 0 || (s->nne == 1 && s->nonempty[0] == s->rank);
     srm_slab slab; /* most triangles are settled by the cheap slab test */
-    pdt_srm_slab_of(&slab, s->strip, s->p, s->rank);
+    if (s->tree) pdt_srm_cell_of(&slab, s->tree, s->strip, s->rank);
+    else pdt_srm_slab_of(&slab, s->strip, s->p, s->rank);
     size_t k = 0;
     enum { AHEAD = 16 }; /* the triangles are in the kernel's (leaf) order:
                           * fetch ahead (traced: the points in their own) */
@@ -416,7 +513,7 @@ pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err
 {
     *buf = NULL;
     *len = 0;
-    int send_hull = s->holds_hull && pdt_srm_holder(s->rank, s->p, level) == s->rank;
+    int send_hull = s->holds_hull && pdt_srm_holder_of(s->tree, s->rank, s->p, level) == s->rank;
     size_t nt = 0;
     for (size_t i = 0; i < s->npend; i++) nt += s->pend[i].level == level;
     size_t nh = send_hull ? s->nhull : 0;
@@ -700,6 +797,8 @@ static pdt_status border_set(merge_job *j)
     j->ns = ns;
     j->nb = u;
     if (u > s->cnt.border_max) s->cnt.border_max = u;
+    if (j->level < PDT_PAR_MAX_LEVELS && u > s->cnt.border_level[j->level])
+        s->cnt.border_level[j->level] = u;
     return PDT_OK;
 }
 
@@ -730,6 +829,28 @@ static pdt_status border_kernel(merge_job *j)
     return PDT_OK;
 }
 
+/* The cut between the groups of the merge: a point of the pair is in G_L
+ * iff its axis key is below the split (in_left).  Strips (and a rank's two
+ * strips): the first key of G_R's first non-empty strip, or with none,
+ * CUT_ALL_LEFT (every point in G_L: no key is "below" UINT64_MAX, the key of
+ * (2^31 - 1, 2^31 - 1)); a bisection range: its cut. */
+enum { CUT_ALL_LEFT = 2 };
+
+static int in_left(srm_cut c, srm_pt p)
+{
+    return c.axis == CUT_ALL_LEFT || srm_axis_key(c.axis, p.x, p.y) < c.split;
+}
+
+static srm_cut merge_cut(const merge_job *j)
+{
+    const srm_rank *s = j->s;
+    const srm_tree *t = s->tree;
+    if (t && !(t->k > 1 && j->level == 0)) return pdt_srm_cut_of(t, j->gl / t->k, j->ge / t->k);
+    for (int q = j->gr; q < j->ge; q++)
+        if (s->strip[q].count) return (srm_cut){s->strip[q].first_key, 0};
+    return (srm_cut){UINT64_MAX, CUT_ALL_LEFT};
+}
+
 /* Selection: keep the triangles of T*(B) with vertices in both groups and
  * the shipped ones it contains; each kept one is final or waits for a later
  * level (reclassified against the boxes outside the merged group). */
@@ -738,14 +859,7 @@ static pdt_status select_kept(merge_job *j)
     srm_rank *s = j->s;
     pdt_trace *tr = s->tr;
     const srm_pt *B = j->B;
-    uint64_t first_r = UINT64_MAX;
-    int have_r = 0;
-    for (int q = j->gr; q < j->ge; q++)
-        if (s->strip[q].count) {
-            first_r = s->strip[q].first_key;
-            have_r = 1;
-            break;
-        }
+    srm_cut cut = merge_cut(j);
     j->tb = malloc((j->ntri + 1) * sizeof *j->tb);
     if (!j->tb) return nomem(j->err, s->who, "merge");
     for (size_t i = 0; i < j->ntri; i++) {
@@ -753,7 +867,7 @@ static pdt_status select_kept(merge_job *j)
         gtri g = canon3(j->bg[v[0]], j->bg[v[1]], j->bg[v[2]]);
         j->tb[j->ntb++] = g;
         int nl = 0;
-        for (int k = 0; k < 3; k++) nl += !have_r || srm_key(B[v[k]]) < first_r;
+        for (int k = 0; k < 3; k++) nl += in_left(cut, B[v[k]]);
         int multi = nl > 0 && nl < 3;
         if (!multi && !has_gtri(j->shipped, j->ns, g)) continue;
         j->kept++;
@@ -878,7 +992,7 @@ pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t 
     j.s = s;
     j.level = level;
     j.err = err;
-    pdt_srm_pair(s->rank, s->p, level, &j.gl, &j.gr, &j.ge);
+    pdt_srm_pair_of(s->tree, s->rank, s->p, level, &j.gl, &j.gr, &j.ge);
     j.nm = j.ge - j.gl;
     double t0 = now(s), c0 = cpu_now();
     PDT_TRACE(s->tr, 1, PDT_EV_MERGE_BEGIN, level, j.gl, j.gr, j.ge, s->rank);

@@ -33,6 +33,42 @@ typedef struct srm_strip {
     int32_t xmin, xmax, ymin, ymax;
 } srm_strip;
 
+/* The regions of a bisection partition (algorithm.md §3.12): the rank
+ * range [0, p) is cut into [lo, mid) and [mid, hi), mid = lo + ceil((hi -
+ * lo) / 2), recursively; the points of a range with more than one rank are
+ * cut by one key: left are those whose axis key is below `split` (axis 0:
+ * the key (x, y) of pdt_key; axis 1: the key of (y, x)).  cut[] holds the
+ * p - 1 cuts in preorder (a range's cut, then its left subtree's, then its
+ * right's).  Every rank holds k strips (1 or 2; two: the rank's points cut
+ * lexicographically in two halves, merged first, at level 0).  The merge
+ * tree is the bisection tree: a range at depth d merges its two halves at
+ * level levels_p - 1 - d (+ 1 with two strips a rank), so the groups of a
+ * level are the ranges of one depth, and the merge rank of a range is the
+ * first rank of its right half. */
+typedef struct srm_cut {
+    uint64_t split;
+    int axis;
+} srm_cut;
+
+typedef struct srm_tree {
+    int p, k;          /* ranks, strips a rank */
+    int levels_p;      /* ceil(log2 p): the depth of the bisection tree */
+    srm_cut *cut;      /* p - 1 cuts, preorder (malloc'd by its maker) */
+} srm_tree;
+
+/* The key of a point along a cut's axis. */
+static inline uint64_t srm_axis_key(int axis, int32_t x, int32_t y)
+{
+    pdt_point q = {axis ? y : x, axis ? x : y};
+    return pdt_key(q);
+}
+
+/* The middle of the rank range [lo, hi) (its left half gets the larger). */
+static inline int srm_bis_mid(int lo, int hi)
+{
+    return lo + (hi - lo + 1) / 2;
+}
+
 /* A pending triangle (counter-clockwise) and the merge level it waits for. */
 typedef struct srm_tri {
     srm_pt p[3];
@@ -120,24 +156,30 @@ int pdt_srm_disk_touch(const srm_disk *d, const srm_strip *box);
 /* An x-range certainly containing the disk (for a search by x). */
 void pdt_srm_disk_xrange(const srm_disk *d, double *lo, double *hi);
 
-/* The open slab xl < x < xr around a strip that holds no point of a foreign
- * strip, so no foreign box meets it (xl = -inf, xr = +inf on a side with no
- * other points). */
+/* The open box xl < x < xr, yl < y < yh around a strip that holds no point
+ * of a foreign strip, so no foreign box meets it (infinite on a side with no
+ * other points; strips: yl = -inf, yh = +inf, a slab). */
 typedef struct srm_slab {
-    double xl, xr;
+    double xl, xr, yl, yh;
 } srm_slab;
 
 /* The slab of rank h: from the nearest non-empty strip on each side (strips
  * are lexicographic blocks, so boxes on the left end at x <= xl). */
 void pdt_srm_slab_of(srm_slab *sl, const srm_strip *strip, int p, int h);
 
+/* The open box of strip h of a bisection run: its cell, the cuts on the
+ * path to its rank (a cut's own coordinate on each side: a point left of an
+ * x-cut at key (sx, sy) has x <= sx, one right of it x >= sx), and with
+ * two strips a rank, the other strip's box. */
+void pdt_srm_cell_of(srm_slab *sl, const srm_tree *t, const srm_strip *strip, int h);
+
 /* A cheap pre-test, no division and no square root: 1 only if the closed
  * circumdisk of (a, b, c) (not collinear) certainly lies inside the open
- * slab, so that it misses every foreign box; 0 says nothing.  The disk lies
+ * box, so that it misses every foreign box; 0 says nothing.  The disk lies
  * within 2R of a (R its radius) and 4R^2 = l1 l2 l3 / D^2 (l: squared side
  * lengths, D = twice the signed area, exact in int64 for differences below
- * 2^29), so a.x - 2R > xl and a.x + 2R < xr when g^2 D^2 > l1 l2 l3, g the
- * distance from a.x to the nearer side.  Both sides are products of positive
+ * 2^29), so a.x - 2R > xl, a.x + 2R < xr and the same in y when
+ * g^2 D^2 > l1 l2 l3, g the distance from a to the nearest side.  Both sides are products of positive
  * numbers, each computed with a relative error below 8 eps (eps = 2^-53);
  * the factor 1 + 2^-40 on the right makes the computed comparison imply the
  * exact one (sound: never 1 for a disk that meets the slab's outside). */
@@ -150,6 +192,9 @@ static inline int srm_disk_in_slab(const srm_slab *sl, srm_pt a, srm_pt b, srm_p
         (uint64_t)(cx + lim) >= (uint64_t)(2 * lim) || (uint64_t)(cy + lim) >= (uint64_t)(2 * lim))
         return 0;
     double gl = (double)a.x - sl->xl, gr = sl->xr - (double)a.x, g = gl < gr ? gl : gr;
+    double gb = (double)a.y - sl->yl, gt = sl->yh - (double)a.y;
+    g = gb < g ? gb : g;
+    g = gt < g ? gt : g;
     if (!(g > 0)) return 0;
     int64_t D = bx * cy - by * cx, dx = cx - bx, dy = cy - by;
     double l1 = (double)(bx * bx + by * by), l2 = (double)(cx * cx + cy * cy),
@@ -176,6 +221,7 @@ typedef struct srm_msg_head {
 typedef struct srm_counts {
     uint64_t local_tris, final_at_once, deferred, shipped, merges, border_max, kept, discarded,
         final_merge;
+    uint64_t border_level[PDT_PAR_MAX_LEVELS]; /* largest |B| of a merge here, per level */
     double critical_path; /* compute seconds along the longest dependent chain */
     double critical_cpu;  /* the same chain in CPU seconds (insensitive to load) */
 } srm_counts;
@@ -186,6 +232,8 @@ typedef struct srm_rank {
     int per_rank;                 /* strips per rank in an MPI run (0, 1: one) */
     char who[64];                 /* how messages name it (pdt_srm_name) */
     const srm_strip *strip;       /* p descriptors (not owned) */
+    const srm_tree *tree;         /* bisection regions (not owned), NULL: strips */
+    srm_strip *nbox;              /* with a tree: the box of every rank range, preorder */
     int *nonempty;                /* ranks with points, in order (x-sorted boxes) */
     int nne;
     /* output: final triangles as global indices, CCW: the local phase's in
@@ -264,6 +312,23 @@ pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t 
 
 /* ceil(log2 p): the number of merge levels. */
 int pdt_srm_ceil_log2(int p);
+
+/* The schedule of either partition: t NULL for strips (the rank blocks
+ * above, np participants), else the bisection tree t (np = t->p * t->k
+ * strips).  The same contracts as pdt_srm_pair and pdt_srm_holder. */
+int pdt_srm_pair_of(const srm_tree *t, int g, int np, int level, int *gl, int *gr, int *ge);
+int pdt_srm_holder_of(const srm_tree *t, int g, int np, int level);
+/* The number of merge levels. */
+int pdt_srm_levels_of(const srm_tree *t, int np);
+/* The level whose merge first puts participants q != h in one group. */
+int pdt_srm_meet_of(const srm_tree *t, int q, int h);
+/* The cut between the halves of the rank range [lo, hi) of t (a range of
+ * the tree with hi - lo >= 2). */
+srm_cut pdt_srm_cut_of(const srm_tree *t, int lo, int hi);
+
+/* After pdt_srm_init: s works on the bisection tree t (kept by pointer;
+ * t->p * t->k == s->p) instead of strips' rank blocks. */
+pdt_status pdt_srm_use_tree(srm_rank *s, const srm_tree *t, pdt_err *err);
 
 /* ---- plain.c: the plain run on strips, one after the other ---------------- */
 

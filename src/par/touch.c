@@ -123,8 +123,8 @@ int pdt_srm_edge_touch(srm_pt u, srm_pt v, const srm_strip *box)
 
 void pdt_srm_slab_of(srm_slab *sl, const srm_strip *strip, int p, int h)
 {
-    sl->xl = -INFINITY;
-    sl->xr = INFINITY;
+    sl->xl = sl->yl = -INFINITY;
+    sl->xr = sl->yh = INFINITY;
     for (int q = h - 1; q >= 0; q--)
         if (strip[q].count) {
             sl->xl = strip[q].xmax;
@@ -135,4 +135,31 @@ void pdt_srm_slab_of(srm_slab *sl, const srm_strip *strip, int p, int h)
             sl->xr = strip[q].xmin;
             break;
         }
+}
+
+void pdt_srm_cell_of(srm_slab *sl, const srm_tree *t, const srm_strip *strip, int h)
+{
+    sl->xl = sl->yl = -INFINITY;
+    sl->xr = sl->yh = INFINITY;
+    int r = h / t->k, lo = 0, hi = t->p, at = 0;
+    while (hi - lo >= 2) {
+        int mid = srm_bis_mid(lo, hi);
+        srm_cut c = t->cut[at];
+        pdt_point sp = srm_key_point(c.split); /* (y, x) for a y-cut */
+        double v = (double)sp.x;
+        double *lim = r < mid ? (c.axis ? &sl->yh : &sl->xr) : (c.axis ? &sl->yl : &sl->xl);
+        if (r < mid ? v < *lim : v > *lim) *lim = v;
+        if (r < mid) {
+            hi = mid;
+            at += 1;
+        } else {
+            at += mid - lo; /* past the left subtree's mid - lo - 1 cuts */
+            lo = mid;
+        }
+    }
+    if (t->k == 2) { /* the rank's other strip: a lexicographic neighbour */
+        const srm_strip *o = &strip[h ^ 1];
+        if (o->count && (h & 1) == 0 && (double)o->xmin < sl->xr) sl->xr = o->xmin;
+        if (o->count && (h & 1) == 1 && (double)o->xmax > sl->xl) sl->xl = o->xmax;
+    }
 }

@@ -499,8 +499,11 @@ static pdt_status ck_lift(CK_ARGS)
     }
     c->lifts_local++;
     uint64_t key = pdt_key(p);
+    uint64_t ykey = pdt_key((pdt_point){p.y, p.x});
     if (!c->nlocal[r] || key < c->kmin[r]) c->kmin[r] = key;
     if (!c->nlocal[r] || key > c->kmax[r]) c->kmax[r] = key;
+    if (!c->nlocal[r] || ykey < c->ymin[r]) c->ymin[r] = ykey;
+    if (!c->nlocal[r] || ykey > c->ymax[r]) c->ymax[r] = ykey;
     c->nlocal[r]++;
     if (!(c->mark[e->a] & M_REP))
         return chk_viol(c, r, seq, e, "pt %" PRIu32 " is a duplicate of an earlier input point "
@@ -795,6 +798,36 @@ static pdt_status check_merges(chk *c)
     return PDT_OK;
 }
 
+/* A bisection run's regions: at every merge step the local lift-ups of the
+ * left group's ranks all come before those of the right group's in one
+ * lexicographic order, (x, y) or (y, x) -- one cut separates them. */
+static pdt_status check_regions(chk *c)
+{
+    for (size_t i = 0; i < c->nmg; i++) {
+        const merge *g = &c->mg[i];
+        uint64_t lx = 0, ly = 0, rx = UINT64_MAX, ry = UINT64_MAX;
+        int any_l = 0, any_r = 0;
+        for (uint32_t q = g->gl; q < g->end; q++) {
+            if (!c->nlocal[q]) continue;
+            if (q < g->gr) {
+                lx = c->kmax[q] > lx ? c->kmax[q] : lx;
+                ly = c->ymax[q] > ly ? c->ymax[q] : ly;
+                any_l = 1;
+            } else {
+                rx = c->kmin[q] < rx ? c->kmin[q] : rx;
+                ry = c->ymin[q] < ry ? c->ymin[q] : ry;
+                any_r = 1;
+            }
+        }
+        if (any_l && any_r && !(lx < rx) && !(ly < ry))
+            return chk_viol(c, g->rank, g->seq, NULL, "the merge at level %" PRIu32 " joins ranks [%"
+                            PRIu32 ", %" PRIu32 ") and [%" PRIu32 ", %" PRIu32 ") whose local "
+                            "points no cut separates (in x nor in y): the regions overlap",
+                            g->level, g->gl, g->gr, g->gr, g->end);
+    }
+    return PDT_OK;
+}
+
 /* ---- the hull of a hull run ------------------------------------------------------ */
 
 /* The final Graham stack compared with the hull recomputed in memory. */
@@ -896,9 +929,11 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
     c.kmin = calloc(nr, sizeof *c.kmin);
     c.kmax = calloc(nr, sizeof *c.kmax);
     c.nlocal = calloc(nr, sizeof *c.nlocal);
+    c.ymin = calloc(nr, sizeof *c.ymin);
+    c.ymax = calloc(nr, sizeof *c.ymax);
     size_t nu = 0;
     pdt_status st = PDT_OK;
-    if (!c.kmin || !c.kmax || !c.nlocal) st = chk_nomem(&c);
+    if (!c.kmin || !c.kmax || !c.nlocal || !c.ymin || !c.ymax) st = chk_nomem(&c);
     else if (chk_marks_new(&c)) st = chk_tmp_fail(&c, "the marks of the points", "cannot create");
     c.give_back = c.mark_map || (uint64_t)c.npts * sizeof *c.pts > budget / 4;
     if (st == PDT_OK) st = chk_find_distinct(&c, &nu);
@@ -913,8 +948,10 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
                 st = chk_viol(&c, 0, 0, NULL, "pt %zu was never lifted (%" PRIu64 " local lift-ups "
                                           "for %zu distinct points)", i, c.lifts_local, nu);
     }
-    /* strips: the ranks' local points are consecutive lexicographic blocks */
-    for (size_t r = 0, prev = SIZE_MAX; st == PDT_OK && c.is_tri && r < nr; r++) {
+    /* strips: the ranks' local points are consecutive lexicographic blocks
+     * (a bisection's regions: check_regions, once the merges are sorted) */
+    int bisect = m->partition == 1;
+    for (size_t r = 0, prev = SIZE_MAX; st == PDT_OK && c.is_tri && !bisect && r < nr; r++) {
         if (!c.nlocal[r]) continue;
         if (prev != SIZE_MAX && c.kmin[r] <= c.kmax[prev])
             st = chk_viol(&c, 0, 0, NULL, "the local lift-ups of rank %zu (%" PRIu64 " points) are not "
@@ -925,6 +962,7 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
     if (st == PDT_OK && c.is_tri) st = chk_finals(&c, nu);
     if (st == PDT_OK && c.is_hull) st = check_graham_hull(&c);
     if (st == PDT_OK) st = check_merges(&c);
+    if (st == PDT_OK && c.is_tri && bisect) st = check_regions(&c);
     if (st == PDT_OK) st = check_messages(&c);
     if (st == PDT_OK && cap)
         snprintf(summary, cap,
@@ -969,6 +1007,8 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
     free(c.kmin);
     free(c.kmax);
     free(c.nlocal);
+    free(c.ymin);
+    free(c.ymax);
     free(c.fin);
     for (size_t i = 0; i < c.nruns; i++) fclose(c.runs[i]);
     free(c.runs);

@@ -77,8 +77,9 @@ typedef struct chk {
     uint64_t events, pushes, pops, instances, lifts_local, lifts_merge, sorts, hulls;
     uint64_t edge_scopes;   /* kernel runs whose level-2 edges were replayed */
     uint64_t edge_spills;   /* of them, replayed on disk (over a quarter of the budget) */
-    /* the strip of each rank: lexicographic keys of its local lift-ups */
-    uint64_t *kmin, *kmax, *nlocal;
+    /* the region of each rank: lexicographic keys of its local lift-ups,
+     * (x, y) and (y, x) */
+    uint64_t *kmin, *kmax, *nlocal, *ymin, *ymax;
 } chk;
 
 enum { M_SORTED = 1, M_DELETED = 2, M_PUSHED = 4, M_LIFTED = 8, M_REP = 16 };

@@ -148,6 +148,7 @@ pdt_status pdt_run_write_manifest(const char *dir, const pdt_manifest *m, pdt_er
     fprintf(fp, "n = %" PRIu64 "\n", m->n);
     fprintf(fp, "ranks = %d\n", m->nranks);
     fprintf(fp, "level = %d\n", m->level);
+    if (m->partition == 1) fprintf(fp, "partition = bisect\n"); /* (strips: no line) */
     fprintf(fp, "wall_start_ns = %" PRIu64 "\n", m->wall_start_ns);
     fprintf(fp, "clock_offset_ns =");
     for (int r = 0; r < m->nranks; r++)
@@ -272,6 +273,14 @@ pdt_status pdt_tf_manifest_parse(const char *path, char *text, pdt_manifest *m, 
             }
             if (k[0] == 'r') m->nranks = (int)x;
             else m->level = (int)x;
+        } else if (!strcmp(k, "partition")) {
+            if (!strcmp(v, "strips") || !strcmp(v, "bisect")) {
+                m->partition = v[0] == 'b';
+            } else {
+                st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad partition '%s' (expected "
+                                 "strips or bisect)", path, line, v);
+                break;
+            }
         } else if (!strcmp(k, "clock_offset_ns")) {
             offsets = v;
             offsets_line = line;

@@ -142,7 +142,7 @@ static pdt_status live_rank(pdt_comm *c, void *arg, pdt_err *err)
     (void)p;
     uint64_t n = J->n, lo = J->first[r], hi = J->first[r + 1];
     pdt_par_input in = {malloc((size_t)(hi - lo) * sizeof(pdt_point) + 1), (size_t)(hi - lo), lo,
-                        n, 0, 0, 0};
+                        n, 0, 0, 0, PDT_PART_STRIPS};
     pdt_status st = in.pts ? PDT_OK : pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: out of memory", r);
     if (st == PDT_OK) memcpy(in.pts, J->pts + lo, in.n * sizeof *in.pts);
     st = pdt_par_agree(c, st, NULL, err);

@@ -301,7 +301,7 @@ static pdt_status rank_partition(pdt_comm *c, void *arg, pdt_err *err)
     part_job *j = arg;
     int r = pdt_comm_rank(c), P = pdt_comm_size(c);
     size_t lo = j->n * (size_t)r / (size_t)P, hi = j->n * (size_t)(r + 1) / (size_t)P;
-    pdt_par_input in = {malloc((hi - lo + 1) * sizeof(pdt_point)), hi - lo, lo, j->n, 0, 1, 0};
+    pdt_par_input in = {malloc((hi - lo + 1) * sizeof(pdt_point)), hi - lo, lo, j->n, 0, 1, 0, PDT_PART_STRIPS};
     if (!in.pts) WRONG("out of memory");
     for (size_t i = lo; i < hi; i++) in.pts[i - lo] = part_pt(j, i);
     pdt_par_output out;

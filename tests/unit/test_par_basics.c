@@ -135,7 +135,7 @@ TEST(slab_pretest_is_sound)
                      (__int128)(p[1].y - p[0].y) * (p[2].x - p[0].x);
         if (o == 0) continue;
         int64_t xl = rndi(-3 * R, R), xr = xl + rndi(0, 4 * R);
-        srm_slab sl = {(double)xl, (double)xr};
+        srm_slab sl = {(double)xl, (double)xr, -INFINITY, INFINITY};
         if (it % 7 == 0) sl.xl = -INFINITY; /* one side open */
         if (it % 11 == 0) sl.xr = INFINITY;
         int ap = srm_disk_in_slab(&sl, p[0], p[1], p[2]);
@@ -145,13 +145,13 @@ TEST(slab_pretest_is_sound)
         if (ap && !ex) wrong++;
         /* a small fat triangle deep inside a wide slab: must be settled */
         srm_pt q[3] = {{0, 0, 0}, {rndi(5, 20), rndi(-3, 3), 1}, {rndi(-3, 3), rndi(5, 20), 2}};
-        srm_slab wide = {-1000.0, 1000.0};
+        srm_slab wide = {-1000.0, 1000.0, -INFINITY, INFINITY};
         easy++;
         easy_yes += srm_disk_in_slab(&wide, q[0], q[1], q[2]);
     }
     /* far outside the int64 range of the pre-test: says nothing */
     srm_pt big[3] = {{-(1 << 30), 0, 0}, {1 << 30, 0, 1}, {0, 1 << 30, 2}};
-    srm_slab all = {-INFINITY, INFINITY};
+    srm_slab all = {-INFINITY, INFINITY, -INFINITY, INFINITY};
     CHECK(!srm_disk_in_slab(&all, big[0], big[1], big[2]));
     CHECK_MSG(wrong == 0, "%d of %d unsound answers", wrong, checked);
     CHECK_MSG(yes > checked / 20, "only %d of %d settled", yes, checked);

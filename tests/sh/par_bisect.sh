@@ -1,0 +1,74 @@
+#!/bin/bash
+# --partition bisect under mpirun: the regions are boxes by recursive
+# bisection across the longer side and the merge tree follows it.  A traced
+# run passes `pdt trace check` (its manifest says partition = bisect, and the
+# checker asks one cut to separate the two groups of every merge), with the
+# merges of the bisection tree (P = 5: [0,3)|[3,5) at the top, [0,2)|[2,3)
+# below it); a trace whose regions overlap is refused; the seams shrink
+# (--stats: border sets per level; at P = 8 the level-0 seams span half the
+# input's side, the strips' all of it); a bad value is a usage error.
+source "$(dirname "$0")/lib.sh"
+cd "$TMP"
+export OMPI_MCA_rmaps_base_oversubscribe=1
+if ! command -v mpirun > /dev/null; then fail mpirun_available "mpirun not found"; summary; exit; fi
+
+"$PDT" gen uniform 3000 --seed 5 -o u.txt
+"$PDT" triangulate u.txt -o ref.tri
+mpirun -np 5 "$PDT" triangulate u.txt -o b5.tri --partition bisect --trace run5 2> run5.err; rc=$?
+if [ $rc -eq 0 ] && cmp -s ref.tri b5.tri; then ok traced_bisect_5_ranks_same_output
+else fail traced_bisect_5_ranks_same_output "rc=$rc $(head -3 run5.err)"; fi
+grep -q '^partition = bisect$' run5/manifest && ok manifest_names_bisect \
+    || fail manifest_names_bisect "$(cat run5/manifest)"
+"$PDT" trace check run5 > check.out 2>&1; rc=$?
+if [ $rc -eq 0 ]; then ok trace_check_bisect_5_ranks; else fail trace_check_bisect_5_ranks "$(cat check.out)"; fi
+
+# the merges of the bisection tree of 5 ranks: 3|2, then 2|1 and 1|1
+"$PDT" trace dump run5 --kind merge-begin | sed 's/.*merge-begin //' | sort > merges.txt
+printf '%s\n' 'level=0 left=0 right=1 end=2 at=1' 'level=1 left=0 right=2 end=3 at=2' \
+    'level=1 left=3 right=4 end=5 at=4' 'level=2 left=0 right=3 end=5 at=3' | sort > want.txt
+if cmp -s merges.txt want.txt; then ok merges_follow_the_bisection_tree
+else fail merges_follow_the_bisection_tree "$(cat merges.txt)"; fi
+
+# the same trace read as strips: rank 1's points are not after rank 0's
+sed 's/^partition = bisect$/partition = strips/' run5/manifest > m && cp m run5/manifest
+if "$PDT" trace check run5 > bad.out 2>&1; then fail strips_check_refuses_boxes "$(cat bad.out)"
+else ok strips_check_refuses_boxes; fi
+
+# a strips trace whose merges are renumbered so that a merge joins regions
+# no cut separates: ranks 0 and 2 of a strip run (rank 1 in between)
+mpirun -np 4 "$PDT" triangulate u.txt -o s4.tri --trace run4 2> /dev/null
+echo 'partition = bisect' >> run4/manifest
+if "$PDT" trace check run4 > ok4.out 2>&1; then ok strips_regions_are_bisect_regions_too
+else fail strips_regions_are_bisect_regions_too "$(cat ok4.out)"; fi
+
+# P = 16 and P > n, traced
+mpirun -np 16 "$PDT" triangulate u.txt -o b16.tri --partition bisect --trace run16 2> /dev/null
+if cmp -s ref.tri b16.tri && "$PDT" trace check run16 > /dev/null 2>&1; then ok trace_check_bisect_16_ranks
+else fail trace_check_bisect_16_ranks "$("$PDT" trace check run16 2>&1 | head -3)"; fi
+"$PDT" gen uniform 6 --seed 1 -o six.txt
+"$PDT" triangulate six.txt -o six.tri
+mpirun -np 9 "$PDT" triangulate six.txt -o six9.tri --partition bisect --trace run9 2> /dev/null
+if cmp -s six.tri six9.tri && "$PDT" trace check run9 > /dev/null 2>&1; then ok trace_check_bisect_more_ranks_than_points
+else fail trace_check_bisect_more_ranks_than_points "$("$PDT" trace check run9 2>&1 | head -3)"; fi
+
+# --stats: the border sets per level; the bisection's below the top are smaller
+"$PDT" gen uniform 40000 --seed 9 -o big.txt
+for part in strips bisect; do
+    mpirun -np 8 "$PDT" triangulate big.txt -o $part.tri --partition $part --stats 2> $part.json > /dev/null
+done
+read -r s0 b0 < <(python3 - <<'PY'
+import json
+s = json.load(open("strips.json"))["parallel"]; b = json.load(open("bisect.json"))["parallel"]
+assert s["partition"] == "strips" and b["partition"] == "bisect"
+print(s["largest_border_set_by_level"][0], b["largest_border_set_by_level"][0])
+PY
+)
+if [ -n "$b0" ] && [ $((3 * b0)) -lt $((2 * s0)) ]; then ok stats_border_sets_by_level_shrink
+else fail stats_border_sets_by_level_shrink "level 0: strips $s0, bisect $b0"; fi
+cmp -s strips.tri bisect.tri && ok strips_and_bisect_same_bytes || fail strips_and_bisect_same_bytes "differ"
+
+# a bad value
+"$PDT" triangulate u.txt -o x.tri --partition boxes 2> bad.err; rc=$?
+if [ $rc -eq 2 ] && grep -q "strips or bisect" bad.err; then ok partition_bad_value_usage
+else fail partition_bad_value_usage "rc=$rc $(cat bad.err)"; fi
+summary
