@@ -1,5 +1,5 @@
 /* pdt — large scratch arrays: mmap'd, huge pages asked for (see bigmem.h). */
-#include "bigmem.h"
+#include "pdt/bigmem.h"
 
 #include <errno.h>
 #include <fcntl.h>

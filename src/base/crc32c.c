@@ -1,5 +1,5 @@
-/* pdt — the run folder's checksums: CRC-32C (Castagnoli), CRC-64/XZ, their
- * combination over concatenated data, and the manifest's points checksum.
+/* pdt — checksums: CRC-32C (Castagnoli), CRC-64/XZ, and their combination
+ * over concatenated data (the run folder's blocks, points.bin, the kept index).
  *
  * CRC-32C: reflected polynomial 0x82F63B78, initial value 0xFFFFFFFF, final
  * XOR 0xFFFFFFFF (the iSCSI / ext4 / Btrfs CRC).  CRC-32C("123456789") =
@@ -16,7 +16,7 @@
  * (zlib's crc32_combine): every rank checksums its block of points.bin and
  * rank 0 combines the blocks in rank order, with the same result as one pass
  * over the whole file, whatever the number of ranks. */
-#include "tf_internal.h"
+#include "pdt/checksum.h"
 
 #include <string.h>
 
@@ -269,41 +269,4 @@ uint64_t pdt_crc64(uint64_t crc, const void *data, size_t n)
 uint64_t pdt_crc64_combine(uint64_t crc_a, uint64_t crc_b, uint64_t len_b)
 {
     return gf2_combine(crc_a, crc_b, len_b, 0xC96C5795D7870F42ull, 64);
-}
-
-/* ---- the points checksums ------------------------------------------------------ */
-
-void pdt_points_encode(uint8_t *out, const pdt_point *pts, size_t n)
-{
-    for (size_t i = 0; i < n; i++) {
-        tf_put32(out + 8 * i, (uint32_t)pts[i].x);
-        tf_put32(out + 8 * i + 4, (uint32_t)pts[i].y);
-    }
-}
-
-uint64_t pdt_points_checksum(const pdt_point *pts, size_t n)
-{
-    uint8_t buf[8 * 1024];
-    uint64_t crc = 0;
-    for (size_t i = 0; i < n;) {
-        size_t k = n - i < sizeof buf / 8 ? n - i : sizeof buf / 8;
-        pdt_points_encode(buf, pts + i, k);
-        crc = pdt_crc64(crc, buf, 8 * k);
-        i += k;
-    }
-    return crc;
-}
-
-uint64_t pdt_points_fnv1a64(const pdt_point *pts, size_t n)
-{
-    uint64_t h = 0xcbf29ce484222325u; /* FNV-1a 64 offset basis */
-    for (size_t i = 0; i < n; i++) {
-        uint32_t xy[2] = {(uint32_t)pts[i].x, (uint32_t)pts[i].y};
-        for (int k = 0; k < 2; k++)
-            for (int s = 0; s < 32; s += 8) {
-                h ^= (xy[k] >> s) & 0xffu;
-                h *= 0x100000001b3u; /* FNV-1a 64 prime */
-            }
-    }
-    return h;
 }

@@ -9,7 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cli.h"
+#include "pdt/exit.h"
+#include "pdt/opts.h"
 
 /* "pdt " before a command name ("hull"), nothing before a program name
  * ("pdtview"). */

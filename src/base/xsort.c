@@ -6,7 +6,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "xsort.h"
+#include "pdt/xsort.h"
 
 #define MAX_RUNS 128               /* open runs before they are merged into one */
 

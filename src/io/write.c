@@ -3,7 +3,8 @@
  * than the triangulation itself on big outputs. */
 #include "pdt/io.h"
 
-#include "../geom/bigmem.h"
+#include "pdt/bigmem.h"
+#include "pdt/testhook.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -402,7 +403,7 @@ static int section_threads(void)
  * small inputs, every thread's turn taken). */
 static size_t section_chunk(void)
 {
-    const char *e = getenv("PDT_TEST_WRITE_CHUNK");
+    const char *e = pdt_test_hook("PDT_TEST_WRITE_CHUNK");
     long c = e ? atol(e) : 0;
     return c > 0 && (size_t)c < SEC_CHUNK ? (size_t)c : SEC_CHUNK;
 }
@@ -428,7 +429,7 @@ static int section_run(section_job *jb)
     pthread_t th[SEC_MAX_THREADS];
     int started = 1;
     for (int t = 0; t < jb->nthreads; t++) wk[t] = (section_worker){ jb, t };
-    const char *cap = getenv("PDT_TEST_WRITE_HELPERS"); /* tests: helpers that can start */
+    const char *cap = pdt_test_hook("PDT_TEST_WRITE_HELPERS"); /* tests: helpers that can start */
     int most = cap && *cap ? atoi(cap) : SEC_MAX_THREADS;
     for (; started < jb->nthreads; started++) {
         if (started > most ||

@@ -7,7 +7,7 @@
 
 #include "pdt/predicates.h"
 #include "certify.h"
-#include "xsort.h"
+#include "pdt/xsort.h"
 
 /* The coordinates of this many corners are read between two givings-back
  * of the points' resident pages. */

@@ -13,8 +13,8 @@
 #include "pdt/predicates.h"
 #include "certify.h"
 #include "check_int.h"
-#include "xsort.h"
-#include "../geom/bigmem.h"
+#include "pdt/xsort.h"
+#include "pdt/bigmem.h"
 
 static int cmp_tri(const void *a, const void *b)
 {

@@ -5,6 +5,7 @@
 # with the test hook PDT_TEST_KERNEL_LIMIT (2^29 points do not fit here);
 # test_kernel_limit checks that the real constant is the kernel's.
 source "$(dirname "$0")/lib.sh"
+PDT=$PDT_HOOKED  # injects faults (PDT_TEST_*)
 cd "$TMP"
 "$PDT" gen uniform 100 --seed 4 -o in.txt
 "$PDT" triangulate in.txt -o ref.tri

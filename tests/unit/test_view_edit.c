@@ -7,7 +7,7 @@
 #include <unistd.h>
 
 #include "../harness.h"
-#include "../../src/view/edit.h"
+#include "../../src/view/app/edit.h"
 #include "pdt/delaunay.h"
 #include "pdt/gen.h"
 #include "pdt/io.h"

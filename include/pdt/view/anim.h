@@ -21,8 +21,8 @@
 
 #include <cairo.h>
 
-#include "pdt/render.h"
-#include "pdt/replay.h"
+#include "pdt/view/render.h"
+#include "pdt/view/replay.h"
 
 typedef enum pdt_anim_format {
     PDT_ANIM_GIF = 0,

@@ -6,7 +6,7 @@
 #ifndef PDT_DESCRIBE_H
 #define PDT_DESCRIBE_H
 
-#include "pdt/replay.h"
+#include "pdt/view/replay.h"
 
 /* The event before cursor s->k, in words, as the window's event line shows
  * it ("rank 0: pop p4 (point 2) — Area2(p3, p4, p5) = -24: right turn").

@@ -2,11 +2,11 @@
  * stack holds, whether a hull or stack is still the current one, which line
  * of the pseudo-code the current event belongs to, how many points lie inside
  * a circle.  The renderer draws their answers; tests and tools (lesson
- * checks) can ask them without cairo.  See pdt/replay.h for states. */
+ * checks) can ask them without cairo.  See pdt/view/replay.h for states. */
 #ifndef PDT_QUERY_H
 #define PDT_QUERY_H
 
-#include "pdt/replay.h"
+#include "pdt/view/replay.h"
 
 /* The points of the stack whose top node is `top` (-1: empty), bottom to
  * top, into out[0 .. cap); returns how many were written (at most cap; the
@@ -33,7 +33,7 @@ int pdt_replay_stack_open(const pdt_replay *r, const pdt_rstate *s, int32_t top)
  * point out of range.  Costs one in-circle test per input point. */
 size_t pdt_replay_inside_count(const pdt_replay *r, const uint32_t v[3]);
 
-/* The pseudo-code line (0-based, pdt_code_text of pdt/describe.h) of the
+/* The pseudo-code line (0-based, pdt_code_text of pdt/view/describe.h) of the
  * current event of s (event k-1), and in *id the listing it belongs to
  * (PDT_CODE_GRAHAM or PDT_CODE_SRM); -1 when no line applies (cursor 0, or
  * an event outside both listings). */

@@ -13,7 +13,7 @@
 
 #include <cairo.h>
 
-#include "pdt/replay.h"
+#include "pdt/view/replay.h"
 
 /* What the viewer shows and how (owned by the caller). */
 typedef struct pdt_view {

@@ -1,6 +1,6 @@
 /* pdt — the viewer's point editor (pdtview --edit FILE): points in, the
  * real algorithm re-run in the viewer's process after every change
- * (include/pdt/live.h), the replay reloaded at the same place.
+ * (include/pdt/view/live.h), the replay reloaded at the same place.
  *
  * The model (open, add, move, delete, undo, redo, random points, presets,
  * modes) knows nothing of SDL; pdt_editor_hook() connects it to the shell
@@ -11,8 +11,8 @@
 #ifndef PDT_VIEW_EDIT_H
 #define PDT_VIEW_EDIT_H
 
-#include "pdt/live.h"
-#include "pdt/render.h"
+#include "pdt/view/live.h"
+#include "pdt/view/render.h"
 #include "shell.h"
 
 typedef struct pdt_editor pdt_editor;

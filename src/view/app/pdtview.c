@@ -23,16 +23,17 @@
 
 #include <cairo.h>
 
-#include "pdt/anim.h"
-#include "pdt/describe.h"
-#include "pdt/query.h"
-#include "pdt/render.h"
-#include "pdt/replay.h"
+#include "pdt/view/anim.h"
+#include "pdt/view/describe.h"
+#include "pdt/view/query.h"
+#include "pdt/view/render.h"
+#include "pdt/view/replay.h"
 #include "pdt/tracefile.h"
-#include "pdt/viewsynth.h"
+#include "pdt/view/viewsynth.h"
 #include "edit.h"
 #include "shell.h"
-#include "../cli/cli.h"
+#include "pdt/exit.h"
+#include "pdt/opts.h"
 
 #define PROG "pdtview"
 

@@ -6,9 +6,9 @@
  * One quit path (shell_quit).  The frame is drawn at the drawable size, so
  * it is sharp on high-DPI screens; mouse positions are scaled to match. */
 #include "shell.h"
-#include "pdt/query.h"
+#include "pdt/view/query.h"
 
-#include "pdt/anim.h"
+#include "pdt/view/anim.h"
 
 #include <SDL.h>
 #include <math.h>

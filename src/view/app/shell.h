@@ -2,7 +2,7 @@
 #ifndef PDT_VIEW_SHELL_H
 #define PDT_VIEW_SHELL_H
 
-#include "pdt/render.h"
+#include "pdt/view/render.h"
 
 /* Input as the shell saw it, for a hook (the editor): drawable pixels. */
 enum { PDT_IN_DOWN = 1, PDT_IN_UP, PDT_IN_MOVE, PDT_IN_KEY };

@@ -4,9 +4,9 @@
  * it).  One pass over the triangles born so far, in their order, shared
  * by two threads on big runs; a kept index's pages are given back behind
  * it. */
-#include "pdt/replay.h"
+#include "pdt/view/replay.h"
 #include "replay_int.h"
-#include "../geom/bigmem.h"
+#include "pdt/bigmem.h"
 
 #include <math.h>
 #include <pthread.h>

@@ -1,6 +1,6 @@
 /* pdt — the viewer's words: the event line and the pseudo-code listings
- * (see pdt/describe.h). */
-#include "pdt/describe.h"
+ * (see pdt/view/describe.h). */
+#include "pdt/view/describe.h"
 
 #include <inttypes.h>
 #include <stdio.h>

@@ -11,7 +11,7 @@
  * one or a few blocks (some 50 microseconds each). */
 #include "pdt/tracefile.h"
 #include "replay_int.h"
-#include "../geom/bigmem.h"
+#include "pdt/bigmem.h"
 
 #include <stdlib.h>
 #include <string.h>

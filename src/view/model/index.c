@@ -28,9 +28,9 @@
  * of every file in the folder (but dot-files) and of the manifest's bytes.
  * An index whose identity, sizes or checksums do not match is rebuilt. */
 #include "pdt/io.h"
-#include "pdt/replay.h"
+#include "pdt/view/replay.h"
 #include "replay_int.h"
-#include "../geom/bigmem.h"
+#include "pdt/bigmem.h"
 
 #include <dirent.h>
 #include <errno.h>

@@ -1,7 +1,7 @@
-/* pdt — live runs for the editor (include/pdt/live.h): the real algorithm
+/* pdt — live runs for the editor (include/pdt/view/live.h): the real algorithm
  * traced into memory, in the order and with the framing events of the
  * commands' own tracing (src/cli/trace_run.c). */
-#include "pdt/live.h"
+#include "pdt/view/live.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -1,6 +1,6 @@
-/* pdt — questions about a replay state (see pdt/query.h). */
-#include "pdt/query.h"
-#include "pdt/describe.h"
+/* pdt — questions about a replay state (see pdt/view/query.h). */
+#include "pdt/view/query.h"
+#include "pdt/view/describe.h"
 #include "pdt/predicates.h"
 
 #include <math.h>

@@ -1,7 +1,7 @@
 /* pdt — the replay model: index the events once, then answer "state at k". */
-#include "pdt/replay.h"
+#include "pdt/view/replay.h"
 #include "replay_int.h"
-#include "../geom/bigmem.h"
+#include "pdt/bigmem.h"
 
 #include <errno.h>
 #include <stdio.h>

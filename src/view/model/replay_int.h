@@ -3,8 +3,8 @@
 #ifndef PDT_REPLAY_INT_H
 #define PDT_REPLAY_INT_H
 
-#include "pdt/replay.h"
-#include "../geom/bigmem.h"
+#include "pdt/view/replay.h"
+#include "pdt/bigmem.h"
 
 /* Checkpoints a kept index holds, at most (index.c makes 17 at most). */
 #define PDT_ICK_MAX 48

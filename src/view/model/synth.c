@@ -1,5 +1,5 @@
-/* pdt — synthetic runs for the viewer (see pdt/viewsynth.h). */
-#include "pdt/viewsynth.h"
+/* pdt — synthetic runs for the viewer (see pdt/view/viewsynth.h). */
+#include "pdt/view/viewsynth.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,4 +1,4 @@
-/* pdt — animation export (include/pdt/anim.h): cairo image surfaces in,
+/* pdt — animation export (include/pdt/view/anim.h): cairo image surfaces in,
  * an animated GIF (giflib) or a video (libavcodec + libavformat +
  * libswscale) out, written atomically through pdt_out_open().
  *
@@ -10,7 +10,7 @@
  * through a lazily filled 2^24 table (one byte per colour, index + 1).
  * Frames after the first keep only the changed rectangle, unchanged pixels
  * inside it transparent (index 255, disposal "leave in place"). */
-#include "pdt/anim.h"
+#include "pdt/view/anim.h"
 
 #include <dlfcn.h>
 #include <errno.h>

@@ -1,7 +1,7 @@
 /* pdt — the world picture of the viewer: strip boxes, triangles by status
  * and rank, kernel edges, hulls and stacks, points and their labels, the
  * merge in progress, the current event's highlight, the selection. */
-#include "pdt/describe.h"
+#include "pdt/view/describe.h"
 #include "render_int.h"
 
 

@@ -1,7 +1,7 @@
 /* pdt — the viewer's text panels: the event line at the top, the legend,
  * the pseudo-code with the current line, the stacks being built, the help
  * overlay. */
-#include "pdt/describe.h"
+#include "pdt/view/describe.h"
 #include "render_int.h"
 
 static void draw_prompt(ctx *c);

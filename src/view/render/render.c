@@ -1,4 +1,4 @@
-/* pdt — the cairo renderer (see pdt/render.h): one frame, its context and
+/* pdt — the cairo renderer (see pdt/view/render.h): one frame, its context and
  * colours.  The parts of the frame are drawn by the files listed in
  * render_int.h. */
 #include "render_int.h"

@@ -13,7 +13,7 @@
  *   render_lod.c  millions of triangles drawn as their coverage per cell
  *
  * The questions about the replay these files ask (is a hull still live,
- * which pseudo-code line, ...) are the model's: pdt/query.h. */
+ * which pseudo-code line, ...) are the model's: pdt/view/query.h. */
 #ifndef PDT_VIEW_RENDER_INT_H
 #define PDT_VIEW_RENDER_INT_H
 
@@ -22,8 +22,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "pdt/query.h"
-#include "pdt/render.h"
+#include "pdt/view/query.h"
+#include "pdt/view/render.h"
 
 #define NONE32 UINT32_MAX
 #define SANS "DejaVu Sans"
