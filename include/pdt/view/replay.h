@@ -333,16 +333,24 @@ pdt_status pdt_replay_open_kept(const char *dir, uint64_t budget, pdt_replay **o
                                 pdt_replay_open_info *info, pdt_err *err);
 /* Verify kept indexes of at least min_bytes bytes lazily: at the opening
  * only their header and chunk table; each 16 MiB chunk of the tables when a
- * frame first reads it (its pages stay closed until then; a SIGSEGV handler
- * opens them, chaining any handler installed before).  When a chunk does not
- * match its checksum, the index file is removed and on_damage is called with
- * a message naming it, from the signal handler: it may only make
- * async-signal-safe calls (write, _exit) and must not return.  Such an
- * index's rank file blocks are checked as they are decoded (a mismatch:
- * the same, from the replay's caller).  Without this call (or with
- * on_damage NULL), every index is verified whole when opened, and the rank
- * files' blocks with it. */
+ * frame first reads it.  Its pages stay closed until then, so the program
+ * must route SIGSEGV to pdt_replay_lazy_fault (the library installs no
+ * handler).  Such an index's rank file blocks are checked as they are
+ * decoded: on a mismatch the index file is removed and on_damage is called
+ * with a message naming it (the program should stop; if it returns, the
+ * block's events are ignored).  Without this call (or with on_damage
+ * NULL), every index is verified whole when opened, and the rank files'
+ * blocks with it. */
 void pdt_replay_lazy_verify(void (*on_damage)(const char *msg), uint64_t min_bytes);
+
+/* For the program's SIGSEGV handler (async-signal-safe): addr is the
+ * faulting address.  1: it lies in a lazily verified index whose chunks
+ * there are now verified and open (return from the handler: the read is
+ * retried); 0: a chunk there did not match its checksum (or could not be
+ * opened): the index file has been removed, *msg says so, and the program
+ * must stop (write and _exit only); -1: not such an address (a real
+ * fault: the program's usual SIGSEGV behaviour). */
+int pdt_replay_lazy_fault(const void *addr, const char **msg);
 
 /* What the reader said about damage in the run when the kept index was
  * built ("" if nothing, or for a replay not opened from an index). */

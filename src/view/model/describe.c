@@ -188,69 +188,91 @@ void pdt_replay_describe(const pdt_replay *r, size_t k, char *buf, size_t cap)
     pdt_rstate_free(s);
 }
 
-void pdt_replay_describe_state(const pdt_replay *r, const pdt_rstate *s, size_t k, char *buf,
-                               size_t cap)
+/* A stack event (push, pop) into o[0..c). */
+static void describe_stack(const pdt_replay *r, const pdt_rstate *s, const pdt_rec *rec, char *o,
+                           size_t c)
 {
-    if (!cap) return;
-    if (s) k = s->k;
-    size_t m = pdt_replay_count(r), npts;
-    pdt_replay_points(r, &npts);
-    if (k == 0 || k > m) {
-        snprintf(buf, cap, "start — %zu events, %d ranks; press Space or → to begin", m,
-                 pdt_replay_nranks(r));
-        return;
-    }
-    const pdt_rec held = *pdt_replay_rec(r, k - 1); /* (a kept index's pointer is short-lived) */
-    const pdt_rec *rec = &held;
     const pdt_event *e = &rec->ev;
-    char p1[64], p2[64], t3[48], why[192];
-    int n = snprintf(buf, cap, "rank %u: ", rec->rank);
-    if (n < 0 || (size_t)n >= cap) return;
-    char *o = buf + n;
-    size_t c = cap - (size_t)n;
+    size_t npts;
+    pdt_replay_points(r, &npts);
+    char p1[64], why[192];
     const char *stk = pdt_stack_name(e->sub) ? pdt_stack_name(e->sub) : "?";
-    const char *ph = pdt_phase_name(e->sub) ? pdt_phase_name(e->sub) : "?";
-    switch (e->kind) {
-    case PDT_EV_PHASE_BEGIN:
-        if (e->sub == PDT_PH_MERGE) snprintf(o, c, "begin phase merge, level %u", e->a);
-        else snprintf(o, c, "begin phase %s", ph);
-        break;
-    case PDT_EV_PHASE_END: snprintf(o, c, "end of phase %s", ph); break;
-    case PDT_EV_PUSH:
+    if (e->kind == PDT_EV_PUSH) {
         if (e->sub == PDT_STACK_GRAHAM)
             snprintf(o, c, "push %s on the Graham stack (depth %u)", gpt(r, e->a, p1, sizeof p1), e->b);
         else
             snprintf(o, c, "push %s on the %s stack (depth %u)", pt_str(r, e->a, p1, sizeof p1), stk, e->b);
-        break;
-    case PDT_EV_POP:
-        if (e->c != NONE32 && e->c < npts) {
-            pop_reason(r, s, rec, why, sizeof why);
-            if (e->sub == PDT_STACK_GRAHAM)
-                snprintf(o, c, "pop %s — %s", gpt(r, e->a, p1, sizeof p1), why);
-            else
-                snprintf(o, c, "pop %s from the %s stack — %s", pt_str(r, e->a, p1, sizeof p1), stk, why);
-        } else {
-            snprintf(o, c, "pop %s from the %s stack", pt_str(r, e->a, p1, sizeof p1), stk);
-        }
-        break;
-    case PDT_EV_LIFT:
+    } else if (e->c != NONE32 && e->c < npts) {
+        pop_reason(r, s, rec, why, sizeof why);
+        if (e->sub == PDT_STACK_GRAHAM)
+            snprintf(o, c, "pop %s — %s", gpt(r, e->a, p1, sizeof p1), why);
+        else
+            snprintf(o, c, "pop %s from the %s stack — %s", pt_str(r, e->a, p1, sizeof p1), stk, why);
+    } else {
+        snprintf(o, c, "pop %s from the %s stack", pt_str(r, e->a, p1, sizeof p1), stk);
+    }
+}
+
+/* A deferred triangle: every rank whose box the circle touches (the boxes
+ * the picture outlines), and the one the trace records: the merge it
+ * waits for. */
+static void describe_defer(const pdt_replay *r, const pdt_rec *rec, char *o, size_t c)
+{
+    const pdt_event *e = &rec->ev;
+    char t3[48], why[192];
+    uint32_t v[3] = {e->a, e->b, e->c};
+    int nr = pdt_replay_nranks(r), cnt = 0, last = -1;
+    for (int q = 0; q < nr; q++)
+        if (q != (int)rec->rank && pdt_replay_disk_touches(r, v, q)) cnt++, last = q;
+    size_t w = 0;
+    why[0] = 0;
+    for (int q = 0, i = 0; q < nr && w < sizeof why; q++) {
+        if (q == (int)rec->rank || !pdt_replay_disk_touches(r, v, q)) continue;
+        int d = snprintf(why + w, sizeof why - w, "%s%d", i == 0 ? "" : q == last ? " and " : ", ", q);
+        if (d > 0) w += (size_t)d;
+        i++;
+    }
+    if (cnt == 0)
+        snprintf(o, c, "defer %s — waits for the merge with rank %lld's group",
+                 tri_str(r, e, t3, sizeof t3), (long long)e->v);
+    else if (cnt == 1 && last == (int)e->v)
+        snprintf(o, c, "defer %s — its circle touches the box of rank %lld",
+                 tri_str(r, e, t3, sizeof t3), (long long)e->v);
+    else
+        snprintf(o, c, "defer %s — its circle touches the box%s of rank%s %s (waits for rank "
+                 "%lld's group)",
+                 tri_str(r, e, t3, sizeof t3), cnt > 1 ? "es" : "", cnt > 1 ? "s" : "", why,
+                 (long long)e->v);
+}
+
+/* Graham's and the lift's point events (lift, sort, delete). */
+static void describe_point(const pdt_replay *r, const pdt_event *e, char *o, size_t c)
+{
+    char p1[64], p2[64];
+    if (e->kind == PDT_EV_LIFT)
         snprintf(o, c, "lift %s to z = %lld", pt_str(r, e->a, p1, sizeof p1), (long long)e->v);
-        break;
-    case PDT_EV_SORT:
-        if (e->b == 0)
-            snprintf(o, c, "sort: %s is the origin p0 (the rightmost lowest point)",
-                     pt_str(r, e->a, p1, sizeof p1));
-        else
-            snprintf(o, c, "sort: %s becomes p%u", pt_str(r, e->a, p1, sizeof p1), e->b);
-        break;
-    case PDT_EV_DELETE:
-        if (e->sub == PDT_DEL_COINCIDENT)
-            snprintf(o, c, "delete %s — a copy of %s", gpt(r, e->a, p1, sizeof p1),
-                     gpt(r, e->b, p2, sizeof p2));
-        else
-            snprintf(o, c, "delete %s — same angle as %s, and closer to p0", gpt(r, e->a, p1, sizeof p1),
-                     gpt(r, e->b, p2, sizeof p2));
-        break;
+    else if (e->kind == PDT_EV_SORT && e->b == 0)
+        snprintf(o, c, "sort: %s is the origin p0 (the rightmost lowest point)",
+                 pt_str(r, e->a, p1, sizeof p1));
+    else if (e->kind == PDT_EV_SORT)
+        snprintf(o, c, "sort: %s becomes p%u", pt_str(r, e->a, p1, sizeof p1), e->b);
+    else if (e->sub == PDT_DEL_COINCIDENT)
+        snprintf(o, c, "delete %s — a copy of %s", gpt(r, e->a, p1, sizeof p1),
+                 gpt(r, e->b, p2, sizeof p2));
+    else
+        snprintf(o, c, "delete %s — same angle as %s, and closer to p0", gpt(r, e->a, p1, sizeof p1),
+                 gpt(r, e->b, p2, sizeof p2));
+}
+
+/* The triangle events (candidate, final, deferred, shipped, discarded). */
+static void describe_tri(const pdt_replay *r, const pdt_rstate *s, const pdt_rec *rec, char *o,
+                         size_t c)
+{
+    const pdt_event *e = &rec->ev;
+    size_t npts;
+    pdt_replay_points(r, &npts);
+    char p2[64], t3[48];
+    switch (e->kind) {
     case PDT_EV_TRI_NEW:
         snprintf(o, c, "candidate triangle %s from the %s kernel", tri_str(r, e, t3, sizeof t3),
                  e->sub ? "border" : "local");
@@ -259,44 +281,31 @@ void pdt_replay_describe_state(const pdt_replay *r, const pdt_rstate *s, size_t 
         snprintf(o, c, "triangle %s is final — %s", tri_str(r, e, t3, sizeof t3),
                  final_reason(r, s, (int)rec->rank));
         break;
-    case PDT_EV_RA_DEFER: {
-        /* every rank whose box the circle touches (the boxes the picture
-         * outlines), and the one the trace records: the merge it waits for */
-        uint32_t v[3] = {e->a, e->b, e->c};
-        int nr = pdt_replay_nranks(r), cnt = 0, last = -1;
-        for (int q = 0; q < nr; q++)
-            if (q != (int)rec->rank && pdt_replay_disk_touches(r, v, q)) cnt++, last = q;
-        size_t w = 0;
-        why[0] = 0;
-        for (int q = 0, i = 0; q < nr && w < sizeof why; q++) {
-            if (q == (int)rec->rank || !pdt_replay_disk_touches(r, v, q)) continue;
-            int d = snprintf(why + w, sizeof why - w, "%s%d", i == 0 ? "" : q == last ? " and " : ", ", q);
-            if (d > 0) w += (size_t)d;
-            i++;
-        }
-        if (cnt == 0)
-            snprintf(o, c, "defer %s — waits for the merge with rank %lld's group",
-                     tri_str(r, e, t3, sizeof t3), (long long)e->v);
-        else if (cnt == 1 && last == (int)e->v)
-            snprintf(o, c, "defer %s — its circle touches the box of rank %lld",
-                     tri_str(r, e, t3, sizeof t3), (long long)e->v);
-        else
-            snprintf(o, c, "defer %s — its circle touches the box%s of rank%s %s (waits for rank "
-                     "%lld's group)",
-                     tri_str(r, e, t3, sizeof t3), cnt > 1 ? "es" : "", cnt > 1 ? "s" : "", why,
-                     (long long)e->v);
-        break;
-    }
+    case PDT_EV_RA_DEFER: describe_defer(r, rec, o, c); break;
     case PDT_EV_SHIP:
         snprintf(o, c, "ship %s to rank %lld", tri_str(r, e, t3, sizeof t3), (long long)e->v);
         break;
-    case PDT_EV_DISCARD:
+    default: /* PDT_EV_DISCARD */
         if (e->v >= 0 && (uint64_t)e->v < npts)
             snprintf(o, c, "discard %s — not Delaunay: %s is inside its circle",
                      tri_str(r, e, t3, sizeof t3), pt_str(r, (uint32_t)e->v, p2, sizeof p2));
         else
             snprintf(o, c, "discard %s — not Delaunay", tri_str(r, e, t3, sizeof t3));
         break;
+    }
+}
+
+/* The other events: phases, merges, messages, the kernel's. */
+static void describe_other(const pdt_event *e, char *o, size_t c)
+{
+    char p1[64], p2[64];
+    const char *ph = pdt_phase_name(e->sub) ? pdt_phase_name(e->sub) : "?";
+    switch (e->kind) {
+    case PDT_EV_PHASE_BEGIN:
+        if (e->sub == PDT_PH_MERGE) snprintf(o, c, "begin phase merge, level %u", e->a);
+        else snprintf(o, c, "begin phase %s", ph);
+        break;
+    case PDT_EV_PHASE_END: snprintf(o, c, "end of phase %s", ph); break;
     case PDT_EV_MERGE_BEGIN:
         snprintf(o, c, "merge level %u: %s with %s, at rank %lld", e->sub,
                  group_str(e->a, e->b, p1, sizeof p1), group_str(e->b, e->c, p2, sizeof p2),
@@ -323,6 +332,38 @@ void pdt_replay_describe_state(const pdt_replay *r, const pdt_rstate *s, size_t 
                  (e->v & 3) == 2 ? "inside" : (e->v & 3) == 0 ? "outside" : "on the circle");
         break;
     default: snprintf(o, c, "event of kind %u", e->kind); break;
+    }
+}
+
+void pdt_replay_describe_state(const pdt_replay *r, const pdt_rstate *s, size_t k, char *buf,
+                               size_t cap)
+{
+    if (!cap) return;
+    if (s) k = s->k;
+    size_t m = pdt_replay_count(r);
+    if (k == 0 || k > m) {
+        snprintf(buf, cap, "start — %zu events, %d ranks; press Space or → to begin", m,
+                 pdt_replay_nranks(r));
+        return;
+    }
+    const pdt_rec held = *pdt_replay_rec(r, k - 1); /* (a kept index's pointer is short-lived) */
+    const pdt_event *e = &held.ev;
+    int n = snprintf(buf, cap, "rank %u: ", held.rank);
+    if (n < 0 || (size_t)n >= cap) return;
+    char *o = buf + n;
+    size_t c = cap - (size_t)n;
+    switch (e->kind) {
+    case PDT_EV_PUSH:
+    case PDT_EV_POP: describe_stack(r, s, &held, o, c); break;
+    case PDT_EV_LIFT:
+    case PDT_EV_SORT:
+    case PDT_EV_DELETE: describe_point(r, e, o, c); break;
+    case PDT_EV_TRI_NEW:
+    case PDT_EV_TRI_FINAL:
+    case PDT_EV_RA_DEFER:
+    case PDT_EV_SHIP:
+    case PDT_EV_DISCARD: describe_tri(r, s, &held, o, c); break;
+    default: describe_other(e, o, c); break;
     }
 }
 

@@ -128,11 +128,12 @@ typedef struct verify_job {
  * Checksumming a whole index of gigabytes at every opening costs seconds; a
  * frame reads a small part of it.  So a big index (pdt_replay_lazy_verify)
  * is mapped with no access but its header page: the first read of a page
- * faults, and the handler (SIGSEGV) checksums the chunks the page belongs
- * to, reading the file (pread), before it opens their
- * pages to the replay.  Nothing of the index is used unverified.  A mismatch
- * removes the index and calls the program's damage hook (which must not
- * return: the replay cannot go on with a damaged table). */
+ * faults, and the program's SIGSEGV handler hands the address to
+ * pdt_replay_lazy_fault, which checksums the chunks the page belongs to,
+ * reading the file (pread), before it opens their pages to the replay.
+ * Nothing of the index is used unverified.  A mismatch removes the index
+ * and tells the program, which stops (the replay cannot go on with a
+ * damaged table).  The library installs no handler: the program does. */
 
 #define LAZY_MAX 8  /* indexes open at once with lazy verification */
 

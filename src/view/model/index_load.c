@@ -11,7 +11,6 @@
 #include <fcntl.h>
 #include <limits.h>
 #include <pthread.h>
-#include <signal.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -270,6 +269,140 @@ static void unmap_ranks(pdt_replay *r)
     r->src = NULL;
 }
 
+/* Read and check the header of the index open on fd against the run
+ * (ident, n when pts): 1, or 0 with a reason in why. */
+static int read_header(int fd, ihdr *h, uint64_t ident, const pdt_point *pts, size_t n, char *why,
+                       size_t wcap)
+{
+    struct stat sb;
+    uint32_t lay[12];
+    pdt_ix_layout_of(lay);
+    if (fstat(fd, &sb) != 0 || (uint64_t)sb.st_size < HDR_BYTES ||
+        pread(fd, h, sizeof *h, 0) != (ssize_t)sizeof *h)
+        return snprintf(why, wcap, "damaged: shorter than its header"), 0;
+    if (memcmp(h->magic, magic, sizeof magic) || h->version != INDEX_VERSION ||
+        memcmp(h->layout, lay, sizeof lay))
+        return snprintf(why, wcap, "made by another version of pdtview"), 0;
+    if (pdt_ix_ihdr_crc(h) != h->hdr_crc)
+        return snprintf(why, wcap, "damaged: header checksum mismatch"), 0;
+    if (h->ident != ident)
+        return snprintf(why, wcap, "stale: the run folder changed since it was made"), 0;
+    if (h->file_bytes != (uint64_t)sb.st_size)
+        return snprintf(why, wcap, "damaged: %llu bytes, want %llu", (unsigned long long)sb.st_size,
+                        (unsigned long long)h->file_bytes), 0;
+    if ((pts && h->n != n) || h->nranks == 0 || h->nranks > INT32_MAX)
+        return snprintf(why, wcap, "stale: made for %llu points, the run has %zu",
+                        (unsigned long long)h->n, n), 0;
+    for (int i = 0; i < NSEC; i++)
+        if (h->sec[i].off < HDR_BYTES || h->sec[i].off > h->file_bytes ||
+            h->sec[i].bytes > h->file_bytes - h->sec[i].off)
+            return snprintf(why, wcap, "damaged: section %d outside the file", i), 0;
+    if (h->ctab.off < HDR_BYTES || h->ctab.off > h->file_bytes ||
+        h->ctab.bytes > h->file_bytes - h->ctab.off)
+        return snprintf(why, wcap, "damaged: chunk table outside the file"), 0;
+    return 1;
+}
+
+/* Map the index (checked whole now, or lazily when verify and big: then
+ * *L): the mapping, or MAP_FAILED with a reason in why. */
+static void *map_index(int fd, const ihdr *h, const char *path, int verify, lazy **L, char *why,
+                       size_t wcap)
+{
+    int lazily = verify && h->file_bytes >= pdt_ix_lazy_min_bytes;
+    if (verify && !lazily && !pdt_ix_verify_chunks(fd, h, why, wcap)) return MAP_FAILED;
+    void *map = mmap(NULL, h->file_bytes, PROT_READ, MAP_SHARED, fd, 0);
+    if (map == MAP_FAILED) {
+        snprintf(why, wcap, "cannot map it: %s", strerror(errno));
+        return MAP_FAILED;
+    }
+    if (!lazily) return map;
+    /* only the chunk table now; each chunk when first read */
+    uint32_t *tab = pdt_ix_read_ctab(fd, h, why, wcap);
+    if (tab) *L = pdt_ix_lazy_start(map, h->file_bytes, h, tab, fd, path);
+    if (tab && !*L) free(tab);
+    if (!tab || (!*L && !pdt_ix_verify_chunks(fd, h, why, wcap))) {
+        munmap(map, h->file_bytes);
+        return MAP_FAILED;
+    }
+    return map;
+}
+
+/* A new replay with the header's counts and checkpoints (its tables not
+ * set yet), or NULL with a reason in why. */
+static pdt_replay *replay_of_header(const ihdr *h, char *why, size_t wcap)
+{
+    pdt_replay *r = calloc(1, sizeof *r);
+    if (r) r->src = calloc(1, sizeof *r->src);
+    if (!r || !r->src) {
+        free(r);
+        snprintf(why, wcap, "out of memory");
+        return NULL;
+    }
+    r->src->nseg = h->count[S_SEGS];
+    r->src->nblk = h->count[S_BLKTAB];
+    r->src->m = h->m;
+    r->src->nranks = (int)h->nranks;
+    r->n = h->n;
+    r->m = h->m;
+    r->skipped = h->skipped;
+    r->nranks = (int)h->nranks;
+    for (int k = 0; k < PDT_EV_KIND_COUNT; k++) r->kind_count[k] = h->kind_count[k];
+    r->ntri = h->count[S_TRIS];
+    r->nhist = h->count[S_HIST];
+    r->nedge = h->count[S_EDGES];
+    r->nnode = h->count[S_NODES];
+    r->nphase = h->count[S_PHASES];
+    r->nmerge = h->count[S_MERGES];
+    r->nmsg = h->count[S_MSGS];
+    r->nhull = h->count[S_HULLS];
+    r->nch = h->count[S_CH];
+    r->warnings = h->count[S_WARN] ? "" : NULL;  /* so that pdt_ix_sections() sizes it */
+    r->ick_every = h->ick_every;
+    r->nick = h->nick;
+    int ck_ok = r->nick <= PDT_ICK_MAX &&
+                (!r->nick || (r->ick_every && (r->nick - 1) * r->ick_every <= r->m));
+    for (size_t c = 0; ck_ok && c <= r->nick; c++) {
+        r->ick_off[c] = h->ick_off[c];
+        if (c == 0) {
+            ck_ok = h->ick_off[0] == 0;
+            continue;
+        }
+        r->ick_born[c - 1] = h->ick_born[c - 1];
+        ck_ok = h->ick_born[c - 1] <= r->ntri &&
+                h->ick_off[c] == h->ick_off[c - 1] + pdt_rstate_blob_bytes(r, h->ick_born[c - 1]);
+    }
+    if (!ck_ok) {
+        snprintf(why, wcap, "damaged: checkpoints do not fit the tables");
+        free(r->src);
+        free(r);
+        return NULL;
+    }
+    return r;
+}
+
+/* Point r's tables into the mapping: 1, or 0 with a reason in why. */
+static int set_tables(pdt_replay *r, const ihdr *h, void *map, char *why, size_t wcap)
+{
+    void **ptr[NSEC];
+    size_t elem[NSEC];
+    uint64_t count[NSEC];
+    pdt_ix_sections(r, ptr, elem, count);
+    count[S_WARN] = h->count[S_WARN];
+    if (h->count[S_SORT]) count[S_SORT] = count[S_DEL] = count[S_SORTPOS] = r->n;  /* Graham's */
+    for (int i = 0; i < NSEC; i++) {
+        if (count[i] != h->count[i] || count[i] * elem[i] != h->sec[i].bytes)
+            return snprintf(why, wcap, "damaged: section %d has the wrong size", i), 0;
+        *ptr[i] = (char *)map + h->sec[i].off;
+    }
+    if (!h->count[S_SORT]) { /* a run without Graham's sort */
+        r->sort_ev = r->del_ev = NULL;
+        r->sort_pos = NULL;
+    }
+    if (h->count[S_WARN] && ((const char *)map)[h->sec[S_WARN].off + h->count[S_WARN] - 1])
+        return snprintf(why, wcap, "damaged: warnings not terminated"), 0;
+    return 1;
+}
+
 pdt_replay *pdt_ix_load(const char *path, const char *dir, uint64_t ident, const pdt_point *pts,
                         size_t n, int verify, char *why, size_t wcap)
 {
@@ -278,146 +411,21 @@ pdt_replay *pdt_ix_load(const char *path, const char *dir, uint64_t ident, const
         snprintf(why, wcap, "%s", errno == ENOENT ? "no index yet" : strerror(errno));
         return NULL;
     }
-    struct stat sb;
     ihdr h;
-    uint32_t lay[12];
-    pdt_ix_layout_of(lay);
     pdt_replay *r = NULL;
     void *map = MAP_FAILED;
     lazy *L = NULL;
-    if (fstat(fd, &sb) != 0 || (uint64_t)sb.st_size < HDR_BYTES ||
-        pread(fd, &h, sizeof h, 0) != (ssize_t)sizeof h) {
-        snprintf(why, wcap, "damaged: shorter than its header");
-        goto fail;
-    }
-    if (memcmp(h.magic, magic, sizeof magic) || h.version != INDEX_VERSION ||
-        memcmp(h.layout, lay, sizeof lay)) {
-        snprintf(why, wcap, "made by another version of pdtview");
-        goto fail;
-    }
-    if (pdt_ix_ihdr_crc(&h) != h.hdr_crc) {
-        snprintf(why, wcap, "damaged: header checksum mismatch");
-        goto fail;
-    }
-    if (h.ident != ident) {
-        snprintf(why, wcap, "stale: the run folder changed since it was made");
-        goto fail;
-    }
-    if (h.file_bytes != (uint64_t)sb.st_size) {
-        snprintf(why, wcap, "damaged: %llu bytes, want %llu", (unsigned long long)sb.st_size,
-                 (unsigned long long)h.file_bytes);
-        goto fail;
-    }
-    if ((pts && h.n != n) || h.nranks == 0 || h.nranks > INT32_MAX) {
-        snprintf(why, wcap, "stale: made for %llu points, the run has %zu", (unsigned long long)h.n, n);
-        goto fail;
-    }
-    for (int i = 0; i < NSEC; i++)
-        if (h.sec[i].off < HDR_BYTES || h.sec[i].off > h.file_bytes ||
-            h.sec[i].bytes > h.file_bytes - h.sec[i].off) {
-            snprintf(why, wcap, "damaged: section %d outside the file", i);
-            goto fail;
-        }
-    if (h.ctab.off < HDR_BYTES || h.ctab.off > h.file_bytes ||
-        h.ctab.bytes > h.file_bytes - h.ctab.off) {
-        snprintf(why, wcap, "damaged: chunk table outside the file");
-        goto fail;
-    }
-    int lazily = verify && h.file_bytes >= pdt_ix_lazy_min_bytes;
-    if (verify && !lazily && !pdt_ix_verify_chunks(fd, &h, why, wcap)) goto fail;
-    map = mmap(NULL, h.file_bytes, PROT_READ, MAP_SHARED, fd, 0);
-    if (map == MAP_FAILED) {
-        snprintf(why, wcap, "cannot map it: %s", strerror(errno));
-        goto fail;
-    }
-    if (lazily) { /* only the chunk table now; each chunk when first read */
-        uint32_t *tab = pdt_ix_read_ctab(fd, &h, why, wcap);
-        if (!tab) goto fail;
-        L = pdt_ix_lazy_start(map, h.file_bytes, &h, tab, fd, path);
-        if (!L) {
-            free(tab);
-            if (!pdt_ix_verify_chunks(fd, &h, why, wcap)) goto fail;
-        }
-    }
-    r = calloc(1, sizeof *r);
-    if (r) r->src = calloc(1, sizeof *r->src);
-    if (!r || !r->src) {
-        free(r);
-        r = NULL;
-        snprintf(why, wcap, "out of memory");
-        goto fail;
-    }
-    r->src->nseg = h.count[S_SEGS];
-    r->src->nblk = h.count[S_BLKTAB];
-    r->src->m = h.m;
-    r->src->nranks = (int)h.nranks;
-    r->n = h.n;
-    r->m = h.m;
-    r->skipped = h.skipped;
-    r->nranks = (int)h.nranks;
-    for (int k = 0; k < PDT_EV_KIND_COUNT; k++) r->kind_count[k] = h.kind_count[k];
-    r->ntri = h.count[S_TRIS];
-    r->nhist = h.count[S_HIST];
-    r->nedge = h.count[S_EDGES];
-    r->nnode = h.count[S_NODES];
-    r->nphase = h.count[S_PHASES];
-    r->nmerge = h.count[S_MERGES];
-    r->nmsg = h.count[S_MSGS];
-    r->nhull = h.count[S_HULLS];
-    r->nch = h.count[S_CH];
-    r->warnings = h.count[S_WARN] ? "" : NULL;  /* so that pdt_ix_sections() sizes it */
-    r->ick_every = h.ick_every;
-    r->nick = h.nick;
-    int ck_ok = r->nick <= PDT_ICK_MAX &&
-                (!r->nick || (r->ick_every && (r->nick - 1) * r->ick_every <= r->m));
-    for (size_t c = 0; ck_ok && c <= r->nick; c++) {
-        r->ick_off[c] = h.ick_off[c];
-        if (c == 0) {
-            ck_ok = h.ick_off[0] == 0;
-            continue;
-        }
-        r->ick_born[c - 1] = h.ick_born[c - 1];
-        ck_ok = h.ick_born[c - 1] <= r->ntri &&
-                h.ick_off[c] == h.ick_off[c - 1] + pdt_rstate_blob_bytes(r, h.ick_born[c - 1]);
-    }
-    if (!ck_ok) {
-        snprintf(why, wcap, "damaged: checkpoints do not fit the tables");
+    if (!read_header(fd, &h, ident, pts, n, why, wcap)) goto fail;
+    map = map_index(fd, &h, path, verify, &L, why, wcap);
+    if (map == MAP_FAILED || !(r = replay_of_header(&h, why, wcap))) goto fail;
+    if (!set_tables(r, &h, map, why, wcap)) {
         free(r->src);
         free(r);
-        r = NULL;
-        goto fail;
-    }
-    void **ptr[NSEC];
-    size_t elem[NSEC];
-    uint64_t count[NSEC];
-    pdt_ix_sections(r, ptr, elem, count);
-    count[S_WARN] = h.count[S_WARN];
-    if (h.count[S_SORT]) count[S_SORT] = count[S_DEL] = count[S_SORTPOS] = r->n;  /* Graham's */
-    for (int i = 0; i < NSEC; i++) {
-        if (count[i] != h.count[i] || count[i] * elem[i] != h.sec[i].bytes) {
-            snprintf(why, wcap, "damaged: section %d has the wrong size", i);
-            free(r->src);
-            free(r);
-            r = NULL;
-            goto fail;
-        }
-        *ptr[i] = (char *)map + h.sec[i].off;
-    }
-    if (!h.count[S_SORT]) { /* a run without Graham's sort */
-        r->sort_ev = r->del_ev = NULL;
-        r->sort_pos = NULL;
-    }
-    if (h.count[S_WARN] && ((const char *)map)[h.sec[S_WARN].off + h.count[S_WARN] - 1]) {
-        snprintf(why, wcap, "damaged: warnings not terminated");
-        free(r->src);
-        free(r);
-        r = NULL;
         goto fail;
     }
     if (!map_ranks(r, dir, L, why, wcap)) {
         unmap_ranks(r);
         free(r);
-        r = NULL;
         goto fail;
     }
     if (pts) r->pts = pts;  /* the run's own copy (the same points) */

@@ -11,7 +11,6 @@
 #include <fcntl.h>
 #include <limits.h>
 #include <pthread.h>
-#include <signal.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -146,8 +145,6 @@ int pdt_ix_verify_chunks(int fd, const ihdr *h, char *why, size_t wcap)
 static _Atomic(lazy *) lazies[LAZY_MAX];
 static void (*damage_hook)(const char *msg);
 uint64_t pdt_ix_lazy_min_bytes = UINT64_MAX;
-static struct sigaction old_segv;
-static pthread_once_t segv_once = PTHREAD_ONCE_INIT;
 
 void pdt_replay_lazy_verify(void (*on_damage)(const char *msg), uint64_t min_bytes)
 {
@@ -242,8 +239,8 @@ static char *cat(char *dst, const char *end, const char *src)
 }
 
 /* A chunk did not match (ok 0) or could not be opened (-1): remove the
- * index, tell the program, stop (async-signal-safe). */
-static _Noreturn void lazy_fail(lazy *L, int ok)
+ * index and say so in L->msg (async-signal-safe). */
+static const char *lazy_fail(lazy *L, int ok)
 {
     char *m = L->msg, *end = L->msg + sizeof L->msg - 1;
     m = cat(m, end, "the kept index ");
@@ -253,38 +250,21 @@ static _Noreturn void lazy_fail(lazy *L, int ok)
                             : " cannot be opened to the replay (mprotect failed)");
     *m = 0;
     if (ok == 0) unlink(L->path);
-    if (damage_hook) damage_hook(L->msg);
-    abort();
+    return L->msg;
 }
 
-static void segv_handler(int sig, siginfo_t *si, void *uc)
+int pdt_replay_lazy_fault(const void *addr, const char **msg)
 {
-    const char *a = si->si_addr;
+    const char *a = addr;
     for (int k = 0; k < LAZY_MAX; k++) {
         lazy *L = atomic_load(&lazies[k]);
         if (!L || a < L->base || a >= L->base + L->len) continue;
         int ok = lazy_open_page(L, (uint64_t)(a - L->base));
-        if (ok == 1) return;
-        lazy_fail(L, ok);
+        if (ok == 1) return 1;
+        *msg = lazy_fail(L, ok);
+        return 0;
     }
-    /* not ours: what was there before */
-    if ((old_segv.sa_flags & SA_SIGINFO) && old_segv.sa_sigaction) {
-        old_segv.sa_sigaction(sig, si, uc);
-    } else if (old_segv.sa_handler != SIG_DFL && old_segv.sa_handler != SIG_IGN) {
-        old_segv.sa_handler(sig);
-    } else {
-        signal(SIGSEGV, SIG_DFL);  /* the fault repeats and ends the process as usual */
-    }
-}
-
-static void segv_install(void)
-{
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_sigaction = segv_handler;
-    sa.sa_flags = SA_SIGINFO | SA_NODEFER;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGSEGV, &sa, &old_segv);
+    return -1;
 }
 
 /* Make r's mapping (map, len, header h, chunk table tab) lazily verified:
@@ -312,7 +292,6 @@ lazy *pdt_ix_lazy_start(char *map, size_t len, const ihdr *h, uint32_t *tab, int
     L->tab = tab;
     for (int i = 0; i < NSEC; i++) L->off[i] = h->sec[i].off, L->bytes[i] = h->sec[i].bytes;
     strcpy(L->path, path);
-    pthread_once(&segv_once, segv_install);
     int slot = -1;
     for (int k = 0; k < LAZY_MAX && slot < 0; k++) {
         lazy *none = NULL;
@@ -340,16 +319,11 @@ void pdt_ix_lazy_stop(lazy *L)
     free(L);
 }
 
-/* ---- loading ------------------------------------------------------------------ */
-
-/* Map the index at `path` onto a new replay over pts.  Returns NULL with a
- * reason in why when it is missing, stale or damaged.  verify: check every
- * section's checksum (reading the file through a small buffer), or, for an
- * index of at least pdt_ix_lazy_min_bytes, each chunk when it is first read. */
 /* A rank file's block did not match its checksum when it was decoded (a
  * lazily verified index's source): the run folder changed behind the index
- * (its files' sizes and times are the same).  Remove the index, tell the
- * program, stop: the replay cannot go on without its events. */
+ * (its files' sizes and times are the same).  Remove the index and tell the
+ * program, which should stop; if it goes on, the block's events read as
+ * events of no known kind, which every table ignores (evsrc.c). */
 void pdt_ix_run_damaged(void *ctx, uint32_t rank)
 {
     lazy *L = ctx;
@@ -364,5 +338,4 @@ void pdt_ix_run_damaged(void *ctx, uint32_t rank)
     *m = 0;
     unlink(L->path);
     if (damage_hook) damage_hook(L->msg);
-    abort();
 }

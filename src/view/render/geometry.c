@@ -78,25 +78,13 @@ size_t pdt_unique_edges(uint64_t *e, size_t n)
     return k;
 }
 
-static void draw_triangles(ctx *c)
+/* The triangles shown, bucketed by (status, maker) so that each bucket is
+ * one stroke: bucket b is order[start[b] .. start[b + 1]).  0 when out of
+ * memory. */
+static int bucket_tris(const ctx *c, size_t nt, size_t nb, size_t *start, uint32_t *order)
 {
-    cairo_t *cr = c->cr;
-    size_t nt;
-    const pdt_rtri *T = pdt_replay_tris(c->r, &nt);
+    const pdt_rtri *T = pdt_replay_tris(c->r, &(size_t){0});
     const pdt_rtri_hist *H = pdt_replay_tri_hist(c->r);
-    if (!nt || pdt_draw_lod(c)) return;  /* millions of triangles: their coverage */
-    nt = pdt_replay_born_at_most(c->r, c->s->k);  /* none beyond has an entry yet */
-    /* bucket by (status, maker) so that each bucket is one stroke */
-    size_t nb = (size_t)PDT_TS_COUNT * (size_t)c->nranks;
-    size_t *start = calloc(nb + 1, sizeof *start);
-    uint32_t *order = malloc(nt * sizeof *order);
-    uint64_t *edges = malloc(3 * nt * sizeof *edges); /* one bucket's edges */
-    if (!start || !order || !edges) {
-        free(start);
-        free(order);
-        free(edges);
-        return;
-    }
     for (size_t t = 0; t < nt; t++) {
         uint32_t h = pdt_rstate_tri_entry(c->r, c->s, t);
         if (h == NONE32 || !shown(c, T[t].maker)) continue;
@@ -104,12 +92,7 @@ static void draw_triangles(ctx *c)
     }
     for (size_t b = 0; b < nb; b++) start[b + 1] += start[b];
     size_t *fill = malloc((nb + 1) * sizeof *fill);
-    if (!fill) {
-        free(start);
-        free(order);
-        free(edges);
-        return;
-    }
+    if (!fill) return 0;
     memcpy(fill, start, (nb + 1) * sizeof *fill);
     for (size_t t = 0; t < nt; t++) {
         uint32_t h = pdt_rstate_tri_entry(c->r, c->s, t);
@@ -117,8 +100,115 @@ static void draw_triangles(ctx *c)
         order[fill[(size_t)H[h].status * (size_t)c->nranks + T[t].maker]++] = (uint32_t)t;
     }
     free(fill);
-    cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+    return 1;
+}
+
+/* Discarded triangles (of rank q, order[from .. to)), fading with age, each
+ * with a red cross. */
+static void draw_discarded(ctx *c, int q, const uint32_t *order, size_t from, size_t to)
+{
+    cairo_t *cr = c->cr;
+    const pdt_rtri *T = pdt_replay_tris(c->r, &(size_t){0});
+    const pdt_rtri_hist *H = pdt_replay_tri_hist(c->r);
+    for (size_t i = from; i < to; i++) {
+        uint32_t t = order[i];
+        double age = (double)c->s->k - H[pdt_rstate_tri_entry(c->r, c->s, t)].ev;
+        double a = c->v->fade > 0 ? 1 - age / c->v->fade : 1;
+        if (a <= 0.02) continue;
+        pdt_status_style(cr, PDT_TS_DISCARDED, c->lw);
+        tri_path(c, T[t].v);
+        set_rank(cr, q, 0.6 * a);
+        cairo_stroke(cr);
+        double x = 0, y = 0, px, py;
+        for (int j = 0; j < 3; j++) {
+            wpt(c, T[t].v[j], &px, &py);
+            x += px / 3;
+            y += py / 3;
+        }
+        cairo_set_line_width(cr, 1.6 * c->lw);
+        cross(cr, x, y, 0.35 * c->L.font);
+        rgb(cr, RED, a);
+        cairo_stroke(cr);
+    }
+}
+
+/* The edges of triangles order[from .. to) inside the picture, each once
+ * (two triangles of a bucket share most of theirs), as separate segments
+ * (no joins) stroked in chunks: much faster than one long path of closed
+ * triangles.  edges: room for 3 (to - from). */
+static void stroke_bucket_edges(ctx *c, const uint32_t *order, size_t from, size_t to,
+                                uint64_t *edges)
+{
+    cairo_t *cr = c->cr;
+    const pdt_rtri *T = pdt_replay_tris(c->r, &(size_t){0});
     double gx0 = c->L.geo.x, gx1 = c->L.geo.x + c->L.geo.w, gy0 = c->L.geo.y, gy1 = c->L.geo.y + c->L.geo.h;
+    size_t ne = 0;
+    for (size_t i = from; i < to; i++) {
+        const uint32_t *v = T[order[i]].v;
+        double x[3], y[3];
+        for (int j = 0; j < 3; j++) wpt(c, v[j], &x[j], &y[j]);
+        if ((x[0] < gx0 && x[1] < gx0 && x[2] < gx0) || (x[0] > gx1 && x[1] > gx1 && x[2] > gx1) ||
+            (y[0] < gy0 && y[1] < gy0 && y[2] < gy0) || (y[0] > gy1 && y[1] > gy1 && y[2] > gy1))
+            continue;
+        for (int j = 0; j < 3; j++) {
+            uint32_t a = v[j], e = v[(j + 1) % 3];
+            edges[ne++] = a < e ? (uint64_t)a << 32 | e : (uint64_t)e << 32 | a;
+        }
+    }
+    ne = pdt_unique_edges(edges, ne);
+    size_t seg = 0;
+    for (size_t i = 0; i < ne; i++) {
+        double x0, y0, x1, y1;
+        wpt(c, (uint32_t)(edges[i] >> 32), &x0, &y0);
+        wpt(c, (uint32_t)edges[i], &x1, &y1);
+        cairo_move_to(cr, x0, y0);
+        cairo_line_to(cr, x1, y1);
+        if (++seg >= 3000) {
+            cairo_stroke(cr);
+            seg = 0;
+        }
+    }
+    cairo_stroke(cr);
+}
+
+/* Bucket b (status st, rank q): its triangles in their status' style. */
+static void draw_bucket(ctx *c, int st, int q, const uint32_t *order, size_t from, size_t to,
+                        int dense, uint64_t *edges)
+{
+    cairo_t *cr = c->cr;
+    if (st == PDT_TS_DISCARDED) {
+        draw_discarded(c, q, order, from, to);
+        return;
+    }
+    if (c->v->clean && !dense) { /* T* filled by rank */
+        const pdt_rtri *T = pdt_replay_tris(c->r, &(size_t){0});
+        for (size_t i = from; i < to; i++) tri_path(c, T[order[i]].v);
+        set_rank(cr, q, 0.16);
+        cairo_fill(cr);
+    }
+    pdt_status_style(cr, st, dense ? 0.8 : c->lw);
+    set_rank(cr, q, st == PDT_TS_CANDIDATE ? 0.75 : 1);
+    stroke_bucket_edges(c, order, from, to, edges);
+}
+
+static void draw_triangles(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    size_t nt;
+    pdt_replay_tris(c->r, &nt);
+    if (!nt || pdt_draw_lod(c)) return;  /* millions of triangles: their coverage */
+    nt = pdt_replay_born_at_most(c->r, c->s->k);  /* none beyond has an entry yet */
+    size_t nb = (size_t)PDT_TS_COUNT * (size_t)c->nranks;
+    size_t *start = calloc(nb + 1, sizeof *start);
+    uint32_t *order = malloc(nt * sizeof *order);
+    uint64_t *edges = malloc(3 * nt * sizeof *edges); /* one bucket's edges */
+    if (!start || !order || !edges || !bucket_tris(c, nt, nb, start, order)) {
+        free(start);
+        free(order);
+        free(edges);
+        return;
+    }
+    cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
     /* dense pictures: thin lines without antialiasing (a mesh of 10^5 edges
      * looks the same and draws several times faster) */
     int dense = start[nb] > 10000;
@@ -133,67 +223,7 @@ static void draw_triangles(ctx *c)
         if (c->v->clean && st != PDT_TS_FINAL) continue; /* the clean picture: T* only */
         for (int q = 0; q < c->nranks; q++) {
             size_t b = (size_t)st * (size_t)c->nranks + (size_t)q;
-            if (start[b] == start[b + 1]) continue;
-            if (st == PDT_TS_DISCARDED) {
-                for (size_t i = start[b]; i < start[b + 1]; i++) {
-                    uint32_t t = order[i];
-                    double age = (double)c->s->k - H[pdt_rstate_tri_entry(c->r, c->s, t)].ev;
-                    double a = c->v->fade > 0 ? 1 - age / c->v->fade : 1;
-                    if (a <= 0.02) continue;
-                    pdt_status_style(cr, st, c->lw);
-                    tri_path(c, T[t].v);
-                    set_rank(cr, q, 0.6 * a);
-                    cairo_stroke(cr);
-                    double x = 0, y = 0, px, py;
-                    for (int j = 0; j < 3; j++) {
-                        wpt(c, T[t].v[j], &px, &py);
-                        x += px / 3;
-                        y += py / 3;
-                    }
-                    cairo_set_line_width(cr, 1.6 * c->lw);
-                    cross(cr, x, y, 0.35 * c->L.font);
-                    rgb(cr, RED, a);
-                    cairo_stroke(cr);
-                }
-                continue;
-            }
-            if (c->v->clean && !dense) { /* T* filled by rank */
-                for (size_t i = start[b]; i < start[b + 1]; i++) tri_path(c, T[order[i]].v);
-                set_rank(cr, q, 0.16);
-                cairo_fill(cr);
-            }
-            pdt_status_style(cr, st, dense ? 0.8 : c->lw);
-            set_rank(cr, q, st == PDT_TS_CANDIDATE ? 0.75 : 1);
-            /* separate segments (no joins), each edge once (two triangles of
-             * a bucket share most of theirs), stroked in chunks: much faster
-             * than one long path of closed triangles */
-            size_t ne = 0;
-            for (size_t i = start[b]; i < start[b + 1]; i++) {
-                const uint32_t *v = T[order[i]].v;
-                double x[3], y[3];
-                for (int j = 0; j < 3; j++) wpt(c, v[j], &x[j], &y[j]);
-                if ((x[0] < gx0 && x[1] < gx0 && x[2] < gx0) || (x[0] > gx1 && x[1] > gx1 && x[2] > gx1) ||
-                    (y[0] < gy0 && y[1] < gy0 && y[2] < gy0) || (y[0] > gy1 && y[1] > gy1 && y[2] > gy1))
-                    continue;
-                for (int j = 0; j < 3; j++) {
-                    uint32_t a = v[j], e = v[(j + 1) % 3];
-                    edges[ne++] = a < e ? (uint64_t)a << 32 | e : (uint64_t)e << 32 | a;
-                }
-            }
-            ne = pdt_unique_edges(edges, ne);
-            size_t seg = 0;
-            for (size_t i = 0; i < ne; i++) {
-                double x0, y0, x1, y1;
-                wpt(c, (uint32_t)(edges[i] >> 32), &x0, &y0);
-                wpt(c, (uint32_t)edges[i], &x1, &y1);
-                cairo_move_to(cr, x0, y0);
-                cairo_line_to(cr, x1, y1);
-                if (++seg >= 3000) {
-                    cairo_stroke(cr);
-                    seg = 0;
-                }
-            }
-            cairo_stroke(cr);
+            if (start[b] != start[b + 1]) draw_bucket(c, st, q, order, start[b], start[b + 1], dense, edges);
         }
     }
     cairo_restore(cr);
