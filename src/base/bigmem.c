@@ -1,5 +1,6 @@
 /* pdt — large scratch arrays: mmap'd, huge pages asked for (see bigmem.h). */
 #include "pdt/bigmem.h"
+#include "pdt/tmpfile.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -134,25 +135,9 @@ void pdt_prefault_stop(pdt_prefault *pf)
     free(pf);
 }
 
-/* A new anonymous temporary file in $TMPDIR (else /tmp), open for reading
- * and writing, or -1 (errno). */
-static int temp_fd(void)
-{
-    const char *dir = getenv("TMPDIR");
-    if (!dir || !*dir) dir = "/tmp";
-    int fd = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
-    if (fd < 0) {  /* a file system without O_TMPFILE: a named file, unlinked */
-        char path[4096];
-        snprintf(path, sizeof path, "%s/pdt-scratch.XXXXXX", dir);
-        if ((fd = mkstemp(path)) < 0) return -1;
-        unlink(path);
-    }
-    return fd;
-}
-
 void *pdt_temp_zeros(size_t bytes)
 {
-    int fd = temp_fd();
+    int fd = pdt_tmp_fd("pdt-scratch");
     if (fd < 0) return NULL;
     void *p = MAP_FAILED;
     if (ftruncate(fd, (off_t)(bytes ? bytes : 1)) == 0)
@@ -170,7 +155,7 @@ int pdt_temp_map_new(pdt_temp_map *m, size_t bytes)
     m->p = NULL;
     m->bytes = 0;
     if (!bytes) bytes = 1;
-    if ((m->fd = temp_fd()) < 0) return -1;
+    if ((m->fd = pdt_tmp_fd("pdt-scratch")) < 0) return -1;
     void *p = MAP_FAILED;
     if (ftruncate(m->fd, (off_t)bytes) == 0)
         p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, m->fd, 0);

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "pdt/xsort.h"
+#include "pdt/tmpfile.h"
 
 #define MAX_RUNS 128               /* open runs before they are merged into one */
 
@@ -60,27 +61,6 @@ static void radix_sort(pdt_kv **a, pdt_kv **t, size_t n)
 }
 
 /* ---- runs on disk ------------------------------------------------------------ */
-
-/* A new anonymous temporary file in $TMPDIR (else /tmp) with a stdio
- * buffer of `buffer` bytes, or NULL (errno). */
-static FILE *temp_file(size_t buffer)
-{
-    const char *dir = getenv("TMPDIR");
-    char path[4096];
-    snprintf(path, sizeof path, "%s/pdt-sort.XXXXXX", dir && *dir ? dir : "/tmp");
-    int fd = mkstemp(path);
-    if (fd < 0) return NULL;
-    unlink(path);
-    FILE *f = fdopen(fd, "w+b");
-    if (!f) {
-        int e = errno;
-        close(fd);
-        errno = e;
-        return NULL;
-    }
-    setvbuf(f, NULL, _IOFBF, buffer);  /* (before any other operation on it) */
-    return f;
-}
 
 static void src_advance(run_src *s, int *failed)
 {
@@ -156,7 +136,7 @@ static int merge_next(pdt_xsort *x, pdt_kv *kv)
 /* Merge every run on disk into one (when MAX_RUNS piled up). */
 static int compact(pdt_xsort *x)
 {
-    FILE *out = temp_file(x->run_buffer);
+    FILE *out = pdt_tmp_file("pdt-sort", x->run_buffer);
     if (!out) return -1;
     merge_open(x, NULL, 0);
     pdt_kv kv;
@@ -181,7 +161,7 @@ static int spill(pdt_xsort *x)
     if (!x->n) return 0;
     if (x->nruns == MAX_RUNS && compact(x)) return -1;
     radix_sort(&x->buf, &x->tmp, x->n);
-    FILE *f = temp_file(x->run_buffer);
+    FILE *f = pdt_tmp_file("pdt-sort", x->run_buffer);
     if (!f) return -1;
     x->runs[x->nruns++] = f;
     x->spilled++;
