@@ -61,15 +61,14 @@ void pdt_release_pages(const void *p, size_t len);
  * part of one splits it and frees nothing until the kernel gets round to it;
  * the page that holds `to` goes with a later call.  The memory can serve the
  * next allocation (e.g. the page cache of a file being written) at once,
- * which on this project's VMs is far cheaper than memory the host has taken
+ * which on a virtual machine is far cheaper than memory the host has taken
  * back (see below). */
 void pdt_big_release_front(void *base, size_t from, size_t to);
 
-/* Fault in memory ahead of use, on an idle core.  On this project's test
- * machine (a Firecracker VM) the first touch of memory new to a process is
- * its dearest cost: about 2 s per GiB (the host backs each page on demand;
- * the guest zeroes it), so a pipeline that touches 700 MB of fresh scratch
- * spends a second on page faults.  pdt_prefault_start starts one thread
+/* Fault in memory ahead of use, on an idle core.  On a virtual machine
+ * whose host backs each page on demand, the first touch of memory new to a
+ * process can be a pipeline's dearest cost (the host backs the page, the
+ * guest zeroes it; docs/benchmarks.md has figures).  pdt_prefault_start starts one thread
  * that asks the kernel to populate the pages of the given ranges, in order,
  * 2 MiB at a time (madvise MADV_POPULATE_WRITE: the pages are made present
  * and writable, their contents are left alone, so the caller may already be

@@ -286,9 +286,8 @@ enum { SEC_CHUNK = WBUF / PDT_LINE_MAX, SEC_MIN_ITEMS = 1 << 18, SEC_MAX_THREADS
  * RELEASE_STEP items at a time or more (whole 2 MiB pages:
  * pdt_big_release_front).  The page cache of the file being written then
  * takes memory that was in use a moment before rather than memory the host
- * has taken back: on this project's VM the write of 3*10^7 points' triangles
- * took 0.48, 0.49 and 0.74 s in three runs, against 0.49, 0.89 and 0.99 s
- * without (the triangles are half the file's size: the other half still
+ * has taken back, which on a virtual machine makes the write's time steadier
+ * and shorter (the triangles are half the file's size: the other half still
  * comes from the free lists). */
 enum { RELEASE_STEP = 1 << 18 };
 

@@ -253,9 +253,9 @@ typedef struct tri_first {
 /* Fine bits a streamed build may use at most (pdt_rp_tri_number keeps a bucket's
  * number in 16 bits). */
 #define FINE_BITS_MAX 16u
-/* The least room planned for the grouping, whatever the budget (below it,
- * more and smaller buckets only make the build slower: 2^11 buckets made
- * the 10^7-point run's build 15-20 % slower than 2^8). */
+/* The least room planned for the grouping, whatever the budget: below it,
+ * more and smaller buckets only make the build slower (each bucket costs
+ * its own buffers and passes). */
 #define PLAN_ROOM_MIN ((uint64_t)64 << 20)
 
 /* ---- shared between the replay's files (each defined in the file named) ---- */

@@ -25,11 +25,10 @@
 #define STEP_FACTOR 1
 
 /* Restoring a kept checkpoint costs about a step per this many of its bytes
- * when the state is in memory (191 MiB in 9-15 ms on the 4*10^7-point run,
- * a step 12.6 ns; a paged state's pages cost more: one step per 64 bytes).
- * At 64 for both, a seek there stepped up to 3*10^6 events from where it
- * was rather than restore: the worst of 101 random seeks took 108-143 ms,
- * 93-104 ms with this. */
+ * when the state is in memory (copying memory is far cheaper per byte than
+ * stepping per event).  Too small a figure makes a seek step millions of
+ * events rather than restore; too large, restore when a few steps would
+ * do. */
 #define RESTORE_BYTES_PER_STEP 192
 
 size_t pdt_replay_state_bytes(const pdt_replay *r)

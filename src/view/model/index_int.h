@@ -41,24 +41,22 @@
 #include "replay_int.h"
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 10u /* 8: the histories in the triangles' order; 9: a triangle's state
-                             * in 16 bits (an offset from its first entry); 10: up to 48
-                             * checkpoints */
+#define INDEX_VERSION 10u /* raised whenever the layout changes: an index of another
+                             * version is rebuilt */
 #define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/8 events, at least this */
 #define ICK_PARTS 8u
 /* ... and at most every ICK_MAX_EVERY events while ICK_MAX_PARTS allow: a
- * seek steps at most half of it, 2^22 events, 55 ms here on the 4*10^7-point
- * run (12.6 ns an event), after restoring a checkpoint (15 ms for its 191
- * MiB).  So up to 4*10^8 events (some 10^8 points); beyond, the steps grow
- * again (23 parts, the cap before, left a 5*10^8-event run's seeks stepping
- * up to 1.1*10^7 events; 47 keep them to 5.3*10^6, for twice the
- * checkpoints' disk) */
+ * seek then steps at most half of that, 2^22 events, after restoring a
+ * checkpoint, so that a far seek costs about what restoring a checkpoint
+ * costs.  That holds up to 4*10^8 events (some 10^8 points); beyond, the
+ * steps grow with the run, and each part more costs one more checkpoint's
+ * disk.  (docs/benchmarks.md has the seek times.) */
 #define ICK_MAX_EVERY ((size_t)1 << 23)
 #define ICK_MAX_PARTS 47u
 _Static_assert(ICK_MAX_PARTS + 1 <= PDT_ICK_MAX, "the header holds every checkpoint's place");
-#define CHUNK_BYTES ((uint64_t)16 << 20) /* pdt_ix_sections are checksummed in chunks of this: the
-                                          * least a lazily checked frame reads (1 MiB made
-                                          * lazily checked seeks 5x slower: not understood) */
+#define CHUNK_BYTES ((uint64_t)16 << 20) /* sections are checksummed in chunks of this: the
+                                          * least a lazily checked frame reads (smaller chunks
+                                          * made lazily checked seeks slower) */
 #define HDR_BYTES 4096u
 #define EST_BYTES_PER_EVENT 100u /* what the replay model holds per event in memory */
 

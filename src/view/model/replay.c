@@ -168,7 +168,7 @@ static void bucket_plan(builder *b, uint64_t m, uint64_t budget)
  * buckets planned, and the tables sized (in memory: once, from counts of
  * the events that create objects and of the triangle events per bucket;
  * streamed: the events come once, the buckets are spilled in chunks,
- * counted as they come, and the small tables pdt_rp_grow).  0 when out of memory. */
+ * counted as they come, and the small tables grow).  0 when out of memory. */
 static int builder_open(builder *b, pdt_replay *r, const pdt_replay_place *pl)
 {
     memset(b, 0, sizeof *b);
