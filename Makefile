@@ -89,7 +89,7 @@ MPI_LIBS    := $(shell pkg-config --libs ompi-c 2>/dev/null)
 VIEW_CFLAGS := $(shell pkg-config --cflags cairo sdl2 2>/dev/null)
 CAIRO_LIBS  := $(shell pkg-config --libs cairo 2>/dev/null)
 SDL_LIBS    := $(shell pkg-config --libs sdl2 2>/dev/null)
-# animation export (src/view/anim.c): giflib (no pkg-config file on Debian
+# animation export (src/view/render/anim.c): giflib (no pkg-config file on Debian
 # 12) is linked; FFmpeg's libraries are opened with dlopen when a video is
 # written (their codec libraries' start-up code is more than valgrind runs)
 AV_PKGS     := libavformat libavcodec libswscale libavutil

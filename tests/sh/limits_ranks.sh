@@ -16,6 +16,14 @@ if [ $rc -eq 2 ] && grep -q '^pdt: in.txt: 100 points on 1 rank: more than 40 po
     ok plain_run_over_limit_refused
 else fail plain_run_over_limit_refused "rc=$rc $(cat p1.err)"; fi
 
+# the release program never reads the test hooks (only test builds do:
+# bin/test/pdt, the sanitizer build): the same run goes through
+if [ "$(basename "$BIN")" != san ]; then
+    PDT_TEST_KERNEL_LIMIT=40 "$BIN/pdt" triangulate in.txt -o prod.tri 2> prod.err; rc=$?
+    if [ $rc -eq 0 ] && cmp -s ref.tri prod.tri; then ok release_build_ignores_test_hooks
+    else fail release_build_ignores_test_hooks "rc=$rc $(cat prod.err)"; fi
+fi
+
 if command -v mpirun > /dev/null; then
     PDT_TEST_KERNEL_LIMIT=40 mpirun -np 2 "$PDT" triangulate in.txt -o p2.tri 2> p2.err; rc=$?
     n=$(grep -c 'more than 40 points per rank' p2.err)

@@ -153,6 +153,118 @@ static void set_font_scale(shell *sh, double f)
     sh->v->font_scale = fmin(4, fmax(0.4, f));
 }
 
+/* Ctrl + key: font scale, and stepping by rank. */
+static void ctrl_key(shell *sh, SDL_Keycode k)
+{
+    sh->dirty = 1;
+    switch (k) {
+    case SDLK_EQUALS:
+    case SDLK_PLUS:
+    case SDLK_KP_PLUS: set_font_scale(sh, sh->v->font_scale * 1.15); return;
+    case SDLK_MINUS:
+    case SDLK_KP_MINUS: set_font_scale(sh, sh->v->font_scale / 1.15); return;
+    case SDLK_0:
+    case SDLK_KP_0: set_font_scale(sh, 1); return;
+    case SDLK_RIGHT:
+    case SDLK_LEFT: {
+        /* next / previous event of the current event's rank */
+        size_t cur = sh->s->k;
+        int q = cur ? (int)pdt_replay_rank_of(sh->r, cur - 1) : 0;
+        sh->playing = 0;
+        seek(sh, pdt_replay_find_rank(sh->r, cur, k == SDLK_RIGHT ? 1 : -1, q));
+        return;
+    }
+    default: sh->dirty = 0; return;
+    }
+}
+
+/* Right / left: a step; with Shift, the next event of the class shown
+ * (k) among the visible ranks. */
+static void arrow_key(shell *sh, SDL_Keycode k, int shift)
+{
+    int dir = k == SDLK_RIGHT ? 1 : -1;
+    sh->playing = 0;
+    if (!shift) {
+        pdt_replay_step(sh->r, sh->s, dir);
+        return;
+    }
+    uint8_t *vis = malloc((size_t)sh->nranks);
+    if (vis)
+        for (int q = 0; q < sh->nranks; q++) vis[q] = !sh->hidden[q];
+    seek(sh, pdt_replay_find(sh->r, sh->s->k, dir, sh->v->ev_class, vis));
+    free(vis);
+}
+
+/* The keys that move the cursor or the clock: 1 if k was one. */
+static int move_key(shell *sh, SDL_Keycode k, int shift)
+{
+    size_t m = pdt_replay_count(sh->r), cur = sh->s->k;
+    switch (k) {
+    case SDLK_SPACE:
+        sh->playing = !sh->playing;
+        sh->acc = 0;
+        return 1;
+    case SDLK_RIGHT:
+    case SDLK_LEFT: arrow_key(sh, k, shift); return 1;
+    case SDLK_PAGEDOWN: seek(sh, pdt_replay_find_phase(sh->r, cur, 1)); return 1;
+    case SDLK_PAGEUP: seek(sh, pdt_replay_find_phase(sh->r, cur, -1)); return 1;
+    case SDLK_HOME: seek(sh, 0); return 1;
+    case SDLK_END: seek(sh, m); return 1;
+    case SDLK_PLUS:
+    case SDLK_EQUALS:
+    case SDLK_KP_PLUS: sh->speed = fmin(sh->speed * 2, 1e7); return 1;
+    case SDLK_MINUS:
+    case SDLK_KP_MINUS: sh->speed = fmax(sh->speed / 2, 0.25); return 1;
+    case SDLK_g:
+        sh->typing = 1;
+        sh->num[0] = 0;
+        goto_key(sh, SDLK_UNKNOWN);
+        return 1;
+    case SDLK_m:
+        sh->mark = cur;
+        fprintf(stderr, "pdtview: mark at event %zu (r records from here to the current event)\n", cur);
+        return 1;
+    default: return 0;
+    }
+}
+
+/* The keys that change the view or the window: 1 if k was one. */
+static int view_key(shell *sh, SDL_Keycode k, int shift)
+{
+    switch (k) {
+    case SDLK_ESCAPE:
+    case SDLK_q: sh->quit = 1; return 1;
+    case SDLK_k: sh->v->ev_class = sh->v->ev_class % (PDT_EVC_COUNT - 1) + 1; return 1;
+    case SDLK_0: memset(sh->hidden, 0, (size_t)sh->nranks); return 1;
+    case SDLK_f:
+        sh->v->zoom = 1;
+        sh->v->centred = 0;
+        return 1;
+    case SDLK_h:
+    case SDLK_QUESTION: sh->v->help = !sh->v->help; return 1;
+    case SDLK_SLASH:
+        if (shift) sh->v->help = !sh->v->help;
+        return 1;
+    case SDLK_s: screenshot(sh, sh->o->screenshot); return 1;
+    case SDLK_r: record(sh); return 1;
+    case SDLK_F11:
+        sh->fullscreen = !sh->fullscreen;
+        SDL_SetWindowFullscreen(sh->win, sh->fullscreen ? SDL_WINDOW_FULLSCREEN_DESKTOP : 0);
+        return 1;
+    case SDLK_t: sh->v->theme = (sh->v->theme + 1) % PDT_THEME_COUNT; return 1;
+    case SDLK_c: sh->v->clean = !sh->v->clean; return 1;
+    case SDLK_o: sh->v->circles = !sh->v->circles; return 1;
+    case SDLK_v: sh->v->voronoi = !sh->v->voronoi; return 1;
+    default:
+        if (k >= SDLK_1 && k <= SDLK_9) {
+            int q = (int)(k - SDLK_1);
+            if (q < sh->nranks) sh->hidden[q] = !sh->hidden[q];
+            return 1;
+        }
+        return 0;
+    }
+}
+
 static void key(shell *sh, SDL_Keycode k, Uint16 mod)
 {
     int shift = (mod & KMOD_SHIFT) != 0, ctrl = (mod & KMOD_CTRL) != 0;
@@ -161,104 +273,11 @@ static void key(shell *sh, SDL_Keycode k, Uint16 mod)
         sh->dirty = 1;
         return;
     }
-    if (ctrl) { /* Ctrl: font scale, and stepping by rank */
-        sh->dirty = 1;
-        switch (k) {
-        case SDLK_EQUALS:
-        case SDLK_PLUS:
-        case SDLK_KP_PLUS: set_font_scale(sh, sh->v->font_scale * 1.15); return;
-        case SDLK_MINUS:
-        case SDLK_KP_MINUS: set_font_scale(sh, sh->v->font_scale / 1.15); return;
-        case SDLK_0:
-        case SDLK_KP_0: set_font_scale(sh, 1); return;
-        case SDLK_RIGHT:
-        case SDLK_LEFT: {
-            /* next / previous event of the current event's rank */
-            size_t cur = sh->s->k;
-            int q = cur ? (int)pdt_replay_rank_of(sh->r, cur - 1) : 0;
-            sh->playing = 0;
-            seek(sh, pdt_replay_find_rank(sh->r, cur, k == SDLK_RIGHT ? 1 : -1, q));
-            return;
-        }
-        default: sh->dirty = 0; return;
-        }
+    if (ctrl) {
+        ctrl_key(sh, k);
+        return;
     }
-    size_t m = pdt_replay_count(sh->r), cur = sh->s->k;
-    uint8_t *vis = NULL;
-    sh->dirty = 1;
-    switch (k) {
-    case SDLK_ESCAPE:
-    case SDLK_q: sh->quit = 1; break;
-    case SDLK_SPACE:
-        sh->playing = !sh->playing;
-        sh->acc = 0;
-        break;
-    case SDLK_RIGHT:
-    case SDLK_LEFT: {
-        int dir = k == SDLK_RIGHT ? 1 : -1;
-        sh->playing = 0;
-        if (!shift) {
-            pdt_replay_step(sh->r, sh->s, dir);
-            break;
-        }
-        vis = malloc((size_t)sh->nranks);
-        if (vis)
-            for (int q = 0; q < sh->nranks; q++) vis[q] = !sh->hidden[q];
-        seek(sh, pdt_replay_find(sh->r, cur, dir, sh->v->ev_class, vis));
-        free(vis);
-        break;
-    }
-    case SDLK_k:
-        sh->v->ev_class = sh->v->ev_class % (PDT_EVC_COUNT - 1) + 1;
-        break;
-    case SDLK_PAGEDOWN: seek(sh, pdt_replay_find_phase(sh->r, cur, 1)); break;
-    case SDLK_PAGEUP: seek(sh, pdt_replay_find_phase(sh->r, cur, -1)); break;
-    case SDLK_HOME: seek(sh, 0); break;
-    case SDLK_END: seek(sh, m); break;
-    case SDLK_PLUS:
-    case SDLK_EQUALS:
-    case SDLK_KP_PLUS: sh->speed = fmin(sh->speed * 2, 1e7); break;
-    case SDLK_MINUS:
-    case SDLK_KP_MINUS: sh->speed = fmax(sh->speed / 2, 0.25); break;
-    case SDLK_0:
-        memset(sh->hidden, 0, (size_t)sh->nranks);
-        break;
-    case SDLK_f:
-        sh->v->zoom = 1;
-        sh->v->centred = 0;
-        break;
-    case SDLK_h:
-    case SDLK_QUESTION: sh->v->help = !sh->v->help; break;
-    case SDLK_SLASH:
-        if (shift) sh->v->help = !sh->v->help;
-        break;
-    case SDLK_s: screenshot(sh, sh->o->screenshot); break;
-    case SDLK_m:
-        sh->mark = cur;
-        fprintf(stderr, "pdtview: mark at event %zu (r records from here to the current event)\n", cur);
-        break;
-    case SDLK_r: record(sh); break;
-    case SDLK_g:
-        sh->typing = 1;
-        sh->num[0] = 0;
-        goto_key(sh, SDLK_UNKNOWN);
-        break;
-    case SDLK_F11:
-        sh->fullscreen = !sh->fullscreen;
-        SDL_SetWindowFullscreen(sh->win, sh->fullscreen ? SDL_WINDOW_FULLSCREEN_DESKTOP : 0);
-        break;
-    case SDLK_t: sh->v->theme = (sh->v->theme + 1) % PDT_THEME_COUNT; break;
-    case SDLK_c: sh->v->clean = !sh->v->clean; break;
-    case SDLK_o: sh->v->circles = !sh->v->circles; break;
-    case SDLK_v: sh->v->voronoi = !sh->v->voronoi; break;
-    default:
-        if (k >= SDLK_1 && k <= SDLK_9) {
-            int q = (int)(k - SDLK_1);
-            if (q < sh->nranks) sh->hidden[q] = !sh->hidden[q];
-        } else {
-            sh->dirty = 0;
-        }
-    }
+    sh->dirty = move_key(sh, k, shift) || view_key(sh, k, shift);
 }
 
 static void click(shell *sh, double x, double y)
@@ -358,6 +377,113 @@ static void mouse(shell *sh, const SDL_Event *e)
  * C-left), key:NAME / key:C-NAME (any SDL key name, C- = with Ctrl), wait:N
  * (frames), click:X,Y, rclick:X,Y (right button) and wheel:X,Y,N (window
  * coordinates), drag:X0,Y0,X1,Y1. */
+/* A key token of a script (a name of the table, a digit, key:NAME or
+ * key:C-NAME with SDL's key names): pushed as a key press; 0 if tok is
+ * not one. */
+static int script_key(const char *tok)
+{
+    static const struct { const char *name; SDL_Keycode k; Uint16 mod; } keys[] = {
+        {"space", SDLK_SPACE, 0},   {"right", SDLK_RIGHT, 0},  {"left", SDLK_LEFT, 0},
+        {"S-right", SDLK_RIGHT, KMOD_LSHIFT}, {"S-left", SDLK_LEFT, KMOD_LSHIFT},
+        {"pgdn", SDLK_PAGEDOWN, 0}, {"pgup", SDLK_PAGEUP, 0},  {"home", SDLK_HOME, 0},
+        {"end", SDLK_END, 0},       {"plus", SDLK_PLUS, 0},    {"minus", SDLK_MINUS, 0},
+        {"h", SDLK_h, 0},           {"k", SDLK_k, 0},          {"f", SDLK_f, 0},
+        {"s", SDLK_s, 0},           {"q", SDLK_q, 0},          {"esc", SDLK_ESCAPE, 0},
+        {"m", SDLK_m, 0},           {"r", SDLK_r, 0},
+        {"g", SDLK_g, 0},           {"enter", SDLK_RETURN, 0}, {"bksp", SDLK_BACKSPACE, 0},
+        {"t", SDLK_t, 0},           {"c", SDLK_c, 0},          {"o", SDLK_o, 0},
+        {"v", SDLK_v, 0},           {"f11", SDLK_F11, 0},
+        {"C-plus", SDLK_EQUALS, KMOD_LCTRL}, {"C-minus", SDLK_MINUS, KMOD_LCTRL},
+        {"C-0", SDLK_0, KMOD_LCTRL}, {"C-right", SDLK_RIGHT, KMOD_LCTRL},
+        {"C-left", SDLK_LEFT, KMOD_LCTRL},
+    };
+    SDL_Event e;
+    memset(&e, 0, sizeof e);
+    e.type = SDL_KEYDOWN;
+    for (size_t i = 0; i < sizeof keys / sizeof *keys; i++)
+        if (!strcmp(tok, keys[i].name)) {
+            e.key.keysym.sym = keys[i].k;
+            e.key.keysym.mod = keys[i].mod;
+            SDL_PushEvent(&e);
+            return 1;
+        }
+    if (tok[0] >= '0' && tok[0] <= '9' && !tok[1]) {
+        e.key.keysym.sym = SDLK_0 + (tok[0] - '0');
+        SDL_PushEvent(&e);
+        return 1;
+    }
+    if (strncmp(tok, "key:", 4)) return 0;
+    const char *name = tok + 4;
+    int ctrl = !strncmp(name, "C-", 2);
+    e.key.keysym.sym = SDL_GetKeyFromName(ctrl ? name + 2 : name);
+    e.key.keysym.mod = ctrl ? KMOD_LCTRL : 0;
+    if (e.key.keysym.sym == SDLK_UNKNOWN) return 0;
+    SDL_PushEvent(&e);
+    return 1;
+}
+
+/* A press and release of mouse button `button` at (x, y). */
+static void push_click(Uint8 button, int x, int y)
+{
+    SDL_Event e;
+    memset(&e, 0, sizeof e);
+    e.type = SDL_MOUSEBUTTONDOWN;
+    e.button.button = button;
+    e.button.x = x;
+    e.button.y = y;
+    SDL_PushEvent(&e);
+    e.type = SDL_MOUSEBUTTONUP;
+    SDL_PushEvent(&e);
+}
+
+/* A left-button drag from (a, b) to (c, d). */
+static void push_drag(int a, int b, int c, int d)
+{
+    SDL_Event e;
+    memset(&e, 0, sizeof e);
+    e.type = SDL_MOUSEBUTTONDOWN;
+    e.button.button = SDL_BUTTON_LEFT;
+    e.button.x = a;
+    e.button.y = b;
+    SDL_PushEvent(&e);
+    SDL_Event mv;
+    memset(&mv, 0, sizeof mv);
+    mv.type = SDL_MOUSEMOTION;
+    mv.motion.x = c;
+    mv.motion.y = d;
+    SDL_PushEvent(&mv);
+    e.type = SDL_MOUSEBUTTONUP;
+    e.button.x = c;
+    e.button.y = d;
+    SDL_PushEvent(&e);
+}
+
+/* The mouse and timing tokens of a script (rclick, wait, click, drag,
+ * wheel); an unknown token is reported. */
+static void script_other(shell *sh, const char *tok)
+{
+    int a, b, c, d;
+    if (sscanf(tok, "rclick:%d,%d", &a, &b) == 2) {
+        push_click(SDL_BUTTON_RIGHT, a, b);
+    } else if (sscanf(tok, "wait:%d", &a) == 1) {
+        sh->wait_frames = a;
+    } else if (sscanf(tok, "click:%d,%d", &a, &b) == 2) {
+        push_click(SDL_BUTTON_LEFT, a, b);
+    } else if (sscanf(tok, "drag:%d,%d,%d,%d", &a, &b, &c, &d) == 4) {
+        push_drag(a, b, c, d);
+    } else if (sscanf(tok, "wheel:%d,%d,%d", &a, &b, &c) == 3) {
+        SDL_WarpMouseInWindow(sh->win, a, b);
+        SDL_Event e;
+        memset(&e, 0, sizeof e);
+        e.type = SDL_MOUSEWHEEL;
+        e.wheel.y = c;
+        SDL_PushEvent(&e);
+    } else {
+        fprintf(stderr, "pdtview: script: unknown token \"%s\"\n", tok);
+    }
+}
+
+/* The script's next token, as the events it stands for. */
 static void script_step(shell *sh)
 {
     if (!sh->script) return;
@@ -376,91 +502,7 @@ static void script_step(shell *sh)
     memcpy(tok, sh->script, n);
     tok[n] = 0;
     sh->script += strcspn(sh->script, " ");
-    static const struct { const char *name; SDL_Keycode k; Uint16 mod; } keys[] = {
-        {"space", SDLK_SPACE, 0},   {"right", SDLK_RIGHT, 0},  {"left", SDLK_LEFT, 0},
-        {"S-right", SDLK_RIGHT, KMOD_LSHIFT}, {"S-left", SDLK_LEFT, KMOD_LSHIFT},
-        {"pgdn", SDLK_PAGEDOWN, 0}, {"pgup", SDLK_PAGEUP, 0},  {"home", SDLK_HOME, 0},
-        {"end", SDLK_END, 0},       {"plus", SDLK_PLUS, 0},    {"minus", SDLK_MINUS, 0},
-        {"h", SDLK_h, 0},           {"k", SDLK_k, 0},          {"f", SDLK_f, 0},
-        {"s", SDLK_s, 0},           {"q", SDLK_q, 0},          {"esc", SDLK_ESCAPE, 0},
-        {"m", SDLK_m, 0},           {"r", SDLK_r, 0},
-        {"g", SDLK_g, 0},           {"enter", SDLK_RETURN, 0}, {"bksp", SDLK_BACKSPACE, 0},
-        {"t", SDLK_t, 0},           {"c", SDLK_c, 0},          {"o", SDLK_o, 0},
-        {"v", SDLK_v, 0},           {"f11", SDLK_F11, 0},
-        {"C-plus", SDLK_EQUALS, KMOD_LCTRL}, {"C-minus", SDLK_MINUS, KMOD_LCTRL},
-        {"C-0", SDLK_0, KMOD_LCTRL}, {"C-right", SDLK_RIGHT, KMOD_LCTRL},
-        {"C-left", SDLK_LEFT, KMOD_LCTRL},
-    };
-    SDL_Event e;
-    memset(&e, 0, sizeof e);
-    for (size_t i = 0; i < sizeof keys / sizeof *keys; i++)
-        if (!strcmp(tok, keys[i].name)) {
-            e.type = SDL_KEYDOWN;
-            e.key.keysym.sym = keys[i].k;
-            e.key.keysym.mod = keys[i].mod;
-            SDL_PushEvent(&e);
-            return;
-        }
-    if (tok[0] >= '0' && tok[0] <= '9' && !tok[1]) {
-        e.type = SDL_KEYDOWN;
-        e.key.keysym.sym = SDLK_0 + (tok[0] - '0');
-        SDL_PushEvent(&e);
-        return;
-    }
-    if (!strncmp(tok, "key:", 4)) { /* key:NAME or key:C-NAME (SDL key names: z, F1, ...) */
-        const char *name = tok + 4;
-        int ctrl = !strncmp(name, "C-", 2);
-        e.type = SDL_KEYDOWN;
-        e.key.keysym.sym = SDL_GetKeyFromName(ctrl ? name + 2 : name);
-        e.key.keysym.mod = ctrl ? KMOD_LCTRL : 0;
-        if (e.key.keysym.sym != SDLK_UNKNOWN) {
-            SDL_PushEvent(&e);
-            return;
-        }
-    }
-    int a, b, c, d;
-    if (sscanf(tok, "rclick:%d,%d", &a, &b) == 2) {
-        e.type = SDL_MOUSEBUTTONDOWN;
-        e.button.button = SDL_BUTTON_RIGHT;
-        e.button.x = a;
-        e.button.y = b;
-        SDL_PushEvent(&e);
-        e.type = SDL_MOUSEBUTTONUP;
-        SDL_PushEvent(&e);
-    } else if (sscanf(tok, "wait:%d", &a) == 1) {
-        sh->wait_frames = a;
-    } else if (sscanf(tok, "click:%d,%d", &a, &b) == 2) {
-        e.type = SDL_MOUSEBUTTONDOWN;
-        e.button.button = SDL_BUTTON_LEFT;
-        e.button.x = a;
-        e.button.y = b;
-        SDL_PushEvent(&e);
-        e.type = SDL_MOUSEBUTTONUP;
-        SDL_PushEvent(&e);
-    } else if (sscanf(tok, "drag:%d,%d,%d,%d", &a, &b, &c, &d) == 4) {
-        e.type = SDL_MOUSEBUTTONDOWN;
-        e.button.button = SDL_BUTTON_LEFT;
-        e.button.x = a;
-        e.button.y = b;
-        SDL_PushEvent(&e);
-        SDL_Event mv;
-        memset(&mv, 0, sizeof mv);
-        mv.type = SDL_MOUSEMOTION;
-        mv.motion.x = c;
-        mv.motion.y = d;
-        SDL_PushEvent(&mv);
-        e.type = SDL_MOUSEBUTTONUP;
-        e.button.x = c;
-        e.button.y = d;
-        SDL_PushEvent(&e);
-    } else if (sscanf(tok, "wheel:%d,%d,%d", &a, &b, &c) == 3) {
-        SDL_WarpMouseInWindow(sh->win, a, b);
-        e.type = SDL_MOUSEWHEEL;
-        e.wheel.y = c;
-        SDL_PushEvent(&e);
-    } else {
-        fprintf(stderr, "pdtview: script: unknown token \"%s\"\n", tok);
-    }
+    if (!script_key(tok)) script_other(sh, tok);
 }
 
 static int make_texture(shell *sh);

@@ -14,7 +14,7 @@ typedef struct pdt_shell_input {
     int ctrl, shift; /* modifiers held */
 } pdt_shell_input;
 
-/* A layer over the replay (the editor, src/view/edit.c): it sees input first,
+/* A layer over the replay (the editor, src/view/app/edit.c): it sees input first,
  * may replace the replay the shell shows, and draws over each frame. */
 typedef struct pdt_shell_hook {
     void *user;

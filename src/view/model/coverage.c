@@ -1,6 +1,6 @@
 /* Level of detail: the triangles of a replay state counted per cell of a
  * grid (pdt_replay_coverage), so that a picture of millions of triangles
- * shows their density, makers and statuses (src/view/render_lod.c paints
+ * shows their density, makers and statuses (src/view/render/render_lod.c paints
  * it).  One pass over the triangles born so far, in their order, shared
  * by two threads on big runs; a kept index's pages are given back behind
  * it. */

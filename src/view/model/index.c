@@ -464,15 +464,12 @@ static int streamed_sec(const pdt_replay *r, int i, uint64_t *at)
     }
 }
 
-static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
-                               evcopy *ec, pdt_err *err)
+/* The places of the tables in the file from pc->off on (the checkpoints
+ * last: their sizes are known once they are made); returns where the
+ * checkpoints go. */
+static uint64_t place_tables(pdt_replay *r, ihdr *h, const placer *pc, size_t elem[NSEC],
+                             const uint64_t count[NSEC])
 {
-    void **ptr[NSEC];
-    size_t elem[NSEC];
-    uint64_t count[NSEC];
-    pdt_ix_sections(r, ptr, elem, count);
-    /* the places of the tables (the checkpoints last: their sizes are known
-     * once they are made) */
     uint64_t off = pc->off;
     for (int i = 0; i < NSEC; i++) {
         h->count[i] = count[i];
@@ -486,7 +483,16 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
         h->sec[i] = (isec){off, count[i] * elem[i], 0, 0};
         off += h->sec[i].bytes;
     }
-    off = (off + 63) & ~(uint64_t)63;
+    return (off + 63) & ~(uint64_t)63;
+}
+
+/* Write the tables held in memory (ptr) while a second thread writes the
+ * checkpoints at off (their checksums into *ck_crc).  The points are read
+ * in place from the run: a chunk at a time, their pages given back behind,
+ * while the checkpoints' state is held.  1, or 0 (errno). */
+static int write_sections(pdt_replay *r, int fd, const ihdr *h, const placer *pc, void **ptr[NSEC],
+                          uint64_t off, crcacc *ck_crc)
+{
     ck_job ck = {r, fd, 0, off, {0}};
     pthread_t th;
     int threaded = pthread_create(&th, NULL, ck_worker, &ck) == 0;
@@ -494,8 +500,6 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     for (int i = 0; wrote && i < NSEC; i++) {
         uint64_t at;
         if (i == S_SEGS || i == S_CKPT || streamed_sec(r, i, &at)) continue;
-        /* (the points, read in place from the run: a chunk at a time, their
-         * pages given back behind, while the checkpoints' state is held) */
         for (uint64_t o = 0; wrote && o < h->sec[i].bytes; o += CHUNK_BYTES) {
             uint64_t k = h->sec[i].bytes - o < CHUNK_BYTES ? h->sec[i].bytes - o : CHUNK_BYTES;
             wrote = write_all(fd, (const char *)*ptr[i] + o, (size_t)k, h->sec[i].off + o);
@@ -505,17 +509,18 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     }
     if (threaded) pthread_join(th, NULL);
     else ck_worker(&ck);
-    crcacc ck_crc = ck.crc;
-    if (!wrote || !ck.ok) {
-        free(ck_crc.crc);
-        return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-    }
-    h->count[S_CKPT] = r->nick ? r->ick_off[r->nick] : 0;
-    h->sec[S_CKPT] = (isec){off, h->count[S_CKPT], 0, 0};
-    off += h->count[S_CKPT];
-    /* the chunk checksums: of the tables in memory from memory, of the
-     * records and checkpoints as they were written, of the streamed
-     * triangles and histories read back (pread, by up to four threads) */
+    *ck_crc = ck.crc;
+    return wrote && ck.ok;
+}
+
+/* The chunk checksums (*tab, *n of them): of the tables in memory from
+ * memory, of the records and checkpoints as they were written, of the
+ * streamed triangles and histories read back (pread, by up to four
+ * threads). */
+static pdt_status chunk_table(pdt_replay *r, int fd, const ihdr *h, const placer *pc,
+                              void **ptr[NSEC], const evcopy *ec, const crcacc *ck_crc,
+                              uint32_t **tab_out, uint64_t *n_out, pdt_err *err)
+{
     uint64_t first[NSEC + 1], n = 0;
     for (int i = 0; i < NSEC; i++) first[i] = n, n += chunks_of(h->sec[i].bytes);
     first[NSEC] = n;
@@ -527,7 +532,7 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
         if (i == S_SEGS) {
             have = pdt_ix_crc_done(&ec->segs_crc, h->sec[i].bytes, tab + first[i]);
         } else if (i == S_CKPT) {
-            have = pdt_ix_crc_done(&ck_crc, h->sec[i].bytes, tab + first[i]);
+            have = pdt_ix_crc_done(ck_crc, h->sec[i].bytes, tab + first[i]);
         } else if (streamed_sec(r, i, &at)) {
             memset(todo + first[i], 1, nc);
         } else {
@@ -541,7 +546,6 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
             }
         }
     }
-    free(ck_crc.crc);
     if (!have) {
         free(tab);
         free(todo);
@@ -554,16 +558,19 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
         free(tab);
         return pdt_err_set(err, PDT_ERR_IO, "reading the index back for its checksums failed");
     }
-    off = (off + 63) & ~(uint64_t)63;
-    h->ctab = (isec){off, n * sizeof *tab, pdt_crc32c(0, tab, (size_t)(n * sizeof *tab)), 0};
-    wrote = write_all(fd, tab, (size_t)(n * sizeof *tab), off);
-    free(tab);
-    if (!wrote) return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-    off += h->ctab.bytes;
+    *tab_out = tab;
+    *n_out = n;
+    return PDT_OK;
+}
+
+/* The header of the index of r (file_bytes long) into its first page. */
+static pdt_status write_header(pdt_replay *r, int fd, ihdr *h, uint64_t ident, uint64_t file_bytes,
+                               pdt_err *err)
+{
     memcpy(h->magic, magic, sizeof magic);
     h->version = INDEX_VERSION;
     h->ident = ident;
-    h->file_bytes = off;
+    h->file_bytes = file_bytes;
     pdt_ix_layout_of(h->layout);
     h->n = r->n;
     h->m = r->m;
@@ -578,9 +585,38 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     unsigned char page[HDR_BYTES];
     memset(page, 0, sizeof page);
     memcpy(page, h, sizeof *h);
-    if (ftruncate(fd, (off_t)off) != 0 || !write_all(fd, page, sizeof page, 0))
+    if (ftruncate(fd, (off_t)file_bytes) != 0 || !write_all(fd, page, sizeof page, 0))
         return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
     return PDT_OK;
+}
+
+static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
+                               evcopy *ec, pdt_err *err)
+{
+    void **ptr[NSEC];
+    size_t elem[NSEC];
+    uint64_t count[NSEC];
+    pdt_ix_sections(r, ptr, elem, count);
+    uint64_t off = place_tables(r, h, pc, elem, count);
+    crcacc ck_crc;
+    if (!write_sections(r, fd, h, pc, ptr, off, &ck_crc)) {
+        free(ck_crc.crc);
+        return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+    }
+    h->count[S_CKPT] = r->nick ? r->ick_off[r->nick] : 0;
+    h->sec[S_CKPT] = (isec){off, h->count[S_CKPT], 0, 0};
+    off += h->count[S_CKPT];
+    uint32_t *tab = NULL;
+    uint64_t n = 0;
+    pdt_status st = chunk_table(r, fd, h, pc, ptr, ec, &ck_crc, &tab, &n, err);
+    free(ck_crc.crc);
+    if (st != PDT_OK) return st;
+    off = (off + 63) & ~(uint64_t)63;
+    h->ctab = (isec){off, n * sizeof *tab, pdt_crc32c(0, tab, (size_t)(n * sizeof *tab)), 0};
+    int wrote = write_all(fd, tab, (size_t)(n * sizeof *tab), off);
+    free(tab);
+    if (!wrote) return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+    return write_header(r, fd, h, ident, off + h->ctab.bytes, err);
 }
 
 /* Remove the temporary files (path.tmpPID) that builds of processes no
