@@ -46,19 +46,37 @@
 #
 # Layout: build/rel/... and build/san/... hold objects; bin/ the release
 # programs; bin/san/ the sanitizer programs; build/smpi/ and bin/smpi/pdt
-# the simulated build.  Sources are picked up by
-# wildcard: src/geom (predicates, hull, kernel, checker), src/io (files,
-# generators), src/trace (hook, writer, reader), src/par (parallel driver:
-# every file but comm_mpi.c goes into libpdtpar.a, which unit tests link; the
-# only code that includes mpi.h is src/par/comm_mpi.c, linked into bin/pdt
-# alone), src/cli (the pdt
-# program), src/view (replay model, cairo renderer, SDL2 shell: every file
-# but shell.c and pdtview.c goes into libpdtview.a, which needs cairo, and
-# for anim.c giflib (FFmpeg's libraries are opened with dlopen); bin/pdtview
-# adds SDL2, the option parser src/cli/opts.c and libpdtpar.a (the editor's
-# live runs on simulated ranks: src/view/live.c).  Unit tests named
-# tests/unit/test_view*.c are compiled with the cairo/SDL flags and linked
-# with libpdtview.a.
+# the simulated build (make smpi).  Sources are picked up by
+# wildcard, one folder per module, each with its private header:
+#   src/base    errors, clock, memory (bigmem), temporary files, checksums,
+#               external sort, the option parser both programs use; public
+#               headers include/pdt/{common,bigmem,tmpfile,checksum,xsort,
+#               opts,exit}.h.  Everything below builds on it; it calls nothing.
+#   src/geom    predicates, hull, kernel, checker, generators
+#   src/io      point and triangle files
+#   src/trace   the trace format: hook, writer, reader, checks, exports
+#   src/par     the parallel driver: every file but comm_mpi.c goes into
+#               libpdtpar.a, which unit tests link; the only code that
+#               includes mpi.h is src/par/comm_mpi.c, linked into bin/pdt alone
+#   src/cli     the pdt program
+#   src/view    the viewer in three rooms: model/ (replay, kept index,
+#               queries, synthetic and live runs; no cairo, no SDL:
+#               libpdtmodel.a), render/ (cairo drawing and picture/animation
+#               export: libpdtrender.a, and giflib for anim.c; FFmpeg's
+#               libraries are opened with dlopen), app/ (the SDL2 program:
+#               options, shell, editor, headless, bench: libpdtapp.a, and
+#               pdtview.c's main; bin/pdtview also links libpdtpar.a for the
+#               editor's live runs on simulated ranks).  Public headers of the viewer
+#               are in include/pdt/view/.
+# Unit tests named tests/unit/test_view*.c are compiled with the cairo/SDL
+# flags and linked with the viewer's libraries.  Header dependencies are
+# generated (-MMD -MP: build/VARIANT/**/*.d).
+#
+# Test hooks: the PDT_TEST_* fault-injection variables are read only by
+# builds compiled with -DPDT_TEST_HOOKS (src/base/testhook.c): the
+# sanitizer build and bin/test/pdt (the release objects linked with the
+# hooked testhook.o), which the shell tests that inject faults run.  The
+# release bin/pdt never reads them.
 
 CC      ?= gcc
 ifeq ($(origin CC),default)
@@ -82,7 +100,7 @@ MPI_LIBS    := $(shell pkg-config --libs ompi-c 2>/dev/null)
 VIEW_CFLAGS := $(shell pkg-config --cflags cairo sdl2 2>/dev/null)
 CAIRO_LIBS  := $(shell pkg-config --libs cairo 2>/dev/null)
 SDL_LIBS    := $(shell pkg-config --libs sdl2 2>/dev/null)
-# animation export (src/view/anim.c): giflib (no pkg-config file on Debian
+# animation export (src/view/render/anim.c): giflib (no pkg-config file on Debian
 # 12) is linked; FFmpeg's libraries are opened with dlopen when a video is
 # written (their codec libraries' start-up code is more than valgrind runs)
 AV_PKGS     := libavformat libavcodec libswscale libavutil
@@ -101,23 +119,29 @@ DEB_FUZZ  := clang libclang-rt-dev
 
 # the comm front and its local (threads) backend need no MPI: in libpdt.a
 COMM_SRC := src/par/comm.c src/par/comm_local.c
-LIB_SRC  := $(wildcard src/geom/*.c src/io/*.c src/trace/*.c) $(COMM_SRC)
+LIB_SRC  := $(wildcard src/base/*.c src/geom/*.c src/io/*.c src/trace/*.c) $(COMM_SRC)
 PAR_SRC  := $(filter-out $(COMM_SRC) src/par/comm_mpi.c,$(wildcard src/par/*.c))
 CLI_SRC  := $(wildcard src/cli/*.c)
-VIEWLIB_SRC := $(filter-out src/view/shell.c src/view/pdtview.c,$(wildcard src/view/*.c))
-VIEWAPP_SRC := $(filter src/view/shell.c src/view/pdtview.c,$(wildcard src/view/*.c))
+MODEL_SRC  := $(wildcard src/view/model/*.c)
+RENDER_SRC := $(wildcard src/view/render/*.c)
+APP_SRC  := $(filter-out src/view/app/pdtview.c,$(wildcard src/view/app/*.c))
 UNIT_SRC := $(wildcard tests/unit/*.c)
 
 # ---- one build variant: $(call variant,NAME,FLAGS,BINDIR) -------------------
 define variant
 $(1)_OBJ := build/$(1)
 $(1)_LIB := build/$(1)/libpdt.a
-$(1)_VIEWLIB := build/$(1)/libpdtview.a
 $(1)_PARLIB := build/$(1)/libpdtpar.a
 
-build/$(1)/%.o: %.c $$(wildcard include/pdt/*.h src/*/*.h) | build/$(1)/.dirs
+build/$(1)/%.o: %.c | build/$(1)/.dirs
 	@mkdir -p $$(dir $$@)
-	$$(CC) $(CSTD) $(2) $(WARN) $(INC) $$(if $$(findstring src/par/comm_mpi,$$<),$(MPI_CFLAGS)) $$(if $$(findstring /view/,$$<),$(VIEW_CFLAGS)) $$(if $$(findstring tests/unit/test_view,$$<),$(VIEW_CFLAGS)) -c $$< -o $$@
+	$$(CC) $(CSTD) $(2) $(WARN) $(INC) -MMD -MP $$(if $$(findstring src/par/comm_mpi,$$<),$(MPI_CFLAGS)) $$(if $$(findstring /view/render/,$$<)$$(findstring /view/app/,$$<),$(VIEW_CFLAGS)) $$(if $$(findstring tests/unit/test_view,$$<),$(VIEW_CFLAGS)) -c $$< -o $$@
+
+# the test hooks' reader, compiled to read them (linked ahead of libpdt.a
+# into the programs and tests that inject faults)
+build/$(1)/hooks/testhook.o: src/base/testhook.c | build/$(1)/.dirs
+	@mkdir -p $$(dir $$@)
+	$$(CC) $(CSTD) $(2) $(WARN) $(INC) -MMD -MP -DPDT_TEST_HOOKS -c $$< -o $$@
 
 build/$(1)/.dirs:
 	@mkdir -p build/$(1) $(3)
@@ -131,27 +155,43 @@ build/$(1)/libpdtpar.a: $$(patsubst %.c,build/$(1)/%.o,$(PAR_SRC))
 	@rm -f $$@
 	ar rcs $$@ $$^
 
-build/$(1)/libpdtview.a: $$(patsubst %.c,build/$(1)/%.o,$(VIEWLIB_SRC))
+build/$(1)/libpdtmodel.a: $$(patsubst %.c,build/$(1)/%.o,$(MODEL_SRC))
 	@rm -f $$@
 	ar rcs $$@ $$^
 
-$(3)/pdt: $$(patsubst %.c,build/$(1)/%.o,$(CLI_SRC) src/par/comm_mpi.c) build/$(1)/libpdtpar.a build/$(1)/libpdt.a
+build/$(1)/libpdtrender.a: $$(patsubst %.c,build/$(1)/%.o,$(RENDER_SRC))
+	@rm -f $$@
+	ar rcs $$@ $$^
+
+build/$(1)/libpdtapp.a: $$(patsubst %.c,build/$(1)/%.o,$(APP_SRC))
+	@rm -f $$@
+	ar rcs $$@ $$^
+
+$(3)/pdt: $$(patsubst %.c,build/$(1)/%.o,$(CLI_SRC) src/par/comm_mpi.c) $(4) build/$(1)/libpdtpar.a build/$(1)/libpdt.a
 	$$(CC) $(2) -o $$@ $$^ $(MPI_LIBS) $(OTF2_LIBS) $(LIBS)
 
-$(3)/pdtview: $$(patsubst %.c,build/$(1)/%.o,$(VIEWAPP_SRC) src/cli/opts.c) build/$(1)/libpdtview.a build/$(1)/libpdtpar.a build/$(1)/libpdt.a
+$(3)/test/pdt: $$(patsubst %.c,build/$(1)/%.o,$(CLI_SRC) src/par/comm_mpi.c) build/$(1)/hooks/testhook.o build/$(1)/libpdtpar.a build/$(1)/libpdt.a
+	@mkdir -p $$(dir $$@)
+	$$(CC) $(2) -o $$@ $$^ $(MPI_LIBS) $(OTF2_LIBS) $(LIBS)
+
+$(3)/pdtview: build/$(1)/src/view/app/pdtview.o $(4) build/$(1)/libpdtapp.a build/$(1)/libpdtrender.a build/$(1)/libpdtmodel.a build/$(1)/libpdtpar.a build/$(1)/libpdt.a
 	$$(CC) $(2) -o $$@ $$^ $(SDL_LIBS) $(CAIRO_LIBS) $(ANIM_LIBS) $(LIBS)
 
-$(3)/tests/%: build/$(1)/tests/unit/%.o $(if $(VIEWLIB_SRC),build/$(1)/libpdtview.a) build/$(1)/libpdtpar.a build/$(1)/libpdt.a
+$(3)/tests/%: build/$(1)/tests/unit/%.o build/$(1)/hooks/testhook.o build/$(1)/libpdtapp.a build/$(1)/libpdtrender.a build/$(1)/libpdtmodel.a build/$(1)/libpdtpar.a build/$(1)/libpdt.a
 	@mkdir -p $$(dir $$@)
 	$$(CC) $(2) -o $$@ $$^ $(CAIRO_LIBS) $(ANIM_LIBS) $(LIBS)
 
-$(1)-all: $(3)/pdt $(if $(VIEWAPP_SRC),$(3)/pdtview) $(patsubst tests/unit/%.c,$(3)/tests/%,$(UNIT_SRC))
+$(1)-all: $(3)/pdt $(3)/test/pdt $(3)/pdtview $(patsubst tests/unit/%.c,$(3)/tests/%,$(UNIT_SRC))
+
+-include $$(shell find build/$(1) -name '*.d' 2>/dev/null)
 endef
 
-$(eval $(call variant,rel,$(OPT),bin))
-$(eval $(call variant,san,$(SAN),bin/san))
+# variant NAME, flags, programs' folder, what the programs link ahead of
+# libpdt.a (the sanitizer build is a test build: its programs read the hooks)
+$(eval $(call variant,rel,$(OPT),bin,))
+$(eval $(call variant,san,$(SAN),bin/san,build/san/hooks/testhook.o))
 
-.PHONY: all deps deps-lesson test demo lesson bench table1 clean rel-all san-all check-deps fuzz fuzz-build fuzz-seeds \
+.PHONY: all deps deps-bench deps-fuzz deps-lesson test demo lesson bench table1 clean rel-all san-all fuzz fuzz-build fuzz-seeds \
         smpi smpi-build simulate
 .DEFAULT_GOAL := all
 
@@ -233,9 +273,11 @@ FUZZ_TARGETS ?= points_text points_node tris manifest trace_rank trace_run
 FUZZ_FLAGS   := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined \
                 -fno-sanitize-recover=undefined
 
-build/fuzz/%.o: %.c $(wildcard include/pdt/*.h src/*/*.h)
+build/fuzz/%.o: %.c
 	@mkdir -p $(dir $@)
-	$(FUZZ_CC) $(CSTD) $(FUZZ_FLAGS) -fsanitize=fuzzer-no-link $(INC) -c $< -o $@
+	$(FUZZ_CC) $(CSTD) $(FUZZ_FLAGS) -fsanitize=fuzzer-no-link $(INC) -MMD -MP -c $< -o $@
+
+-include $(shell find build/fuzz -name '*.d' 2>/dev/null)
 
 build/fuzz/libpdt.a: $(patsubst %.c,build/fuzz/%.o,$(LIB_SRC))
 	@rm -f $@

@@ -133,9 +133,9 @@ enum {
     /* (or'd with one of the above) a second thread faults the pipeline's
      * working memory in ahead of use (docs/geometry.md, "Prefault"): only
      * for a caller that leaves a core idle (a plain run, never an MPI rank
-     * sharing the machine's cores); costs that core about 2 s of CPU per
-     * GiB of fresh memory on this project's VM, saves the caller about as
-     * much on the critical path.  Same results with or without. */
+     * sharing the machine's cores); costs that core the CPU time of the
+     * page faults, and saves the caller about as much on the critical
+     * path.  Same results with or without. */
     PDT_TRI_PREFAULT = 2
 };
 

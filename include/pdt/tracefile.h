@@ -37,6 +37,7 @@
 #define PDT_TRACEFILE_H
 
 #include "pdt/common.h"
+#include "pdt/checksum.h"
 #include "pdt/trace.h"
 
 /* Version of the run-folder format written by this code.  A reader accepts
@@ -87,18 +88,6 @@ void pdt_points_encode(uint8_t *out, const pdt_point *pts, size_t n);
  * bytes have CRC-32C data_crc. */
 #define PDT_POINTS_HEADER_BYTES 24
 void pdt_points_header(uint8_t *h, uint64_t n, uint32_t data_crc);
-/* CRC-32C (Castagnoli, reflected 0x82F63B78, init and final xor ~0) of n
- * bytes, continuing from `crc` (start with 0): the checksum of trace blocks
- * and points.bin.  pdt_crc32c(0, "123456789", 9) == 0xE3069283. */
-uint32_t pdt_crc32c(uint32_t crc, const void *data, size_t n);
-/* CRC-64/XZ (reflected 0xC96C5795D7870F42, init and final xor ~0) of n bytes,
- * continuing from `crc` (start with 0).  pdt_crc64(0, "123456789", 9) ==
- * 0x995DC9BBDF1939FA. */
-uint64_t pdt_crc64(uint64_t crc, const void *data, size_t n);
-/* The CRC of A followed by B, from crc_a = CRC(A), crc_b = CRC(B) and
- * len_b = |B| in bytes (any length; O(log len_b)). */
-uint32_t pdt_crc32c_combine(uint32_t crc_a, uint32_t crc_b, uint64_t len_b);
-uint64_t pdt_crc64_combine(uint64_t crc_a, uint64_t crc_b, uint64_t len_b);
 /* Realtime clock in nanoseconds since the epoch (for wall_start_ns). */
 uint64_t pdt_wall_ns(void);
 

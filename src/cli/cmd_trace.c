@@ -69,13 +69,9 @@ typedef struct phase_rec {
     size_t depth;
 } phase_rec;
 
-static int cmd_info(const char *dir)
+/* info: the manifest's lines. */
+static void info_manifest(const char *dir, const pdt_manifest *m, int p)
 {
-    pdt_run *run;
-    int rc = open_run(dir, &run);
-    if (rc) return rc;
-    const pdt_manifest *m = pdt_run_manifest(run);
-    int p = pdt_run_nranks(run);
     printf("run folder   %s (format %d.%d)\n", dir, m->format_version, m->format_minor);
     printf("command      %s  (pdt %s)\n", m->command[0] ? m->command : "?",
            m->program_version[0] ? m->program_version : "?");
@@ -93,13 +89,11 @@ static int cmd_info(const char *dir)
         printf("started      %s\n", when);
     }
     printf("ranks        %d   trace level %d\n\n", p, m->level);
+}
 
-    uint64_t (*cnt)[PDT_EV_KIND_COUNT + 1] = calloc((size_t)p, sizeof *cnt);
-    if (!cnt) {
-        fprintf(stderr, "pdt: out of memory\n");
-        pdt_run_close(run);
-        return PDT_EXIT_USAGE;
-    }
+/* info: every rank's events, blocks and bytes. */
+static void info_ranks(pdt_run *run, int p)
+{
     printf("rank      events   blocks        bytes  bytes/event  complete\n");
     uint64_t tev = 0, tbytes = 0;
     for (int r = 0; r < p; r++) {
@@ -114,11 +108,12 @@ static int cmd_info(const char *dir)
     if (p > 1)
         printf(" all %11" PRIu64 " %8s %12" PRIu64 " %12.2f\n", tev, "", tbytes,
                tev ? (double)tbytes / (double)tev : 0.0);
+}
 
-    /* one pass per rank: counts and phases (listed in the order they begin) */
-    printf("\nphases (rank, phase, start on the aligned clock, duration; nested ones "
-           "indented):\n");
-    uint64_t t0 = UINT64_MAX;  /* the earliest aligned time of any rank */
+/* The earliest aligned time of any rank's first event. */
+static uint64_t first_time(pdt_run *run, int p)
+{
+    uint64_t t0 = UINT64_MAX;
     for (int r = 0; r < p; r++) {
         pdt_cursor *c;
         pdt_event e;
@@ -126,58 +121,70 @@ static int cmd_info(const char *dir)
         if (pdt_cursor_next(c, &e, NULL) && e.t < t0) t0 = e.t;
         pdt_cursor_close(c);
     }
-    for (int r = 0; r < p; r++) {
-        pdt_cursor *c;
-        pdt_err err = {0};
-        if (pdt_cursor_open(run, r, &c, &err) != PDT_OK) continue;
-        phase_rec *ph = NULL;
-        size_t nph = 0, cap = 0, *open = NULL, depth = 0, capo = 0;
-        pdt_event e;
-        int nomem = 0;
-        while (!nomem && pdt_cursor_next(c, &e, NULL)) {
-            cnt[r][e.kind < PDT_EV_KIND_COUNT ? e.kind : PDT_EV_KIND_COUNT]++;
-            if (e.kind == PDT_EV_PHASE_BEGIN || e.kind == PDT_EV_MERGE_BEGIN) {
-                if (nph == cap) {
-                    cap = cap ? 2 * cap : 64;
-                    phase_rec *q = realloc(ph, cap * sizeof *q);
-                    if (!q) { nomem = 1; break; }
-                    ph = q;
-                }
-                if (depth == capo) {
-                    capo = capo ? 2 * capo : 16;
-                    size_t *q = realloc(open, capo * sizeof *q);
-                    if (!q) { nomem = 1; break; }
-                    open = q;
-                }
-                ph[nph] = (phase_rec){e, e.t, UINT64_MAX, depth};
-                open[depth++] = nph++;
-            } else if ((e.kind == PDT_EV_PHASE_END || e.kind == PDT_EV_MERGE_END) && depth > 0) {
-                ph[open[--depth]].end = e.t;
-            }
-        }
-        for (size_t i = 0; i < nph; i++) {
-            const pdt_event *b = &ph[i].begin;
-            const char *pn = pdt_phase_name(b->sub);
-            char name[80];
-            if (b->kind == PDT_EV_MERGE_BEGIN)
-                snprintf(name, sizeof name, "merge step level %u: [%u,%u)+[%u,%u)", b->sub, b->a,
-                         b->b, b->b, b->c);
-            else if (b->a)
-                snprintf(name, sizeof name, "%s %u", pn ? pn : "?", b->a);
-            else
-                snprintf(name, sizeof name, "%s", pn ? pn : "?");
-            printf("  r%-3d %*s%-*s start %12.6f ms  ", r, (int)(2 * ph[i].depth), "",
-                   (int)(34 - 2 * (ph[i].depth < 8 ? ph[i].depth : 8)), name,
-                   (double)(ph[i].t - t0) / 1e6);
-            if (ph[i].end == UINT64_MAX) printf("never ends\n");
-            else printf("duration %12.6f ms\n", (double)(ph[i].end - ph[i].t) / 1e6);
-        }
-        if (nomem) printf("  r%-3d (out of memory: phase list cut short)\n", r);
-        free(ph);
-        free(open);
-        pdt_cursor_close(c);
-    }
+    return t0;
+}
 
+/* One phase line of rank r (times from t0). */
+static void print_phase(int r, const phase_rec *ph, uint64_t t0)
+{
+    const pdt_event *b = &ph->begin;
+    const char *pn = pdt_phase_name(b->sub);
+    char name[80];
+    if (b->kind == PDT_EV_MERGE_BEGIN)
+        snprintf(name, sizeof name, "merge step level %u: [%u,%u)+[%u,%u)", b->sub, b->a,
+                 b->b, b->b, b->c);
+    else if (b->a)
+        snprintf(name, sizeof name, "%s %u", pn ? pn : "?", b->a);
+    else
+        snprintf(name, sizeof name, "%s", pn ? pn : "?");
+    printf("  r%-3d %*s%-*s start %12.6f ms  ", r, (int)(2 * ph->depth), "",
+           (int)(34 - 2 * (ph->depth < 8 ? ph->depth : 8)), name, (double)(ph->t - t0) / 1e6);
+    if (ph->end == UINT64_MAX) printf("never ends\n");
+    else printf("duration %12.6f ms\n", (double)(ph->end - ph->t) / 1e6);
+}
+
+/* info: one pass over rank r: its counts per kind (cnt) and its phases,
+ * listed in the order they begin, nested ones indented. */
+static void info_rank_phases(pdt_run *run, int r, uint64_t t0, uint64_t *cnt)
+{
+    pdt_cursor *c;
+    pdt_err err = {0};
+    if (pdt_cursor_open(run, r, &c, &err) != PDT_OK) return;
+    phase_rec *ph = NULL;
+    size_t nph = 0, cap = 0, *open = NULL, depth = 0, capo = 0;
+    pdt_event e;
+    int nomem = 0;
+    while (!nomem && pdt_cursor_next(c, &e, NULL)) {
+        cnt[e.kind < PDT_EV_KIND_COUNT ? e.kind : PDT_EV_KIND_COUNT]++;
+        if (e.kind == PDT_EV_PHASE_BEGIN || e.kind == PDT_EV_MERGE_BEGIN) {
+            if (nph == cap) {
+                cap = cap ? 2 * cap : 64;
+                phase_rec *q = realloc(ph, cap * sizeof *q);
+                if (!q) { nomem = 1; break; }
+                ph = q;
+            }
+            if (depth == capo) {
+                capo = capo ? 2 * capo : 16;
+                size_t *q = realloc(open, capo * sizeof *q);
+                if (!q) { nomem = 1; break; }
+                open = q;
+            }
+            ph[nph] = (phase_rec){e, e.t, UINT64_MAX, depth};
+            open[depth++] = nph++;
+        } else if ((e.kind == PDT_EV_PHASE_END || e.kind == PDT_EV_MERGE_END) && depth > 0) {
+            ph[open[--depth]].end = e.t;
+        }
+    }
+    for (size_t i = 0; i < nph; i++) print_phase(r, &ph[i], t0);
+    if (nomem) printf("  r%-3d (out of memory: phase list cut short)\n", r);
+    free(ph);
+    free(open);
+    pdt_cursor_close(c);
+}
+
+/* info: the events per kind, per rank (the first 16) and in all. */
+static void info_kinds(int p, uint64_t (*cnt)[PDT_EV_KIND_COUNT + 1])
+{
     printf("\nevents per kind:\n%-12s", "kind");
     for (int r = 0; r < p && r < 16; r++) printf(" %10s%d", "r", r);
     if (p > 1) printf(" %11s", "all");
@@ -192,6 +199,27 @@ static int cmd_info(const char *dir)
         printf("\n");
     }
     if (p > 16) printf("(per-rank columns shown for ranks 0..15)\n");
+}
+
+static int cmd_info(const char *dir)
+{
+    pdt_run *run;
+    int rc = open_run(dir, &run);
+    if (rc) return rc;
+    int p = pdt_run_nranks(run);
+    info_manifest(dir, pdt_run_manifest(run), p);
+    uint64_t (*cnt)[PDT_EV_KIND_COUNT + 1] = calloc((size_t)p, sizeof *cnt);
+    if (!cnt) {
+        fprintf(stderr, "pdt: out of memory\n");
+        pdt_run_close(run);
+        return PDT_EXIT_USAGE;
+    }
+    info_ranks(run, p);
+    printf("\nphases (rank, phase, start on the aligned clock, duration; nested ones "
+           "indented):\n");
+    uint64_t t0 = first_time(run, p);
+    for (int r = 0; r < p; r++) info_rank_phases(run, r, t0, cnt[r]);
+    info_kinds(p, cnt);
     free(cnt);
     print_warnings(run, stdout);
     pdt_run_close(run);

@@ -18,6 +18,7 @@
 #include "pdt/delaunay.h"
 #include "pdt/io.h"
 #include "pdt/par.h"
+#include "pdt/testhook.h"
 #include "run_opts.h"
 
 static const char help[] =
@@ -259,7 +260,7 @@ static pdt_status check_size(run *R, pdt_err *err)
 {
     set_phase(R, "options");
     uint64_t limit = PDT_KERNEL_MAX_POINTS, n = R->in.n_total, p = (uint64_t)R->p;
-    const char *t = getenv("PDT_TEST_KERNEL_LIMIT");
+    const char *t = pdt_test_hook("PDT_TEST_KERNEL_LIMIT");
     if (t && strtoull(t, NULL, 10) > 0) limit = strtoull(t, NULL, 10);
     pdt_status st = PDT_OK;
     if (R->rank == 0 && (n + p - 1) / p > limit) {

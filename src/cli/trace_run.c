@@ -13,6 +13,7 @@
 #include "pdt/io.h"
 #include "pdt/par.h"
 #include "pdt/tracefile.h"
+#include "pdt/testhook.h"
 #include "run_opts.h"
 
 struct pdt_cli_trace {
@@ -202,7 +203,7 @@ typedef struct block_sums {
  * points.bin (after the temporary exists), as a full disk would. */
 static pdt_status test_fail_points(int rank, const char *path, pdt_err *err)
 {
-    const char *e = getenv("PDT_TEST_FAIL_TRACE_POINTS");
+    const char *e = pdt_test_hook("PDT_TEST_FAIL_TRACE_POINTS");
     if (e && *e && atoi(e) == rank)
         return pdt_err_set(err, PDT_ERR_IO, "%s: write error: injected by "
                            "PDT_TEST_FAIL_TRACE_POINTS", path);

@@ -36,7 +36,7 @@
 
 #include "pdt/predicates.h"
 
-#include "bigmem.h"
+#include "pdt/bigmem.h"
 #include "pred_inline.h"
 
 #include <stdlib.h>

@@ -11,7 +11,7 @@
 #include <unistd.h>
 
 #include "io_internal.h"
-#include "../geom/bigmem.h"
+#include "pdt/bigmem.h"
 
 static int has_ext(const char *path, const char *ext)
 {

@@ -1,7 +1,7 @@
 /* pdt — loading a text file and scanning it line by line (see io_internal.h). */
 #include "io_internal.h"
 
-#include "../geom/bigmem.h"
+#include "pdt/bigmem.h"
 #include "pdt/io.h"
 
 #include <errno.h>

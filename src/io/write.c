@@ -3,7 +3,8 @@
  * than the triangulation itself on big outputs. */
 #include "pdt/io.h"
 
-#include "../geom/bigmem.h"
+#include "pdt/bigmem.h"
+#include "pdt/testhook.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -285,9 +286,8 @@ enum { SEC_CHUNK = WBUF / PDT_LINE_MAX, SEC_MIN_ITEMS = 1 << 18, SEC_MAX_THREADS
  * RELEASE_STEP items at a time or more (whole 2 MiB pages:
  * pdt_big_release_front).  The page cache of the file being written then
  * takes memory that was in use a moment before rather than memory the host
- * has taken back: on this project's VM the write of 3*10^7 points' triangles
- * took 0.48, 0.49 and 0.74 s in three runs, against 0.49, 0.89 and 0.99 s
- * without (the triangles are half the file's size: the other half still
+ * has taken back, which on a virtual machine makes the write's time steadier
+ * and shorter (the triangles are half the file's size: the other half still
  * comes from the free lists). */
 enum { RELEASE_STEP = 1 << 18 };
 
@@ -402,7 +402,7 @@ static int section_threads(void)
  * small inputs, every thread's turn taken). */
 static size_t section_chunk(void)
 {
-    const char *e = getenv("PDT_TEST_WRITE_CHUNK");
+    const char *e = pdt_test_hook("PDT_TEST_WRITE_CHUNK");
     long c = e ? atol(e) : 0;
     return c > 0 && (size_t)c < SEC_CHUNK ? (size_t)c : SEC_CHUNK;
 }
@@ -428,7 +428,7 @@ static int section_run(section_job *jb)
     pthread_t th[SEC_MAX_THREADS];
     int started = 1;
     for (int t = 0; t < jb->nthreads; t++) wk[t] = (section_worker){ jb, t };
-    const char *cap = getenv("PDT_TEST_WRITE_HELPERS"); /* tests: helpers that can start */
+    const char *cap = pdt_test_hook("PDT_TEST_WRITE_HELPERS"); /* tests: helpers that can start */
     int most = cap && *cap ? atoi(cap) : SEC_MAX_THREADS;
     for (; started < jb->nthreads; started++) {
         if (started > most ||

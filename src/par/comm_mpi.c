@@ -69,11 +69,10 @@ static const pdt_comm_ops mpi_ops;
  * environment it gives each rank), ask for the shared-memory point-to-point
  * layer (pml ob1, which uses the vader BTL) unless the user chose a pml or an
  * mtl: by default Open MPI 4.1 also opens its network MTLs (PSM, PSM2) to
- * find none, which took 0.22 s of the 0.32 s of MPI_Init on a 2-core machine
- * (0.10 s with ob1).  Likewise only the BTLs a node needs (self, vader: no
- * TCP, which sets up its sockets in every rank) unless the user chose BTLs:
- * a 10-point job 0.32 -> 0.22 s (medians of 5, loaded machine).  On several
- * nodes nothing changes. */
+ * find none, which is most of MPI_Init's time on a small machine.  Likewise
+ * only the BTLs a node needs (self, vader: no TCP, which sets up its sockets
+ * in every rank) unless the user chose BTLs.  On several nodes nothing
+ * changes. */
 static void one_node_defaults(void)
 {
     const char *size = getenv("OMPI_COMM_WORLD_SIZE");
@@ -86,10 +85,9 @@ static void one_node_defaults(void)
 
 /* The connection to the node's launcher daemon (PMIx over TCP on the
  * loopback with Open MPI 4.1) without Nagle's algorithm.  MPI_Finalize ends
- * with a fence through the daemon; its small request waited for the
- * daemon's delayed acknowledgement of the previous message: 45 ms of every
- * run (2 ms of CPU), 3 ms with TCP_NODELAY on our end (a 10-line MPI program,
- * 2 ranks, medians of 3, both ways, 26 Nov 2026).  Our sockets are
+ * with a fence through the daemon; with Nagle's algorithm its small request
+ * waits for the daemon's delayed acknowledgement of the previous message,
+ * tens of milliseconds of every run spent idle.  Our sockets are
  * PMIx's, made inside MPI_Init: every TCP socket of this process connected
  * to a loopback address gets the option; nothing else is touched, and a
  * failure changes nothing but the delay. */

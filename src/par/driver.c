@@ -27,6 +27,7 @@
 #include <unistd.h>
 
 #include "pdt/delaunay.h"
+#include "pdt/testhook.h"
 #include "srm.h"
 
 enum {
@@ -119,7 +120,7 @@ static pdt_status nomem(drv *d, const char *phase)
  * is created when the sleep begins. */
 static void test_sleep(int rank)
 {
-    const char *e = getenv("PDT_TEST_SLEEP_BEFORE_MERGE");
+    const char *e = pdt_test_hook("PDT_TEST_SLEEP_BEFORE_MERGE");
     int r;
     double sec;
     if (e && sscanf(e, "%d:%lf", &r, &sec) == 2 && r == rank && sec > 0) {
@@ -904,7 +905,7 @@ static void order_room_free(order_room *o)
  * in the block (tests: every choice of room below runs on small inputs). */
 static size_t test_order_room(size_t cap)
 {
-    const char *e = getenv("PDT_TEST_ORDER_ROOM");
+    const char *e = pdt_test_hook("PDT_TEST_ORDER_ROOM");
     char *end;
     unsigned long long v = e && *e ? strtoull(e, &end, 10) : 0;
     return e && *e && !*end && v < cap ? (size_t)v : cap;

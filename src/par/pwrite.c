@@ -23,7 +23,8 @@
 #include "pdt/io.h"
 #include "pdt/par.h"
 
-#include "../geom/bigmem.h"
+#include "pdt/bigmem.h"
+#include "pdt/testhook.h"
 
 /* Bytes formatted at once (then written): 4 MiB of the longest lines. */
 enum { PIECE_LINES = 65536 };
@@ -100,7 +101,7 @@ static volatile sig_atomic_t npending;
 
 void pdt_par_test_mark(void)
 {
-    const char *m = getenv("PDT_TEST_MARK");
+    const char *m = pdt_test_hook("PDT_TEST_MARK");
     if (!m || !*m) return;
     int fd = open(m, O_WRONLY | O_CREAT, 0644);
     if (fd >= 0) close(fd);
@@ -116,7 +117,7 @@ void pdt_par_write_abandon(void)
  * PDT_TEST_MARK=FILE is created when the sleep begins. */
 static void test_sleep_in_write(int rank)
 {
-    const char *e = getenv("PDT_TEST_SLEEP_IN_WRITE");
+    const char *e = pdt_test_hook("PDT_TEST_SLEEP_IN_WRITE");
     int r;
     double sec;
     if (e && sscanf(e, "%d:%lf", &r, &sec) == 2 && r == rank && sec > 0) {
@@ -130,7 +131,7 @@ static void test_sleep_in_write(int rank)
  * parallel write (after the temporary file exists), as a full disk would. */
 static pdt_status test_fail_write(int rank, const char *path, pdt_err *err)
 {
-    const char *e = getenv("PDT_TEST_FAIL_WRITE");
+    const char *e = pdt_test_hook("PDT_TEST_FAIL_WRITE");
     if (e && *e && atoi(e) == rank)
         return pdt_err_set(err, PDT_ERR_IO, "%s: write error: injected by PDT_TEST_FAIL_WRITE",
                            path);

@@ -17,7 +17,7 @@
 #include "pdt/trace.h"
 #include <stdlib.h>
 
-#include "../geom/bigmem.h"
+#include "pdt/bigmem.h"
 #include "pdt/delaunay.h"
 
 /* A point with its identity: global input index of its representative. */

@@ -7,7 +7,8 @@
 
 #include "pdt/predicates.h"
 #include "certify.h"
-#include "xsort.h"
+#include "pdt/xsort.h"
+#include "pdt/tmpfile.h"
 
 /* The coordinates of this many corners are read between two givings-back
  * of the points' resident pages. */
@@ -74,10 +75,9 @@ void pdt_cert_free(pdt_cert *c)
 
 static pdt_status tmp_fail(pdt_err *err, const char *what)
 {
-    const char *dir = getenv("TMPDIR");
     if (errno == ENOMEM) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     return pdt_err_set(err, PDT_ERR_IO, "temporary file for the triangles' sides in %s: %s: %s",
-                       dir && *dir ? dir : "/tmp", what, strerror(errno));
+                       pdt_tmp_dir(), what, strerror(errno));
 }
 
 pdt_status pdt_cert_add(pdt_cert *c, const uint32_t v[3], pdt_err *err)

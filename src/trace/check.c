@@ -16,8 +16,8 @@
 #include "pdt/tracefile.h"
 #include "check_int.h"
 #include "hullcert.h"
-#include "xsort.h"
-#include "../geom/bigmem.h"
+#include "pdt/xsort.h"
+#include "pdt/bigmem.h"
 
 pdt_status chk_nomem(chk *c)
 {

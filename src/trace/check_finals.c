@@ -13,8 +13,9 @@
 #include "pdt/predicates.h"
 #include "certify.h"
 #include "check_int.h"
-#include "xsort.h"
-#include "../geom/bigmem.h"
+#include "pdt/xsort.h"
+#include "pdt/bigmem.h"
+#include "pdt/tmpfile.h"
 
 static int cmp_tri(const void *a, const void *b)
 {
@@ -249,10 +250,9 @@ static void fm_close(fin_merge *m)
 /* A temporary file's failure: "temporary file for <of> in DIR: <what>: why". */
 pdt_status chk_tmp_fail(chk *c, const char *of, const char *what)
 {
-    const char *dir = getenv("TMPDIR");
     if (errno == ENOMEM) return chk_nomem(c);
     return pdt_err_set(c->err, PDT_ERR_IO, "temporary file for %s in %s: %s: %s", of,
-                       dir && *dir ? dir : "/tmp", what, strerror(errno));
+                       pdt_tmp_dir(), what, strerror(errno));
 }
 
 static pdt_status io_fail(chk *c, const char *what)
@@ -260,24 +260,10 @@ static pdt_status io_fail(chk *c, const char *what)
     return chk_tmp_fail(c, "the final triangles", what);
 }
 
-/* A new anonymous temporary file in $TMPDIR (else /tmp), or NULL (errno). */
-static FILE *spill_file(void)
-{
-    const char *dir = getenv("TMPDIR");
-    char path[4096];
-    snprintf(path, sizeof path, "%s/pdt-finals.XXXXXX", dir && *dir ? dir : "/tmp");
-    int fd = mkstemp(path);
-    if (fd < 0) return NULL;
-    unlink(path);  /* gone when closed, even if we are killed */
-    FILE *f = fdopen(fd, "w+b");
-    if (!f) close(fd);
-    return f;
-}
-
 /* Merge every spilled run into one (when too many piled up). */
 static pdt_status compact_runs(chk *c)
 {
-    FILE *out = spill_file();
+    FILE *out = pdt_tmp_file("pdt-finals", 0);
     if (!out) return io_fail(c, "cannot create");
     fin_merge m;
     pdt_status st = PDT_OK;
@@ -303,7 +289,7 @@ pdt_status chk_spill_finals(chk *c)
     if (!c->nfin) return PDT_OK;
     sort_fins(c->fin, c->nfin, c->npts);
     if (chk_grow((void **)&c->runs, &c->capruns, c->nruns, sizeof *c->runs)) return chk_nomem(c);
-    FILE *f = spill_file();
+    FILE *f = pdt_tmp_file("pdt-finals", 0);
     if (!f) return io_fail(c, "cannot create");
     c->runs[c->nruns++] = f;
     c->spills++;

@@ -10,7 +10,7 @@
 
 #include "pdt/tracefile.h"
 #include "tf_internal.h"
-#include "../geom/bigmem.h"
+#include "pdt/bigmem.h"
 
 typedef struct fin {   /* a TRI_FINAL, rotated to start at its smallest index */
     pdt_tri t;

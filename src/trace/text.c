@@ -39,6 +39,38 @@ static pdt_event tri_rotated(const pdt_event *e)
     return r;
 }
 
+/* The triangle events (corners already rotated to start at the least). */
+static void format_tri(const pdt_event *e, char *buf, size_t cap)
+{
+    char t1[24];
+    switch (e->kind) {
+    case PDT_EV_TRI_NEW:
+        snprintf(buf, cap, "tri-new %s %" PRIu32 " %" PRIu32 " %" PRIu32,
+                 e->sub == 0 ? "local" : e->sub == 1 ? "border" : or_num(NULL, t1, sizeof t1, e->sub),
+                 e->a, e->b, e->c);
+        break;
+    case PDT_EV_TRI_FINAL:
+        snprintf(buf, cap, "tri-final %" PRIu32 " %" PRIu32 " %" PRIu32, e->a, e->b, e->c);
+        break;
+    case PDT_EV_RA_DEFER:
+        snprintf(buf, cap, "ra-defer %" PRIu32 " %" PRIu32 " %" PRIu32 " rank=%" PRId64, e->a, e->b,
+                 e->c, e->v);
+        break;
+    case PDT_EV_SHIP:
+        snprintf(buf, cap, "ship %" PRIu32 " %" PRIu32 " %" PRIu32 " to=%" PRId64, e->a, e->b, e->c,
+                 e->v);
+        break;
+    case PDT_EV_DISCARD:
+        if (e->v < 0)
+            snprintf(buf, cap, "discard %" PRIu32 " %" PRIu32 " %" PRIu32 " witness=-", e->a, e->b,
+                     e->c);
+        else
+            snprintf(buf, cap, "discard %" PRIu32 " %" PRIu32 " %" PRIu32 " witness=%" PRId64, e->a,
+                     e->b, e->c, e->v);
+        break;
+    }
+}
+
 char *pdt_event_format(const pdt_event *e0, char *buf, size_t cap)
 {
     char t1[24], t2[24];
@@ -79,29 +111,10 @@ char *pdt_event_format(const pdt_event *e0, char *buf, size_t cap)
                  e->a, e->b);
         break;
     case PDT_EV_TRI_NEW:
-        snprintf(buf, cap, "tri-new %s %" PRIu32 " %" PRIu32 " %" PRIu32,
-                 e->sub == 0 ? "local" : e->sub == 1 ? "border" : or_num(NULL, t1, sizeof t1, e->sub),
-                 e->a, e->b, e->c);
-        break;
     case PDT_EV_TRI_FINAL:
-        snprintf(buf, cap, "tri-final %" PRIu32 " %" PRIu32 " %" PRIu32, e->a, e->b, e->c);
-        break;
     case PDT_EV_RA_DEFER:
-        snprintf(buf, cap, "ra-defer %" PRIu32 " %" PRIu32 " %" PRIu32 " rank=%" PRId64, e->a, e->b,
-                 e->c, e->v);
-        break;
     case PDT_EV_SHIP:
-        snprintf(buf, cap, "ship %" PRIu32 " %" PRIu32 " %" PRIu32 " to=%" PRId64, e->a, e->b, e->c,
-                 e->v);
-        break;
-    case PDT_EV_DISCARD:
-        if (e->v < 0)
-            snprintf(buf, cap, "discard %" PRIu32 " %" PRIu32 " %" PRIu32 " witness=-", e->a, e->b,
-                     e->c);
-        else
-            snprintf(buf, cap, "discard %" PRIu32 " %" PRIu32 " %" PRIu32 " witness=%" PRId64, e->a,
-                     e->b, e->c, e->v);
-        break;
+    case PDT_EV_DISCARD: format_tri(e, buf, cap); break;
     case PDT_EV_MERGE_BEGIN:
         snprintf(buf, cap,
                  "merge-begin level=%u left=%" PRIu32 " right=%" PRIu32 " end=%" PRIu32

@@ -4,6 +4,9 @@
 : "${ROOT:=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)}"
 : "${BIN:=$ROOT/bin}"
 PDT=$BIN/pdt
+# the same program built to read the PDT_TEST_* fault-injection variables
+# (src/base/testhook.c): for the scripts that inject faults
+PDT_HOOKED=$BIN/test/pdt
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 T_PASS=0; T_FAIL=0
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/pdt-test.XXXXXX")

@@ -5,6 +5,7 @@
 # with the test hook PDT_TEST_KERNEL_LIMIT (2^29 points do not fit here);
 # test_kernel_limit checks that the real constant is the kernel's.
 source "$(dirname "$0")/lib.sh"
+PDT=$PDT_HOOKED  # injects faults (PDT_TEST_*)
 cd "$TMP"
 "$PDT" gen uniform 100 --seed 4 -o in.txt
 "$PDT" triangulate in.txt -o ref.tri
@@ -14,6 +15,14 @@ if [ $rc -eq 2 ] && grep -q '^pdt: in.txt: 100 points on 1 rank: more than 40 po
    grep -q 'at least 3 ranks (mpirun -np 3' p1.err && [ ! -e p1.tri ] && [ ! -e run1/points.bin ]; then
     ok plain_run_over_limit_refused
 else fail plain_run_over_limit_refused "rc=$rc $(cat p1.err)"; fi
+
+# the release program never reads the test hooks (only test builds do:
+# bin/test/pdt, the sanitizer build): the same run goes through
+if [ "$(basename "$BIN")" != san ]; then
+    PDT_TEST_KERNEL_LIMIT=40 "$BIN/pdt" triangulate in.txt -o prod.tri 2> prod.err; rc=$?
+    if [ $rc -eq 0 ] && cmp -s ref.tri prod.tri; then ok release_build_ignores_test_hooks
+    else fail release_build_ignores_test_hooks "rc=$rc $(cat prod.err)"; fi
+fi
 
 if command -v mpirun > /dev/null; then
     PDT_TEST_KERNEL_LIMIT=40 mpirun -np 2 "$PDT" triangulate in.txt -o p2.tri 2> p2.err; rc=$?

@@ -5,6 +5,7 @@
 # Also the quiet cases: empty and collinear input give 0 triangles and say so.
 # san: yes
 source "$(dirname "$0")/lib.sh"
+PDT=$PDT_HOOKED  # injects faults (PDT_TEST_*)
 cd "$TMP"
 export OMPI_MCA_rmaps_base_oversubscribe=1
 # Open MPI's own allocations in MPI_Init/Finalize are suppressed in

@@ -7,6 +7,7 @@
 # at rank 0; a rank that fails its share of an .ele write leaves neither the
 # .ele nor the .node (nor a temporary).
 source "$(dirname "$0")/lib.sh"
+PDT=$PDT_HOOKED  # injects faults (PDT_TEST_*)
 cd "$TMP"
 if ! command -v mpirun > /dev/null; then fail mpirun_available "mpirun not found"; summary; exit; fi
 

@@ -8,6 +8,7 @@
 # stay byte-identical to the plain run.
 # san: yes
 source "$(dirname "$0")/lib.sh"
+PDT=$PDT_HOOKED  # injects faults (PDT_TEST_*)
 cd "$TMP"
 export ASAN_OPTIONS="${ASAN_OPTIONS:-}:fast_unwind_on_malloc=0"
 export OMPI_MCA_mca_base_component_disable_dlclose=1 PMIX_MCA_mca_base_component_disable_dlclose=1

@@ -5,6 +5,7 @@
 # per pair of groups per level.  A traced run whose rank is killed leaves
 # trace files that can still be read.
 source "$(dirname "$0")/lib.sh"
+PDT=$PDT_HOOKED  # injects faults (PDT_TEST_*)
 cd "$TMP"
 export OMPI_MCA_rmaps_base_oversubscribe=1
 if ! command -v mpirun > /dev/null; then fail mpirun_available "mpirun not found"; summary; exit; fi

@@ -7,6 +7,7 @@
 # from the page's definition); a rank failing its block leaves no points.bin,
 # no temporary, no manifest and names the rank; format 1 runs still read.
 source "$(dirname "$0")/lib.sh"
+PDT=$PDT_HOOKED  # injects faults (PDT_TEST_*)
 cd "$TMP"
 if ! command -v mpirun > /dev/null; then fail mpirun_available "mpirun not found"; summary; exit; fi
 

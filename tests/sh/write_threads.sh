@@ -12,6 +12,7 @@
 # file (>>) with the one-thread loop, redirected to a file (>) on threads.
 # san: yes
 source "$(dirname "$0")/lib.sh"
+PDT=$PDT_HOOKED  # injects faults (PDT_TEST_*)
 cd "$TMP"
 
 "$PDT" gen uniform 3000 --seed 5 -o in.txt 2> /dev/null

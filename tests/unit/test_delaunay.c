@@ -6,7 +6,7 @@
 #include "pdt/delaunay.h"
 #include "pdt/gen.h"
 #include "pdt/predicates.h"
-#include "../../src/geom/bigmem.h"
+#include "pdt/bigmem.h"
 
 #include <string.h>
 #include <sys/mman.h>

@@ -7,7 +7,7 @@
 #include <sys/mman.h>
 
 #include "../harness.h"
-#include "../../src/geom/bigmem.h"
+#include "pdt/bigmem.h"
 #include "../../src/trace/hullcert.h"
 #include "pdt/gen.h"
 #include "pdt/hull.h"

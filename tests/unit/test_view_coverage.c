@@ -8,9 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "pdt/replay.h"
-#include "pdt/viewsynth.h"
-#include "../../src/view/replay_int.h"
+#include "pdt/view/replay.h"
+#include "pdt/view/viewsynth.h"
+#include "../../src/view/model/replay_int.h"
 
 static pdt_rec rec(int rank, int kind, uint32_t a, uint32_t b, uint32_t c, int64_t v)
 {

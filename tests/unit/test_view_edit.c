@@ -1,5 +1,5 @@
-/* pdt — the point editor's model (src/view/edit.c) and live runs
- * (src/view/live.c): the file written after every change, undo/redo, the
+/* pdt — the point editor's model (src/view/app/edit.c) and live runs
+ * (src/view/model/live.c): the file written after every change, undo/redo, the
  * replay re-built with the real algorithm, refusals, the tie report. */
 #include <stdio.h>
 #include <stdlib.h>
@@ -7,7 +7,7 @@
 #include <unistd.h>
 
 #include "../harness.h"
-#include "../../src/view/edit.h"
+#include "../../src/view/app/edit.h"
 #include "pdt/delaunay.h"
 #include "pdt/gen.h"
 #include "pdt/io.h"

@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "../harness.h"
-#include "pdt/render.h"
+#include "pdt/view/render.h"
 
 TEST(panels_parse)
 {

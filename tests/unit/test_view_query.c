@@ -1,13 +1,13 @@
-/* pdt — the replay queries of pdt/query.h (no cairo): stacks listed from
+/* pdt — the replay queries of pdt/view/query.h (no cairo): stacks listed from
  * their top node against stacks kept by hand from the push/pop events,
  * Graham's scan ending, hulls still live, the pseudo-code line of events. */
 #include <stdlib.h>
 #include <string.h>
 
 #include "../harness.h"
-#include "pdt/describe.h"
-#include "pdt/query.h"
-#include "pdt/viewsynth.h"
+#include "pdt/view/describe.h"
+#include "pdt/view/query.h"
+#include "pdt/view/viewsynth.h"
 
 typedef struct fix {
     pdt_synth syn;

@@ -6,10 +6,10 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "pdt/query.h"
-#include "pdt/render.h"
-#include "pdt/replay.h"
-#include "pdt/viewsynth.h"
+#include "pdt/view/query.h"
+#include "pdt/view/render.h"
+#include "pdt/view/replay.h"
+#include "pdt/view/viewsynth.h"
 
 #define W 1200
 #define H 800

@@ -5,11 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "pdt/describe.h"
-#include "pdt/query.h"
-#include "pdt/replay.h"
-#include "pdt/viewsynth.h"
-#include "../../src/view/replay_int.h"
+#include "pdt/view/describe.h"
+#include "pdt/view/query.h"
+#include "pdt/view/replay.h"
+#include "pdt/view/viewsynth.h"
+#include "../../src/view/model/replay_int.h"
 
 static pdt_rec rec(int rank, int kind, int sub, uint32_t a, uint32_t b, uint32_t c, int64_t v)
 {

@@ -1,0 +1,186 @@
+/* Level of detail: the triangles of a replay state counted per cell of a
+ * grid (pdt_replay_coverage), so that a picture of millions of triangles
+ * shows their density, makers and statuses (src/view/render/render_lod.c paints
+ * it).  One pass over the triangles born so far, in their order, shared
+ * by two threads on big runs; a kept index's pages are given back behind
+ * it. */
+#include "pdt/view/replay.h"
+#include "replay_int.h"
+#include "pdt/bigmem.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define NONE32 UINT32_MAX
+
+/* Add triangle t (status st, maker q) to cell (i, j). */
+static void cov_add(pdt_cov_cell *cell, uint32_t q, uint8_t st)
+{
+    cell->rank = cell->n == 0 || cell->rank == q ? q : PDT_COV_MIXED;
+    cell->n++;
+    cell->by_status[st]++;
+}
+
+/* The x range of triangle (grid coordinates x[], y[]) within the band
+ * lo <= y <= hi: from its vertices in the band and its edges' crossings of
+ * the band's two lines.  0 if it does not reach the band. */
+static int band_range(const double x[3], const double y[3], double lo, double hi, double *xmin,
+                      double *xmax)
+{
+    int any = 0;
+    *xmin = INFINITY;
+    *xmax = -INFINITY;
+    for (int k = 0; k < 3; k++) {
+        double ax = x[k], ay = y[k], bx = x[(k + 1) % 3], by = y[(k + 1) % 3];
+        if (ay >= lo && ay <= hi) {
+            *xmin = fmin(*xmin, ax);
+            *xmax = fmax(*xmax, ax);
+            any = 1;
+        }
+        const double lines[2] = {lo, hi};
+        for (int l = 0; l < 2; l++) {
+            double yl = lines[l];
+            if ((ay < yl && by > yl) || (ay > yl && by < yl)) {
+                double xc = ax + (bx - ax) * (yl - ay) / (by - ay);
+                *xmin = fmin(*xmin, xc);
+                *xmax = fmax(*xmax, xc);
+                any = 1;
+            }
+        }
+    }
+    return any;
+}
+
+#define COV_AHEAD 16  /* triangles ahead whose points are fetched (pdt_replay_coverage) */
+#define COV_RELEASE ((size_t)1 << 16) /* triangles between givings back of a kept
+                                       * index's pages (pdt_index_release) */
+
+
+/* One share of the coverage pass: triangles t0 .. t1-1 of state s into
+ * cells (zeroed), what touches the box counted in binned. */
+typedef struct cov_job {
+    const pdt_replay *r;
+    const pdt_rstate *s;
+    double x0, y0, sx, sy;
+    int cols, rows;
+    const uint8_t *vis;
+    pdt_cov_cell *cells;
+    size_t t0, t1, binned;
+} cov_job;
+
+static void cov_range(cov_job *J)
+{
+    const pdt_replay *r = J->r;
+    const pdt_rstate *s = J->s;
+    const int cols = J->cols, rows = J->rows;
+    pdt_cov_cell *cells = J->cells;
+    size_t binned = 0, nt = J->t1;
+    for (size_t t = J->t0; t < nt; t++) {
+        if (t > J->t0 && (t - J->t0) % COV_RELEASE == 0) { /* the triangles read and their
+                                          * entries (a kept index holds them in
+                                          * the triangles' order): behind the pass */
+            const pdt_rtri *from = &r->tris[t - COV_RELEASE];
+            pdt_index_release(r, from, COV_RELEASE * sizeof *r->tris);
+            pdt_index_release(r, &r->hist[from->h0], (r->tris[t].h0 - from->h0) * sizeof *r->hist);
+            /* a paged state's entries behind too (the corners' points, read at
+             * random, are kept until the frame is done: pdt_render) */
+            if (s->paged[1]) pdt_release_pages(&s->tcur[t - COV_RELEASE], COV_RELEASE * sizeof *s->tcur);
+        }
+        /* the corners' points and the history entry of a triangle a few
+         * ahead: random places in tables of 10^8 bytes (a hint only) */
+        if (t + COV_AHEAD < nt && s->tcur[t + COV_AHEAD] != PDT_TCUR_NONE) {
+            const pdt_rtri *ahead = &r->tris[t + COV_AHEAD];
+            for (int k = 0; k < 3; k++) __builtin_prefetch(&r->pts[ahead->v[k]]);
+            __builtin_prefetch(&r->hist[ahead->h0 + s->tcur[t + COV_AHEAD]]);
+        }
+        uint32_t h = pdt_rstate_tri_entry(r, s, t);
+        if (h == NONE32) continue;
+        const pdt_rtri *tr = &r->tris[t];
+        if (J->vis && !J->vis[tr->maker]) continue;
+        double x[3], y[3];
+        for (int k = 0; k < 3; k++) {
+            x[k] = (r->pts[tr->v[k]].x - J->x0) * J->sx;
+            y[k] = (r->pts[tr->v[k]].y - J->y0) * J->sy;
+        }
+        double xlo = fmin(x[0], fmin(x[1], x[2])), xhi = fmax(x[0], fmax(x[1], x[2]));
+        double ylo = fmin(y[0], fmin(y[1], y[2])), yhi = fmax(y[0], fmax(y[1], y[2]));
+        if (xhi < 0 || xlo >= cols || yhi < 0 || ylo >= rows) continue;  /* outside the box */
+        uint8_t st = r->hist[h].status;
+        binned++;
+        int j0 = ylo < 0 ? 0 : (int)ylo, j1 = yhi >= rows ? rows - 1 : (int)yhi;
+        if ((int)xlo == (int)xhi && j0 == j1 && xlo >= 0) {  /* the usual case: one cell */
+            cov_add(&cells[(size_t)j0 * (size_t)cols + (size_t)xlo], tr->maker, st);
+            continue;
+        }
+        for (int j = j0; j <= j1; j++) {  /* every cell the triangle touches, band by band */
+            double a, b;
+            if (!band_range(x, y, j, j + 1.0, &a, &b)) continue;
+            int i0 = a < 0 ? 0 : (int)a, i1 = b >= cols ? cols - 1 : (int)b;
+            for (int i = i0; i <= i1; i++)
+                cov_add(&cells[(size_t)j * (size_t)cols + (size_t)i], tr->maker, st);
+        }
+    }
+    J->binned = binned;
+}
+
+static void *cov_thread(void *arg)
+{
+    cov_range(arg);
+    return NULL;
+}
+
+/* Cell c of one share added to the same cell of another: the counts add
+ * up, and the cell is mixed when either is or their makers differ, as
+ * when one pass counts both. */
+static void cov_merge(pdt_cov_cell *to, const pdt_cov_cell *from)
+{
+    if (!from->n) return;
+    to->rank = to->n == 0 || to->rank == from->rank ? from->rank : PDT_COV_MIXED;
+    to->n += from->n;
+    for (int k = 0; k < PDT_TS_COUNT; k++) to->by_status[k] += from->by_status[k];
+}
+
+/* Triangles from which the coverage pass is shared by two threads (the
+ * frame of a run of millions of triangles: 2.2-2.7 s of CPU for 8*10^7);
+ * the tests lower it (pdt_replay_set_cov_split). */
+static size_t cov_split = (size_t)1 << 20;
+
+void pdt_replay_set_cov_split(size_t tris) { cov_split = tris; }
+
+size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, double y0,
+                           double x1, double y1, int cols, int rows,
+                           const uint8_t *rank_visible, pdt_cov_cell *cells)
+{
+    if (cols <= 0 || rows <= 0) return 0;
+    size_t ncell = (size_t)cols * (size_t)rows;
+    memset(cells, 0, ncell * sizeof *cells);
+    if (!(x1 > x0) || !(y1 > y0)) return 0;
+    size_t nt = pdt_replay_born_at_most(r, s->k);
+    cov_job J[2];
+    J[0] = (cov_job){r, s, x0, y0, cols / (x1 - x0), rows / (y1 - y0), cols, rows, rank_visible,
+                     cells, 0, nt, 0};
+    J[1] = J[0];
+    pthread_t th;
+    int two = 0;
+    if (nt >= cov_split && nt >= 2 && sysconf(_SC_NPROCESSORS_ONLN) > 1 &&
+        (J[1].cells = calloc(ncell, sizeof *cells)) != NULL) {
+        J[0].t1 = J[1].t0 = nt / 2;
+        two = pthread_create(&th, NULL, cov_thread, &J[1]) == 0;
+        if (!two) {
+            free(J[1].cells);
+            J[0].t1 = nt;
+        }
+    }
+    cov_range(&J[0]);
+    if (two) {
+        pthread_join(th, NULL);
+        for (size_t c = 0; c < ncell; c++) cov_merge(&cells[c], &J[1].cells[c]);
+        free(J[1].cells);
+    }
+    return J[0].binned + (two ? J[1].binned : 0);
+}
+

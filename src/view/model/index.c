@@ -1,0 +1,863 @@
+/* pdt — the kept index: building it at a run's first opening, and opening a
+ * run (from its kept index, building one, or in memory).  The file's layout
+ * is in index_int.h. */
+#include "pdt/io.h"
+#include "pdt/view/replay.h"
+#include "replay_int.h"
+#include "index_int.h"
+#include "pdt/bigmem.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+uint32_t pdt_ix_ihdr_crc(const ihdr *h)
+{
+    ihdr c = *h;
+    c.hdr_crc = 0;
+    return pdt_crc32c(0, &c, sizeof c);
+}
+
+/* ---- building ------------------------------------------------------------------ */
+
+static int write_all(int fd, const void *p, size_t len, uint64_t off)
+{
+    const char *b = p;
+    while (len) {
+        ssize_t w = pwrite(fd, b, len > ((size_t)1 << 30) ? (size_t)1 << 30 : len, (off_t)off);
+        if (w <= 0) return 0;
+        b += w;
+        len -= (size_t)w;
+        off += (uint64_t)w;
+    }
+    return 1;
+}
+
+/* The events of a build: the merged order as segments (S_SEGS), and the
+ * tables that find a block of a rank file (held here until write_tables
+ * writes them). */
+typedef struct evcopy {
+    pdt_evsrc src;           /* over the reader's mappings and S_SEGS, once written */
+    pdt_block_ref *blk;      /* src.blk */
+    uint64_t *rank_blk;      /* src.rank_blk */
+    crcacc segs_crc;
+} evcopy;
+
+/* The table of every rank's intact blocks (where each payload is in its
+ * file, its aligned time base), and the source decoding them from the
+ * reader's mappings of the rank files. */
+static pdt_status block_table(pdt_run *run, evcopy *ec, pdt_err *err)
+{
+    int nranks = pdt_run_nranks(run);
+    size_t nblk = 0;
+    for (int q = 0; q < nranks; q++) {
+        const pdt_block_ref *b;
+        const uint8_t *file;
+        int64_t shift;
+        nblk += pdt_run_rank_blocks(run, q, &b, &file, &shift);
+    }
+    ec->blk = malloc((nblk ? nblk : 1) * sizeof *ec->blk);
+    ec->rank_blk = malloc(((size_t)nranks + 1) * sizeof *ec->rank_blk);
+    ec->src.file = calloc((size_t)nranks + 1, sizeof *ec->src.file);
+    ec->src.file_len = calloc((size_t)nranks + 1, sizeof *ec->src.file_len);
+    if (!ec->blk || !ec->rank_blk || !ec->src.file || !ec->src.file_len)
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    size_t k = 0;
+    for (int q = 0; q < nranks; q++) {
+        const pdt_block_ref *b;
+        const uint8_t *file;
+        int64_t shift;
+        size_t nb = pdt_run_rank_blocks(run, q, &b, &file, &shift);
+        pdt_rank_info ri;
+        pdt_run_rank_info(run, q, &ri);
+        ec->rank_blk[q] = k;
+        ec->src.file[q] = file;
+        ec->src.file_len[q] = file ? ri.bytes : 0;
+        for (size_t j = 0; j < nb; j++, k++)
+            ec->blk[k] = (pdt_block_ref){b[j].off + PDT_BLOCK_HEADER_BYTES, b[j].first,
+                                         b[j].base_t + (uint64_t)shift, b[j].len, b[j].count};
+    }
+    ec->rank_blk[nranks] = k;
+    ec->src.nblk = nblk;
+    ec->src.nranks = nranks;
+    return PDT_OK;
+}
+
+/* The merged order of run, streamed to the build (pass 1) by the reader's
+ * merge (one decoded block per rank in memory), and written as it goes
+ * into fd after the blocks as segments (S_SEGS).  At its end the blocks and
+ * segments are mapped, and ec->src decodes the events from there. */
+typedef struct evstream {
+    pdt_merge *mg;
+    int fd;
+    ihdr *h;
+    evcopy *ec;
+    uint64_t at, off;     /* S_SEGS: where it starts, where the next batch goes */
+    pdt_evseg cur, *buf;  /* the segment being made; a batch of finished ones */
+    size_t nb, count, nseg;
+    void *map;            /* at the end: [0, the end of S_SEGS) of the file */
+    size_t map_len;
+    uint64_t *place_off;  /* the placer's start: after S_SEGS */
+    int done;
+} evstream;
+
+enum { SEG_BATCH = 8192 };
+
+static int seg_flush(evstream *es, pdt_err *err)
+{
+    if (!es->nb) return 1;
+    if (!write_all(es->fd, es->buf, es->nb * sizeof *es->buf, es->off)) {
+        pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+        return 0;
+    }
+    pdt_ix_crc_feed(&es->ec->segs_crc, es->buf, es->nb * sizeof *es->buf);
+    es->off += es->nb * sizeof *es->buf;
+    es->nseg += es->nb;
+    es->nb = 0;
+    return 1;
+}
+
+/* The last segment out, the section's place, the mapping for ec->src. */
+static int stream_finish(evstream *es, pdt_err *err)
+{
+    if (es->cur.rank != UINT32_MAX) es->buf[es->nb++] = es->cur;
+    if (!seg_flush(es, err)) return 0;
+    es->h->sec[S_SEGS] = (isec){es->at, (uint64_t)es->nseg * sizeof(pdt_evseg), 0, 0};
+    es->h->count[S_SEGS] = es->nseg;
+    es->map_len = (size_t)es->off;
+    es->map = mmap(NULL, es->map_len, PROT_READ, MAP_SHARED, es->fd, 0);
+    if (es->map == MAP_FAILED) {
+        es->map = NULL;
+        pdt_err_set(err, PDT_ERR_IO, "mapping the index: %s", strerror(errno));
+        return 0;
+    }
+    pdt_evsrc *src = &es->ec->src;
+    src->blk = es->ec->blk;
+    src->rank_blk = es->ec->rank_blk;
+    src->seg = (const pdt_evseg *)(void *)((const char *)es->map + es->at);
+    src->nseg = es->nseg;
+    src->m = es->count;
+    src->drop_behind = 1;
+    *es->place_off = es->off;
+    return 1;
+}
+
+static int stream_fill(evstream *es, pdt_rec *out, size_t max, pdt_err *err)
+{
+    size_t j = 0;
+    while (!es->done && j < max) {
+        int got = pdt_merge_next(es->mg, &out[j], err);
+        if (got < 0) return -1;
+        if (got == 0) {
+            es->done = 1;
+            if (!stream_finish(es, err)) return -1;
+            break;
+        }
+        const pdt_rec *rec = &out[j++];
+        if (rec->rank != es->cur.rank || rec->seq - es->cur.seq0 != es->count - es->cur.start) {
+            if (es->cur.rank != UINT32_MAX) {
+                es->buf[es->nb++] = es->cur;
+                if (es->nb == SEG_BATCH && !seg_flush(es, err)) return -1;
+            }
+            es->cur = (pdt_evseg){(uint32_t)es->count, rec->rank, rec->seq};
+        }
+        es->count++;
+    }
+    return (int)j;
+}
+
+/* The merge (decoding the rank files, the busier half of the build's first
+ * pass) runs in a thread of its own, a batch of events ahead of the build:
+ * two batches, one filled while the other is read. */
+enum { PIPE_BATCH = 8192 };
+
+typedef struct evpipe {
+    evstream *es;
+    pthread_t th;
+    int started;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    pdt_rec *buf[2];
+    size_t n[2];
+    int full[2];      /* filled, not yet read */
+    int last[2];      /* the stream ends after this batch (n may be 0) */
+    int failed[2];    /* the stream failed filling it (perr) */
+    int stop;         /* the reader is gone: stop filling */
+    pdt_err perr;
+    size_t slot, at;  /* the reader's batch and place in it */
+    int ended;
+} evpipe;
+
+static void *pipe_worker(void *arg)
+{
+    evpipe *p = arg;
+    for (size_t k = 0;; k ^= 1) {
+        pthread_mutex_lock(&p->mu);
+        while (p->full[k] && !p->stop) pthread_cond_wait(&p->cv, &p->mu);
+        int stop = p->stop;
+        pthread_mutex_unlock(&p->mu);
+        if (stop) return NULL;
+        int got = stream_fill(p->es, p->buf[k], PIPE_BATCH, &p->perr);
+        pthread_mutex_lock(&p->mu);
+        p->n[k] = got > 0 ? (size_t)got : 0;
+        p->failed[k] = got < 0;
+        p->last[k] = got <= 0 || p->es->done;
+        p->full[k] = 1;
+        int end = p->last[k];
+        pthread_cond_broadcast(&p->cv);
+        pthread_mutex_unlock(&p->mu);
+        if (end) return NULL;
+    }
+}
+
+static int stream_next(void *ctx, pdt_rec *out, size_t max, pdt_err *err)
+{
+    evpipe *p = *(evpipe **)ctx;
+    size_t j = 0;
+    while (j < max && !p->ended) {
+        size_t k = p->slot;
+        pthread_mutex_lock(&p->mu);
+        while (!p->full[k]) pthread_cond_wait(&p->cv, &p->mu);
+        pthread_mutex_unlock(&p->mu);
+        if (p->failed[k]) {
+            *err = p->perr;
+            return -1;
+        }
+        size_t take = p->n[k] - p->at < max - j ? p->n[k] - p->at : max - j;
+        memcpy(out + j, p->buf[k] + p->at, take * sizeof *out);
+        j += take;
+        p->at += take;
+        if (p->at == p->n[k]) { /* give the batch back */
+            if (p->last[k]) p->ended = 1;
+            pthread_mutex_lock(&p->mu);
+            p->full[k] = 0;
+            pthread_cond_broadcast(&p->cv);
+            pthread_mutex_unlock(&p->mu);
+            p->slot ^= 1;
+            p->at = 0;
+        }
+    }
+    return (int)j;
+}
+
+/* Start the merge's thread: 1, or 0 and err set. */
+static int pipe_start(evpipe *p, evstream *es, pdt_err *err)
+{
+    memset(p, 0, sizeof *p);
+    p->es = es;
+    p->buf[0] = malloc(PIPE_BATCH * sizeof *p->buf[0]);
+    p->buf[1] = malloc(PIPE_BATCH * sizeof *p->buf[1]);
+    if (!p->buf[0] || !p->buf[1]) {
+        pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+        return 0;
+    }
+    pthread_mutex_init(&p->mu, NULL);
+    pthread_cond_init(&p->cv, NULL);
+    if (pthread_create(&p->th, NULL, pipe_worker, p) != 0) {
+        pdt_err_set(err, PDT_ERR_NOMEM, "cannot start a thread: %s", strerror(errno));
+        return 0;
+    }
+    p->started = 1;
+    return 1;
+}
+
+/* Stop the merge's thread (wherever it is) and free the batches. */
+static void pipe_stop(evpipe *p)
+{
+    if (p->started) {
+        pthread_mutex_lock(&p->mu);
+        p->stop = 1;
+        pthread_cond_broadcast(&p->cv);
+        pthread_mutex_unlock(&p->mu);
+        pthread_join(p->th, NULL);
+        pthread_mutex_destroy(&p->mu);
+        pthread_cond_destroy(&p->cv);
+    }
+    free(p->buf[0]);
+    free(p->buf[1]);
+    p->started = 0;
+}
+
+static int read_all(int fd, uint64_t at, void *p, size_t bytes);
+
+static int fd_get(void *ctx, uint64_t at, void *p, size_t bytes)
+{
+    return read_all(*(const int *)ctx, at, p, bytes);
+}
+
+/* The state at every r->ick_every-th cursor, stepped forwards from 0 (the
+ * streamed replay's tables read back from fd), written at off one after
+ * the other (r->nick of them), each holding the triangles born before its
+ * cursor; sets r->ick_off and r->ick_born.  Memory: one state. */
+static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
+{
+    static const uint8_t zeros[8];
+    r->ick_off[0] = 0;
+    if (!r->nick) return 1;
+    pdt_rstate *s = pdt_rstate_new(r);
+    pdt_fwd *fw = pdt_fwd_new(r, fd_get, &fd);
+    int ok = s && fw;
+    for (size_t c = 0; ok && c < r->nick; c++) {
+        ok = pdt_fwd_to(fw, s, c * r->ick_every);
+        size_t born = pdt_rstate_born(r, s), bytes = pdt_rstate_blob_bytes(r, born);
+        const void *part[5];
+        size_t len[5], pad[5];
+        uint64_t at = off + r->ick_off[c];
+        pdt_rstate_blob_parts(r, s, born, part, len, pad);
+        for (int j = 0; ok && j < 5; j++) {
+            for (size_t o = 0; ok && o < len[j]; o += CHUNK_BYTES) { /* (a paged state's
+                                                                       * pages go back) */
+                size_t k = len[j] - o < CHUNK_BYTES ? len[j] - o : CHUNK_BYTES;
+                ok = write_all(fd, (const char *)part[j] + o, k, at + o);
+                pdt_ix_crc_feed(crc, (const char *)part[j] + o, k);
+                pdt_replay_give_back(r, s);
+            }
+            ok = ok && write_all(fd, zeros, pad[j], at + len[j]);
+            pdt_ix_crc_feed(crc, zeros, pad[j]);
+            at += len[j] + pad[j];
+        }
+        r->ick_born[c] = born;
+        r->ick_off[c + 1] = r->ick_off[c] + bytes;
+    }
+    pdt_fwd_free(fw);
+    pdt_rstate_free(s);
+    return ok;
+}
+
+/* The triangles and histories of a replay being built, streamed to the index
+ * file itself (pdt_replay_place): written once, in place, by pwrite (not
+ * through a shared mapping: on this file system page faults on a file being
+ * written back wait for the disk), and never held in memory.  The triangle
+ * events the build groups go to a spill of their own, an unnamed file
+ * beside the index (O_TMPFILE), dropped (closed) once they are grouped: its
+ * pages leave the page cache with it, mostly before they were written back. */
+typedef struct placer {
+    struct evpipe *pipe; /* (first: the stream's context is the placer's) */
+    int fd;
+    uint64_t off;  /* where the next table goes */
+    int sfd[PDT_SCR_COUNT];  /* the scratch files (-1: not made yet, or dropped) */
+    const char *near;        /* made in the folder of this path */
+    pdt_run *run;
+    pthread_mutex_t mu;      /* (the grouping's threads make them) */
+} placer;
+
+static uint64_t place_reserve(void *ctx, uint64_t bytes)
+{
+    placer *pc = ctx;
+    uint64_t at = (pc->off + 63) & ~(uint64_t)63;
+    pc->off = at + bytes;
+    return at;
+}
+
+static int place_put(void *ctx, uint64_t at, const void *p, size_t bytes)
+{
+    return write_all(((placer *)ctx)->fd, p, bytes, at);
+}
+
+static int read_all(int fd, uint64_t at, void *p, size_t bytes)
+{
+    char *b = p;
+    while (bytes) {
+        ssize_t got = pread(fd, b, bytes, (off_t)at);
+        if (got <= 0) return 0;
+        b += got;
+        bytes -= (size_t)got;
+        at += (uint64_t)got;
+    }
+    return 1;
+}
+
+static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
+{
+    return read_all(((placer *)ctx)->fd, at, p, bytes);
+}
+
+static int open_spill(const char *path);
+
+static int scratch_put(void *ctx, int file, uint64_t at, const void *p, size_t bytes)
+{
+    placer *pc = ctx;
+    if (file < 0 || file >= PDT_SCR_COUNT) return 0;
+    pthread_mutex_lock(&pc->mu);
+    if (pc->sfd[file] < 0) pc->sfd[file] = open_spill(pc->near);
+    int fd = pc->sfd[file];
+    pthread_mutex_unlock(&pc->mu);
+    return fd >= 0 && write_all(fd, p, bytes, at);
+}
+
+static int scratch_get(void *ctx, int file, uint64_t at, void *p, size_t bytes)
+{
+    placer *pc = ctx;
+    if (file < 0 || file >= PDT_SCR_COUNT || pc->sfd[file] < 0) return 0;
+    return read_all(pc->sfd[file], at, p, bytes);
+}
+
+static void points_read(void *ctx) { pdt_run_release_points(((placer *)ctx)->run); }
+
+/* A scratch file done with: closed (unnamed: its pages go with it, mostly
+ * before they were written back). */
+static void scratch_drop(void *ctx, int file)
+{
+    placer *pc = ctx;
+    if (file < 0 || file >= PDT_SCR_COUNT || pc->sfd[file] < 0) return;
+    close(pc->sfd[file]);
+    pc->sfd[file] = -1;
+}
+
+/* An unnamed scratch file in the folder of `path` (O_TMPFILE; where the file
+ * system has none, a named one removed at once), or -1. */
+static int open_spill(const char *path)
+{
+    char dir[PATH_MAX + 128];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    if (slash) *slash = 0;
+    else snprintf(dir, sizeof dir, ".");
+    int fd = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    if (fd >= 0) return fd;
+    char name[PATH_MAX + 160];
+    snprintf(name, sizeof name, "%s.spill", path);
+    fd = open(name, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd >= 0) unlink(name);
+    return fd;
+}
+
+/* Write the tables of r after the records and the streamed ones (at pc->off),
+ * then the header. */
+/* write_checkpoints in a thread of its own (stepping through the run takes
+ * a core while the tables are written). */
+typedef struct ck_job {
+    pdt_replay *r;
+    int fd, ok;
+    uint64_t off;
+    crcacc crc;
+} ck_job;
+
+static void *ck_worker(void *arg)
+{
+    ck_job *j = arg;
+    j->ok = write_checkpoints(j->r, j->fd, j->off, &j->crc);
+    return NULL;
+}
+
+/* 1 if section i of a streamed replay was written by the build (at *at). */
+static int streamed_sec(const pdt_replay *r, int i, uint64_t *at)
+{
+    if (!r->streamed) return 0;
+    switch (i) {
+    case S_TRIS: *at = r->tris_at; return 1;
+    case S_HIST: *at = r->hist_at; return 1;
+    case S_EVOBJ: *at = r->evobj_at; return 1;
+    case S_EVKIND: *at = r->evkind_at; return 1;
+    case S_LIFT: *at = r->lift_at; return 1;
+    default: return 0;
+    }
+}
+
+/* The places of the tables in the file from pc->off on (the checkpoints
+ * last: their sizes are known once they are made); returns where the
+ * checkpoints go. */
+static uint64_t place_tables(pdt_replay *r, ihdr *h, const placer *pc, size_t elem[NSEC],
+                             const uint64_t count[NSEC])
+{
+    uint64_t off = pc->off;
+    for (int i = 0; i < NSEC; i++) {
+        h->count[i] = count[i];
+        if (i == S_SEGS || i == S_CKPT) continue; /* (S_SEGS: written first, stream_next) */
+        uint64_t at;
+        if (streamed_sec(r, i, &at)) {
+            h->sec[i] = (isec){at, count[i] * elem[i], 0, 0};
+            continue;
+        }
+        off = (off + 63) & ~(uint64_t)63;
+        h->sec[i] = (isec){off, count[i] * elem[i], 0, 0};
+        off += h->sec[i].bytes;
+    }
+    return (off + 63) & ~(uint64_t)63;
+}
+
+/* Write the tables held in memory (ptr) while a second thread writes the
+ * checkpoints at off (their checksums into *ck_crc).  The points are read
+ * in place from the run: a chunk at a time, their pages given back behind,
+ * while the checkpoints' state is held.  1, or 0 (errno). */
+static int write_sections(pdt_replay *r, int fd, const ihdr *h, const placer *pc, void **ptr[NSEC],
+                          uint64_t off, crcacc *ck_crc)
+{
+    ck_job ck = {r, fd, 0, off, {0}};
+    pthread_t th;
+    int threaded = pthread_create(&th, NULL, ck_worker, &ck) == 0;
+    int wrote = 1;
+    for (int i = 0; wrote && i < NSEC; i++) {
+        uint64_t at;
+        if (i == S_SEGS || i == S_CKPT || streamed_sec(r, i, &at)) continue;
+        for (uint64_t o = 0; wrote && o < h->sec[i].bytes; o += CHUNK_BYTES) {
+            uint64_t k = h->sec[i].bytes - o < CHUNK_BYTES ? h->sec[i].bytes - o : CHUNK_BYTES;
+            wrote = write_all(fd, (const char *)*ptr[i] + o, (size_t)k, h->sec[i].off + o);
+            if (i == S_POINTS) pdt_run_release_points(pc->run);
+            pdt_replay_tab_release(r, (const char *)*ptr[i] + o, (size_t)k);  /* (paged) */
+        }
+    }
+    if (threaded) pthread_join(th, NULL);
+    else ck_worker(&ck);
+    *ck_crc = ck.crc;
+    return wrote && ck.ok;
+}
+
+/* The chunk checksums (*tab, *n of them): of the tables in memory from
+ * memory, of the records and checkpoints as they were written, of the
+ * streamed triangles and histories read back (pread, by up to four
+ * threads). */
+static pdt_status chunk_table(pdt_replay *r, int fd, const ihdr *h, const placer *pc,
+                              void **ptr[NSEC], const evcopy *ec, const crcacc *ck_crc,
+                              uint32_t **tab_out, uint64_t *n_out, pdt_err *err)
+{
+    uint64_t first[NSEC + 1], n = 0;
+    for (int i = 0; i < NSEC; i++) first[i] = n, n += chunks_of(h->sec[i].bytes);
+    first[NSEC] = n;
+    uint32_t *tab = malloc(n ? n * sizeof *tab : 1);
+    uint8_t *todo = calloc(n ? n : 1, 1);
+    int have = tab && todo;
+    for (int i = 0; have && i < NSEC; i++) {
+        uint64_t nc = chunks_of(h->sec[i].bytes), at;
+        if (i == S_SEGS) {
+            have = pdt_ix_crc_done(&ec->segs_crc, h->sec[i].bytes, tab + first[i]);
+        } else if (i == S_CKPT) {
+            have = pdt_ix_crc_done(ck_crc, h->sec[i].bytes, tab + first[i]);
+        } else if (streamed_sec(r, i, &at)) {
+            memset(todo + first[i], 1, nc);
+        } else {
+            const char *p = *ptr[i];
+            for (uint64_t c = 0; c < nc; c++) {
+                uint64_t lo = c * CHUNK_BYTES, hi = lo + CHUNK_BYTES;
+                if (hi > h->sec[i].bytes) hi = h->sec[i].bytes;
+                tab[first[i] + c] = pdt_crc32c(0, p + lo, (size_t)(hi - lo));
+                if (i == S_POINTS) pdt_run_release_points(pc->run);
+                pdt_replay_tab_release(r, p + lo, (size_t)(hi - lo));
+            }
+        }
+    }
+    if (!have) {
+        free(tab);
+        free(todo);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for the index's checksums");
+    }
+    verify_job j = {fd, h, tab, 1, todo, n, first, 0, 0};
+    pdt_ix_run_job(&j);
+    free(todo);
+    if (atomic_load(&j.bad)) {
+        free(tab);
+        return pdt_err_set(err, PDT_ERR_IO, "reading the index back for its checksums failed");
+    }
+    *tab_out = tab;
+    *n_out = n;
+    return PDT_OK;
+}
+
+/* The header of the index of r (file_bytes long) into its first page. */
+static pdt_status write_header(pdt_replay *r, int fd, ihdr *h, uint64_t ident, uint64_t file_bytes,
+                               pdt_err *err)
+{
+    memcpy(h->magic, magic, sizeof magic);
+    h->version = INDEX_VERSION;
+    h->ident = ident;
+    h->file_bytes = file_bytes;
+    pdt_ix_layout_of(h->layout);
+    h->n = r->n;
+    h->m = r->m;
+    h->skipped = r->skipped;
+    h->nranks = (uint64_t)r->nranks;
+    h->ick_every = r->ick_every;
+    h->nick = r->nick;
+    memcpy(h->ick_off, r->ick_off, sizeof h->ick_off);
+    memcpy(h->ick_born, r->ick_born, sizeof h->ick_born);
+    for (int k = 0; k < PDT_EV_KIND_COUNT; k++) h->kind_count[k] = r->kind_count[k];
+    h->hdr_crc = pdt_ix_ihdr_crc(h);
+    unsigned char page[HDR_BYTES];
+    memset(page, 0, sizeof page);
+    memcpy(page, h, sizeof *h);
+    if (ftruncate(fd, (off_t)file_bytes) != 0 || !write_all(fd, page, sizeof page, 0))
+        return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+    return PDT_OK;
+}
+
+static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
+                               evcopy *ec, pdt_err *err)
+{
+    void **ptr[NSEC];
+    size_t elem[NSEC];
+    uint64_t count[NSEC];
+    pdt_ix_sections(r, ptr, elem, count);
+    uint64_t off = place_tables(r, h, pc, elem, count);
+    crcacc ck_crc;
+    if (!write_sections(r, fd, h, pc, ptr, off, &ck_crc)) {
+        free(ck_crc.crc);
+        return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+    }
+    h->count[S_CKPT] = r->nick ? r->ick_off[r->nick] : 0;
+    h->sec[S_CKPT] = (isec){off, h->count[S_CKPT], 0, 0};
+    off += h->count[S_CKPT];
+    uint32_t *tab = NULL;
+    uint64_t n = 0;
+    pdt_status st = chunk_table(r, fd, h, pc, ptr, ec, &ck_crc, &tab, &n, err);
+    free(ck_crc.crc);
+    if (st != PDT_OK) return st;
+    off = (off + 63) & ~(uint64_t)63;
+    h->ctab = (isec){off, n * sizeof *tab, pdt_crc32c(0, tab, (size_t)(n * sizeof *tab)), 0};
+    int wrote = write_all(fd, tab, (size_t)(n * sizeof *tab), off);
+    free(tab);
+    if (!wrote) return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
+    return write_header(r, fd, h, ident, off + h->ctab.bytes, err);
+}
+
+/* Remove the temporary files (path.tmpPID) that builds of processes no
+ * longer alive left beside path (a crash or a kill while building). */
+static void clean_stale_temps(const char *path)
+{
+    char dir[PATH_MAX];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    const char *base = slash ? slash + 1 : path;
+    if (slash) *slash = 0;
+    else snprintf(dir, sizeof dir, ".");
+    size_t blen = strlen(base);
+    DIR *d = opendir(dir);
+    if (!d) return;
+    struct dirent *de;
+    while ((de = readdir(d))) {
+        const char *nm = de->d_name;
+        if (strncmp(nm, base, blen) || strncmp(nm + blen, ".tmp", 4)) continue;
+        const char *digits = nm + blen + 4;
+        char *end;
+        errno = 0;
+        long pid = strtol(digits, &end, 10);
+        if (!*digits || *end || errno || pid <= 0 || pid == (long)getpid()) continue;
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;  /* alive, or not ours to judge */
+        char victim[PATH_MAX + 256];
+        snprintf(victim, sizeof victim, "%s/%s", dir, nm);
+        unlink(victim);
+    }
+    closedir(d);
+}
+
+/* Build the index of run at `path` (temporary file + rename). */
+static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks, uint64_t ident,
+                        const char *path, uint64_t budget, uint64_t *work, uint32_t *buckets,
+                        pdt_err *err)
+{
+    char tmp[PATH_MAX + 128];
+    clean_stale_temps(path);
+    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
+    int fd = open(tmp, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) return pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
+    ihdr *h = calloc(1, sizeof *h);
+    evcopy ec;
+    memset(&ec, 0, sizeof ec);
+    pdt_replay *r = NULL;
+    uint64_t events = 0;
+    for (int q = 0; q < nranks; q++) {
+        pdt_rank_info ri;
+        pdt_run_rank_info(run, q, &ri);
+        events += ri.events;
+    }
+    size_t m = (size_t)events;
+    evstream es;
+    memset(&es, 0, sizeof es);
+    es.cur.rank = UINT32_MAX;
+    es.buf = malloc(SEG_BATCH * sizeof *es.buf);
+    evpipe pipe;
+    memset(&pipe, 0, sizeof pipe);
+    placer pc = {&pipe, fd, 0, {0}, tmp, run, PTHREAD_MUTEX_INITIALIZER};
+    for (int k = 0; k < PDT_SCR_COUNT; k++) pc.sfd[k] = -1;
+    pdt_replay_place pl = {place_reserve, place_put,   place_get, scratch_put, scratch_get,
+                           scratch_drop,  points_read, &pc,       budget,      stream_next,
+                           &ec.src,       0,           0};
+    pdt_status st = h && es.buf ? block_table(run, &ec, err)
+                                : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    if (st == PDT_OK) st = pdt_merge_open(run, &es.mg, err);
+    if (st == PDT_OK) {
+        es.fd = fd;
+        es.h = h;
+        es.ec = &ec;
+        /* the per-event tables first (their sizes are known: pass 1 writes
+         * them as it goes), then the segments */
+        pc.off = HDR_BYTES;
+        pl.evobj_at = place_reserve(&pc, (uint64_t)m * sizeof(int32_t));
+        pl.evkind_at = place_reserve(&pc, m);
+        es.at = es.off = (pc.off + 63) & ~(uint64_t)63;
+        es.place_off = &pc.off;
+        if ((pc.sfd[PDT_SCR_SPILL] = open_spill(tmp)) < 0)
+            st = pdt_err_set(err, PDT_ERR_IO, "%s: a scratch file beside it: %s", tmp, strerror(errno));
+    }
+    if (st == PDT_OK && !pipe_start(&pipe, &es, err)) st = err->code;
+    if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
+    pipe_stop(&pipe);
+    for (int k = 0; k < PDT_SCR_COUNT; k++) scratch_drop(&pc, k);  /* the scratch: gone */
+    if (st == PDT_OK) {
+        r->warnings = pdt_run_warnings(run);
+        size_t parts = (r->m + ICK_MAX_EVERY - 1) / ICK_MAX_EVERY;
+        parts = parts < ICK_PARTS ? ICK_PARTS : parts > ICK_MAX_PARTS ? ICK_MAX_PARTS : parts;
+        size_t every = r->m / parts;
+        r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
+        r->nick = r->m / r->ick_every + 1;
+        /* the checkpoints' state: paged beyond a quarter of the budget, as a
+         * replay's is (pdt_replay_set_mem) */
+        r->mem_budget = budget;
+        r->state_paged = budget && pdt_replay_state_bytes(r) > budget / 4;
+        st = write_tables(r, fd, h, ident, &pc, &ec, err);
+        pdt_run_release_points(run);  /* (written from them) */
+        *work = r->build_peak + (r->state_paged ? 0 : pdt_replay_state_bytes(r)); /* (the
+                                                            * checkpoints' state, when held) */
+        *buckets = r->build_buckets;
+        r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
+    }
+    pdt_replay_free(r);
+    pdt_evsrc_clear(&ec.src);
+    pdt_merge_close(es.mg);
+    free(es.buf);
+    if (es.map) munmap(es.map, es.map_len);
+    if (close(fd) != 0 && st == PDT_OK)
+        st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
+    /* into place over a stale index without ext4 writing the new one back
+     * inside the call (pdt_replace_file: gigabytes for a big run) */
+    if (st == PDT_OK && pdt_replace_file(tmp, path) != 0)
+        st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", path, strerror(errno));
+    if (st != PDT_OK) unlink(tmp);
+    free(h);
+    free(ec.blk);
+    free(ec.rank_blk);
+    free(ec.src.file);
+    free(ec.src.file_len);
+    free(ec.segs_crc.crc);
+    return st;
+}
+
+/* ---- opening a run ---------------------------------------------------------------- */
+
+pdt_status pdt_replay_open_kept(const char *dir, uint64_t budget, pdt_replay **out,
+                                pdt_replay_open_info *info, pdt_err *err)
+{
+    pdt_replay_open_info dummy;
+    if (!info) info = &dummy;
+    memset(info, 0, sizeof *info);
+    *out = NULL;
+    uint64_t ident = 0;
+    pdt_status st = pdt_ix_run_ident(dir, &ident, err);
+    if (st != PDT_OK) return st;
+    char path[PATH_MAX];
+    for (int where = 0; where < 2; where++) {
+        char why[160];
+        if (!pdt_ix_index_path(dir, where, path, sizeof path)) continue;
+        pdt_replay *r = pdt_ix_load(path, dir, ident, NULL, 0, 1, why, sizeof why);
+        if (!r) {
+            if (where == 0 || strcmp(why, "no index yet"))
+                snprintf(info->why, sizeof info->why, "%s", why);
+            continue;
+        }
+        info->indexed = 1;
+        info->events = r->m;
+        snprintf(info->path, sizeof info->path, "%s", path);
+        pdt_replay_set_mem(r, budget);
+        *out = r;
+        return PDT_OK;
+    }
+    return PDT_OK;
+}
+
+/* The replay of run in memory, as before the kept index. */
+static pdt_status in_memory(pdt_run *run, const pdt_point *pts, size_t n, int nranks,
+                            pdt_replay **out, pdt_err *err)
+{
+    const pdt_rec *recs;
+    size_t m;
+    pdt_status st = pdt_run_merged(run, &recs, &m, err);
+    if (st != PDT_OK) return st;
+    return pdt_replay_new(pts, n, recs, m, nranks, out, err);
+}
+
+static void release_run_points(const void *run)
+{
+    pdt_run_release_points(run);
+}
+
+pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, int use_index,
+                               pdt_replay **out, pdt_replay_open_info *info, pdt_err *err)
+{
+    pdt_replay_open_info dummy;
+    if (!info) info = &dummy;
+    memset(info, 0, sizeof *info);
+    *out = NULL;
+    size_t n;
+    const pdt_point *pts = pdt_run_points(run, &n);
+    int nranks = pdt_run_nranks(run);
+    uint64_t events = 0;
+    for (int q = 0; q < nranks; q++) {
+        pdt_rank_info ri;
+        pdt_run_rank_info(run, q, &ri);
+        events += ri.events;
+    }
+    info->events = events;
+    if (use_index < 0) use_index = events * EST_BYTES_PER_EVENT > budget / 4;
+    pdt_status st;
+    if (!use_index) {
+        st = in_memory(run, pts, n, nranks, out, err);
+        if (st == PDT_OK) pdt_replay_set_mem(*out, budget);
+        return st;
+    }
+    uint64_t ident = 0;
+    st = pdt_ix_run_ident(dir, &ident, err);
+    if (st != PDT_OK) return st;
+    char path[PATH_MAX];
+    pdt_replay *r = NULL;
+    /* a kept index beside the run, else in the cache */
+    for (int where = 0; where < 2 && !r; where++) {
+        char why[160];
+        if (!pdt_ix_index_path(dir, where, path, sizeof path)) continue;
+        r = pdt_ix_load(path, dir, ident, pts, n, 1, why, sizeof why);
+        if (!r && where == 0) snprintf(info->why, sizeof info->why, "%s", why);
+        if (!r && where == 1 && strcmp(why, "no index yet"))
+            snprintf(info->why, sizeof info->why, "%s", why);
+    }
+    if (!r) { /* (re)build it: beside the run if the folder takes it, else in the cache */
+        double t0 = pdt_seconds();
+        for (int where = 0; where < 2 && !r; where++) {
+            if (!pdt_ix_index_path(dir, where, path, sizeof path)) continue;
+            if (where == 1) {
+                char cdir[PATH_MAX];
+                if (!pdt_ix_cache_dir(cdir, sizeof cdir) || !pdt_ix_make_dirs(cdir)) continue;
+            }
+            pdt_err e2 = {0};
+            if (build(run, pts, n, nranks, ident, path, budget, &info->build_bytes,
+                      &info->build_buckets, &e2) != PDT_OK) {
+                snprintf(info->write_error, sizeof info->write_error, "%s", e2.msg);
+                pdt_err_clear(&e2);
+                continue;
+            }
+            char why[160];
+            r = pdt_ix_load(path, dir, ident, pts, n, 0, why, sizeof why);
+        }
+        info->built = r != NULL;
+        info->build_s = pdt_seconds() - t0;
+    }
+    if (!r) { /* no place to keep an index: the whole run in memory */
+        st = in_memory(run, pts, n, nranks, out, err);
+        if (st == PDT_OK) pdt_replay_set_mem(*out, budget);
+        return st;
+    }
+    info->indexed = 1;
+    snprintf(info->path, sizeof info->path, "%s", path);
+    r->release_points = release_run_points;  /* read in place: given back after frames */
+    r->release_ctx = run;
+    pdt_replay_set_mem(r, budget);
+    *out = r;
+    return PDT_OK;
+}

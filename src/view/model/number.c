@@ -1,0 +1,308 @@
+/* pdt — the replay's build: the triangles' numbers by first event, and the
+ * per-event tables (in memory, or streamed in windows of events). */
+#include "pdt/view/replay.h"
+#include "replay_int.h"
+#include "build_int.h"
+#include "pdt/bigmem.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+/* A streamed build reads the records (a mapping of the index file) from
+ * start to end a few times: the pages behind the pass are let go every
+ * DROP_EVERY records (they stay in the page cache), so the process does not
+ * hold all of them at once. */
+#define DROP_EVERY ((size_t)1 << 20)
+
+void pdt_rp_drop_recs(const builder *b, size_t upto)
+{
+    if (!b->pl || !b->r->recs || !upto || upto % DROP_EVERY) return;
+    pdt_release_pages(b->r->recs + upto - DROP_EVERY, DROP_EVERY * sizeof *b->r->recs);
+}
+
+/* Number the triangles by their first event (after tri_groups): the
+ * triangle table (in r->tris, or streamed to tris_at), and ev_obj[ev] = the
+ * triangle of every triangle event; the entry of a triangle's first event
+ * is marked (FIRST_ENTRY). */
+int pdt_rp_tri_ids(builder *b)
+{
+    pdt_replay *r = b->r;
+    enum { TBUF = 4096 };
+    pdt_rtri tb[TBUF], *to = b->pl ? tb : r->tris;
+    size_t nb = 0;
+    r->ntri = 0;
+    for (size_t i = 0; i < r->m; i++) {
+        pdt_rp_drop_recs(b, i);
+        if (i + PREFETCH_AHEAD < r->m) {
+            int32_t a = r->ev_obj[i + PREFETCH_AHEAD];
+            if (a >= 0 && is_tri_kind(r->ev_kind[i + PREFETCH_AHEAD])) __builtin_prefetch(&r->ev_obj[a]);
+        }
+        if (!is_tri_kind(kind_at(r, i))) continue;
+        int32_t o = r->ev_obj[i];
+        if (o == -1) continue;  /* skipped */
+        if (o >= 0) {
+            r->ev_obj[i] = r->ev_obj[o];
+            continue;
+        }
+        const pdt_rec *rec = rec_at(r, i);
+        to[b->pl ? nb++ : r->ntri] = (pdt_rtri){{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank,
+                                               r->ev_ent[i], (uint32_t)(-1 - o)};
+        r->ev_kind[i] |= KIND_FIRST;
+        r->ev_obj[i] = (int32_t)r->ntri++;
+        if (nb == TBUF) {
+            if (!pdt_rp_tput(b, NULL, r->tris_at, r->ntri - nb, tb, nb, sizeof *tb)) return 0;
+            nb = 0;
+        }
+    }
+    return pdt_rp_tput(b, NULL, r->tris_at, r->ntri - nb, tb, nb, sizeof *tb);
+}
+
+/* Records of `rec` bytes, read in order from `left` of them at `at` of
+ * scratch file `file`, cap at a time (a bucket's: the builder's cur_recs). */
+typedef struct bcur {
+    int file;
+    uint64_t at;
+    size_t left, rec, n, i, cap;  /* cap: records the buffer holds */
+    unsigned char *buf;
+} bcur;
+
+/* The next record, or NULL at the end (or when a read failed: b->failed). */
+static const void *bcur_peek(builder *b, bcur *c)
+{
+    if (c->i < c->n) return c->buf + c->i * c->rec;
+    if (!c->left) return NULL;
+    size_t k = c->left < c->cap ? c->left : c->cap;
+    if (!b->pl->sget(b->pl->ctx, c->file, c->at, c->buf, k * c->rec)) {
+        b->failed = 1;
+        c->left = 0;
+        return NULL;
+    }
+    c->at += k * c->rec;
+    c->left -= k;
+    c->n = k;
+    c->i = 0;
+    return c->buf;
+}
+
+/* Records appended at `at` of scratch file `file` (file < 0: of the place),
+ * cap at a time.  0 when a write failed. */
+static int bput_flush(builder *b, bcur *c)
+{
+    if (!c->n) return 1;
+    size_t bytes = c->n * c->rec;
+    int ok = c->file < 0 ? b->pl->put(b->pl->ctx, c->at, c->buf, bytes)
+                         : b->pl->sput(b->pl->ctx, c->file, c->at, c->buf, bytes);
+    c->at += bytes;
+    c->n = 0;
+    if (!ok) b->failed = 1;
+    return ok;
+}
+
+static int bput(builder *b, bcur *c, const void *p)
+{
+    memcpy(c->buf + c->n * c->rec, p, c->rec);
+    return ++c->n < c->cap || bput_flush(b, c);
+}
+
+/* nfine cursors over records of rec bytes with one buffer; NULL when out of memory. */
+static bcur *bcurs_new(builder *b, size_t rec)
+{
+    bcur *c = pdt_rp_bmalloc(b, b->nfine * sizeof *c);
+    unsigned char *buf = pdt_rp_bmalloc(b, (size_t)b->nfine * b->cur_recs * rec);
+    if (!c || !buf) {
+        pdt_rp_bfree(b, c, b->nfine * sizeof *c);
+        pdt_rp_bfree(b, buf, (size_t)b->nfine * b->cur_recs * rec);
+        return NULL;
+    }
+    memset(c, 0, b->nfine * sizeof *c);
+    for (size_t f = 0; f < b->nfine; f++)
+        c[f].buf = buf + f * b->cur_recs * rec, c[f].rec = rec, c[f].cap = b->cur_recs;
+    return c;
+}
+
+static void bcurs_free(builder *b, bcur *c, size_t rec)
+{
+    if (!c) return;
+    pdt_rp_bfree(b, c[0].buf, (size_t)b->nfine * b->cur_recs * rec);
+    pdt_rp_bfree(b, c, b->nfine * sizeof *c);
+}
+
+/* Number the triangles by their first events: the triangle table and the
+ * history table in the triangles' order (streamed to tris_at and hist_at:
+ * a pass over the triangles reads their entries in order), a bucket's
+ * numbers in PDT_SCR_IDS (from fine_off[f]); the corners and maker of a
+ * triangle from its first event (decoded, in event order).  Each bucket's
+ * entries (PDT_SCR_HIST, from its fine_off) are its triangles' in order. */
+int pdt_rp_tri_number(builder *b)
+{
+    pdt_replay *r = b->r;
+    bcur *tc = bcurs_new(b, sizeof(tri_first)), *ic = bcurs_new(b, sizeof(uint32_t));
+    bcur *hc = bcurs_new(b, sizeof(pdt_rtri_hist)), tw, hw;
+    uint32_t *wn = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *wn);
+    uint16_t *wf = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *wf);
+    memset(&tw, 0, sizeof tw);
+    memset(&hw, 0, sizeof hw);
+    tw.buf = pdt_rp_bmalloc(b, CUR_RECS * sizeof(pdt_rtri));
+    hw.buf = pdt_rp_bmalloc(b, CUR_RECS * sizeof(pdt_rtri_hist));
+    int ok = tc && ic && hc && wn && wf && tw.buf && hw.buf;
+    if (ok) {
+        for (size_t f = 0; f < b->nfine; f++) {
+            tc[f].file = PDT_SCR_TRIS;
+            tc[f].at = (uint64_t)b->fine_off[f] * sizeof(tri_first);
+            tc[f].left = b->tcount[f];
+            ic[f].file = PDT_SCR_IDS;
+            ic[f].at = (uint64_t)b->fine_off[f] * sizeof(uint32_t);
+            hc[f].file = PDT_SCR_HIST;
+            hc[f].at = (uint64_t)b->fine_off[f] * sizeof(pdt_rtri_hist);
+            hc[f].left = b->fine_off[f + 1] - b->fine_off[f];
+        }
+        tw.file = hw.file = -1;
+        tw.at = r->tris_at;
+        tw.rec = sizeof(pdt_rtri);
+    tw.cap = hw.cap = CUR_RECS;
+        hw.at = r->hist_at;
+        hw.rec = sizeof(pdt_rtri_hist);
+    }
+    r->ntri = 0;
+    size_t h0 = 0;
+    for (size_t lo = 0; ok && lo < r->m; lo += NUM_WINDOW) {
+        size_t hi = r->m - lo < NUM_WINDOW ? r->m : lo + NUM_WINDOW;
+        memset(wn, 0, (hi - lo) * sizeof *wn);
+        for (size_t f = 0; f < b->nfine; f++) {
+            const tri_first *t;
+            while ((t = bcur_peek(b, &tc[f])) && t->ev < hi) {
+                if (t->ev < lo || !t->n) { /* (not in event order: never written so) */
+                    b->failed = 1;
+                    break;
+                }
+                wn[t->ev - lo] = t->n;
+                wf[t->ev - lo] = (uint16_t)f;
+                tc[f].i++;
+            }
+        }
+        for (size_t k = 0; ok && k < hi - lo; k++) {
+            if (!wn[k]) continue;
+            const pdt_rec *rec = rec_at(r, lo + k);
+            pdt_rtri t = {{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank, (uint32_t)h0, wn[k]};
+            uint32_t id = (uint32_t)r->ntri++;
+            ok = bput(b, &tw, &t) && bput(b, &ic[wf[k]], &id);
+            for (uint32_t j = 0; ok && j < wn[k]; j++) { /* its entries, from its bucket's */
+                const pdt_rtri_hist *e = bcur_peek(b, &hc[wf[k]]);
+                ok = e && bput(b, &hw, e);
+                hc[wf[k]].i++;
+            }
+            h0 += wn[k];
+        }
+        ok = ok && !b->failed;
+    }
+    for (size_t f = 0; ok && f < b->nfine; f++) ok = bput_flush(b, &ic[f]);
+    ok = ok && bput_flush(b, &tw) && bput_flush(b, &hw) && h0 == r->nhist;
+    pdt_rp_bfree(b, tw.buf, CUR_RECS * sizeof(pdt_rtri));
+    pdt_rp_bfree(b, hw.buf, CUR_RECS * sizeof(pdt_rtri_hist));
+    pdt_rp_bfree(b, wn, NUM_WINDOW * sizeof *wn);
+    pdt_rp_bfree(b, wf, NUM_WINDOW * sizeof *wf);
+    bcurs_free(b, tc, sizeof(tri_first));
+    bcurs_free(b, ic, sizeof(uint32_t));
+    bcurs_free(b, hc, sizeof(pdt_rtri_hist));
+    if (!ok) b->failed = 1;
+    return ok;
+}
+
+/* Give every triangle event of every bucket its triangle's number (in
+ * place in PDT_SCR_TRIEV), with the bucket's numbers in memory. */
+int pdt_rp_tri_join(builder *b)
+{
+    size_t most = 0;
+    for (size_t f = 0; f < b->nfine; f++)
+        if (b->tcount[f] > most) most = b->tcount[f];
+    enum { JOIN_RECS = 1 << 16 };
+    uint32_t *ids = pdt_rp_bmalloc(b, most * sizeof *ids);
+    tri_ev *ev = pdt_rp_bmalloc(b, JOIN_RECS * sizeof *ev);
+    int ok = ids && ev;
+    for (size_t f = 0; ok && f < b->nfine; f++) {
+        ok = !b->tcount[f] || b->pl->sget(b->pl->ctx, PDT_SCR_IDS, (uint64_t)b->fine_off[f] * sizeof *ids,
+                                         ids, b->tcount[f] * sizeof *ids);
+        for (size_t j = b->fine_off[f]; ok && j < b->fine_off[f + 1]; j += JOIN_RECS) {
+            size_t k = b->fine_off[f + 1] - j < JOIN_RECS ? b->fine_off[f + 1] - j : JOIN_RECS;
+            uint64_t at = (uint64_t)j * sizeof *ev;
+            ok = b->pl->sget(b->pl->ctx, PDT_SCR_TRIEV, at, ev, k * sizeof *ev);
+            for (size_t i = 0; ok && i < k; i++) {
+                uint32_t q = ev[i].t & ~TEV_FIRST;
+                if (q >= b->tcount[f]) {
+                    ok = 0;
+                    break;
+                }
+                ev[i].t = ids[q] | (ev[i].t & TEV_FIRST);
+            }
+            ok = ok && b->pl->sput(b->pl->ctx, PDT_SCR_TRIEV, at, ev, k * sizeof *ev);
+        }
+    }
+    if (!ok) b->failed = 1;
+    pdt_rp_bfree(b, ids, most * sizeof *ids);
+    pdt_rp_bfree(b, ev, JOIN_RECS * sizeof *ev);
+    return ok;
+}
+
+/* The per-event tables (at evobj_at and evkind_at of the place): pass 1's,
+ * completed in place with every triangle event's triangle and the mark on
+ * a triangle's first event (PDT_SCR_TRIEV, bucket by bucket in event order). */
+int pdt_rp_ev_tables(builder *b)
+{
+    pdt_replay *r = b->r;
+    const pdt_replay_place *pl = b->pl;
+    bcur *ec = bcurs_new(b, sizeof(tri_ev));
+    int32_t *obj = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *obj);
+    uint8_t *kind = pdt_rp_bmalloc(b, NUM_WINDOW);
+    int ok = ec && obj && kind;
+    for (size_t f = 0; ok && f < b->nfine; f++) {
+        ec[f].file = PDT_SCR_TRIEV;
+        ec[f].at = (uint64_t)b->fine_off[f] * sizeof(tri_ev);
+        ec[f].left = b->fine_off[f + 1] - b->fine_off[f];
+    }
+    for (size_t lo = 0; ok && lo < r->m; lo += NUM_WINDOW) {
+        size_t hi = r->m - lo < NUM_WINDOW ? r->m : lo + NUM_WINDOW, k = hi - lo;
+        ok = pl->get(pl->ctx, r->evobj_at + (uint64_t)lo * sizeof *obj, obj, k * sizeof *obj) &&
+             pl->get(pl->ctx, r->evkind_at + lo, kind, k);
+        for (size_t f = 0; ok && f < b->nfine; f++) {
+            const tri_ev *t;
+            while ((t = bcur_peek(b, &ec[f])) && t->ev < hi) {
+                if (t->ev < lo) {
+                    b->failed = 1;
+                    break;
+                }
+                obj[t->ev - lo] = (int32_t)(t->t & ~TEV_FIRST);
+                if (t->t & TEV_FIRST) kind[t->ev - lo] |= KIND_FIRST;
+                ec[f].i++;
+            }
+        }
+        ok = ok && !b->failed && pl->put(pl->ctx, r->evobj_at + (uint64_t)lo * sizeof *obj, obj, k * sizeof *obj) &&
+             pl->put(pl->ctx, r->evkind_at + lo, kind, k);
+    }
+    if (!ok) b->failed = 1;
+    pdt_rp_bfree(b, obj, NUM_WINDOW * sizeof *obj);
+    pdt_rp_bfree(b, kind, NUM_WINDOW);
+    bcurs_free(b, ec, sizeof(tri_ev));
+    return ok;
+}
+
+/* Pass 1 of a streamed build: the window of per-event tables out to the
+ * place when event i is past it (or at the end: i == m). */
+int pdt_rp_ev_window(builder *b, size_t i)
+{
+    if (i - b->wlo < EVW && i < b->r->m) return 1;
+    size_t k = i - b->wlo;
+    const pdt_replay_place *pl = b->pl;
+    if (k && (!pl->put(pl->ctx, b->r->evobj_at + (uint64_t)b->wlo * 4, b->wobj, k * 4) ||
+              !pl->put(pl->ctx, b->r->evkind_at + b->wlo, b->wkind, k))) {
+        b->failed = 1;
+        return 0;
+    }
+    b->wlo = i;
+    return 1;
+}

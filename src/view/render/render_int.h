@@ -1,0 +1,233 @@
+/* pdt — internals of the cairo renderer, shared by its files (not installed,
+ * not part of the API):
+ *
+ *   render.c    pdt_render(): the frame, the context, colours
+ *   layout.c    view defaults, panel rectangles, screen <-> world
+ *   geometry.c  the world picture (boxes, triangles, hulls, stacks, points,
+ *               merges, the current event, the selection)
+ *   panels.c    text panels: event line, legend, pseudo-code, stacks, help
+ *   lifted.c    the lifted view (paraboloid)
+ *   timeline.c  the timeline and seeking by a click on it
+ *   export.c    pdt_render_file(): PNG, SVG, PDF
+ *   pick.c      what is under the mouse
+ *   render_lod.c  millions of triangles drawn as their coverage per cell
+ *
+ * The questions about the replay these files ask (is a hull still live,
+ * which pseudo-code line, ...) are the model's: pdt/view/query.h. */
+#ifndef PDT_VIEW_RENDER_INT_H
+#define PDT_VIEW_RENDER_INT_H
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pdt/view/query.h"
+#include "pdt/view/render.h"
+
+#define NONE32 UINT32_MAX
+#define SANS "DejaVu Sans"
+#define MONO "DejaVu Sans Mono"
+
+#define PDT_UNUSED __attribute__((unused))
+static const double RED[3] PDT_UNUSED = {0.85, 0.0, 0.0};
+
+/* The colours of a theme (pdt_view.theme).  Rank colours are the same in
+ * every theme (pdt_rank_rgb). */
+typedef struct pdt_theme {
+    double bg[3];       /* picture background */
+    double panel[3];    /* panel background */
+    double border[3];   /* panel border */
+    double topbar[3];   /* event line background */
+    double ink[3];      /* text, lifted points, hull-ish marks */
+    double hollow[3];   /* points not yet lifted */
+    double label[3];    /* point labels */
+    double select[3];   /* the clicked point, edge or triangle */
+    double disk[3];     /* circumdisk outline */
+    double mark[3];     /* current code line, disk fill */
+    double hull;        /* hull colour = rank colour mixed towards ink by this */
+    double tint;        /* strip box tint (0: none) */
+    double lwf;         /* line width factor */
+} pdt_theme;
+
+/* The theme of id PDT_THEME_* (light for an unknown id). */
+const pdt_theme *pdt_theme_get(int id);
+
+/* World -> screen of the geometry area: screen = (ox + s*x, oy - s*y). */
+typedef struct xform {
+    double s, ox, oy;
+} xform;
+
+/* The transform of the geometry area for a w x h picture (layout.c). */
+xform pdt_geo_xform(const pdt_replay *r, const pdt_view *v, double w, double h);
+
+/* Everything one frame's drawing functions share. */
+typedef struct ctx {
+    cairo_t *cr;
+    const pdt_replay *r;
+    const pdt_rstate *s;
+    const pdt_view *v;
+    pdt_layout L;
+    xform X;
+    const pdt_point *P;
+    size_t n;
+    int nranks;
+    double lw;      /* base line width */
+    const pdt_rec *cur;  /* the current event or NULL (&cur_copy: a kept index's
+                          * pointer would not outlast the frame's other reads) */
+    pdt_rec cur_copy;
+    int all_lifted;      /* no lift events but triangles: show every point lifted */
+    int no_lift;         /* no lift events and no triangles (a hull-only run) */
+    double spacing;      /* typical distance between points, pixels */
+    const pdt_theme *T;  /* colours */
+} ctx;
+
+/* The parts of the frame, each clipped to its rectangle of c->L. */
+void pdt_draw_geometry(ctx *c);                 /* geometry.c */
+/* Sorts the packed edges e[0..n) (smaller vertex in the high half) and
+ * removes repeats; returns how many distinct edges stay in front. */
+size_t pdt_unique_edges(uint64_t *e, size_t n);
+/* Level of detail (render_lod.c): when the triangles in the geometry area are
+ * too many to draw one by one, paint their coverage per cell instead and
+ * return 1; else draw nothing and return 0. */
+int pdt_draw_lod(ctx *c);
+void pdt_draw_top(ctx *c);                      /* panels.c */
+void pdt_draw_legend(ctx *c);
+void pdt_draw_code(ctx *c);
+void pdt_draw_stack_panel(ctx *c);
+void pdt_draw_help(ctx *c, double w, double h);
+void pdt_draw_lifted(ctx *c);                   /* lifted.c */
+void pdt_draw_timeline(ctx *c);                 /* timeline.c */
+/* Timeline geometry shared by the drawing and the click: the x range of the
+ * event axis in R for base font f. */
+void pdt_timeline_axis(pdt_rect R, double f, double *x0, double *x1);
+
+/* ---- small drawing helpers ------------------------------------------------------ */
+
+static inline void set_rank(cairo_t *cr, int rank, double alpha)
+{
+    double c[3];
+    pdt_rank_rgb(rank, c);
+    cairo_set_source_rgba(cr, c[0], c[1], c[2], alpha);
+}
+
+static inline void rgb(cairo_t *cr, const double c[3], double a)
+{
+    cairo_set_source_rgba(cr, c[0], c[1], c[2], a);
+}
+
+static inline void text_at(cairo_t *cr, const char *face, int bold, double size, double x,
+                           double y, const char *s)
+{
+    cairo_select_font_face(cr, face, CAIRO_FONT_SLANT_NORMAL,
+                           bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_set_font_size(cr, size);
+    cairo_move_to(cr, x, y);
+    cairo_show_text(cr, s);
+}
+
+static inline double text_wb(cairo_t *cr, const char *face, int bold, double size, const char *s)
+{
+    cairo_text_extents_t te;
+    cairo_select_font_face(cr, face, CAIRO_FONT_SLANT_NORMAL,
+                           bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_set_font_size(cr, size);
+    cairo_text_extents(cr, s, &te);
+    return te.x_advance;
+}
+
+static inline double text_w(cairo_t *cr, const char *face, double size, const char *s)
+{
+    return text_wb(cr, face, 0, size, s);
+}
+
+static inline void panel(cairo_t *cr, const pdt_theme *T, pdt_rect R, const char *title, double f)
+{
+    cairo_rectangle(cr, R.x + 2, R.y + 2, R.w - 4, R.h - 4);
+    rgb(cr, T->panel, 1);
+    cairo_fill_preserve(cr);
+    rgb(cr, T->border, 1);
+    cairo_set_line_width(cr, 1);
+    cairo_stroke(cr);
+    if (title) {
+        double fs = 0.85 * f, tw = text_wb(cr, SANS, 1, fs, title);
+        if (tw > R.w - f) fs *= fmax(0.7, (R.w - f) / tw); /* long titles: smaller */
+        rgb(cr, T->ink, 1);
+        text_at(cr, SANS, 1, fs, R.x + 0.5 * f, R.y + 1.15 * f, title);
+    }
+}
+
+static inline void clip_rect(cairo_t *cr, pdt_rect R)
+{
+    cairo_rectangle(cr, R.x, R.y, R.w, R.h);
+    cairo_clip(cr);
+}
+
+/* Circumcircle in world coordinates; 0 if degenerate. */
+static inline int circum(const pdt_point *P, const uint32_t v[3], double *ox, double *oy,
+                         double *rr)
+{
+    pdt_point A = P[v[0]], B = P[v[1]], C = P[v[2]];
+    double bx = (double)B.x - A.x, by = (double)B.y - A.y, cx = (double)C.x - A.x,
+           cy = (double)C.y - A.y;
+    double d = 2 * (bx * cy - by * cx);
+    if (d == 0) return 0;
+    double ux = (cy * (bx * bx + by * by) - by * (cx * cx + cy * cy)) / d;
+    double uy = (bx * (cx * cx + cy * cy) - cx * (bx * bx + by * by)) / d;
+    *ox = A.x + ux;
+    *oy = A.y + uy;
+    *rr = sqrt(ux * ux + uy * uy);
+    return 1;
+}
+
+static inline int shown(const ctx *c, uint32_t rank)
+{
+    return !c->v->hidden || rank >= (uint32_t)c->nranks || !c->v->hidden[rank];
+}
+
+static inline void wpt(const ctx *c, uint32_t p, double *x, double *y)
+{
+    *x = c->X.ox + c->X.s * c->P[p].x;
+    *y = c->X.oy - c->X.s * c->P[p].y;
+}
+
+static inline void tri_path(const ctx *c, const uint32_t v[3])
+{
+    double x, y;
+    wpt(c, v[0], &x, &y);
+    cairo_move_to(c->cr, x, y);
+    wpt(c, v[1], &x, &y);
+    cairo_line_to(c->cr, x, y);
+    wpt(c, v[2], &x, &y);
+    cairo_line_to(c->cr, x, y);
+    cairo_close_path(c->cr);
+}
+
+static inline int is_tri_event(int k)
+{
+    return k == PDT_EV_TRI_NEW || k == PDT_EV_TRI_FINAL || k == PDT_EV_RA_DEFER ||
+           k == PDT_EV_SHIP || k == PDT_EV_DISCARD || k == PDT_EV_INCIRCLE;
+}
+
+static inline void cross(cairo_t *cr, double x, double y, double a)
+{
+    cairo_move_to(cr, x - a, y - a);
+    cairo_line_to(cr, x + a, y + a);
+    cairo_move_to(cr, x - a, y + a);
+    cairo_line_to(cr, x + a, y - a);
+}
+
+/* The colour of rank q's hulls: its rank colour mixed towards the ink. */
+static inline void set_hull(const ctx *c, int q, double alpha)
+{
+    double col[3];
+    pdt_rank_rgb(q, col);
+    double m = c->T->hull;
+    cairo_set_source_rgba(c->cr, (1 - m) * col[0] + m * c->T->ink[0], (1 - m) * col[1] + m * c->T->ink[1],
+                          (1 - m) * col[2] + m * c->T->ink[2], alpha);
+}
+
+/* Line style of a triangle status: width and dash (render.c). */
+void pdt_status_style(cairo_t *cr, int st, double lw);
+
+#endif
