@@ -89,7 +89,7 @@ DEB_FUZZ  := clang libclang-rt-dev
 
 # the comm front and its local (threads) backend need no MPI: in libpdt.a
 COMM_SRC := src/par/comm.c src/par/comm_local.c
-LIB_SRC  := $(wildcard src/geom/*.c src/io/*.c src/trace/*.c) $(COMM_SRC)
+LIB_SRC  := $(wildcard src/base/*.c src/geom/*.c src/io/*.c src/trace/*.c) $(COMM_SRC)
 PAR_SRC  := $(filter-out $(COMM_SRC) src/par/comm_mpi.c,$(wildcard src/par/*.c))
 CLI_SRC  := $(wildcard src/cli/*.c)
 VIEWLIB_SRC := $(filter-out src/view/shell.c src/view/pdtview.c,$(wildcard src/view/*.c))

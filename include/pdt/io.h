@@ -10,6 +10,7 @@
 #include <stdio.h>
 
 #include "pdt/common.h"
+#include "pdt/safefile.h"
 
 /* ---- atomic output ---------------------------------------------------- */
 
@@ -17,15 +18,20 @@ typedef struct pdt_outfile {
     FILE *fp;        /* write here */
     char *path;      /* final name (NULL for standard output) */
     char *tmp;       /* temporary name (NULL: writing directly) */
+    pdt_safe_file sf; /* the rule of pdt/safefile.h */
 } pdt_outfile;
 
-/* Open `path` for atomic writing ("-" or NULL = standard output).  A path
- * that names an existing device or pipe (/dev/null, a fifo) is written
- * directly, never replaced. */
+/* Open `path` for atomic writing ("-" or NULL = standard output) by the
+ * rule of pdt/safefile.h (mode, owner and links kept; read-only targets
+ * refused).  A path that names an existing device or pipe (/dev/null, a
+ * fifo) is written directly, never replaced. */
 pdt_status pdt_out_open(pdt_outfile *o, const char *path, pdt_err *err);
 /* Flush, close and rename into place.  On any write error the temporary is
  * removed and an error returned. */
 pdt_status pdt_out_commit(pdt_outfile *o, pdt_err *err);
+/* Flush and close both, then replace both targets together (an .ele and its
+ * .node): both or neither. */
+pdt_status pdt_out_commit_pair(pdt_outfile *a, pdt_outfile *b, pdt_err *err);
 /* Close and remove the temporary (nothing is left behind). */
 void pdt_out_abort(pdt_outfile *o);
 /* Put the finished temporary `tmp` in the place of `path` (same folder),

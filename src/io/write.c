@@ -505,7 +505,8 @@ static int has_ext(const char *path, const char *ext)
     return n >= e && strcmp(path + n - e, ext) == 0;
 }
 
-static pdt_status finish(pdt_outfile *o, wbuf *w, pdt_err *err)
+/* Flush w into o; on a write error, remove o's temporary. */
+static pdt_status flushed(pdt_outfile *o, wbuf *w, pdt_err *err)
 {
     wb_flush(w);
     if (w->bad) {
@@ -515,7 +516,13 @@ static pdt_status finish(pdt_outfile *o, wbuf *w, pdt_err *err)
         pdt_out_abort(o);
         return PDT_ERR_IO;
     }
-    return pdt_out_commit(o, err);
+    return PDT_OK;
+}
+
+static pdt_status finish(pdt_outfile *o, wbuf *w, pdt_err *err)
+{
+    pdt_status st = flushed(o, w, err);
+    return st == PDT_OK ? pdt_out_commit(o, err) : st;
 }
 
 /* ---- points ---------------------------------------------------------------- */
@@ -595,7 +602,7 @@ static pdt_status write_tris(const char *path, pdt_tri_format fmt, const pdt_poi
     pdt_status st = PDT_OK;
     onode.fp = NULL;
     if (fmt == PDT_FMT_ELE) {
-        /* The .node first, but renamed into place only after the .ele is done. */
+        /* The .node first; both replaced together once the .ele is done. */
         npath = node_path_of(path);
         if (!npath) {
             free(w);
@@ -625,10 +632,10 @@ static pdt_status write_tris(const char *path, pdt_tri_format fmt, const pdt_poi
         w->n = 0;
         w->bad = w->err = 0;
         emit_tris(w, fmt, pts, n, tris, ntri, release);
-        st = finish(&o, w, err);
+        st = fmt == PDT_FMT_ELE ? flushed(&o, w, err) : finish(&o, w, err);
     }
     if (fmt == PDT_FMT_ELE) {
-        if (st == PDT_OK) st = pdt_out_commit(&onode, err);
+        if (st == PDT_OK) st = pdt_out_commit_pair(&o, &onode, err);
         else pdt_out_abort(&onode);
     }
     free(npath);
