@@ -71,6 +71,7 @@ typedef struct pdt_safe_dir {
     char *target;  /* the folder replaced (a symlink to a folder is followed) */
     char *tmp;     /* write here */
     int exists;    /* target existed at open */
+    int swapped;   /* the new folder is in place (pdt_safe_dir_swap) */
 } pdt_safe_dir;
 
 /* Check `dir` and create the temporary folder beside it.  Refused: a
@@ -82,6 +83,12 @@ pdt_status pdt_safe_dir_open(pdt_safe_dir *d, const char *dir, pdt_err *err);
 pdt_status pdt_safe_dir_commit(pdt_safe_dir *d, pdt_err *err);
 /* Remove the temporary folder and what was written in it. */
 void pdt_safe_dir_abort(pdt_safe_dir *d);
+/* The commit in two steps, for a folder that goes in place with other files
+ * (a traced run's output): swap the new folder in, keeping the old one under
+ * the temporary name; then finish: keep (remove the old folder) or not (the
+ * old folder back, the new one removed).  Frees d's names. */
+pdt_status pdt_safe_dir_swap(pdt_safe_dir *d, pdt_err *err);
+void pdt_safe_dir_finish(pdt_safe_dir *d, int keep);
 
 /* 1 if `name` (a file name without folder) is one a run folder holds:
  * manifest, points.bin, rank-NNNN.trace, the kept index, pdt's temporaries. */

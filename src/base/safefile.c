@@ -540,13 +540,7 @@ pdt_status pdt_safe_dir_open(pdt_safe_dir *d, const char *dir, pdt_err *err)
     return st;
 }
 
-void pdt_safe_dir_abort(pdt_safe_dir *d)
-{
-    if (d->tmp) remove_run_dir(d->tmp);
-    free_dir_names(d);
-}
-
-pdt_status pdt_safe_dir_commit(pdt_safe_dir *d, pdt_err *err)
+pdt_status pdt_safe_dir_swap(pdt_safe_dir *d, pdt_err *err)
 {
     int rc;
     if (d->exists) {
@@ -555,12 +549,35 @@ pdt_status pdt_safe_dir_commit(pdt_safe_dir *d, pdt_err *err)
         rc = renameat2(AT_FDCWD, d->tmp, AT_FDCWD, d->target, RENAME_NOREPLACE);
         if (rc != 0 && (errno == EINVAL || errno == ENOSYS)) rc = rename(d->tmp, d->target);
     }
-    pdt_status st = PDT_OK;
     if (rc != 0)
-        st = pdt_err_set(err, PDT_ERR_IO, "%s: cannot put the new run folder in place: %s; "
-                         "left as it was", d->name, strerror(errno));
-    if (st != PDT_OK || d->exists) remove_run_dir(d->tmp); /* the old folder, or the new */
+        return pdt_err_set(err, PDT_ERR_IO, "%s: cannot put the new run folder in place: %s; "
+                           "left as it was", d->name, strerror(errno));
+    d->swapped = 1;
+    return PDT_OK;
+}
+
+void pdt_safe_dir_finish(pdt_safe_dir *d, int keep)
+{
+    if (!d->target) return;
+    if (d->swapped && !keep) { /* the old folder back, the new one under the temporary name */
+        if (d->exists) (void)renameat2(AT_FDCWD, d->tmp, AT_FDCWD, d->target, RENAME_EXCHANGE);
+        else (void)rename(d->target, d->tmp);
+    }
+    /* the temporary name holds the old folder (kept, exchanged), the new
+     * one (not kept), or nothing (kept, renamed) */
+    if (!keep || d->exists) remove_run_dir(d->tmp);
     free_dir_names(d);
+}
+
+void pdt_safe_dir_abort(pdt_safe_dir *d)
+{
+    pdt_safe_dir_finish(d, 0);
+}
+
+pdt_status pdt_safe_dir_commit(pdt_safe_dir *d, pdt_err *err)
+{
+    pdt_status st = pdt_safe_dir_swap(d, err);
+    pdt_safe_dir_finish(d, st == PDT_OK);
     return st;
 }
 

@@ -56,10 +56,12 @@ static int out_close(pdt_outfile *o)
     return e;
 }
 
-pdt_status pdt_out_commit_pair(pdt_outfile *a, pdt_outfile *b, pdt_err *err)
+pdt_status pdt_out_finish_pair(pdt_outfile *a, pdt_outfile *b, pdt_pending_write *pw,
+                              pdt_err *err)
 {
     pdt_outfile *o[2] = {a, b};
     int n = b ? 2 : 1;
+    pw->n = 0;
     for (int k = 0; k < n; k++)
         if (!o[k]->fp) return pdt_err_set(err, PDT_ERR_ARG, "output file is not open");
     if (!a->path) { /* standard output: flush and check */
@@ -76,16 +78,33 @@ pdt_status pdt_out_commit_pair(pdt_outfile *a, pdt_outfile *b, pdt_err *err)
         if (e && st == PDT_OK)
             st = pdt_err_set(err, PDT_ERR_IO, "%s: write error: %s", o[k]->path, strerror(e));
     }
-    pdt_safe_file sf[2];
     for (int k = 0; k < n; k++) {
-        sf[k] = o[k]->sf;
+        pw->f[k] = o[k]->sf;
         o[k]->path = o[k]->tmp = NULL;
     }
-    if (st != PDT_OK) {
-        for (int k = 0; k < n; k++) pdt_safe_abort(&sf[k]);
-        return st;
-    }
-    return pdt_safe_commit_group(sf, n, err);
+    pw->n = n;
+    if (st != PDT_OK) pdt_pending_drop(pw);
+    return st;
+}
+
+pdt_status pdt_pending_commit(pdt_pending_write *pw, pdt_err *err)
+{
+    int n = pw->n;
+    pw->n = 0;
+    return n ? pdt_safe_commit_group(pw->f, n, err) : PDT_OK;
+}
+
+void pdt_pending_drop(pdt_pending_write *pw)
+{
+    for (int k = 0; k < pw->n; k++) pdt_safe_abort(&pw->f[k]);
+    pw->n = 0;
+}
+
+pdt_status pdt_out_commit_pair(pdt_outfile *a, pdt_outfile *b, pdt_err *err)
+{
+    pdt_pending_write pw;
+    pdt_status st = pdt_out_finish_pair(a, b, &pw, err);
+    return st == PDT_OK ? pdt_pending_commit(&pw, err) : st;
 }
 
 pdt_status pdt_out_commit(pdt_outfile *o, pdt_err *err)

@@ -587,8 +587,11 @@ static char *node_path_of(const char *ele)
     return p;
 }
 
+/* Write the triangles; put the file(s) in place, or leave them in *defer
+ * (when not NULL) for the caller to. */
 static pdt_status write_tris(const char *path, pdt_tri_format fmt, const pdt_point *pts, size_t n,
-                             const pdt_tri *tris, size_t ntri, int release, pdt_err *err)
+                             const pdt_tri *tris, size_t ntri, int release,
+                             pdt_pending_write *defer, pdt_err *err)
 {
     if ((fmt == PDT_FMT_ELE || fmt == PDT_FMT_OFF) && !pts && n > 0)
         return pdt_err_set(err, PDT_ERR_ARG, "writing .ele or .off needs the points");
@@ -632,12 +635,12 @@ static pdt_status write_tris(const char *path, pdt_tri_format fmt, const pdt_poi
         w->n = 0;
         w->bad = w->err = 0;
         emit_tris(w, fmt, pts, n, tris, ntri, release);
-        st = fmt == PDT_FMT_ELE ? flushed(&o, w, err) : finish(&o, w, err);
+        st = flushed(&o, w, err);
     }
-    if (fmt == PDT_FMT_ELE) {
-        if (st == PDT_OK) st = pdt_out_commit_pair(&o, &onode, err);
-        else pdt_out_abort(&onode);
-    }
+    pdt_outfile *node = fmt == PDT_FMT_ELE ? &onode : NULL;
+    if (st == PDT_OK && defer) st = pdt_out_finish_pair(&o, node, defer, err);
+    else if (st == PDT_OK) st = pdt_out_commit_pair(&o, node, err);
+    else if (node) pdt_out_abort(node);
     free(npath);
     free(w);
     return st;
@@ -646,11 +649,19 @@ static pdt_status write_tris(const char *path, pdt_tri_format fmt, const pdt_poi
 pdt_status pdt_write_tris(const char *path, pdt_tri_format fmt, const pdt_point *pts, size_t n,
                           const pdt_tri *tris, size_t ntri, pdt_err *err)
 {
-    return write_tris(path, fmt, pts, n, tris, ntri, 0, err);
+    return write_tris(path, fmt, pts, n, tris, ntri, 0, NULL, err);
 }
 
 pdt_status pdt_write_tris_releasing(const char *path, pdt_tri_format fmt, const pdt_point *pts,
                                     size_t n, pdt_tri *tris, size_t ntri, pdt_err *err)
 {
-    return write_tris(path, fmt, pts, n, tris, ntri, 1, err);
+    return write_tris(path, fmt, pts, n, tris, ntri, 1, NULL, err);
+}
+
+pdt_status pdt_write_tris_deferred(const char *path, pdt_tri_format fmt, const pdt_point *pts,
+                                   size_t n, pdt_tri *tris, size_t ntri, int release,
+                                   pdt_pending_write *defer, pdt_err *err)
+{
+    defer->n = 0;
+    return write_tris(path, fmt, pts, n, tris, ntri, release, defer, err);
 }
