@@ -101,5 +101,8 @@ int pdt_safe_same_file(const char *a, const char *b);
 /* 1 if `path` (existing or not) is `dir` or lies inside it (symlinks of
  * both followed). */
 int pdt_safe_inside(const char *path, const char *dir);
+/* 1 if writing `path` would replace a file of run folder `rundir`: it names
+ * one of the run's files there, or is the same file as one of them. */
+int pdt_safe_touches_run(const char *path, const char *rundir);
 
 #endif

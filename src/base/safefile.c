@@ -218,8 +218,10 @@ static mode_t cur_umask(void)
 static pdt_status check_folder(const char *name, const char *dir, pdt_err *err)
 {
     struct stat sb;
-    if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode))
-        return pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: no such folder %s", name, dir);
+    if (stat(dir, &sb) != 0)
+        return pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: %s", name, strerror(errno));
+    if (!S_ISDIR(sb.st_mode))
+        return pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: %s", name, strerror(ENOTDIR));
     if (faccessat(AT_FDCWD, dir, W_OK | X_OK, AT_EACCESS) != 0)
         return pdt_err_set(err, PDT_ERR_IO, "%s: cannot write in the folder %s: %s; nothing "
                            "written", name, dir, strerror(errno));
@@ -619,4 +621,22 @@ int pdt_safe_inside(const char *path, const char *dir)
     free(rp);
     free(rd);
     return in;
+}
+
+int pdt_safe_touches_run(const char *path, const char *rundir)
+{
+    if (!path || !rundir || !strcmp(path, "-")) return 0;
+    if (pdt_safe_inside(path, rundir) && pdt_safe_run_name(base_of(path))) return 1;
+    DIR *d = opendir(rundir);
+    if (!d) return 0;
+    struct stat out, sb;
+    int hit = 0;
+    if (stat(path, &out) == 0) {
+        struct dirent *de;
+        while (!hit && (de = readdir(d)))
+            hit = pdt_safe_run_name(de->d_name) && fstatat(dirfd(d), de->d_name, &sb, 0) == 0 &&
+                  sb.st_dev == out.st_dev && sb.st_ino == out.st_ino;
+    }
+    closedir(d);
+    return hit;
 }

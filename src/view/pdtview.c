@@ -24,6 +24,7 @@
 #include <cairo.h>
 
 #include "pdt/anim.h"
+#include "pdt/safefile.h"
 #include "pdt/describe.h"
 #include "pdt/query.h"
 #include "pdt/render.h"
@@ -317,7 +318,9 @@ static int headless(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const opts 
             pdt_replay_seek(r, s, k);
             char path[4096];
             snprintf(path, sizeof path, "%s/frame-%06zu.png", o->frames, count++);
-            if (pdt_render_file(path, o->w, o->h, r, s, v, err) != PDT_OK) return 1;
+            /* (a frame's name is ours: a link planted there is replaced, not followed) */
+            if (pdt_render_file_ex(path, PDT_SAFE_NOFOLLOW, o->w, o->h, r, s, v, err) != PDT_OK)
+                return 1;
             if (k == m) break;
         }
         if (!o->quiet) printf("pdtview: wrote %zu frames to %s\n", count, o->frames);
@@ -591,8 +594,11 @@ static int write_run(const char *dir, const loaded *L, const char *command, int 
     pdt_trace_writer **w = calloc((size_t)p, sizeof *w);
     int64_t *off = calloc((size_t)p, sizeof *off);
     pdt_status st = PDT_OK;
+    pdt_safe_dir sd = {0};  /* written whole beside DIR, swapped in at the end */
     if (!w || !off) st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    for (int q = 0; q < p && st == PDT_OK; q++) st = pdt_tw_open(dir, q, level, &w[q], err);
+    if (st == PDT_OK) st = pdt_safe_dir_open(&sd, dir, err);
+    const char *into = sd.tmp;
+    for (int q = 0; q < p && st == PDT_OK; q++) st = pdt_tw_open(into, q, level, &w[q], err);
     /* every writer's clock starts at its open: align them on rank 0's */
     if (st == PDT_OK) {
         uint64_t t0 = pdt_tw_now(w[0]);
@@ -603,7 +609,7 @@ static int write_run(const char *dir, const loaded *L, const char *command, int 
         tr->sink(tr, &L->recs[i].ev);
     }
     for (int q = 0; q < p && w; q++) {
-        pdt_status s2 = pdt_tw_close(w[q], err);
+        pdt_status s2 = w[q] ? pdt_tw_close(w[q], err) : PDT_OK;
         if (st == PDT_OK) st = s2;
     }
     if (st == PDT_OK) {
@@ -620,8 +626,10 @@ static int write_run(const char *dir, const loaded *L, const char *command, int 
         snprintf(mf.command, sizeof mf.command, "%s", command);
         mf.clock_offset_ns = off;
         mf.wall_start_ns = pdt_wall_ns();
-        st = pdt_run_write_meta(dir, &mf, L->pts, L->n, err);
+        st = pdt_run_write_meta(into, &mf, L->pts, L->n, err);
     }
+    if (st == PDT_OK) st = pdt_safe_dir_commit(&sd, err);
+    else pdt_safe_dir_abort(&sd);
     free(w);
     free(off);
     return st == PDT_OK ? 0 : 1;
@@ -768,11 +776,36 @@ static void index_damaged(const char *msg)
  * read ($PDTVIEW_VERIFY=lazy: all of them; =eager: none, whole at opening). */
 #define LAZY_VERIFY_MIN ((uint64_t)64 << 20)
 
+/* An input is never an output: the run folder or the edited file read must
+ * not be replaced by -o, --gif, --video or --write-run (checked before
+ * anything is written).  0, or the exit status after a message. */
+static int check_outputs(const opts *o)
+{
+    const char *in = o->edit ? o->edit : o->run && strncmp(o->run, "synth:", 6) ? o->run : NULL;
+    const char *outs[3] = {o->out, o->gif, o->video};
+    for (int k = 0; k < 3 && in; k++) {
+        if (!outs[k]) continue;
+        if (o->edit ? pdt_safe_same_file(outs[k], in) : pdt_safe_touches_run(outs[k], in)) {
+            fprintf(stderr, "pdtview: %s would replace %s%s, which is read; choose another "
+                    "name; nothing written\n", outs[k], o->edit ? "" : "a file of the run folder ",
+                    in);
+            return 2;
+        }
+    }
+    if (o->write_run && in && pdt_safe_inside(in, o->write_run)) {
+        fprintf(stderr, "pdtview: %s is inside the run folder %s that --write-run replaces; "
+                "choose another folder; nothing written\n", in, o->write_run);
+        return 2;
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     opts o;
     int prc = parse_args(argc, argv, &o);
     if (prc >= 0) return prc;
+    if ((prc = check_outputs(&o))) return prc;
     if (o.bench_live) return bench_live(&o);
     if (o.edit) return edit(&o);
     const char *verify = getenv("PDTVIEW_VERIFY");
