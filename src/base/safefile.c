@@ -394,8 +394,11 @@ static pdt_status swap_in(pdt_safe_file *f, pdt_err *err)
         else if ((errno == EINVAL || errno == ENOSYS) && (rc = rename(f->tmp, f->target)) == 0)
             f->swapped = SWAP_RENAMED;
     } else {
-        rc = renameat2(AT_FDCWD, f->tmp, AT_FDCWD, f->target, RENAME_NOREPLACE);
-        if (rc != 0 && (errno == EINVAL || errno == ENOSYS)) rc = rename(f->tmp, f->target);
+        struct stat sb; /* (a link at the name, PDT_SAFE_NOFOLLOW: replaced) */
+        int link = lstat(f->target, &sb) == 0 && S_ISLNK(sb.st_mode);
+        rc = link ? -1 : renameat2(AT_FDCWD, f->tmp, AT_FDCWD, f->target, RENAME_NOREPLACE);
+        if (link || (rc != 0 && (errno == EINVAL || errno == ENOSYS)))
+            rc = rename(f->tmp, f->target);
         if (rc == 0) f->swapped = SWAP_RENAMED;
     }
     if (rc != 0)
@@ -567,7 +570,7 @@ void pdt_safe_dir_finish(pdt_safe_dir *d, int keep)
     }
     /* the temporary name holds the old folder (kept, exchanged), the new
      * one (not kept), or nothing (kept, renamed) */
-    if (!keep || d->exists) remove_run_dir(d->tmp);
+    if (d->tmp && (!keep || d->exists)) remove_run_dir(d->tmp);
     free_dir_names(d);
 }
 
