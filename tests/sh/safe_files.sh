@@ -176,18 +176,17 @@ mkdir ".krun.pdt-tmp.$dead.0badf00d"; echo x > ".krun.pdt-tmp.$dead.0badf00d/ran
 "$PDT" triangulate u.txt -o kr.tri --trace krun 2>/dev/null
 [ ! -e ".krun.pdt-tmp.$dead.0badf00d" ] && ok killed_runs_temporary_folder_removed ||
     fail killed_runs_temporary_folder_removed "$(ls -A)"
-echo mine > run/.pdtview-index.tmp123 2>/dev/null || true
 
 # ---- the same families on pdtview's outputs ------------------------------------------------
 if [ -x "$V" ]; then
     "$PDT" triangulate u.txt -o vr.tri --trace vrun 2>/dev/null
-    echo mine > vrun/.pdtview-index.tmp123
-    "$V" vrun --headless --quiet -o vpic.png 2>err; rc=$?
-    [ $rc -eq 0 ] && [ "$(cat vrun/.pdtview-index.tmp123)" = mine ] && ok index_build_keeps_users_lookalike_file ||
+    echo mine > "vrun/.pdtview-index.tmp$dead"  # (a process that is gone: the old cleaner took it for its own)
+    "$V" vrun --headless --quiet --index on -o vpic.png 2>err; rc=$?
+    [ $rc -eq 0 ] && [ "$(cat "vrun/.pdtview-index.tmp$dead")" = mine ] && ok index_build_keeps_users_lookalike_file ||
         fail index_build_keeps_users_lookalike_file "rc=$rc $(cat err)"
-    rm -f vrun/.pdtview-index vrun/.pdtview-index.tmp123; echo victim > v2
+    rm -f vrun/.pdtview-index "vrun/.pdtview-index.tmp$dead"; echo victim > v2
     ln -s "$PWD/v2" vrun/.pdtview-index
-    "$V" vrun --headless --quiet -o vpic.png 2>/dev/null
+    "$V" vrun --headless --quiet --index on -o vpic.png 2>/dev/null
     [ "$(cat v2)" = victim ] && ok index_not_written_through_planted_link || fail index_not_written_through_planted_link
     before=$(snap vrun)
     "$V" vrun --headless --quiet -o vrun/manifest 2>err; rc=$?
