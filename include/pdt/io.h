@@ -10,6 +10,7 @@
 #include <stdio.h>
 
 #include "pdt/common.h"
+#include "pdt/safefile.h"
 
 /* ---- atomic output ---------------------------------------------------- */
 
@@ -17,17 +18,37 @@ typedef struct pdt_outfile {
     FILE *fp;        /* write here */
     char *path;      /* final name (NULL for standard output) */
     char *tmp;       /* temporary name (NULL: writing directly) */
+    pdt_safe_file sf; /* the rule of pdt/safefile.h */
 } pdt_outfile;
 
-/* Open `path` for atomic writing ("-" or NULL = standard output).  A path
- * that names an existing device or pipe (/dev/null, a fifo) is written
- * directly, never replaced. */
+/* Open `path` for atomic writing ("-" or NULL = standard output) by the
+ * rule of pdt/safefile.h (mode, owner and links kept; read-only targets
+ * refused).  A path that names an existing device or pipe (/dev/null, a
+ * fifo) is written directly, never replaced. */
 pdt_status pdt_out_open(pdt_outfile *o, const char *path, pdt_err *err);
 /* Flush, close and rename into place.  On any write error the temporary is
  * removed and an error returned. */
 pdt_status pdt_out_commit(pdt_outfile *o, pdt_err *err);
+/* Flush and close both, then replace both targets together (an .ele and its
+ * .node): both or neither. */
+pdt_status pdt_out_commit_pair(pdt_outfile *a, pdt_outfile *b, pdt_err *err);
 /* Close and remove the temporary (nothing is left behind). */
 void pdt_out_abort(pdt_outfile *o);
+
+/* Files written completely but not yet in place: a write whose commit waits
+ * for something else to succeed (a traced run's folder). */
+typedef struct pdt_pending_write {
+    pdt_safe_file f[2];
+    int n;               /* 0: nothing to put in place (standard output) */
+} pdt_pending_write;
+/* As pdt_out_commit_pair (b may be NULL), the files left in *pw for
+ * pdt_pending_commit or pdt_pending_drop. */
+pdt_status pdt_out_finish_pair(pdt_outfile *a, pdt_outfile *b, pdt_pending_write *pw,
+                              pdt_err *err);
+/* Put pw's files in place together (or none); pw is empty afterwards. */
+pdt_status pdt_pending_commit(pdt_pending_write *pw, pdt_err *err);
+/* Remove pw's temporaries; the targets are untouched. */
+void pdt_pending_drop(pdt_pending_write *pw);
 /* Put the finished temporary `tmp` in the place of `path` (same folder),
  * atomically: rename(2), or, when `path` is an existing regular file, an
  * exchange of the two names (renameat2 RENAME_EXCHANGE) and the removal of
@@ -197,6 +218,11 @@ pdt_status pdt_write_tris(const char *path, pdt_tri_format fmt, const pdt_point 
  * The file's page cache then reuses memory that was just in use. */
 pdt_status pdt_write_tris_releasing(const char *path, pdt_tri_format fmt, const pdt_point *pts,
                                     size_t n, pdt_tri *tris, size_t ntri, pdt_err *err);
+/* pdt_write_tris (releasing when `release`), the file(s) complete but left
+ * in *defer for pdt_pending_commit / pdt_pending_drop. */
+pdt_status pdt_write_tris_deferred(const char *path, pdt_tri_format fmt, const pdt_point *pts,
+                                   size_t n, pdt_tri *tris, size_t ntri, int release,
+                                   pdt_pending_write *defer, pdt_err *err);
 
 /* ---- formatting, for writers that place the bytes themselves ----------------
  * (the parallel write: every rank formats its block of lines and writes it

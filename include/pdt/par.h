@@ -307,6 +307,12 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
  * rank (pdt_par_agree). */
 pdt_status pdt_par_write(pdt_comm *c, const char *path, pdt_tri_format fmt, const pdt_par_input *in,
                          const pdt_par_output *out, pdt_err *err);
+/* pdt_par_write, the complete file(s) left at rank 0 in *defer (empty at
+ * the other ranks) for pdt_pending_commit / pdt_pending_drop: a traced run
+ * puts its output in place only once its run folder is complete. */
+pdt_status pdt_par_write_deferred(pdt_comm *c, const char *path, pdt_tri_format fmt,
+                                  const pdt_par_input *in, const pdt_par_output *out,
+                                  pdt_pending_write *defer, pdt_err *err);
 
 /* T* of n points (a pdt_tstar_fn for pdt_run_check_tstar): as a plain run
  * computes it for a .tri output, on two strips one after the other from 2^21

@@ -24,26 +24,34 @@ static const char help[] =
     "Exit status: 0 success, 2 usage or input error.\n";
 
 /* Graham's scan on pts[0..n), traced when o asks for it. */
+/* Graham's scan on pts[0..n), traced into *t when o asks for it (the run
+ * folder complete, not yet in place: write_hull puts it there). */
 static pdt_status compute(const pdt_run_opts *o, const pdt_point *pts, size_t n, uint32_t *out,
-                          size_t *nout, pdt_err *err)
+                          size_t *nout, pdt_cli_trace **t, pdt_err *err)
 {
-    pdt_cli_trace *t;
-    pdt_status st = pdt_cli_trace_open(o, pts, n, &t, err);
+    pdt_status st = pdt_cli_trace_open(o, pts, n, t, err);
     if (st != PDT_OK) return st;
-    st = pdt_hull_graham(pts, n, out, nout, pdt_cli_trace_hook(t));
+    st = pdt_hull_graham(pts, n, out, nout, pdt_cli_trace_hook(*t));
     if (st != PDT_OK) pdt_err_set(err, st, "hull failed: %s", pdt_status_str(st));
-    pdt_status cst = pdt_cli_trace_close(t, err);
+    pdt_status cst = pdt_cli_trace_end(*t, err);
     return st != PDT_OK ? st : cst;
 }
 
-/* One index per line, atomically. */
-static pdt_status write_hull(const char *path, const uint32_t *h, size_t nh, pdt_err *err)
+/* One index per line, atomically; the output and the run folder t go in
+ * place together. */
+static pdt_status write_hull(const char *path, const uint32_t *h, size_t nh, pdt_cli_trace *t,
+                             pdt_err *err)
 {
     pdt_outfile f;
+    pdt_pending_write pw;
     pdt_status st = pdt_out_open(&f, path, err);
     if (st != PDT_OK) return st;
     for (size_t i = 0; i < nh; i++) fprintf(f.fp, "%u\n", (unsigned)h[i]);
-    return pdt_out_commit(&f, err);
+    st = pdt_out_finish_pair(&f, NULL, &pw, err);
+    if (st == PDT_OK) st = pdt_cli_trace_swap(t, err);
+    if (st == PDT_OK) return pdt_pending_commit(&pw, err);
+    pdt_pending_drop(&pw);
+    return st;
 }
 
 int pdt_cmd_hull(int argc, char **argv)
@@ -63,12 +71,14 @@ int pdt_cmd_hull(int argc, char **argv)
         hull = malloc((n ? n : 1) * sizeof *hull);
         if (!hull) st = pdt_err_set(&err, PDT_ERR_NOMEM, "out of memory");
     }
-    if (st == PDT_OK) st = compute(&o, pts, n, hull, &nh, &err);
-    t2 = pdt_seconds();
+    pdt_cli_trace *t = NULL;
     if (st == PDT_OK && pdt_cli_same_file(o.output, o.input))
         st = pdt_err_set(&err, PDT_ERR_ARG, "%s: output would replace the input; choose another "
                          "-o name", o.output);
-    if (st == PDT_OK) st = write_hull(o.output, hull, nh, &err);
+    if (st == PDT_OK) st = compute(&o, pts, n, hull, &nh, &t, &err);
+    t2 = pdt_seconds();
+    if (st == PDT_OK) st = write_hull(o.output, hull, nh, t, &err);
+    pdt_cli_trace_finish(t, st == PDT_OK);
     t3 = pdt_seconds();
 
     if (st == PDT_OK) {

@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "cli.h"
+#include "pdt/safefile.h"
 #include "pdt/io.h"
 #include "pdt/par.h"
 #include "pdt/tracefile.h"
@@ -513,6 +514,9 @@ static int cmd_export(int argc, char **argv)
         return pdt_cli_usage("trace export", "--otf2 needs -o ARCHIVE_DIR (a new folder)");
     if (otf2 && events)
         return pdt_cli_usage("trace export", "--events is for --chrome only");
+    if (out && pdt_safe_touches_run(out, pos[0])) /* an input is never an output */
+        return pdt_cli_usage("trace export", "-o %s would replace a file of the run folder %s "
+                             "being read; choose another -o name", out, pos[0]);
     pdt_run *run;
     if ((rc = open_run(pos[0], &run))) return rc;
     print_warnings(run, stderr);

@@ -339,6 +339,26 @@ static pdt_status compute(run *R, pdt_err *err)
     return report_failure(R, st, R->rank, err);
 }
 
+/* A traced run: the rank files complete, then (rank 0) the run folder and
+ * the output put in place together, or neither. */
+static pdt_status put_in_place(run *R, pdt_pending_write *pw, pdt_err *err)
+{
+    set_phase(R, "trace");
+    pdt_status st = agreed(R, pdt_cli_trace_end(R->trace, err), err);
+    if (st == PDT_OK) st = pdt_comm_commit_ok(R->c, R->o->output, err); /* (not if stopped) */
+    if (st != PDT_OK) {
+        pdt_cli_trace_finish(R->trace, 0);
+        R->trace = NULL;
+        return st;
+    }
+    if (R->rank == 0) st = pdt_cli_trace_swap(R->trace, err);
+    if (R->rank == 0 && st == PDT_OK) st = pdt_pending_commit(pw, err);
+    st = agreed(R, st, err);
+    pdt_cli_trace_finish(R->trace, st == PDT_OK);
+    R->trace = NULL;
+    return st;
+}
+
 static pdt_status write_output(run *R, pdt_err *err)
 {
     pdt_trace *tr = io_hook(R);
@@ -347,18 +367,15 @@ static pdt_status write_output(run *R, pdt_err *err)
     PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_WRITE, 0, 0, 0, 0);
     R->out.release_tris = 1; /* nothing reads them after the write: their memory
                               * serves the output's page cache */
-    pdt_status st = pdt_par_write(R->c, R->o->output, pdt_tri_format_of(R->o->output), &R->in,
-                                  &R->out, err);
+    pdt_pending_write pw = {.n = 0};
+    pdt_status st = pdt_par_write_deferred(R->c, R->o->output, pdt_tri_format_of(R->o->output),
+                                           &R->in, &R->out, R->trace ? &pw : NULL, err);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_WRITE, 0, 0, 0, 0);
     R->me.t_write = pdt_comm_wtime(R->c) - t0;
     R->me.written = R->out.ntri;
     st = agreed(R, st, err);
-    if (st == PDT_OK) {
-        set_phase(R, "trace");
-        pdt_status tst = pdt_cli_trace_close(R->trace, err);
-        R->trace = NULL;
-        st = agreed(R, tst, err);
-    }
+    if (st == PDT_OK && R->trace) st = put_in_place(R, &pw, err);
+    pdt_pending_drop(&pw);
     return st;
 }
 
@@ -527,7 +544,7 @@ int pdt_cmd_triangulate(int argc, char **argv)
     if (st == PDT_OK) st = report(&R, &err);
     stop_phase = NULL;
 
-    if (R.trace) pdt_cli_trace_close(R.trace, NULL);
+    pdt_cli_trace_finish(R.trace, 0);
     pdt_par_input_free(&R.in);
     pdt_par_output_free(&R.out);
     pdt_comm_finalize(R.c, NULL);

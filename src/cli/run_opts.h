@@ -48,8 +48,18 @@ pdt_status pdt_cli_trace_open(const pdt_run_opts *o, const pdt_point *pts, size_
 pdt_trace *pdt_cli_trace_hook(pdt_cli_trace *t);
 /* Record the output triangles as final (TRI_FINAL); nothing if t is NULL. */
 void pdt_cli_trace_finals(pdt_cli_trace *t, const pdt_tri *tris, size_t ntri);
-/* Finish the run folder and free t (t may be NULL). */
-pdt_status pdt_cli_trace_close(pdt_cli_trace *t, pdt_err *err);
+/* The run folder is written whole under a temporary name beside DIR (rank
+ * 0 makes it; pdt/safefile.h) and put in place only when the run and its
+ * output succeeded, with the output:
+ *   pdt_cli_trace_end    every rank: its rank file complete (t stays);
+ *   pdt_cli_trace_swap   rank 0: the new folder in DIR's place, the old one
+ *                        kept aside until
+ *   pdt_cli_trace_finish every rank: keep = 1 removes the old folder,
+ *                        keep = 0 puts it back (or removes the temporary
+ *                        folder); frees t.  t may be NULL in all three. */
+pdt_status pdt_cli_trace_end(pdt_cli_trace *t, pdt_err *err);
+pdt_status pdt_cli_trace_swap(pdt_cli_trace *t, pdt_err *err);
+void pdt_cli_trace_finish(pdt_cli_trace *t, int keep);
 
 /* The trace of a `pdt triangulate` run on every rank of c (collective; the
  * same status at every rank): rank 0 creates the folder, then every rank

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "pdt/io.h"
+#include "pdt/safefile.h"
 #include "pdt/par.h"
 #include "pdt/tracefile.h"
 #include "pdt/testhook.h"
@@ -20,6 +21,9 @@ struct pdt_cli_trace {
     pdt_trace_writer *w;
     int64_t *offsets; /* clock offsets of the ranks (rank 0's matter) */
     int nranks;
+    pdt_safe_dir dir; /* rank 0: the run folder, written whole beside it */
+    char wdir[4096];  /* the folder every rank writes into (dir.tmp) */
+    const char *shown; /* the user's name of the folder (messages) */
 };
 
 /* The command line as one string, arguments separated by spaces. */
@@ -75,14 +79,54 @@ static pdt_status fill_manifest(const pdt_run_opts *o, int p, const int64_t *off
 }
 
 /* A one-process run (pdt hull): points.bin and the manifest, by this process. */
-static pdt_status write_manifest(const pdt_run_opts *o, const pdt_point *pts, size_t n,
-                                 pdt_err *err)
+static pdt_status write_manifest(const pdt_run_opts *o, const char *dir, const pdt_point *pts,
+                                 size_t n, pdt_err *err)
 {
     pdt_manifest m;
     int64_t offset0 = 0;
     pdt_status st = fill_manifest(o, 1, &offset0, pdt_points_checksum(pts, n), n, &m, err);
-    if (st == PDT_OK) st = pdt_run_write_meta(o->trace_dir, &m, pts, n, err);
+    if (st == PDT_OK) st = pdt_run_write_meta(dir, &m, pts, n, err);
     free(m.command_line);
+    return st;
+}
+
+/* An input is never an output: --trace DIR replaces the whole of DIR, so
+ * the input, -o and an .ele's .node must not lie inside it. */
+static pdt_status check_inputs(const pdt_run_opts *o, pdt_err *err)
+{
+    const char *dir = o->trace_dir;
+    if (o->input && strcmp(o->input, "-") && pdt_safe_inside(o->input, dir))
+        return pdt_err_set(err, PDT_ERR_ARG, "%s: the input is inside the run folder %s that "
+                           "--trace replaces; choose another --trace folder; nothing written",
+                           o->input, dir);
+    if (o->output && strcmp(o->output, "-") && pdt_safe_inside(o->output, dir))
+        return pdt_err_set(err, PDT_ERR_ARG, "%s: the output is inside the run folder %s that "
+                           "--trace replaces; choose another -o name; nothing written",
+                           o->output, dir);
+    size_t len = o->output ? strlen(o->output) : 0;
+    if (len > 4 && !strcmp(o->output + len - 4, ".ele")) {
+        char node[4096];
+        snprintf(node, sizeof node, "%.*s.node", (int)(len - 4), o->output);
+        if (pdt_safe_inside(node, dir))
+            return pdt_err_set(err, PDT_ERR_ARG, "%s: the .node of -o %s is inside the run "
+                               "folder %s that --trace replaces; nothing written", node,
+                               o->output, dir);
+    }
+    return PDT_OK;
+}
+
+/* Rank 0: check the options, then the temporary run folder beside DIR. */
+static pdt_status open_folder(const pdt_run_opts *o, pdt_cli_trace *ct, pdt_err *err)
+{
+    pdt_status st = traceable(o, err);
+    ct->shown = o->trace_dir;
+    if (st == PDT_OK) st = check_inputs(o, err);
+    if (st == PDT_OK) st = pdt_safe_dir_open(&ct->dir, o->trace_dir, err);
+    if (st == PDT_OK && strlen(ct->dir.tmp) >= sizeof ct->wdir) {
+        pdt_safe_dir_abort(&ct->dir);
+        st = pdt_err_set(err, PDT_ERR_ARG, "%s: name too long", o->trace_dir);
+    }
+    if (st == PDT_OK) snprintf(ct->wdir, sizeof ct->wdir, "%s", ct->dir.tmp);
     return st;
 }
 
@@ -91,20 +135,14 @@ pdt_status pdt_cli_trace_open(const pdt_run_opts *o, const pdt_point *pts, size_
 {
     *t = NULL;
     if (!o->trace_dir) return PDT_OK;
-    pdt_status st = traceable(o, err);
-    if (st != PDT_OK) return st;
     pdt_cli_trace *ct = calloc(1, sizeof *ct);
     if (!ct) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    st = pdt_tw_open(o->trace_dir, 0, o->trace_level, &ct->w, err);
-    if (st != PDT_OK) {
-        free(ct);
-        return st;
-    }
+    pdt_status st = open_folder(o, ct, err);
+    if (st == PDT_OK) st = pdt_tw_open(ct->wdir, 0, o->trace_level, &ct->w, err);
     /* the manifest first, so that a killed run still leaves a complete folder */
-    st = write_manifest(o, pts, n, err);
+    if (st == PDT_OK) st = write_manifest(o, ct->wdir, pts, n, err);
     if (st != PDT_OK) {
-        pdt_tw_abort(ct->w);
-        free(ct);
+        pdt_cli_trace_finish(ct, 0);
         return st;
     }
     PDT_TRACE(pdt_tw_hook(ct->w), 1, PDT_EV_PHASE_BEGIN, PDT_PH_RUN, 0, 0, 0, 0);
@@ -166,22 +204,23 @@ pdt_status pdt_cli_trace_open_ranks(const pdt_run_opts *o, pdt_comm *c, pdt_cli_
     int r = pdt_comm_rank(c), p = pdt_comm_size(c);
     pdt_cli_trace *ct = calloc(1, sizeof *ct);
     int64_t *off = calloc((size_t)p, sizeof *off);
-    pdt_status st = ct && off ? traceable(o, err) : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    /* rank 0 makes the folder first */
-    if (st == PDT_OK && r == 0) st = pdt_tw_open(o->trace_dir, 0, o->trace_level, &ct->w, err);
+    pdt_status st = ct && off ? PDT_OK : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    /* rank 0 makes the temporary folder; every rank writes into it */
+    if (st == PDT_OK && r == 0) st = open_folder(o, ct, err);
     st = pdt_par_agree(c, st, NULL, err);
-    if (st == PDT_OK && r != 0) st = pdt_tw_open(o->trace_dir, r, o->trace_level, &ct->w, err);
+    if (st == PDT_OK) st = pdt_comm_bcast(c, ct->wdir, sizeof ct->wdir, 0, err);
+    if (ct) ct->shown = o->trace_dir;
+    if (st == PDT_OK) st = pdt_tw_open(ct->wdir, r, o->trace_level, &ct->w, err);
     st = pdt_par_agree(c, st, NULL, err);
     if (st == PDT_OK && pdt_comm_is_simulated(c)) pdt_tw_set_clock(ct->w, simulated_ns, c);
     if (st == PDT_OK && p > 1) st = clock_offsets(c, ct->w, off, err);
     st = pdt_par_agree(c, st, NULL, err);
+    if (ct) ct->offsets = off;
     if (st != PDT_OK) {
-        if (ct && ct->w) pdt_tw_abort(ct->w);
-        free(ct);
-        free(off);
+        if (ct) pdt_cli_trace_finish(ct, 0);
+        else free(off);
         return st;
     }
-    ct->offsets = off;
     ct->nranks = p;
     PDT_TRACE(pdt_tw_hook(ct->w), 1, PDT_EV_PHASE_BEGIN, PDT_PH_RUN, 0, 0, 0, 0);
     *t = ct;
@@ -318,16 +357,20 @@ static pdt_status write_run_meta(pdt_cli_trace *t, const pdt_run_opts *o, pdt_co
     long pid = (long)getpid();
     pdt_status st = pdt_comm_bcast(c, &pid, sizeof pid, 0, err);
     if (st != PDT_OK) return st;
-    size_t len = strlen(o->trace_dir) + 64;
+    size_t len = strlen(t->wdir) + 64;
     char *path = malloc(len), *tmp = malloc(len);
     st = path && tmp ? PDT_OK : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     st = pdt_par_agree(c, st, NULL, err);
     uint64_t checksum = 0;
     if (st == PDT_OK) {
-        snprintf(path, len, "%s/points.bin", o->trace_dir);
-        snprintf(tmp, len, "%s/.points.bin.tmp.%ld", o->trace_dir, pid);
+        snprintf(path, len, "%s/points.bin", t->wdir);
+        snprintf(tmp, len, "%s/.points.bin.tmp.%ld", t->wdir, pid);
         st = write_points_tmp(c, tmp, in, &checksum, err);
-        if (st != PDT_OK) name_final(err, tmp, path);
+        if (st != PDT_OK) {
+            char shown[4096 + 16];
+            snprintf(shown, sizeof shown, "%s/points.bin", o->trace_dir);
+            name_final(err, tmp, shown);
+        }
     }
     if (r == 0 && st == PDT_OK && pdt_replace_file(tmp, path) != 0)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: cannot rename into place: %s", path,
@@ -336,7 +379,7 @@ static pdt_status write_run_meta(pdt_cli_trace *t, const pdt_run_opts *o, pdt_co
     if (r == 0 && st == PDT_OK) {
         pdt_manifest m;
         st = fill_manifest(o, t->nranks, t->offsets, checksum, in->n_total, &m, err);
-        if (st == PDT_OK) st = pdt_run_write_manifest(o->trace_dir, &m, err);
+        if (st == PDT_OK) st = pdt_run_write_manifest(t->wdir, &m, err);
         free(m.command_line);
     }
     free(path);
@@ -366,12 +409,27 @@ void pdt_cli_trace_finals(pdt_cli_trace *t, const pdt_tri *tris, size_t ntri)
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_OUTPUT, 0, 0, 0, 0);
 }
 
-pdt_status pdt_cli_trace_close(pdt_cli_trace *t, pdt_err *err)
+pdt_status pdt_cli_trace_end(pdt_cli_trace *t, pdt_err *err)
 {
-    if (!t) return PDT_OK;
+    if (!t || !t->w) return PDT_OK;
     PDT_TRACE(pdt_tw_hook(t->w), 1, PDT_EV_PHASE_END, PDT_PH_RUN, 0, 0, 0, 0);
     pdt_status st = pdt_tw_close(t->w, err);
+    t->w = NULL;
+    if (st != PDT_OK) name_final(err, t->wdir, t->shown);
+    return st;
+}
+
+pdt_status pdt_cli_trace_swap(pdt_cli_trace *t, pdt_err *err)
+{
+    if (!t || !t->dir.target) return PDT_OK;
+    return pdt_safe_dir_swap(&t->dir, err);
+}
+
+void pdt_cli_trace_finish(pdt_cli_trace *t, int keep)
+{
+    if (!t) return;
+    if (t->w) pdt_tw_abort(t->w);
+    pdt_safe_dir_finish(&t->dir, keep);
     free(t->offsets);
     free(t);
-    return st;
 }

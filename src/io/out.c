@@ -1,5 +1,5 @@
-/* pdt — atomic output: write a temporary file beside the target, rename it
- * into place only when every byte was written. */
+/* pdt — atomic output: a FILE over a pdt/safefile.h temporary, renamed into
+ * place only when every byte was written. */
 #include "pdt/io.h"
 
 #include <errno.h>
@@ -26,117 +26,101 @@ int pdt_replace_file(const char *tmp, const char *path)
 
 pdt_status pdt_out_open(pdt_outfile *o, const char *path, pdt_err *err)
 {
-    o->fp = NULL;
-    o->path = NULL;
-    o->tmp = NULL;
+    memset(o, 0, sizeof *o);
+    o->sf.fd = -1;
     if (!path || strcmp(path, "-") == 0) {
         o->fp = stdout;
         return PDT_OK;
     }
-    struct stat sb;
-    int exists = stat(path, &sb) == 0;
-    if (exists && S_ISDIR(sb.st_mode))
-        return pdt_err_set(err, PDT_ERR_IO, "%s: is a directory", path);
-    if (exists && !S_ISREG(sb.st_mode)) {
-        /* A device or a pipe (/dev/null, /dev/stdout, a fifo): write to it
-         * directly; it cannot be replaced atomically, and must not be. */
-        o->path = strdup(path);
-        if (!o->path) return pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory", path);
-        o->fp = fopen(path, "w");
-        if (!o->fp) {
-            int e = errno;
-            free(o->path);
-            o->path = NULL;
-            return pdt_err_set(err, PDT_ERR_IO, "%s: cannot open: %s", path, strerror(e));
-        }
-        return PDT_OK; /* tmp == NULL marks the direct mode */
-    }
-    /* The temporary lives in the target's directory so that rename() is
-     * atomic: "DIR/.BASE.tmpXXXXXX". */
-    const char *slash = strrchr(path, '/');
-    size_t dirlen = slash ? (size_t)(slash - path) + 1 : 0;
-    size_t plen = strlen(path);
-    o->path = malloc(plen + 1);
-    o->tmp = malloc(plen + 16);
-    if (!o->path || !o->tmp) {
-        free(o->path);
-        free(o->tmp);
-        o->path = o->tmp = NULL;
-        return pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory", path);
-    }
-    memcpy(o->path, path, plen + 1);
-    memcpy(o->tmp, path, dirlen);
-    o->tmp[dirlen] = '.';
-    memcpy(o->tmp + dirlen + 1, path + dirlen, plen - dirlen);
-    memcpy(o->tmp + plen + 1, ".tmpXXXXXX", 11);
-    int fd = mkstemp(o->tmp);
-    if (fd < 0) {
-        int e = errno;
-        free(o->path);
-        free(o->tmp);
-        o->path = o->tmp = NULL;
-        return pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: %s", path, strerror(e));
-    }
-    /* mkstemp makes the file 0600; give it the mode a plain fopen() would. */
-    mode_t um = umask(0);
-    umask(um);
-    (void)fchmod(fd, (mode_t)(0666 & ~um));
-    o->fp = fdopen(fd, "w");
+    pdt_status st = pdt_safe_open(&o->sf, path, PDT_SAFE_DIRECT, err);
+    if (st != PDT_OK) return st;
+    o->fp = fdopen(o->sf.fd, "w");
     if (!o->fp) {
         int e = errno;
-        close(fd);
-        unlink(o->tmp);
-        free(o->path);
-        free(o->tmp);
-        o->path = o->tmp = NULL;
+        pdt_safe_abort(&o->sf);
         return pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: %s", path, strerror(e));
     }
+    o->path = o->sf.name;
+    o->tmp = o->sf.tmp;
     return PDT_OK;
 }
 
-pdt_status pdt_out_commit(pdt_outfile *o, pdt_err *err)
+/* Flush and close o's FILE (the descriptor goes with it); 0 or an errno. */
+static int out_close(pdt_outfile *o)
 {
-    if (!o->fp) return pdt_err_set(err, PDT_ERR_ARG, "output file is not open");
-    if (!o->path) { /* standard output: flush and check */
-        int bad = fflush(o->fp) != 0 || ferror(o->fp);
+    int bad = fflush(o->fp) != 0 || ferror(o->fp);
+    int e = bad ? (errno ? errno : EIO) : 0;
+    if (fclose(o->fp) != 0 && !e) e = errno ? errno : EIO;
+    o->fp = NULL;
+    o->sf.fd = -1;
+    return e;
+}
+
+pdt_status pdt_out_finish_pair(pdt_outfile *a, pdt_outfile *b, pdt_pending_write *pw,
+                              pdt_err *err)
+{
+    pdt_outfile *o[2] = {a, b};
+    int n = b ? 2 : 1;
+    pw->n = 0;
+    for (int k = 0; k < n; k++)
+        if (!o[k]->fp) return pdt_err_set(err, PDT_ERR_ARG, "output file is not open");
+    if (!a->path) { /* standard output: flush and check */
+        int bad = fflush(a->fp) != 0 || ferror(a->fp);
         int e = errno;
-        o->fp = NULL;
+        a->fp = NULL;
         if (bad)
             return pdt_err_set(err, PDT_ERR_IO, "standard output: write error: %s", strerror(e));
         return PDT_OK;
     }
-    int bad = fflush(o->fp) != 0 || ferror(o->fp);
-    int e = errno;
-    if (fclose(o->fp) != 0 && !bad) {
-        bad = 1;
-        e = errno;
-    }
-    o->fp = NULL;
-    if (!bad && o->tmp && pdt_replace_file(o->tmp, o->path) != 0) {
-        bad = 1;
-        e = errno;
-    }
     pdt_status st = PDT_OK;
-    if (bad) {
-        if (o->tmp) unlink(o->tmp);
-        st = pdt_err_set(err, PDT_ERR_IO, "%s: write error: %s", o->path, strerror(e));
+    for (int k = 0; k < n; k++) {
+        int e = out_close(o[k]);
+        if (e && st == PDT_OK)
+            st = pdt_err_set(err, PDT_ERR_IO, "%s: write error: %s", o[k]->path, strerror(e));
     }
-    free(o->path);
-    free(o->tmp);
-    o->path = o->tmp = NULL;
+    for (int k = 0; k < n; k++) {
+        pw->f[k] = o[k]->sf;
+        o[k]->path = o[k]->tmp = NULL;
+    }
+    pw->n = n;
+    if (st != PDT_OK) pdt_pending_drop(pw);
     return st;
+}
+
+pdt_status pdt_pending_commit(pdt_pending_write *pw, pdt_err *err)
+{
+    int n = pw->n;
+    pw->n = 0;
+    return n ? pdt_safe_commit_group(pw->f, n, err) : PDT_OK;
+}
+
+void pdt_pending_drop(pdt_pending_write *pw)
+{
+    for (int k = 0; k < pw->n; k++) pdt_safe_abort(&pw->f[k]);
+    pw->n = 0;
+}
+
+pdt_status pdt_out_commit_pair(pdt_outfile *a, pdt_outfile *b, pdt_err *err)
+{
+    pdt_pending_write pw;
+    pdt_status st = pdt_out_finish_pair(a, b, &pw, err);
+    return st == PDT_OK ? pdt_pending_commit(&pw, err) : st;
+}
+
+pdt_status pdt_out_commit(pdt_outfile *o, pdt_err *err)
+{
+    return pdt_out_commit_pair(o, NULL, err);
 }
 
 void pdt_out_abort(pdt_outfile *o)
 {
     if (o->path) {
         if (o->fp) fclose(o->fp);
-        if (o->tmp) unlink(o->tmp);
+        o->sf.fd = -1;
+        pdt_safe_abort(&o->sf);
     } else if (o->fp) {
         fflush(o->fp);
     }
-    free(o->path);
-    free(o->tmp);
     o->fp = NULL;
     o->path = o->tmp = NULL;
 }

@@ -505,7 +505,8 @@ static int has_ext(const char *path, const char *ext)
     return n >= e && strcmp(path + n - e, ext) == 0;
 }
 
-static pdt_status finish(pdt_outfile *o, wbuf *w, pdt_err *err)
+/* Flush w into o; on a write error, remove o's temporary. */
+static pdt_status flushed(pdt_outfile *o, wbuf *w, pdt_err *err)
 {
     wb_flush(w);
     if (w->bad) {
@@ -515,7 +516,13 @@ static pdt_status finish(pdt_outfile *o, wbuf *w, pdt_err *err)
         pdt_out_abort(o);
         return PDT_ERR_IO;
     }
-    return pdt_out_commit(o, err);
+    return PDT_OK;
+}
+
+static pdt_status finish(pdt_outfile *o, wbuf *w, pdt_err *err)
+{
+    pdt_status st = flushed(o, w, err);
+    return st == PDT_OK ? pdt_out_commit(o, err) : st;
 }
 
 /* ---- points ---------------------------------------------------------------- */
@@ -580,8 +587,11 @@ static char *node_path_of(const char *ele)
     return p;
 }
 
+/* Write the triangles; put the file(s) in place, or leave them in *defer
+ * (when not NULL) for the caller to. */
 static pdt_status write_tris(const char *path, pdt_tri_format fmt, const pdt_point *pts, size_t n,
-                             const pdt_tri *tris, size_t ntri, int release, pdt_err *err)
+                             const pdt_tri *tris, size_t ntri, int release,
+                             pdt_pending_write *defer, pdt_err *err)
 {
     if ((fmt == PDT_FMT_ELE || fmt == PDT_FMT_OFF) && !pts && n > 0)
         return pdt_err_set(err, PDT_ERR_ARG, "writing .ele or .off needs the points");
@@ -595,7 +605,7 @@ static pdt_status write_tris(const char *path, pdt_tri_format fmt, const pdt_poi
     pdt_status st = PDT_OK;
     onode.fp = NULL;
     if (fmt == PDT_FMT_ELE) {
-        /* The .node first, but renamed into place only after the .ele is done. */
+        /* The .node first; both replaced together once the .ele is done. */
         npath = node_path_of(path);
         if (!npath) {
             free(w);
@@ -625,12 +635,12 @@ static pdt_status write_tris(const char *path, pdt_tri_format fmt, const pdt_poi
         w->n = 0;
         w->bad = w->err = 0;
         emit_tris(w, fmt, pts, n, tris, ntri, release);
-        st = finish(&o, w, err);
+        st = flushed(&o, w, err);
     }
-    if (fmt == PDT_FMT_ELE) {
-        if (st == PDT_OK) st = pdt_out_commit(&onode, err);
-        else pdt_out_abort(&onode);
-    }
+    pdt_outfile *node = fmt == PDT_FMT_ELE ? &onode : NULL;
+    if (st == PDT_OK && defer) st = pdt_out_finish_pair(&o, node, defer, err);
+    else if (st == PDT_OK) st = pdt_out_commit_pair(&o, node, err);
+    else if (node) pdt_out_abort(node);
     free(npath);
     free(w);
     return st;
@@ -639,11 +649,19 @@ static pdt_status write_tris(const char *path, pdt_tri_format fmt, const pdt_poi
 pdt_status pdt_write_tris(const char *path, pdt_tri_format fmt, const pdt_point *pts, size_t n,
                           const pdt_tri *tris, size_t ntri, pdt_err *err)
 {
-    return write_tris(path, fmt, pts, n, tris, ntri, 0, err);
+    return write_tris(path, fmt, pts, n, tris, ntri, 0, NULL, err);
 }
 
 pdt_status pdt_write_tris_releasing(const char *path, pdt_tri_format fmt, const pdt_point *pts,
                                     size_t n, pdt_tri *tris, size_t ntri, pdt_err *err)
 {
-    return write_tris(path, fmt, pts, n, tris, ntri, 1, err);
+    return write_tris(path, fmt, pts, n, tris, ntri, 1, NULL, err);
+}
+
+pdt_status pdt_write_tris_deferred(const char *path, pdt_tri_format fmt, const pdt_point *pts,
+                                   size_t n, pdt_tri *tris, size_t ntri, int release,
+                                   pdt_pending_write *defer, pdt_err *err)
+{
+    defer->n = 0;
+    return write_tris(path, fmt, pts, n, tris, ntri, release, defer, err);
 }

@@ -302,7 +302,7 @@ static pdt_status local_file_open(pdt_comm *c, pdt_comm_file *f, pdt_err *err)
     pdt_status s = PDT_OK;
     local_pub me = {.fd = -1};
     if (c->rank == 0) {
-        me.fd = open(f->path, O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
+        me.fd = open(f->path, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0666);
         if (me.fd >= 0 && ftruncate(me.fd, (off_t)f->size) != 0) {
             int e = errno;
             close(me.fd);

@@ -6,9 +6,9 @@
  * counts its bytes, a prefix sum gives its offset, and it formats its block
  * with the plain writer's own printer (pdt_format_lines) a piece at a time
  * and writes each piece at its place (pdt_comm_file_write_at: MPI-IO).
- * Everything goes to "DIR/.BASE.tmp.PID" (rank 0's pid), renamed by rank 0
- * once every rank succeeded (an .ele's .node after the .ele, as in a plain
- * run), removed otherwise.  Standard output, a device or a pipe cannot be
+ * Everything goes to temporaries rank 0 creates by the rule of
+ * pdt/safefile.h, put in place by rank 0 once every rank succeeded (an .ele
+ * and its .node together), removed otherwise.  Standard output, a device or a pipe cannot be
  * written at offsets: the blocks are gathered at rank 0 and written there. */
 #include <errno.h>
 #include <fcntl.h>
@@ -22,6 +22,7 @@
 
 #include "pdt/io.h"
 #include "pdt/par.h"
+#include "pdt/safefile.h"
 
 #include "pdt/bigmem.h"
 #include "pdt/testhook.h"
@@ -77,7 +78,8 @@ static pdt_status gather_all(pdt_comm *c, const void *mine, size_t n, size_t ele
 }
 
 static pdt_status write_gathered(pdt_comm *c, const char *path, pdt_tri_format fmt,
-                                 const pdt_par_input *in, const pdt_par_output *out, pdt_err *err)
+                                 const pdt_par_input *in, const pdt_par_output *out,
+                                 pdt_pending_write *defer, pdt_err *err)
 {
     void *pts = NULL, *tris = NULL;
     uint64_t np = 0, nt = 0;
@@ -85,7 +87,9 @@ static pdt_status write_gathered(pdt_comm *c, const char *path, pdt_tri_format f
     if (fmt != PDT_FMT_TRI) st = gather_all(c, in->pts, in->n, sizeof(pdt_point), &pts, &np, err);
     if (st == PDT_OK) st = gather_all(c, out->tris, out->ntri, sizeof(pdt_tri), &tris, &nt, err);
     if (st == PDT_OK && pdt_comm_rank(c) == 0)
-        st = pdt_write_tris(path, fmt, pts, (size_t)np, tris, (size_t)nt, err);
+        st = defer ? pdt_write_tris_deferred(path, fmt, pts, (size_t)np, tris, (size_t)nt, 0,
+                                             defer, err)
+                   : pdt_write_tris(path, fmt, pts, (size_t)np, tris, (size_t)nt, err);
     free(pts);
     free(tris);
     return pdt_par_agree(c, st, NULL, err);
@@ -145,14 +149,6 @@ static int renamable(const char *path)
     struct stat sb;
     if (!path || strcmp(path, "-") == 0) return 0;
     return stat(path, &sb) != 0 || S_ISREG(sb.st_mode);
-}
-
-/* "DIR/.BASE.tmp.PID" for path (pid: rank 0's, broadcast by the caller). */
-static void temp_name(char *tmp, size_t size, const char *path, long pid)
-{
-    const char *slash = strrchr(path, '/');
-    int dl = slash ? (int)(slash - path + 1) : 0;
-    snprintf(tmp, size, "%.*s.%s.tmp.%ld", dl, path, slash ? slash + 1 : path, pid);
 }
 
 /* The temporary could not be created: name the user's file and why. */
@@ -233,31 +229,59 @@ static pdt_status write_file(pdt_comm *c, outfile *o, pdt_err *err)
     return pdt_par_agree(c, cst, NULL, err);
 }
 
-/* Collective: the files (one, or an .ele and its .node) written in parallel
- * into their temporaries, then renamed into place by rank 0 in order (the
- * last first: a plain run commits the .node after the .ele). */
-static pdt_status write_files(pdt_comm *c, outfile *o, int nfile, pdt_err *err)
+/* Rank 0: the temporaries of the n files, by the rule of pdt/safefile.h
+ * (created O_EXCL|O_NOFOLLOW beside each target, its mode and owner; a
+ * read-only target refused); their names broadcast into o[k].tmp. */
+static pdt_status make_temps(pdt_comm *c, outfile *o, int n, pdt_safe_file *sf, pdt_err *err)
 {
     int r = pdt_comm_rank(c);
-    long pid = (long)getpid();
-    pdt_status st = pdt_comm_bcast(c, &pid, sizeof pid, 0, err);
-    if (st != PDT_OK) return st;
-    int made = 0;
-    for (; made < nfile && st == PDT_OK; made++) {
-        temp_name(o[made].tmp, sizeof o[made].tmp, o[made].path, pid);
-        if (pdt_comm_is_mpi(c)) { /* (one process per rank: the list is this rank's) */
-            memcpy(pending[made], o[made].tmp, sizeof pending[made]);
-            npending = made + 1;
-        }
-        st = write_file(c, &o[made], err);
+    pdt_status st = PDT_OK;
+    for (int k = 0; k < n && r == 0; k++) {
+        sf[k].fd = -1;
+        sf[k].tmp = NULL;
+        if (st == PDT_OK) st = pdt_safe_open(&sf[k], o[k].path, 0, err);
+        if (st == PDT_OK && strlen(sf[k].tmp) >= sizeof o[k].tmp)
+            st = pdt_err_set(err, PDT_ERR_IO, "%s: name too long", o[k].path);
+        if (st == PDT_OK) snprintf(o[k].tmp, sizeof o[k].tmp, "%s", sf[k].tmp);
     }
-    if (st == PDT_OK) st = pdt_comm_commit_ok(c, o[0].path, err); /* (not if stopped) */
-    for (int k = 0; k < nfile && st == PDT_OK && r == 0; k++)
-        if (pdt_replace_file(o[k].tmp, o[k].path) != 0)
-            st = pdt_err_set(err, PDT_ERR_IO, "%s: cannot rename into place: %s", o[k].path,
-                             strerror(errno));
+    st = pdt_par_agree(c, st, NULL, err);
+    for (int k = 0; k < n && st == PDT_OK; k++)
+        st = pdt_comm_bcast(c, o[k].tmp, sizeof o[k].tmp, 0, err);
     if (st != PDT_OK && r == 0)
-        for (int k = 0; k < made; k++) unlink(o[k].tmp); /* (renamed ones are gone already) */
+        for (int k = 0; k < n; k++)
+            if (sf[k].name) pdt_safe_abort(&sf[k]);
+    return st;
+}
+
+/* Collective: the files (one, or an .ele and its .node) written in parallel
+ * into their temporaries, then put in place by rank 0 together (both or
+ * neither: pdt_safe_commit_group). */
+static pdt_status write_files(pdt_comm *c, outfile *o, int nfile, pdt_pending_write *defer,
+                              pdt_err *err)
+{
+    int r = pdt_comm_rank(c);
+    pdt_safe_file sf[2];
+    memset(sf, 0, sizeof sf);
+    pdt_status st = make_temps(c, o, nfile, sf, err);
+    if (st != PDT_OK) return st;
+    for (int k = 0; k < nfile; k++)
+        if (pdt_comm_is_mpi(c)) { /* (one process per rank: the list is this rank's) */
+            memcpy(pending[k], o[k].tmp, sizeof pending[k]);
+            npending = k + 1;
+        }
+    for (int k = 0; k < nfile && st == PDT_OK; k++) st = write_file(c, &o[k], err);
+    if (st == PDT_OK && !defer) st = pdt_comm_commit_ok(c, o[0].path, err); /* (not if stopped) */
+    if (r == 0) {
+        if (st == PDT_OK && defer) {
+            for (int k = 0; k < nfile; k++) defer->f[k] = sf[k];
+            defer->n = nfile;
+            return pdt_par_agree(c, st, NULL, err); /* (the list stays until the commit) */
+        } else if (st == PDT_OK) {
+            st = pdt_safe_commit_group(sf, nfile, err);
+        } else {
+            for (int k = 0; k < nfile; k++) pdt_safe_abort(&sf[k]);
+        }
+    }
     if (pdt_comm_is_mpi(c)) npending = 0;
     return pdt_par_agree(c, st, NULL, err);
 }
@@ -272,14 +296,24 @@ static void node_path(char *buf, size_t size, const char *ele)
 pdt_status pdt_par_write(pdt_comm *c, const char *path, pdt_tri_format fmt,
                          const pdt_par_input *in, const pdt_par_output *out, pdt_err *err)
 {
+    return pdt_par_write_deferred(c, path, fmt, in, out, NULL, err);
+}
+
+pdt_status pdt_par_write_deferred(pdt_comm *c, const char *path, pdt_tri_format fmt,
+                                  const pdt_par_input *in, const pdt_par_output *out,
+                                  pdt_pending_write *defer, pdt_err *err)
+{
+    if (defer) defer->n = 0;
     if (pdt_comm_size(c) == 1)
-        return out->release_tris
+        return defer ? pdt_write_tris_deferred(path, fmt, in->pts, in->n, out->tris, out->ntri,
+                                               out->release_tris, defer, err)
+               : out->release_tris
                    ? pdt_write_tris_releasing(path, fmt, in->pts, in->n, out->tris, out->ntri, err)
                    : pdt_write_tris(path, fmt, in->pts, in->n, out->tris, out->ntri, err);
     int direct = renamable(path) && strlen(path) < 3000;
     if (pdt_par_agree(c, direct ? PDT_OK : PDT_ERR_ARG, NULL, err) != PDT_OK) {
         pdt_err_clear(err);
-        return write_gathered(c, path, fmt, in, out, err);
+        return write_gathered(c, path, fmt, in, out, defer, err);
     }
     outfile o[2];
     memset(o, 0, sizeof o);
@@ -295,11 +329,11 @@ pdt_status pdt_par_write(pdt_comm *c, const char *path, pdt_tri_format fmt,
         o[0].sec[o[0].nsec++] = (section){PDT_LINES_OFF_POINT, in->pts, sizeof(pdt_point), in->n,
                                           in->first, 0};
     o[0].sec[o[0].nsec++] = tris;
-    if (fmt != PDT_FMT_ELE) return write_files(c, o, 1, err);
+    if (fmt != PDT_FMT_ELE) return write_files(c, o, 1, defer, err);
     node_path(npath, sizeof npath, path);
     o[1].path = npath;
     o[1].hlen = pdt_format_node_header(o[1].head, in->n_total);
     o[1].sec[o[1].nsec++] = (section){PDT_LINES_NODE, in->pts, sizeof(pdt_point), in->n,
                                       in->first, 0};
-    return write_files(c, o, 2, err);
+    return write_files(c, o, 2, defer, err);
 }

@@ -3,6 +3,7 @@
 #include "pdt/io.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,8 +40,11 @@ static pdt_status af_open(afile *f, const char *dir, const char *name, pdt_err *
     }
     snprintf(f->path, len, "%s/%s", dir, name);
     snprintf(f->tmp, len, "%s/.%s.tmp.%ld", dir, name, (long)getpid());
-    f->fp = fopen(f->tmp, "wb");
+    (void)unlink(f->tmp); /* a fresh file, never through a link planted at the name */
+    int fd = open(f->tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    f->fp = fd >= 0 ? fdopen(fd, "wb") : NULL;
     if (!f->fp) {
+        if (fd >= 0) close(fd);
         pdt_status st =
             pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: %s", f->tmp, strerror(errno));
         free(f->path);

@@ -143,7 +143,11 @@ pdt_status pdt_tw_open(const char *dir, int rank, int level, pdt_trace_writer **
             free(p);
         }
     }
-    w->fd = open(w->path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    /* a fresh file: never through a link or into another name's inode
+     * planted at this name (a traced run writes into a folder it created
+     * itself: pdt/safefile.h) */
+    (void)unlink(w->path);
+    w->fd = open(w->path, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
     if (w->fd < 0) {
         st = pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: %s", w->path, strerror(errno));
         pdt_tw_abort(w);

@@ -163,24 +163,27 @@ out=$("$PDT" trace check "$TMP/nolift" 2>&1); rc=$?
     ok check_fails_removed_lift || fail check_fails_removed_lift "rc=$rc $out"
 
 # ---- a run killed with SIGKILL leaves a readable trace ------------------------------------
+# (in the temporary folder beside DIR: a killed run leaves DIR as it was, here absent)
 "$PDT" gen uniform 400000 -o "$TMP/big.txt"
 "$PDT" triangulate "$TMP/big.txt" -o "$TMP/big.tri" --trace "$TMP/killed" 2>/dev/null &
 pid=$!
 for ((i = 0; i < 400; i++)); do  # until a few blocks are on disk (or the run ended)
-    sz=$(stat -c %s "$TMP/killed/rank-0000.trace" 2>/dev/null || echo 0)
+    sz=$(cat "$TMP"/.killed.pdt-tmp.*/rank-0000.trace 2>/dev/null | wc -c)
     [ "$sz" -ge 150000 ] && break
     kill -0 "$pid" 2>/dev/null || break
     sleep 0.02
 done
 if kill -9 "$pid" 2>/dev/null; then
     wait "$pid" 2>/dev/null
-    info=$("$PDT" trace info "$TMP/killed")
+    kdir=$(ls -d "$TMP"/.killed.pdt-tmp.* 2>/dev/null | head -1)
+    info=$("$PDT" trace info "$kdir")
     ev=$(echo "$info" | awk '$1 == "0" && NF >= 5 {print $2; exit}')
     if [[ "$info" == *"warning: rank-0000.trace: "*"run killed?"* || "$info" == *"warning: rank-0000.trace: block"* ]] &&
-        [ "${ev:-0}" -gt 4000 ]; then ok killed_run_readable; else fail killed_run_readable "$info"; fi
-    out=$("$PDT" trace check "$TMP/killed" 2>&1); rc=$?
+        [ "${ev:-0}" -gt 4000 ] && [ ! -e "$TMP/killed" ]; then ok killed_run_readable; else fail killed_run_readable "$info"; fi
+    out=$("$PDT" trace check "$kdir" 2>&1); rc=$?
     [[ $rc -eq 1 && "$out" == *"damaged run folder"* ]] && ok killed_run_fails_check ||
         fail killed_run_fails_check "rc=$rc $out"
+    rm -rf "$kdir"
 else
     wait "$pid"
     echo "ok - killed_run_readable # skip: the run finished before it could be killed"

@@ -75,15 +75,19 @@ same_pictures "$R" 16K 0 2345 end && ok paged_state_same_pictures || fail paged_
 case "$("$V" "$R" --check --mem 1M)" in *"checkpoints every"*) ok checkpoints_made ;;
     *) fail checkpoints_made "no checkpoints under --mem 1M" ;; esac
 
-# a build that crashed left its temporary file: the next build removes it
-# (its process is gone), and leaves alone the one of a process still alive
+# a build that crashed left its temporary file (pdt/safefile.h's name): the
+# next build removes it (its process is gone), and leaves alone the one of a
+# process still alive, and a file of the user's that only looks alike
 dead=$(sh -c 'echo $$')
+echo junk > "$R/.${IDX##*/}.pdt-tmp.$dead.0badf00d"
+echo junk > "$R/.${IDX##*/}.pdt-tmp.$$.0badf00d"
 echo junk > "$IDX.tmp$dead"
-echo junk > "$IDX.tmp$$"
 mv "$IDX" "$TMP/idx.keep"
 "$V" "$R" --counts --end --mem 1M >/dev/null 2>&1
-if [ ! -e "$IDX.tmp$dead" ] && [ -e "$IDX.tmp$$" ] && [ -s "$IDX" ]; then ok stale_temp_removed
+if [ ! -e "$R/.${IDX##*/}.pdt-tmp.$dead.0badf00d" ] && [ -e "$R/.${IDX##*/}.pdt-tmp.$$.0badf00d" ] &&
+    [ -e "$IDX.tmp$dead" ] && [ -s "$IDX" ]; then ok stale_temp_removed
 else fail stale_temp_removed "$(ls -a "$R")"; fi
+rm -f "$R/.${IDX##*/}.pdt-tmp.$$.0badf00d" "$IDX.tmp$dead"
 rm -f "$IDX.tmp$$"
 
 # lazy verification (what a big index gets; PDTVIEW_VERIFY=lazy forces it):
@@ -119,7 +123,9 @@ else fail same_picture "the end frame differs through the index"; fi
 
 # stale: a run file changed (size and time) -> rebuilt, never trusted
 "$PDT" gen uniform 1400 --seed 8 > "$TMP/v.txt"
-"$PDT" triangulate "$TMP/v.txt" -o "$TMP/v.tri" --trace "$R" >/dev/null
+# (a new --trace into R would replace the folder whole, index and all: copy the files in)
+"$PDT" triangulate "$TMP/v.txt" -o "$TMP/v.tri" --trace "$TMP/vrun" >/dev/null
+cp "$TMP/vrun/manifest" "$TMP/vrun/points.bin" "$TMP/vrun/rank-0000.trace" "$R/"
 want=$("$V" "$R" --counts --end --index off)
 got=$("$V" "$R" --counts --end --mem 1M 2>"$TMP/e3")
 if [ "$got" = "$want" ] && grep -q "rebuilt the index (stale" "$TMP/e3"; then ok stale_rebuilt

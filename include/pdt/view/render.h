@@ -108,9 +108,15 @@ void pdt_render_layout_view(double w, double h, int nranks, const pdt_view *v, p
 pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, const pdt_rstate *s,
                       const pdt_view *v, pdt_err *err);
 
-/* Draw into a file: the format comes from the extension (.png, .svg, .pdf). */
+/* Draw into a file: the format comes from the extension (.png, .svg, .pdf);
+ * written by the rule of pdt/safefile.h (a device such as /dev/null
+ * directly). */
 pdt_status pdt_render_file(const char *path, int w, int h, const pdt_replay *r,
                            const pdt_rstate *s, const pdt_view *v, pdt_err *err);
+/* pdt_render_file with pdt_safe_open's flags (PDT_SAFE_NOFOLLOW for a file
+ * pdtview names itself inside a folder: --frames). */
+pdt_status pdt_render_file_ex(const char *path, int flags, int w, int h, const pdt_replay *r,
+                              const pdt_rstate *s, const pdt_view *v, pdt_err *err);
 
 /* The colour of a rank (Okabe–Ito for 0..7; beyond, the same hues darker or
  * lighter), components in [0,1]. */

@@ -10,6 +10,7 @@
 
 #include <cairo.h>
 
+#include "pdt/safefile.h"
 #include "pdt/view/anim.h"
 #include "pdt/view/describe.h"
 #include "pdt/view/query.h"
@@ -41,7 +42,9 @@ int pdt_app_headless(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const opts
             pdt_replay_seek(r, s, k);
             char path[4096];
             snprintf(path, sizeof path, "%s/frame-%06zu.png", o->frames, count++);
-            if (pdt_render_file(path, o->w, o->h, r, s, v, err) != PDT_OK) return PDT_EXIT_USAGE;
+            /* (a frame's name is ours: a link planted there is replaced, not followed) */
+            if (pdt_render_file_ex(path, PDT_SAFE_NOFOLLOW, o->w, o->h, r, s, v, err) != PDT_OK)
+                return PDT_EXIT_USAGE;
             if (k == m) break;
         }
         if (!o->quiet) printf("pdtview: wrote %zu frames to %s\n", count, o->frames);

@@ -26,6 +26,7 @@
 
 #include <cairo.h>
 
+#include "pdt/safefile.h"
 #include "pdt/view/anim.h"
 #include "pdt/view/describe.h"
 #include "pdt/view/query.h"
@@ -276,12 +277,37 @@ static void utf8_ctype(void)
     if (strcmp(cs, "UTF-8") && !setlocale(LC_CTYPE, "C.UTF-8")) setlocale(LC_CTYPE, "C");
 }
 
+/* An input is never an output: the run folder or the edited file read must
+ * not be replaced by -o, --gif, --video or --write-run (checked before
+ * anything is written).  0, or the exit status after a message. */
+static int check_outputs(const opts *o)
+{
+    const char *in = o->edit ? o->edit : o->run && strncmp(o->run, "synth:", 6) ? o->run : NULL;
+    const char *outs[3] = {o->out, o->gif, o->video};
+    for (int k = 0; k < 3 && in; k++) {
+        if (!outs[k]) continue;
+        if (o->edit ? pdt_safe_same_file(outs[k], in) : pdt_safe_touches_run(outs[k], in)) {
+            fprintf(stderr, "pdtview: %s would replace %s%s, which is read; choose another "
+                    "name; nothing written\n", outs[k], o->edit ? "" : "a file of the run folder ",
+                    in);
+            return PDT_EXIT_USAGE;
+        }
+    }
+    if (o->write_run && in && pdt_safe_inside(in, o->write_run)) {
+        fprintf(stderr, "pdtview: %s is inside the run folder %s that --write-run replaces; "
+                "choose another folder; nothing written\n", in, o->write_run);
+        return PDT_EXIT_USAGE;
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     opts o;
     utf8_ctype();
     int prc = pdt_app_parse_args(argc, argv, &o);
     if (prc >= 0) return prc;
+    if ((prc = check_outputs(&o))) return prc;
     if (o.bench_live) return pdt_app_bench_live(&o);
     if (o.edit) return pdt_app_edit(&o);
     lazy_verify_setup();

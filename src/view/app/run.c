@@ -10,6 +10,7 @@
 
 #include <cairo.h>
 
+#include "pdt/safefile.h"
 #include "pdt/view/anim.h"
 #include "pdt/view/describe.h"
 #include "pdt/view/query.h"
@@ -79,8 +80,11 @@ int pdt_app_write_run(const char *dir, const loaded *L, const char *command, int
     pdt_trace_writer **w = calloc((size_t)p, sizeof *w);
     int64_t *off = calloc((size_t)p, sizeof *off);
     pdt_status st = PDT_OK;
+    pdt_safe_dir sd = {0};  /* written whole beside DIR, swapped in at the end */
     if (!w || !off) st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    for (int q = 0; q < p && st == PDT_OK; q++) st = pdt_tw_open(dir, q, level, &w[q], err);
+    if (st == PDT_OK) st = pdt_safe_dir_open(&sd, dir, err);
+    const char *into = sd.tmp;
+    for (int q = 0; q < p && st == PDT_OK; q++) st = pdt_tw_open(into, q, level, &w[q], err);
     /* every writer's clock starts at its open: align them on rank 0's */
     if (st == PDT_OK) {
         uint64_t t0 = pdt_tw_now(w[0]);
@@ -91,7 +95,7 @@ int pdt_app_write_run(const char *dir, const loaded *L, const char *command, int
         tr->sink(tr, &L->recs[i].ev);
     }
     for (int q = 0; q < p && w; q++) {
-        pdt_status s2 = pdt_tw_close(w[q], err);
+        pdt_status s2 = w[q] ? pdt_tw_close(w[q], err) : PDT_OK;
         if (st == PDT_OK) st = s2;
     }
     if (st == PDT_OK) {
@@ -108,8 +112,10 @@ int pdt_app_write_run(const char *dir, const loaded *L, const char *command, int
         snprintf(mf.command, sizeof mf.command, "%s", command);
         mf.clock_offset_ns = off;
         mf.wall_start_ns = pdt_wall_ns();
-        st = pdt_run_write_meta(dir, &mf, L->pts, L->n, err);
+        st = pdt_run_write_meta(into, &mf, L->pts, L->n, err);
     }
+    if (st == PDT_OK) st = pdt_safe_dir_commit(&sd, err);
+    else pdt_safe_dir_abort(&sd);
     free(w);
     free(off);
     return st == PDT_OK ? 0 : 1;

@@ -1,6 +1,7 @@
 /* pdt — the kept index: building it at a run's first opening, and opening a
  * run (from its kept index, building one, or in memory).  The file's layout
  * is in index_int.h. */
+#include "pdt/safefile.h"
 #include "pdt/io.h"
 #include "pdt/view/replay.h"
 #include "replay_int.h"
@@ -619,46 +620,19 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     return write_header(r, fd, h, ident, off + h->ctab.bytes, err);
 }
 
-/* Remove the temporary files (path.tmpPID) that builds of processes no
- * longer alive left beside path (a crash or a kill while building). */
-static void clean_stale_temps(const char *path)
-{
-    char dir[PATH_MAX];
-    snprintf(dir, sizeof dir, "%s", path);
-    char *slash = strrchr(dir, '/');
-    const char *base = slash ? slash + 1 : path;
-    if (slash) *slash = 0;
-    else snprintf(dir, sizeof dir, ".");
-    size_t blen = strlen(base);
-    DIR *d = opendir(dir);
-    if (!d) return;
-    struct dirent *de;
-    while ((de = readdir(d))) {
-        const char *nm = de->d_name;
-        if (strncmp(nm, base, blen) || strncmp(nm + blen, ".tmp", 4)) continue;
-        const char *digits = nm + blen + 4;
-        char *end;
-        errno = 0;
-        long pid = strtol(digits, &end, 10);
-        if (!*digits || *end || errno || pid <= 0 || pid == (long)getpid()) continue;
-        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;  /* alive, or not ours to judge */
-        char victim[PATH_MAX + 256];
-        snprintf(victim, sizeof victim, "%s/%s", dir, nm);
-        unlink(victim);
-    }
-    closedir(d);
-}
-
 /* Build the index of run at `path` (temporary file + rename). */
 static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks, uint64_t ident,
                         const char *path, uint64_t budget, uint64_t *work, uint32_t *buckets,
                         pdt_err *err)
 {
-    char tmp[PATH_MAX + 128];
-    clean_stale_temps(path);
-    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
-    int fd = open(tmp, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) return pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
+    /* the index's name is ours: a link planted there is replaced, not
+     * followed; leftovers of killed builds are removed (pdt/safefile.h) */
+    pdt_safe_file sf;
+    pdt_status st0 = pdt_safe_open(&sf, path, PDT_SAFE_NOFOLLOW, err);
+    if (st0 != PDT_OK) return st0;
+    char tmp[PATH_MAX + 256];
+    snprintf(tmp, sizeof tmp, "%s", sf.tmp);
+    int fd = sf.fd;
     ihdr *h = calloc(1, sizeof *h);
     evcopy ec;
     memset(&ec, 0, sizeof ec);
@@ -725,13 +699,10 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     pdt_merge_close(es.mg);
     free(es.buf);
     if (es.map) munmap(es.map, es.map_len);
-    if (close(fd) != 0 && st == PDT_OK)
-        st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", tmp, strerror(errno));
-    /* into place over a stale index without ext4 writing the new one back
-     * inside the call (pdt_replace_file: gigabytes for a big run) */
-    if (st == PDT_OK && pdt_replace_file(tmp, path) != 0)
-        st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", path, strerror(errno));
-    if (st != PDT_OK) unlink(tmp);
+    /* into place over a stale index by an exchange of names, without ext4
+     * writing the new one back inside the call (gigabytes for a big run) */
+    if (st == PDT_OK) st = pdt_safe_commit(&sf, err);
+    else pdt_safe_abort(&sf);
     free(h);
     free(ec.blk);
     free(ec.rank_blk);
