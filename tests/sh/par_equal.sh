@@ -6,7 +6,7 @@
 # output.  The matrix is chosen to fit in a few minutes: every family x every
 # P up to 16 at n = 100, fewer P at n = 2000 and 10^4, P = 32 on two
 # families, and the tiny sizes (0..5 points, P > n, empty regions) on the
-# families where they differ.  (tests/unit/test_par_bisect runs the same
+# families where they differ.  (tests/unit/test_par_bisect.c runs the same
 # comparison on the thread backend for more P.)
 source "$(dirname "$0")/lib.sh"
 cd "$TMP"

@@ -8,7 +8,7 @@
 #include <unistd.h>
 
 #include "../harness.h"
-#include "../../src/view/edit.h"
+#include "../../src/view/app/edit.h"
 
 static char dir[] = "/tmp/pdt-edit-files.XXXXXX";
 
