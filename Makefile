@@ -211,7 +211,7 @@ deps-bench:
 	@scripts/deps.sh $(DEB_BUILD) $(DEB_TEST) $(DEB_BENCH)
 
 test: deps
-	$(MAKE) rel-all san-all smpi-build
+	$(MAKE) -j2 rel-all san-all smpi-build
 	tests/run.sh
 
 demo: deps-lesson
