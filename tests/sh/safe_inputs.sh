@@ -136,7 +136,7 @@ stop_job() {
     rm -f "mark-$name"
     PDT_TEST_SLEEP_IN_WRITE=0:$sleep PDT_TEST_MARK="$TMP/mark-$name" \
         mpirun -np 2 -x PDT_TEST_SLEEP_IN_WRITE -x PDT_TEST_MARK \
-        "$PDT" triangulate u.txt -o "out-$name.tri" > "log-$name.out" 2> "log-$name.err" &
+        "$PDT_HOOKED" triangulate u.txt -o "out-$name.tri" > "log-$name.out" 2> "log-$name.err" &
     local mp=$!
     for _ in $(seq 1 600); do [ -e "mark-$name" ] && break; sleep 0.05; done
     kids=$(pgrep -P "$mp")
