@@ -32,3 +32,15 @@ par_same() {
         ok "$name"
     fi
 }
+
+# pdtview_window PATTERN: the id of a pdtview window whose title matches the
+# extended regex PATTERN (empty if none).  Found by class, then by title:
+# pdtview's title is UTF-8 (WM_NAME of type UTF8_STRING), which
+# `xdotool search --name` does not match.
+pdtview_window() {
+    local w
+    for w in $(xdotool search --class pdtview 2>/dev/null); do
+        if xdotool getwindowname "$w" 2>/dev/null | grep -qE "$1"; then echo "$w"; return 0; fi
+    done
+    return 1
+}

@@ -63,7 +63,7 @@ F=$TMP/mine.txt
 "$V" --edit "$F" --size ${W}x${H} --screenshot "$TMP/edit.png" >"$TMP/out.log" 2>"$TMP/err.log" &
 VPID=$!
 wid=
-for i in $(seq 100); do wid=$(xdotool search --name 'pdtview' 2>/dev/null | head -1); [ -n "$wid" ] && break; sleep 0.1; done
+for i in $(seq 100); do wid=$(pdtview_window 'pdtview'); [ -n "$wid" ] && break; sleep 0.1; done
 if [ -n "$wid" ] && [ -f "$F" ] && [ ! -s "$F" ]; then ok edit_creates_missing_file
 else fail edit_creates_missing_file "window '$wid', file: $(ls -l "$F" 2>&1)"; fi
 sleep 1.5
@@ -108,7 +108,7 @@ cp "$TMP/c300.txt" "$G"
 "$V" --edit "$G" --ranks 4 --size ${W}x${H} --screenshot "$TMP/four.png" >"$TMP/out4.log" 2>"$TMP/err4.log" &
 VPID=$!
 wid=
-for i in $(seq 100); do wid=$(xdotool search --name 'editing.*four' 2>/dev/null | head -1); [ -n "$wid" ] && break; sleep 0.1; done
+for i in $(seq 100); do wid=$(pdtview_window 'editing.*four'); [ -n "$wid" ] && break; sleep 0.1; done
 # wait until the window title matches $1
 wait_title() { for i in $(seq 100); do xdotool getwindowname "$wid" 2>/dev/null | grep -q "$1" && return 0; sleep 0.1; done; return 1; }
 if [ -n "$wid" ] && wait_title 'triangulate, 4 ranks'; then ok edit_ranks_4_window

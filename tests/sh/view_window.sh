@@ -49,7 +49,7 @@ last=$("$V" --headless "$RUN" --at "${k:-0}" -o "$TMP/x.png" --size 320x200 2>&1
 if [ -n "$k" ] && [ "$k" -gt 5 ]; then ok script_moved; else fail script_moved "cursor $k"; fi
 
 # real X key presses: → twice, s, then q
-wid=$(xdotool search --name pdtview | head -1)
+wid=$(pdtview_window pdtview)
 if [ -n "$wid" ]; then
     xdotool key --window "$wid" Right Right s 2>/dev/null
     for i in $(seq 50); do [ "$(grep -c screenshot "$TMP/err.log")" -ge 2 ] && break; sleep 0.1; done
