@@ -16,14 +16,6 @@ int pdt_cli_fail(const pdt_err *err)
     return err->code == PDT_ERR_CHECK ? PDT_EXIT_CHECK : PDT_EXIT_USAGE;
 }
 
-int pdt_cli_same_file(const char *a, const char *b)
-{
-    struct stat sa, sb;
-    if (!a || !b || strcmp(a, "-") == 0 || strcmp(b, "-") == 0) return 0;
-    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
-           sa.st_ino == sb.st_ino;
-}
-
 long pdt_cli_peak_kib(void)
 {
     struct rusage ru;

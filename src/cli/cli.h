@@ -29,8 +29,6 @@ int pdt_cmd_trace(int argc, char **argv);
  * it (PDT_EXIT_CHECK for PDT_ERR_CHECK, PDT_EXIT_USAGE otherwise). */
 int pdt_cli_fail(const pdt_err *err);
 
-/* 1 if paths a and b name the same existing file (never for "-"). */
-int pdt_cli_same_file(const char *a, const char *b);
 
 /* Peak resident memory of this process in KiB (getrusage), or 0. */
 long pdt_cli_peak_kib(void);

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "pdt/safefile.h"
 #include "pdt/hull.h"
 #include "pdt/io.h"
 #include "run_opts.h"
@@ -72,7 +73,7 @@ int pdt_cmd_hull(int argc, char **argv)
         if (!hull) st = pdt_err_set(&err, PDT_ERR_NOMEM, "out of memory");
     }
     pdt_cli_trace *t = NULL;
-    if (st == PDT_OK && pdt_cli_same_file(o.output, o.input))
+    if (st == PDT_OK && pdt_safe_same_file(o.output, o.input))
         st = pdt_err_set(&err, PDT_ERR_ARG, "%s: output would replace the input; choose another "
                          "-o name", o.output);
     if (st == PDT_OK) st = compute(&o, pts, n, hull, &nh, &t, &err);

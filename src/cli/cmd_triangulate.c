@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "pdt/safefile.h"
 #include "pdt/delaunay.h"
 #include "pdt/io.h"
 #include "pdt/par.h"
@@ -226,11 +227,11 @@ static pdt_status check_output(run *R, pdt_err *err)
             if (!node) return agreed(R, pdt_err_set(err, PDT_ERR_NOMEM, "out of memory"), err);
             memcpy(node, o->output, len - 4);
             memcpy(node + len - 4, ".node", 6);
-            if (pdt_cli_same_file(node, o->input))
+            if (pdt_safe_same_file(node, o->input))
                 st = pdt_err_set(err, PDT_ERR_ARG, "%s: writing %s would replace the input %s; "
                                  "choose another -o name", o->output, node, o->input);
             free(node);
-        } else if (pdt_cli_same_file(o->output, o->input)) {
+        } else if (pdt_safe_same_file(o->output, o->input)) {
             st = pdt_err_set(err, PDT_ERR_ARG, "%s: output would replace the input; choose "
                              "another -o name", o->output);
         }
