@@ -256,7 +256,7 @@ static int merge(dt *d, uint32_t ldo, uint32_t ldi, uint32_t rdi, uint32_t rdo, 
 static int build(dt *d, uint32_t lo, uint32_t hi, int axis, uint32_t *le, uint32_t *re)
 {
     uint32_t n = hi - lo;
-    if (n <= 3) { /* sorted in frame `axis` by cut_order */
+    if (n <= 3) { /* sorted in frame `axis` by pdt_dt_cut_order */
         uint32_t s1 = lo, s2 = lo + 1;
         uint32_t a = make_edge(d, s1, s2);
         if (a == NIL) return 0;
