@@ -236,6 +236,44 @@ static void dump_line(uint32_t rank, uint64_t seq, const pdt_event *e)
            pdt_event_format(e, text, sizeof text));
 }
 
+/* The events of one rank, from its event `from` on, at most count of kind
+ * k (any when k < 0). */
+static int dump_rank(pdt_run *run, uint64_t rank, uint64_t from, uint64_t count, int k)
+{
+    pdt_err err = {0};
+    pdt_cursor *c;
+    if (pdt_cursor_open(run, (int)rank, &c, &err) != PDT_OK ||
+        pdt_cursor_seek(c, from, &err) != PDT_OK)
+        return pdt_cli_fail(&err);
+    pdt_event e;
+    uint64_t seq;
+    while (count > 0 && pdt_cursor_next(c, &e, &seq)) {
+        if (k >= 0 && e.kind != k) continue;
+        dump_line((uint32_t)rank, seq, &e);
+        count--;
+    }
+    pdt_cursor_close(c);
+    return PDT_EXIT_OK;
+}
+
+/* The events of all ranks merged by time, streamed (memory independent of
+ * the run's size), from the merged event `from` on, as dump_rank. */
+static int dump_merged(pdt_run *run, uint64_t from, uint64_t count, int k)
+{
+    pdt_err err = {0};
+    pdt_merge *mg;
+    if (pdt_merge_open(run, &mg, &err) != PDT_OK) return pdt_cli_fail(&err);
+    pdt_rec rec;
+    int got = 0;
+    for (uint64_t i = 0; count > 0 && (got = pdt_merge_next(mg, &rec, &err)) == 1; i++) {
+        if (i < from || (k >= 0 && rec.ev.kind != k)) continue;
+        dump_line(rec.rank, rec.seq, &rec.ev);
+        count--;
+    }
+    pdt_merge_close(mg);
+    return got < 0 ? pdt_cli_fail(&err) : PDT_EXIT_OK;
+}
+
 static int cmd_dump(int argc, char **argv)
 {
     const char *pos[1];
@@ -259,47 +297,16 @@ static int cmd_dump(int argc, char **argv)
     pdt_run *run;
     if ((rc = open_run(pos[0], &run))) return rc;
     print_warnings(run, stderr);
-    pdt_err err = {0};
-    if (rank != UINT64_MAX) {
-        if (rank >= (uint64_t)pdt_run_nranks(run)) {
-            pdt_run_close(run);
-            return pdt_cli_usage("trace dump", "--rank %" PRIu64 ": the run has ranks 0..%d", rank,
-                                 pdt_run_nranks(run) - 1);
-        }
-        pdt_cursor *c;
-        if (pdt_cursor_open(run, (int)rank, &c, &err) != PDT_OK ||
-            pdt_cursor_seek(c, from, &err) != PDT_OK) {
-            pdt_run_close(run);
-            return pdt_cli_fail(&err);
-        }
-        pdt_event e;
-        uint64_t seq;
-        while (count > 0 && pdt_cursor_next(c, &e, &seq)) {
-            if (k >= 0 && e.kind != k) continue;
-            dump_line((uint32_t)rank, seq, &e);
-            count--;
-        }
-        pdt_cursor_close(c);
-    } else {
-        pdt_merge *mg;  /* streamed: memory independent of the run's size */
-        if (pdt_merge_open(run, &mg, &err) != PDT_OK) {
-            pdt_run_close(run);
-            return pdt_cli_fail(&err);
-        }
-        pdt_rec rec;
-        int got = 0;
-        for (uint64_t i = 0; count > 0 && (got = pdt_merge_next(mg, &rec, &err)) == 1; i++) {
-            if (i < from || (k >= 0 && rec.ev.kind != k)) continue;
-            dump_line(rec.rank, rec.seq, &rec.ev);
-            count--;
-        }
-        pdt_merge_close(mg);
-        if (got < 0) {
-            pdt_run_close(run);
-            return pdt_cli_fail(&err);
-        }
+    if (rank != UINT64_MAX && rank >= (uint64_t)pdt_run_nranks(run)) {
+        int last = pdt_run_nranks(run) - 1;
+        pdt_run_close(run);
+        return pdt_cli_usage("trace dump", "--rank %" PRIu64 ": the run has ranks 0..%d", rank,
+                             last);
     }
+    rc = rank != UINT64_MAX ? dump_rank(run, rank, from, count, k)
+                            : dump_merged(run, from, count, k);
     pdt_run_close(run);
+    if (rc) return rc;
     return fflush(stdout) == 0 && !ferror(stdout) ? PDT_EXIT_OK : PDT_EXIT_USAGE;
 }
 
@@ -373,20 +380,30 @@ static void chrome_ev(FILE *f, int *first, const char *ph, const char *name, con
  * the JSON would be too big for a browser to open. */
 #define CHROME_EVENTS_MAX 2000000u
 
-static int export_chrome(pdt_run *run, FILE *f, int all_events)
+/* The JSON's head: the command, the process and one named thread per rank. */
+static void chrome_head(FILE *f, const pdt_manifest *m, int p)
 {
-    const pdt_manifest *m = pdt_run_manifest(run);
-    int p = pdt_run_nranks(run), first = 1;
     fprintf(f, "{\"displayTimeUnit\":\"ns\",\"otherData\":{\"command\":");
     json_str(f, m->command);
     fprintf(f, ",\"command_line\":");
     json_str(f, m->command_line ? m->command_line : "");
     fprintf(f, ",\"n\":%" PRIu64 ",\"ranks\":%d},\n\"traceEvents\":[", m->n, p);
-    fprintf(f, "\n{\"ph\":\"M\",\"name\":\"process_name\",\"pid\":0,\"args\":{\"name\":\"pdt %s\"}}",
-            m->command);
-    first = 0;
-    uint64_t total = 0;
+    fprintf(f, "\n{\"ph\":\"M\",\"name\":\"process_name\",\"pid\":0,"
+               "\"args\":{\"name\":\"pdt %s\"}}", m->command);
     for (int r = 0; r < p; r++) {
+        fprintf(f, ",\n{\"ph\":\"M\",\"name\":\"thread_name\",\"pid\":0,\"tid\":%d,"
+                   "\"args\":{\"name\":\"rank %d\"}}", r, r);
+        fprintf(f, ",\n{\"ph\":\"M\",\"name\":\"thread_sort_index\",\"pid\":0,\"tid\":%d,"
+                   "\"args\":{\"sort_index\":%d}}", r, r);
+    }
+}
+
+/* --events, unless the run has more than CHROME_EVENTS_MAX events (then a
+ * warning). */
+static int chrome_all_events(pdt_run *run, int all_events)
+{
+    uint64_t total = 0;
+    for (int r = 0; r < pdt_run_nranks(run); r++) {
         pdt_rank_info in;
         pdt_run_rank_info(run, r, &in);
         total += in.events;
@@ -394,79 +411,104 @@ static int export_chrome(pdt_run *run, FILE *f, int all_events)
     if (all_events && total > CHROME_EVENTS_MAX) {
         fprintf(stderr, "warning: the run has %" PRIu64 " events: --events ignored above %u "
                         "(phases, merge steps and messages only)\n", total, CHROME_EVENTS_MAX);
-        all_events = 0;
+        return 0;
     }
-    for (int r = 0; r < p; r++) {
-        fprintf(f, ",\n{\"ph\":\"M\",\"name\":\"thread_name\",\"pid\":0,\"tid\":%d,"
-                   "\"args\":{\"name\":\"rank %d\"}}", r, r);
-        fprintf(f, ",\n{\"ph\":\"M\",\"name\":\"thread_sort_index\",\"pid\":0,\"tid\":%d,"
-                   "\"args\":{\"sort_index\":%d}}", r, r);
+    return all_events;
+}
+
+/* One rank's export as it goes: the open phases and merge steps. */
+typedef struct chrome_rank {
+    FILE *f;
+    int *first;
+    int r;
+    uint64_t depth;
+} chrome_rank;
+
+static void chrome_phase(chrome_rank *c, const pdt_event *e)
+{
+    char name[200];
+    const char *pn = pdt_phase_name(e->sub);
+    if (e->a) snprintf(name, sizeof name, "%s %u", pn ? pn : "?", e->a);
+    else snprintf(name, sizeof name, "%s", pn ? pn : "?");
+    int b = e->kind == PDT_EV_PHASE_BEGIN;
+    if (!b && c->depth == 0) return; /* unbalanced (damaged) */
+    c->depth += b ? 1 : (uint64_t)-1;
+    chrome_ev(c->f, c->first, b ? "B" : "E", name, "phase", c->r, e->t);
+    fprintf(c->f, "}");
+}
+
+static void chrome_merge(chrome_rank *c, const pdt_event *e)
+{
+    char name[200];
+    snprintf(name, sizeof name, "merge level %u", e->sub);
+    if (e->kind == PDT_EV_MERGE_BEGIN) {
+        c->depth++;
+        chrome_ev(c->f, c->first, "B", name, "merge", c->r, e->t);
+        fprintf(c->f, ",\"args\":{\"left\":%u,\"right\":%u,\"end\":%u}}", e->a, e->b, e->c);
+        return;
     }
+    if (c->depth == 0) return;
+    c->depth--;
+    chrome_ev(c->f, c->first, "E", name, "merge", c->r, e->t);
+    fprintf(c->f, ",\"args\":{\"shipped\":%u,\"border\":%u,\"kept\":%u,"
+                  "\"discarded\":%" PRId64 "}}", e->a, e->b, e->c, e->v);
+}
+
+static void chrome_message(chrome_rank *c, const pdt_event *e)
+{
+    char name[200];
+    int send = e->kind == PDT_EV_SEND;
+    unsigned src = send ? (unsigned)c->r : e->a, dst = send ? e->a : (unsigned)c->r;
+    snprintf(name, sizeof name, "%s %s %u (%u bytes)", send ? "send" : "recv",
+             send ? "to" : "from", e->a, e->b);
+    chrome_ev(c->f, c->first, "X", name, "message", c->r, e->t);
+    fprintf(c->f, ",\"dur\":0.001,\"args\":{\"tag\":%u,\"seq\":%" PRId64 "}}", e->sub, e->v);
+    chrome_ev(c->f, c->first, send ? "s" : "f", "message", "message", c->r, e->t);
+    fprintf(c->f, ",\"id\":\"%u-%u-%u-%" PRId64 "\"%s}", src, dst, e->sub, e->v,
+            send ? "" : ",\"bp\":\"e\"");
+}
+
+/* Rank r's phases, merge steps and messages (and with all_events every
+ * other event as an instant); what a damaged trace left open is closed. */
+static int chrome_rank_events(pdt_run *run, int r, FILE *f, int *first, int all_events)
+{
+    pdt_cursor *cur;
+    pdt_err err = {0};
+    if (pdt_cursor_open(run, r, &cur, &err) != PDT_OK) return pdt_cli_fail(&err);
+    chrome_rank c = { f, first, r, 0 };
+    pdt_event e;
+    uint64_t seq, last_t = 0;
+    char name[200];
+    while (pdt_cursor_next(cur, &e, &seq)) {
+        last_t = e.t;
+        if (e.kind == PDT_EV_PHASE_BEGIN || e.kind == PDT_EV_PHASE_END) {
+            chrome_phase(&c, &e);
+        } else if (e.kind == PDT_EV_MERGE_BEGIN || e.kind == PDT_EV_MERGE_END) {
+            chrome_merge(&c, &e);
+        } else if (e.kind == PDT_EV_SEND || e.kind == PDT_EV_RECV) {
+            chrome_message(&c, &e);
+        } else if (all_events) {
+            pdt_event_format(&e, name, sizeof name);
+            chrome_ev(f, first, "i", name, "event", r, e.t);
+            fprintf(f, ",\"s\":\"t\",\"args\":{\"seq\":%" PRIu64 "}}", seq);
+        }
+    }
+    for (; c.depth > 0; c.depth--) {
+        chrome_ev(f, first, "E", "(unfinished)", "phase", r, last_t);
+        fprintf(f, "}");
+    }
+    pdt_cursor_close(cur);
+    return PDT_EXIT_OK;
+}
+
+static int export_chrome(pdt_run *run, FILE *f, int all_events)
+{
+    int p = pdt_run_nranks(run), first = 0; /* (the head's entries come first) */
+    chrome_head(f, pdt_run_manifest(run), p);
+    all_events = chrome_all_events(run, all_events);
     for (int r = 0; r < p; r++) {
-        pdt_cursor *c;
-        pdt_err err = {0};
-        if (pdt_cursor_open(run, r, &c, &err) != PDT_OK) return pdt_cli_fail(&err);
-        pdt_event e;
-        uint64_t seq, depth = 0, last_t = 0;
-        char name[200];
-        while (pdt_cursor_next(c, &e, &seq)) {
-            last_t = e.t;
-            switch (e.kind) {
-            case PDT_EV_PHASE_BEGIN:
-            case PDT_EV_PHASE_END: {
-                const char *pn = pdt_phase_name(e.sub);
-                if (e.a) snprintf(name, sizeof name, "%s %u", pn ? pn : "?", e.a);
-                else snprintf(name, sizeof name, "%s", pn ? pn : "?");
-                int b = e.kind == PDT_EV_PHASE_BEGIN;
-                if (!b && depth == 0) break;  /* unbalanced (damaged) */
-                depth += b ? 1 : (uint64_t)-1;
-                chrome_ev(f, &first, b ? "B" : "E", name, "phase", r, e.t);
-                fprintf(f, "}");
-                break;
-            }
-            case PDT_EV_MERGE_BEGIN:
-                snprintf(name, sizeof name, "merge level %u", e.sub);
-                depth++;
-                chrome_ev(f, &first, "B", name, "merge", r, e.t);
-                fprintf(f, ",\"args\":{\"left\":%u,\"right\":%u,\"end\":%u}}", e.a, e.b, e.c);
-                break;
-            case PDT_EV_MERGE_END:
-                if (depth == 0) break;
-                depth--;
-                snprintf(name, sizeof name, "merge level %u", e.sub);
-                chrome_ev(f, &first, "E", name, "merge", r, e.t);
-                fprintf(f, ",\"args\":{\"shipped\":%u,\"border\":%u,\"kept\":%u,"
-                           "\"discarded\":%" PRId64 "}}", e.a, e.b, e.c, e.v);
-                break;
-            case PDT_EV_SEND:
-            case PDT_EV_RECV: {
-                int send = e.kind == PDT_EV_SEND;
-                unsigned src = send ? (unsigned)r : e.a, dst = send ? e.a : (unsigned)r;
-                snprintf(name, sizeof name, "%s %s %u (%u bytes)", send ? "send" : "recv",
-                         send ? "to" : "from", e.a, e.b);
-                chrome_ev(f, &first, "X", name, "message", r, e.t);
-                fprintf(f, ",\"dur\":0.001,\"args\":{\"tag\":%u,\"seq\":%" PRId64 "}}", e.sub,
-                        e.v);
-                chrome_ev(f, &first, send ? "s" : "f", "message", "message", r, e.t);
-                fprintf(f, ",\"id\":\"%u-%u-%u-%" PRId64 "\"%s}", src, dst, e.sub, e.v,
-                        send ? "" : ",\"bp\":\"e\"");
-                break;
-            }
-            default:
-                if (all_events) {
-                    pdt_event_format(&e, name, sizeof name);
-                    chrome_ev(f, &first, "i", name, "event", r, e.t);
-                    fprintf(f, ",\"s\":\"t\",\"args\":{\"seq\":%" PRIu64 "}}", seq);
-                }
-                break;
-            }
-        }
-        while (depth > 0) {  /* close what a damaged trace left open */
-            chrome_ev(f, &first, "E", "(unfinished)", "phase", r, last_t);
-            fprintf(f, "}");
-            depth--;
-        }
-        pdt_cursor_close(c);
+        int rc = chrome_rank_events(run, r, f, &first, all_events);
+        if (rc) return rc;
     }
     fprintf(f, "\n]}\n");
     return PDT_EXIT_OK;

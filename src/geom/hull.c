@@ -113,40 +113,42 @@ static void angular_sort(const angular_ctx *c, uint32_t *idx, uint32_t *tmp, siz
     memcpy(idx, tmp, n * sizeof *idx);
 }
 
-pdt_status pdt_hull_graham(const pdt_point *pts, size_t n, uint32_t *out, size_t *nout,
-                           pdt_trace *tr)
+/* 1 of the pseudo-code: the rightmost lowest point (first such index). */
+static uint32_t graham_p0(const pdt_point *pts, size_t n)
 {
-    *nout = 0;
-    if (n == 0) return PDT_OK;
-    if (n > UINT32_MAX) return PDT_ERR_ARG;
-
-    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_GRAHAM_SORT, 0, 0, 0, 0);
-    /* 1: the rightmost lowest point (first such index) is p0. */
     uint32_t o = 0;
     for (uint32_t i = 1; i < (uint32_t)n; i++)
         if (pts[i].y < pts[o].y || (pts[i].y == pts[o].y && pts[i].x > pts[o].x)) o = i;
+    return o;
+}
 
-    /* 2: sort the others angularly about p0 ... */
-    uint32_t *idx = malloc(n * sizeof *idx), *tmp = malloc(n * sizeof *tmp);
-    if (!idx || !tmp) {
-        free(idx);
-        free(tmp);
-        return PDT_ERR_NOMEM;
-    }
+/* 2: idx[0] = o, then the others sorted angularly about p0 = pts[o].
+ * Returns 0 when out of memory. */
+static int graham_sort(const pdt_point *pts, size_t n, uint32_t o, uint32_t *idx, pdt_trace *tr)
+{
+    uint32_t *tmp = malloc(n * sizeof *tmp);
+    if (!tmp) return 0;
     size_t m = 0;
     idx[m++] = o;
     for (uint32_t i = 0; i < (uint32_t)n; i++)
         if (i != o) idx[m++] = i;
     angular_ctx ctx = {pts, pts[o]};
     angular_sort(&ctx, idx + 1, tmp, n - 1);
+    free(tmp);
     for (size_t k = 0; k < n; k++)
         PDT_TRACE(tr, 1, PDT_EV_SORT, 0, PDT_TRACE_PT(tr, idx[k]), k, 0, 0);
+    return 1;
+}
 
-    /* ... and, in a pass after the sort (not inside the comparator), delete
-     * on an angular tie every point but the farthest, and of coincident points
-     * all copies but one.  Copies of p0 go (p0 is kept); for the other
-     * coincident points the thesis deletes the one with the lower index, so
-     * the copy with the highest index stays (it sorts last in its group). */
+/* 3, in a pass after the sort (not inside the comparator): delete on an
+ * angular tie every point but the farthest, and of coincident points all
+ * copies but one.  Copies of p0 go (p0 is kept); for the other coincident
+ * points the thesis deletes the one with the lower index, so the copy with
+ * the highest index stays (it sorts last in its group).  Returns the points
+ * left, idx[0, m). */
+static size_t graham_ties(const pdt_point *pts, size_t n, uint32_t o, uint32_t *idx,
+                          pdt_trace *tr)
+{
     size_t w = 1, k = 1;
     while (k < n && pts[idx[k]].x == pts[o].x && pts[idx[k]].y == pts[o].y) {
         PDT_TRACE(tr, 1, PDT_EV_DELETE, PDT_DEL_COINCIDENT, PDT_TRACE_PT(tr, idx[k]),
@@ -166,13 +168,14 @@ pdt_status pdt_hull_graham(const pdt_point *pts, size_t n, uint32_t *out, size_t
         idx[w++] = keep;
         k = e;
     }
-    m = w;
-    free(tmp);
-    PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_GRAHAM_SORT, 0, 0, 0, 0);
+    return w;
+}
 
-    /* 4-9 of the pseudo-code (lessons/02, the viewer's panel): S := (p0, p1),
-     * then push p_i only on a strict left turn, else pop. */
-    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_GRAHAM_SCAN, 0, 0, 0, 0);
+/* 4-9 of the pseudo-code (lessons/02, the viewer's panel): S := (p0, p1),
+ * then push p_i only on a strict left turn, else pop.  The hull to out. */
+static pdt_status graham_scan(const pdt_point *pts, const uint32_t *idx, size_t m, uint32_t *out,
+                              size_t *nout, pdt_trace *tr)
+{
     pdt_stack s;
     pdt_status st = pdt_stack_init(&s, m, PDT_STACK_GRAHAM, tr);
     if (st == PDT_OK) st = pdt_stack_push(&s, idx[0]);
@@ -192,6 +195,27 @@ pdt_status pdt_hull_graham(const pdt_point *pts, size_t n, uint32_t *out, size_t
         *nout = s.n;
     }
     pdt_stack_free(&s);
+    return st;
+}
+
+pdt_status pdt_hull_graham(const pdt_point *pts, size_t n, uint32_t *out, size_t *nout,
+                           pdt_trace *tr)
+{
+    *nout = 0;
+    if (n == 0) return PDT_OK;
+    if (n > UINT32_MAX) return PDT_ERR_ARG;
+    uint32_t *idx = malloc(n * sizeof *idx);
+    if (!idx) return PDT_ERR_NOMEM;
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_GRAHAM_SORT, 0, 0, 0, 0);
+    uint32_t o = graham_p0(pts, n);
+    if (!graham_sort(pts, n, o, idx, tr)) {
+        free(idx);
+        return PDT_ERR_NOMEM;
+    }
+    size_t m = graham_ties(pts, n, o, idx, tr);
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_GRAHAM_SORT, 0, 0, 0, 0);
+    PDT_TRACE(tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_GRAHAM_SCAN, 0, 0, 0, 0);
+    pdt_status st = graham_scan(pts, idx, m, out, nout, tr);
     free(idx);
     PDT_TRACE(tr, 1, PDT_EV_PHASE_END, PDT_PH_GRAHAM_SCAN, 0, 0, 0, 0);
     return st;

@@ -570,6 +570,69 @@ static pdt_status head_body(reader *r, pdt_points_head *h, const char *buf)
     return PDT_OK;
 }
 
+/* One look at the file's first len bytes, buf[0, len] (room for the zero
+ * byte): 1 when its first line with something on it is whole (h->body,
+ * body_nl and last_nl set; *st an error in that line, if any), 0 to look at
+ * more, -1 when it is no text of pdt's (*st says so). */
+static int head_try(char *buf, size_t len, const char *path, double scale, pdt_points_head *h,
+                    pdt_status *st, pdt_err *err)
+{
+    buf[len] = '\0';
+    pdt_io_text t = {buf, len, 0, NULL};
+    reader r = {.scale = scale, .err = err};
+    pdt_io_cur_init(&r.cur, &t, path);
+    r.cur.fields = !h->node;
+    int some = pdt_io_next_line(&r.cur);
+    int whole = len == h->size;
+    if (whole || (some && memchr(r.cur.p, '\n', (size_t)(r.cur.end - r.cur.p)))) {
+        if (some) *st = head_body(&r, h, buf);
+        else h->body = len;
+        if (*st == PDT_OK && h->body == 0 && r.cur.end - buf >= 3 &&
+            memcmp(buf, "\xEF\xBB\xBF", 3) == 0)
+            h->body = 3;
+        h->body_nl = count_nl(buf, (size_t)h->body);
+        h->last_nl = buf[len - 1] == '\n';
+        return 1;
+    }
+    if (len >= PDT_IO_LINE_SPAN && /* (a line of garbage: not read on to the end) */
+        !memchr(buf + len - PDT_IO_LINE_SPAN, '\n', PDT_IO_LINE_SPAN)) {
+        *st = pdt_err_set(err, PDT_ERR_PARSE, "%s:%zu: no end of line in %zu bytes: not a "
+                          "text file of pdt's", path, (size_t)count_nl(buf, len) + 1,
+                          PDT_IO_LINE_SPAN);
+        return -1;
+    }
+    return 0;
+}
+
+/* The start of the regular file fd (h->size bytes), read longer until its
+ * first line with something on it is whole (head_try); then whether the
+ * file ends with a newline. */
+static pdt_status head_scan(int fd, const char *path, double scale, pdt_points_head *h,
+                            pdt_err *err)
+{
+    pdt_status st = PDT_OK;
+    char *buf = NULL;
+    size_t len = h->size < 65536 ? (size_t)h->size : 65536;
+    for (;;) {
+        char *nb = realloc(buf, len + 1);
+        if (!nb) {
+            st = pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory", path);
+            break;
+        }
+        buf = nb;
+        if ((st = pread_full(fd, buf, len, 0, path, err)) != PDT_OK) break;
+        if (head_try(buf, len, path, scale, h, &st, err) != 0) break;
+        len = h->size - len < len ? (size_t)h->size : 2 * len;
+    }
+    free(buf);
+    if (st == PDT_OK && len < h->size) {
+        char last;
+        st = pread_full(fd, &last, 1, h->size - 1, path, err);
+        h->last_nl = last == '\n';
+    }
+    return st;
+}
+
 pdt_status pdt_points_head_read(const char *path, double scale, pdt_points_head *h,
                                 pdt_err *err)
 {
@@ -590,50 +653,7 @@ pdt_status pdt_points_head_read(const char *path, double scale, pdt_points_head 
     h->parts = 1;
     h->node = has_ext(path, ".node");
     h->size = (uint64_t)sb.st_size;
-    /* the start of the file, longer until its first line with something
-     * on it is whole */
-    char *buf = NULL;
-    size_t len = h->size < 65536 ? (size_t)h->size : 65536;
-    for (;;) {
-        char *nb = realloc(buf, len + 1);
-        if (!nb) {
-            st = pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory", path);
-            break;
-        }
-        buf = nb;
-        if ((st = pread_full(fd, buf, len, 0, path, err)) != PDT_OK) break;
-        buf[len] = '\0';
-        pdt_io_text t = {buf, len, 0, NULL};
-        reader r = {.scale = scale, .err = err};
-        pdt_io_cur_init(&r.cur, &t, path);
-        r.cur.fields = !h->node;
-        int some = pdt_io_next_line(&r.cur);
-        int whole = len == h->size;
-        if (whole || (some && memchr(r.cur.p, '\n', (size_t)(r.cur.end - r.cur.p)))) {
-            if (some) st = head_body(&r, h, buf);
-            else h->body = len;
-            if (st == PDT_OK && h->body == 0 && r.cur.end - buf >= 3 &&
-                memcmp(buf, "\xEF\xBB\xBF", 3) == 0)
-                h->body = 3;
-            h->body_nl = count_nl(buf, (size_t)h->body);
-            h->last_nl = buf[len - 1] == '\n';
-            break;
-        }
-        if (len >= PDT_IO_LINE_SPAN && /* (a line of garbage: not read on to the end) */
-            !memchr(buf + len - PDT_IO_LINE_SPAN, '\n', PDT_IO_LINE_SPAN)) {
-            st = pdt_err_set(err, PDT_ERR_PARSE, "%s:%zu: no end of line in %zu bytes: not a "
-                             "text file of pdt's", path, (size_t)count_nl(buf, len) + 1,
-                             PDT_IO_LINE_SPAN);
-            break;
-        }
-        len = h->size - len < len ? (size_t)h->size : 2 * len;
-    }
-    if (st == PDT_OK && len < h->size) {
-        char last;
-        st = pread_full(fd, &last, 1, h->size - 1, path, err);
-        h->last_nl = last == '\n';
-    }
-    free(buf);
+    st = head_scan(fd, path, scale, h, err);
     close(fd);
     return st;
 }

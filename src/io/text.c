@@ -273,6 +273,66 @@ int pdt_io_parse_int(const char *tok, size_t len, int64_t *v)
     return 0;
 }
 
+/* The digits of a mantissa from tok[*i] on: the integer part, then a
+ * fraction after a point, into d->m (at most 19 significant digits; a
+ * dropped one sets d->inexact) with *e the power of ten they leave.
+ * Returns whether there was any digit. */
+static int dec_mantissa(const char *tok, size_t len, size_t *i, pdt_io_dec *d, int64_t *e)
+{
+    int sig = 0, seen_digit = 0;
+    size_t k = *i;
+    for (; k < len && tok[k] >= '0' && tok[k] <= '9'; k++) {
+        seen_digit = 1;
+        unsigned dg = (unsigned)(tok[k] - '0');
+        if (d->m == 0 && dg == 0) continue;
+        if (sig < 19) {
+            d->m = d->m * 10 + dg;
+            sig++;
+        } else {
+            (*e)++; /* a dropped digit before the point scales by 10 */
+            if (dg) d->inexact = 1;
+        }
+    }
+    if (k < len && tok[k] == '.') {
+        for (k++; k < len && tok[k] >= '0' && tok[k] <= '9'; k++) {
+            seen_digit = 1;
+            unsigned dg = (unsigned)(tok[k] - '0');
+            if (d->m == 0 && dg == 0) {
+                (*e)--;
+                continue;
+            }
+            if (sig < 19) {
+                d->m = d->m * 10 + dg;
+                sig++;
+                (*e)--;
+            } else if (dg) {
+                d->inexact = 1;
+            }
+        }
+    }
+    *i = k;
+    return seen_digit;
+}
+
+/* An exponent "e[+-]digits" at tok[*i], if there is one, added to *e
+ * (digits stop counting once it reaches 10^8; the caller clamps e).
+ * Returns 1 if it has no digits. */
+static int dec_exponent(const char *tok, size_t len, size_t *i, int64_t *e)
+{
+    size_t k = *i;
+    if (!(k < len && (tok[k] == 'e' || tok[k] == 'E'))) return 0;
+    k++;
+    int eneg = 0;
+    if (k < len && (tok[k] == '+' || tok[k] == '-')) eneg = tok[k++] == '-';
+    if (k == len) return 1;
+    int64_t x = 0;
+    for (; k < len && tok[k] >= '0' && tok[k] <= '9'; k++)
+        if (x < 100000000) x = x * 10 + (tok[k] - '0');
+    *e += eneg ? -x : x;
+    *i = k;
+    return 0;
+}
+
 int pdt_io_parse_dec(const char *tok, size_t len, pdt_io_dec *d)
 {
     size_t i = 0;
@@ -281,50 +341,10 @@ int pdt_io_parse_dec(const char *tok, size_t len, pdt_io_dec *d)
     d->neg = 0;
     d->inexact = 0;
     if (i < len && (tok[i] == '+' || tok[i] == '-')) d->neg = tok[i++] == '-';
-    int sig = 0, seen_digit = 0;
     int64_t e = 0;
-    for (; i < len && tok[i] >= '0' && tok[i] <= '9'; i++) {
-        seen_digit = 1;
-        unsigned dg = (unsigned)(tok[i] - '0');
-        if (d->m == 0 && dg == 0) continue;
-        if (sig < 19) {
-            d->m = d->m * 10 + dg;
-            sig++;
-        } else {
-            e++; /* a dropped digit before the point scales by 10 */
-            if (dg) d->inexact = 1;
-        }
-    }
-    if (i < len && tok[i] == '.') {
-        for (i++; i < len && tok[i] >= '0' && tok[i] <= '9'; i++) {
-            seen_digit = 1;
-            unsigned dg = (unsigned)(tok[i] - '0');
-            if (d->m == 0 && dg == 0) {
-                e--;
-                continue;
-            }
-            if (sig < 19) {
-                d->m = d->m * 10 + dg;
-                sig++;
-                e--;
-            } else if (dg) {
-                d->inexact = 1;
-            }
-        }
-    }
-    if (!seen_digit) return 1;
-    if (i < len && (tok[i] == 'e' || tok[i] == 'E')) {
-        i++;
-        int eneg = 0;
-        if (i < len && (tok[i] == '+' || tok[i] == '-')) eneg = tok[i++] == '-';
-        if (i == len) return 1;
-        int64_t x = 0;
-        for (; i < len && tok[i] >= '0' && tok[i] <= '9'; i++)
-            if (x < 100000000) x = x * 10 + (tok[i] - '0');
-        e += eneg ? -x : x;
-    }
-    if (i != len) return 1;
-    if (d->m == 0) {
+    if (!dec_mantissa(tok, len, &i, d, &e)) return 1;
+    if (dec_exponent(tok, len, &i, &e) || i != len) return 1;
+    if (d->m == 0) { /* one zero: no sign, no exponent */
         d->e = 0;
         d->neg = 0;
         return 0;

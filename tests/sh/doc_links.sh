@@ -15,7 +15,7 @@
 #     §3.10"): FILE.md has a heading numbered N.M; inside docs/algorithm.md a bare §N.M
 #     refers to that file.
 # Then the checker is run on a small tree with a broken link, a missing file and a
-# missing section, and must report each.
+# missing section, in a document, a source file and a public header, and must report each.
 source "$(dirname "$0")/lib.sh"
 
 CHECKER=$TMP/doc_links.py
@@ -191,5 +191,21 @@ if [ $? -ne 0 ] && grep -q 'README.md:3: link to docs/gone.md' "$TMP/fake.txt" &
     ok checker_finds_broken_link_missing_file_and_section
 else
     fail checker_finds_broken_link_missing_file_and_section "$(tr '\n' ' ' < "$TMP/fake.txt")"
+fi
+
+# A public header's comment is read too: a cited source file and a cited section that do not
+# exist fail the check, on their line; the ones that exist (a multi-line comment's later
+# line included) do not.
+mkdir -p "$F/include/pdt"
+printf '/* pdt: see src/geom/x.c,\n * src/geom/dt_gone.c and docs/algorithm.md §2.3 and §4.1. */\nint z;\n' \
+    > "$F/include/pdt/z.h"
+printf '// docs/guide.md §2.2 and src/geom/y.c\n' > "$F/include/pdt/w.h"
+python3 "$CHECKER" "$F" > "$TMP/fake2.txt"
+if [ $? -ne 0 ] && grep -q 'include/pdt/z.h:2: cites src/geom/dt_gone.c' "$TMP/fake2.txt" &&
+   grep -q 'include/pdt/z.h:2: docs/algorithm.md has no section 4.1' "$TMP/fake2.txt" &&
+   ! grep -q 'z.h:1\|w.h\|section 2.3' "$TMP/fake2.txt"; then
+    ok checker_reads_header_comments
+else
+    fail checker_reads_header_comments "$(tr '\n' ' ' < "$TMP/fake2.txt")"
 fi
 summary

@@ -1,0 +1,232 @@
+/* pdt — the canonical order of the triangles (docs/geometry.md): each
+ * rotated to start at its smallest index, then sorted by its three indices.
+ * Alone (pdt_tri_canonical), or in buckets of first indices spread over ranks
+ * (pdt_tri_bucket_*).  dt_int.h lists the kernel's other files. */
+#include "dt_int.h"
+
+#include "pdt/bigmem.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static int tri_cmp(const pdt_tri *a, const pdt_tri *b)
+{
+    for (int k = 0; k < 3; k++)
+        if (a->v[k] != b->v[k]) return a->v[k] < b->v[k] ? -1 : 1;
+    return 0;
+}
+
+static int tri_qcmp(const void *a, const void *b)
+{
+    return tri_cmp(a, b);
+}
+
+/* Rotate t to start at its smallest index, branch-free (which corner is
+ * the smallest is random: a branch on it mispredicted every other
+ * triangle). */
+static void tri_rotate(pdt_tri *t)
+{
+    uint32_t a = t->v[0], b = t->v[1], c = t->v[2];
+    uint32_t w[5] = {a, b, c, a, b};
+    unsigned r = (unsigned)((b < a) & (b < c)) + 2u * (unsigned)((c < a) & (c < b));
+    t->v[0] = w[r];
+    t->v[1] = w[r + 1];
+    t->v[2] = w[r + 2];
+}
+
+/* a before b in the canonical order */
+static inline int tri_less(const pdt_tri *a, const pdt_tri *b)
+{
+    uint64_t ka = (uint64_t)a->v[0] << 32 | a->v[1], kb = (uint64_t)b->v[0] << 32 | b->v[1];
+    return ka < kb || (ka == kb && a->v[2] < b->v[2]);
+}
+
+/* Sort tris[lo, hi), all with the same first index, by (v[1], v[2]):
+ * insertion sort for short runs, qsort for long ones (a vertex of huge degree
+ * must not make this quadratic). */
+static void sort_run(pdt_tri *t, size_t lo, size_t hi)
+{
+    if (hi - lo > 32) {
+        qsort(t + lo, hi - lo, sizeof *t, tri_qcmp);
+        return;
+    }
+    for (size_t i = lo + 1; i < hi; i++) {
+        pdt_tri v = t[i];
+        size_t j = i;
+        while (j > lo && tri_cmp(&t[j - 1], &v) > 0) {
+            t[j] = t[j - 1];
+            j--;
+        }
+        t[j] = v;
+    }
+}
+
+/* t[lo, hi) is in order by first index: put each run of one first index in
+ * order by the other two.  One insertion pass over the whole range (a
+ * triangle moves only within its run; runs are two triangles long on
+ * average, so a check per triangle and few moves, where finding each run's
+ * end first mispredicted once a run); when the moves pass 8 per triangle (a
+ * vertex of huge degree), the rest goes run by run with sort_run. */
+static void order_first_runs(pdt_tri *t, size_t lo, size_t hi)
+{
+    size_t budget = 8 * (hi - lo) + 64;
+    for (size_t i = lo + 1; i < hi; i++) {
+        if (!tri_less(&t[i], &t[i - 1])) continue;
+        pdt_tri v = t[i];
+        size_t j = i;
+        do {
+            t[j] = t[j - 1];
+            j--;
+        } while (j > lo && tri_less(&v, &t[j - 1]));
+        t[j] = v;
+        if (i - j >= budget) {
+            for (size_t a = lo; a < hi;) {
+                size_t b = a + 1;
+                while (b < hi && t[b].v[0] == t[a].v[0]) b++;
+                if (b - a > 1) sort_run(t, a, b);
+                a = b;
+            }
+            return;
+        }
+        budget -= i - j;
+    }
+}
+
+/* One bucket of first indices [base, base + nlo) whose triangles lie in ns
+ * places seg[k][0, len[k]) and have been counted by first index into
+ * lc[v - base + 1] (lc: nlo + 1 counters): written to out in canonical order
+ * (a counting pass by first index, then the runs of one first index by the
+ * other two). */
+static void bucket_place(const pdt_tri *const *seg, const size_t *len, size_t ns, uint32_t base,
+                         size_t nlo, size_t *lc, pdt_tri *out)
+{
+    lc[0] = 0;
+    for (size_t l = 1; l <= nlo; l++) lc[l] += lc[l - 1];
+    for (size_t k = 0; k < ns; k++)
+        for (size_t i = 0; i < len[k]; i++) out[lc[seg[k][i].v[0] - base]++] = seg[k][i];
+    order_first_runs(out, 0, lc[nlo]);
+}
+
+/* The triangles are put in order by their first (smallest) index with two
+ * counting passes: first by its high bits into at most 2048 buckets (2048
+ * output streams: cache lines and huge pages enough for all), then each
+ * bucket, now small enough for the cache, by its low bits; equal first
+ * indices (two triangles per vertex on average) are then sorted by the other
+ * two.  A random scatter of all triangles in one pass, as before, missed the
+ * cache and the TLB on every triangle at 10^7 points.  (dt_int.h: the
+ * contract.) */
+void pdt_dt_canonical(pdt_tri *in, pdt_tri *out, size_t ntri, pdt_tri *scratch)
+{
+    if (ntri == 0) return;
+    uint32_t minv = UINT32_MAX, maxv = 0;
+    for (size_t i = 0; i < ntri; i++) {
+        tri_rotate(&in[i]);
+        if (in[i].v[0] > maxv) maxv = in[i].v[0];
+        if (in[i].v[0] < minv) minv = in[i].v[0];
+    }
+    uint32_t span = maxv - minv;
+    int bits = 32 - __builtin_clz(span | 1u), shift = bits > 11 ? bits - 11 : 0;
+    size_t nhi = ((size_t)span >> shift) + 1, nlo = (size_t)1 << shift;
+    pdt_tri *tmp = ntri <= 64 ? NULL : scratch ? scratch : pdt_big_alloc(ntri * sizeof *tmp);
+    size_t *hc = tmp ? calloc(nhi + 1, sizeof *hc) : NULL;
+    size_t *lc = hc ? malloc((nlo + 1) * sizeof *lc) : NULL;
+    if (!lc) {
+        if (tmp != scratch) pdt_big_free(tmp, ntri * sizeof *tmp);
+        free(hc);
+        qsort(in, ntri, sizeof *in, tri_qcmp);
+        if (out != in) memmove(out, in, ntri * sizeof *out);
+        return;
+    }
+    for (size_t i = 0; i < ntri; i++) hc[((in[i].v[0] - minv) >> shift) + 1]++;
+    for (size_t h = 1; h <= nhi; h++) hc[h] += hc[h - 1];
+    for (size_t i = 0; i < ntri; i++) tmp[hc[(in[i].v[0] - minv) >> shift]++] = in[i];
+    /* hc[h] is now the end of high bucket h */
+    size_t start = 0;
+    for (size_t h = 0; h < nhi; h++) {
+        size_t end = hc[h];
+        if (end == start) continue; /* (no counters to clear for an empty bucket) */
+        const pdt_tri *seg = tmp + start;
+        size_t len = end - start;
+        uint32_t base = minv + ((uint32_t)h << shift);
+        memset(lc, 0, (nlo + 1) * sizeof *lc);
+        for (size_t i = 0; i < len; i++) lc[seg[i].v[0] - base + 1]++;
+        bucket_place(&seg, &len, 1, base, nlo, lc, out + start);
+        start = end;
+    }
+    if (tmp != scratch) pdt_big_free(tmp, ntri * sizeof *tmp);
+    free(hc);
+    free(lc);
+}
+
+void pdt_tri_canonical(pdt_tri *tris, size_t ntri)
+{
+    pdt_dt_canonical(tris, tris, ntri, NULL);
+}
+
+void pdt_tri_canonical_on(pdt_tri *tris, size_t ntri, pdt_tri *scratch)
+{
+    pdt_dt_canonical(tris, tris, ntri, scratch);
+}
+
+/* ---- the canonical order in buckets (spread over ranks) ---- */
+
+void pdt_tri_bucket_count(pdt_tri *t, size_t n, int shift, uint64_t *hist)
+{
+    for (size_t i = 0; i < n; i++) {
+        tri_rotate(&t[i]);
+        hist[t[i].v[0] >> shift]++;
+    }
+}
+
+void pdt_tri_bucket_scatter(const pdt_tri *t, size_t n, int shift, uint64_t *at, pdt_tri *dst)
+{
+    for (size_t i = 0; i < n; i++) dst[at[t[i].v[0] >> shift]++] = t[i];
+}
+
+void pdt_tri_bucket_scatter_round(const pdt_tri *t, size_t n, int shift, const uint8_t *in,
+                                  uint64_t *at, pdt_tri *dst)
+{
+    for (size_t i = 0; i < n; i++) { /* (branch-free: which round is random) */
+        uint32_t b = t[i].v[0] >> shift;
+        uint64_t a = at[b];
+        dst[a] = t[i];
+        at[b] = a + in[b];
+    }
+}
+
+/* Each bucket in turn, the smallest at a run's head first: its part of every
+ * run found and counted by first index in one scan, then placed. */
+pdt_status pdt_tri_bucket_order(const pdt_tri *const *src, const size_t *len, size_t ns, int shift,
+                                pdt_tri *out)
+{
+    size_t nlo = (size_t)1 << shift;
+    size_t *lc = malloc((nlo + 1) * sizeof *lc), *at = calloc(ns + 1, sizeof *at),
+           *sl = malloc((ns + 1) * sizeof *sl);
+    const pdt_tri **seg = malloc((ns + 1) * sizeof *seg);
+    pdt_status st = lc && at && sl && seg ? PDT_OK : PDT_ERR_NOMEM;
+    while (st == PDT_OK) {
+        uint64_t b = UINT64_MAX;
+        for (size_t k = 0; k < ns; k++) {
+            uint64_t head = at[k] < len[k] ? src[k][at[k]].v[0] >> shift : UINT64_MAX;
+            b = head < b ? head : b;
+        }
+        if (b == UINT64_MAX) break;
+        uint32_t base = (uint32_t)(b << shift);
+        memset(lc, 0, (nlo + 1) * sizeof *lc);
+        for (size_t k = 0; k < ns; k++) {
+            size_t e = at[k];
+            for (; e < len[k] && (src[k][e].v[0] >> shift) == b; e++)
+                lc[src[k][e].v[0] - base + 1]++;
+            seg[k] = src[k] + at[k];
+            sl[k] = e - at[k];
+            at[k] = e;
+        }
+        bucket_place(seg, sl, ns, base, nlo, lc, out);
+        out += lc[nlo];
+    }
+    free(lc);
+    free(at);
+    free(sl);
+    free((void *)seg);
+    return st;
+}
