@@ -185,10 +185,19 @@ typedef struct pdt_trace_buf {
     pdt_event *ev;
     size_t n, cap;
     int failed; /* allocation failed at some point: events were lost */
+    int timed;  /* 0: an event's t is its index (logical time); 1: nanoseconds
+                 * on the monotonic clock since t0 */
+    uint64_t t0;
 } pdt_trace_buf;
 
-/* Initialise `tr` to record every event of level <= `level` into `buf`. */
+/* Initialise `tr` to record every event of level <= `level` into `buf`,
+ * each event's t its index in buf (logical time). */
 void pdt_trace_buf_init(pdt_trace *tr, pdt_trace_buf *buf, int level, int rank);
+/* The same, each event's t the nanoseconds since t0 on the monotonic clock
+ * (pdt_trace_ns): several ranks' buffers given one t0 merge by time. */
+void pdt_trace_buf_init_timed(pdt_trace *tr, pdt_trace_buf *buf, int level, int rank, uint64_t t0);
+/* Nanoseconds on the monotonic clock. */
+uint64_t pdt_trace_ns(void);
 void pdt_trace_buf_free(pdt_trace_buf *buf);
 
 #endif

@@ -3,7 +3,8 @@
  * One streaming pass per rank (cursor: memory O(block) plus what is being
  * checked), then the cross-rank checks.  The first violation found is
  * reported as "rank R event #K (the event as text): what is wrong".  The
- * final triangles and what grows with the points are check_finals.c's. */
+ * final triangles and what grows with the points are check_finals.c's, the
+ * checks of the whole run after the ranks' passes check_run.c's. */
 #include <errno.h>
 #include <inttypes.h>
 #include <stdarg.h>
@@ -164,7 +165,7 @@ static pdt_status stack_push(chk *c, chk_stack *s, uint32_t x)
     return PDT_OK;
 }
 
-static void stack_free(chk *c, chk_stack *s)
+void chk_stack_free(chk *c, chk_stack *s)
 {
     if (s->map.p) {
         pdt_temp_map_free(&s->map);
@@ -177,7 +178,7 @@ static void stack_free(chk *c, chk_stack *s)
 
 /* The resident pages of the stacks in files given back (they stay in the
  * file: the next push or pop reads its page again). */
-static void stacks_give_back(chk_stack *st, size_t n)
+void chk_stacks_give_back(chk_stack *st, size_t n)
 {
     for (size_t i = 0; i < n; i++)
         if (st[i].map.p) pdt_release_pages(st[i].map.p, st[i].map.bytes);
@@ -205,7 +206,7 @@ typedef struct rank_state {
 
 static void rank_state_free(chk *c, rank_state *s)
 {
-    for (int i = 0; i < 256; i++) stack_free(c, &s->stack[i]);
+    for (int i = 0; i < 256; i++) chk_stack_free(c, &s->stack[i]);
     free(s->phases.v);
     free(s->phase_seq_lo.v);
     free(s->edges.k);
@@ -712,7 +713,7 @@ static pdt_status check_rank(chk *c, uint32_t r)
         if (done == got) break;
         c->events++;
         chk_tick(c);
-        if (c->events % GIVE_BACK_EVERY == 0) stacks_give_back(rs->stack, 256);
+        if (c->events % GIVE_BACK_EVERY == 0) chk_stacks_give_back(rs->stack, 256);
         st = check_event(c, rs, r, seqs[done % CHECK_AHEAD], &ring[done % CHECK_AHEAD]);
         done++;
     }
@@ -734,160 +735,6 @@ static pdt_status check_rank(chk *c, uint32_t r)
     return st;
 }
 
-static int cmp_msg(const void *a, const void *b)
-{
-    const msg *x = a, *y = b;
-    if (x->src != y->src) return x->src < y->src ? -1 : 1;
-    if (x->dst != y->dst) return x->dst < y->dst ? -1 : 1;
-    if (x->tag != y->tag) return x->tag < y->tag ? -1 : 1;
-    if (x->seq_no != y->seq_no) return x->seq_no < y->seq_no ? -1 : 1;
-    /* the SEND before the RECV of the same message */
-    return (x->ev.kind == PDT_EV_RECV) - (y->ev.kind == PDT_EV_RECV);
-}
-
-static pdt_status check_messages(chk *c)
-{
-    if (c->nmsg) qsort(c->msg, c->nmsg, sizeof *c->msg, cmp_msg);
-    for (size_t i = 0; i < c->nmsg;) {
-        const msg *m = &c->msg[i];
-        const msg *n = i + 1 < c->nmsg ? &c->msg[i + 1] : NULL;
-        if (n && !(m->ev.kind == PDT_EV_SEND && n->ev.kind == PDT_EV_RECV && n->src == m->src &&
-                   n->dst == m->dst && n->tag == m->tag && n->seq_no == m->seq_no))
-            n = NULL;
-        if (!n) {
-            if (m->ev.kind == PDT_EV_SEND)
-                return chk_viol(c, m->rank, m->seq, &m->ev, "no matching recv on rank %" PRIu32,
-                            m->dst);
-            return chk_viol(c, m->rank, m->seq, &m->ev, "no matching send on rank %" PRIu32, m->src);
-        }
-        if (n->bytes != m->bytes)
-            return chk_viol(c, n->rank, n->seq, &n->ev, "the send (rank %" PRIu32 " event #%" PRIu64
-                                                    ") has %" PRIu64 " bytes",
-                        m->rank, m->seq, m->bytes);
-        i += 2;
-    }
-    return PDT_OK;
-}
-
-static int cmp_merge(const void *a, const void *b)
-{
-    const merge *x = a, *y = b;
-    if (x->level != y->level) return x->level < y->level ? -1 : 1;
-    return x->gl < y->gl ? -1 : x->gl > y->gl;
-}
-
-static pdt_status check_merges(chk *c)
-{
-    if (c->nmg) qsort(c->mg, c->nmg, sizeof *c->mg, cmp_merge);
-    for (size_t i = 1; i < c->nmg; i++) {
-        const merge *a = &c->mg[i - 1], *b = &c->mg[i];
-        if (a->level == b->level && b->gl < a->end)
-            return chk_viol(c, 0, 0, NULL, "merge steps at level %" PRIu32 " overlap: ranks [%" PRIu32
-                                       ", %" PRIu32 ") (rank %" PRIu32 " event #%" PRIu64
-                                       ") and [%" PRIu32 ", %" PRIu32 ") (rank %" PRIu32
-                                       " event #%" PRIu64 ")",
-                        a->level, a->gl, a->end, a->rank, a->seq, b->gl, b->end, b->rank, b->seq);
-    }
-    int p = pdt_run_nranks(c->run);
-    if (c->is_tri && p > 1) {
-        const merge *top = c->nmg ? &c->mg[c->nmg - 1] : NULL;
-        if (!top || top->gl != 0 || top->end != (uint32_t)p)
-            return chk_viol(c, 0, 0, NULL, "no merge step joins all %d ranks (the last merge %s)", p,
-                        top ? "covers fewer ranks" : "is missing");
-    }
-    return PDT_OK;
-}
-
-/* A bisection run's regions: at every merge step the local lift-ups of the
- * left group's ranks all come before those of the right group's in one
- * lexicographic order, (x, y) or (y, x) -- one cut separates them. */
-static pdt_status check_regions(chk *c)
-{
-    for (size_t i = 0; i < c->nmg; i++) {
-        const merge *g = &c->mg[i];
-        uint64_t lx = 0, ly = 0, rx = UINT64_MAX, ry = UINT64_MAX;
-        int any_l = 0, any_r = 0;
-        for (uint32_t q = g->gl; q < g->end; q++) {
-            if (!c->nlocal[q]) continue;
-            if (q < g->gr) {
-                lx = c->kmax[q] > lx ? c->kmax[q] : lx;
-                ly = c->ymax[q] > ly ? c->ymax[q] : ly;
-                any_l = 1;
-            } else {
-                rx = c->kmin[q] < rx ? c->kmin[q] : rx;
-                ry = c->ymin[q] < ry ? c->ymin[q] : ry;
-                any_r = 1;
-            }
-        }
-        if (any_l && any_r && !(lx < rx) && !(ly < ry))
-            return chk_viol(c, g->rank, g->seq, NULL, "the merge at level %" PRIu32 " joins ranks [%"
-                            PRIu32 ", %" PRIu32 ") and [%" PRIu32 ", %" PRIu32 ") whose local "
-                            "points no cut separates (in x nor in y): the regions overlap",
-                            g->level, g->gl, g->gr, g->gr, g->end);
-    }
-    return PDT_OK;
-}
-
-/* ---- the hull of a hull run ------------------------------------------------------ */
-
-/* The final Graham stack compared with the hull recomputed in memory. */
-static pdt_status hull_recomputed(chk *c)
-{
-    const chk_stack *g = &c->graham_final;
-    uint32_t *hull = malloc((c->npts ? c->npts : 1) * sizeof *hull);
-    size_t nh = 0;
-    if (!hull) return chk_nomem(c);
-    pdt_status st = pdt_hull_graham(c->pts, c->npts, hull, &nh, NULL);
-    if (st != PDT_OK) pdt_err_set(c->err, st, "recomputing the hull failed: %s", pdt_status_str(st));
-    if (st == PDT_OK && (nh != g->n || (nh && memcmp(hull, g->v, nh * sizeof *hull) != 0))) {
-        size_t k = 0;
-        while (k < nh && k < g->n && hull[k] == g->v[k]) k++;
-        st = chk_viol(c, 0, 0, NULL, "the final Graham stack (%zu points) is not the hull of the "
-                                    "run's points (%zu points); first difference at position %zu",
-                      g->n, nh, k);
-    }
-    free(hull);
-    return st;
-}
-
-/* (pdt_hull_certify's release) */
-static void hull_give_back(void *ctx)
-{
-    chk *c = ctx;
-    pdt_run_release_points(c->run);
-    stacks_give_back(&c->graham_final, 1);
-}
-
-/* The final Graham stack certified in one pass over the points. */
-static pdt_status hull_certified(chk *c)
-{
-    const chk_stack *g = &c->graham_final;
-    pdt_err why = {0};
-    if (pdt_hull_certify(c->pts, c->npts, g->v, g->n, hull_give_back, c, &why) == PDT_OK)
-        return PDT_OK;
-    return chk_viol(c, 0, 0, NULL, "the final Graham stack (%zu points) is not the hull of the "
-                                  "run's points: %s", g->n, why.msg);
-}
-
-/* A hull run: every point sorted, each deleted or pushed, and the final
- * Graham stack is the hull of the run's points, recomputed while that fits
- * the budget (HULL_BYTES_PER_POINT), else certified (hullcert.h). */
-static pdt_status check_graham_hull(chk *c)
-{
-    pdt_status st = PDT_OK;
-    for (size_t i = 0; st == PDT_OK && i < c->npts; i++) {
-        chk_tick(c);
-        if (!(c->mark[i] & M_SORTED))
-            st = chk_viol(c, 0, 0, NULL, "pt %zu never appears in the angular order", i);
-        else if (!(c->mark[i] & (M_DELETED | M_PUSHED)))
-            st = chk_viol(c, 0, 0, NULL, "pt %zu was neither deleted nor pushed", i);
-        else if ((c->mark[i] & M_DELETED) && (c->mark[i] & M_PUSHED))
-            st = chk_viol(c, 0, 0, NULL, "pt %zu was deleted and also pushed", i);
-    }
-    if (st != PDT_OK) return st;
-    return c->hull_certify ? hull_certified(c) : hull_recomputed(c);
-}
-
 pdt_status pdt_run_check(pdt_run *run, char *summary, size_t cap, pdt_err *err)
 {
     return pdt_run_check_mem(run, PDT_TRACE_MEM_DEFAULT, summary, cap, err);
@@ -897,6 +744,59 @@ pdt_status pdt_run_check_mem(pdt_run *run, uint64_t budget, char *summary, size_
                              pdt_err *err)
 {
     return pdt_run_check_tstar(run, budget, NULL, summary, cap, err);
+}
+
+/* c set up for run within budget: the manifest's command, what is certified
+ * rather than recomputed, the per-rank tables, the marks and the distinct
+ * points (*nu of them). */
+static pdt_status check_setup(chk *c, pdt_run *run, uint64_t budget, pdt_tstar_fn tstar,
+                              size_t *nu, pdt_err *err)
+{
+    memset(c, 0, sizeof *c);
+    c->run = run;
+    c->err = err;
+    c->pts = pdt_run_points(run, &c->npts);
+    c->budget = budget;
+    c->tstar = tstar;
+    /* half the budget for the finals' buffer; at least a few, so that a tiny
+     * budget spills often instead of failing */
+    c->maxfin = (size_t)(budget / 2 / sizeof(fin) < 16 ? 16 : budget / 2 / sizeof(fin));
+    const pdt_manifest *m = pdt_run_manifest(run);
+    c->is_tri = !strcmp(m->command, "triangulate");
+    c->is_hull = !strcmp(m->command, "hull");
+    c->bisect = m->partition == 1;
+    c->certify = (uint64_t)c->npts * TSTAR_BYTES_PER_POINT > budget;
+    c->hull_certify = (uint64_t)c->npts * HULL_BYTES_PER_POINT > budget;
+    c->dedup_on_disk = (uint64_t)c->npts * DEDUP_BYTES_PER_POINT > budget;
+    size_t nr = (size_t)pdt_run_nranks(run);
+    c->kmin = calloc(nr, sizeof *c->kmin);
+    c->kmax = calloc(nr, sizeof *c->kmax);
+    c->nlocal = calloc(nr, sizeof *c->nlocal);
+    c->ymin = calloc(nr, sizeof *c->ymin);
+    c->ymax = calloc(nr, sizeof *c->ymax);
+    *nu = 0;
+    pdt_status st = PDT_OK;
+    if (!c->kmin || !c->kmax || !c->nlocal || !c->ymin || !c->ymax) st = chk_nomem(c);
+    else if (chk_marks_new(c)) st = chk_tmp_fail(c, "the marks of the points", "cannot create");
+    c->give_back = c->mark_map || (uint64_t)c->npts * sizeof *c->pts > budget / 4;
+    if (st == PDT_OK) st = chk_find_distinct(c, nu);
+    return st;
+}
+
+static void check_free(chk *c)
+{
+    chk_marks_free(c);
+    free(c->kmin);
+    free(c->kmax);
+    free(c->nlocal);
+    free(c->ymin);
+    free(c->ymax);
+    free(c->fin);
+    for (size_t i = 0; i < c->nruns; i++) fclose(c->runs[i]);
+    free(c->runs);
+    free(c->msg);
+    free(c->mg);
+    chk_stack_free(c, &c->graham_final);
 }
 
 pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar, char *summary,
@@ -910,110 +810,17 @@ pdt_status pdt_run_check_tstar(pdt_run *run, uint64_t budget, pdt_tstar_fn tstar
                            (int)(nl ? nl - w : (long)strlen(w)), w);
     }
     chk c;
-    memset(&c, 0, sizeof c);
-    c.run = run;
-    c.err = err;
-    c.pts = pdt_run_points(run, &c.npts);
-    c.budget = budget;
-    c.tstar = tstar;
-    /* half the budget for the finals' buffer; at least a few, so that a tiny
-     * budget spills often instead of failing */
-    c.maxfin = (size_t)(budget / 2 / sizeof(fin) < 16 ? 16 : budget / 2 / sizeof(fin));
-    const pdt_manifest *m = pdt_run_manifest(run);
-    c.is_tri = !strcmp(m->command, "triangulate");
-    c.is_hull = !strcmp(m->command, "hull");
-    c.certify = (uint64_t)c.npts * TSTAR_BYTES_PER_POINT > budget;
-    c.hull_certify = (uint64_t)c.npts * HULL_BYTES_PER_POINT > budget;
-    c.dedup_on_disk = (uint64_t)c.npts * DEDUP_BYTES_PER_POINT > budget;
-    size_t nr = (size_t)pdt_run_nranks(run);
-    c.kmin = calloc(nr, sizeof *c.kmin);
-    c.kmax = calloc(nr, sizeof *c.kmax);
-    c.nlocal = calloc(nr, sizeof *c.nlocal);
-    c.ymin = calloc(nr, sizeof *c.ymin);
-    c.ymax = calloc(nr, sizeof *c.ymax);
-    size_t nu = 0;
-    pdt_status st = PDT_OK;
-    if (!c.kmin || !c.kmax || !c.nlocal || !c.ymin || !c.ymax) st = chk_nomem(&c);
-    else if (chk_marks_new(&c)) st = chk_tmp_fail(&c, "the marks of the points", "cannot create");
-    c.give_back = c.mark_map || (uint64_t)c.npts * sizeof *c.pts > budget / 4;
-    if (st == PDT_OK) st = chk_find_distinct(&c, &nu);
-
+    size_t nu;
+    pdt_status st = check_setup(&c, run, budget, tstar, &nu, err);
     for (int r = 0; st == PDT_OK && r < pdt_run_nranks(run); r++) st = check_rank(&c, (uint32_t)r);
-
-    if (st == PDT_OK && c.is_tri) {
-        if (c.lifts_local == 0 && nu > 0)
-            st = chk_viol(&c, 0, 0, NULL, "no lift-up events (the run has %zu distinct points)", nu);
-        for (size_t i = 0; st == PDT_OK && i < c.npts; i++)
-            if ((c.mark[i] & M_REP) && !(c.mark[i] & M_LIFTED))
-                st = chk_viol(&c, 0, 0, NULL, "pt %zu was never lifted (%" PRIu64 " local lift-ups "
-                                          "for %zu distinct points)", i, c.lifts_local, nu);
-    }
-    /* strips: the ranks' local points are consecutive lexicographic blocks
-     * (a bisection's regions: check_regions, once the merges are sorted) */
-    int bisect = m->partition == 1;
-    for (size_t r = 0, prev = SIZE_MAX; st == PDT_OK && c.is_tri && !bisect && r < nr; r++) {
-        if (!c.nlocal[r]) continue;
-        if (prev != SIZE_MAX && c.kmin[r] <= c.kmax[prev])
-            st = chk_viol(&c, 0, 0, NULL, "the local lift-ups of rank %zu (%" PRIu64 " points) are not "
-                                      "a lexicographic block after those of rank %zu: the strips "
-                                      "overlap", r, c.nlocal[r], prev);
-        prev = r;
-    }
+    if (st == PDT_OK && c.is_tri) st = chk_lifts(&c, nu);
+    if (st == PDT_OK && c.is_tri && !c.bisect) st = chk_strips(&c);
     if (st == PDT_OK && c.is_tri) st = chk_finals(&c, nu);
-    if (st == PDT_OK && c.is_hull) st = check_graham_hull(&c);
-    if (st == PDT_OK) st = check_merges(&c);
-    if (st == PDT_OK && c.is_tri && bisect) st = check_regions(&c);
-    if (st == PDT_OK) st = check_messages(&c);
-    if (st == PDT_OK && cap)
-        snprintf(summary, cap,
-                 "%d rank%s, %" PRIu64 " events: %" PRIu64 " stack instances (%" PRIu64
-                 " pushes, %" PRIu64 " pops, %" PRIu64 " chain hulls), %" PRIu64 " local + %" PRIu64
-                 " merge lift-ups, %zu final triangles%s, %zu merge steps, %zu messages, "
-                 "%" PRIu64 " kernel runs with edges replayed",
-                 pdt_run_nranks(run), pdt_run_nranks(run) == 1 ? "" : "s", c.events, c.instances,
-                 c.pushes, c.pops, c.hulls, c.lifts_local, c.lifts_merge, (size_t)c.totfin,
-                 c.is_tri ? " = T*" : "", c.nmg, c.nmsg / 2, c.edge_scopes);
-    if (st == PDT_OK && cap && c.tstar_strips) {
-        size_t len = strlen(summary);
-        snprintf(summary + len, cap - len, " (T* recomputed on %d strips)", c.tstar_strips);
-    }
-    if (st == PDT_OK && cap && c.edge_spills) {
-        size_t len = strlen(summary);
-        snprintf(summary + len, cap - len, " (%" PRIu64 " of them replayed on disk: over a quarter "
-                 "of the memory budget)", c.edge_spills);
-    }
-    if (st == PDT_OK && cap && c.certify && c.is_tri) {
-        size_t len = strlen(summary);
-        char runs[64] = "", dedup[96] = "";
-        if (c.cert_runs) snprintf(runs, sizeof runs, " on disk in %" PRIu64 " sorted runs",
-                                  c.cert_runs);
-        if (c.dedup_on_disk)
-            snprintf(dedup, sizeof dedup, ", the distinct points found by a sort on disk in %"
-                     PRIu64 " runs", c.dedup_runs);
-        snprintf(summary + len, cap - len, " (T* certified side by side%s%s: recomputing it would "
-                 "not fit the memory budget)", runs, dedup);
-    }
-    if (st == PDT_OK && cap && c.hull_certify && c.is_hull) {
-        size_t len = strlen(summary);
-        snprintf(summary + len, cap - len, " (the hull certified point by point: recomputing it "
-                 "would not fit the memory budget)");
-    }
-    if (st == PDT_OK && cap && c.spills) {
-        size_t len = strlen(summary);
-        snprintf(summary + len, cap - len, " (final triangles sorted on disk in %" PRIu64
-                 " runs: over the memory budget)", c.spills);
-    }
-    chk_marks_free(&c);
-    free(c.kmin);
-    free(c.kmax);
-    free(c.nlocal);
-    free(c.ymin);
-    free(c.ymax);
-    free(c.fin);
-    for (size_t i = 0; i < c.nruns; i++) fclose(c.runs[i]);
-    free(c.runs);
-    free(c.msg);
-    free(c.mg);
-    stack_free(&c, &c.graham_final);
+    if (st == PDT_OK && c.is_hull) st = chk_graham_hull(&c);
+    if (st == PDT_OK) st = chk_merges(&c);
+    if (st == PDT_OK && c.is_tri && c.bisect) st = chk_regions(&c);
+    if (st == PDT_OK) st = chk_messages(&c);
+    if (st == PDT_OK && cap) chk_summary(&c, summary, cap);
+    check_free(&c);
     return st;
 }

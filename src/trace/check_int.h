@@ -49,6 +49,7 @@ typedef struct chk {
     const pdt_point *pts;
     size_t npts;
     int is_tri, is_hull;
+    int bisect;             /* the run was cut by bisection (its regions are checked, not strips) */
     uint8_t *mark;          /* per point: see M_* */
     size_t mark_map;        /* bytes of the marks' file mapping (0: in memory) */
     int certify;            /* T* certified on disk, not recomputed (over budget) */
@@ -104,6 +105,25 @@ pdt_status chk_viol(chk *c, uint32_t rank, uint64_t seq, const pdt_event *e, con
     __attribute__((format(printf, 5, 6)));
 /* Room for one more of n elements of `size` bytes in *p (doubling).  0 or -1. */
 int chk_grow(void **p, size_t *cap, size_t n, size_t size);
+/* Give back the resident pages of n stacks' arrays beyond their use. */
+void chk_stacks_give_back(chk_stack *st, size_t n);
+void chk_stack_free(chk *c, chk_stack *s);
+
+/* check_run.c: the checks of the whole run, after every rank's pass */
+/* Every distinct point lifted (nu of them). */
+pdt_status chk_lifts(chk *c, size_t nu);
+/* The ranks' local points are consecutive lexicographic blocks (strips). */
+pdt_status chk_strips(chk *c);
+/* Every send received, of the same size. */
+pdt_status chk_messages(chk *c);
+/* The merge steps of a level do not overlap; the last joins every rank. */
+pdt_status chk_merges(chk *c);
+/* A bisection: one cut separates the two groups of every merge step. */
+pdt_status chk_regions(chk *c);
+/* A hull run: every point sorted, each deleted or pushed, the final stack the hull. */
+pdt_status chk_graham_hull(chk *c);
+/* The one-line summary of a run that passed. */
+void chk_summary(const chk *c, char *summary, size_t cap);
 
 /* check_finals.c */
 /* A temporary file's failure: "temporary file for <of> in DIR: <what>: why". */

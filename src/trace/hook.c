@@ -2,6 +2,7 @@
 #include "pdt/trace.h"
 
 #include <stdlib.h>
+#include <time.h>
 
 static const char *const kind_names[PDT_EV_KIND_COUNT] = {
     [PDT_EV_NONE] = "none",          [PDT_EV_PHASE_BEGIN] = "phase-begin",
@@ -61,8 +62,15 @@ static void buf_sink(pdt_trace *tr, const pdt_event *ev)
     }
     pdt_event *dst = &b->ev[b->n];
     *dst = *ev;
-    dst->t = b->n;  /* logical time */
+    dst->t = b->timed ? pdt_trace_ns() - b->t0 : b->n;
     b->n++;
+}
+
+uint64_t pdt_trace_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
 }
 
 void pdt_trace_buf_init(pdt_trace *tr, pdt_trace_buf *buf, int level, int rank)
@@ -70,11 +78,20 @@ void pdt_trace_buf_init(pdt_trace *tr, pdt_trace_buf *buf, int level, int rank)
     buf->ev = NULL;
     buf->n = buf->cap = 0;
     buf->failed = 0;
+    buf->timed = 0;
+    buf->t0 = 0;
     tr->level = level;
     tr->rank = rank;
     tr->gid = NULL;
     tr->sink = buf_sink;
     tr->user = buf;
+}
+
+void pdt_trace_buf_init_timed(pdt_trace *tr, pdt_trace_buf *buf, int level, int rank, uint64_t t0)
+{
+    pdt_trace_buf_init(tr, buf, level, rank);
+    buf->timed = 1;
+    buf->t0 = t0;
 }
 
 void pdt_trace_buf_free(pdt_trace_buf *buf)

@@ -185,136 +185,175 @@ static void copy_field(char *dst, size_t cap, const char *src)
     snprintf(dst, cap, "%s", src);
 }
 
+/* The manifest being parsed: where (for the messages) and what so far. */
+typedef struct mf_parse {
+    const char *path;
+    int line;
+    pdt_manifest *m;
+    char *offsets;       /* clock_offset_ns's value, parsed once ranks is known */
+    int offsets_line;
+    pdt_err *err;
+} mf_parse;
+
+static pdt_status mf_format(mf_parse *P, const char *v)
+{
+    char *end = NULL;
+    long maj = strtol(v, &end, 10), min = 0;
+    if (end == v || (*end != '.' && *end != '\0')) end = NULL;
+    else if (*end == '.') min = strtol(end + 1, &end, 10);
+    if (!end || *end != '\0' || maj < 0 || maj > 1000000 || min < 0 || min > 1000000)
+        return pdt_err_set(P->err, PDT_ERR_FORMAT, "%s:%d: bad format version '%s'", P->path,
+                           P->line, v);
+    P->m->format_version = (int)maj;
+    P->m->format_minor = (int)min;
+    if (maj < PDT_TRACE_FORMAT_OLDEST || maj > PDT_TRACE_FORMAT_MAJOR)
+        return pdt_err_set(P->err, PDT_ERR_FORMAT,
+                           "%s:%d: run folder format %ld.%ld; this pdt reads formats "
+                           "%d.x to %d.x", P->path, P->line, maj, min, PDT_TRACE_FORMAT_OLDEST,
+                           PDT_TRACE_FORMAT_MAJOR);
+    return PDT_OK;
+}
+
+/* command_line or input_name (k): escaped text. */
+static pdt_status mf_text(mf_parse *P, const char *k, const char *v)
+{
+    char *d = unescape_dup(v);
+    if (!d) return pdt_err_set(P->err, PDT_ERR_NOMEM, "out of memory");
+    char **slot = !strcmp(k, "command_line") ? &P->m->command_line : &P->m->input_name;
+    free(*slot);
+    *slot = d;
+    return PDT_OK;
+}
+
+/* The value names its algorithm; no name: format 1's FNV-1a 64. */
+static pdt_status mf_checksum(mf_parse *P, const char *v)
+{
+    const char *h = v;
+    char *end = NULL;
+    P->m->input_checksum_kind = PDT_CHECKSUM_FNV1A64;
+    if (!strncmp(v, "crc64:", 6)) {
+        h = v + 6;
+        P->m->input_checksum_kind = PDT_CHECKSUM_CRC64;
+    } else if (!strncmp(v, "fnv1a64:", 8)) {
+        h = v + 8;
+    }
+    errno = 0;
+    P->m->input_checksum = strtoull(h, &end, 16);
+    if (end == h || *end || errno || strspn(h, "0123456789abcdefABCDEF") != strlen(h))
+        return pdt_err_set(P->err, PDT_ERR_FORMAT, "%s:%d: bad checksum '%s' (expected "
+                           "crc64: or fnv1a64: and hex digits)", P->path, P->line, v);
+    return PDT_OK;
+}
+
+/* n or wall_start_ns (k): a 64-bit count. */
+static pdt_status mf_u64(mf_parse *P, const char *k, const char *v)
+{
+    char *end = NULL;
+    errno = 0;
+    uint64_t x = strtoull(v, &end, 10);
+    if (end == v || *end || errno)
+        return pdt_err_set(P->err, PDT_ERR_FORMAT, "%s:%d: bad number '%s'", P->path, P->line, v);
+    if (k[0] == 'n') P->m->n = x;
+    else P->m->wall_start_ns = x;
+    return PDT_OK;
+}
+
+/* ranks or level (k): 0 .. 2^20. */
+static pdt_status mf_small(mf_parse *P, const char *k, const char *v)
+{
+    char *end = NULL;
+    long x = strtol(v, &end, 10);
+    if (end == v || *end || x < 0 || x > (1L << 20))
+        return pdt_err_set(P->err, PDT_ERR_FORMAT, "%s:%d: bad %s '%s'", P->path, P->line, k, v);
+    if (k[0] == 'r') P->m->nranks = (int)x;
+    else P->m->level = (int)x;
+    return PDT_OK;
+}
+
+static pdt_status mf_partition(mf_parse *P, const char *v)
+{
+    if (strcmp(v, "strips") && strcmp(v, "bisect"))
+        return pdt_err_set(P->err, PDT_ERR_FORMAT, "%s:%d: bad partition '%s' (expected "
+                           "strips or bisect)", P->path, P->line, v);
+    P->m->partition = v[0] == 'b';
+    return PDT_OK;
+}
+
+/* One "key = value" line; unknown keys are ignored. */
+static pdt_status mf_field(mf_parse *P, const char *k, char *v)
+{
+    pdt_manifest *m = P->m;
+    if (!strcmp(k, "format")) return mf_format(P, v);
+    if (!strcmp(k, "program_version")) copy_field(m->program_version, sizeof m->program_version, v);
+    else if (!strcmp(k, "command")) copy_field(m->command, sizeof m->command, v);
+    else if (!strcmp(k, "command_line") || !strcmp(k, "input_name")) return mf_text(P, k, v);
+    else if (!strcmp(k, "input_checksum")) return mf_checksum(P, v);
+    else if (!strcmp(k, "n") || !strcmp(k, "wall_start_ns")) return mf_u64(P, k, v);
+    else if (!strcmp(k, "ranks") || !strcmp(k, "level")) return mf_small(P, k, v);
+    else if (!strcmp(k, "partition")) return mf_partition(P, v);
+    else if (!strcmp(k, "clock_offset_ns")) {
+        P->offsets = v;
+        P->offsets_line = P->line;
+    }
+    return PDT_OK;
+}
+
+/* Line s (its end cut): nothing (blank, comment), or its key and value. */
+static pdt_status mf_line(mf_parse *P, char *s)
+{
+    size_t len = strlen(s);
+    if (len && s[len - 1] == '\r') s[--len] = '\0';
+    while (*s == ' ' || *s == '\t') s++;
+    if (*s == '\0' || *s == '#') return PDT_OK;
+    char *eq = strchr(s, '=');
+    if (!eq) return pdt_err_set(P->err, PDT_ERR_FORMAT, "%s:%d: expected 'key = value'", P->path, P->line);
+    char *ke = eq;
+    while (ke > s && (ke[-1] == ' ' || ke[-1] == '\t')) ke--;
+    *ke = '\0';
+    char *v = eq + 1;
+    while (*v == ' ' || *v == '\t') v++;
+    return mf_field(P, s, v);
+}
+
+/* The per-rank clock offsets, one number a rank (none given: zeros). */
+static pdt_status mf_offsets(mf_parse *P)
+{
+    pdt_manifest *m = P->m;
+    m->clock_offset_ns = calloc((size_t)m->nranks, sizeof *m->clock_offset_ns);
+    if (!m->clock_offset_ns) return pdt_err_set(P->err, PDT_ERR_NOMEM, "out of memory");
+    char *p = P->offsets;
+    for (int r = 0; p && r < m->nranks; r++) {
+        char *end;
+        errno = 0;
+        long long x = strtoll(p, &end, 10);
+        if (end == p || errno)
+            return pdt_err_set(P->err, PDT_ERR_FORMAT,
+                               "%s:%d: clock_offset_ns needs %d numbers, found %d", P->path,
+                               P->offsets_line, m->nranks, r);
+        m->clock_offset_ns[r] = x;
+        p = end;
+    }
+    return PDT_OK;
+}
+
 pdt_status pdt_tf_manifest_parse(const char *path, char *text, pdt_manifest *m, pdt_err *err)
 {
     memset(m, 0, sizeof *m);
     m->format_version = -1;
     m->nranks = -1;
-    char *offsets = NULL;
-    int line = 0, offsets_line = 0;
+    mf_parse P = {path, 0, m, NULL, 0, err};
     pdt_status st = PDT_OK;
-    for (char *s = text, *next; s && *s; s = next) {
-        line++;
+    for (char *s = text, *next; st == PDT_OK && s && *s; s = next) {
+        P.line++;
         next = strchr(s, '\n');
         if (next) *next++ = '\0';
-        size_t len = strlen(s);
-        if (len && s[len - 1] == '\r') s[--len] = '\0';
-        while (*s == ' ' || *s == '\t') s++;
-        if (*s == '\0' || *s == '#') continue;
-        char *eq = strchr(s, '=');
-        if (!eq) {
-            st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: expected 'key = value'", path, line);
-            break;
-        }
-        char *ke = eq;
-        while (ke > s && (ke[-1] == ' ' || ke[-1] == '\t')) ke--;
-        *ke = '\0';
-        char *v = eq + 1;
-        while (*v == ' ' || *v == '\t') v++;
-        const char *k = s;
-        char *end = NULL;
-        errno = 0;
-        if (!strcmp(k, "format")) {
-            long maj = strtol(v, &end, 10), min = 0;
-            if (end == v || (*end != '.' && *end != '\0')) end = NULL;
-            else if (*end == '.') min = strtol(end + 1, &end, 10);
-            if (!end || *end != '\0' || maj < 0 || maj > 1000000 || min < 0 || min > 1000000) {
-                st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad format version '%s'", path,
-                                 line, v);
-                break;
-            }
-            m->format_version = (int)maj;
-            m->format_minor = (int)min;
-            if (maj < PDT_TRACE_FORMAT_OLDEST || maj > PDT_TRACE_FORMAT_MAJOR) {
-                st = pdt_err_set(err, PDT_ERR_FORMAT,
-                                 "%s:%d: run folder format %ld.%ld; this pdt reads formats "
-                                 "%d.x to %d.x", path, line, maj, min, PDT_TRACE_FORMAT_OLDEST,
-                                 PDT_TRACE_FORMAT_MAJOR);
-                break;
-            }
-        } else if (!strcmp(k, "program_version")) {
-            copy_field(m->program_version, sizeof m->program_version, v);
-        } else if (!strcmp(k, "command")) {
-            copy_field(m->command, sizeof m->command, v);
-        } else if (!strcmp(k, "command_line") || !strcmp(k, "input_name")) {
-            char *d = unescape_dup(v);
-            if (!d) {
-                st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-                break;
-            }
-            char **slot = !strcmp(k, "command_line") ? &m->command_line : &m->input_name;
-            free(*slot);
-            *slot = d;
-        } else if (!strcmp(k, "input_checksum")) {
-            /* the value names its algorithm; no name: format 1's FNV-1a 64 */
-            const char *h = v;
-            m->input_checksum_kind = PDT_CHECKSUM_FNV1A64;
-            if (!strncmp(v, "crc64:", 6)) {
-                h = v + 6;
-                m->input_checksum_kind = PDT_CHECKSUM_CRC64;
-            } else if (!strncmp(v, "fnv1a64:", 8)) {
-                h = v + 8;
-            }
-            m->input_checksum = strtoull(h, &end, 16);
-            if (end == h || *end || errno || strspn(h, "0123456789abcdefABCDEF") != strlen(h)) {
-                st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad checksum '%s' (expected "
-                                 "crc64: or fnv1a64: and hex digits)", path, line, v);
-                break;
-            }
-        } else if (!strcmp(k, "n") || !strcmp(k, "wall_start_ns")) {
-            uint64_t x = strtoull(v, &end, 10);
-            if (end == v || *end || errno) {
-                st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad number '%s'", path, line, v);
-                break;
-            }
-            if (k[0] == 'n') m->n = x;
-            else m->wall_start_ns = x;
-        } else if (!strcmp(k, "ranks") || !strcmp(k, "level")) {
-            long x = strtol(v, &end, 10);
-            if (end == v || *end || x < 0 || x > (1L << 20)) {
-                st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad %s '%s'", path, line, k, v);
-                break;
-            }
-            if (k[0] == 'r') m->nranks = (int)x;
-            else m->level = (int)x;
-        } else if (!strcmp(k, "partition")) {
-            if (!strcmp(v, "strips") || !strcmp(v, "bisect")) {
-                m->partition = v[0] == 'b';
-            } else {
-                st = pdt_err_set(err, PDT_ERR_FORMAT, "%s:%d: bad partition '%s' (expected "
-                                 "strips or bisect)", path, line, v);
-                break;
-            }
-        } else if (!strcmp(k, "clock_offset_ns")) {
-            offsets = v;
-            offsets_line = line;
-        }
+        st = mf_line(&P, s);
     }
     if (st == PDT_OK && m->format_version < 0)
         st = pdt_err_set(err, PDT_ERR_FORMAT, "%s: no 'format' line: not a pdt manifest", path);
     if (st == PDT_OK && m->nranks < 1)
         st = pdt_err_set(err, PDT_ERR_FORMAT, "%s: no valid 'ranks' line", path);
-    if (st == PDT_OK) {
-        m->clock_offset_ns = calloc((size_t)m->nranks, sizeof *m->clock_offset_ns);
-        if (!m->clock_offset_ns)
-            st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    }
-    if (st == PDT_OK && offsets) {
-        char *p = offsets;
-        for (int r = 0; r < m->nranks; r++) {
-            char *end;
-            errno = 0;
-            long long x = strtoll(p, &end, 10);
-            if (end == p || errno) {
-                st = pdt_err_set(err, PDT_ERR_FORMAT,
-                                 "%s:%d: clock_offset_ns needs %d numbers, found %d", path,
-                                 offsets_line, m->nranks, r);
-                break;
-            }
-            m->clock_offset_ns[r] = x;
-            p = end;
-        }
-    }
+    if (st == PDT_OK) st = mf_offsets(&P);
     if (st != PDT_OK) pdt_manifest_free(m);
     return st;
 }

@@ -1,5 +1,7 @@
-/* pdt — the reader library: open a run folder, validate, decode, merge. */
+/* pdt — the reader library: open a run folder, validate, decode (the merged
+ * order of the ranks' events: merge.c). */
 #include "tf_internal.h"
+#include "run_int.h"
 #include "pdt/io.h"
 
 #include <errno.h>
@@ -12,39 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-typedef pdt_block_ref tf_block;  /* off: of the block header; first: its first event */
-_Static_assert(PDT_BLOCK_HEADER_BYTES == TF_BLOCK_HEADER_SIZE, "tracefile.h says the header size");
-
-typedef struct tf_rank {
-    int present, complete, level;
-    int absent;       /* the file does not exist (reported in ranges by pdt_run_open) */
-    uint8_t *map;
-    size_t size;
-    tf_block *blk;
-    size_t nblk;
-    uint64_t nev;
-    int64_t shift;    /* added to every time: offset - min(0, min offsets) */
-    pdt_event *ev;    /* all events, decoded on demand */
-} tf_rank;
-
-struct pdt_run {
-    char *dir;
-    pdt_manifest m;
-    pdt_point *pts;
-    size_t npts;
-    uint8_t *pts_map;  /* points.bin, when pts points into it (no copy) */
-    size_t pts_map_size;
-    int nranks;
-    tf_rank *rk;
-    char *warn;
-    size_t wlen, wcap;
-    pdt_rec *merged;
-    size_t nmerged;
-    int merged_done;
-};
-
-static void warnf(pdt_run *run, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void warnf(pdt_run *run, const char *fmt, ...)
+void pdt_tf_warnf(pdt_run *run, const char *fmt, ...)
 {
     char line[1024];
     va_list ap;
@@ -154,11 +124,13 @@ void pdt_run_release_points(const pdt_run *run)
 }
 
 /* Validate the header and index the blocks of one rank file. */
-static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
+/* Map rank r's file (rk->map) and check its header: PDT_OK with rk->present
+ * set when its blocks can be read; PDT_OK without (a warning said why, or
+ * the file is absent: rk->absent); an error for a format this pdt cannot
+ * read. */
+static pdt_status rank_header(pdt_run *run, int r, const char *name, pdt_err *err)
 {
     tf_rank *rk = &run->rk[r];
-    char name[32];
-    rank_name(name, sizeof name, r);
     char *path = pdt_tf_path_join(run->dir, name);
     if (!path) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     char why[160];
@@ -169,16 +141,16 @@ static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
         return PDT_OK;
     }
     if (e) {
-        warnf(run, "%s: %s: no events for rank %d", name, why, r);
+        pdt_tf_warnf(run, "%s: %s: no events for rank %d", name, why, r);
         return PDT_OK;
     }
     const uint8_t *p = rk->map;
     if (rk->size < TF_HEADER_SIZE || memcmp(p, TF_MAGIC, 8) != 0) {
-        warnf(run, "%s: not a pdt trace file (bad header): no events for rank %d", name, r);
+        pdt_tf_warnf(run, "%s: not a pdt trace file (bad header): no events for rank %d", name, r);
         return PDT_OK;
     }
     if (tf_get32(p + 28) != pdt_crc32c(0, p, 28)) {
-        warnf(run, "%s: file header checksum mismatch: no events for rank %d", name, r);
+        pdt_tf_warnf(run, "%s: file header checksum mismatch: no events for rank %d", name, r);
         return PDT_OK;
     }
     unsigned maj = tf_get16(p + 8), min = tf_get16(p + 10);
@@ -189,90 +161,115 @@ static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
                            PDT_TRACE_FORMAT_MAJOR);
     uint32_t hsize = tf_get32(p + 12);
     if (hsize < TF_HEADER_SIZE || hsize > rk->size) {
-        warnf(run, "%s: bad header size %u: no events for rank %d", name, hsize, r);
+        pdt_tf_warnf(run, "%s: bad header size %u: no events for rank %d", name, hsize, r);
         return PDT_OK;
     }
-    if (tf_get32(p + 16) != (uint32_t)r)
-        warnf(run, "%s: header says rank %u", name, tf_get32(p + 16));
+    if (tf_get32(p + 16) != (uint32_t)r) pdt_tf_warnf(run, "%s: header says rank %u", name, tf_get32(p + 16));
     rk->level = (int)tf_get32(p + 20);
     rk->present = 1;
+    return PDT_OK;
+}
 
+enum { BLK_NEXT, BLK_END, BLK_DAMAGED };
+
+/* The end marker at byte off (its payload len bytes): whether its count
+ * matches the blocks' (rk->complete), and what follows it. */
+static void end_marker(pdt_run *run, tf_rank *rk, const char *name, uint64_t off, uint32_t len,
+                       uint64_t expect)
+{
+    const uint8_t *h = rk->map + off;
+    uint64_t total = len >= 8 ? tf_get64(h + TF_BLOCK_HEADER_SIZE) : UINT64_MAX;
+    if (total != expect)
+        pdt_tf_warnf(run, "%s: end marker at byte %" PRIu64 " counts %" PRIu64
+                          " events, blocks hold %" PRIu64, name, off, total, expect);
+    else
+        rk->complete = 1;
+    if (off + TF_BLOCK_HEADER_SIZE + len != rk->size)
+        pdt_tf_warnf(run, "%s: %" PRIu64 " bytes after the end marker ignored", name,
+                     rk->size - (off + TF_BLOCK_HEADER_SIZE + len));
+}
+
+/* Block k at byte *off: checked (its header, checksum and events), then
+ * noted in rk->blk and *off moved past it (BLK_NEXT); the end marker
+ * (BLK_END); or damage, said in a warning (BLK_DAMAGED).  -1 when out of
+ * memory. */
+static int scan_block(pdt_run *run, tf_rank *rk, const char *name, size_t k, uint64_t *off,
+                      size_t *cap)
+{
+    uint64_t left = rk->size - *off, at = *off, expect = rk->nev;
+    if (left < TF_BLOCK_HEADER_SIZE) {
+        pdt_tf_warnf(run, "%s: block %zu at byte %" PRIu64 ": truncated block header (%" PRIu64
+                          " of %u bytes)", name, k, at, left, TF_BLOCK_HEADER_SIZE);
+        return BLK_DAMAGED;
+    }
+    const uint8_t *h = rk->map + at;
+    uint32_t magic = tf_get32(h), len = tf_get32(h + 4), count = tf_get32(h + 24);
+    uint64_t first = tf_get64(h + 8), base = tf_get64(h + 16);
+    if (magic != TF_BLOCK_MAGIC && magic != TF_END_MAGIC) {
+        pdt_tf_warnf(run, "%s: block %zu at byte %" PRIu64 ": bad block magic 0x%08x", name, k, at,
+                     magic);
+        return BLK_DAMAGED;
+    }
+    if (len > left - TF_BLOCK_HEADER_SIZE) {
+        pdt_tf_warnf(run, "%s: block %zu at byte %" PRIu64 ": truncated (payload of %u bytes, %" PRIu64
+                          " left)", name, k, at, len, left - TF_BLOCK_HEADER_SIZE);
+        return BLK_DAMAGED;
+    }
+    if (pdt_crc32c(pdt_crc32c(0, h, 28), h + TF_BLOCK_HEADER_SIZE, len) != tf_get32(h + 28)) {
+        pdt_tf_warnf(run, "%s: block %zu at byte %" PRIu64 ": checksum mismatch", name, k, at);
+        return BLK_DAMAGED;
+    }
+    if (magic == TF_END_MAGIC) {
+        end_marker(run, rk, name, at, len, expect);
+        return BLK_END;
+    }
+    if (first != expect) {
+        pdt_tf_warnf(run, "%s: block %zu at byte %" PRIu64 ": starts at event %" PRIu64
+                          ", expected %" PRIu64, name, k, at, first, expect);
+        return BLK_DAMAGED;
+    }
+    if (count == 0 || pdt_tf_decode(h + TF_BLOCK_HEADER_SIZE, len, count, base, NULL) != 0) {
+        pdt_tf_warnf(run, "%s: block %zu at byte %" PRIu64 ": malformed event data", name, k, at);
+        return BLK_DAMAGED;
+    }
+    if (rk->nblk == *cap) {
+        size_t nc = *cap ? 2 * *cap : 64;
+        tf_block *b = realloc(rk->blk, nc * sizeof *b);
+        if (!b) return -1;
+        rk->blk = b;
+        *cap = nc;
+    }
+    rk->blk[rk->nblk++] = (tf_block){at, first, base, len, count};
+    rk->nev += count;
+    *off += TF_BLOCK_HEADER_SIZE + len;
+    return BLK_NEXT;
+}
+
+/* Rank r's file: its header, then every block up to the end marker or the
+ * first damage (the blocks before it are kept); warnings say what is wrong. */
+static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
+{
+    tf_rank *rk = &run->rk[r];
+    char name[32];
+    rank_name(name, sizeof name, r);
+    pdt_status st = rank_header(run, r, name, err);
+    if (st != PDT_OK || !rk->present) return st;
     size_t cap = 0, released = 0;
-    uint64_t off = hsize, expect = 0;
-    int damaged = 0;
-    for (size_t k = 0; off < rk->size; k++) {
+    uint64_t off = tf_get32(rk->map + 12);
+    int how = BLK_NEXT;
+    rk->nev = 0;
+    for (size_t k = 0; how == BLK_NEXT && off < rk->size; k++) {
         if (off - released >= RELEASE_STEP) released = release_pages(rk->map, released, off);
-        uint64_t left = rk->size - off;
-        if (left < TF_BLOCK_HEADER_SIZE) {
-            warnf(run, "%s: block %zu at byte %" PRIu64 ": truncated block header (%" PRIu64
-                       " of %u bytes)", name, k, off, left, TF_BLOCK_HEADER_SIZE);
-            damaged = 1;
-            break;
-        }
-        const uint8_t *h = p + off;
-        uint32_t magic = tf_get32(h), len = tf_get32(h + 4), count = tf_get32(h + 24);
-        uint64_t first = tf_get64(h + 8), base = tf_get64(h + 16);
-        if (magic != TF_BLOCK_MAGIC && magic != TF_END_MAGIC) {
-            warnf(run, "%s: block %zu at byte %" PRIu64 ": bad block magic 0x%08x", name, k, off,
-                  magic);
-            damaged = 1;
-            break;
-        }
-        if (len > left - TF_BLOCK_HEADER_SIZE) {
-            warnf(run, "%s: block %zu at byte %" PRIu64 ": truncated (payload of %u bytes, %" PRIu64
-                       " left)", name, k, off, len, left - TF_BLOCK_HEADER_SIZE);
-            damaged = 1;
-            break;
-        }
-        uint32_t crc = pdt_crc32c(pdt_crc32c(0, h, 28), h + TF_BLOCK_HEADER_SIZE, len);
-        if (crc != tf_get32(h + 28)) {
-            warnf(run, "%s: block %zu at byte %" PRIu64 ": checksum mismatch", name, k, off);
-            damaged = 1;
-            break;
-        }
-        if (magic == TF_END_MAGIC) {
-            uint64_t total = len >= 8 ? tf_get64(h + TF_BLOCK_HEADER_SIZE) : UINT64_MAX;
-            if (total != expect)
-                warnf(run, "%s: end marker at byte %" PRIu64 " counts %" PRIu64
-                           " events, blocks hold %" PRIu64, name, off, total, expect);
-            else
-                rk->complete = 1;
-            if (off + TF_BLOCK_HEADER_SIZE + len != rk->size)
-                warnf(run, "%s: %" PRIu64 " bytes after the end marker ignored", name,
-                      rk->size - (off + TF_BLOCK_HEADER_SIZE + len));
-            break;
-        }
-        if (first != expect) {
-            warnf(run, "%s: block %zu at byte %" PRIu64 ": starts at event %" PRIu64
-                       ", expected %" PRIu64, name, k, off, first, expect);
-            damaged = 1;
-            break;
-        }
-        if (count == 0 ||
-            pdt_tf_decode(h + TF_BLOCK_HEADER_SIZE, len, count, base, NULL) != 0) {
-            warnf(run, "%s: block %zu at byte %" PRIu64 ": malformed event data", name, k, off);
-            damaged = 1;
-            break;
-        }
-        if (rk->nblk == cap) {
-            size_t nc = cap ? 2 * cap : 64;
-            tf_block *b = realloc(rk->blk, nc * sizeof *b);
-            if (!b) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-            rk->blk = b;
-            cap = nc;
-        }
-        rk->blk[rk->nblk++] = (tf_block){off, first, base, len, count};
-        expect += count;
-        off += TF_BLOCK_HEADER_SIZE + len;
+        how = scan_block(run, rk, name, k, &off, &cap);
+        if (how < 0) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     }
     release_pages(rk->map, released, rk->size);
-    rk->nev = expect;
-    if (damaged)
-        warnf(run, "%s: read %" PRIu64 " events in %zu intact blocks before the damage", name,
-              expect, rk->nblk);
+    if (how == BLK_DAMAGED)
+        pdt_tf_warnf(run, "%s: read %" PRIu64 " events in %zu intact blocks before the damage", name,
+                     rk->nev, rk->nblk);
     else if (!rk->complete)
-        warnf(run, "%s: no end marker (run killed?): read %" PRIu64 " events in %zu blocks",
-              name, expect, rk->nblk);
+        pdt_tf_warnf(run, "%s: no end marker (run killed?): read %" PRIu64 " events in %zu blocks",
+                     name, rk->nev, rk->nblk);
     return PDT_OK;
 }
 
@@ -316,7 +313,7 @@ static pdt_status guess_manifest(pdt_run *run, pdt_err *err)
     run->m.clock_offset_ns = calloc((size_t)n, sizeof *run->m.clock_offset_ns);
     if (!run->m.clock_offset_ns)
         return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    warnf(run, "manifest: missing (run killed before it was written?); found %d rank file%s, "
+    pdt_tf_warnf(run, "manifest: missing (run killed before it was written?); found %d rank file%s, "
                "clocks not aligned, no points", n, n == 1 ? "" : "s");
     return PDT_OK;
 }
@@ -343,7 +340,7 @@ static int64_t clock_base(pdt_run *run)
     int64_t *off = run->m.clock_offset_ns, minoff = 0;
     for (int r = 0; r < run->nranks; r++) {
         if (off[r] < -CLOCK_OFFSET_MAX || off[r] > CLOCK_OFFSET_MAX) {
-            warnf(run, "manifest: clock_offset_ns of rank %d is %" PRId64 " ns, beyond +-%" PRId64
+            pdt_tf_warnf(run, "manifest: clock_offset_ns of rank %d is %" PRId64 " ns, beyond +-%" PRId64
                        " ns: clocks not aligned", r, off[r], CLOCK_OFFSET_MAX);
             memset(off, 0, (size_t)run->nranks * sizeof *off);
             return 0;
@@ -353,22 +350,15 @@ static int64_t clock_base(pdt_run *run)
     return minoff;
 }
 
-pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
+/* The manifest (run->m), or one guessed from the rank files when there is
+ * none. */
+static pdt_status read_manifest(pdt_run *run, const char *dir, pdt_err *err)
 {
-    *out = NULL;
-    pdt_run *run = calloc(1, sizeof *run);
-    if (!run) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    pdt_status st = PDT_OK;
-    run->dir = pdt_tf_path_join(dir, "");
     char *mpath = pdt_tf_path_join(dir, "manifest");
-    if (!run->dir || !mpath) {
-        free(mpath);
-        pdt_run_close(run);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    }
-    run->dir[strlen(dir)] = '\0';  /* join added a '/' */
+    if (!mpath) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     int e;
     char why[160];
+    pdt_status st;
     char *text = read_text(mpath, &e, why, sizeof why);
     if (text) {
         st = pdt_tf_manifest_parse(mpath, text, &run->m, err);
@@ -381,56 +371,67 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
         st = pdt_err_set(err, PDT_ERR_IO, "%s: %s", mpath, why);
     }
     free(mpath);
-    if (st != PDT_OK) {
-        pdt_run_close(run);
-        return st;
-    }
-    run->nranks = run->m.nranks;
+    return st;
+}
 
-    /* points.bin */
-    if (run->m.command[0]) {
-        char *ppath = pdt_tf_path_join(dir, "points.bin");
-        uint8_t *map = NULL;
-        size_t size = 0;
-        if (!ppath) st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-        else if ((e = map_file(ppath, &map, &size, why, sizeof why)) != 0)
-            warnf(run, "points.bin: %s: the run cannot be replayed or checked", why);
-        else {
-            pdt_err perr = {0};
-            if (points_in_place(map, size, &run->pts, &run->npts)) {
-                run->pts_map = map; /* (kept: the points are read from it) */
-                run->pts_map_size = size;
-            }
-            if (!run->pts_map &&
-                pdt_tf_points_parse("points.bin", map, size, &run->pts, &run->npts, &perr) != PDT_OK) {
-                if (perr.code == PDT_ERR_NOMEM) st = pdt_err_set(err, perr.code, "%s", perr.msg);
-                else warnf(run, "%s", perr.msg);
-            } else if (run->npts != run->m.n) {
-                warnf(run, "points.bin: %zu points, manifest says %" PRIu64, run->npts,
-                      run->m.n);
-            } else if (points_sum(&run->m, run->pts, run->npts) != run->m.input_checksum) {
-                warnf(run, "points.bin: points do not match the manifest's input_checksum");
-            }
+/* points.bin's points (run->pts: in place in its mapping, or a copy), checked
+ * against the manifest; what is wrong is a warning (the run then cannot be
+ * replayed or checked), only running out of memory an error. */
+static pdt_status read_points(pdt_run *run, const char *dir, pdt_err *err)
+{
+    char *ppath = pdt_tf_path_join(dir, "points.bin");
+    if (!ppath) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    uint8_t *map = NULL;
+    size_t size = 0;
+    char why[160];
+    pdt_status st = PDT_OK;
+    if (map_file(ppath, &map, &size, why, sizeof why) != 0) {
+        pdt_tf_warnf(run, "points.bin: %s: the run cannot be replayed or checked", why);
+    } else {
+        pdt_err perr = {0};
+        if (points_in_place(map, size, &run->pts, &run->npts)) {
+            run->pts_map = map; /* (kept: the points are read from it) */
+            run->pts_map_size = size;
         }
-        if (run->pts_map) release_pages(map, 0, size); /* (the checksums read every page) */
-        else if (map) munmap(map, size);
-        free(ppath);
-        if (st != PDT_OK) {
-            pdt_run_close(run);
-            return st;
+        if (!run->pts_map &&
+            pdt_tf_points_parse("points.bin", map, size, &run->pts, &run->npts, &perr) != PDT_OK) {
+            if (perr.code == PDT_ERR_NOMEM) st = pdt_err_set(err, perr.code, "%s", perr.msg);
+            else pdt_tf_warnf(run, "%s", perr.msg);
+        } else if (run->npts != run->m.n) {
+            pdt_tf_warnf(run, "points.bin: %zu points, manifest says %" PRIu64, run->npts, run->m.n);
+        } else if (points_sum(&run->m, run->pts, run->npts) != run->m.input_checksum) {
+            pdt_tf_warnf(run, "points.bin: points do not match the manifest's input_checksum");
         }
     }
+    if (run->pts_map) release_pages(map, 0, size); /* (the checksums read every page) */
+    else if (map) munmap(map, size);
+    free(ppath);
+    return st;
+}
 
+/* Ranks from .. to-1 have no file: one warning for them all. */
+static void report_absent(pdt_run *run, int from, int to)
+{
+    char a[32], b[32];
+    rank_name(a, sizeof a, from);
+    rank_name(b, sizeof b, to - 1);
+    if (from == to - 1)
+        pdt_tf_warnf(run, "%s: missing: no events for rank %d", a, from);
+    else
+        pdt_tf_warnf(run, "%s to %s: missing (%d files): no events for ranks %d to %d", a, b,
+                     to - from, from, to - 1);
+}
+
+/* Every rank's file, its clock shifted by its offset.  Missing rank files
+ * are reported as ranges: a damaged manifest may announce up to 2^20
+ * ranks, and one line per absent file would bury the other warnings. */
+static pdt_status scan_ranks(pdt_run *run, pdt_err *err)
+{
     run->rk = calloc((size_t)run->nranks, sizeof *run->rk);
-    if (!run->rk) {
-        pdt_run_close(run);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    }
+    if (!run->rk) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     int64_t minoff = clock_base(run);
-    /* Missing rank files are reported as ranges: a damaged manifest may
-     * announce up to 2^20 ranks, and one line per absent file would bury the
-     * other warnings. */
     int absent_from = -1;
+    pdt_status st = PDT_OK;
     for (int r = 0; r <= run->nranks && st == PDT_OK; r++) {
         if (r < run->nranks) {
             run->rk[r].shift = run->m.clock_offset_ns[r] - minoff;
@@ -440,18 +441,27 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
                 continue;
             }
         }
-        if (absent_from >= 0) {
-            char a[32], b[32];
-            rank_name(a, sizeof a, absent_from);
-            rank_name(b, sizeof b, r - 1);
-            if (absent_from == r - 1)
-                warnf(run, "%s: missing: no events for rank %d", a, absent_from);
-            else
-                warnf(run, "%s to %s: missing (%d files): no events for ranks %d to %d", a, b,
-                      r - absent_from, absent_from, r - 1);
-            absent_from = -1;
-        }
+        if (absent_from >= 0) report_absent(run, absent_from, r);
+        absent_from = -1;
     }
+    return st;
+}
+
+pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
+{
+    *out = NULL;
+    pdt_run *run = calloc(1, sizeof *run);
+    if (!run) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    run->dir = pdt_tf_path_join(dir, "");
+    if (!run->dir) {
+        pdt_run_close(run);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    }
+    run->dir[strlen(dir)] = '\0';  /* join added a '/' */
+    pdt_status st = read_manifest(run, dir, err);
+    if (st == PDT_OK) run->nranks = run->m.nranks;
+    if (st == PDT_OK && run->m.command[0]) st = read_points(run, dir, err);
+    if (st == PDT_OK) st = scan_ranks(run, err);
     if (st != PDT_OK) {
         pdt_run_close(run);
         return st;
@@ -536,7 +546,7 @@ int pdt_block_decode(const uint8_t *payload, uint32_t len, uint32_t count, uint6
 /* malloc() for the big arrays of decoded and merged events (hundreds of MB
  * for 10^7 events): they ask for transparent huge pages, which cuts the page
  * faults of filling them.  NULL when out of memory; free with free(). */
-static void *big_alloc(size_t bytes)
+void *pdt_tf_big_alloc(size_t bytes)
 {
     const size_t huge = (size_t)2 << 20;
     if (bytes < 2 * huge) return malloc(bytes ? bytes : 1);
@@ -564,7 +574,7 @@ pdt_status pdt_run_rank_events(pdt_run *run, int rank, const pdt_event **ev, siz
     if (!rk->ev && rk->nev) {
         if (rk->nev > SIZE_MAX / sizeof *rk->ev)
             return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-        rk->ev = big_alloc((size_t)rk->nev * sizeof *rk->ev);
+        rk->ev = pdt_tf_big_alloc((size_t)rk->nev * sizeof *rk->ev);
         if (!rk->ev)
             return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: out of memory (%" PRIu64 " events)",
                                rank, rk->nev);
@@ -670,350 +680,4 @@ void pdt_cursor_close(pdt_cursor *c)
     if (!c) return;
     free(c->buf);
     free(c);
-}
-
-/* ---- merged order ----------------------------------------------------------- */
-
-typedef struct msg_key {
-    uint32_t src, dst, tag;
-    int64_t seq;
-} msg_key;
-
-typedef struct msg_slot {
-    msg_key k;
-    uint32_t count;  /* sends not yet received */
-    int used;
-} msg_slot;
-
-typedef struct msg_set {
-    msg_slot *s;
-    size_t cap, n;
-} msg_set;
-
-static uint64_t key_hash(const msg_key *k)
-{
-    uint64_t h = k->src * 0x9e3779b97f4a7c15u ^ k->dst * 0xc2b2ae3d27d4eb4fu ^
-                 k->tag * 0x165667b19e3779f9u ^ (uint64_t)k->seq * 0xff51afd7ed558ccdu;
-    return h ^ (h >> 29);
-}
-
-static int key_eq(const msg_key *a, const msg_key *b)
-{
-    return a->src == b->src && a->dst == b->dst && a->tag == b->tag && a->seq == b->seq;
-}
-
-/* Slot of k (inserting if `add`); NULL if absent or out of memory. */
-static msg_slot *msg_find(msg_set *m, const msg_key *k, int add)
-{
-    if (add && 2 * (m->n + 1) > m->cap) {
-        size_t cap = m->cap ? 2 * m->cap : 64;
-        msg_slot *s = calloc(cap, sizeof *s);
-        if (!s) return NULL;
-        for (size_t i = 0; i < m->cap; i++) {
-            if (!m->s[i].used) continue;
-            size_t j = key_hash(&m->s[i].k) & (cap - 1);
-            while (s[j].used) j = (j + 1) & (cap - 1);
-            s[j] = m->s[i];
-        }
-        free(m->s);
-        m->s = s;
-        m->cap = cap;
-    }
-    if (!m->cap) return NULL;
-    size_t j = key_hash(k) & (m->cap - 1);
-    while (m->s[j].used) {
-        if (key_eq(&m->s[j].k, k)) return &m->s[j];
-        j = (j + 1) & (m->cap - 1);
-    }
-    if (!add) return NULL;
-    m->s[j].used = 1;
-    m->s[j].k = *k;
-    m->s[j].count = 0;
-    m->n++;
-    return &m->s[j];
-}
-
-static msg_key ev_key(const pdt_event *e, uint32_t rank)
-{
-    msg_key k;
-    k.tag = e->sub;
-    k.seq = e->v;
-    if (e->kind == PDT_EV_SEND) {
-        k.src = rank;
-        k.dst = e->a;
-    } else {
-        k.src = e->a;
-        k.dst = rank;
-    }
-    return k;
-}
-
-/* ---- the streaming merge ------------------------------------------------------
- *
- * One cursor per rank; a heap of the ranks whose next event (head) may go
- * next, ordered by (aligned time, rank); a rank whose head is a RECV whose
- * SEND is still to come waits ("blocked") until that SEND has gone out.
- * Memory: one decoded block per rank plus the message sets — independent of
- * the number of events. */
-
-struct pdt_merge {
-    pdt_run *run;
-    uint32_t R;
-    pdt_cursor **cur;    /* per rank */
-    pdt_event *head;     /* per rank: its next event, valid while has[r] */
-    uint64_t *pos;       /* per rank: index of head in the rank */
-    uint8_t *has;
-    uint32_t *heap;      /* ranks whose head may go next */
-    size_t nheap;
-    uint8_t *blocked;    /* ranks whose head is a RECV waiting for its SEND */
-    size_t nblocked;
-    msg_set sent;        /* sends placed and not yet received */
-    msg_set unsent;      /* sends not yet placed (all SENDs of the run at the start) */
-    uint32_t next;       /* a rank known to go next without asking the heap, or UINT32_MAX */
-    uint64_t left;       /* events not yet delivered */
-};
-
-static int head_less(const pdt_merge *m, uint32_t a, uint32_t b)
-{
-    uint64_t ta = m->head[a].t, tb = m->head[b].t;
-    return ta != tb ? ta < tb : a < b;
-}
-
-static void heap_push(pdt_merge *m, uint32_t r)
-{
-    size_t i = m->nheap++;
-    m->heap[i] = r;
-    while (i > 0) {
-        size_t p = (i - 1) / 2;
-        if (!head_less(m, m->heap[i], m->heap[p])) break;
-        uint32_t t = m->heap[i];
-        m->heap[i] = m->heap[p];
-        m->heap[p] = t;
-        i = p;
-    }
-}
-
-static uint32_t heap_pop(pdt_merge *m)
-{
-    uint32_t top = m->heap[0];
-    m->heap[0] = m->heap[--m->nheap];
-    size_t i = 0;
-    for (;;) {
-        size_t l = 2 * i + 1, k = i;
-        if (l < m->nheap && head_less(m, m->heap[l], m->heap[k])) k = l;
-        if (l + 1 < m->nheap && head_less(m, m->heap[l + 1], m->heap[k])) k = l + 1;
-        if (k == i) break;
-        uint32_t t = m->heap[i];
-        m->heap[i] = m->heap[k];
-        m->heap[k] = t;
-        i = k;
-    }
-    return top;
-}
-
-/* Load rank r's next event into head[r]. */
-static void advance(pdt_merge *m, uint32_t r)
-{
-    m->has[r] = (uint8_t)pdt_cursor_next(m->cur[r], &m->head[r], &m->pos[r]);
-}
-
-/* Put rank r's head event into the heap, or mark it blocked.  A RECV waits
- * only for a SEND that is still to come: one whose SEND is in no file (a
- * lost or damaged rank file) is placed by its time at once, so it cannot
- * hold up, or be forced ahead of, messages that are all there. */
-static void schedule(pdt_merge *m, uint32_t r)
-{
-    if (!m->has[r]) return;
-    const pdt_event *e = &m->head[r];
-    if (e->kind == PDT_EV_RECV) {
-        msg_key key = ev_key(e, r);
-        msg_slot *s = msg_find(&m->sent, &key, 0);
-        msg_slot *u = msg_find(&m->unsent, &key, 0);
-        if ((!s || s->count == 0) && u && u->count > 0) {
-            m->blocked[r] = 1;
-            m->nblocked++;
-            return;
-        }
-    }
-    heap_push(m, r);
-}
-
-/* Every SEND of the run into m->unsent (one pass over the events). */
-static pdt_status count_sends(pdt_merge *m, pdt_err *err)
-{
-    for (uint32_t r = 0; r < m->R; r++) {
-        pdt_cursor *c;
-        pdt_status st = pdt_cursor_open(m->run, (int)r, &c, err);
-        if (st != PDT_OK) return st;
-        pdt_event e;
-        while (pdt_cursor_next(c, &e, NULL)) {
-            if (e.kind != PDT_EV_SEND) continue;
-            msg_key key = ev_key(&e, r);
-            msg_slot *u = msg_find(&m->unsent, &key, 1);
-            if (!u) {
-                pdt_cursor_close(c);
-                return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory (message index)");
-            }
-            u->count++;
-        }
-        pdt_cursor_close(c);
-    }
-    return PDT_OK;
-}
-
-pdt_status pdt_merge_open(pdt_run *run, pdt_merge **out, pdt_err *err)
-{
-    *out = NULL;
-    pdt_merge *m = calloc(1, sizeof *m);
-    if (!m) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    size_t R = (size_t)run->nranks;
-    m->run = run;
-    m->R = (uint32_t)R;
-    m->next = UINT32_MAX;
-    m->cur = calloc(R ? R : 1, sizeof *m->cur);
-    m->head = calloc(R ? R : 1, sizeof *m->head);
-    m->pos = calloc(R ? R : 1, sizeof *m->pos);
-    m->has = calloc(R ? R : 1, 1);
-    m->heap = calloc(R ? R : 1, sizeof *m->heap);
-    m->blocked = calloc(R ? R : 1, 1);
-    pdt_status st = PDT_OK;
-    if (!m->cur || !m->head || !m->pos || !m->has || !m->heap || !m->blocked)
-        st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    /* one rank: the order is its file order whatever the messages say */
-    if (st == PDT_OK && R > 1) st = count_sends(m, err);
-    for (uint32_t r = 0; st == PDT_OK && r < R; r++) {
-        st = pdt_cursor_open(run, (int)r, &m->cur[r], err);
-        m->left += run->rk[r].nev;
-    }
-    if (st != PDT_OK) {
-        pdt_merge_close(m);
-        return st;
-    }
-    for (uint32_t r = 0; r < R; r++) {
-        advance(m, r);
-        schedule(m, r);
-    }
-    *out = m;
-    return PDT_OK;
-}
-
-/* Bookkeeping of the messages when event e of rank r is placed. */
-static int place_message(pdt_merge *m, const pdt_event *e, uint32_t r, uint64_t seq)
-{
-    msg_key key = ev_key(e, r);
-    if (e->kind == PDT_EV_SEND) {
-        msg_slot *s = msg_find(&m->sent, &key, 1);
-        if (!s) return -1;
-        s->count++;
-        msg_slot *u = msg_find(&m->unsent, &key, 0);
-        if (u && u->count) u->count--;
-        uint32_t d = key.dst;  /* wake the receiver waiting for this message */
-        if (m->nblocked && d < m->R && m->blocked[d]) {
-            msg_key wk = ev_key(&m->head[d], d);
-            if (key_eq(&wk, &key)) {
-                m->blocked[d] = 0;
-                m->nblocked--;
-                heap_push(m, d);
-            }
-        }
-    } else {
-        msg_slot *s = msg_find(&m->sent, &key, 0);
-        if (s && s->count) s->count--;
-        else  /* its SEND is in no file, or a cycle forced it */
-            warnf(m->run, "rank %u event #%" PRIu64 ": recv from rank %u (tag %u, seq %" PRId64
-                          ") has no matching send", r, seq, e->a, e->sub, e->v);
-    }
-    return 0;
-}
-
-int pdt_merge_next(pdt_merge *m, pdt_rec *rec, pdt_err *err)
-{
-    if (m->left == 0) return 0;
-    uint32_t r = UINT32_MAX;
-    if (m->next != UINT32_MAX) {
-        r = m->next;
-        m->next = UINT32_MAX;
-    } else if (m->nheap > 0) {
-        r = heap_pop(m);
-    } else {  /* every remaining head is a RECV whose SEND is missing: force one */
-        for (uint32_t q = 0; q < m->R; q++)
-            if (m->blocked[q] && (r == UINT32_MAX || head_less(m, q, r))) r = q;
-        if (r == UINT32_MAX) {  /* a cursor stopped early: it could not get memory */
-            pdt_err_set(err, PDT_ERR_NOMEM, "out of memory decoding a trace block");
-            return -1;
-        }
-        m->blocked[r] = 0;
-        m->nblocked--;
-    }
-    rec->ev = m->head[r];
-    rec->rank = r;
-    rec->seq = (uint32_t)m->pos[r];
-    m->left--;
-    advance(m, r);
-    if ((rec->ev.kind == PDT_EV_SEND || rec->ev.kind == PDT_EV_RECV) &&
-        place_message(m, &rec->ev, r, m->pos[r] - 1) != 0) {
-        pdt_err_set(err, PDT_ERR_NOMEM, "out of memory (message index)");
-        return -1;
-    }
-    /* Fast path: if r's next event is no RECV and comes before every head in
-     * the heap, pushing r and popping the heap would give r again (the order
-     * (t, rank) is total), so skip both. */
-    if (m->has[r] && m->head[r].kind != PDT_EV_RECV &&
-        (m->nheap == 0 || head_less(m, r, m->heap[0])))
-        m->next = r;
-    else
-        schedule(m, r);
-    return 1;
-}
-
-void pdt_merge_close(pdt_merge *m)
-{
-    if (!m) return;
-    for (uint32_t r = 0; m->cur && r < m->R; r++) pdt_cursor_close(m->cur[r]);
-    free(m->cur);
-    free(m->head);
-    free(m->pos);
-    free(m->has);
-    free(m->heap);
-    free(m->blocked);
-    free(m->sent.s);
-    free(m->unsent.s);
-    free(m);
-}
-
-pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err *err)
-{
-    *recs = NULL;
-    *n = 0;
-    if (run->merged_done) {
-        *recs = run->merged;
-        *n = run->nmerged;
-        return PDT_OK;
-    }
-    uint64_t total = 0;
-    for (int r = 0; r < run->nranks; r++) total += run->rk[r].nev;
-    if (total > SIZE_MAX / sizeof(pdt_rec))
-        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory (%" PRIu64 " events)", total);
-    pdt_merge *m;
-    pdt_status st = pdt_merge_open(run, &m, err);
-    if (st != PDT_OK) return st;
-    pdt_rec *out = big_alloc((size_t)total * sizeof *out);
-    if (!out) {
-        pdt_merge_close(m);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory (%" PRIu64 " events)", total);
-    }
-    size_t k = 0;
-    int got;
-    while (k < total && (got = pdt_merge_next(m, &out[k], err)) == 1) k++;
-    pdt_merge_close(m);
-    if (k < total) {
-        free(out);
-        return err->code ? err->code : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    }
-    run->merged = out;
-    run->nmerged = (size_t)total;
-    run->merged_done = 1;
-    *recs = run->merged;
-    *n = run->nmerged;
-    return PDT_OK;
 }

@@ -71,14 +71,11 @@ static void format_tri(const pdt_event *e, char *buf, size_t cap)
     }
 }
 
-char *pdt_event_format(const pdt_event *e0, char *buf, size_t cap)
+/* Phases, the stacks and Graham's points: 1 when e is one of them (then
+ * written to buf). */
+static int format_local(const pdt_event *e, const char *kn, char *buf, size_t cap)
 {
     char t1[24], t2[24];
-    int tri = e0->kind == PDT_EV_TRI_NEW || e0->kind == PDT_EV_TRI_FINAL ||
-              e0->kind == PDT_EV_RA_DEFER || e0->kind == PDT_EV_SHIP || e0->kind == PDT_EV_DISCARD;
-    pdt_event rot = tri ? tri_rotated(e0) : *e0;
-    const pdt_event *e = &rot;
-    const char *kn = pdt_event_kind_name(e->kind);
     switch (e->kind) {
     case PDT_EV_PHASE_BEGIN:
     case PDT_EV_PHASE_END:
@@ -110,11 +107,16 @@ char *pdt_event_format(const pdt_event *e0, char *buf, size_t cap)
                                                  : or_num(NULL, t1, sizeof t1, e->sub),
                  e->a, e->b);
         break;
-    case PDT_EV_TRI_NEW:
-    case PDT_EV_TRI_FINAL:
-    case PDT_EV_RA_DEFER:
-    case PDT_EV_SHIP:
-    case PDT_EV_DISCARD: format_tri(e, buf, cap); break;
+    default: return 0;
+    }
+    return 1;
+}
+
+/* Merges, messages, hulls, edges and incircle tests: 1 when e is one of
+ * them (then written to buf). */
+static int format_global(const pdt_event *e, const char *kn, char *buf, size_t cap)
+{
+    switch (e->kind) {
     case PDT_EV_MERGE_BEGIN:
         snprintf(buf, cap,
                  "merge-begin level=%u left=%" PRIu32 " right=%" PRIu32 " end=%" PRIu32
@@ -144,14 +146,31 @@ char *pdt_event_format(const pdt_event *e0, char *buf, size_t cap)
         snprintf(buf, cap, "incircle %" PRIu32 " %" PRIu32 " %" PRIu32 " pt=%" PRId64 " result=%d",
                  e->a, e->b, e->c, e->v >> 2, (int)(e->v & 3) - 1);
         break;
-    default:
-        if (kn)
-            snprintf(buf, cap, "%s sub=%u a=%" PRIu32 " b=%" PRIu32 " c=%" PRIu32 " v=%" PRId64, kn,
-                     e->sub, e->a, e->b, e->c, e->v);
-        else
-            snprintf(buf, cap, "kind-%u sub=%u a=%" PRIu32 " b=%" PRIu32 " c=%" PRIu32
-                               " v=%" PRId64, e->kind, e->sub, e->a, e->b, e->c, e->v);
-        break;
+    default: return 0;
     }
+    return 1;
+}
+
+/* An event of no kind above: its fields as numbers. */
+static void format_other(const pdt_event *e, const char *kn, char *buf, size_t cap)
+{
+    if (kn)
+        snprintf(buf, cap, "%s sub=%u a=%" PRIu32 " b=%" PRIu32 " c=%" PRIu32 " v=%" PRId64, kn,
+                 e->sub, e->a, e->b, e->c, e->v);
+    else
+        snprintf(buf, cap, "kind-%u sub=%u a=%" PRIu32 " b=%" PRIu32 " c=%" PRIu32
+                           " v=%" PRId64, e->kind, e->sub, e->a, e->b, e->c, e->v);
+}
+
+char *pdt_event_format(const pdt_event *e0, char *buf, size_t cap)
+{
+    int tri = e0->kind == PDT_EV_TRI_NEW || e0->kind == PDT_EV_TRI_FINAL ||
+              e0->kind == PDT_EV_RA_DEFER || e0->kind == PDT_EV_SHIP || e0->kind == PDT_EV_DISCARD;
+    pdt_event rot = tri ? tri_rotated(e0) : *e0;
+    const pdt_event *e = &rot;
+    const char *kn = pdt_event_kind_name(e->kind);
+    if (tri) format_tri(e, buf, cap);
+    else if (!format_local(e, kn, buf, cap) && !format_global(e, kn, buf, cap))
+        format_other(e, kn, buf, cap);
     return buf;
 }

@@ -332,25 +332,15 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
 pdt_status pdt_replay_open_kept(const char *dir, uint64_t budget, pdt_replay **out,
                                 pdt_replay_open_info *info, pdt_err *err);
 /* Verify kept indexes of at least min_bytes bytes lazily: at the opening
- * only their header and chunk table; each 16 MiB chunk of the tables when a
- * frame first reads it.  Its pages stay closed until then, so the program
- * must route SIGSEGV to pdt_replay_lazy_fault (the library installs no
- * handler).  Such an index's rank file blocks are checked as they are
- * decoded: on a mismatch the index file is removed and on_damage is called
- * with a message naming it (the program should stop; if it returns, the
- * block's events are ignored).  Without this call (or with on_damage
- * NULL), every index is verified whole when opened, and the rank files'
- * blocks with it. */
+ * their header, chunk table and small tables; each 16 MiB chunk of the big
+ * tables when the replay first reads it (the replay checks it before the
+ * read: no page is closed, no fault trapped).  A chunk that does not match,
+ * or a rank file block that does not when it is decoded, removes the index
+ * file and calls on_damage with a message naming it (the program should
+ * stop; if it returns, the replay's answers are no longer meaningful).
+ * Without this call (or with on_damage NULL), every index is verified
+ * whole when opened, and the rank files' blocks with it. */
 void pdt_replay_lazy_verify(void (*on_damage)(const char *msg), uint64_t min_bytes);
-
-/* For the program's SIGSEGV handler (async-signal-safe): addr is the
- * faulting address.  1: it lies in a lazily verified index whose chunks
- * there are now verified and open (return from the handler: the read is
- * retried); 0: a chunk there did not match its checksum (or could not be
- * opened): the index file has been removed, *msg says so, and the program
- * must stop (write and _exit only); -1: not such an address (a real
- * fault: the program's usual SIGSEGV behaviour). */
-int pdt_replay_lazy_fault(const void *addr, const char **msg);
 
 /* What the reader said about damage in the run when the kept index was
  * built ("" if nothing, or for a replay not opened from an index). */

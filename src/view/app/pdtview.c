@@ -16,7 +16,6 @@
 #include <errno.h>
 #include <langinfo.h>
 #include <locale.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -86,54 +85,23 @@ int pdt_app_edit(const opts *o)
 }
 
 /* A kept index found damaged while it is read (pdt_replay_lazy_verify): say
- * so and stop.  Called from a signal handler: write and _exit only. */
+ * so and stop (the replay cannot go on over a damaged table). */
 static void index_damaged(const char *msg)
 {
-    static const char pre[] = "pdtview: ";
-    if (write(2, pre, sizeof pre - 1) < 0 || write(2, msg, strlen(msg)) < 0 || write(2, "\n", 1) < 0)
-        _exit(PDT_EXIT_USAGE);
-    _exit(PDT_EXIT_USAGE);
+    fprintf(stderr, "pdtview: %s\n", msg);
+    exit(PDT_EXIT_USAGE);
 }
 
 /* Kept indexes from this size on are verified chunk by chunk as they are
  * read ($PDTVIEW_VERIFY=lazy: all of them; =eager: none, whole at opening). */
 #define LAZY_VERIFY_MIN ((uint64_t)64 << 20)
 
-static struct sigaction old_segv;
-
-/* SIGSEGV: the first read of a page of a lazily verified kept index (the
- * replay verifies the chunks there and opens them, and the read is
- * retried), a damaged chunk (stop), or a real fault (what was there
- * before, else the default: the fault repeats and ends the process). */
-static void segv_handler(int sig, siginfo_t *si, void *uc)
-{
-    const char *msg = NULL;
-    int ok = pdt_replay_lazy_fault(si->si_addr, &msg);
-    if (ok == 1) return;
-    if (ok == 0) index_damaged(msg);
-    if ((old_segv.sa_flags & SA_SIGINFO) && old_segv.sa_sigaction)
-        old_segv.sa_sigaction(sig, si, uc);
-    else if (old_segv.sa_handler != SIG_DFL && old_segv.sa_handler != SIG_IGN)
-        old_segv.sa_handler(sig);
-    else
-        signal(SIGSEGV, SIG_DFL);
-}
-
-/* Verify big kept indexes lazily ($PDTVIEW_VERIFY=lazy: all of them; =eager:
- * none, every index whole at opening), routing the faults to the replay. */
 static void lazy_verify_setup(void)
 {
     const char *verify = getenv("PDTVIEW_VERIFY");
     if (verify && !strcmp(verify, "eager")) return;
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_sigaction = segv_handler;
-    sa.sa_flags = SA_SIGINFO | SA_NODEFER;
-    sigemptyset(&sa.sa_mask);
-    if (sigaction(SIGSEGV, &sa, &old_segv) != 0) return;  /* then every index is verified whole */
     pdt_replay_lazy_verify(index_damaged, verify && !strcmp(verify, "lazy") ? 0 : LAZY_VERIFY_MIN);
 }
-
 
 /* The replay of o's run: from its kept index, else loaded (into L) and
  * replayed; info says how.  With --write-run, the run is written instead

@@ -55,7 +55,11 @@ typedef struct keymap {
 #define KIND_FIRST 0x80
 _Static_assert(PDT_EV_KIND_COUNT <= KIND_UNKNOWN, "every kind has a code below KIND_UNKNOWN");
 
-static inline int kind_at(const pdt_replay *r, size_t i) { return r->ev_kind[i] & KIND_MASK; }
+static inline int kind_at(const pdt_replay *r, size_t i)
+{
+    ix_check_events(r, i, i + 1);  /* (a kept index's chunk checked before its first read) */
+    return r->ev_kind[i] & KIND_MASK;
+}
 
 /* Event i (< m): from the array, or decoded (a kept index: the pointer
  * holds for PDT_EVSRC_KEEP - 1 more calls). */

@@ -222,16 +222,18 @@ static void step_prefetch(const pdt_replay *r, const pdt_rstate *s, size_t i)
 
 static void step_to(const pdt_replay *r, pdt_rstate *s, size_t k)
 {
+    size_t lo = s->k < k ? s->k : k, hi = s->k < k ? k : s->k;
+    if (!ix_check_events(r, lo, hi) || !ix_check_born(r, hi)) return;
     /* (a paged state's pages are given back when the seek is done, not on
      * the way: a page of a file mapping written again costs a fault into
      * the file system, which made seeks several times slower) */
     while (s->k < k) {
         if (s->k + STEP_AHEAD < k) step_prefetch(r, s, s->k + STEP_AHEAD);
-        pdt_replay_step(r, s, 1);
+        pdt_rp_step(r, s, 1);
     }
     while (s->k > k) {
         if (s->k > k + STEP_AHEAD) step_prefetch(r, s, s->k - 1 - STEP_AHEAD);
-        pdt_replay_step(r, s, -1);
+        pdt_rp_step(r, s, -1);
     }
 }
 
@@ -248,7 +250,8 @@ void pdt_replay_seek(const pdt_replay *r, pdt_rstate *s, size_t k)
         if (c >= r->nick) c = r->nick - 1;
         size_t ck = c * r->ick_every;
         size_t bytes = (size_t)(r->ick_off[c + 1] - r->ick_off[c]);
-        if (from_here > dist(ck, k) * STEP_FACTOR + bytes / (s->paged[1] ? 64 : RESTORE_BYTES_PER_STEP)) {
+        if (from_here > dist(ck, k) * STEP_FACTOR + bytes / (s->paged[1] ? 64 : RESTORE_BYTES_PER_STEP) &&
+            (!r->lazy || pdt_ix_need_ckpt(r, c))) {
             pdt_rstate_from_blob(r, s, r->ick + r->ick_off[c], r->ick_born[c], ck);
             pdt_index_release(r, r->ick + r->ick_off[c], bytes); /* (copied: not kept) */
         }

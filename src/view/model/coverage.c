@@ -158,7 +158,7 @@ size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, 
     if (cols <= 0 || rows <= 0) return 0;
     size_t ncell = (size_t)cols * (size_t)rows;
     memset(cells, 0, ncell * sizeof *cells);
-    if (!(x1 > x0) || !(y1 > y0)) return 0;
+    if (!(x1 > x0) || !(y1 > y0) || !ix_check_points(r) || !ix_check_born(r, s->k)) return 0;
     size_t nt = pdt_replay_born_at_most(r, s->k);
     cov_job J[2];
     J[0] = (cov_job){r, s, x0, y0, cols / (x1 - x0), rows / (y1 - y0), cols, rows, rank_visible,

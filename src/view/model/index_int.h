@@ -121,27 +121,34 @@ typedef struct verify_job {
     atomic_int bad;
 } verify_job;
 
-/* ---- verifying a big index lazily: each chunk when it is first read -------------
+/* ---- verifying a big index lazily: each chunk when it is first asked for ------
  *
  * Checksumming a whole index of gigabytes at every opening costs seconds; a
  * frame reads a small part of it.  So a big index (pdt_replay_lazy_verify)
- * is mapped with no access but its header page: the first read of a page
- * faults, and the program's SIGSEGV handler hands the address to
- * pdt_replay_lazy_fault, which checksums the chunks the page belongs to,
- * reading the file (pread), before it opens their pages to the replay.
- * Nothing of the index is used unverified.  A mismatch removes the index
- * and tells the program, which stops (the replay cannot go on with a
- * damaged table).  The library installs no handler: the program does. */
-
-#define LAZY_MAX 8  /* indexes open at once with lazy verification */
+ * is checked in two steps.  At the opening: its header, its chunk table and
+ * every chunk of its small sections.  The big tables (the per-event ones,
+ * the triangles and their histories, the points and their per-point tables,
+ * the checkpoints) are checked a chunk at a time by the replay itself,
+ * before it reads them: every place of the model that reads such a table
+ * asks for the range it is about to read (pdt_ix_need and the helpers in
+ * replay_int.h), and the chunks there not checked yet are read (pread) and
+ * checksummed then, by the verifying threads.  A flag per chunk remembers
+ * what is checked.  The tables the renderer is handed (triangles, their
+ * histories, points) are asked for whole (points) or up to the triangles
+ * born by the state's cursor (pdt_ix_need_born), which is all a frame of
+ * that state reads.  A mismatch removes the index and tells the program,
+ * which stops (the replay cannot go on with a damaged table).  No page of
+ * the index is closed and no fault is trapped. */
 
 typedef struct lazy {
-    char *base;                  /* the replay's mapping */
     int fd;                      /* the file, read (pread) for the checksums */
-    size_t len;
-    uint64_t off[NSEC], bytes[NSEC], first[NSEC + 1];
+    ihdr h;                      /* its header */
+    uint64_t first[NSEC + 1];    /* per section: index of its first chunk in tab */
+    uint64_t nchunk;
     uint32_t *tab;               /* the chunk checksums */
-    atomic_uchar *done;          /* per chunk: verified */
+    uint8_t *done;               /* per chunk: verified */
+    size_t tris_upto;            /* triangles 0 .. tris_upto-1 and their entries checked */
+    int bad;                     /* a mismatch was found (reported once) */
     char path[PATH_MAX];
     char msg[PATH_MAX + 256];
 } lazy;
@@ -169,8 +176,11 @@ int pdt_ix_crc_done(const crcacc *a, uint64_t bytes, uint32_t *tab);
 void pdt_ix_run_job(verify_job *j);
 uint32_t *pdt_ix_read_ctab(int fd, const ihdr *h, char *why, size_t wcap);
 int pdt_ix_verify_chunks(int fd, const ihdr *h, char *why, size_t wcap);
-lazy *pdt_ix_lazy_start(char *map, size_t len, const ihdr *h, uint32_t *tab, int fd,
-                        const char *path);
+/* The lazy checks of the index open on fd (header h, chunk table tab, taken
+ * over), the small sections checked now: NULL when out of memory, or with
+ * a reason in why when a small section does not match. */
+lazy *pdt_ix_lazy_start(const ihdr *h, uint32_t *tab, int fd, const char *path, char *why,
+                        size_t wcap);
 void pdt_ix_lazy_stop(lazy *L);
 void pdt_ix_run_damaged(void *ctx, uint32_t rank);
 

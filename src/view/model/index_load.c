@@ -78,7 +78,7 @@ void pdt_index_unmap(pdt_replay *r)
 {
     unmap_ranks(r);
     if (r->lazy) pdt_ix_lazy_stop(r->lazy);
-    else munmap(r->map, r->map_len);
+    munmap(r->map, r->map_len);
     r->lazy = NULL;
     r->map = NULL;
 }
@@ -311,20 +311,21 @@ static void *map_index(int fd, const ihdr *h, const char *path, int verify, lazy
                        size_t wcap)
 {
     int lazily = verify && h->file_bytes >= pdt_ix_lazy_min_bytes;
+    if (lazily) { /* the chunk table and the small sections now; the big ones when asked for */
+        uint32_t *tab = pdt_ix_read_ctab(fd, h, why, wcap);
+        if (!tab) return MAP_FAILED;
+        why[0] = 0;
+        *L = pdt_ix_lazy_start(h, tab, fd, path, why, wcap);
+        if (!*L) free(tab);
+        if (!*L && why[0]) return MAP_FAILED;
+        lazily = *L != NULL;
+    }
     if (verify && !lazily && !pdt_ix_verify_chunks(fd, h, why, wcap)) return MAP_FAILED;
     void *map = mmap(NULL, h->file_bytes, PROT_READ, MAP_SHARED, fd, 0);
     if (map == MAP_FAILED) {
         snprintf(why, wcap, "cannot map it: %s", strerror(errno));
-        return MAP_FAILED;
-    }
-    if (!lazily) return map;
-    /* only the chunk table now; each chunk when first read */
-    uint32_t *tab = pdt_ix_read_ctab(fd, h, why, wcap);
-    if (tab) *L = pdt_ix_lazy_start(map, h->file_bytes, h, tab, fd, path);
-    if (tab && !*L) free(tab);
-    if (!tab || (!*L && !pdt_ix_verify_chunks(fd, h, why, wcap))) {
-        munmap(map, h->file_bytes);
-        return MAP_FAILED;
+        if (*L) pdt_ix_lazy_stop(*L);
+        *L = NULL;
     }
     return map;
 }
@@ -439,7 +440,7 @@ pdt_replay *pdt_ix_load(const char *path, const char *dir, uint64_t ident, const
     return r;
 fail:
     if (L) pdt_ix_lazy_stop(L);
-    else if (map != MAP_FAILED) munmap(map, h.file_bytes);
+    if (map != MAP_FAILED) munmap(map, h.file_bytes);
     close(fd);
     return NULL;
 }

@@ -1,5 +1,6 @@
 /* pdt — verifying a kept index: chunk checksums of data written in order,
- * checked in parallel at opening, or lazily, each chunk when first read. */
+ * checked in parallel at opening, or lazily: each chunk of the big tables
+ * the first time the replay asks for it (pdt_ix_need). */
 #include "pdt/io.h"
 #include "pdt/view/replay.h"
 #include "replay_int.h"
@@ -142,7 +143,6 @@ int pdt_ix_verify_chunks(int fd, const ihdr *h, char *why, size_t wcap)
     return 1;
 }
 
-static _Atomic(lazy *) lazies[LAZY_MAX];
 static void (*damage_hook)(const char *msg);
 uint64_t pdt_ix_lazy_min_bytes = UINT64_MAX;
 
@@ -152,132 +152,134 @@ void pdt_replay_lazy_verify(void (*on_damage)(const char *msg), uint64_t min_byt
     pdt_ix_lazy_min_bytes = on_damage ? min_bytes : UINT64_MAX;
 }
 
-/* The file range of chunk c. */
-static void lazy_chunk(const lazy *L, uint64_t c, uint64_t *lo, uint64_t *hi)
+/* The sections checked as they are first read: the big ones, sized by the
+ * events, the points or the triangles.  Every other section is small and
+ * checked whole at the opening. */
+static int lazy_section(int i)
 {
-    int i = 0;
-    while (i + 1 < NSEC && L->first[i + 1] <= c) i++;
-    *lo = L->off[i] + (c - L->first[i]) * CHUNK_BYTES;
-    *hi = *lo + CHUNK_BYTES < L->off[i] + L->bytes[i] ? *lo + CHUNK_BYTES : L->off[i] + L->bytes[i];
+    switch (i) {
+    case S_EVOBJ: case S_EVKIND: case S_TRIS: case S_HIST: case S_LIFT: case S_SORT:
+    case S_DEL: case S_SORTPOS: case S_POINTS: case S_CKPT: return 1;
+    default: return 0;
+    }
 }
 
-/* Checksum chunk c (once).  0 on a mismatch. */
-static int lazy_verify(lazy *L, uint64_t c)
+/* A chunk did not match: remove the index, say so in L->msg and tell the
+ * program (which should stop).  Always 0. */
+static int lazy_fail(lazy *L)
 {
-    if (atomic_load(&L->done[c])) return 1;
-    uint64_t lo, hi;
-    lazy_chunk(L, c, &lo, &hi);
-    /* read through a small buffer (pread: async-signal-safe, and cheaper
-     * than faulting the pages of a second mapping in) */
-    unsigned char buf[1 << 16];
-    uint32_t crc = 0;
-    for (uint64_t o = lo; o < hi;) {
-        size_t want = hi - o < sizeof buf ? (size_t)(hi - o) : sizeof buf;
-        ssize_t got = pread(L->fd, buf, want, (off_t)o);
-        if (got <= 0) return 0;
-        crc = pdt_crc32c(crc, buf, (size_t)got);
-        o += (uint64_t)got;
+    if (!L->bad) {
+        L->bad = 1;
+        snprintf(L->msg, sizeof L->msg,
+                 "the kept index %s is damaged (a checksum mismatch, found when a part of it was "
+                 "first read); it was removed: open the run again to rebuild it", L->path);
+        unlink(L->path);
+        if (damage_hook) damage_hook(L->msg);
     }
-    if (crc != L->tab[c]) return 0;
-    atomic_store(&L->done[c], 1);
+    return 0;
+}
+
+/* Check the chunks c0 .. c1-1 (of the whole table) not checked yet: one
+ * here, several by the verifying threads.  1, or 0 on a mismatch. */
+static int lazy_check(lazy *L, uint64_t c0, uint64_t c1)
+{
+    uint64_t todo_n = 0;
+    for (uint64_t c = c0; c < c1; c++) todo_n += !L->done[c];
+    if (!todo_n) return 1;
+    if (L->bad) return 0;
+    uint8_t *todo = calloc(L->nchunk ? L->nchunk : 1, 1);
+    if (!todo) return lazy_fail(L);  /* (cannot check: treated as damaged) */
+    for (uint64_t c = c0; c < c1; c++) todo[c] = !L->done[c];
+    verify_job j = {L->fd, &L->h, L->tab, 0, todo, L->nchunk, L->first, 0, 0};
+    j.next = c0;
+    pdt_ix_run_job(&j);
+    free(todo);
+    if (atomic_load(&j.bad)) return lazy_fail(L);
+    for (uint64_t c = c0; c < c1; c++) L->done[c] = 1;
     return 1;
 }
 
-/* Verify every chunk overlapping the file range [lo, hi).  0 on a mismatch. */
-static int lazy_verify_range(lazy *L, uint64_t lo, uint64_t hi)
+int pdt_ix_need(const pdt_replay *r, int sec, uint64_t lo, uint64_t hi)
 {
-    for (int i = 0; i < NSEC; i++) {
-        uint64_t s = L->off[i], e = L->off[i] + L->bytes[i];
-        if (!L->bytes[i] || e <= lo || s >= hi) continue;
-        uint64_t from = (lo > s ? lo : s) - s, to = (hi < e ? hi : e) - s;
-        for (uint64_t c = from / CHUNK_BYTES; c <= (to - 1) / CHUNK_BYTES; c++)
-            if (!lazy_verify(L, L->first[i] + c)) return 0;
-    }
+    lazy *L = r->lazy;
+    if (!L || !lazy_section(sec)) return 1;
+    if (L->bad) return 0;
+    if (hi > L->h.sec[sec].bytes) hi = L->h.sec[sec].bytes;
+    if (lo >= hi) return 1;
+    uint64_t c0 = L->first[sec] + lo / CHUNK_BYTES, c1 = L->first[sec] + (hi - 1) / CHUNK_BYTES + 1;
+    if (c1 == c0 + 1 && L->done[c0]) return 1;  /* the usual case */
+    return lazy_check(L, c0, c1);
+}
+
+int pdt_ix_need_events(const pdt_replay *r, size_t lo, size_t hi)
+{
+    return pdt_ix_need(r, S_EVOBJ, lo * sizeof *r->ev_obj, hi * sizeof *r->ev_obj) &&
+           pdt_ix_need(r, S_EVKIND, lo, hi);
+}
+
+int pdt_ix_need_born(const pdt_replay *r, size_t k)
+{
+    lazy *L = r->lazy;
+    size_t born = pdt_replay_born_at_most(r, k);
+    if (born <= L->tris_upto) return !L->bad;  /* (none born: tris_upto 0) */
+    if (!pdt_ix_need(r, S_TRIS, 0, born * sizeof *r->tris)) return 0;
+    const pdt_rtri *last = &r->tris[born - 1];
+    uint64_t hend = (uint64_t)last->h0 + last->hn;
+    if (!pdt_ix_need(r, S_HIST, 0, hend * sizeof *r->hist)) return 0;
+    L->tris_upto = born;
     return 1;
 }
 
-/* Verify chunk c and open its pages to the replay (the chunks sharing its
- * end pages verified first).  1, 0 on a mismatch, -1 if mprotect failed. */
-static int lazy_open_chunk(lazy *L, uint64_t c)
+int pdt_ix_need_ckpt(const pdt_replay *r, size_t c)
 {
-    uint64_t lo, hi;
-    lazy_chunk(L, c, &lo, &hi);
-    uint64_t plo = lo & ~(uint64_t)4095, phi = (hi + 4095) & ~(uint64_t)4095;
-    if (phi > L->len) phi = L->len;
-    if (!lazy_verify(L, c) || !lazy_verify_range(L, plo, lo) || !lazy_verify_range(L, hi, phi))
-        return 0;
-    return mprotect(L->base + plo, (size_t)(phi - plo), PROT_READ) == 0 ? 1 : -1;
+    return pdt_ix_need(r, S_CKPT, r->ick_off[c], r->ick_off[c + 1]);
 }
 
-/* Open the page at file offset pos to the replay: the chunks on it are
- * verified, then each of them is opened whole (and the chunks sharing its
- * end pages verified first).  0 on a mismatch or when the pages cannot be
- * opened. */
-static int lazy_open_page(lazy *L, uint64_t pos)
+int pdt_ix_need_point(const pdt_replay *r, size_t p)
 {
-    uint64_t p = pos & ~(uint64_t)4095, pe = p + 4096 < L->len ? p + 4096 : L->len;
-    int any = 0;
-    for (int i = 0; i < NSEC; i++) {
-        uint64_t s = L->off[i], e = L->off[i] + L->bytes[i];
-        if (!L->bytes[i] || e <= p || s >= pe) continue;
-        uint64_t from = (p > s ? p : s) - s, to = (pe < e ? pe : e) - s;
-        for (uint64_t c = from / CHUNK_BYTES; c <= (to - 1) / CHUNK_BYTES; c++) {
-            int ok = lazy_open_chunk(L, L->first[i] + c);
-            if (ok != 1) return ok;
-            any = 1;
-        }
-    }
-    if (!any && mprotect(L->base + p, (size_t)(pe - p), PROT_READ) != 0) return -1;  /* padding */
+    return pdt_ix_need(r, S_LIFT, p * 4, p * 4 + 4) && pdt_ix_need(r, S_SORT, p * 4, p * 4 + 4) &&
+           pdt_ix_need(r, S_DEL, p * 4, p * 4 + 4) &&
+           pdt_ix_need(r, S_SORTPOS, p * sizeof *r->sort_pos, (p + 1) * sizeof *r->sort_pos);
+}
+
+int pdt_ix_need_points(const pdt_replay *r)
+{
+    return pdt_ix_need(r, S_POINTS, 0, UINT64_MAX);
+}
+
+int pdt_ix_need_all(const pdt_replay *r)
+{
+    for (int i = 0; i < NSEC; i++)
+        if (!pdt_ix_need(r, i, 0, UINT64_MAX)) return 0;
     return 1;
 }
 
-/* Append src to dst (async-signal-safe). */
-static char *cat(char *dst, const char *end, const char *src)
+/* Check every chunk of the sections that are not checked lazily (at the
+ * opening).  1, or 0 with a reason in why. */
+static int check_small_sections(lazy *L, char *why, size_t wcap)
 {
-    while (*src && dst < end) *dst++ = *src++;
-    return dst;
+    uint8_t *todo = calloc(L->nchunk ? L->nchunk : 1, 1);
+    if (!todo) return snprintf(why, wcap, "out of memory"), 0;
+    for (int i = 0; i < NSEC; i++)
+        if (!lazy_section(i))
+            for (uint64_t c = L->first[i]; c < L->first[i + 1]; c++) todo[c] = 1, L->done[c] = 1;
+    verify_job j = {L->fd, &L->h, L->tab, 0, todo, L->nchunk, L->first, 0, 0};
+    pdt_ix_run_job(&j);
+    free(todo);
+    if (atomic_load(&j.bad)) return snprintf(why, wcap, "damaged: checksum mismatch"), 0;
+    return 1;
 }
 
-/* A chunk did not match (ok 0) or could not be opened (-1): remove the
- * index and say so in L->msg (async-signal-safe). */
-static const char *lazy_fail(lazy *L, int ok)
-{
-    char *m = L->msg, *end = L->msg + sizeof L->msg - 1;
-    m = cat(m, end, "the kept index ");
-    m = cat(m, end, L->path);
-    m = cat(m, end, ok == 0 ? " is damaged (a checksum mismatch, found when a part of it was "
-                              "first read); it was removed: open the run again to rebuild it"
-                            : " cannot be opened to the replay (mprotect failed)");
-    *m = 0;
-    if (ok == 0) unlink(L->path);
-    return L->msg;
-}
-
-int pdt_replay_lazy_fault(const void *addr, const char **msg)
-{
-    const char *a = addr;
-    for (int k = 0; k < LAZY_MAX; k++) {
-        lazy *L = atomic_load(&lazies[k]);
-        if (!L || a < L->base || a >= L->base + L->len) continue;
-        int ok = lazy_open_page(L, (uint64_t)(a - L->base));
-        if (ok == 1) return 1;
-        *msg = lazy_fail(L, ok);
-        return 0;
-    }
-    return -1;
-}
-
-/* Make r's mapping (map, len, header h, chunk table tab) lazily verified:
- * every page but the header's closed until read.  0 if it cannot be
- * (then the caller verifies the whole index). */
-lazy *pdt_ix_lazy_start(char *map, size_t len, const ihdr *h, uint32_t *tab, int fd,
-                        const char *path)
+lazy *pdt_ix_lazy_start(const ihdr *h, uint32_t *tab, int fd, const char *path, char *why,
+                        size_t wcap)
 {
     lazy *L = calloc(1, sizeof *L);
     if (!L) return NULL;
     uint64_t n = 0;
     for (int i = 0; i < NSEC; i++) L->first[i] = n, n += chunks_of(h->sec[i].bytes);
     L->first[NSEC] = n;
+    L->nchunk = n;
+    L->h = *h;
     L->done = calloc(n ? n : 1, 1);
     L->fd = fcntl(fd, F_DUPFD_CLOEXEC, 0);
     if (!L->done || L->fd < 0 || strlen(path) >= sizeof L->path) {
@@ -286,34 +288,19 @@ lazy *pdt_ix_lazy_start(char *map, size_t len, const ihdr *h, uint32_t *tab, int
         free(L);
         return NULL;
     }
-    L->base = map;
-
-    L->len = len;
     L->tab = tab;
-    for (int i = 0; i < NSEC; i++) L->off[i] = h->sec[i].off, L->bytes[i] = h->sec[i].bytes;
     strcpy(L->path, path);
-    int slot = -1;
-    for (int k = 0; k < LAZY_MAX && slot < 0; k++) {
-        lazy *none = NULL;
-        if (atomic_compare_exchange_strong(&lazies[k], &none, L)) slot = k;
-    }
-    if (slot < 0 || mprotect(map + HDR_BYTES, len - HDR_BYTES, PROT_NONE) != 0) {
-        if (slot >= 0) atomic_store(&lazies[slot], NULL);
-        close(L->fd);
-        free(L->done);
-        free(L);
+    if (!check_small_sections(L, why, wcap)) {
+        L->tab = NULL;  /* (the caller's) */
+        pdt_ix_lazy_stop(L);
         return NULL;
     }
     return L;
 }
 
-/* Forget a lazily verified mapping and unmap it. */
 void pdt_ix_lazy_stop(lazy *L)
 {
-    for (int k = 0; k < LAZY_MAX; k++)
-        if (atomic_load(&lazies[k]) == L) atomic_store(&lazies[k], NULL);
     close(L->fd);
-    munmap(L->base, L->len);
     free(L->tab);
     free(L->done);
     free(L);
@@ -327,15 +314,9 @@ void pdt_ix_lazy_stop(lazy *L)
 void pdt_ix_run_damaged(void *ctx, uint32_t rank)
 {
     lazy *L = ctx;
-    char *m = L->msg, *end = L->msg + sizeof L->msg - 1, num[16];
-    snprintf(num, sizeof num, "%04u", rank);
-    m = cat(m, end, "the kept index ");
-    m = cat(m, end, L->path);
-    m = cat(m, end, " refers to rank-");
-    m = cat(m, end, num);
-    m = cat(m, end, ".trace, which no longer matches it (a block's checksum); the index was removed: "
-                    "open the run again to rebuild it");
-    *m = 0;
+    snprintf(L->msg, sizeof L->msg,
+             "the kept index %s refers to rank-%04u.trace, which no longer matches it (a block's "
+             "checksum); the index was removed: open the run again to rebuild it", L->path, rank);
     unlink(L->path);
     if (damage_hook) damage_hook(L->msg);
 }

@@ -5,7 +5,6 @@
 
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "pdt/delaunay.h"
 #include "pdt/hull.h"
@@ -68,10 +67,7 @@ static pdt_status run_hull(const pdt_point *pts, size_t n, pdt_trace *tr, pdt_li
  * (every rank is a thread of this process: no clock offsets), and its block
  * of T*. */
 typedef struct rank_rec {
-    pdt_event *ev;
-    size_t n, cap;
-    int failed;
-    uint64_t t0;          /* the run's start, ns */
+    pdt_trace_buf buf;    /* its events, t in ns since the run's start */
     pdt_par_output out;
 } rank_rec;
 
@@ -81,6 +77,7 @@ typedef struct par_job {
     int level;
     rank_rec *rk;         /* one per rank */
     uint64_t *first;      /* P + 1: rank q's block is points first[q] .. first[q+1] - 1 */
+    uint64_t t0;          /* the run's start, ns (pdt_trace_ns) */
 } par_job;
 
 /* The blocks pdt_par_read deals from the file pdt_write_points writes for
@@ -102,31 +99,6 @@ static void file_blocks(const pdt_point *pts, size_t n, int p, int node, uint64_
     first[p] = n;
 }
 
-static uint64_t mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
-}
-
-static void stamp_sink(pdt_trace *tr, const pdt_event *ev)
-{
-    rank_rec *b = tr->user;
-    if (b->n == b->cap) {
-        size_t cap = b->cap ? 2 * b->cap : 1024;
-        pdt_event *e = realloc(b->ev, cap * sizeof *e);
-        if (!e) {
-            b->failed = 1;
-            return;
-        }
-        b->ev = e;
-        b->cap = cap;
-    }
-    b->ev[b->n] = *ev;
-    b->ev[b->n].t = mono_ns() - b->t0;
-    b->n++;
-}
-
 /* One rank of `mpirun -np P pdt triangulate FILE --trace DIR`: its block of
  * the input as pdt_par_read deals it ([n q / P, n (q+1) / P)), and the
  * events the command records around the library calls (run, read, the
@@ -136,7 +108,8 @@ static pdt_status live_rank(pdt_comm *c, void *arg, pdt_err *err)
     par_job *J = arg;
     int r = pdt_comm_rank(c), p = pdt_comm_size(c);
     rank_rec *R = &J->rk[r];
-    pdt_trace tr = {J->level, r, NULL, stamp_sink, R};
+    pdt_trace tr;
+    pdt_trace_buf_init_timed(&tr, &R->buf, J->level, r, J->t0);
     PDT_TRACE(&tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_RUN, 0, 0, 0, 0);
     PDT_TRACE(&tr, 1, PDT_EV_PHASE_BEGIN, PDT_PH_READ, 0, 0, 0, 0);
     (void)p;
@@ -156,7 +129,7 @@ static pdt_status live_rank(pdt_comm *c, void *arg, pdt_err *err)
         PDT_TRACE(&tr, 1, PDT_EV_PHASE_END, PDT_PH_RUN, 0, 0, 0, 0);
     }
     pdt_par_input_free(&in);
-    if (st == PDT_OK && R->failed)
+    if (st == PDT_OK && R->buf.failed)
         st = pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: out of memory while recording", r);
     return st;
 }
@@ -176,7 +149,7 @@ static int placeable(const pdt_event *e, int r, int p, const uint64_t *sent)
 static pdt_status merge_ranks(const rank_rec *rk, int p, pdt_live_result *res, pdt_err *err)
 {
     size_t total = 0;
-    for (int q = 0; q < p; q++) total += rk[q].n;
+    for (int q = 0; q < p; q++) total += rk[q].buf.n;
     size_t *pos = calloc((size_t)p, sizeof *pos);
     uint64_t *sent = calloc((size_t)p * (size_t)p, sizeof *sent);
     res->recs = malloc((total ? total : 1) * sizeof *res->recs);
@@ -188,14 +161,14 @@ static pdt_status merge_ranks(const rank_rec *rk, int p, pdt_live_result *res, p
     for (size_t k = 0; k < total; k++) {
         int best = -1, forced = -1;
         for (int q = 0; q < p; q++) {
-            if (pos[q] == rk[q].n) continue;
-            const pdt_event *e = &rk[q].ev[pos[q]];
+            if (pos[q] == rk[q].buf.n) continue;
+            const pdt_event *e = &rk[q].buf.ev[pos[q]];
             int ok = placeable(e, q, p, sent);
             int *slot = ok ? &best : &forced;
-            if (*slot < 0 || e->t < rk[*slot].ev[pos[*slot]].t) *slot = q;
+            if (*slot < 0 || e->t < rk[*slot].buf.ev[pos[*slot]].t) *slot = q;
         }
         int q = best >= 0 ? best : forced; /* a RECV without its SEND: by its time */
-        const pdt_event *e = &rk[q].ev[pos[q]];
+        const pdt_event *e = &rk[q].buf.ev[pos[q]];
         if (e->kind == PDT_EV_SEND && e->a < (uint32_t)p) sent[(size_t)q * (size_t)p + e->a]++;
         res->recs[k] = (pdt_rec){*e, (uint32_t)q, (uint32_t)pos[q]};
         pos[q]++;
@@ -228,21 +201,20 @@ static pdt_status run_ranks(const pdt_point *pts, size_t n, const pdt_live_opts 
     int p = o->ranks;
     rank_rec *rk = calloc((size_t)p, sizeof *rk);
     if (!rk) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-    uint64_t t0 = mono_ns();
-    for (int q = 0; q < p; q++) rk[q].t0 = t0;
+    uint64_t t0 = pdt_trace_ns();
     uint64_t *first = malloc((size_t)(p + 1) * sizeof *first);
     if (!first) {
         free(rk);
         return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     }
     file_blocks(pts, n, p, o->node, first);
-    par_job J = {pts, n, o->level == 2 ? 2 : 1, rk, first};
+    par_job J = {pts, n, o->level == 2 ? 2 : 1, rk, first, t0};
     pdt_status st = pdt_comm_local_run(p, live_rank, &J, err);
     if (st == PDT_OK) st = merge_ranks(rk, p, res, err);
     if (st == PDT_OK) st = gather_tris(rk, p, res, err);
     if (st == PDT_OK) st = pdt_live_ties(pts, n, res->tris, res->ntri, &res->ties, &res->nties, err);
     for (int q = 0; q < p; q++) {
-        free(rk[q].ev);
+        pdt_trace_buf_free(&rk[q].buf);
         pdt_par_output_free(&rk[q].out);
     }
     free(rk);

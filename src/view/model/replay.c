@@ -488,6 +488,7 @@ const char *pdt_replay_run_warnings(const pdt_replay *r) { return r->warnings ? 
 const pdt_point *pdt_replay_points(const pdt_replay *r, size_t *n)
 {
     *n = r->n;
+    ix_check_points(r);
     return r->pts;
 }
 
@@ -518,10 +519,13 @@ const pdt_rtri_hist *pdt_replay_tri_hist(const pdt_replay *r) { return r->hist; 
 
 int64_t pdt_replay_sort_pos(const pdt_replay *r, size_t p)
 {
-    return p < r->n && r->sort_pos ? r->sort_pos[p] : -1;
+    return p < r->n && r->sort_pos && ix_check_point(r, p) ? r->sort_pos[p] : -1;
 }
 
-uint32_t pdt_replay_lift_ev(const pdt_replay *r, size_t p) { return p < r->n ? r->lift_ev[p] : NONE32; }
+uint32_t pdt_replay_lift_ev(const pdt_replay *r, size_t p)
+{
+    return p < r->n && ix_check_point(r, p) ? r->lift_ev[p] : NONE32;
+}
 
 int pdt_replay_box(const pdt_replay *r, int rank, pdt_point *lo, pdt_point *hi)
 {
@@ -538,6 +542,7 @@ int pdt_replay_bbox(const pdt_replay *r, pdt_point *lo, pdt_point *hi)
      * first frame: 8 bytes a point read at every frame otherwise */
     pdt_replay *w = (pdt_replay *)r;
     if (!w->bbox_known) {
+        if (!ix_check_points(r)) return 0;
         pdt_point a = r->pts[0], b = r->pts[0];
         for (size_t p = 1; p < r->n; p++) {
             if (p % ((size_t)1 << 21) == 0 && r->release_points) r->release_points(r->release_ctx);

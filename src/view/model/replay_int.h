@@ -285,4 +285,29 @@ void pdt_replay_tab_release(const pdt_replay *r, const void *p, size_t len);
 /* Unmap a replay's kept index (index.c). */
 void pdt_index_unmap(pdt_replay *r);
 
+/* ---- a lazily verified kept index: the checks before a read (index_verify.c) ----
+ *
+ * A replay whose kept index is verified lazily (r->lazy) checks each chunk
+ * of its big tables the first time one of these asks for it.  Each returns
+ * 1, or 0 when the chunk did not match (the index is then removed and the
+ * program told: it should stop).  Without r->lazy they cost one branch. */
+/* pdt_replay_step without the checks: the caller asked for the events and triangles
+ * (state.c). */
+int pdt_rp_step(const pdt_replay *r, pdt_rstate *s, int dir);
+int pdt_ix_need(const pdt_replay *r, int sec, uint64_t lo, uint64_t hi); /* bytes of section sec */
+int pdt_ix_need_events(const pdt_replay *r, size_t lo, size_t hi);  /* ev_obj, ev_kind */
+int pdt_ix_need_born(const pdt_replay *r, size_t k); /* the triangles born by cursor k, entries */
+int pdt_ix_need_ckpt(const pdt_replay *r, size_t c);                 /* checkpoint c */
+int pdt_ix_need_point(const pdt_replay *r, size_t p);  /* point p's per-point tables */
+int pdt_ix_need_points(const pdt_replay *r);                         /* the points */
+int pdt_ix_need_all(const pdt_replay *r);                            /* every table */
+
+static inline int ix_check_events(const pdt_replay *r, size_t lo, size_t hi)
+{
+    return !r->lazy || pdt_ix_need_events(r, lo, hi);
+}
+static inline int ix_check_born(const pdt_replay *r, size_t k) { return !r->lazy || pdt_ix_need_born(r, k); }
+static inline int ix_check_point(const pdt_replay *r, size_t p) { return !r->lazy || pdt_ix_need_point(r, p); }
+static inline int ix_check_points(const pdt_replay *r) { return !r->lazy || pdt_ix_need_points(r); }
+
 #endif

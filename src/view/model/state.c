@@ -97,6 +97,7 @@ void pdt_replay_give_back(const pdt_replay *r, const pdt_rstate *s)
 
 static uint8_t point_flags(const pdt_replay *r, size_t p, size_t k)
 {
+    ix_check_point(r, p);
     return (uint8_t)((r->lift_ev[p] < k ? PDT_PF_LIFTED : 0) |
                      (r->sort_ev && r->sort_ev[p] < k ? PDT_PF_SORTED : 0) |
                      (r->del_ev && r->del_ev[p] < k ? PDT_PF_DELETED : 0));
@@ -126,6 +127,7 @@ void pdt_replay_seek_direct(const pdt_replay *r, pdt_rstate *s, size_t k)
         seek_zero(r, s);
         return;
     }
+    if (r->lazy && !pdt_ix_need_all(r)) return;  /* (every table is read) */
     s->k = k;
     for (size_t p = 0; p < r->n; p++) s->pflags[p] = point_flags(r, p, k);
     for (size_t t = 0; t < r->ntri; t++) {
@@ -191,6 +193,15 @@ static void apply(const pdt_replay *r, pdt_rstate *s, size_t i, int fwd)
 }
 
 int pdt_replay_step(const pdt_replay *r, pdt_rstate *s, int dir)
+{
+    if (r->lazy) { /* the event's entries and the triangles born by then, checked first */
+        size_t i = dir > 0 ? s->k : s->k - (s->k > 0);
+        if (!pdt_ix_need_events(r, i, i + 1) || !pdt_ix_need_born(r, s->k + (dir > 0))) return 0;
+    }
+    return pdt_rp_step(r, s, dir);
+}
+
+int pdt_rp_step(const pdt_replay *r, pdt_rstate *s, int dir)
 {
     if (dir > 0) {
         if (s->k >= r->m) return 0;
