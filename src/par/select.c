@@ -15,10 +15,10 @@
  *            cut into W parts, the keys up to each cut counted (binary
  *            searches) and summed over the ranks (one SUM allreduce), and
  *            each search keeps the part holding its answer.  W shares a
- *            budget of SEL_BUDGET counters among the groups, at least
- *            SEL_MIN_WAYS each: the first round cuts the whole key range in
- *            SEL_BUDGET parts, the later ones each splitter's part in 8 or
- *            more.
+ *            budget of 256 + 16 ns counters among the groups, at least 16
+ *            each: the first round of the p - 1 splitters cuts the whole
+ *            key range in 16 p + 240 parts, the later ones each splitter's
+ *            part in 16 or more.
  *
  * (The first version cut every splitter's interval in 256 parts every
  * round: (p - 1) x 255 counts and binary searches per rank and round, the
@@ -28,7 +28,10 @@
 
 #include "driver.h"
 
-enum { SEL_BUDGET = 8192, SEL_MIN_WAYS = 8 };
+/* Counters per round: SEL_BASE + SEL_MIN_WAYS per search, at least
+ * SEL_MIN_WAYS per group (each costs a binary search on every rank, and 8
+ * bytes in the allreduce). */
+enum { SEL_BASE = 256, SEL_MIN_WAYS = 16 };
 
 /* The j-th of the W - 1 cuts of [lo, hi] (parts of `step` keys). */
 static uint64_t sel_cut(uint64_t lo, uint64_t hi, uint64_t step, size_t j)
@@ -106,7 +109,8 @@ static size_t sel_groups(sel *s)
         s->g[q] = same ? s->g[p] : (size_t)q;
         ng += !same;
     }
-    size_t ways = ng ? SEL_BUDGET / ng : 0, nc = 0;
+    size_t budget = SEL_BASE + SEL_MIN_WAYS * (size_t)s->ns;
+    size_t ways = ng ? budget / ng : 0, nc = 0;
     if (ways < SEL_MIN_WAYS) ways = SEL_MIN_WAYS;
     for (int q = 0; q < s->ns; q++) {
         if (!sel_open(s, q) || s->g[q] != (size_t)q) continue;
@@ -150,7 +154,7 @@ static pdt_status sel_count(drv *d, sel *s, pdt_err *err)
 pdt_status pdt_drv_select_keys(drv *d, int ns, const srm_rec *const *arr, const size_t *len,
                                const uint64_t *t, uint64_t *lo, uint64_t *hi, pdt_err *err)
 {
-    size_t z = (size_t)ns + 1, nv = SEL_BUDGET + SEL_MIN_WAYS * z;
+    size_t z = (size_t)ns + 1, nv = SEL_BASE + 2 * SEL_MIN_WAYS * z;
     sel s = {ns, arr, len, t, lo, hi, malloc(nv * sizeof *s.v), malloc(z * sizeof *s.g),
              malloc(z * sizeof *s.w), malloc(z * sizeof *s.at)};
     pdt_status st = s.v && s.g && s.w && s.at ? PDT_OK : pdt_drv_nomem(d, "partition");
