@@ -2,9 +2,11 @@
 # pdt on a simulated cluster (scripts/simulate.sh: bin/smpi/pdt under
 # SimGrid's smpirun, docs/simulation.md): 256 simulated ranks on a small
 # input write the plain run's bytes (every rank pwrites its block into the
-# one process's file), without PDT_MPI=1 (pdt sees smpirun by itself), with
+# one process's file), on every family of pdt gen and with either
+# partition, without PDT_MPI=1 (pdt sees smpirun by itself), with
 # --stats saying "simulated": true and 256 ranks; more ranks than points
-# work; --trace writes one file per rank that `pdt trace check` accepts.
+# work; --trace writes one file per rank (256 of them) that `pdt trace
+# check` accepts.
 # Builds bin/smpi/pdt if it is missing.
 source "$(dirname "$0")/lib.sh"
 SIM=$ROOT/scripts/simulate.sh
@@ -45,6 +47,21 @@ else
     fail smpi_256_ranks_same_bytes_as_plain "exit $?: $(head -3 p256.err)"
 fi
 
+# every family of pdt gen at 256 ranks, both partitions in turn: the plain
+# run's bytes (ties, duplicates, collinear and cocircular points at scale)
+part=strips
+for fam in uniform grid circle circle-round parabola clusters collinear duplicates column; do
+    "$PDT" gen "$fam" 300 --seed 3 -o "f-$fam.txt"
+    "$PDT" triangulate "f-$fam.txt" -o "f-$fam.ele"
+    if sim "f-$fam" 256 "f-$fam.txt" -o "f-$fam-sim.ele" --partition "$part" &&
+        cmp -s "f-$fam.ele" "f-$fam-sim.ele"; then
+        ok "smpi_256_ranks_${fam}_${part}_same_bytes"
+    else
+        fail "smpi_256_ranks_${fam}_${part}_same_bytes" "$(head -3 "f-$fam.err")"
+    fi
+    if [ "$part" = strips ]; then part=bisect; else part=strips; fi
+done
+
 # more ranks than points: 64 ranks, 20 points (most ranks get none)
 "$PDT" gen uniform 20 --seed 7 -o few.txt
 "$PDT" triangulate few.txt -o few.ele
@@ -57,11 +74,11 @@ fi
 # a simulated trace: one file per rank, simulated clock, accepted by the checker
 "$PDT" gen clusters 600 -o c.txt
 "$PDT" triangulate c.txt -o c.ele
-if sim tr 64 c.txt -o c-sim.ele --trace run && cmp -s c.ele c-sim.ele &&
-    [ "$(ls run/rank-*.trace | wc -l)" = 64 ] && "$PDT" trace check run > check.out 2>&1; then
-    ok smpi_trace_64_ranks_checks
+if sim tr 256 c.txt -o c-sim.ele --partition strips --trace run && cmp -s c.ele c-sim.ele &&
+    [ "$(ls run/rank-*.trace | wc -l)" = 256 ] && "$PDT" trace check run > check.out 2>&1; then
+    ok smpi_trace_256_ranks_checks
 else
-    fail smpi_trace_64_ranks_checks "$(head -3 tr.err) $(tail -3 check.out 2>/dev/null)"
+    fail smpi_trace_256_ranks_checks "$(head -3 tr.err) $(tail -3 check.out 2>/dev/null)"
 fi
 
 # a wrong platform is a usage error

@@ -320,11 +320,14 @@ static pdt_status rank_partition(pdt_comm *c, void *arg, pdt_err *err)
     return PDT_OK;
 }
 
-TEST(partition_exact_shares_p2_to_p7)
+/* (P = 33 and 64: many splitters share the selection's first rounds) */
+TEST(partition_exact_shares_p2_to_p7_33_64)
 {
+    static const int ps[] = {2, 3, 4, 5, 6, 7, 33, 64};
     for (int dups = 0; dups <= 1; dups++)
-        for (int P = 2; P <= 7; P++) {
-            uint64_t pts[8] = {0};
+        for (size_t k = 0; k < sizeof ps / sizeof *ps; k++) {
+            int P = ps[k];
+            uint64_t pts[64] = {0};
             part_job j = {3000, dups, dups ? 2001 : 3000, pts};
             pdt_err err = {0};
             pdt_status s = pdt_comm_local_run(P, rank_partition, &j, &err);
@@ -343,6 +346,6 @@ int main(void)
     RUN(one_file_written_by_all_ranks);
     RUN(failing_rank_ends_the_run);
     RUN(commit_refused_when_any_rank_is_stopped);
-    RUN(partition_exact_shares_p2_to_p7);
+    RUN(partition_exact_shares_p2_to_p7_33_64);
     return test_summary();
 }
