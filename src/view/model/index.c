@@ -656,6 +656,31 @@ static void evcopy_free(evcopy *ec)
     free(ec->segs_crc.crc);
 }
 
+static void evstream_free(evstream *es)
+{
+    pdt_merge_close(es->mg);
+    free(es->buf);
+    if (es->map) munmap(es->map, es->map_len);
+}
+
+/* The replay r built: its checkpoints planned and every table written to
+ * the index (fd, header h); the build's working memory (*work) and
+ * buckets said. */
+static pdt_status finish_build(pdt_replay *r, pdt_run *run, int fd, ihdr *h, uint64_t ident,
+                               placer *pc, evcopy *ec, uint64_t budget, uint64_t *work,
+                               uint32_t *buckets, pdt_err *err)
+{
+    r->warnings = pdt_run_warnings(run);
+    plan_checkpoints(r, budget);
+    pdt_status st = write_tables(r, fd, h, ident, pc, ec, err);
+    pdt_run_release_points(run);  /* (written from them) */
+    *work = r->build_peak + (r->state_paged ? 0 : pdt_replay_state_bytes(r)); /* (the
+                                                        * checkpoints' state, when held) */
+    *buckets = r->build_buckets;
+    r->nick = 0;  /* r's own tables are freed by the caller; it has no mapped checkpoints */
+    return st;
+}
+
 static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks, uint64_t ident,
                         const char *path, uint64_t budget, uint64_t *work, uint32_t *buckets,
                         pdt_err *err)
@@ -705,21 +730,10 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
     pipe_stop(&pipe);
     for (int k = 0; k < PDT_SCR_COUNT; k++) scratch_drop(&pc, k);  /* the scratch: gone */
-    if (st == PDT_OK) {
-        r->warnings = pdt_run_warnings(run);
-        plan_checkpoints(r, budget);
-        st = write_tables(r, fd, h, ident, &pc, &ec, err);
-        pdt_run_release_points(run);  /* (written from them) */
-        *work = r->build_peak + (r->state_paged ? 0 : pdt_replay_state_bytes(r)); /* (the
-                                                            * checkpoints' state, when held) */
-        *buckets = r->build_buckets;
-        r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
-    }
+    if (st == PDT_OK) st = finish_build(r, run, fd, h, ident, &pc, &ec, budget, work, buckets, err);
     pdt_replay_free(r);
     pdt_evsrc_clear(&ec.src);
-    pdt_merge_close(es.mg);
-    free(es.buf);
-    if (es.map) munmap(es.map, es.map_len);
+    evstream_free(&es);
     /* into place over a stale index by an exchange of names, without ext4
      * writing the new one back inside the call (gigabytes for a big run) */
     if (st == PDT_OK) st = pdt_safe_commit(&sf, err);
