@@ -111,6 +111,33 @@ static pdt_status make_dir(const char *dir, pdt_err *err)
     return pdt_err_set(err, PDT_ERR_IO, "%s: cannot create folder: %s", dir, strerror(errno));
 }
 
+/* Remove the folder's manifest and points.bin (rank 0, at the start of a
+ * run).  0 when out of memory. */
+static int remove_stale_meta(const char *dir)
+{
+    const char *stale[] = {"manifest", "points.bin"};
+    for (int i = 0; i < 2; i++) {
+        char *p = pdt_tf_path_join(dir, stale[i]);
+        if (!p) return 0;
+        unlink(p);
+        free(p);
+    }
+    return 1;
+}
+
+/* A rank file's header (TF_HEADER_SIZE bytes at h). */
+static void file_header(uint8_t *h, int rank, int level)
+{
+    memset(h, 0, TF_HEADER_SIZE);
+    memcpy(h, TF_MAGIC, 8);
+    h[8] = PDT_TRACE_FORMAT_MAJOR;
+    h[10] = PDT_TRACE_FORMAT_MINOR;
+    tf_put32(h + 12, TF_HEADER_SIZE);
+    tf_put32(h + 16, (uint32_t)rank);
+    tf_put32(h + 20, (uint32_t)level);
+    tf_put32(h + 28, pdt_crc32c(0, h, 28));
+}
+
 pdt_status pdt_tw_open(const char *dir, int rank, int level, pdt_trace_writer **out,
                        pdt_err *err)
 {
@@ -131,17 +158,9 @@ pdt_status pdt_tw_open(const char *dir, int rank, int level, pdt_trace_writer **
         pdt_tw_abort(w);
         return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     }
-    if (rank == 0) {  /* a stale manifest must not describe the new traces */
-        const char *stale[] = {"manifest", "points.bin"};
-        for (int i = 0; i < 2; i++) {
-            char *p = pdt_tf_path_join(dir, stale[i]);
-            if (!p) {
-                pdt_tw_abort(w);
-                return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
-            }
-            unlink(p);
-            free(p);
-        }
+    if (rank == 0 && !remove_stale_meta(dir)) {  /* a stale manifest must not describe the new traces */
+        pdt_tw_abort(w);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     }
     /* a fresh file: never through a link or into another name's inode
      * planted at this name (a traced run writes into a folder it created
@@ -153,14 +172,8 @@ pdt_status pdt_tw_open(const char *dir, int rank, int level, pdt_trace_writer **
         pdt_tw_abort(w);
         return st;
     }
-    uint8_t h[TF_HEADER_SIZE] = {0};
-    memcpy(h, TF_MAGIC, 8);
-    h[8] = PDT_TRACE_FORMAT_MAJOR;
-    h[10] = PDT_TRACE_FORMAT_MINOR;
-    tf_put32(h + 12, TF_HEADER_SIZE);
-    tf_put32(h + 16, (uint32_t)rank);
-    tf_put32(h + 20, (uint32_t)level);
-    tf_put32(h + 28, pdt_crc32c(0, h, 28));
+    uint8_t h[TF_HEADER_SIZE];
+    file_header(h, rank, level);
     tw_write(w, h, sizeof h);
     if (w->err.code != PDT_OK) {
         st = pdt_err_set(err, w->err.code, "%s", w->err.msg);

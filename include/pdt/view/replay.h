@@ -170,6 +170,11 @@ const pdt_point *pdt_replay_points(const pdt_replay *r, size_t *n);
 const pdt_rec *pdt_replay_rec(const pdt_replay *r, size_t i);
 /* The rank of event i, without decoding it; UINT32_MAX if i >= count. */
 uint32_t pdt_replay_rank_of(const pdt_replay *r, size_t i);
+/* The triangles and (pdt_replay_tri_hist) their entries.  Of a lazily
+ * verified kept index (pdt_replay_lazy_verify) only the triangles born by
+ * a cursor a state of r has been moved to (pdt_replay_born_at_most) are
+ * checked, with their entries: read a triangle only once a state says it
+ * has an entry (pdt_rstate_tri_entry), as the renderer does. */
 const pdt_rtri *pdt_replay_tris(const pdt_replay *r, size_t *n);
 /* A bound on the triangles born before cursor k, known without reading a
  * table: triangles t >= it have no entry at k (the triangles are numbered by

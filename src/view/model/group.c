@@ -246,12 +246,58 @@ static pdt_rtri_hist hist_of_x(const pdt_replay *r, const tri_xrec *t)
  * first place: fine_off[f]), both in event order within each bucket, and
  * the triangles per bucket (tcount).  Nothing is written per event in
  * memory: numbering the triangles comes after (pdt_rp_tri_number). */
+/* Run k's records (its buckets' spilled chunks, one after the other) into
+ * buf (nb of them): 1, or 0 when they cannot be read. */
+static int read_run(group_job *J, size_t k, tri_xrec *buf, size_t nb)
+{
+    builder *b = J->b;
+    const pdt_replay_place *pl = b->pl;
+    for (size_t c = b->ck_start[J->run[k]], got = 0; c < b->ck_start[J->run[k + 1]]; c++) {
+        const spill_chunk *ck = &b->tlog.chunk[c]; /* the run's chunks, bucket by bucket */
+        if (got + ck->n > nb ||
+            !pl->sget(pl->ctx, PDT_SCR_SPILL, ck->off, buf + got, ck->n * sizeof *buf))
+            return 0;
+        got += ck->n;
+    }
+    return 1;
+}
+
+/* Run k grouped (S, its records buf from base on): bucket by bucket, its
+ * triangles are the groups first seen in it; their first events and the
+ * entries and per-event marks of the run written to the scratch.  1, or 0
+ * when a write failed. */
+static int write_run(group_job *J, size_t k, group_scratch *S, const tri_xrec *buf,
+                     pdt_rtri_hist *out, tri_ev *eout, tri_first *tout, size_t base)
+{
+    builder *b = J->b;
+    pdt_replay *r = b->r;
+    const pdt_replay_place *pl = b->pl;
+    size_t nb = b->fine_off[J->run[k + 1]] - base;
+    uint32_t g0 = 0;
+    for (size_t f = J->run[k]; f < J->run[k + 1]; f++) {
+        size_t j0 = b->fine_off[f] - base, j1 = b->fine_off[f + 1] - base;
+        uint32_t g1 = g0;
+        for (size_t j = j0; j < j1; j++) {
+            uint32_t q = S->gid[j], ev = buf[j].ev, at = S->gfill[q]++;
+            if (q >= g1) g1 = q + 1;
+            out[at - base] = hist_of_x(r, &buf[j]);
+            eout[j] = (tri_ev){ev, (q - g0) | (ev == S->gfirst[q] ? TEV_FIRST : 0)};
+        }
+        for (uint32_t q = g0; q < g1; q++) tout[q - g0] = (tri_first){S->gfirst[q], S->gn[q]};
+        b->tcount[f] = g1 - g0;
+        if (g1 > g0 && !pl->sput(pl->ctx, PDT_SCR_TRIS, (uint64_t)b->fine_off[f] * sizeof *tout,
+                                 tout, (g1 - g0) * sizeof *tout))
+            return 0;
+        g0 = g1;
+    }
+    return pl->sput(pl->ctx, PDT_SCR_HIST, base * sizeof *out, out, nb * sizeof *out) &&
+           pl->sput(pl->ctx, PDT_SCR_TRIEV, (uint64_t)base * sizeof *eout, eout, nb * sizeof *eout);
+}
+
 static void *group_worker_streamed(void *arg)
 {
     group_job *J = arg;
     builder *b = J->b;
-    pdt_replay *r = b->r;
-    const pdt_replay_place *pl = b->pl;
     size_t most = J->most;
     group_scratch S;
     int ok = scratch_get(b, &S, most, sizeof(tri_xrec));
@@ -266,40 +312,13 @@ static void *group_worker_streamed(void *arg)
         if (k >= J->nrun) break;
         size_t base = b->fine_off[J->run[k]], nb = b->fine_off[J->run[k + 1]] - base;
         if (!nb) continue;
-        for (size_t c = b->ck_start[J->run[k]], got = 0; c < b->ck_start[J->run[k + 1]]; c++) {
-            const spill_chunk *ck = &b->tlog.chunk[c]; /* the run's chunks, bucket by bucket */
-            if (got + ck->n > nb ||
-                !pl->sget(pl->ctx, PDT_SCR_SPILL, ck->off, buf + got, ck->n * sizeof *buf)) {
-                J->io = 1;
-                ok = 0;
-                break;
-            }
-            got += ck->n;
+        if (!read_run(J, k, buf, nb)) {
+            J->io = 1;
+            ok = 0;
+            break;
         }
-        if (!ok) break;
         uint32_t ng = scratch_group(&S, nb, base);
-        /* bucket by bucket: its triangles are the groups first seen in it */
-        uint32_t g0 = 0;
-        for (size_t f = J->run[k]; f < J->run[k + 1]; f++) {
-            size_t j0 = b->fine_off[f] - base, j1 = b->fine_off[f + 1] - base;
-            uint32_t g1 = g0;
-            for (size_t j = j0; j < j1; j++) {
-                uint32_t q = S.gid[j], ev = buf[j].ev, at = S.gfill[q]++;
-                if (q >= g1) g1 = q + 1;
-                out[at - base] = hist_of_x(r, &buf[j]);
-                eout[j] = (tri_ev){ev, (q - g0) | (ev == S.gfirst[q] ? TEV_FIRST : 0)};
-            }
-            for (uint32_t q = g0; q < g1; q++) tout[q - g0] = (tri_first){S.gfirst[q], S.gn[q]};
-            b->tcount[f] = g1 - g0;
-            if (g1 > g0 && !pl->sput(pl->ctx, PDT_SCR_TRIS, (uint64_t)b->fine_off[f] * sizeof *tout,
-                                     tout, (g1 - g0) * sizeof *tout)) {
-                ok = 0;
-                break;
-            }
-            g0 = g1;
-        }
-        if (!ok || !pl->sput(pl->ctx, PDT_SCR_HIST, base * sizeof *out, out, nb * sizeof *out) ||
-            !pl->sput(pl->ctx, PDT_SCR_TRIEV, (uint64_t)base * sizeof *eout, eout, nb * sizeof *eout)) {
+        if (!write_run(J, k, &S, buf, out, eout, tout, base)) {
             J->io = 1;
             ok = 0;
         }

@@ -621,6 +621,66 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
 }
 
 /* Build the index of run at `path` (temporary file + rename). */
+/* The events of the run's ranks. */
+static size_t run_events(pdt_run *run, int nranks)
+{
+    uint64_t events = 0;
+    for (int q = 0; q < nranks; q++) {
+        pdt_rank_info ri;
+        pdt_run_rank_info(run, q, &ri);
+        events += ri.events;
+    }
+    return (size_t)events;
+}
+
+/* Where the index's checkpoints go: every m/ICK_PARTS events or more often
+ * for a long run (ICK_MAX_EVERY), within ICK_MAX_PARTS; their state paged
+ * beyond a quarter of the budget, as a replay's is (pdt_replay_set_mem). */
+static void plan_checkpoints(pdt_replay *r, uint64_t budget)
+{
+    size_t parts = (r->m + ICK_MAX_EVERY - 1) / ICK_MAX_EVERY;
+    parts = parts < ICK_PARTS ? ICK_PARTS : parts > ICK_MAX_PARTS ? ICK_MAX_PARTS : parts;
+    size_t every = r->m / parts;
+    r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
+    r->nick = r->m / r->ick_every + 1;
+    r->mem_budget = budget;
+    r->state_paged = budget && pdt_replay_state_bytes(r) > budget / 4;
+}
+
+static void evcopy_free(evcopy *ec)
+{
+    free(ec->blk);
+    free(ec->rank_blk);
+    free(ec->src.file);
+    free(ec->src.file_len);
+    free(ec->segs_crc.crc);
+}
+
+static void evstream_free(evstream *es)
+{
+    pdt_merge_close(es->mg);
+    free(es->buf);
+    if (es->map) munmap(es->map, es->map_len);
+}
+
+/* The replay r built: its checkpoints planned and every table written to
+ * the index (fd, header h); the build's working memory (*work) and
+ * buckets said. */
+static pdt_status finish_build(pdt_replay *r, pdt_run *run, int fd, ihdr *h, uint64_t ident,
+                               placer *pc, evcopy *ec, uint64_t budget, uint64_t *work,
+                               uint32_t *buckets, pdt_err *err)
+{
+    r->warnings = pdt_run_warnings(run);
+    plan_checkpoints(r, budget);
+    pdt_status st = write_tables(r, fd, h, ident, pc, ec, err);
+    pdt_run_release_points(run);  /* (written from them) */
+    *work = r->build_peak + (r->state_paged ? 0 : pdt_replay_state_bytes(r)); /* (the
+                                                        * checkpoints' state, when held) */
+    *buckets = r->build_buckets;
+    r->nick = 0;  /* r's own tables are freed by the caller; it has no mapped checkpoints */
+    return st;
+}
+
 static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks, uint64_t ident,
                         const char *path, uint64_t budget, uint64_t *work, uint32_t *buckets,
                         pdt_err *err)
@@ -637,13 +697,7 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     evcopy ec;
     memset(&ec, 0, sizeof ec);
     pdt_replay *r = NULL;
-    uint64_t events = 0;
-    for (int q = 0; q < nranks; q++) {
-        pdt_rank_info ri;
-        pdt_run_rank_info(run, q, &ri);
-        events += ri.events;
-    }
-    size_t m = (size_t)events;
+    size_t m = run_events(run, nranks);
     evstream es;
     memset(&es, 0, sizeof es);
     es.cur.rank = UINT32_MAX;
@@ -676,39 +730,16 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
     pipe_stop(&pipe);
     for (int k = 0; k < PDT_SCR_COUNT; k++) scratch_drop(&pc, k);  /* the scratch: gone */
-    if (st == PDT_OK) {
-        r->warnings = pdt_run_warnings(run);
-        size_t parts = (r->m + ICK_MAX_EVERY - 1) / ICK_MAX_EVERY;
-        parts = parts < ICK_PARTS ? ICK_PARTS : parts > ICK_MAX_PARTS ? ICK_MAX_PARTS : parts;
-        size_t every = r->m / parts;
-        r->ick_every = every < ICK_MIN_EVERY ? ICK_MIN_EVERY : every;
-        r->nick = r->m / r->ick_every + 1;
-        /* the checkpoints' state: paged beyond a quarter of the budget, as a
-         * replay's is (pdt_replay_set_mem) */
-        r->mem_budget = budget;
-        r->state_paged = budget && pdt_replay_state_bytes(r) > budget / 4;
-        st = write_tables(r, fd, h, ident, &pc, &ec, err);
-        pdt_run_release_points(run);  /* (written from them) */
-        *work = r->build_peak + (r->state_paged ? 0 : pdt_replay_state_bytes(r)); /* (the
-                                                            * checkpoints' state, when held) */
-        *buckets = r->build_buckets;
-        r->nick = 0;  /* r's own tables are freed below; it has no mapped checkpoints */
-    }
+    if (st == PDT_OK) st = finish_build(r, run, fd, h, ident, &pc, &ec, budget, work, buckets, err);
     pdt_replay_free(r);
     pdt_evsrc_clear(&ec.src);
-    pdt_merge_close(es.mg);
-    free(es.buf);
-    if (es.map) munmap(es.map, es.map_len);
+    evstream_free(&es);
     /* into place over a stale index by an exchange of names, without ext4
      * writing the new one back inside the call (gigabytes for a big run) */
     if (st == PDT_OK) st = pdt_safe_commit(&sf, err);
     else pdt_safe_abort(&sf);
     free(h);
-    free(ec.blk);
-    free(ec.rank_blk);
-    free(ec.src.file);
-    free(ec.src.file_len);
-    free(ec.segs_crc.crc);
+    evcopy_free(&ec);
     return st;
 }
 
@@ -760,6 +791,54 @@ static void release_run_points(const void *run)
     pdt_run_release_points(run);
 }
 
+/* A valid kept index of the run (identity ident) beside it, else in the
+ * cache: the replay (its place in path), or NULL (info->why says why). */
+static pdt_replay *find_kept(const char *dir, uint64_t ident, const pdt_point *pts, size_t n,
+                             char *path, size_t pcap, pdt_replay_open_info *info)
+{
+    pdt_replay *r = NULL;
+    for (int where = 0; where < 2 && !r; where++) {
+        char why[160];
+        if (!pdt_ix_index_path(dir, where, path, pcap)) continue;
+        r = pdt_ix_load(path, dir, ident, pts, n, 1, why, sizeof why);
+        if (!r && where == 0) snprintf(info->why, sizeof info->why, "%s", why);
+        if (!r && where == 1 && strcmp(why, "no index yet"))
+            snprintf(info->why, sizeof info->why, "%s", why);
+    }
+    return r;
+}
+
+/* Build the run's index beside it if the folder takes it, else in the
+ * cache, and open it: the replay (its place in path), or NULL
+ * (info->write_error says why). */
+static pdt_replay *build_kept(pdt_run *run, const char *dir, uint64_t ident, uint64_t budget,
+                              char *path, size_t pcap, pdt_replay_open_info *info)
+{
+    size_t n;
+    const pdt_point *pts = pdt_run_points(run, &n);
+    pdt_replay *r = NULL;
+    double t0 = pdt_seconds();
+    for (int where = 0; where < 2 && !r; where++) {
+        if (!pdt_ix_index_path(dir, where, path, pcap)) continue;
+        if (where == 1) {
+            char cdir[PATH_MAX];
+            if (!pdt_ix_cache_dir(cdir, sizeof cdir) || !pdt_ix_make_dirs(cdir)) continue;
+        }
+        pdt_err e2 = {0};
+        if (build(run, pts, n, pdt_run_nranks(run), ident, path, budget, &info->build_bytes,
+                  &info->build_buckets, &e2) != PDT_OK) {
+            snprintf(info->write_error, sizeof info->write_error, "%s", e2.msg);
+            pdt_err_clear(&e2);
+            continue;
+        }
+        char why[160];
+        r = pdt_ix_load(path, dir, ident, pts, n, 0, why, sizeof why);
+    }
+    info->built = r != NULL;
+    info->build_s = pdt_seconds() - t0;
+    return r;
+}
+
 pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, int use_index,
                                pdt_replay **out, pdt_replay_open_info *info, pdt_err *err)
 {
@@ -770,56 +849,15 @@ pdt_status pdt_replay_open_run(pdt_run *run, const char *dir, uint64_t budget, i
     size_t n;
     const pdt_point *pts = pdt_run_points(run, &n);
     int nranks = pdt_run_nranks(run);
-    uint64_t events = 0;
-    for (int q = 0; q < nranks; q++) {
-        pdt_rank_info ri;
-        pdt_run_rank_info(run, q, &ri);
-        events += ri.events;
-    }
-    info->events = events;
-    if (use_index < 0) use_index = events * EST_BYTES_PER_EVENT > budget / 4;
-    pdt_status st;
-    if (!use_index) {
-        st = in_memory(run, pts, n, nranks, out, err);
-        if (st == PDT_OK) pdt_replay_set_mem(*out, budget);
-        return st;
-    }
+    info->events = run_events(run, nranks);
+    if (use_index < 0) use_index = info->events * EST_BYTES_PER_EVENT > budget / 4;
     uint64_t ident = 0;
-    st = pdt_ix_run_ident(dir, &ident, err);
+    pdt_status st = use_index ? pdt_ix_run_ident(dir, &ident, err) : PDT_OK;
     if (st != PDT_OK) return st;
     char path[PATH_MAX];
-    pdt_replay *r = NULL;
-    /* a kept index beside the run, else in the cache */
-    for (int where = 0; where < 2 && !r; where++) {
-        char why[160];
-        if (!pdt_ix_index_path(dir, where, path, sizeof path)) continue;
-        r = pdt_ix_load(path, dir, ident, pts, n, 1, why, sizeof why);
-        if (!r && where == 0) snprintf(info->why, sizeof info->why, "%s", why);
-        if (!r && where == 1 && strcmp(why, "no index yet"))
-            snprintf(info->why, sizeof info->why, "%s", why);
-    }
-    if (!r) { /* (re)build it: beside the run if the folder takes it, else in the cache */
-        double t0 = pdt_seconds();
-        for (int where = 0; where < 2 && !r; where++) {
-            if (!pdt_ix_index_path(dir, where, path, sizeof path)) continue;
-            if (where == 1) {
-                char cdir[PATH_MAX];
-                if (!pdt_ix_cache_dir(cdir, sizeof cdir) || !pdt_ix_make_dirs(cdir)) continue;
-            }
-            pdt_err e2 = {0};
-            if (build(run, pts, n, nranks, ident, path, budget, &info->build_bytes,
-                      &info->build_buckets, &e2) != PDT_OK) {
-                snprintf(info->write_error, sizeof info->write_error, "%s", e2.msg);
-                pdt_err_clear(&e2);
-                continue;
-            }
-            char why[160];
-            r = pdt_ix_load(path, dir, ident, pts, n, 0, why, sizeof why);
-        }
-        info->built = r != NULL;
-        info->build_s = pdt_seconds() - t0;
-    }
-    if (!r) { /* no place to keep an index: the whole run in memory */
+    pdt_replay *r = use_index ? find_kept(dir, ident, pts, n, path, sizeof path, info) : NULL;
+    if (use_index && !r) r = build_kept(run, dir, ident, budget, path, sizeof path, info);
+    if (!r) { /* not asked for, or no place to keep an index: the whole run in memory */
         st = in_memory(run, pts, n, nranks, out, err);
         if (st == PDT_OK) pdt_replay_set_mem(*out, budget);
         return st;

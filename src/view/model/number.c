@@ -139,77 +139,116 @@ static void bcurs_free(builder *b, bcur *c, size_t rec)
  * numbers in PDT_SCR_IDS (from fine_off[f]); the corners and maker of a
  * triangle from its first event (decoded, in event order).  Each bucket's
  * entries (PDT_SCR_HIST, from its fine_off) are its triangles' in order. */
+/* The numbering pass's cursors: per fine bucket, its triangles' first
+ * events (tc), their ids (ic, written) and their entries (hc); the
+ * triangle table and the entries written in order (tw, hw); the window's
+ * triangles by event (wn: entries, 0 for none; wf: their bucket). */
+typedef struct numbering {
+    bcur *tc, *ic, *hc, tw, hw;
+    uint32_t *wn;
+    uint16_t *wf;
+    size_t h0;  /* entries written */
+} numbering;
+
+static int num_open(builder *b, numbering *N)
+{
+    pdt_replay *r = b->r;
+    memset(N, 0, sizeof *N);
+    N->tc = bcurs_new(b, sizeof(tri_first));
+    N->ic = bcurs_new(b, sizeof(uint32_t));
+    N->hc = bcurs_new(b, sizeof(pdt_rtri_hist));
+    N->wn = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *N->wn);
+    N->wf = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *N->wf);
+    N->tw.buf = pdt_rp_bmalloc(b, CUR_RECS * sizeof(pdt_rtri));
+    N->hw.buf = pdt_rp_bmalloc(b, CUR_RECS * sizeof(pdt_rtri_hist));
+    if (!N->tc || !N->ic || !N->hc || !N->wn || !N->wf || !N->tw.buf || !N->hw.buf) return 0;
+    for (size_t f = 0; f < b->nfine; f++) {
+        N->tc[f].file = PDT_SCR_TRIS;
+        N->tc[f].at = (uint64_t)b->fine_off[f] * sizeof(tri_first);
+        N->tc[f].left = b->tcount[f];
+        N->ic[f].file = PDT_SCR_IDS;
+        N->ic[f].at = (uint64_t)b->fine_off[f] * sizeof(uint32_t);
+        N->hc[f].file = PDT_SCR_HIST;
+        N->hc[f].at = (uint64_t)b->fine_off[f] * sizeof(pdt_rtri_hist);
+        N->hc[f].left = b->fine_off[f + 1] - b->fine_off[f];
+    }
+    N->tw.file = N->hw.file = -1;
+    N->tw.at = r->tris_at;
+    N->tw.rec = sizeof(pdt_rtri);
+    N->tw.cap = N->hw.cap = CUR_RECS;
+    N->hw.at = r->hist_at;
+    N->hw.rec = sizeof(pdt_rtri_hist);
+    return 1;
+}
+
+static void num_close(builder *b, numbering *N)
+{
+    pdt_rp_bfree(b, N->tw.buf, CUR_RECS * sizeof(pdt_rtri));
+    pdt_rp_bfree(b, N->hw.buf, CUR_RECS * sizeof(pdt_rtri_hist));
+    pdt_rp_bfree(b, N->wn, NUM_WINDOW * sizeof *N->wn);
+    pdt_rp_bfree(b, N->wf, NUM_WINDOW * sizeof *N->wf);
+    bcurs_free(b, N->tc, sizeof(tri_first));
+    bcurs_free(b, N->ic, sizeof(uint32_t));
+    bcurs_free(b, N->hc, sizeof(pdt_rtri_hist));
+}
+
+/* The triangles whose first event is in [lo, hi), from every bucket, by
+ * event (N->wn, N->wf). */
+static void num_window(builder *b, numbering *N, size_t lo, size_t hi)
+{
+    memset(N->wn, 0, (hi - lo) * sizeof *N->wn);
+    for (size_t f = 0; f < b->nfine; f++) {
+        const tri_first *t;
+        while ((t = bcur_peek(b, &N->tc[f])) && t->ev < hi) {
+            if (t->ev < lo || !t->n) { /* (not in event order: never written so) */
+                b->failed = 1;
+                break;
+            }
+            N->wn[t->ev - lo] = t->n;
+            N->wf[t->ev - lo] = (uint16_t)f;
+            N->tc[f].i++;
+        }
+    }
+}
+
+/* The window's triangles numbered in the order of their first events:
+ * each written to the table with its entries, its id to its bucket's. */
+static int num_emit(builder *b, numbering *N, size_t lo, size_t hi)
+{
+    pdt_replay *r = b->r;
+    int ok = 1;
+    for (size_t k = 0; ok && k < hi - lo; k++) {
+        uint32_t nk = N->wn[k];
+        if (!nk) continue;
+        const pdt_rec *rec = rec_at(r, lo + k);
+        pdt_rtri t = {{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank, (uint32_t)N->h0, nk};
+        uint32_t id = (uint32_t)r->ntri++;
+        bcur *hc = &N->hc[N->wf[k]];
+        ok = bput(b, &N->tw, &t) && bput(b, &N->ic[N->wf[k]], &id);
+        for (uint32_t j = 0; ok && j < nk; j++) { /* its entries, from its bucket's */
+            const pdt_rtri_hist *e = bcur_peek(b, hc);
+            ok = e && bput(b, &N->hw, e);
+            hc->i++;
+        }
+        N->h0 += nk;
+    }
+    return ok;
+}
+
 int pdt_rp_tri_number(builder *b)
 {
     pdt_replay *r = b->r;
-    bcur *tc = bcurs_new(b, sizeof(tri_first)), *ic = bcurs_new(b, sizeof(uint32_t));
-    bcur *hc = bcurs_new(b, sizeof(pdt_rtri_hist)), tw, hw;
-    uint32_t *wn = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *wn);
-    uint16_t *wf = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *wf);
-    memset(&tw, 0, sizeof tw);
-    memset(&hw, 0, sizeof hw);
-    tw.buf = pdt_rp_bmalloc(b, CUR_RECS * sizeof(pdt_rtri));
-    hw.buf = pdt_rp_bmalloc(b, CUR_RECS * sizeof(pdt_rtri_hist));
-    int ok = tc && ic && hc && wn && wf && tw.buf && hw.buf;
-    if (ok) {
-        for (size_t f = 0; f < b->nfine; f++) {
-            tc[f].file = PDT_SCR_TRIS;
-            tc[f].at = (uint64_t)b->fine_off[f] * sizeof(tri_first);
-            tc[f].left = b->tcount[f];
-            ic[f].file = PDT_SCR_IDS;
-            ic[f].at = (uint64_t)b->fine_off[f] * sizeof(uint32_t);
-            hc[f].file = PDT_SCR_HIST;
-            hc[f].at = (uint64_t)b->fine_off[f] * sizeof(pdt_rtri_hist);
-            hc[f].left = b->fine_off[f + 1] - b->fine_off[f];
-        }
-        tw.file = hw.file = -1;
-        tw.at = r->tris_at;
-        tw.rec = sizeof(pdt_rtri);
-    tw.cap = hw.cap = CUR_RECS;
-        hw.at = r->hist_at;
-        hw.rec = sizeof(pdt_rtri_hist);
-    }
+    numbering N;
+    int ok = num_open(b, &N);
     r->ntri = 0;
-    size_t h0 = 0;
     for (size_t lo = 0; ok && lo < r->m; lo += NUM_WINDOW) {
         size_t hi = r->m - lo < NUM_WINDOW ? r->m : lo + NUM_WINDOW;
-        memset(wn, 0, (hi - lo) * sizeof *wn);
-        for (size_t f = 0; f < b->nfine; f++) {
-            const tri_first *t;
-            while ((t = bcur_peek(b, &tc[f])) && t->ev < hi) {
-                if (t->ev < lo || !t->n) { /* (not in event order: never written so) */
-                    b->failed = 1;
-                    break;
-                }
-                wn[t->ev - lo] = t->n;
-                wf[t->ev - lo] = (uint16_t)f;
-                tc[f].i++;
-            }
-        }
-        for (size_t k = 0; ok && k < hi - lo; k++) {
-            if (!wn[k]) continue;
-            const pdt_rec *rec = rec_at(r, lo + k);
-            pdt_rtri t = {{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank, (uint32_t)h0, wn[k]};
-            uint32_t id = (uint32_t)r->ntri++;
-            ok = bput(b, &tw, &t) && bput(b, &ic[wf[k]], &id);
-            for (uint32_t j = 0; ok && j < wn[k]; j++) { /* its entries, from its bucket's */
-                const pdt_rtri_hist *e = bcur_peek(b, &hc[wf[k]]);
-                ok = e && bput(b, &hw, e);
-                hc[wf[k]].i++;
-            }
-            h0 += wn[k];
-        }
-        ok = ok && !b->failed;
+        num_window(b, &N, lo, hi);
+        ok = num_emit(b, &N, lo, hi) && !b->failed;
     }
-    for (size_t f = 0; ok && f < b->nfine; f++) ok = bput_flush(b, &ic[f]);
-    ok = ok && bput_flush(b, &tw) && bput_flush(b, &hw) && h0 == r->nhist;
-    pdt_rp_bfree(b, tw.buf, CUR_RECS * sizeof(pdt_rtri));
-    pdt_rp_bfree(b, hw.buf, CUR_RECS * sizeof(pdt_rtri_hist));
-    pdt_rp_bfree(b, wn, NUM_WINDOW * sizeof *wn);
-    pdt_rp_bfree(b, wf, NUM_WINDOW * sizeof *wf);
-    bcurs_free(b, tc, sizeof(tri_first));
-    bcurs_free(b, ic, sizeof(uint32_t));
-    bcurs_free(b, hc, sizeof(pdt_rtri_hist));
+    for (size_t f = 0; ok && f < b->nfine; f++) ok = bput_flush(b, &N.ic[f]);
+    ok = ok && bput_flush(b, &N.tw) && bput_flush(b, &N.hw) && N.h0 == r->nhist;
+    num_close(b, &N);
     if (!ok) b->failed = 1;
     return ok;
 }

@@ -65,47 +65,46 @@ size_t pdt_replay_inside_count(const pdt_replay *r, const uint32_t v[3])
     return k;
 }
 
-int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
+/* The phase event e of state s is in (-1: none but the run) and whether it
+ * is inside a merge (*in_merge). */
+static int event_phase(const pdt_replay *r, const pdt_rstate *s, const pdt_rec *e, int *in_merge)
 {
-    if (!s->k || s->k > pdt_replay_count(r)) {
-        *id = PDT_CODE_SRM;
-        return -1;
-    }
-    const pdt_rec held = *pdt_replay_rec(r, s->k - 1); /* (a kept index's pointer is short-lived) */
-    const pdt_rec *e = &held;
-    *id = PDT_CODE_SRM;
-    const pdt_event *ev = &e->ev;
     int32_t ph = pdt_rstate_slot(r, s, (int)e->rank, PDT_SLOT_PHASE);
     size_t np;
     const pdt_rphase *Ph = pdt_replay_phases(r, &np);
-    int in_merge = pdt_rstate_slot(r, s, (int)e->rank, PDT_SLOT_MERGE) >= 0;
+    *in_merge = pdt_rstate_slot(r, s, (int)e->rank, PDT_SLOT_MERGE) >= 0;
     int phase = -1;
     for (int32_t p = ph; p >= 0; p = Ph[p].parent) {
         if (phase < 0 && Ph[p].phase != PDT_PH_RUN) phase = (int)Ph[p].phase;
-        if (Ph[p].phase == PDT_PH_MERGE) in_merge = 1;
+        if (Ph[p].phase == PDT_PH_MERGE) *in_merge = 1;
     }
-    if (ev->kind == PDT_EV_PHASE_BEGIN || ev->kind == PDT_EV_PHASE_END) phase = ev->sub;
-    int gr = phase == PDT_PH_GRAHAM_SORT || phase == PDT_PH_GRAHAM_SCAN || ev->kind == PDT_EV_SORT ||
-             ev->kind == PDT_EV_DELETE ||
-             ((ev->kind == PDT_EV_PUSH || ev->kind == PDT_EV_POP) && ev->sub == PDT_STACK_GRAHAM);
-    /* a hull run keeps Graham's listing to its last event ("run" lights no line) */
-    int graham_run = pdt_replay_kind_count(r, PDT_EV_SORT) > 0 &&
-                     pdt_replay_kind_count(r, PDT_EV_TRI_NEW) == 0;
-    if (graham_run) *id = PDT_CODE_GRAHAM;
-    if (graham_run && !gr) return -1;
-    if (gr) {
-        *id = PDT_CODE_GRAHAM;
-        switch (ev->kind) {
-        case PDT_EV_SORT: return ev->b == 0 ? 0 : 1;
-        case PDT_EV_DELETE: return 2;
-        case PDT_EV_PUSH: return ev->b <= 2 ? 3 : 7;
-        case PDT_EV_POP: return 8;
-        case PDT_EV_HULL: return 9;
-        case PDT_EV_PHASE_BEGIN: return phase == PDT_PH_GRAHAM_SCAN ? 4 : 0;
-        case PDT_EV_PHASE_END: return phase == PDT_PH_GRAHAM_SCAN ? 9 : 1;
-        default: return 5;
-        }
+    if (e->ev.kind == PDT_EV_PHASE_BEGIN || e->ev.kind == PDT_EV_PHASE_END) phase = e->ev.sub;
+    return phase;
+}
+
+/* The line of Graham's listing for event ev in phase. */
+static int graham_line(const pdt_event *ev, int phase)
+{
+    switch (ev->kind) {
+    case PDT_EV_SORT: return ev->b == 0 ? 0 : 1;
+    case PDT_EV_DELETE: return 2;
+    case PDT_EV_PUSH: return ev->b <= 2 ? 3 : 7;
+    case PDT_EV_POP: return 8;
+    case PDT_EV_HULL: return 9;
+    case PDT_EV_PHASE_BEGIN: return phase == PDT_PH_GRAHAM_SCAN ? 4 : 0;
+    case PDT_EV_PHASE_END: return phase == PDT_PH_GRAHAM_SCAN ? 9 : 1;
+    default: return 5;
     }
+}
+
+static int output_phase(int phase)
+{
+    return phase == PDT_PH_OUTPUT || phase == PDT_PH_ORDER || phase == PDT_PH_WRITE;
+}
+
+/* The line of the SRM listing for event ev (-2: none by its kind). */
+static int srm_event_line(const pdt_event *ev, int phase, int in_merge)
+{
     switch (ev->kind) {
     case PDT_EV_LIFT: return in_merge ? 7 : 1;
     case PDT_EV_TRI_NEW: return in_merge ? 7 : 2;
@@ -118,17 +117,21 @@ int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
     case PDT_EV_TRI_FINAL:
     case PDT_EV_RA_DEFER:
         if (in_merge) return 9;
-        if (phase == PDT_PH_OUTPUT || phase == PDT_PH_ORDER || phase == PDT_PH_WRITE) return 10;
+        if (output_phase(phase)) return 10;
         return ev->kind == PDT_EV_TRI_FINAL ? 3 : 4;
     case PDT_EV_SHIP:
     case PDT_EV_SEND:
-    case PDT_EV_RECV:
-        return phase == PDT_PH_OUTPUT || phase == PDT_PH_ORDER || phase == PDT_PH_WRITE ? 10 : 6;
+    case PDT_EV_RECV: return output_phase(phase) ? 10 : 6;
     case PDT_EV_DISCARD: return 8;
     case PDT_EV_MERGE_BEGIN: return 7;
     case PDT_EV_MERGE_END: return 9;
-    default: break;
+    default: return -2;
     }
+}
+
+/* The line of the SRM listing for an event of no line of its own: its phase's. */
+static int srm_phase_line(int phase)
+{
     switch (phase) {
     case PDT_PH_READ:
     case PDT_PH_PARTITION: return 0;
@@ -142,6 +145,27 @@ int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
     case PDT_PH_WRITE: return 10;
     default: return -1;
     }
+}
+
+int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
+{
+    *id = PDT_CODE_SRM;
+    if (!s->k || s->k > pdt_replay_count(r)) return -1;
+    const pdt_rec held = *pdt_replay_rec(r, s->k - 1); /* (a kept index's pointer is short-lived) */
+    const pdt_event *ev = &held.ev;
+    int in_merge;
+    int phase = event_phase(r, s, &held, &in_merge);
+    int gr = phase == PDT_PH_GRAHAM_SORT || phase == PDT_PH_GRAHAM_SCAN || ev->kind == PDT_EV_SORT ||
+             ev->kind == PDT_EV_DELETE ||
+             ((ev->kind == PDT_EV_PUSH || ev->kind == PDT_EV_POP) && ev->sub == PDT_STACK_GRAHAM);
+    /* a hull run keeps Graham's listing to its last event ("run" lights no line) */
+    int graham_run = pdt_replay_kind_count(r, PDT_EV_SORT) > 0 &&
+                     pdt_replay_kind_count(r, PDT_EV_TRI_NEW) == 0;
+    if (graham_run || gr) *id = PDT_CODE_GRAHAM;
+    if (graham_run && !gr) return -1;
+    if (gr) return graham_line(ev, phase);
+    int line = srm_event_line(ev, phase, in_merge);
+    return line != -2 ? line : srm_phase_line(phase);
 }
 
 

@@ -534,6 +534,74 @@ static void ang_sort(const sorter *s, uint32_t *v, size_t n, uint32_t *tmp)
     memcpy(v, tmp, n * sizeof *v);
 }
 
+/* n points from seed in a 100 x 100 square, with copies and near-collinear
+ * points (ties for the sort). */
+static void graham_points(pdt_point *pts, size_t n, uint64_t seed)
+{
+    uint64_t x = seed * 6364136223846793005ull + 1442695040888963407ull;
+    for (size_t i = 0; i < n; i++) {
+        x = x * 6364136223846793005ull + 1442695040888963407ull;
+        int32_t px = (int32_t)((x >> 33) % 100), py = (int32_t)((x >> 13) % 100);
+        if (i % 11 == 5) { px = pts[i - 1].x; py = pts[i - 1].y; }            /* a copy */
+        if (i % 13 == 7) { px = pts[0].x + 2 * (pts[i - 1].x - pts[0].x) / 3; /* near-collinear */
+                           py = pts[0].y + 2 * (pts[i - 1].y - pts[0].y) / 3; }
+        pts[i] = (pdt_point){px, py};
+    }
+}
+
+/* 2: the points but o in angular order about it (v); ties: delete the
+ * closer / all but one copy.  The points kept, first in v: their number. */
+static size_t graham_sort(gen *g, const pdt_point *pts, size_t n, uint32_t o, uint32_t *v,
+                          uint32_t *tmp, uint8_t *del)
+{
+    size_t k = 0;
+    for (uint32_t i = 0; i < n; i++)
+        if (i != o) v[k++] = i;
+    sorter s = {pts, pts[o]};
+    ang_sort(&s, v, k, tmp);
+    EV(g, 0, PDT_EV_SORT, 0, o, 0, 0, 0);
+    for (size_t i = 0; i < k; i++) EV(g, 0, PDT_EV_SORT, 0, v[i], (uint32_t)(i + 1), 0, 0);
+    for (size_t i = 0; i < k; i++) {
+        pdt_point p = pts[v[i]];
+        if (p.x == pts[o].x && p.y == pts[o].y) {
+            del[i] = 1;
+            EV(g, 0, PDT_EV_DELETE, PDT_DEL_COINCIDENT, v[i], o, 0, 0);
+        } else if (i + 1 < k && orient(pts[o], p, pts[v[i + 1]]) == 0) {
+            int same = pts[v[i + 1]].x == p.x && pts[v[i + 1]].y == p.y;
+            del[i] = 1;
+            EV(g, 0, PDT_EV_DELETE, same ? PDT_DEL_COINCIDENT : PDT_DEL_ANGULAR_TIE, v[i], v[i + 1], 0, 0);
+        }
+    }
+    size_t kk = 0;
+    for (size_t i = 0; i < k; i++)
+        if (!del[i]) v[kk++] = v[i];
+    return kk;
+}
+
+/* 3-10: the scan of o and the kk sorted points v, on stack. */
+static void graham_scan(gen *g, const pdt_point *pts, uint32_t o, const uint32_t *v, size_t kk,
+                        uint32_t *stack)
+{
+    size_t d = 0;
+    stack[d++] = o;
+    EV(g, 0, PDT_EV_PUSH, PDT_STACK_GRAHAM, o, 1, 0, 0);
+    if (kk) {
+        stack[d++] = v[0];
+        EV(g, 0, PDT_EV_PUSH, PDT_STACK_GRAHAM, v[0], 2, 0, 0);
+    }
+    for (size_t i = 1; i < kk;) {
+        if (d < 2 || orient(pts[stack[d - 2]], pts[stack[d - 1]], pts[v[i]]) > 0) {
+            stack[d++] = v[i];
+            EV(g, 0, PDT_EV_PUSH, PDT_STACK_GRAHAM, v[i], (uint32_t)d, 0, 0);
+            i++;
+        } else {
+            d--;
+            EV(g, 0, PDT_EV_POP, PDT_STACK_GRAHAM, stack[d], (uint32_t)d, v[i], 0);
+        }
+    }
+    EV(g, 0, PDT_EV_HULL, 0, (uint32_t)d, d < 3, 0, 0);
+}
+
 pdt_status pdt_synth_graham(size_t n, uint64_t seed, pdt_synth *out, pdt_err *err)
 {
     memset(out, 0, sizeof *out);
@@ -547,64 +615,17 @@ pdt_status pdt_synth_graham(size_t n, uint64_t seed, pdt_synth *out, pdt_err *er
     if (!pts || !v || !tmp || !stack || !del) g.failed = 1;
     if (g.failed) goto done;
     g.pts = pts;
-    uint64_t x = seed * 6364136223846793005ull + 1442695040888963407ull;
-    for (size_t i = 0; i < n; i++) {
-        x = x * 6364136223846793005ull + 1442695040888963407ull;
-        int32_t px = (int32_t)((x >> 33) % 100), py = (int32_t)((x >> 13) % 100);
-        if (i % 11 == 5) { px = pts[i - 1].x; py = pts[i - 1].y; }            /* a copy */
-        if (i % 13 == 7) { px = pts[0].x + 2 * (pts[i - 1].x - pts[0].x) / 3; /* near-collinear */
-                           py = pts[0].y + 2 * (pts[i - 1].y - pts[0].y) / 3; }
-        pts[i] = (pdt_point){px, py};
-    }
+    graham_points(pts, n, seed);
     /* 1: rightmost lowest point */
     uint32_t o = 0;
     for (uint32_t i = 1; i < n; i++)
         if (pts[i].y < pts[o].y || (pts[i].y == pts[o].y && pts[i].x > pts[o].x)) o = i;
     EV(&g, 0, PDT_EV_PHASE_BEGIN, PDT_PH_RUN, 0, 0, 0, 0);
     EV(&g, 0, PDT_EV_PHASE_BEGIN, PDT_PH_GRAHAM_SORT, 0, 0, 0, 0);
-    /* 2: angular sort about it; ties: delete the closer / all but one copy */
-    size_t k = 0;
-    for (uint32_t i = 0; i < n; i++)
-        if (i != o) v[k++] = i;
-    sorter s = {pts, pts[o]};
-    ang_sort(&s, v, k, tmp);
-    EV(&g, 0, PDT_EV_SORT, 0, o, 0, 0, 0);
-    for (size_t i = 0; i < k; i++) EV(&g, 0, PDT_EV_SORT, 0, v[i], (uint32_t)(i + 1), 0, 0);
-    for (size_t i = 0; i < k; i++) {
-        pdt_point p = pts[v[i]];
-        if (p.x == pts[o].x && p.y == pts[o].y) {
-            del[i] = 1;
-            EV(&g, 0, PDT_EV_DELETE, PDT_DEL_COINCIDENT, v[i], o, 0, 0);
-        } else if (i + 1 < k && orient(pts[o], p, pts[v[i + 1]]) == 0) {
-            int same = pts[v[i + 1]].x == p.x && pts[v[i + 1]].y == p.y;
-            del[i] = 1;
-            EV(&g, 0, PDT_EV_DELETE, same ? PDT_DEL_COINCIDENT : PDT_DEL_ANGULAR_TIE, v[i], v[i + 1], 0, 0);
-        }
-    }
-    size_t kk = 0;
-    for (size_t i = 0; i < k; i++)
-        if (!del[i]) v[kk++] = v[i];
+    size_t kk = graham_sort(&g, pts, n, o, v, tmp, del);
     EV(&g, 0, PDT_EV_PHASE_END, PDT_PH_GRAHAM_SORT, 0, 0, 0, 0);
     EV(&g, 0, PDT_EV_PHASE_BEGIN, PDT_PH_GRAHAM_SCAN, 0, 0, 0, 0);
-    /* 3-10: the scan */
-    size_t d = 0;
-    stack[d++] = o;
-    EV(&g, 0, PDT_EV_PUSH, PDT_STACK_GRAHAM, o, 1, 0, 0);
-    if (kk) {
-        stack[d++] = v[0];
-        EV(&g, 0, PDT_EV_PUSH, PDT_STACK_GRAHAM, v[0], 2, 0, 0);
-    }
-    for (size_t i = 1; i < kk;) {
-        if (d < 2 || orient(pts[stack[d - 2]], pts[stack[d - 1]], pts[v[i]]) > 0) {
-            stack[d++] = v[i];
-            EV(&g, 0, PDT_EV_PUSH, PDT_STACK_GRAHAM, v[i], (uint32_t)d, 0, 0);
-            i++;
-        } else {
-            d--;
-            EV(&g, 0, PDT_EV_POP, PDT_STACK_GRAHAM, stack[d], (uint32_t)d, v[i], 0);
-        }
-    }
-    EV(&g, 0, PDT_EV_HULL, 0, (uint32_t)d, d < 3, 0, 0);
+    graham_scan(&g, pts, o, v, kk, stack);
     EV(&g, 0, PDT_EV_PHASE_END, PDT_PH_GRAHAM_SCAN, 0, 0, 0, 0);
     EV(&g, 0, PDT_EV_PHASE_END, PDT_PH_RUN, 0, 0, 0, 0);
 done:
