@@ -23,6 +23,7 @@
 #                   the same program for SimGrid's SMPI (scripts/simulate.sh)
 #   make simulate   simulated strong and weak scaling on a 1024-node cluster
 #                   (scripts/simulate-scaling.sh; docs/simulation.md)
+#   make simulate-picture  lesson 10's picture from its simulated table (gnuplot)
 #   make deps       only install missing Debian packages
 #   make clean
 #
@@ -113,6 +114,7 @@ LIBS        := -lm -pthread
 DEB_BUILD := build-essential pkg-config libopenmpi-dev openmpi-bin libsdl2-dev libcairo2-dev fonts-dejavu-core \
              libgif-dev libavcodec-dev libavformat-dev libswscale-dev libavutil-dev libopen-trace-format2-dev
 DEB_SMPI  := libsimgrid-dev
+DEB_PLOT  := gnuplot-nox
 DEB_TEST  := $(DEB_SMPI) time otf2-tools mandoc bash-completion qhull-bin xvfb xdotool x11-apps imagemagick poppler-utils librsvg2-bin python3 valgrind libxml2-utils procps slurmctld slurmd slurm-client munge ffmpeg
 DEB_BENCH := hyperfine libcgal-dev g++ nodejs npm valgrind time
 DEB_FUZZ  := clang libclang-rt-dev
@@ -192,7 +194,7 @@ $(eval $(call variant,rel,$(OPT),bin,))
 $(eval $(call variant,san,$(SAN),bin/san,build/san/hooks/testhook.o))
 
 .PHONY: all deps deps-bench deps-fuzz deps-lesson test demo lesson bench table1 clean rel-all san-all fuzz fuzz-build fuzz-seeds \
-        smpi smpi-build simulate
+        smpi smpi-build simulate simulate-picture
 .DEFAULT_GOAL := all
 
 all: rel-all
@@ -264,6 +266,11 @@ smpi: deps-smpi
 simulate: deps-smpi
 	$(MAKE) rel-all smpi-build
 	scripts/simulate-scaling.sh $(SIM_ARGS)
+
+# lesson 10's picture from its table (a make simulate table of one size)
+simulate-picture:
+	@scripts/deps.sh $(DEB_PLOT)
+	scripts/plot-phases.sh lessons/10-speedup/simulated-1e6.md lessons/10-speedup/phases-1e6.png
 
 # ---- fuzzing (clang + libFuzzer; see tests/fuzz/fuzz_common.h) ----------------
 FUZZ_CC      ?= clang

@@ -6,7 +6,7 @@
 # TABLE.md is the output of scripts/simulate-scaling.sh (make simulate); its
 # first table (one size, strong scaling) becomes one stacked bar per P: the
 # simulated seconds of each phase (read, partition, local, merge, order,
-# write: each the largest over the ranks), with the speedup over the
+# write: each the largest over the ranks), with the speedup (total of the first row / total) over the
 # table's first row above each bar.  Needs gnuplot (gnuplot-nox).
 # Exit status: 0, 1 when gnuplot fails, 2 for a usage error.
 set -u
@@ -42,5 +42,5 @@ plot "$data" using 2:xtic(1) title "read" lc rgb "#9e9e9e", \
      "" using 5 title "merge" lc rgb "#d62728", \
      "" using 6 title "order" lc rgb "#ff7f0e", \
      "" using 7 title "write" lc rgb "#9467bd", \
-     "" using 0:8:(sprintf("%.1fx", \$9)) with labels offset 0,0.8 notitle
+     "" using 0:(\$2+\$3+\$4+\$5+\$6+\$7):(sprintf("%.1fx", \$9)) with labels offset 0,0.8 notitle
 EOF

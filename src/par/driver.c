@@ -1,4 +1,5 @@
-/* pdt — the SRM driver: moves the data between the phases of docs/algorithm.md §3
+/* pdt — the SRM driver (one file per phase, listed in driver.h): moves the
+ * data between the phases of docs/algorithm.md §3
  * with the pdt_comm wrappers.  pdt_par_triangulate reads as its phases:
  *
  *   partition  every rank's input block is sample-sorted by key (equal keys

@@ -26,13 +26,16 @@ typedef struct finals {
 } finals;
 
 /* The buckets: 2^shift consecutive smallest indices each, as many over
- * [0, n_total) as fit in max(2048, 256 p), at most 2^16: about 256 per rank
- * (a bucket is never split between ranks), and narrow enough that one
- * bucket's counters (8 bytes an index) stay a third of its triangles. */
+ * [0, n_total) as fit in max(2048, 16 p), at most 2^16: 16 or more per rank
+ * (a bucket is never split between ranks: a rank's share is within 1/16 of
+ * n / p), and narrow enough that one bucket's counters (8 bytes an index)
+ * stay a third of its triangles.  Their histogram is one allreduce of 8
+ * bytes a bucket: 256 per rank made it 512 KB from 256 ranks on, the
+ * largest message of a run with little work per rank. */
 static int order_shift(const drv *d)
 {
     uint64_t top = d->n_total ? d->n_total - 1 : 0;
-    uint64_t want = (uint64_t)256 * (uint64_t)d->p;
+    uint64_t want = (uint64_t)16 * (uint64_t)d->p;
     if (want < 2048) want = 2048;
     if (want > ((uint64_t)1 << 16)) want = (uint64_t)1 << 16;
     int sh = 0;
