@@ -40,6 +40,9 @@ typedef struct pdt_shell_opts {
     int every;                /* events per frame of a recording (0: 1) */
     const pdt_shell_hook *hook; /* or NULL */
     int fullscreen;           /* start full screen (F11 toggles) */
+    const char *layout_report;/* the texts of the last frame shown, written at exit
+                               * (and by `s`) as JSON (pdt/view/textlog.h), or NULL */
+    int have_size;            /* w x h asked for (else the screen's usable area decides) */
 } pdt_shell_opts;
 
 /* Open the window and run until the user (or the script) quits.  The state
