@@ -32,7 +32,6 @@ typedef struct opts {
     uint64_t mem;      /* --mem BYTES (or $PDTVIEW_MEM): the viewer's memory budget */
     int index;         /* --index on|off|auto: 1, 0, -1 */
     const char *layout_report; /* --layout-report F.json: the texts of the frame drawn */
-    int have_size;     /* --size given (the window then keeps it, within the screen) */
 } opts;
 
 /* ---- the run ----------------------------------------------------------------- */

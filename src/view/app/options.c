@@ -196,7 +196,6 @@ static int check_view(opts *o, raw *w)
         return pdt_cli_usage(PROG, "--every needs a whole number 1 .. 1000000000, not '%llu'",
                              (unsigned long long)w->every);
     o->every = (int)w->every;
-    o->have_size = w->size != NULL;
     if (w->size && !parse_size(w->size, &o->w, &o->h))
         return pdt_cli_usage(PROG, "--size needs WxH, each 64 .. 16384, not '%s'", w->size);
     if (w->panels && pdt_panels_parse(w->panels, &o->panels) != 0)

@@ -10,6 +10,7 @@
 
 #include "pdt/view/anim.h"
 #include "pdt/view/textlog.h"
+#include "window.h"
 
 #include <SDL.h>
 #include <math.h>
@@ -49,6 +50,7 @@ typedef struct shell {
     int typing;
     char num[24], prompt[96];
     int fullscreen;
+    pdt_window_saved saved; /* what full screen replaced */
     char title[480];        /* the hook's title last set */
 } shell;
 
@@ -255,7 +257,7 @@ static int view_key(shell *sh, SDL_Keycode k, int shift)
     case SDLK_r: record(sh); return 1;
     case SDLK_F11:
         sh->fullscreen = !sh->fullscreen;
-        SDL_SetWindowFullscreen(sh->win, sh->fullscreen ? SDL_WINDOW_FULLSCREEN_DESKTOP : 0);
+        pdt_window_fullscreen(sh->win, sh->fullscreen, &sh->saved);
         return 1;
     case SDLK_t: sh->v->theme = (sh->v->theme + 1) % PDT_THEME_COUNT; return 1;
     case SDLK_c: sh->v->clean = !sh->v->clean; return 1;
@@ -726,9 +728,7 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
     char title[512];
     snprintf(title, sizeof title, "pdtview — %s", o->title ? o->title : "");
     sh.fullscreen = o->fullscreen;
-    sh.win = SDL_CreateWindow(title, SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, o->w, o->h,
-                              SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI |
-                                  (o->fullscreen ? SDL_WINDOW_FULLSCREEN_DESKTOP : 0));
+    sh.win = pdt_window_open(title, o->w, o->h, o->fullscreen, &sh.saved);
     if (!sh.win) {
         fprintf(stderr, "pdtview: window: %s\n", SDL_GetError());
         return shell_quit(&sh, 1);

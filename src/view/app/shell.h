@@ -29,7 +29,8 @@ typedef struct pdt_shell_hook {
 } pdt_shell_hook;
 
 typedef struct pdt_shell_opts {
-    int w, h;                 /* initial window size (logical pixels) */
+    int w, h;                 /* initial window size (logical pixels; at most the
+                               * screen's usable area) */
     const char *title;
     const char *script;       /* keys to play, or NULL (see docs/viewer.md) */
     const char *screenshot;   /* PNG written at exit (and by `s` if set), or NULL */
@@ -42,7 +43,6 @@ typedef struct pdt_shell_opts {
     int fullscreen;           /* start full screen (F11 toggles) */
     const char *layout_report;/* the texts of the last frame shown, written at exit
                                * (and by `s`) as JSON (pdt/view/textlog.h), or NULL */
-    int have_size;            /* w x h asked for (else the screen's usable area decides) */
 } pdt_shell_opts;
 
 /* Open the window and run until the user (or the script) quits.  The state
