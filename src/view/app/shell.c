@@ -14,6 +14,7 @@
 
 #include <SDL.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -45,7 +46,9 @@ typedef struct shell {
     /* script */
     const char *script;
     int wait_frames;
-    char status[160];
+    char status[320];
+    char note[160];         /* what the last m, r or s did, shown in the status */
+    Uint32 note_until;      /* ... until this SDL tick */
     /* go to event N: the number being typed after `g` */
     int typing;
     char num[24], prompt[96];
@@ -56,9 +59,22 @@ typedef struct shell {
 
 static void set_status(shell *sh)
 {
-    snprintf(sh->status, sizeof sh->status, "%s · %.0f ev/s · Shift+←/→: %s · h: help",
-             sh->playing ? "playing" : "paused", sh->speed, pdt_ev_class_name(sh->v->ev_class));
+    snprintf(sh->status, sizeof sh->status, "%s%s%s · %.0f ev/s · Shift+←/→: %s · h: help",
+             sh->note, sh->note[0] ? " · " : "", sh->playing ? "playing" : "paused", sh->speed,
+             pdt_ev_class_name(sh->v->ev_class));
     sh->v->status = sh->status;
+}
+
+/* A key's result, on the terminal and for a few seconds in the status. */
+static void say(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void say(shell *sh, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(sh->note, sizeof sh->note, fmt, ap);
+    va_end(ap);
+    sh->note_until = SDL_GetTicks() + 4000;
+    sh->dirty = 1;
 }
 
 static void seek(shell *sh, size_t k)
@@ -91,9 +107,11 @@ static int screenshot(shell *sh, const char *path)
     if (st == PDT_OK && log) st = pdt_text_log_write(log, sh->o->layout_report, &err);
     if (st != PDT_OK) {
         fprintf(stderr, "pdtview: %s\n", err.msg);
+        say(sh, "screenshot failed (see the terminal)");
         return 0;
     }
     fprintf(stderr, "pdtview: screenshot %s (%dx%d, event %zu)\n", path, sh->tw, sh->th, sh->s->k);
+    say(sh, "saved %s", path);
     return 1;
 }
 
@@ -119,9 +137,14 @@ static void record(shell *sh)
     if (!scratch) pdt_err_set(&err, PDT_ERR_NOMEM, "out of memory");
     else pdt_anim_replay(path, &ao, sh->r, scratch, &v, &frames, &err);
     pdt_rstate_free(scratch);
-    if (err.code != PDT_OK) fprintf(stderr, "pdtview: %s\n", err.msg);
-    else fprintf(stderr, "pdtview: recorded %s (%zu frames, events %zu to %zu)\n", path, frames,
-                 ao.from, ao.to);
+    if (err.code != PDT_OK) {
+        fprintf(stderr, "pdtview: %s\n", err.msg);
+        say(sh, "recording failed (see the terminal)");
+    } else {
+        fprintf(stderr, "pdtview: recorded %s (%zu frames, events %zu to %zu)\n", path, frames,
+                ao.from, ao.to);
+        say(sh, "recorded %s (events %zu–%zu)", path, ao.from, ao.to);
+    }
 }
 
 /* The `g` prompt: digits, Backspace, Enter (go), Esc (cancel).  Returns 1
@@ -231,6 +254,7 @@ static int move_key(shell *sh, SDL_Keycode k, int shift)
     case SDLK_m:
         sh->mark = cur;
         fprintf(stderr, "pdtview: mark at event %zu (r records from here to the current event)\n", cur);
+        say(sh, "mark at %zu (r: record to here)", cur);
         return 1;
     default: return 0;
     }
@@ -650,6 +674,10 @@ static void loop(shell *sh)
         got = SDL_PollEvent(&e);
     }
     hook_current(sh);
+    if (sh->note[0] && SDL_TICKS_PASSED(SDL_GetTicks(), sh->note_until)) {
+        sh->note[0] = 0;
+        sh->dirty = 1;
+    }
     uint64_t now = SDL_GetPerformanceCounter();
     double dt = (double)(now - sh->last) / (double)SDL_GetPerformanceFrequency();
     sh->last = now;

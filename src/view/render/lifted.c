@@ -224,7 +224,7 @@ static void draw_point_labels(const ctx *c, const proj *J, const pdt_rec *e, int
                               const uint32_t tv[3])
 {
     cairo_t *cr = c->cr;
-    double fs = 0.8 * c->L.label;
+    double fs = c->L.label;
     uint32_t first[4] = {event_point(e), NONE32, NONE32, NONE32};
     for (int j = 0; j < 3 && have_plane; j++) first[j + 1] = tv[j];
     double bx[64][4];
@@ -285,14 +285,18 @@ static void draw_plane_triangle(const ctx *c, const proj *J, const pdt_rec *e, c
     set_rank(cr, (int)e->rank, 1);
     cairo_set_line_width(cr, 2);
     cairo_stroke(cr);
-    char lab[128];
+    char lab[128], lab2[64];
+    double fs = c->L.label, room = R.w - f;
     snprintf(lab, sizeof lab, "%zu input point%s strictly inside the circle (exact, no tie rule)",
              ninside, ninside == 1 ? "" : "s");
+    if (text_w(cr, SANS, fs, lab) > room)
+        snprintf(lab, sizeof lab, "%zu point%s inside the circle", ninside, ninside == 1 ? "" : "s");
+    snprintf(lab2, sizeof lab2, "%s", "those already lifted: below the plane (red)");
+    if (text_w(cr, SANS, fs, lab2) > room) snprintf(lab2, sizeof lab2, "%s", "lifted ones: below (red)");
     rgb(cr, ninside ? RED : c->T->ink, 1);
-    text_at(cr, SANS, 0, 0.72 * f, R.x + 0.5 * f, R.y + R.h - 1.4 * f, lab);
+    text_at(cr, SANS, 0, fs, R.x + 0.5 * f, R.y + R.h - 0.5 * f - 1.25 * fs, lab);
     rgb(cr, c->T->ink, 1);
-    text_at(cr, SANS, 0, 0.72 * f, R.x + 0.5 * f, R.y + R.h - 0.5 * f,
-            "those already lifted: below the plane (red)");
+    text_at(cr, SANS, 0, fs, R.x + 0.5 * f, R.y + R.h - 0.5 * f, lab2);
 }
 
 void pdt_draw_lifted(ctx *c)
@@ -322,8 +326,9 @@ void pdt_draw_lifted(ctx *c)
     if (have_plane) draw_plane_triangle(c, &J, e, tv, ninside, R, f);
     if (c->no_lift) {
         rgb(cr, c->T->ink, 1);
-        text_at(cr, SANS, 0, 0.8 * f, R.x + 0.5 * f, R.y + R.h - 0.5 * f,
-                "no lift-up in this run (points stay on the floor)");
+        const char *t = "no lift-up in this run (points stay on the floor)";
+        if (text_w(cr, SANS, c->L.label, t) > R.w - f) t = "no lift-up in this run";
+        text_at(cr, SANS, 0, c->L.label, R.x + 0.5 * f, R.y + R.h - 0.5 * f, t);
     }
     cairo_restore(cr);
 }
