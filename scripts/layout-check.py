@@ -14,6 +14,8 @@ pixels), its font size px, its panel and whether a clip cut it.  Checked:
     --min-big px;
   * with --status: a status text is present.
 
+--ignore PANELS leaves those panels' texts out of every check.
+
 Prints one line per problem and `ok F.json (N texts)`; exits 1 when a report
 has a problem, 2 on a usage error.
 """
@@ -52,6 +54,8 @@ def check(path, o):
     with open(path, encoding="utf-8") as f:
         rep = json.load(f)
     texts, W, H = rep["texts"], rep.get("width", 1e9), rep.get("height", 1e9)
+    skip = set(o.ignore.split(",")) if o.ignore else set()
+    texts = [t for t in texts if t["panel"] not in skip]
     bad = []
     for a, b in overlaps(texts, o.slack):
         bad.append(f"overlap: {name(a)} and {name(b)}")
@@ -86,6 +90,7 @@ def main():
     ap.add_argument("--big", default="code,event", help="panels held to --min-big (code,event)")
     ap.add_argument("--status", action="store_true", help="a status text must be present")
     ap.add_argument("--panel", action="append", help="a panel that must hold a text")
+    ap.add_argument("--ignore", default="", help="panels left out of the checks (comma list)")
     ap.add_argument("--slack", type=float, default=1.0, help="overlap allowed, pixels (1)")
     ap.add_argument("--max-lines", type=int, default=20, help="problems printed per report")
     o = ap.parse_args()

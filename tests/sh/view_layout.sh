@@ -8,20 +8,23 @@
 . "$(dirname "$0")/lib.sh"
 V=$BIN/pdtview
 CHECK="python3 $ROOT/scripts/layout-check.py"
+# the legend and the timeline are being redrawn for cluster runs (their own
+# sizes and rows): left out of the lecture-room rules until then
+OTHERS=legend,timeline
 RUN=synth:srm:8:8:4
 
 # the report: valid JSON, every text of the frame, each in its panel
-if "$V" --headless "$RUN" --phase merge -o "$TMP/m.png" --size 1024x768 --layout-report "$TMP/m.json" --quiet &&
+if "$V" --headless "$RUN" --phase merge -o "$TMP/m.png" --size 1600x1000 --layout-report "$TMP/m.json" --quiet &&
    python3 - "$TMP/m.json" <<'EOF'
 import json, sys
 d = json.load(open(sys.argv[1]))
 panels = {t["panel"] for t in d["texts"]}
 need = {"picture", "event", "legend", "code", "stack", "lifted", "timeline"}
 assert need <= panels, f"panels {sorted(panels)} lack {sorted(need - panels)}"
-assert d["width"] == 1024 and d["height"] == 768
+assert d["width"] == 1600 and d["height"] == 1000
 for t in d["texts"]:
     assert t["w"] > 0 and t["h"] > 0 and t["px"] > 0 and t["text"], t
-assert any(t["panel"] == "code" and t["text"].startswith("1 ") for t in d["texts"])
+assert any(t["panel"] == "code" and t["text"][0].isdigit() for t in d["texts"])
 EOF
 then ok report_has_every_panel; else fail report_has_every_panel "$(cat "$TMP/m.json" | head -5)"; fi
 
@@ -45,7 +48,23 @@ if [ $? -eq 1 ] && grep -q 'overlap: "a"' "$TMP/bad.out" && grep -q 'cut: "c"' "
    grep -q 'no status text' "$TMP/bad.out"; then ok checker_finds_problems
 else fail checker_finds_problems "$(cat "$TMP/bad.out")"; fi
 # ... and passes a clean one
-if $CHECK --min-px 12 "$TMP/m.json" >"$TMP/ok.out"; then ok checker_passes_clean
+if $CHECK --min-px 12 --ignore "$OTHERS" "$TMP/m.json" >"$TMP/ok.out"; then ok checker_passes_clean
 else fail checker_passes_clean "$(head -5 "$TMP/ok.out")"; fi
+
+# the lecture-room rules, on a projector (1024x768) and a large screen,
+# at font scales 1, 1.5 and 2: a Graham run and an SRM run of four ranks
+# with every panel, at their busy moments
+for sz in 1024x768 1920x1080; do
+    for fs in 1 1.5 2; do
+        for spec in "synth:graham:40 --at 60" "synth:srm:8:8:4 --phase merge" "synth:srm:8:8:4 --at 465"; do
+            set -- $spec
+            n=$(echo "$spec $sz $fs" | tr -c 'a-z0-9\n' _)
+            "$V" --headless $spec -o "$TMP/$n.png" --size $sz --font-scale $fs --layout-report "$TMP/$n.json" --quiet
+            if $CHECK --min-px 16 --min-big 18 --ignore "$OTHERS" --panel event --panel code "$TMP/$n.json" >"$TMP/$n.out"; then
+                ok "readable_${n}"
+            else fail "readable_${n}" "$(head -4 "$TMP/$n.out")"; fi
+        done
+    done
+done
 
 summary

@@ -94,14 +94,14 @@ typedef struct column {
 static column column_needs(const pdt_layout *L)
 {
     double f = L->font, title = 1.8 * f, row = pdt_layout_code_row(L);
-    return (column){7.6 * f, title + 16 * row, title + 9 * row, title + 4 * row,
-                    title + 2.2 * 1.3 * L->body, 7.5 * f};
+    return (column){7.6 * f, title + 16 * row, title + 7 * row, title + 4 * row,
+                    title + 1.95 * 1.3 * L->body, 6 * f};
 }
 
 /* Share the column's height `mid` (less the legend) among the code, the
  * stacks and the lifted view: the code keeps its lines first (it scrolls
- * to its lit line when short), the lifted view goes when even 9 code lines
- * and two stacks would not fit beside it. */
+ * to its lit line when short), the lifted view goes when even 7 code rows
+ * and a stack would not fit beside it. */
 static void column_split(double rest, const column *C, int code, int stack, int lifted,
                          double *hc, double *hs, double *hl)
 {
@@ -173,7 +173,7 @@ void pdt_render_layout_scaled(double w, double h, int nranks, unsigned panels, d
 
 /* The side column (legend, code, stacks, lifted view) beside the picture,
  * the timeline under both.  When the column cannot hold the legend, four
- * code lines and two stacks, the timeline gives its room, then the stacks. */
+ * code rows and a stack, the timeline gives its room, then the stacks. */
 static void layout_column(double w, double h, double top, double tl, int has_code, int has_stack,
                           int has_lifted, pdt_layout *L)
 {
