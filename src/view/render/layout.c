@@ -110,7 +110,11 @@ static void column_split(double rest, const column *C, int code, int stack, int 
         want = (code ? C->code_mid : 0) + (stack ? C->stack_min : 0);
         if (rest - want < C->lifted_min) lifted = 0;
     }
-    *hc = code ? C->code_want : 0;
+    /* beside the lifted view the code wants no more than leaves it a share */
+    double share = lifted ? (stack ? 0.3 : 0.42) * rest : 0;
+    double code_want = fmax(C->code_mid, fmin(C->code_want, rest - fmax(share, C->lifted_min) -
+                                                                (stack ? C->stack_min : 0)));
+    *hc = code ? code_want : 0;
     *hs = stack ? C->stack_min : 0;
     *hl = lifted ? C->lifted_min : 0;
     double over = *hc + *hs + *hl - rest;
@@ -123,8 +127,8 @@ static void column_split(double rest, const column *C, int code, int stack, int 
     if (over > 0 && code) *hc = fmax(0, rest - *hs - *hl);
     double extra = rest - *hc - *hs - *hl;
     if (extra <= 0) return;
-    if (code && *hc < C->code_want) { /* the code's lines first */
-        double give = fmin(extra, C->code_want - *hc);
+    if (code && *hc < code_want) { /* the code's lines first */
+        double give = fmin(extra, code_want - *hc);
         *hc += give;
         extra -= give;
     }

@@ -81,13 +81,15 @@ void pdt_draw_top(ctx *c)
         text_at(cr, SANS, 1, fs, x, y2, part);
         rest += n2 + (rest[n2] == ' ');
     }
-    if (*rest) {
-        double rw = text_wb(cr, SANS, 1, fs, rest);
-        cairo_rectangle(cr, x - 0.3 * f, R.y + R.h, rw + 0.6 * f, 1.4 * fs);
+    for (double y = R.y + R.h; *rest; y += 1.4 * fs) { /* the rest: in boxes under the bar */
+        size_t n = fit_words(cr, rest, fs, R.w - x - 0.5 * f);
+        snprintf(part, sizeof part, "%.*s", (int)n, rest);
+        cairo_rectangle(cr, x - 0.3 * f, y, text_wb(cr, SANS, 1, fs, part) + 0.6 * f, 1.4 * fs);
         rgb(cr, c->T->topbar, 0.92);
         cairo_fill(cr);
         rgb(cr, c->T->ink, 1);
-        text_at(cr, SANS, 1, fs, x, R.y + R.h + 1.05 * fs, rest);
+        text_at(cr, SANS, 1, fs, x, y + 1.05 * fs, part);
+        rest += n + (rest[n] == ' ');
     }
     if (c->v->prompt) draw_prompt(c);
 }
