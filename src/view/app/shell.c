@@ -92,6 +92,13 @@ static void seek(shell *sh, size_t k)
     sh->dirty = 1;
 }
 
+/* The file name of path, without its folders (for the status row). */
+static const char *base_name(const char *path)
+{
+    const char *s = strrchr(path, '/');
+    return s ? s + 1 : path;
+}
+
 static int screenshot(shell *sh, const char *path)
 {
     char name[64];
@@ -111,7 +118,7 @@ static int screenshot(shell *sh, const char *path)
         return 0;
     }
     fprintf(stderr, "pdtview: screenshot %s (%dx%d, event %zu)\n", path, sh->tw, sh->th, sh->s->k);
-    say(sh, "saved %s", path);
+    say(sh, "saved %.40s", base_name(path));
     return 1;
 }
 
@@ -143,7 +150,7 @@ static void record(shell *sh)
     } else {
         fprintf(stderr, "pdtview: recorded %s (%zu frames, events %zu to %zu)\n", path, frames,
                 ao.from, ao.to);
-        say(sh, "recorded %s (events %zu–%zu)", path, ao.from, ao.to);
+        say(sh, "recorded %.40s (events %zu–%zu)", base_name(path), ao.from, ao.to);
     }
 }
 
@@ -636,6 +643,26 @@ static int draw(shell *sh)
     return 1;
 }
 
+/* The clock: playback advances, a status note expires. */
+static void tick(shell *sh)
+{
+    if (sh->note[0] && SDL_TICKS_PASSED(SDL_GetTicks(), sh->note_until)) {
+        sh->note[0] = 0;
+        sh->dirty = 1;
+    }
+    uint64_t now = SDL_GetPerformanceCounter();
+    double dt = (double)(now - sh->last) / (double)SDL_GetPerformanceFrequency();
+    sh->last = now;
+    if (sh->playing) {
+        sh->acc += fmin(dt, 0.25) * sh->speed;
+        size_t adv = (size_t)sh->acc;
+        sh->acc -= (double)adv;
+        if (adv) seek(sh, sh->s->k + adv);
+        if (sh->s->k >= pdt_replay_count(sh->r)) sh->playing = 0;
+        sh->dirty = 1;
+    }
+}
+
 /* One frame: events, playback, draw, present. */
 static void loop(shell *sh)
 {
@@ -674,21 +701,7 @@ static void loop(shell *sh)
         got = SDL_PollEvent(&e);
     }
     hook_current(sh);
-    if (sh->note[0] && SDL_TICKS_PASSED(SDL_GetTicks(), sh->note_until)) {
-        sh->note[0] = 0;
-        sh->dirty = 1;
-    }
-    uint64_t now = SDL_GetPerformanceCounter();
-    double dt = (double)(now - sh->last) / (double)SDL_GetPerformanceFrequency();
-    sh->last = now;
-    if (sh->playing) {
-        sh->acc += fmin(dt, 0.25) * sh->speed;
-        size_t adv = (size_t)sh->acc;
-        sh->acc -= (double)adv;
-        if (adv) seek(sh, sh->s->k + adv);
-        if (sh->s->k >= pdt_replay_count(sh->r)) sh->playing = 0;
-        sh->dirty = 1;
-    }
+    tick(sh);
     if (!make_texture(sh)) {
         fprintf(stderr, "pdtview: texture: %s\n", SDL_GetError());
         sh->quit = 1;

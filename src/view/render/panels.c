@@ -63,10 +63,16 @@ void pdt_draw_top(ctx *c)
     double f = c->L.font, fs = f, y1 = R.y + 1.35 * f, y2 = R.y + 2.75 * f;
     double x = draw_counter(c, y1), sx = R.w - 0.5 * f;
     if (c->v->status) {
-        sx -= text_w(cr, SANS, c->L.label, c->v->status);
+        char st[512];
+        snprintf(st, sizeof st, "%s", c->v->status);
+        for (size_t n = strlen(st); n > 1 && text_w(cr, SANS, c->L.label, st) > R.w - f;) {
+            do n--; while (n > 1 && ((unsigned char)st[n] & 0xC0) == 0x80);
+            snprintf(st + n, sizeof st - n, "…"); /* a very narrow window */
+        }
+        sx -= text_w(cr, SANS, c->L.label, st);
         rgb(cr, c->T->ink, 0.8);
         pdt_text_log_panel(cr, "status");
-        text_at(cr, SANS, 0, c->L.label, sx, y2, c->v->status);
+        text_at(cr, SANS, 0, c->L.label, sx, y2, st);
         pdt_text_log_panel(cr, "event");
     }
     size_t n1 = fit_words(cr, line, fs, R.w - x - 0.5 * f);
@@ -75,8 +81,16 @@ void pdt_draw_top(ctx *c)
     snprintf(part, sizeof part, "%.*s", (int)n1, line);
     rgb(cr, c->T->ink, 1);
     text_at(cr, SANS, 1, fs, x, y1, part);
-    if (*rest) {
-        size_t n2 = fit_words(cr, rest, fs, sx - 1.0 * f - x);
+    double room2 = sx - 1.0 * f - x;
+    if (*rest && text_wb(cr, SANS, 1, fs, rest) > room2) { /* the rest must fit beside the status */
+        size_t n = strcspn(rest, " ");
+        if (n >= sizeof part) n = sizeof part - 1;
+        memcpy(part, rest, n);
+        part[n] = 0;
+        if (text_wb(cr, SANS, 1, fs, part) > room2) room2 = 0;
+    }
+    if (*rest && room2 > 0) {
+        size_t n2 = fit_words(cr, rest, fs, room2);
         snprintf(part, sizeof part, "%.*s", (int)n2, rest);
         text_at(cr, SANS, 1, fs, x, y2, part);
         rest += n2 + (rest[n2] == ' ');
