@@ -470,7 +470,7 @@ static int overlaps(const lbox *B, size_t nb, lbox b)
  * points the current event names are placed first (trying four sides), then
  * the selected one, then the others in index order; a label that would
  * overlap one already placed gives way. */
-static void draw_labels(ctx *c)
+static size_t points_in_view(const ctx *c)
 {
     size_t nvis = 0;
     for (size_t p = 0; p < c->n; p++) {
@@ -479,11 +479,17 @@ static void draw_labels(ctx *c)
         nvis += x >= c->L.geo.x && x <= c->L.geo.x + c->L.geo.w && y >= c->L.geo.y &&
                 y <= c->L.geo.y + c->L.geo.h;
     }
+    return nvis;
+}
+
+static void draw_labels(ctx *c)
+{
+    size_t nvis = points_in_view(c);
     uint32_t named[4];
     int nn = named_points(c, named);
     int many = nvis > 400; /* only the named (and selected) points get labels */
     size_t cap = (many ? 0 : c->n) + 6;
-    lbox *B = malloc(cap * sizeof *B);
+    lbox *B = malloc((cap + (size_t)c->ntaken) * sizeof *B); /* the strip labels' boxes too */
     uint32_t *order = malloc(cap * sizeof *order);
     if (!B || !order) {
         free(B);
@@ -491,13 +497,6 @@ static void draw_labels(ctx *c)
         return;
     }
     size_t no = 0, nb = 0;
-    lbox *B2 = realloc(B, (cap + (size_t)c->ntaken) * sizeof *B);
-    if (!B2) {
-        free(B);
-        free(order);
-        return;
-    }
-    B = B2;
     for (int i = 0; i < c->ntaken; i++) B[nb++] = c->taken[i]; /* the strip labels */
     for (int i = 0; i < nn; i++) order[no++] = named[i];
     if (c->v->sel_point >= 0 && (size_t)c->v->sel_point < c->n) order[no++] = (uint32_t)c->v->sel_point;

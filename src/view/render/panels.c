@@ -28,83 +28,113 @@ static size_t fit_words(cairo_t *cr, const char *s, double fs, double room)
     return best;
 }
 
-/* The counter and the current rank's swatch; returns where the event
- * line starts. */
-static double draw_counter(ctx *c, double y)
+/* The top bar's text, planned before it is drawn (the picture's labels
+ * keep off the rows that spill under the bar): the counter, the status and
+ * the event line's rows, the first two in the bar. */
+enum { TOP_ROWS = 8 };
+typedef struct top_plan {
+    char head[64], status[512], row[TOP_ROWS][512];
+    int nrows;
+    double x, sx, y[TOP_ROWS];
+} top_plan;
+
+/* The status, ended by "…" when wider than the bar (a very narrow window). */
+static void plan_status(ctx *c, top_plan *P)
+{
+    double f = c->L.font;
+    snprintf(P->status, sizeof P->status, "%s", c->v->status ? c->v->status : "");
+    for (size_t n = strlen(P->status); n > 1 && text_w(c->cr, SANS, c->L.label, P->status) > c->L.top.w - f;) {
+        do n--; while (n > 1 && ((unsigned char)P->status[n] & 0xC0) == 0x80);
+        snprintf(P->status + n, sizeof P->status - n, "…");
+    }
+    P->sx = c->L.top.w - 0.5 * f - (c->v->status ? text_w(c->cr, SANS, c->L.label, P->status) : 0);
+}
+
+/* Takes the row of `rest` that fits in room into P (at y); returns the rest. */
+static const char *plan_row(ctx *c, top_plan *P, const char *rest, double room, double y)
+{
+    size_t n = fit_words(c->cr, rest, c->L.font, room);
+    snprintf(P->row[P->nrows], sizeof P->row[0], "%.*s", (int)n, rest);
+    P->y[P->nrows++] = y;
+    return rest + n + (rest[n] == ' ');
+}
+
+static void plan_top(ctx *c, top_plan *P)
 {
     cairo_t *cr = c->cr;
-    char head[64];
-    double f = c->L.font, fs = c->L.body;
-    snprintf(head, sizeof head, "%zu / %zu", c->s->k, pdt_replay_count(c->r));
-    rgb(cr, c->T->ink, 0.7);
-    text_at(cr, MONO, 0, fs, 0.5 * f, y, head);
-    double x = 0.5 * f + text_w(cr, MONO, fs, head) + 0.9 * f;
-    if (c->cur) {
-        set_rank(cr, (int)c->cur->rank, 1);
-        cairo_rectangle(cr, x, y - 0.85 * f, 0.7 * f, 1.1 * f);
-        cairo_fill(cr);
-        x += 1.1 * f;
-    }
-    return x;
+    pdt_rect R = c->L.top;
+    double f = c->L.font, fs = f;
+    char line[512];
+    pdt_replay_describe_state(c->r, c->s, c->s->k, line, sizeof line);
+    snprintf(P->head, sizeof P->head, "%zu / %zu", c->s->k, pdt_replay_count(c->r));
+    P->x = 0.5 * f + text_w(cr, MONO, c->L.body, P->head) + 0.9 * f + (c->cur ? 1.1 * f : 0);
+    plan_status(c, P);
+    P->nrows = 0;
+    const char *rest = plan_row(c, P, line, R.w - P->x - 0.5 * f, R.y + 1.35 * f);
+    double room2 = P->sx - 1.0 * f - P->x;
+    char word[512];
+    snprintf(word, sizeof word, "%.*s", (int)strcspn(rest, " "), rest);
+    if (*rest && text_wb(cr, SANS, 1, fs, word) <= room2) /* beside the status */
+        rest = plan_row(c, P, rest, room2, R.y + 2.75 * f);
+    double room = fmax(c->L.geo.x + c->L.geo.w - P->x - 0.5 * f, 4 * f); /* over the picture */
+    for (double y = R.y + R.h + 1.05 * fs; *rest && P->nrows < TOP_ROWS; y += 1.4 * fs)
+        rest = plan_row(c, P, rest, room, y); /* under the bar */
+}
+
+void pdt_top_spill(ctx *c)
+{
+    top_plan *P = malloc(sizeof *P);
+    if (!P) return;
+    plan_top(c, P);
+    double f = c->L.font, bottom = c->L.top.y + c->L.top.h, w = 0;
+    for (int i = 0; i < P->nrows; i++)
+        if (P->y[i] > bottom) {
+            w = fmax(w, text_wb(c->cr, SANS, 1, f, P->row[i]));
+            bottom = P->y[i] + 0.35 * f;
+        }
+    if (w > 0 && c->ntaken < TAKEN_MAX)
+        c->taken[c->ntaken++] = (lbox){P->x - 0.3 * f, c->L.top.y + c->L.top.h, P->x + w + 0.3 * f, bottom};
+    free(P);
 }
 
 /* The top bar: the counter and the event line, then on its second row the
  * status at the right and what of the event line did not fit at the left.
- * Text keeps its size; the very rare rest goes in a box under the bar. */
+ * Text keeps its size; the very rare rest goes in boxes under the bar. */
 void pdt_draw_top(ctx *c)
 {
     cairo_t *cr = c->cr;
     pdt_rect R = c->L.top;
+    double f = c->L.font;
+    top_plan *P = malloc(sizeof *P);
+    if (!P) return;
+    plan_top(c, P);
     cairo_rectangle(cr, R.x, R.y, R.w, R.h);
     rgb(cr, c->T->topbar, 1);
     cairo_fill(cr);
-    char line[512];
-    pdt_replay_describe_state(c->r, c->s, c->s->k, line, sizeof line);
-    double f = c->L.font, fs = f, y1 = R.y + 1.35 * f, y2 = R.y + 2.75 * f;
-    double x = draw_counter(c, y1), sx = R.w - 0.5 * f;
+    rgb(cr, c->T->ink, 0.7);
+    text_at(cr, MONO, 0, c->L.body, 0.5 * f, R.y + 1.35 * f, P->head);
+    if (c->cur) {
+        set_rank(cr, (int)c->cur->rank, 1);
+        cairo_rectangle(cr, P->x - 1.1 * f, R.y + 0.5 * f, 0.7 * f, 1.1 * f);
+        cairo_fill(cr);
+    }
     if (c->v->status) {
-        char st[512];
-        snprintf(st, sizeof st, "%s", c->v->status);
-        for (size_t n = strlen(st); n > 1 && text_w(cr, SANS, c->L.label, st) > R.w - f;) {
-            do n--; while (n > 1 && ((unsigned char)st[n] & 0xC0) == 0x80);
-            snprintf(st + n, sizeof st - n, "…"); /* a very narrow window */
-        }
-        sx -= text_w(cr, SANS, c->L.label, st);
         rgb(cr, c->T->ink, 0.8);
         pdt_text_log_panel(cr, "status");
-        text_at(cr, SANS, 0, c->L.label, sx, y2, st);
+        text_at(cr, SANS, 0, c->L.label, P->sx, R.y + 2.75 * f, P->status);
         pdt_text_log_panel(cr, "event");
     }
-    size_t n1 = fit_words(cr, line, fs, R.w - x - 0.5 * f);
-    const char *rest = line + n1 + (line[n1] == ' ');
-    char part[512];
-    snprintf(part, sizeof part, "%.*s", (int)n1, line);
-    rgb(cr, c->T->ink, 1);
-    text_at(cr, SANS, 1, fs, x, y1, part);
-    double room2 = sx - 1.0 * f - x;
-    if (*rest && text_wb(cr, SANS, 1, fs, rest) > room2) { /* the rest must fit beside the status */
-        size_t n = strcspn(rest, " ");
-        if (n >= sizeof part) n = sizeof part - 1;
-        memcpy(part, rest, n);
-        part[n] = 0;
-        if (text_wb(cr, SANS, 1, fs, part) > room2) room2 = 0;
-    }
-    if (*rest && room2 > 0) {
-        size_t n2 = fit_words(cr, rest, fs, room2);
-        snprintf(part, sizeof part, "%.*s", (int)n2, rest);
-        text_at(cr, SANS, 1, fs, x, y2, part);
-        rest += n2 + (rest[n2] == ' ');
-    }
-    for (double y = R.y + R.h; *rest; y += 1.4 * fs) { /* the rest: in boxes under the bar */
-        size_t n = fit_words(cr, rest, fs, R.w - x - 0.5 * f);
-        snprintf(part, sizeof part, "%.*s", (int)n, rest);
-        cairo_rectangle(cr, x - 0.3 * f, y, text_wb(cr, SANS, 1, fs, part) + 0.6 * f, 1.4 * fs);
-        rgb(cr, c->T->topbar, 0.92);
-        cairo_fill(cr);
+    for (int i = 0; i < P->nrows; i++) {
+        if (P->y[i] > R.y + R.h) {
+            cairo_rectangle(cr, P->x - 0.3 * f, P->y[i] - 1.05 * f,
+                            text_wb(cr, SANS, 1, f, P->row[i]) + 0.6 * f, 1.4 * f);
+            rgb(cr, c->T->topbar, 0.92);
+            cairo_fill(cr);
+        }
         rgb(cr, c->T->ink, 1);
-        text_at(cr, SANS, 1, fs, x, y + 1.05 * fs, part);
-        rest += n + (rest[n] == ' ');
+        text_at(cr, SANS, 1, f, P->x, P->y[i], P->row[i]);
     }
+    free(P);
     if (c->v->prompt) draw_prompt(c);
 }
 

@@ -89,6 +89,7 @@ static void draw_parts(ctx *c, double w, double h)
 {
     cairo_t *cr = c->cr;
     pdt_text_log_panel(cr, "picture");
+    pdt_top_spill(c);
     pdt_draw_geometry(c);
     pdt_text_log_panel(cr, "event");
     pdt_draw_top(c);

@@ -111,6 +111,9 @@ size_t pdt_unique_edges(uint64_t *e, size_t n);
  * return 1; else draw nothing and return 0. */
 int pdt_draw_lod(ctx *c);
 void pdt_draw_top(ctx *c);                      /* panels.c */
+/* The event line's rows that spill under the top bar, as a box the
+ * picture's labels keep off (c->taken). */
+void pdt_top_spill(ctx *c);
 void pdt_draw_legend(ctx *c);
 void pdt_draw_code(ctx *c);
 void pdt_draw_stack_panel(ctx *c);
