@@ -112,8 +112,8 @@ static void column_split(double rest, const column *C, int code, int stack, int 
     }
     /* beside the lifted view the code wants no more than leaves it a share */
     double share = lifted ? (stack ? 0.3 : 0.42) * rest : 0;
-    double code_want = fmax(C->code_mid, fmin(C->code_want, rest - fmax(share, C->lifted_min) -
-                                                                (stack ? C->stack_min : 0)));
+    double others = (lifted ? fmax(share, C->lifted_min) : 0) + (stack ? C->stack_min : 0);
+    double code_want = fmax(C->code_mid, fmin(C->code_want, rest - others));
     *hc = code ? code_want : 0;
     *hs = stack ? C->stack_min : 0;
     *hl = lifted ? C->lifted_min : 0;
