@@ -25,7 +25,7 @@ TEST(hidden_panels_get_no_room)
     pdt_render_layout_panels(1600, 1000, 4, PDT_PANEL_CODE | PDT_PANEL_STACK, &some);
     CHECK(some.lifted.w == 0 && some.lifted.h == 0);
     CHECK(some.timeline.w == 0 && some.timeline.h == 0);
-    CHECK(some.code.h == all.code.h);
+    CHECK_MSG(some.code.h >= all.code.h, "code %g vs %g", some.code.h, all.code.h);
     CHECK_MSG(some.stack.h > all.stack.h, "stack %g vs %g", some.stack.h, all.stack.h);
     CHECK_MSG(some.geo.h > all.geo.h, "geometry %g vs %g", some.geo.h, all.geo.h);
     pdt_layout code_only;
@@ -51,16 +51,62 @@ TEST(no_side_panels_picture_takes_width)
     CHECK(L.geo.w == 1024 && L.timeline.w == 1024 && L.legend.y + L.legend.h <= L.timeline.y);
 }
 
-/* A projector at 1024x768: panel text >= 17 px, labels >= 13 px; at
- * 1920x1080 larger still. */
+/* A projector at 1024x768: event line >= 20 px, code >= 18 px, every other
+ * text >= 16 px; at 1920x1080 larger still. */
 TEST(projector_font_sizes)
 {
     pdt_layout a, b;
     pdt_render_layout(1024, 768, 4, &a);
-    CHECK_MSG(a.body >= 17 && a.label >= 13 && a.font >= a.body, "font %g body %g label %g", a.font,
+    CHECK_MSG(a.font >= 20 && a.body >= 18 && a.label >= 16, "font %g body %g label %g", a.font,
               a.body, a.label);
     pdt_render_layout(1920, 1080, 4, &b);
     CHECK(b.body > a.body && b.label > a.label);
+}
+
+static int rect_in(pdt_rect R, double w, double h)
+{
+    return R.w == 0 || (R.x >= 0 && R.y >= 0 && R.x + R.w <= w && R.y + R.h <= h);
+}
+
+static int rects_meet(pdt_rect a, pdt_rect b)
+{
+    return a.w > 0 && b.w > 0 && a.h > 0 && b.h > 0 && a.x < b.x + b.w && b.x < a.x + a.w &&
+           a.y < b.y + b.h && b.y < a.y + a.h;
+}
+
+/* At every screen size, font scale and panel choice the panels lie in the
+ * frame and do not meet; the code panel keeps four rows and its title. */
+TEST(panels_apart_at_every_scale)
+{
+    static const int sizes[][2] = {{1024, 768}, {1280, 800}, {1600, 1000}, {1920, 1080}};
+    static const double scales[] = {1, 1.3, 1.5, 2};
+    for (size_t i = 0; i < 4; i++)
+        for (size_t j = 0; j < 4; j++)
+            for (unsigned p = 0; p <= PDT_PANEL_ALL; p++) {
+                pdt_layout L;
+                double w = sizes[i][0], h = sizes[i][1];
+                pdt_render_layout_scaled(w, h, 4, p, scales[j], &L);
+                pdt_rect R[] = {L.top, L.geo, L.legend, L.code, L.stack, L.lifted, L.timeline};
+                int bad = 0;
+                for (int a = 0; a < 7; a++) {
+                    bad |= !rect_in(R[a], w, h);
+                    for (int b = a + 1; b < 7; b++) bad |= rects_meet(R[a], R[b]);
+                }
+                if (p & PDT_PANEL_CODE) bad |= L.code.h < 1.8 * L.font + 4 * 1.4 * L.body - 1;
+                CHECK_MSG(!bad, "%gx%g scale %g panels %u", w, h, scales[j], p);
+            }
+}
+
+/* On a projector with every panel, the lifted view gives way before the
+ * code panel loses its lines; at 1600x1000 all stay. */
+TEST(lifted_view_gives_way_first)
+{
+    pdt_layout L;
+    pdt_render_layout(1024, 768, 4, &L);
+    CHECK_MSG(L.lifted.w == 0 && L.code.h >= 1.8 * L.font + 7 * 1.4 * L.body - 1, "code %g lifted %g",
+              L.code.h, L.lifted.h);
+    pdt_render_layout(1600, 1000, 4, &L);
+    CHECK(L.lifted.w > 0 && L.stack.w > 0 && L.code.w > 0 && L.timeline.w > 0);
 }
 
 /* The font scale scales the text and the panels that hold it. */
@@ -93,6 +139,8 @@ int main(void)
 {
     RUN(no_side_panels_picture_takes_width);
     RUN(projector_font_sizes);
+    RUN(panels_apart_at_every_scale);
+    RUN(lifted_view_gives_way_first);
     RUN(font_scale_changes_layout);
     RUN(theme_parse);
     RUN(panels_parse);

@@ -45,6 +45,8 @@ typedef struct pdt_view {
                            * out.  NULL: the viewer's keys only */
     int help_nmore;
     const char *help_more_title;
+    struct pdt_text_log *texts; /* the layout report of the last frame drawn
+                           * (pdt/view/textlog.h), or NULL */
 } pdt_view;
 
 /* Colour themes (pdt_view.theme).  Every theme keeps the colour-blind-safe

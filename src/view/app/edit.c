@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include "pdt/io.h"
+#include "pdt/view/textlog.h"
 
 /* SDL keycodes the hook needs (SDL_keycode.h values; edit.c has no SDL). */
 enum {
@@ -393,7 +394,7 @@ static void report(pdt_editor *ed, pdt_status st, const pdt_err *err, const char
 static int in_geo(double w, double h, const pdt_replay *r, const pdt_view *v, double x, double y)
 {
     pdt_layout L;
-    pdt_render_layout_panels(w, h, pdt_replay_nranks(r), v->panels, &L);
+    pdt_render_layout_view(w, h, pdt_replay_nranks(r), v, &L);
     return x >= L.geo.x && x <= L.geo.x + L.geo.w && y >= L.geo.y && y <= L.geo.y + L.geo.h;
 }
 
@@ -401,7 +402,7 @@ static int in_geo(double w, double h, const pdt_replay *r, const pdt_view *v, do
 static int64_t point_at(pdt_editor *ed, double w, double h, const pdt_view *v, double x, double y)
 {
     pdt_layout L;
-    pdt_render_layout_panels(w, h, pdt_replay_nranks(ed->r), v->panels, &L);
+    pdt_render_layout_view(w, h, pdt_replay_nranks(ed->r), v, &L);
     int64_t best = -1;
     double bd = 0.8 * L.font * 0.8 * L.font;
     for (size_t i = 0; i < ed->n; i++) {
@@ -436,7 +437,7 @@ static void freeze_frame(pdt_editor *ed, double w, double h, pdt_view *v)
 {
     if (v->centred) return;
     pdt_layout L;
-    pdt_render_layout_panels(w, h, pdt_replay_nranks(ed->r), v->panels, &L);
+    pdt_render_layout_view(w, h, pdt_replay_nranks(ed->r), v, &L);
     double cx, cy, ax, ay, bx, by;
     pdt_view_to_world(ed->r, v, w, h, L.geo.x + L.geo.w / 2, L.geo.y + L.geo.h / 2, &cx, &cy);
     pdt_view_to_world(ed->r, v, w, h, 0, 0, &ax, &ay);
@@ -527,7 +528,7 @@ static int edit_key(pdt_editor *ed, const pdt_shell_input *in, double w, double 
     }
     if (in->key == 'n') {
         pdt_layout L;
-        pdt_render_layout_panels(w, h, pdt_replay_nranks(ed->r), v->panels, &L);
+        pdt_render_layout_view(w, h, pdt_replay_nranks(ed->r), v, &L);
         freeze_frame(ed, w, h, v);
         int64_t x0, y0, x1, y1;
         world_at(ed, w, h, v, L.geo.x + 0.1 * L.geo.w, L.geo.y + 0.9 * L.geo.h, &x0, &y0);
@@ -686,25 +687,35 @@ static int hook_current(void *user, const pdt_replay **r, pdt_rstate **s)
     return changed;
 }
 
-/* One line on a white band at (x, y), shrunk to fit max_w pixels. */
+/* One line on a white band at (x, y), shrunk to fit max_w pixels but not
+ * below the viewer's label size (0.82 of the font); what still does not
+ * fit ends in "…". */
 static void overlay_text(cairo_t *cr, double x, double y, double size, double max_w, const char *t,
                          double r, double g, double b)
 {
+    char s[512];
+    snprintf(s, sizeof s, "%s", t);
     cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
     cairo_set_font_size(cr, size);
     cairo_text_extents_t te;
-    cairo_text_extents(cr, t, &te);
+    cairo_text_extents(cr, s, &te);
     if (te.x_advance + 0.6 * size > max_w && te.x_advance > 0) {
-        size *= fmax(0.5, (max_w - 0.6 * size) / te.x_advance);
+        size *= fmax(0.965, (max_w - 0.6 * size) / te.x_advance);
         cairo_set_font_size(cr, size);
-        cairo_text_extents(cr, t, &te);
+        cairo_text_extents(cr, s, &te);
+    }
+    for (size_t n = strlen(s); n > 1 && te.x_advance + 0.6 * size > max_w;) {
+        do n--; while (n > 1 && ((unsigned char)s[n] & 0xC0) == 0x80);
+        snprintf(s + n, sizeof s - n, "…");
+        cairo_text_extents(cr, s, &te);
     }
     cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
     cairo_rectangle(cr, x - 0.3 * size, y - size, te.x_advance + 0.6 * size, 1.35 * size);
     cairo_fill(cr);
     cairo_set_source_rgb(cr, r, g, b);
+    pdt_text_log_note(cr, size, x, y, s);
     cairo_move_to(cr, x, y);
-    cairo_show_text(cr, t);
+    cairo_show_text(cr, s);
 }
 
 static void hook_overlay(void *user, cairo_t *cr, double w, double h, const pdt_view *v)
@@ -712,7 +723,7 @@ static void hook_overlay(void *user, cairo_t *cr, double w, double h, const pdt_
     pdt_editor *ed = user;
     if (v->help) return; /* the help box is on top */
     pdt_layout L;
-    pdt_render_layout_panels(w, h, pdt_replay_nranks(ed->r), v->panels, &L);
+    pdt_render_layout_view(w, h, pdt_replay_nranks(ed->r), v, &L);
     cairo_save(cr);
     cairo_rectangle(cr, L.geo.x, L.geo.y, L.geo.w, L.geo.h);
     cairo_clip(cr);

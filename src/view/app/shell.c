@@ -9,9 +9,12 @@
 #include "pdt/view/query.h"
 
 #include "pdt/view/anim.h"
+#include "pdt/view/textlog.h"
+#include "window.h"
 
 #include <SDL.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,19 +46,35 @@ typedef struct shell {
     /* script */
     const char *script;
     int wait_frames;
-    char status[160];
+    char status[320];
+    char note[160];         /* what the last m, r or s did, shown in the status */
+    Uint32 note_until;      /* ... until this SDL tick */
     /* go to event N: the number being typed after `g` */
     int typing;
     char num[24], prompt[96];
     int fullscreen;
+    pdt_window_saved saved; /* what full screen replaced */
     char title[480];        /* the hook's title last set */
 } shell;
 
 static void set_status(shell *sh)
 {
-    snprintf(sh->status, sizeof sh->status, "%s · %.0f ev/s · Shift+←/→: %s · h: help",
-             sh->playing ? "playing" : "paused", sh->speed, pdt_ev_class_name(sh->v->ev_class));
+    snprintf(sh->status, sizeof sh->status, "%s%s%s · %.0f ev/s · Shift+←/→: %s · h: help",
+             sh->note, sh->note[0] ? " · " : "", sh->playing ? "playing" : "paused", sh->speed,
+             pdt_ev_class_name(sh->v->ev_class));
     sh->v->status = sh->status;
+}
+
+/* A key's result, on the terminal and for a few seconds in the status. */
+static void say(shell *sh, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void say(shell *sh, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(sh->note, sizeof sh->note, fmt, ap);
+    va_end(ap);
+    sh->note_until = SDL_GetTicks() + 4000;
+    sh->dirty = 1;
 }
 
 static void seek(shell *sh, size_t k)
@@ -73,6 +92,13 @@ static void seek(shell *sh, size_t k)
     sh->dirty = 1;
 }
 
+/* The file name of path, without its folders (for the status row). */
+static const char *base_name(const char *path)
+{
+    const char *s = strrchr(path, '/');
+    return s ? s + 1 : path;
+}
+
 static int screenshot(shell *sh, const char *path)
 {
     char name[64];
@@ -81,11 +107,18 @@ static int screenshot(shell *sh, const char *path)
         path = name;
     }
     pdt_err err = {0};
-    if (pdt_render_file(path, sh->tw, sh->th, sh->r, sh->s, sh->v, &err) != PDT_OK) {
+    pdt_text_log *log = sh->v->texts; /* the report is the window's frame's */
+    sh->v->texts = NULL;
+    pdt_status st = pdt_render_file(path, sh->tw, sh->th, sh->r, sh->s, sh->v, &err);
+    sh->v->texts = log;
+    if (st == PDT_OK && log) st = pdt_text_log_write(log, sh->o->layout_report, &err);
+    if (st != PDT_OK) {
         fprintf(stderr, "pdtview: %s\n", err.msg);
+        say(sh, "screenshot failed (see the terminal)");
         return 0;
     }
     fprintf(stderr, "pdtview: screenshot %s (%dx%d, event %zu)\n", path, sh->tw, sh->th, sh->s->k);
+    say(sh, "saved %.40s", base_name(path));
     return 1;
 }
 
@@ -111,9 +144,14 @@ static void record(shell *sh)
     if (!scratch) pdt_err_set(&err, PDT_ERR_NOMEM, "out of memory");
     else pdt_anim_replay(path, &ao, sh->r, scratch, &v, &frames, &err);
     pdt_rstate_free(scratch);
-    if (err.code != PDT_OK) fprintf(stderr, "pdtview: %s\n", err.msg);
-    else fprintf(stderr, "pdtview: recorded %s (%zu frames, events %zu to %zu)\n", path, frames,
-                 ao.from, ao.to);
+    if (err.code != PDT_OK) {
+        fprintf(stderr, "pdtview: %s\n", err.msg);
+        say(sh, "recording failed (see the terminal)");
+    } else {
+        fprintf(stderr, "pdtview: recorded %s (%zu frames, events %zu to %zu)\n", path, frames,
+                ao.from, ao.to);
+        say(sh, "recorded %.40s (events %zu–%zu)", base_name(path), ao.from, ao.to);
+    }
 }
 
 /* The `g` prompt: digits, Backspace, Enter (go), Esc (cancel).  Returns 1
@@ -223,6 +261,7 @@ static int move_key(shell *sh, SDL_Keycode k, int shift)
     case SDLK_m:
         sh->mark = cur;
         fprintf(stderr, "pdtview: mark at event %zu (r records from here to the current event)\n", cur);
+        say(sh, "mark at %zu (r: record to here)", cur);
         return 1;
     default: return 0;
     }
@@ -249,7 +288,7 @@ static int view_key(shell *sh, SDL_Keycode k, int shift)
     case SDLK_r: record(sh); return 1;
     case SDLK_F11:
         sh->fullscreen = !sh->fullscreen;
-        SDL_SetWindowFullscreen(sh->win, sh->fullscreen ? SDL_WINDOW_FULLSCREEN_DESKTOP : 0);
+        pdt_window_fullscreen(sh->win, sh->fullscreen, &sh->saved);
         return 1;
     case SDLK_t: sh->v->theme = (sh->v->theme + 1) % PDT_THEME_COUNT; return 1;
     case SDLK_c: sh->v->clean = !sh->v->clean; return 1;
@@ -604,6 +643,26 @@ static int draw(shell *sh)
     return 1;
 }
 
+/* The clock: playback advances, a status note expires. */
+static void tick(shell *sh)
+{
+    if (sh->note[0] && SDL_TICKS_PASSED(SDL_GetTicks(), sh->note_until)) {
+        sh->note[0] = 0;
+        sh->dirty = 1;
+    }
+    uint64_t now = SDL_GetPerformanceCounter();
+    double dt = (double)(now - sh->last) / (double)SDL_GetPerformanceFrequency();
+    sh->last = now;
+    if (sh->playing) {
+        sh->acc += fmin(dt, 0.25) * sh->speed;
+        size_t adv = (size_t)sh->acc;
+        sh->acc -= (double)adv;
+        if (adv) seek(sh, sh->s->k + adv);
+        if (sh->s->k >= pdt_replay_count(sh->r)) sh->playing = 0;
+        sh->dirty = 1;
+    }
+}
+
 /* One frame: events, playback, draw, present. */
 static void loop(shell *sh)
 {
@@ -642,17 +701,7 @@ static void loop(shell *sh)
         got = SDL_PollEvent(&e);
     }
     hook_current(sh);
-    uint64_t now = SDL_GetPerformanceCounter();
-    double dt = (double)(now - sh->last) / (double)SDL_GetPerformanceFrequency();
-    sh->last = now;
-    if (sh->playing) {
-        sh->acc += fmin(dt, 0.25) * sh->speed;
-        size_t adv = (size_t)sh->acc;
-        sh->acc -= (double)adv;
-        if (adv) seek(sh, sh->s->k + adv);
-        if (sh->s->k >= pdt_replay_count(sh->r)) sh->playing = 0;
-        sh->dirty = 1;
-    }
+    tick(sh);
     if (!make_texture(sh)) {
         fprintf(stderr, "pdtview: texture: %s\n", SDL_GetError());
         sh->quit = 1;
@@ -671,10 +720,21 @@ static void loop(shell *sh)
     SDL_RenderPresent(sh->ren);
 }
 
+/* --layout-report without --screenshot: the texts of the last frame shown. */
+static void write_report(shell *sh)
+{
+    pdt_err err = {0};
+    if (pdt_text_log_write(sh->v->texts, sh->o->layout_report, &err) != PDT_OK)
+        fprintf(stderr, "pdtview: %s\n", err.msg);
+}
+
 /* The one teardown path. */
 static int shell_quit(shell *sh, int rc)
 {
     if (rc == 0 && sh->o->screenshot && sh->tex) screenshot(sh, sh->o->screenshot);
+    else if (rc == 0 && sh->v->texts && sh->tex) write_report(sh);
+    pdt_text_log_free(sh->v->texts);
+    sh->v->texts = NULL;
     if (sh->tex) SDL_DestroyTexture(sh->tex);
     if (sh->ren) SDL_DestroyRenderer(sh->ren);
     if (sh->win) SDL_DestroyWindow(sh->win);
@@ -700,6 +760,7 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
     sh.cap_ranks = MAX_RANKS_SHOWN + sh.nranks;
     if (v->hidden) memcpy(sh.hidden, v->hidden, (size_t)sh.nranks);
     v->hidden = sh.hidden;
+    v->texts = o->layout_report ? pdt_text_log_new() : NULL;
     SDL_SetHint(SDL_HINT_VIDEO_X11_NET_WM_BYPASS_COMPOSITOR, "0");
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
         fprintf(stderr, "pdtview: SDL_Init: %s\n", SDL_GetError());
@@ -708,9 +769,7 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
     char title[512];
     snprintf(title, sizeof title, "pdtview — %s", o->title ? o->title : "");
     sh.fullscreen = o->fullscreen;
-    sh.win = SDL_CreateWindow(title, SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, o->w, o->h,
-                              SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI |
-                                  (o->fullscreen ? SDL_WINDOW_FULLSCREEN_DESKTOP : 0));
+    sh.win = pdt_window_open(title, o->w, o->h, o->fullscreen, &sh.saved);
     if (!sh.win) {
         fprintf(stderr, "pdtview: window: %s\n", SDL_GetError());
         return shell_quit(&sh, 1);

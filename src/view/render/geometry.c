@@ -7,6 +7,26 @@
 
 /* ---- the geometry --------------------------------------------------------------------- */
 
+static int overlaps(const lbox *B, size_t nb, lbox b);
+
+/* Where a strip's label goes: under the box (y1) for `below`, else above
+ * (y0), else the other side, at x; 0 when both would cover a label placed
+ * before (the label is left out: thinned).  The box is then taken. */
+static int place_box_label(ctx *c, int below, double x, double y0, double y1, double tw, double fs,
+                           double *ly)
+{
+    for (int k = 0; k < 2; k++) {
+        int under = k ? !below : below;
+        double y = under ? y1 + 1.05 * fs : y0 - 0.3 * fs;
+        lbox b = {x - 0.1 * fs, y - 0.95 * fs, x + tw + 0.1 * fs, y + 0.3 * fs};
+        if (overlaps(c->taken, (size_t)c->ntaken, b)) continue;
+        if (c->ntaken < TAKEN_MAX) c->taken[c->ntaken++] = b;
+        *ly = y;
+        return 1;
+    }
+    return 0;
+}
+
 /* The strip boxes (labels = 0) or their labels (labels = 1, drawn last, on a
  * white ground so that edges and hulls do not hide them). */
 static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
@@ -40,7 +60,7 @@ static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
             continue;
         }
         char lab[32];
-        double fs = 0.8 * c->L.font;
+        double fs = c->L.label;
         /* the label may run past a narrow strip up to the next strip whose
          * label is on the same side (ranks alternate above and below) */
         double room = c->L.geo.x + c->L.geo.w - x0;
@@ -54,7 +74,8 @@ static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
         if (text_wb(cr, SANS, touched, fs, lab) > room)
             snprintf(lab, sizeof lab, touched ? "r%d!" : "r%d", q); /* very narrow strips */
         double tw = text_wb(cr, SANS, touched, fs, lab);
-        double ly = q % 2 ? y1 + pad + 0.95 * c->L.font : y0 - pad - 0.25 * c->L.font;
+        double ly;
+        if (!place_box_label(c, q % 2, x0 - pad, y0 - pad, y1 + pad, tw, fs, &ly)) continue;
         cairo_rectangle(cr, x0 - pad - 0.1 * fs, ly - 0.85 * fs, tw + 0.2 * fs, 1.1 * fs);
         rgb(cr, c->T->bg, 0.8);
         cairo_fill(cr);
@@ -399,6 +420,7 @@ static void halo_text(ctx *c, int bold, double size, double x, double y, const c
     cairo_select_font_face(cr, SANS, CAIRO_FONT_SLANT_NORMAL,
                            bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
     cairo_set_font_size(cr, size);
+    pdt_text_log_note(cr, size, x, y, s);
     cairo_move_to(cr, x, y);
     cairo_text_path(cr, s);
     rgb(cr, c->T->bg, 0.9);
@@ -436,10 +458,6 @@ static int named_points(const ctx *c, uint32_t out[4])
     return k;
 }
 
-typedef struct lbox {
-    double x0, y0, x1, y1;
-} lbox;
-
 static int overlaps(const lbox *B, size_t nb, lbox b)
 {
     for (size_t i = 0; i < nb; i++)
@@ -452,7 +470,7 @@ static int overlaps(const lbox *B, size_t nb, lbox b)
  * points the current event names are placed first (trying four sides), then
  * the selected one, then the others in index order; a label that would
  * overlap one already placed gives way. */
-static void draw_labels(ctx *c)
+static size_t points_in_view(const ctx *c)
 {
     size_t nvis = 0;
     for (size_t p = 0; p < c->n; p++) {
@@ -461,11 +479,17 @@ static void draw_labels(ctx *c)
         nvis += x >= c->L.geo.x && x <= c->L.geo.x + c->L.geo.w && y >= c->L.geo.y &&
                 y <= c->L.geo.y + c->L.geo.h;
     }
+    return nvis;
+}
+
+static void draw_labels(ctx *c)
+{
+    size_t nvis = points_in_view(c);
     uint32_t named[4];
     int nn = named_points(c, named);
     int many = nvis > 400; /* only the named (and selected) points get labels */
     size_t cap = (many ? 0 : c->n) + 6;
-    lbox *B = malloc(cap * sizeof *B);
+    lbox *B = malloc((cap + (size_t)c->ntaken) * sizeof *B); /* the strip labels' boxes too */
     uint32_t *order = malloc(cap * sizeof *order);
     if (!B || !order) {
         free(B);
@@ -473,6 +497,7 @@ static void draw_labels(ctx *c)
         return;
     }
     size_t no = 0, nb = 0;
+    for (int i = 0; i < c->ntaken; i++) B[nb++] = c->taken[i]; /* the strip labels */
     for (int i = 0; i < nn; i++) order[no++] = named[i];
     if (c->v->sel_point >= 0 && (size_t)c->v->sel_point < c->n) order[no++] = (uint32_t)c->v->sel_point;
     size_t first_other = no;
@@ -577,8 +602,8 @@ static void draw_merge(ctx *c)
             cairo_set_dash(c->cr, NULL, 0, 0);
             char lab[64];
             snprintf(lab, sizeof lab, "%s", side ? "G_R" : "G_L");
-            double tw = text_wb(c->cr, SANS, 1, 0.8 * c->L.font, lab);
-            text_at(c->cr, SANS, 1, 0.8 * c->L.font, side ? x1 - tw : x0, y0 - 0.3 * c->L.font, lab);
+            double tw = text_wb(c->cr, SANS, 1, c->L.label, lab);
+            text_at(c->cr, SANS, 1, c->L.label, side ? x1 - tw : x0, y0 - 0.3 * c->L.font, lab);
         }
         /* the border set B: points the merge rank lifted since the merge began */
         size_t from = mg->begin_ev, to = c->s->k;
@@ -823,8 +848,8 @@ void pdt_draw_geometry(ctx *c)
     if (!c->v->clean) draw_merge(c);
     draw_points(c);
     if (buf && !c->v->clean) draw_current(c, buf, 2 * cap);
+    draw_boxes(c, cur_tri, 1); /* the strip labels first: the point labels keep off them */
     draw_labels(c);
-    draw_boxes(c, cur_tri, 1);
     draw_selection(c);
     free(buf);
     cairo_restore(cr);

@@ -3,6 +3,8 @@
 #include "render_int.h"
 
 static void layout_round(pdt_layout *L);
+static void layout_column(double w, double h, double top, double tl, int has_code, int has_stack,
+                          int has_lifted, pdt_layout *L);
 
 /* ---- view and layout ----------------------------------------------------------- */
 
@@ -68,65 +70,145 @@ void pdt_render_layout_view(double w, double h, int nranks, const pdt_view *v, p
     pdt_render_layout_scaled(w, h, nranks, v ? v->panels : PDT_PANEL_ALL, v ? v->font_scale : 1, L);
 }
 
-void pdt_render_layout_scaled(double w, double h, int nranks, unsigned panels, double scale,
-                              pdt_layout *L)
+/* The text sizes for a w x h picture at font scale `scale`: the base font
+ * is 1/40 of the height or 1/54 of the width, whichever is smaller, but at
+ * least 20 px on a screen from 600 px high (a projector at 1024x768: event
+ * line 20 px, code 19 px, every other text 16.4 px); then scaled. */
+static void layout_fonts(double w, double h, double scale, pdt_layout *L)
 {
-    /* the base font: 1/40 of the height or 1/54 of the width, whichever is
-     * smaller (19 px at 1024x768); panel text is 0.9 of it, point labels 0.72 */
     if (!(scale > 0)) scale = 1;
     if (scale < 0.4) scale = 0.4;
     if (scale > 4) scale = 4;
-    double f = fmin(h / 40, w / 54) * scale;
+    double f = fmax(fmin(h / 40, w / 54), fmin(20, h / 30)) * scale;
     if (f < 8) f = 8;
     L->font = f;
-    L->body = 0.9 * f;
-    L->label = 0.72 * f;
-    double top = 2.0 * f;
+    L->body = 0.95 * f;
+    L->label = 0.82 * f;
+}
+
+/* The heights the panels of the side column want and need (pixels). */
+typedef struct column {
+    double legend, code_want, code_mid, code_min, stack_min, lifted_min;
+} column;
+
+static column column_needs(const pdt_layout *L)
+{
+    double f = L->font, title = 1.8 * f, row = pdt_layout_code_row(L);
+    return (column){7.6 * f, title + 16 * row, title + 7 * row, title + 4 * row,
+                    title + 1.95 * 1.3 * L->body, 6 * f};
+}
+
+/* Share the column's height `mid` (less the legend) among the code, the
+ * stacks and the lifted view: the code keeps its lines first (it scrolls
+ * to its lit line when short), the lifted view goes when even 7 code rows
+ * and a stack would not fit beside it. */
+static void column_split(double rest, const column *C, int code, int stack, int lifted,
+                         double *hc, double *hs, double *hl)
+{
+    double want = (code ? C->code_want : 0) + (stack ? C->stack_min : 0);
+    if (lifted && rest - want < C->lifted_min) {
+        want = (code ? C->code_mid : 0) + (stack ? C->stack_min : 0);
+        if (rest - want < C->lifted_min) lifted = 0;
+    }
+    /* beside the lifted view the code wants no more than leaves it a share */
+    double share = lifted ? (stack ? 0.3 : 0.42) * rest : 0;
+    double others = (lifted ? fmax(share, C->lifted_min) : 0) + (stack ? C->stack_min : 0);
+    double code_want = fmax(C->code_mid, fmin(C->code_want, rest - others));
+    *hc = code ? code_want : 0;
+    *hs = stack ? C->stack_min : 0;
+    *hl = lifted ? C->lifted_min : 0;
+    double over = *hc + *hs + *hl - rest;
+    if (over > 0 && code) { /* the code panel gives first, down to 4 lines */
+        double give = fmin(over, *hc - C->code_min);
+        *hc -= give;
+        over -= give;
+    }
+    if (over > 0 && stack) *hs = fmax(0, *hs - over);
+    if (over > 0 && code) *hc = fmax(0, rest - *hs - *hl);
+    double extra = rest - *hc - *hs - *hl;
+    if (extra <= 0) return;
+    if (code && *hc < code_want) { /* the code's lines first */
+        double give = fmin(extra, code_want - *hc);
+        *hc += give;
+        extra -= give;
+    }
+    if (lifted) *hl += stack ? 0.65 * extra : extra, *hs += stack ? 0.35 * extra : 0;
+    else if (stack) *hs += extra;
+    else *hc += extra;
+}
+
+/* No side column: the picture takes the whole width, the legend is a strip
+ * under it (its items flow in rows). */
+static void layout_strip(double w, double h, double top, double tl, pdt_layout *L)
+{
+    double f = L->font;
+    int lrows = (int)ceil(64 * f / fmax(w - f, f));
+    if (lrows < 1) lrows = 1;
+    if (lrows > 4) lrows = 4;
+    double leg = lrows * 1.45 * f + 0.6 * f;
+    double mid = h - tl - top - leg;
+    L->top = (pdt_rect){0, 0, w, top};
+    L->geo = (pdt_rect){0, top, w, mid};
+    L->legend = (pdt_rect){0, top + mid, w, leg};
+    L->timeline = (pdt_rect){0, h - tl, tl > 0 ? w : 0, tl};
+    L->code = L->stack = L->lifted = (pdt_rect){w, top, 0, 0};
+}
+
+void pdt_render_layout_scaled(double w, double h, int nranks, unsigned panels, double scale,
+                              pdt_layout *L)
+{
+    layout_fonts(w, h, scale, L);
+    double f = L->font, top = pdt_layout_top_height(L);
+    /* timeline rows hold their labels (1.7 x the label size), up to 16 rows */
     int rows = nranks < 1 ? 1 : nranks > 16 ? 16 : nranks;
-    double tl = (rows + 1.6) * f * 1.15;
-    if (tl > 0.28 * h) tl = 0.28 * h;
+    double tl = 1.7 * f + rows * 1.7 * L->label;
+    if (tl > 0.3 * h) tl = 0.3 * h;
     if (!(panels & PDT_PANEL_TIMELINE)) tl = 0;
     int has_code = (panels & PDT_PANEL_CODE) != 0, has_stack = (panels & PDT_PANEL_STACK) != 0,
         has_lifted = (panels & PDT_PANEL_LIFTED) != 0;
     if (!has_code && !has_stack && !has_lifted) {
-        /* no side column: the picture takes the whole width, the legend is
-         * a strip under it (its items flow in rows) */
-        int lrows = (int)ceil(64 * f / fmax(w - f, f));
-        if (lrows < 1) lrows = 1;
-        if (lrows > 4) lrows = 4;
-        double leg = lrows * 1.45 * f + 0.6 * f;
-        double mid = h - tl - top - leg;
-        L->top = (pdt_rect){0, 0, w, top};
-        L->geo = (pdt_rect){0, top, w, mid};
-        L->legend = (pdt_rect){0, top + mid, w, leg};
-        L->timeline = (pdt_rect){0, h - tl, tl > 0 ? w : 0, tl};
-        L->code = L->stack = L->lifted = (pdt_rect){w, top, 0, 0};
+        layout_strip(w, h, top, tl, L);
         layout_round(L);
         return;
     }
-    double side = 0.34 * w;
-    if (side < 22 * f) side = 22 * f;
-    if (side > 0.5 * w) side = 0.5 * w;
+    layout_column(w, h, top, tl, has_code, has_stack, has_lifted, L);
+    layout_round(L);
+}
+
+/* The side column (legend, code, stacks, lifted view) beside the picture,
+ * the timeline under both.  When the column cannot hold the legend, four
+ * code rows and a stack, the timeline gives its room, then the stacks. */
+static void layout_column(double w, double h, double top, double tl, int has_code, int has_stack,
+                          int has_lifted, pdt_layout *L)
+{
+    double f = L->font, side = fmin(fmax(0.34 * w, 19 * f), 0.5 * w);
+    column C = column_needs(L);
+    double need = C.legend + (has_code ? C.code_min : 0) + (has_stack ? C.stack_min : 0);
+    if (h - top - tl < need && tl > 0) {
+        tl = h - top - need;
+        if (tl < 2.2 * f + 1.7 * L->label) tl = 0;
+    }
+    if (h - top - tl < need) has_stack = 0;
+    double mid = h - tl - top;
     L->top = (pdt_rect){0, 0, w, top};
     L->timeline = (pdt_rect){0, h - tl, tl > 0 ? w : 0, tl};
-    double mid = h - tl - top;
     L->geo = (pdt_rect){0, top, w - side, mid};
-    double x = w - side, y = top;
-    double leg = 7.6 * f, code = has_code ? 12.2 * f * 0.9 : 0;
-    double rest = mid - leg - code;
-    if (has_code && rest < 10 * f) { /* small pictures: shrink the code panel first */
-        code = mid - leg - 10 * f;
-        if (code < 4 * f) code = 4 * f;
-        rest = mid - leg - code;
-    }
-    double stk = has_stack ? (has_lifted ? rest * 0.38 : rest) : 0;
-    double lifted = has_lifted ? rest - stk : 0;
-    if (!has_stack && !has_lifted && has_code) code += rest; /* the code panel takes the column */
+    double x = w - side, y = top, leg = fmin(C.legend, mid), code, stk, lifted;
+    column_split(mid - leg, &C, has_code, has_stack, has_lifted, &code, &stk, &lifted);
     L->legend = (pdt_rect){x, y, side, leg};
-    L->code = (pdt_rect){x, y + leg, has_code ? side : 0, code};
-    L->stack = (pdt_rect){x, y + leg + code, has_stack ? side : 0, stk};
-    L->lifted = (pdt_rect){x, y + leg + code + stk, has_lifted ? side : 0, lifted};
-    layout_round(L);
+    L->code = (pdt_rect){x, y + leg, code > 0 ? side : 0, code};
+    L->stack = (pdt_rect){x, y + leg + code, stk > 0 ? side : 0, stk};
+    L->lifted = (pdt_rect){x, y + leg + code + stk, lifted > 0 ? side : 0, lifted};
+}
+
+double pdt_layout_top_height(const pdt_layout *L)
+{
+    return 3.35 * L->font; /* the event line, then the status (or the event's rest) */
+}
+
+double pdt_layout_code_row(const pdt_layout *L)
+{
+    return 1.4 * L->body; /* an underscore stays on its own line */
 }
 
 /* Whole pixels: clipping to them stays a fast box clip. */

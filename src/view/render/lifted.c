@@ -49,7 +49,8 @@ static proj projection(const ctx *c, pdt_rect R, double f)
     J.sy_ = sin(c->v->yaw);
     J.cp = cos(c->v->pitch);
     J.sp = sin(c->v->pitch);
-    double top = R.y + 1.6 * f, H = R.h - 1.9 * f;
+    /* under the title; above the two lines of text at the bottom */
+    double top = R.y + 1.6 * f, H = R.h - 2.0 * f - 2.3 * c->L.label;
     /* vertical extent: z in [0,2], Y in [-1.42,1.42] */
     double ext_y = 2 * J.cp + 2.9 * J.sp, ext_x = 2.9;
     J.s = fmin((R.w - f) / ext_x, H / ext_y);
@@ -217,39 +218,62 @@ static uint32_t event_point(const pdt_rec *e)
     return NONE32;
 }
 
+/* Does box b (x0, y0, x1, y1) meet one of the n boxes of bx? */
+static int box_hit(double (*bx)[4], int n, const double b[4])
+{
+    for (int j = 0; j < n; j++)
+        if (b[0] < bx[j][2] && bx[j][0] < b[2] && b[1] < bx[j][3] && bx[j][1] < b[3]) return 1;
+    return 0;
+}
+
+/* Where the label of width tw at point (sx, sy) goes: right-up, left-up,
+ * right-down, left-down (the first two for the others), the first place
+ * that meets no label placed before; 0 when none is free. */
+static int label_place(double (*bx)[4], int nb, double sx, double sy, double tw, double fs,
+                       int tries, double b[4])
+{
+    for (int k = 0; k < tries; k++) {
+        double x0 = k % 2 ? sx - 0.25 * fs - tw : sx + 0.25 * fs;
+        double y1 = k < 2 ? sy - 0.25 * fs : sy + 1.0 * fs;
+        double t[4] = {x0, y1 - 0.8 * fs, x0 + tw, y1 + 0.05 * fs};
+        if (box_hit(bx, nb, t)) continue;
+        memcpy(b, t, sizeof t);
+        return 1;
+    }
+    return 0;
+}
+
 /* Labels of the lifted points (few points): the current event's point and
  * the plane's corners first, then the others in index order; a label that
- * would overlap one already placed gives way (the panel is small). */
+ * would overlap one already placed (or the panel's lines at the bottom)
+ * moves, else gives way (the panel is small). */
 static void draw_point_labels(const ctx *c, const proj *J, const pdt_rec *e, int have_plane,
                               const uint32_t tv[3])
 {
     cairo_t *cr = c->cr;
-    double fs = 0.8 * c->L.label;
+    double fs = c->L.label, f = c->L.font;
+    pdt_rect R = c->L.lifted;
     uint32_t first[4] = {event_point(e), NONE32, NONE32, NONE32};
     for (int j = 0; j < 3 && have_plane; j++) first[j + 1] = tv[j];
-    double bx[64][4];
-    int nb = 0;
+    double bx[64][4] = {{R.x, R.y + R.h - 0.5 * f - 2.3 * fs, R.x + R.w, R.y + R.h}};
+    int nb = have_plane ? 1 : 0;
     for (size_t i = 0; i < 4 + c->n; i++) {
         uint32_t p = i < 4 ? first[i] : (uint32_t)(i - 4);
         if (p >= c->n) continue;
         int dup = 0;
-        for (int j = 0; j < 4 && i >= 4; j++) dup |= first[j] == p;
+        for (size_t j = 0; j < 4 && j < i; j++) dup |= first[j] == p;
         if (dup) continue;
         int lifted = is_lifted(c, p);
         if (!lifted && i >= 4) continue;
-        double sx, sy;
+        double sx, sy, b[4];
         lift_at(c, J, p, lifted, &sx, &sy);
         char lab[24];
         snprintf(lab, sizeof lab, "%u", p);
-        double x0 = sx + 0.25 * fs, y1 = sy - 0.25 * fs;
-        double b[4] = {x0, y1 - 0.8 * fs, x0 + text_wb(cr, SANS, i < 4, fs, lab), y1};
-        int hit = 0;
-        for (int j = 0; j < nb && !hit; j++)
-            hit = b[0] < bx[j][2] && bx[j][0] < b[2] && b[1] < bx[j][3] && bx[j][1] < b[3];
-        if (hit && i >= 4) continue;
+        if (!label_place(bx, nb, sx, sy, text_wb(cr, SANS, i < 4, fs, lab), fs, i < 4 ? 4 : 2, b))
+            continue;
         if (nb < 64) memcpy(bx[nb++], b, sizeof b);
         rgb(cr, c->T->label, 1);
-        text_at(cr, SANS, i < 4, fs, x0, y1, lab);
+        text_at(cr, SANS, i < 4, fs, b[0], b[3] - 0.05 * fs, lab);
     }
 }
 
@@ -285,14 +309,18 @@ static void draw_plane_triangle(const ctx *c, const proj *J, const pdt_rec *e, c
     set_rank(cr, (int)e->rank, 1);
     cairo_set_line_width(cr, 2);
     cairo_stroke(cr);
-    char lab[128];
+    char lab[128], lab2[64];
+    double fs = c->L.label, room = R.w - f;
     snprintf(lab, sizeof lab, "%zu input point%s strictly inside the circle (exact, no tie rule)",
              ninside, ninside == 1 ? "" : "s");
+    if (text_w(cr, SANS, fs, lab) > room)
+        snprintf(lab, sizeof lab, "%zu point%s inside the circle", ninside, ninside == 1 ? "" : "s");
+    snprintf(lab2, sizeof lab2, "%s", "those already lifted: below the plane (red)");
+    if (text_w(cr, SANS, fs, lab2) > room) snprintf(lab2, sizeof lab2, "%s", "lifted ones: below (red)");
     rgb(cr, ninside ? RED : c->T->ink, 1);
-    text_at(cr, SANS, 0, 0.72 * f, R.x + 0.5 * f, R.y + R.h - 1.4 * f, lab);
+    text_at(cr, SANS, 0, fs, R.x + 0.5 * f, R.y + R.h - 0.5 * f - 1.25 * fs, lab);
     rgb(cr, c->T->ink, 1);
-    text_at(cr, SANS, 0, 0.72 * f, R.x + 0.5 * f, R.y + R.h - 0.5 * f,
-            "those already lifted: below the plane (red)");
+    text_at(cr, SANS, 0, fs, R.x + 0.5 * f, R.y + R.h - 0.5 * f, lab2);
 }
 
 void pdt_draw_lifted(ctx *c)
@@ -322,8 +350,9 @@ void pdt_draw_lifted(ctx *c)
     if (have_plane) draw_plane_triangle(c, &J, e, tv, ninside, R, f);
     if (c->no_lift) {
         rgb(cr, c->T->ink, 1);
-        text_at(cr, SANS, 0, 0.8 * f, R.x + 0.5 * f, R.y + R.h - 0.5 * f,
-                "no lift-up in this run (points stay on the floor)");
+        const char *t = "no lift-up in this run (points stay on the floor)";
+        if (text_w(cr, SANS, c->L.label, t) > R.w - f) t = "no lift-up in this run";
+        text_at(cr, SANS, 0, c->L.label, R.x + 0.5 * f, R.y + R.h - 0.5 * f, t);
     }
     cairo_restore(cr);
 }

@@ -7,75 +7,134 @@
 static void draw_prompt(ctx *c);
 
 
+/* How many bytes of s, cut after a whole word, fit in `room` pixels at
+ * size fs (bold); all of s when it fits, at least its first word. */
+static size_t fit_words(cairo_t *cr, const char *s, double fs, double room)
+{
+    char buf[512];
+    size_t n = strlen(s), best = 0;
+    if (n >= sizeof buf) n = sizeof buf - 1;
+    memcpy(buf, s, n);
+    buf[n] = 0;
+    if (text_wb(cr, SANS, 1, fs, buf) <= room) return n;
+    for (size_t i = 1; i < n; i++) {
+        if (s[i] != ' ') continue;
+        buf[i] = 0;
+        if (text_wb(cr, SANS, 1, fs, buf) > room) break;
+        buf[i] = ' ';
+        best = i;
+    }
+    if (!best) best = strcspn(s, " ");
+    return best;
+}
+
+/* The top bar's text, planned before it is drawn (the picture's labels
+ * keep off the rows that spill under the bar): the counter, the status and
+ * the event line's rows, the first two in the bar. */
+enum { TOP_ROWS = 8 };
+typedef struct top_plan {
+    char head[64], status[512], row[TOP_ROWS][512];
+    int nrows;
+    double x, sx, y[TOP_ROWS];
+} top_plan;
+
+/* The status, ended by "…" when wider than the bar (a very narrow window). */
+static void plan_status(ctx *c, top_plan *P)
+{
+    double f = c->L.font;
+    snprintf(P->status, sizeof P->status, "%s", c->v->status ? c->v->status : "");
+    for (size_t n = strlen(P->status); n > 1 && text_w(c->cr, SANS, c->L.label, P->status) > c->L.top.w - f;) {
+        do n--; while (n > 1 && ((unsigned char)P->status[n] & 0xC0) == 0x80);
+        snprintf(P->status + n, sizeof P->status - n, "…");
+    }
+    P->sx = c->L.top.w - 0.5 * f - (c->v->status ? text_w(c->cr, SANS, c->L.label, P->status) : 0);
+}
+
+/* Takes the row of `rest` that fits in room into P (at y); returns the rest. */
+static const char *plan_row(ctx *c, top_plan *P, const char *rest, double room, double y)
+{
+    size_t n = fit_words(c->cr, rest, c->L.font, room);
+    snprintf(P->row[P->nrows], sizeof P->row[0], "%.*s", (int)n, rest);
+    P->y[P->nrows++] = y;
+    return rest + n + (rest[n] == ' ');
+}
+
+static void plan_top(ctx *c, top_plan *P)
+{
+    cairo_t *cr = c->cr;
+    pdt_rect R = c->L.top;
+    double f = c->L.font, fs = f;
+    char line[512];
+    pdt_replay_describe_state(c->r, c->s, c->s->k, line, sizeof line);
+    snprintf(P->head, sizeof P->head, "%zu / %zu", c->s->k, pdt_replay_count(c->r));
+    P->x = 0.5 * f + text_w(cr, MONO, c->L.body, P->head) + 0.9 * f + (c->cur ? 1.1 * f : 0);
+    plan_status(c, P);
+    P->nrows = 0;
+    const char *rest = plan_row(c, P, line, R.w - P->x - 0.5 * f, R.y + 1.35 * f);
+    double room2 = P->sx - 1.0 * f - P->x;
+    char word[512];
+    snprintf(word, sizeof word, "%.*s", (int)strcspn(rest, " "), rest);
+    if (*rest && text_wb(cr, SANS, 1, fs, word) <= room2) /* beside the status */
+        rest = plan_row(c, P, rest, room2, R.y + 2.75 * f);
+    double room = fmax(c->L.geo.x + c->L.geo.w - P->x - 0.5 * f, 4 * f); /* over the picture */
+    for (double y = R.y + R.h + 1.05 * fs; *rest && P->nrows < TOP_ROWS; y += 1.4 * fs)
+        rest = plan_row(c, P, rest, room, y); /* under the bar */
+}
+
+void pdt_top_spill(ctx *c)
+{
+    top_plan *P = malloc(sizeof *P);
+    if (!P) return;
+    plan_top(c, P);
+    double f = c->L.font, bottom = c->L.top.y + c->L.top.h, w = 0;
+    for (int i = 0; i < P->nrows; i++)
+        if (P->y[i] > bottom) {
+            w = fmax(w, text_wb(c->cr, SANS, 1, f, P->row[i]));
+            bottom = P->y[i] + 0.35 * f;
+        }
+    if (w > 0 && c->ntaken < TAKEN_MAX)
+        c->taken[c->ntaken++] = (lbox){P->x - 0.3 * f, c->L.top.y + c->L.top.h, P->x + w + 0.3 * f, bottom};
+    free(P);
+}
+
+/* The top bar: the counter and the event line, then on its second row the
+ * status at the right and what of the event line did not fit at the left.
+ * Text keeps its size; the very rare rest goes in boxes under the bar. */
 void pdt_draw_top(ctx *c)
 {
     cairo_t *cr = c->cr;
     pdt_rect R = c->L.top;
+    double f = c->L.font;
+    top_plan *P = malloc(sizeof *P);
+    if (!P) return;
+    plan_top(c, P);
     cairo_rectangle(cr, R.x, R.y, R.w, R.h);
     rgb(cr, c->T->topbar, 1);
     cairo_fill(cr);
-    char line[512], head[64];
-    pdt_replay_describe_state(c->r, c->s, c->s->k, line, sizeof line);
-    snprintf(head, sizeof head, "%zu / %zu", c->s->k, pdt_replay_count(c->r));
-    double f = c->L.font;
     rgb(cr, c->T->ink, 0.7);
-    text_at(cr, MONO, 0, 0.9 * f, 0.5 * f, 1.35 * f, head);
-    double x = 0.5 * f + text_w(cr, MONO, 0.9 * f, head) + 1.0 * f;
+    text_at(cr, MONO, 0, c->L.body, 0.5 * f, R.y + 1.35 * f, P->head);
     if (c->cur) {
         set_rank(cr, (int)c->cur->rank, 1);
-        cairo_rectangle(cr, x, 0.45 * f, 0.7 * f, 1.1 * f);
+        cairo_rectangle(cr, P->x - 1.1 * f, R.y + 0.5 * f, 0.7 * f, 1.1 * f);
         cairo_fill(cr);
-        x += 1.1 * f;
-    }
-    /* the event line gets the bar; the status goes under it, at the
-     * picture's top right, when both do not fit */
-    double room = R.w - x - 0.5 * f, sw = 0, sf = 0.85 * f;
-    if (c->v->status) sw = text_w(cr, SANS, sf, c->v->status) + 1.2 * f;
-    double fs = 1.05 * f, lw = text_wb(cr, SANS, 1, fs, line);
-    int status_in_bar = c->v->status && lw + sw <= room;
-    double avail = status_in_bar ? room - sw : room;
-    if (lw > avail) fs = fmax(0.8 * f, fs * avail / lw);
-    /* still too long at the smallest size: the words that fit stay in the
-     * bar, the rest goes on a second line in a box under it (never cut) */
-    char first[512];
-    const char *rest = NULL;
-    snprintf(first, sizeof first, "%s", line);
-    if (text_wb(cr, SANS, 1, fs, first) > avail) {
-        size_t len = strlen(first);
-        while (len > 0) {
-            while (len > 0 && first[len - 1] != ' ') len--;
-            if (len == 0) break;
-            first[len - 1] = 0;
-            if (text_wb(cr, SANS, 1, fs, first) <= avail) break;
-            len--;
-        }
-        if (len > 0) rest = line + len;
-        else snprintf(first, sizeof first, "%s", line);
-    }
-    rgb(cr, c->T->ink, 1);
-    cairo_save(cr);
-    clip_rect(cr, (pdt_rect){R.x, R.y, x + avail, R.h});
-    text_at(cr, SANS, 1, fs, x, 1.4 * f, first);
-    cairo_restore(cr);
-    if (rest) {
-        double rw = text_wb(cr, SANS, 1, fs, rest);
-        cairo_rectangle(cr, x - 0.3 * f, R.y + R.h, rw + 0.6 * f, 1.35 * fs);
-        rgb(cr, c->T->topbar, 0.92);
-        cairo_fill(cr);
-        rgb(cr, c->T->ink, 1);
-        text_at(cr, SANS, 1, fs, x, R.y + R.h + 1.05 * fs, rest);
     }
     if (c->v->status) {
-        double tw = sw - 1.2 * f;
-        double sx = R.w - tw - 0.6 * f, sy = status_in_bar ? 1.35 * f : R.y + R.h + 1.1 * f;
-        if (!status_in_bar) {
-            cairo_rectangle(cr, sx - 0.3 * f, sy - 0.95 * sf, tw + 0.6 * f, 1.3 * sf);
-            rgb(cr, c->T->topbar, 0.9);
+        rgb(cr, c->T->ink, 0.8);
+        pdt_text_log_panel(cr, "status");
+        text_at(cr, SANS, 0, c->L.label, P->sx, R.y + 2.75 * f, P->status);
+        pdt_text_log_panel(cr, "event");
+    }
+    for (int i = 0; i < P->nrows; i++) {
+        if (P->y[i] > R.y + R.h) {
+            cairo_rectangle(cr, P->x - 0.3 * f, P->y[i] - 1.05 * f,
+                            text_wb(cr, SANS, 1, f, P->row[i]) + 0.6 * f, 1.4 * f);
+            rgb(cr, c->T->topbar, 0.92);
             cairo_fill(cr);
         }
-        rgb(cr, c->T->ink, 0.75);
-        text_at(cr, SANS, 0, sf, sx, sy, c->v->status);
+        rgb(cr, c->T->ink, 1);
+        text_at(cr, SANS, 1, f, P->x, P->y[i], P->row[i]);
     }
+    free(P);
     if (c->v->prompt) draw_prompt(c);
 }
 
@@ -287,34 +346,97 @@ void pdt_draw_legend(ctx *c)
     cairo_restore(cr);
 }
 
+/* The pseudo-code as rows: each line wrapped at its words to `room`
+ * pixels, its rest indented under the text; row r belongs to line of[r]. */
+enum { CODE_ROWS = 96, CODE_COLS = 160 };
+
+typedef struct code_rows {
+    char t[CODE_ROWS][CODE_COLS];
+    int of[CODE_ROWS];
+    int n;
+} code_rows;
+
+/* The bytes of s (after the indent pre) that fit in room: up to the last
+ * word end that fits; all of s when it fits or one word is too wide. */
+static size_t code_cut(cairo_t *cr, const char *s, const char *pre, double fs, double room)
+{
+    char row[CODE_COLS];
+    size_t len = strlen(s), best = 0;
+    snprintf(row, sizeof row, "%s%s", pre, s);
+    if (text_w(cr, MONO, fs, row) <= room) return len;
+    for (size_t i = 1; i < len; i++) {
+        if (s[i] != ' ' || s[i - 1] == ' ') continue;
+        snprintf(row, sizeof row, "%s%.*s", pre, (int)i, s);
+        if (text_w(cr, MONO, fs, row) > room) break;
+        best = i;
+    }
+    return best ? best : len;
+}
+
+static void wrap_code(cairo_t *cr, int id, double fs, double room, code_rows *W)
+{
+    W->n = 0;
+    int nl = (int)pdt_code_count(id);
+    for (int i = 0; i < nl && W->n < CODE_ROWS; i++) {
+        const char *s = pdt_code_text(id, (size_t)i);
+        /* a wrapped line's rest goes under its text, two columns in */
+        size_t num = strcspn(s, " "), ind = num + strspn(s + num, " ") + 2;
+        char pre[24] = "", hang[24];
+        snprintf(hang, sizeof hang, "%*s", (int)(ind < sizeof hang ? ind : sizeof hang - 1), "");
+        for (; *s && W->n < CODE_ROWS; snprintf(pre, sizeof pre, "%s", hang)) {
+            size_t cut = code_cut(cr, s, pre, fs, room);
+            snprintf(W->t[W->n], CODE_COLS, "%s%.*s", pre, (int)cut, s);
+            W->of[W->n++] = i;
+            s += cut;
+            while (*s == ' ') s++;
+        }
+    }
+}
+
 void pdt_draw_code(ctx *c)
 {
     cairo_t *cr = c->cr;
     pdt_rect R = c->L.code;
-    double f = c->L.font;
+    double f = c->L.font, fs = c->L.body, lh = pdt_layout_code_row(&c->L);
     int id;
     int line = pdt_replay_code_line(c->r, c->s, &id);
-    panel(cr, c->T, R, pdt_code_title(id), f);
+    panel(cr, c->T, R, NULL, f);
     cairo_save(cr);
     clip_rect(cr, R);
-    int nl = (int)pdt_code_count(id);
-    double lh = (R.h - 1.9 * f) / nl;
-    if (lh > 1.15 * f) lh = 1.15 * f;
-    double fs = fmin(0.78 * f, 0.92 * lh);
-    /* shrink to fit the width */
-    double wmax = 0;
-    for (int i = 0; i < nl; i++) wmax = fmax(wmax, text_w(cr, MONO, fs, pdt_code_text(id, (size_t)i)));
-    if (wmax > R.w - 1.2 * f) fs *= (R.w - 1.2 * f) / wmax;
-    for (int i = 0; i < nl; i++) {
-        double y = R.y + 1.7 * f + (i + 1) * lh;
-        if (i == line) {
-            cairo_rectangle(cr, R.x + 0.3 * f, y - 0.85 * lh, R.w - 0.6 * f, lh);
+    code_rows *W = malloc(sizeof *W);
+    if (!W) {
+        cairo_restore(cr);
+        return;
+    }
+    wrap_code(cr, id, fs, R.w - 1.2 * f, W);
+    /* the rows that fit, scrolled so that the lit line is in view */
+    int fit = (int)((R.h - 1.8 * f - 0.2 * f) / lh), first = 0, lit = -1;
+    for (int r = 0; r < W->n && lit < 0; r++)
+        if (W->of[r] == line) lit = r;
+    if (fit < 1) fit = 1;
+    if (W->n > fit && lit >= 0) first = lit - fit / 3;
+    while (first > 0 && first < lit && W->of[first] == W->of[first - 1]) first++; /* a line's start */
+    if (first > W->n - fit) first = W->n - fit;
+    if (first < 0) first = 0;
+    for (int r = first; r < W->n && r < first + fit; r++) {
+        double top = R.y + 1.8 * f + (r - first) * lh;
+        if (W->of[r] == line) {
+            cairo_rectangle(cr, R.x + 0.3 * f, top, R.w - 0.6 * f, lh);
             rgb(cr, c->T->mark, 0.8);
             cairo_fill(cr);
         }
         rgb(cr, c->T->ink, 1);
-        text_at(cr, MONO, i == line, fs, R.x + 0.6 * f, y - 0.18 * lh, pdt_code_text(id, (size_t)i));
+        text_at(cr, MONO, W->of[r] == line, fs, R.x + 0.6 * f, top + 1.02 * fs, W->t[r]);
     }
+    double aw = 0;
+    if (first > 0 || first + fit < W->n) { /* more above / below: arrows by the title */
+        rgb(cr, c->T->ink, 0.6);
+        const char *mark = first > 0 && first + fit < W->n ? "▲▼" : first > 0 ? "▲" : "▼";
+        aw = text_wb(cr, SANS, 1, fs, mark) + 0.5 * f;
+        text_at(cr, SANS, 1, fs, R.x + R.w - aw - 0.1 * f, R.y + 1.25 * f, mark);
+    }
+    panel_title(cr, c->T, R, pdt_code_title(id), f, fs, R.w - 1.2 * f - aw);
+    free(W);
     cairo_restore(cr);
 }
 

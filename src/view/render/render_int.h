@@ -24,6 +24,7 @@
 
 #include "pdt/view/query.h"
 #include "pdt/view/render.h"
+#include "pdt/view/textlog.h"
 
 #define NONE32 UINT32_MAX
 #define SANS "DejaVu Sans"
@@ -61,6 +62,13 @@ typedef struct xform {
 /* The transform of the geometry area for a w x h picture (layout.c). */
 xform pdt_geo_xform(const pdt_replay *r, const pdt_view *v, double w, double h);
 
+/* A text's box on screen, pixels. */
+typedef struct lbox {
+    double x0, y0, x1, y1;
+} lbox;
+
+enum { TAKEN_MAX = 256 };
+
 /* Everything one frame's drawing functions share. */
 typedef struct ctx {
     cairo_t *cr;
@@ -80,7 +88,18 @@ typedef struct ctx {
     int no_lift;         /* no lift events and no triangles (a hull-only run) */
     double spacing;      /* typical distance between points, pixels */
     const pdt_theme *T;  /* colours */
+    lbox taken[TAKEN_MAX]; /* the strip labels placed: point labels keep off them */
+    int ntaken;
 } ctx;
+
+/* The top bar's height (event line and status rows) and the height of a
+ * pseudo-code row, both from the layout's font (layout.c). */
+double pdt_layout_top_height(const pdt_layout *L);
+double pdt_layout_code_row(const pdt_layout *L);
+
+/* The frame's panels, for the layout report to name a text's panel when
+ * none was set (textlog.c). */
+void pdt_text_log_layout(cairo_t *cr, const pdt_layout *L);
 
 /* The parts of the frame, each clipped to its rectangle of c->L. */
 void pdt_draw_geometry(ctx *c);                 /* geometry.c */
@@ -92,6 +111,9 @@ size_t pdt_unique_edges(uint64_t *e, size_t n);
  * return 1; else draw nothing and return 0. */
 int pdt_draw_lod(ctx *c);
 void pdt_draw_top(ctx *c);                      /* panels.c */
+/* The event line's rows that spill under the top bar, as a box the
+ * picture's labels keep off (c->taken). */
+void pdt_top_spill(ctx *c);
 void pdt_draw_legend(ctx *c);
 void pdt_draw_code(ctx *c);
 void pdt_draw_stack_panel(ctx *c);
@@ -122,6 +144,7 @@ static inline void text_at(cairo_t *cr, const char *face, int bold, double size,
     cairo_select_font_face(cr, face, CAIRO_FONT_SLANT_NORMAL,
                            bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
     cairo_set_font_size(cr, size);
+    pdt_text_log_note(cr, size, x, y, s);
     cairo_move_to(cr, x, y);
     cairo_show_text(cr, s);
 }
@@ -141,6 +164,21 @@ static inline double text_w(cairo_t *cr, const char *face, double size, const ch
     return text_wb(cr, face, 0, size, s);
 }
 
+/* A panel's title in its first row at the label size (never smaller): a
+ * title wider than room loses its end. */
+static inline void panel_title(cairo_t *cr, const pdt_theme *T, pdt_rect R, const char *title,
+                               double f, double fs, double room)
+{
+    char t[160];
+    snprintf(t, sizeof t, "%s", title);
+    for (size_t n = strlen(t); n > 1 && text_wb(cr, SANS, 1, fs, t) > room;) {
+        do n--; while (n > 1 && ((unsigned char)t[n] & 0xC0) == 0x80);
+        snprintf(t + n, sizeof t - n, "…");
+    }
+    rgb(cr, T->ink, 1);
+    text_at(cr, SANS, 1, fs, R.x + 0.5 * f, R.y + 0.3 * f + 0.9 * fs, t);
+}
+
 static inline void panel(cairo_t *cr, const pdt_theme *T, pdt_rect R, const char *title, double f)
 {
     cairo_rectangle(cr, R.x + 2, R.y + 2, R.w - 4, R.h - 4);
@@ -149,12 +187,7 @@ static inline void panel(cairo_t *cr, const pdt_theme *T, pdt_rect R, const char
     rgb(cr, T->border, 1);
     cairo_set_line_width(cr, 1);
     cairo_stroke(cr);
-    if (title) {
-        double fs = 0.85 * f, tw = text_wb(cr, SANS, 1, fs, title);
-        if (tw > R.w - f) fs *= fmax(0.7, (R.w - f) / tw); /* long titles: smaller */
-        rgb(cr, T->ink, 1);
-        text_at(cr, SANS, 1, fs, R.x + 0.5 * f, R.y + 1.15 * f, title);
-    }
+    if (title) panel_title(cr, T, R, title, f, 0.82 * f, R.w - 1.2 * f);
 }
 
 static inline void clip_rect(cairo_t *cr, pdt_rect R)
