@@ -5,7 +5,8 @@
  *   layout.c    view defaults, panel rectangles, screen <-> world
  *   geometry.c  the world picture (boxes, triangles, hulls, stacks, points,
  *               merges, the current event, the selection)
- *   panels.c    text panels: event line, legend, pseudo-code, stacks, help
+ *   panels.c    text panels: event line, pseudo-code, stacks, help
+ *   legend.c    the legend
  *   lifted.c    the lifted view (paraboloid)
  *   timeline.c  the timeline and seeking by a click on it
  *   export.c    pdt_render_file(): PNG, SVG, PDF
@@ -92,7 +93,7 @@ size_t pdt_unique_edges(uint64_t *e, size_t n);
  * return 1; else draw nothing and return 0. */
 int pdt_draw_lod(ctx *c);
 void pdt_draw_top(ctx *c);                      /* panels.c */
-void pdt_draw_legend(ctx *c);
+void pdt_draw_legend(ctx *c);                   /* legend.c */
 void pdt_draw_code(ctx *c);
 void pdt_draw_stack_panel(ctx *c);
 void pdt_draw_help(ctx *c, double w, double h);
