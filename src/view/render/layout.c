@@ -19,6 +19,7 @@ void pdt_view_defaults(pdt_view *v)
     v->panels = PDT_PANEL_ALL;
     v->font_scale = 1;
     v->theme = PDT_THEME_LIGHT;
+    v->tl_t1 = 1;
 }
 
 int pdt_theme_parse(const char *name, int *theme)
@@ -36,7 +37,8 @@ int pdt_panels_parse(const char *list, unsigned *panels)
 {
     static const struct { const char *name; unsigned bit; } names[] = {
         {"code", PDT_PANEL_CODE}, {"stack", PDT_PANEL_STACK}, {"lifted", PDT_PANEL_LIFTED},
-        {"timeline", PDT_PANEL_TIMELINE}, {"all", PDT_PANEL_ALL}, {"none", 0}};
+        {"timeline", PDT_PANEL_TIMELINE}, {"tree", PDT_PANEL_TREE}, {"all", PDT_PANEL_ALL},
+        {"none", 0}};
     unsigned bits = 0;
     const char *p = list;
     while (*p) {
@@ -91,7 +93,7 @@ void pdt_render_layout_scaled(double w, double h, int nranks, unsigned panels, d
     if (!has_code && !has_stack && !has_lifted) {
         /* no side column: the picture takes the whole width, the legend is
          * a strip under it (its items flow in rows) */
-        int lrows = (int)ceil(64 * f / fmax(w - f, f));
+        int lrows = (int)ceil((nranks > PDT_PALETTE_HUES ? 100 : 64) * f / fmax(w - f, f));
         if (lrows < 1) lrows = 1;
         if (lrows > 4) lrows = 4;
         double leg = lrows * 1.45 * f + 0.6 * f;
@@ -101,6 +103,7 @@ void pdt_render_layout_scaled(double w, double h, int nranks, unsigned panels, d
         L->legend = (pdt_rect){0, top + mid, w, leg};
         L->timeline = (pdt_rect){0, h - tl, tl > 0 ? w : 0, tl};
         L->code = L->stack = L->lifted = (pdt_rect){w, top, 0, 0};
+        pdt_layout_tree_strip(L, panels, w, h);
         layout_round(L);
         return;
     }
@@ -112,13 +115,15 @@ void pdt_render_layout_scaled(double w, double h, int nranks, unsigned panels, d
     double mid = h - tl - top;
     L->geo = (pdt_rect){0, top, w - side, mid};
     double x = w - side, y = top;
-    double leg = 7.6 * f, code = has_code ? 12.2 * f * 0.9 : 0;
+    double leg = (nranks > PDT_PALETTE_HUES ? 10.2 : 7.6) * f, code = has_code ? 12.2 * f * 0.9 : 0;
     double rest = mid - leg - code;
     if (has_code && rest < 10 * f) { /* small pictures: shrink the code panel first */
         code = mid - leg - 10 * f;
         if (code < 4 * f) code = 4 * f;
         rest = mid - leg - code;
     }
+    double tree = (panels & PDT_PANEL_TREE) ? (has_stack || has_lifted ? 0.5 * rest : rest) : 0;
+    rest -= tree;
     double stk = has_stack ? (has_lifted ? rest * 0.38 : rest) : 0;
     double lifted = has_lifted ? rest - stk : 0;
     if (!has_stack && !has_lifted && has_code) code += rest; /* the code panel takes the column */
@@ -126,13 +131,15 @@ void pdt_render_layout_scaled(double w, double h, int nranks, unsigned panels, d
     L->code = (pdt_rect){x, y + leg, has_code ? side : 0, code};
     L->stack = (pdt_rect){x, y + leg + code, has_stack ? side : 0, stk};
     L->lifted = (pdt_rect){x, y + leg + code + stk, has_lifted ? side : 0, lifted};
+    L->tree = (pdt_rect){x, y + leg + code + stk + lifted, tree > 0 ? side : 0, tree};
     layout_round(L);
 }
 
 /* Whole pixels: clipping to them stays a fast box clip. */
 static void layout_round(pdt_layout *L)
 {
-    pdt_rect *all[] = {&L->top, &L->geo, &L->legend, &L->code, &L->stack, &L->lifted, &L->timeline};
+    pdt_rect *all[] = {&L->top,    &L->geo,    &L->legend,   &L->code,
+                       &L->stack,  &L->lifted, &L->timeline, &L->tree};
     for (size_t i = 0; i < sizeof all / sizeof *all; i++) {
         double x1 = round(all[i]->x + all[i]->w), y1 = round(all[i]->y + all[i]->h);
         all[i]->x = round(all[i]->x);

@@ -38,6 +38,37 @@ static void flow_text(flow *F, const char *s, double alpha)
     F->x += text_w(F->c->cr, SANS, F->fs, s) + 0.9 * F->f;
 }
 
+/* The groups the legend lists: those on screen (groups.c), or every rank
+ * when there are none; group i's ranks [*lo, *hi).  Returns their number. */
+static int legend_group(const ctx *c, int i, uint32_t *lo, uint32_t *hi)
+{
+    if (!c->hue || !c->tree) {
+        *lo = (uint32_t)i;
+        *hi = (uint32_t)i + 1;
+        return c->nranks < 64 ? c->nranks : 64;
+    }
+    size_t n;
+    const pdt_rtnode *d = &pdt_ranktree_nodes(c->tree, &n)[c->groups[i]];
+    *lo = d->lo;
+    *hi = d->hi;
+    return (int)c->ngroups;
+}
+
+/* Shown unless every rank of the group is hidden. */
+static int group_shown(const ctx *c, uint32_t lo, uint32_t hi)
+{
+    for (uint32_t q = lo; q < hi; q++)
+        if (shown(c, q)) return 1;
+    return 0;
+}
+
+/* "3", or "0–127" for a group ("rank 3", "ranks 0–127" first in a strip). */
+static void group_label(uint32_t lo, uint32_t hi, int first, char *lab, size_t cap)
+{
+    if (hi - lo == 1) snprintf(lab, cap, first ? "rank %u" : "%u", lo);
+    else snprintf(lab, cap, first ? "ranks %u–%u" : "%u–%u", lo, hi - 1);
+}
+
 static void draw_legend_strip(ctx *c)
 {
     cairo_t *cr = c->cr;
@@ -47,15 +78,16 @@ static void draw_legend_strip(ctx *c)
     cairo_save(cr);
     clip_rect(cr, R);
     flow F = {c, R, R.x + 0.5 * f, R.y + 1.3 * f, f, c->L.body};
-    char lab[16];
-    for (int q = 0; q < c->nranks && q < 64; q++) {
-        snprintf(lab, sizeof lab, q ? "%d" : "rank %d", q);
+    char lab[40];
+    uint32_t lo, hi;
+    for (int i = 0; i < legend_group(c, i, &lo, &hi); i++) {
+        group_label(lo, hi, i == 0, lab, sizeof lab);
         flow_room(&F, 1.1 * f + text_w(cr, SANS, F.fs, lab));
         cairo_rectangle(cr, F.x, F.y - 0.75 * f, 0.8 * f, 0.8 * f);
-        set_rank(cr, q, shown(c, (uint32_t)q) ? 1 : 0.2);
+        set_rank(c, (int)lo, group_shown(c, lo, hi) ? 1 : 0.2);
         cairo_fill(cr);
         F.x += 1.0 * f;
-        flow_text(&F, lab, shown(c, (uint32_t)q) ? 1 : 0.4);
+        flow_text(&F, lab, group_shown(c, lo, hi) ? 1 : 0.4);
     }
     static const char *const names[] = {"candidate", "final", "deferred (RA)", "shipped", "discarded"};
     static const int sts[] = {PDT_TS_CANDIDATE, PDT_TS_FINAL, PDT_TS_DEFERRED, PDT_TS_SHIPPED,
@@ -98,6 +130,44 @@ static void draw_legend_strip(ctx *c)
     cairo_restore(cr);
 }
 
+/* The side legend's groups, after "ranks:", in up to three lines when the
+ * run has more ranks than hues (the layout gives it the room); returns how
+ * much lower than one line the statuses go. */
+static double legend_side_groups(ctx *c, double fs)
+{
+    cairo_t *cr = c->cr;
+    pdt_rect R = c->L.legend;
+    double f = c->L.font, y0 = R.y + 2.3 * f, y = y0;
+    int lines = c->nranks > PDT_PALETTE_HUES ? 3 : 1, line = 1;
+    rgb(cr, c->T->ink, 1);
+    const char *head = c->hue && c->tree && c->nranks > PDT_PALETTE_HUES ? "groups:" : "ranks:";
+    text_at(cr, SANS, 0, fs, R.x + 0.5 * f, y, head);
+    double x = R.x + 0.9 * f + text_w(cr, SANS, fs, head), xl = x;
+    uint32_t lo, hi;
+    for (int i = 0; i < legend_group(c, i, &lo, &hi); i++) {
+        char lab[40];
+        group_label(lo, hi, 0, lab, sizeof lab);
+        double tw = text_w(cr, SANS, fs, lab);
+        if (x + 1.2 * f + tw > R.x + R.w - 0.5 * f) {
+            if (line == lines) {
+                rgb(cr, c->T->ink, 1);
+                text_at(cr, SANS, 0, fs, x, y, "…");
+                break;
+            }
+            line++;
+            x = xl;
+            y += 1.3 * f;
+        }
+        cairo_rectangle(cr, x, y - 0.75 * f, 0.8 * f, 0.8 * f);
+        set_rank(c, (int)lo, group_shown(c, lo, hi) ? 1 : 0.2);
+        cairo_fill(cr);
+        rgb(cr, c->T->ink, group_shown(c, lo, hi) ? 1 : 0.4);
+        text_at(cr, SANS, 0, fs, x + 0.95 * f, y, lab);
+        x += 1.3 * f + tw;
+    }
+    return lines > 1 ? 2.6 * f : y - y0;
+}
+
 void pdt_draw_legend(ctx *c)
 {
     cairo_t *cr = c->cr;
@@ -110,26 +180,7 @@ void pdt_draw_legend(ctx *c)
     panel(cr, c->T, R, "Legend", f);
     cairo_save(cr);
     clip_rect(cr, R);
-    /* ranks */
-    double x = R.x + 0.5 * f, y = R.y + 2.3 * f;
-    rgb(cr, c->T->ink, 1);
-    text_at(cr, SANS, 0, fs, x, y, "ranks:");
-    x += text_w(cr, SANS, fs, "ranks:") + 0.4 * f;
-    for (int q = 0; q < c->nranks; q++) {
-        char lab[16];
-        snprintf(lab, sizeof lab, "%d", q);
-        double tw = text_w(cr, SANS, fs, lab);
-        if (x + 1.2 * f + tw > R.x + R.w - 0.5 * f) {
-            text_at(cr, SANS, 0, fs, x, y, "…");
-            break;
-        }
-        cairo_rectangle(cr, x, y - 0.75 * f, 0.8 * f, 0.8 * f);
-        set_rank(cr, q, shown(c, (uint32_t)q) ? 1 : 0.2);
-        cairo_fill(cr);
-        rgb(cr, c->T->ink, shown(c, (uint32_t)q) ? 1 : 0.4);
-        text_at(cr, SANS, 0, fs, x + 0.95 * f, y, lab);
-        x += 1.3 * f + tw;
-    }
+    double dy = legend_side_groups(c, fs);
     /* statuses, two columns */
     static const char *const names[] = {"candidate", "final", "deferred (RA)", "shipped",
                                         "discarded"};
@@ -139,7 +190,7 @@ void pdt_draw_legend(ctx *c)
     pdt_rank_rgb(0, col0);
     double lw = fmax(1.5, 0.14 * f), colw = (R.w - f) / 2;
     for (int i = 0; i < 5; i++) {
-        double lx = R.x + 0.5 * f + (i % 2) * colw, ly = R.y + (3.6 + 1.25 * (i / 2)) * f;
+        double lx = R.x + 0.5 * f + (i % 2) * colw, ly = R.y + dy + (3.6 + 1.25 * (i / 2)) * f;
         legend_line(cr, lx, ly - 0.3 * f, 2.2 * f, sts[i], lw, col0);
         if (sts[i] == PDT_TS_DISCARDED) {
             cairo_set_line_width(cr, lw);
@@ -151,7 +202,7 @@ void pdt_draw_legend(ctx *c)
         text_at(cr, SANS, 0, fs, lx + 2.6 * f, ly, names[i]);
     }
     {   /* hull, in the sixth cell */
-        double lx = R.x + 0.5 * f + colw, ly = R.y + (3.6 + 1.25 * 2) * f;
+        double lx = R.x + 0.5 * f + colw, ly = R.y + dy + (3.6 + 1.25 * 2) * f;
         cairo_set_line_width(cr, 3.2 * lw);
         cairo_move_to(cr, lx, ly - 0.3 * f);
         cairo_line_to(cr, lx + 2.2 * f, ly - 0.3 * f);
@@ -161,7 +212,7 @@ void pdt_draw_legend(ctx *c)
         text_at(cr, SANS, 0, fs, lx + 2.6 * f, ly, "hull / stack");
     }
     /* markers */
-    double ly = R.y + 7.05 * f, lx = R.x + 0.5 * f;
+    double ly = R.y + dy + 7.05 * f, lx = R.x + 0.5 * f;
     cairo_new_sub_path(cr);
     cairo_arc(cr, lx + 0.4 * f, ly - 0.3 * f, 0.25 * f, 0, 2 * M_PI);
     rgb(cr, c->T->ink, 1);

@@ -22,7 +22,7 @@ void pdt_draw_top(ctx *c)
     text_at(cr, MONO, 0, 0.9 * f, 0.5 * f, 1.35 * f, head);
     double x = 0.5 * f + text_w(cr, MONO, 0.9 * f, head) + 1.0 * f;
     if (c->cur) {
-        set_rank(cr, (int)c->cur->rank, 1);
+        set_rank(c, (int)c->cur->rank, 1);
         cairo_rectangle(cr, x, 0.45 * f, 0.7 * f, 1.1 * f);
         cairo_fill(cr);
         x += 1.1 * f;
@@ -155,7 +155,7 @@ void pdt_draw_stack_panel(ctx *c)
             size_t k = pdt_replay_stack_list(c->r, top, buf, c->n + 1);
             char head[48];
             snprintf(head, sizeof head, "r%d %s (%zu):", q, pdt_stack_name(st), k);
-            set_rank(cr, q, 1);
+            set_rank(c, q, 1);
             text_at(cr, SANS, 1, fs, R.x + 0.5 * f, y, head);
             double x0 = R.x + 0.5 * f + text_wb(cr, SANS, 1, fs, head) + 0.4 * f;
             /* as many elements from the top as fit */

@@ -1,0 +1,83 @@
+/* pdt — the groups of ranks a frame shows (pdt/view/ranktree.h): the ranks
+ * on screen are those whose strip box meets the picture's view and those
+ * in the timeline's rows shown; at most eight groups of the merge tree
+ * cover them, one hue each.  Up to eight ranks, every rank is its own
+ * group, in every view, so a small run keeps its colours. */
+#include "render_int.h"
+
+size_t pdt_timeline_rows(const pdt_ranktree *t, const pdt_view *v, int32_t **rows)
+{
+    int32_t cut[PDT_PALETTE_HUES];
+    size_t nc = pdt_ranktree_cut(t, NULL, PDT_PALETTE_HUES, cut);
+    size_t n = pdt_ranktree_rows(t, cut, nc, v->tl_open, NULL, 0);
+    *rows = malloc((n ? n : 1) * sizeof **rows);
+    if (!*rows) return 0;
+    return pdt_ranktree_rows(t, cut, nc, v->tl_open, *rows, n);
+}
+
+/* Ranks whose strip box meets the picture's view (or that have none). */
+static void on_in_picture(const ctx *c, uint8_t *on)
+{
+    pdt_rect G = c->L.geo;
+    if (G.w <= 0 || G.h <= 0) return;
+    double wx0 = (G.x - c->X.ox) / c->X.s, wx1 = (G.x + G.w - c->X.ox) / c->X.s;
+    double wy1 = (c->X.oy - G.y) / c->X.s, wy0 = (c->X.oy - G.y - G.h) / c->X.s;
+    for (int q = 0; q < c->nranks; q++) {
+        pdt_point lo, hi;
+        if (!pdt_replay_box(c->r, q, &lo, &hi)) {
+            on[q] = 1;
+            continue;
+        }
+        if (hi.x >= wx0 && lo.x <= wx1 && hi.y >= wy0 && lo.y <= wy1) on[q] = 1;
+    }
+}
+
+static void on_in_timeline(const ctx *c, uint8_t *on)
+{
+    if (c->L.timeline.w <= 0 || !c->rows) return;
+    tl_geom g;
+    pdt_timeline_geom(c->L.timeline, c->L.font, c->nranks, c->nrows, pdt_replay_count(c->r), c->v, &g);
+    size_t n;
+    const pdt_rtnode *N = pdt_ranktree_nodes(c->tree, &n);
+    for (int i = g.row0; i < g.row0 + g.nshow && (size_t)i < c->nrows; i++)
+        memset(on + N[c->rows[i]].lo, 1, N[c->rows[i]].hi - N[c->rows[i]].lo);
+}
+
+void pdt_frame_groups(ctx *c)
+{
+    c->tree = c->v->tree;
+    if (!c->tree) c->tree = c->own_tree = pdt_ranktree_new(c->r);
+    if (!c->tree || pdt_ranktree_nranks(c->tree) != (c->nranks > 0 ? c->nranks : 1)) {
+        c->tree = NULL;
+        return; /* colours by rank */
+    }
+    c->nrows = pdt_timeline_rows(c->tree, c->v, &c->rows);
+    uint8_t *on = calloc((size_t)c->nranks + 1, 1);
+    c->hue = malloc((size_t)c->nranks + 1);
+    if (!on || !c->hue) {
+        free(on);
+        free(c->hue);
+        c->hue = NULL;
+        return;
+    }
+    if (c->nranks <= PDT_PALETTE_HUES) memset(on, 1, (size_t)c->nranks);
+    on_in_picture(c, on);
+    on_in_timeline(c, on);
+    c->ngroups = pdt_ranktree_cut(c->tree, on, PDT_PALETTE_HUES, c->groups);
+    memset(c->hue, 255, (size_t)c->nranks);
+    size_t n;
+    const pdt_rtnode *N = pdt_ranktree_nodes(c->tree, &n);
+    for (size_t i = 0; i < c->ngroups; i++)
+        memset(c->hue + N[c->groups[i]].lo, (int)i, N[c->groups[i]].hi - N[c->groups[i]].lo);
+    free(on);
+}
+
+void pdt_frame_groups_done(ctx *c)
+{
+    free(c->hue);
+    free(c->rows);
+    pdt_ranktree_free(c->own_tree);
+    c->hue = NULL;
+    c->rows = NULL;
+    c->own_tree = NULL;
+}
