@@ -54,6 +54,8 @@ typedef struct pdt_view {
                                * (0 and 1: all of them) */
     int tl_row0;              /* the timeline's first row shown */
     int follow;               /* keep the current event's region in view (pdt_view_follow) */
+    struct pdt_text_log *texts; /* the layout report of the last frame drawn
+                           * (pdt/view/textlog.h), or NULL */
 } pdt_view;
 
 /* Colour themes (pdt_view.theme).  Every theme keeps the colour-blind-safe

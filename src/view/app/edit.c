@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include "pdt/io.h"
+#include "pdt/view/textlog.h"
 
 /* SDL keycodes the hook needs (SDL_keycode.h values; edit.c has no SDL). */
 enum {
@@ -703,6 +704,7 @@ static void overlay_text(cairo_t *cr, double x, double y, double size, double ma
     cairo_rectangle(cr, x - 0.3 * size, y - size, te.x_advance + 0.6 * size, 1.35 * size);
     cairo_fill(cr);
     cairo_set_source_rgb(cr, r, g, b);
+    pdt_text_log_note(cr, size, x, y, t);
     cairo_move_to(cr, x, y);
     cairo_show_text(cr, t);
 }

@@ -15,6 +15,7 @@
 #include "pdt/view/describe.h"
 #include "pdt/view/query.h"
 #include "pdt/view/render.h"
+#include "pdt/view/textlog.h"
 #include "pdt/view/replay.h"
 #include "pdt/tracefile.h"
 #include "pdt/view/viewsynth.h"
@@ -28,7 +29,17 @@ int pdt_app_headless(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const opts
 {
     size_t m = pdt_replay_count(r);
     if (o->out) {
-        if (pdt_render_file(o->out, o->w, o->h, r, s, v, err) != PDT_OK) return PDT_EXIT_USAGE;
+        pdt_text_log *log = o->layout_report ? pdt_text_log_new() : NULL;
+        if (o->layout_report && !log) {
+            pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+            return PDT_EXIT_USAGE;
+        }
+        v->texts = log;
+        pdt_status st = pdt_render_file(o->out, o->w, o->h, r, s, v, err);
+        v->texts = NULL;
+        if (st == PDT_OK && log) st = pdt_text_log_write(log, o->layout_report, err);
+        pdt_text_log_free(log);
+        if (st != PDT_OK) return PDT_EXIT_USAGE;
         if (!o->quiet) printf("pdtview: wrote %s (event %zu of %zu)\n", o->out, s->k, m);
     }
     if (o->frames) {

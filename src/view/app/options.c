@@ -29,8 +29,10 @@ static const char help_text[] =
     "               [--record FILE.gif|.mp4|.webm] [--fps F] [--every K]\n"
     "               [--font-scale F] [--theme light|dark|contrast] [--fullscreen]\n"
     "               [--clean] [--circles] [--voronoi] [--mem BYTES] [--index on|off|auto]\n"
+    "               [--layout-report F.json]   (the texts of the last frame, at exit)\n"
     "       pdtview --headless RUN (--at N | --phase NAME | --end) -o FILE.png|.svg|.pdf\n"
-    "               [--size WxH]\n"
+    "               [--size WxH] [--layout-report F.json]   (every text placed: box,\n"
+    "               pixel size, panel)\n"
     "       pdtview --headless RUN --frames DIR --every K [--size WxH]\n"
     "       pdtview --headless RUN --gif OUT.gif | --video OUT.mp4|OUT.webm\n"
     "               [--phase P | --from N --to M] [--every K] [--fps F] [--hold S]\n"
@@ -133,6 +135,7 @@ static int parse_table(int argc, char **argv, opts *o, raw *w)
         {"--voronoi", NULL, PDT_OPT_FLAG, &o->voronoi},
         {"--mem", NULL, PDT_OPT_STR, &w->mem},
         {"--index", NULL, PDT_OPT_STR, &w->index},
+        {"--layout-report", NULL, PDT_OPT_STR, &o->layout_report},
         {NULL, NULL, PDT_OPT_FLAG, NULL},
     };
     return pdt_cli_parse(PROG, help_text, argc, argv, table, w->pos, 1, &w->npos);
@@ -224,6 +227,8 @@ static int check_rest(opts *o, const raw *w)
         return pdt_cli_usage(PROG, "--hide needs rank numbers separated by commas, not '%s'", o->hide);
     if (o->headless && !o->out && !o->frames && !o->bench && !o->counts && !o->gif && !o->video)
         return pdt_cli_usage(PROG, "--headless needs -o FILE, --frames DIR, --gif FILE or --video FILE");
+    if (o->layout_report && o->headless && !o->out)
+        return pdt_cli_usage(PROG, "--layout-report F.json reports the picture of -o FILE: add -o");
     return -1;
 }
 

@@ -79,7 +79,8 @@ int pdt_app_edit(const opts *o)
     char title[512];
     snprintf(title, sizeof title, "editing %s", o->edit);
     pdt_shell_opts so = {o->w, o->h, title, o->script, o->screenshot, o->speed,
-                         o->record, o->fps, o->every, pdt_editor_hook(ed), o->fullscreen};
+                         o->record, o->fps, o->every, pdt_editor_hook(ed), o->fullscreen,
+                         o->layout_report};
     int rc = pdt_shell_run(pdt_editor_replay(ed), pdt_editor_state(ed), &v, &so);
     pdt_editor_free(ed);
     return rc;
@@ -264,7 +265,7 @@ static int act(const opts *o, const pdt_replay *r, pdt_rstate *s, pdt_view *v, s
     }
     if (o->headless) return pdt_app_headless(r, s, v, o, err);
     pdt_shell_opts so = {o->w, o->h, o->run, o->script, o->screenshot, o->speed,
-                         o->record, o->fps, o->every, NULL, o->fullscreen};
+                         o->record, o->fps, o->every, NULL, o->fullscreen, o->layout_report};
     return pdt_shell_run(r, s, v, &so);
 }
 

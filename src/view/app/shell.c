@@ -9,6 +9,8 @@
 #include "pdt/view/query.h"
 
 #include "pdt/view/anim.h"
+#include "pdt/view/textlog.h"
+#include "window.h"
 
 #include <SDL.h>
 #include <math.h>
@@ -48,6 +50,7 @@ typedef struct shell {
     int typing;
     char num[24], prompt[96];
     int fullscreen;
+    pdt_window_saved saved; /* what full screen replaced */
     char title[480];        /* the hook's title last set */
 } shell;
 
@@ -81,7 +84,12 @@ static int screenshot(shell *sh, const char *path)
         path = name;
     }
     pdt_err err = {0};
-    if (pdt_render_file(path, sh->tw, sh->th, sh->r, sh->s, sh->v, &err) != PDT_OK) {
+    pdt_text_log *log = sh->v->texts; /* the report is the window's frame's */
+    sh->v->texts = NULL;
+    pdt_status st = pdt_render_file(path, sh->tw, sh->th, sh->r, sh->s, sh->v, &err);
+    sh->v->texts = log;
+    if (st == PDT_OK && log) st = pdt_text_log_write(log, sh->o->layout_report, &err);
+    if (st != PDT_OK) {
         fprintf(stderr, "pdtview: %s\n", err.msg);
         return 0;
     }
@@ -249,7 +257,7 @@ static int view_key(shell *sh, SDL_Keycode k, int shift)
     case SDLK_r: record(sh); return 1;
     case SDLK_F11:
         sh->fullscreen = !sh->fullscreen;
-        SDL_SetWindowFullscreen(sh->win, sh->fullscreen ? SDL_WINDOW_FULLSCREEN_DESKTOP : 0);
+        pdt_window_fullscreen(sh->win, sh->fullscreen, &sh->saved);
         return 1;
     case SDLK_t: sh->v->theme = (sh->v->theme + 1) % PDT_THEME_COUNT; return 1;
     case SDLK_c: sh->v->clean = !sh->v->clean; return 1;
@@ -671,10 +679,21 @@ static void loop(shell *sh)
     SDL_RenderPresent(sh->ren);
 }
 
+/* --layout-report without --screenshot: the texts of the last frame shown. */
+static void write_report(shell *sh)
+{
+    pdt_err err = {0};
+    if (pdt_text_log_write(sh->v->texts, sh->o->layout_report, &err) != PDT_OK)
+        fprintf(stderr, "pdtview: %s\n", err.msg);
+}
+
 /* The one teardown path. */
 static int shell_quit(shell *sh, int rc)
 {
     if (rc == 0 && sh->o->screenshot && sh->tex) screenshot(sh, sh->o->screenshot);
+    else if (rc == 0 && sh->v->texts && sh->tex) write_report(sh);
+    pdt_text_log_free(sh->v->texts);
+    sh->v->texts = NULL;
     if (sh->tex) SDL_DestroyTexture(sh->tex);
     if (sh->ren) SDL_DestroyRenderer(sh->ren);
     if (sh->win) SDL_DestroyWindow(sh->win);
@@ -700,6 +719,7 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
     sh.cap_ranks = MAX_RANKS_SHOWN + sh.nranks;
     if (v->hidden) memcpy(sh.hidden, v->hidden, (size_t)sh.nranks);
     v->hidden = sh.hidden;
+    v->texts = o->layout_report ? pdt_text_log_new() : NULL;
     SDL_SetHint(SDL_HINT_VIDEO_X11_NET_WM_BYPASS_COMPOSITOR, "0");
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
         fprintf(stderr, "pdtview: SDL_Init: %s\n", SDL_GetError());
@@ -708,9 +728,7 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
     char title[512];
     snprintf(title, sizeof title, "pdtview — %s", o->title ? o->title : "");
     sh.fullscreen = o->fullscreen;
-    sh.win = SDL_CreateWindow(title, SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, o->w, o->h,
-                              SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI |
-                                  (o->fullscreen ? SDL_WINDOW_FULLSCREEN_DESKTOP : 0));
+    sh.win = pdt_window_open(title, o->w, o->h, o->fullscreen, &sh.saved);
     if (!sh.win) {
         fprintf(stderr, "pdtview: window: %s\n", SDL_GetError());
         return shell_quit(&sh, 1);

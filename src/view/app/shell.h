@@ -29,7 +29,8 @@ typedef struct pdt_shell_hook {
 } pdt_shell_hook;
 
 typedef struct pdt_shell_opts {
-    int w, h;                 /* initial window size (logical pixels) */
+    int w, h;                 /* initial window size (logical pixels; at most the
+                               * screen's usable area) */
     const char *title;
     const char *script;       /* keys to play, or NULL (see docs/viewer.md) */
     const char *screenshot;   /* PNG written at exit (and by `s` if set), or NULL */
@@ -40,6 +41,8 @@ typedef struct pdt_shell_opts {
     int every;                /* events per frame of a recording (0: 1) */
     const pdt_shell_hook *hook; /* or NULL */
     int fullscreen;           /* start full screen (F11 toggles) */
+    const char *layout_report;/* the texts of the last frame shown, written at exit
+                               * (and by `s`) as JSON (pdt/view/textlog.h), or NULL */
 } pdt_shell_opts;
 
 /* Open the window and run until the user (or the script) quits.  The state

@@ -399,6 +399,7 @@ static void halo_text(ctx *c, int bold, double size, double x, double y, const c
     cairo_select_font_face(cr, SANS, CAIRO_FONT_SLANT_NORMAL,
                            bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
     cairo_set_font_size(cr, size);
+    pdt_text_log_note(cr, size, x, y, s);
     cairo_move_to(cr, x, y);
     cairo_text_path(cr, s);
     rgb(cr, c->T->bg, 0.9);

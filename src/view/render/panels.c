@@ -74,7 +74,9 @@ void pdt_draw_top(ctx *c)
             cairo_fill(cr);
         }
         rgb(cr, c->T->ink, 0.75);
+        pdt_text_log_panel(cr, "status");
         text_at(cr, SANS, 0, sf, sx, sy, c->v->status);
+        pdt_text_log_panel(cr, "event");
     }
     if (c->v->prompt) draw_prompt(c);
 }

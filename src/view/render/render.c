@@ -63,6 +63,30 @@ void pdt_status_style(cairo_t *cr, int st, double lw)
     }
 }
 
+/* The parts of the frame, each naming its panel for the layout report. */
+static void draw_parts(ctx *c, double w, double h)
+{
+    cairo_t *cr = c->cr;
+    pdt_text_log_panel(cr, "picture");
+    pdt_draw_geometry(c);
+    pdt_text_log_panel(cr, "event");
+    pdt_draw_top(c);
+    pdt_text_log_panel(cr, "legend");
+    pdt_draw_legend(c);
+    pdt_text_log_panel(cr, "code");
+    if (c->L.code.w > 0) pdt_draw_code(c);
+    pdt_text_log_panel(cr, "stack");
+    if (c->L.stack.w > 0) pdt_draw_stack_panel(c);
+    pdt_text_log_panel(cr, "lifted");
+    if (c->L.lifted.w > 0) pdt_draw_lifted(c);
+    pdt_text_log_panel(cr, "timeline");
+    if (c->L.timeline.w > 0) pdt_draw_timeline(c);
+    pdt_text_log_panel(cr, "tree");
+    if (c->L.tree.w > 0) pdt_draw_tree(c);
+    pdt_text_log_panel(cr, "help");
+    if (c->v->help) pdt_draw_help(c, w, h);
+}
+
 /* ---- entry points ------------------------------------------------------------------------------ */
 
 pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, const pdt_rstate *s,
@@ -98,18 +122,16 @@ pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, cons
     pdt_frame_groups(&c);
 
     cairo_save(cr);
+    if (v->texts) {
+        pdt_text_log_clear(v->texts, w, h);
+        pdt_text_log_attach(cr, v->texts);
+        pdt_text_log_layout(cr, &c.L);
+    }
     cairo_rectangle(cr, 0, 0, w, h);
     rgb(cr, c.T->bg, 1);
     cairo_fill(cr);
-    pdt_draw_geometry(&c);
-    pdt_draw_top(&c);
-    pdt_draw_legend(&c);
-    if (c.L.code.w > 0) pdt_draw_code(&c);
-    if (c.L.stack.w > 0) pdt_draw_stack_panel(&c);
-    if (c.L.lifted.w > 0) pdt_draw_lifted(&c);
-    if (c.L.timeline.w > 0) pdt_draw_timeline(&c);
-    if (c.L.tree.w > 0) pdt_draw_tree(&c);
-    if (v->help) pdt_draw_help(&c, w, h);
+    draw_parts(&c, w, h);
+    pdt_text_log_panel(cr, NULL); /* a hook's overlay: found from where it lies */
     cairo_restore(cr);
     pdt_frame_groups_done(&c);
     pdt_replay_give_back(r, s);  /* a big run's pages the frame read */

@@ -25,6 +25,7 @@
 
 #include "pdt/view/query.h"
 #include "pdt/view/render.h"
+#include "pdt/view/textlog.h"
 
 #define NONE32 UINT32_MAX
 #define SANS "DejaVu Sans"
@@ -94,6 +95,10 @@ typedef struct ctx {
     size_t nrows;
 } ctx;
 
+/* The frame's panels, for the layout report to name a text's panel when
+ * none was set (textlog.c). */
+void pdt_text_log_layout(cairo_t *cr, const pdt_layout *L);
+
 /* The parts of the frame, each clipped to its rectangle of c->L. */
 void pdt_draw_geometry(ctx *c);                 /* geometry.c */
 /* Sorts the packed edges e[0..n) (smaller vertex in the high half) and
@@ -162,6 +167,7 @@ static inline void text_at(cairo_t *cr, const char *face, int bold, double size,
     cairo_select_font_face(cr, face, CAIRO_FONT_SLANT_NORMAL,
                            bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
     cairo_set_font_size(cr, size);
+    pdt_text_log_note(cr, size, x, y, s);
     cairo_move_to(cr, x, y);
     cairo_show_text(cr, s);
 }

@@ -1,0 +1,51 @@
+#!/bin/bash
+# pdtview --layout-report: every text of the frame with its box, pixel size
+# and panel; scripts/layout-check.py finds overlapping, cut and small texts.
+# The layout itself is held to the lecture-room rules: at 1024x768 and
+# 1920x1080, font scales 1, 1.5 and 2, every panel shown, no text overlaps
+# or is cut, none is under 16 px, code and event line at least 18 px.
+# san: yes
+. "$(dirname "$0")/lib.sh"
+V=$BIN/pdtview
+CHECK="python3 $ROOT/scripts/layout-check.py"
+RUN=synth:srm:8:8:4
+
+# the report: valid JSON, every text of the frame, each in its panel
+if "$V" --headless "$RUN" --phase merge -o "$TMP/m.png" --size 1024x768 --layout-report "$TMP/m.json" --quiet &&
+   python3 - "$TMP/m.json" <<'EOF'
+import json, sys
+d = json.load(open(sys.argv[1]))
+panels = {t["panel"] for t in d["texts"]}
+need = {"picture", "event", "legend", "code", "stack", "lifted", "timeline"}
+assert need <= panels, f"panels {sorted(panels)} lack {sorted(need - panels)}"
+assert d["width"] == 1024 and d["height"] == 768
+for t in d["texts"]:
+    assert t["w"] > 0 and t["h"] > 0 and t["px"] > 0 and t["text"], t
+assert any(t["panel"] == "code" and t["text"].startswith("1 ") for t in d["texts"])
+EOF
+then ok report_has_every_panel; else fail report_has_every_panel "$(cat "$TMP/m.json" | head -5)"; fi
+
+# the report needs a picture to describe
+"$V" --headless "$RUN" --end --layout-report "$TMP/x.json" --frames "$TMP/fr" >/dev/null 2>"$TMP/err"
+if [ $? -eq 2 ] && grep -q "layout-report" "$TMP/err"; then ok report_needs_output
+else fail report_needs_output "$(cat "$TMP/err")"; fi
+
+# the checker finds what is wrong (overlap, cut, small, no status) ...
+cat >"$TMP/bad.json" <<'EOF'
+{"width": 100, "height": 100, "texts": [
+ {"text": "a", "x": 10, "y": 10, "w": 30, "h": 12, "px": 16, "panel": "code", "clipped": false},
+ {"text": "b", "x": 20, "y": 15, "w": 30, "h": 12, "px": 16, "panel": "code", "clipped": false},
+ {"text": "c", "x": 90, "y": 50, "w": 30, "h": 12, "px": 16, "panel": "event", "clipped": false},
+ {"text": "d", "x": 10, "y": 70, "w": 10, "h": 8, "px": 9, "panel": "picture", "clipped": false},
+ {"text": "e", "x": 40, "y": 70, "w": 10, "h": 8, "px": 20, "panel": "stack", "clipped": true}]}
+EOF
+$CHECK --min-px 12 --status "$TMP/bad.json" >"$TMP/bad.out"
+if [ $? -eq 1 ] && grep -q 'overlap: "a"' "$TMP/bad.out" && grep -q 'cut: "c"' "$TMP/bad.out" &&
+   grep -q 'cut: "e"' "$TMP/bad.out" && grep -q 'small: "d"' "$TMP/bad.out" &&
+   grep -q 'no status text' "$TMP/bad.out"; then ok checker_finds_problems
+else fail checker_finds_problems "$(cat "$TMP/bad.out")"; fi
+# ... and passes a clean one
+if $CHECK --min-px 12 "$TMP/m.json" >"$TMP/ok.out"; then ok checker_passes_clean
+else fail checker_passes_clean "$(head -5 "$TMP/ok.out")"; fi
+
+summary
