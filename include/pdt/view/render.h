@@ -58,8 +58,8 @@ typedef struct pdt_view {
                            * (pdt/view/textlog.h), or NULL */
 } pdt_view;
 
-/* Colour themes (pdt_view.theme).  Every theme keeps the colour-blind-safe
- * rank palette (pdt_rank_rgb). */
+/* Colour themes (pdt_view.theme).  Every theme keeps the rank palette
+ * (pdt_palette_rgb), checked for colour-blind viewers. */
 enum {
     PDT_THEME_LIGHT = 0,  /* dark ink on white */
     PDT_THEME_DARK,       /* light ink on near-black (dim rooms) */

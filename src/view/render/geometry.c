@@ -13,6 +13,7 @@ static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
 {
     cairo_t *cr = c->cr;
     int cur_rank = c->cur ? (int)c->cur->rank : -1;
+    if (labels && pdt_draw_group_labels(c)) return;
     for (int q = 0; q < c->nranks; q++) {
         pdt_point lo, hi;
         if (!shown(c, (uint32_t)q) || !pdt_replay_box(c->r, q, &lo, &hi)) continue;

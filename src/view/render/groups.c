@@ -81,3 +81,56 @@ void pdt_frame_groups_done(ctx *c)
     c->rows = NULL;
     c->own_tree = NULL;
 }
+
+/* The screen box of group i's shown ranks; 0 when none has a box. */
+static int group_box(const ctx *c, size_t i, double *x0, double *y0, double *x1, double *y1)
+{
+    size_t n;
+    const pdt_rtnode *d = &pdt_ranktree_nodes(c->tree, &n)[c->groups[i]];
+    int any = 0;
+    for (uint32_t q = d->lo; q < d->hi; q++) {
+        pdt_point lo, hi;
+        if (!shown(c, q) || !pdt_replay_box(c->r, (int)q, &lo, &hi)) continue;
+        double a = c->X.ox + c->X.s * lo.x, b = c->X.ox + c->X.s * hi.x;
+        double e = c->X.oy - c->X.s * hi.y, f = c->X.oy - c->X.s * lo.y;
+        if (!any) *x0 = a, *x1 = b, *y0 = e, *y1 = f;
+        else *x0 = fmin(*x0, a), *x1 = fmax(*x1, b), *y0 = fmin(*y0, e), *y1 = fmax(*y1, f);
+        any = 1;
+    }
+    return any;
+}
+
+int pdt_draw_group_labels(ctx *c)
+{
+    if (!c->hue || !c->tree || c->nranks <= PDT_PALETTE_HUES) return 0;
+    cairo_t *cr = c->cr;
+    double f = c->L.font, fs = 0.8 * f, pad = 0.4 * f;
+    pdt_rect last[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}}; /* the last label above, below */
+    for (size_t i = 0; i < c->ngroups; i++) {
+        double x0, y0, x1, y1;
+        if (!group_box(c, i, &x0, &y0, &x1, &y1)) continue;
+        size_t n;
+        const pdt_rtnode *d = &pdt_ranktree_nodes(c->tree, &n)[c->groups[i]];
+        char lab[40];
+        if (d->hi - d->lo == 1) snprintf(lab, sizeof lab, "rank %u", d->lo);
+        else snprintf(lab, sizeof lab, "ranks %u–%u", d->lo, d->hi - 1);
+        double tw = text_w(cr, SANS, fs, lab);
+        if (tw > x1 - x0 + 2 * pad && d->hi - d->lo > 1) {
+            snprintf(lab, sizeof lab, "%u–%u", d->lo, d->hi - 1);
+            tw = text_w(cr, SANS, fs, lab);
+        }
+        int side = (int)(i % 2);
+        double lx = fmax(x0 - pad, (x0 + x1) / 2 - tw / 2);
+        if (last[side].w > 0 && lx < last[side].x + last[side].w + 0.3 * f) continue; /* thinned */
+        double ly = side ? y1 + pad + 0.95 * f : y0 - pad - 0.25 * f;
+        if (lx < c->L.geo.x || lx + tw > c->L.geo.x + c->L.geo.w) continue;
+        if (ly - fs < c->L.geo.y || ly + 0.3 * fs > c->L.geo.y + c->L.geo.h) continue;
+        last[side] = (pdt_rect){lx, ly - fs, tw, fs};
+        cairo_rectangle(cr, lx - 0.1 * fs, ly - 0.85 * fs, tw + 0.2 * fs, 1.1 * fs);
+        rgb(cr, c->T->bg, 0.8);
+        cairo_fill(cr);
+        set_rank(c, (int)d->lo, 1);
+        text_at(cr, SANS, 0, fs, lx, ly, lab);
+    }
+    return 1;
+}

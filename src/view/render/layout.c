@@ -115,10 +115,11 @@ void pdt_render_layout_scaled(double w, double h, int nranks, unsigned panels, d
     double mid = h - tl - top;
     L->geo = (pdt_rect){0, top, w - side, mid};
     double x = w - side, y = top;
-    double leg = (nranks > PDT_PALETTE_HUES ? 10.2 : 7.6) * f, code = has_code ? 12.2 * f * 0.9 : 0;
+    double extra = pdt_legend_extra(nranks, f, side); /* groups' lines: from the stacks */
+    double leg = 7.6 * f + extra, code = has_code ? 12.2 * f * 0.9 : 0;
     double rest = mid - leg - code;
-    if (has_code && rest < 10 * f) { /* small pictures: shrink the code panel first */
-        code = mid - leg - 10 * f;
+    if (has_code && rest < 10 * f - extra) { /* small pictures: shrink the code panel first */
+        code = mid - leg - 10 * f + extra;
         if (code < 4 * f) code = 4 * f;
         rest = mid - leg - code;
     }

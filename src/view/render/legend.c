@@ -165,7 +165,7 @@ static double legend_side_groups(ctx *c, double fs)
         text_at(cr, SANS, 0, fs, x + 0.95 * f, y, lab);
         x += 1.3 * f + tw;
     }
-    return lines > 1 ? 2.6 * f : y - y0;
+    return lines > 1 ? pdt_legend_extra(c->nranks, f, R.w) : y - y0;
 }
 
 void pdt_draw_legend(ctx *c)
@@ -243,4 +243,23 @@ void pdt_draw_legend(ctx *c)
     rgb(cr, c->T->ink, 1);
     text_at(cr, SANS, 0, fs, lx + 0.95 * f, ly, "circumdisk (RA)");
     cairo_restore(cr);
+}
+
+double pdt_legend_extra(int nranks, double f, double width)
+{
+    if (nranks <= PDT_PALETTE_HUES) return 0;
+    double fs = 0.8 * f, x = 0.9 * f + 3.9 * fs, right = width - 0.5 * f; /* after "groups:" */
+    int lines = 1;
+    for (int i = 0; i < PDT_PALETTE_HUES; i++) { /* eight even groups, digits 0.64 em, dash 0.5 */
+        int lo = i * nranks / PDT_PALETTE_HUES, hi = (i + 1) * nranks / PDT_PALETTE_HUES - 1;
+        char lab[40];
+        snprintf(lab, sizeof lab, "%d%d", lo, hi);
+        double tw = 0.64 * fs * (double)strlen(lab) + 0.5 * fs + 0.1 * f;
+        if (x + 1.2 * f + tw > right) {
+            lines++;
+            x = 0.9 * f + 3.9 * fs;
+        }
+        x += 1.3 * f + tw;
+    }
+    return (lines > 3 ? 2 : lines - 1) * 1.3 * f;
 }

@@ -110,6 +110,9 @@ size_t pdt_unique_edges(uint64_t *e, size_t n);
 int pdt_draw_lod(ctx *c);
 void pdt_draw_top(ctx *c);                      /* panels.c */
 void pdt_draw_legend(ctx *c);                   /* legend.c */
+/* How much taller than one line of ranks the side legend's groups are, for
+ * nranks ranks, base font f, a legend width wide (layout.c sizes by it). */
+double pdt_legend_extra(int nranks, double f, double width);
 void pdt_draw_code(ctx *c);
 void pdt_draw_stack_panel(ctx *c);
 void pdt_draw_help(ctx *c, double w, double h);
@@ -136,6 +139,9 @@ void pdt_timeline_geom(pdt_rect R, double f, int nranks, size_t nrows, size_t m,
  * c->groups, c->hue, c->rows; pdt_frame_groups_done frees them. */
 void pdt_frame_groups(ctx *c);
 void pdt_frame_groups_done(ctx *c);
+/* When the groups on screen are not single ranks: one label per group over
+ * the boxes of its ranks, instead of a label per box; returns 1 if drawn. */
+int pdt_draw_group_labels(ctx *c);
 /* The timeline rows of tree t for view v (all groups of the first cut, opened
  * by v->tl_open) into a new array *rows (the caller frees it); their number. */
 size_t pdt_timeline_rows(const pdt_ranktree *t, const pdt_view *v, int32_t **rows);
