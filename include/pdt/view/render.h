@@ -182,6 +182,12 @@ int32_t pdt_render_timeline_row_at(const pdt_replay *r, const pdt_view *v, doubl
 int pdt_render_timeline_rows(const pdt_replay *r, const pdt_view *v, double w, double h,
                              int *nshow);
 
+/* The groups of ranks a w x h frame of view v shows (at most
+ * PDT_PALETTE_HUES; the legend's, in its order): group i is the ranks
+ * [lo[i], hi[i]).  Returns their number (0 when out of memory). */
+size_t pdt_render_screen_groups(const pdt_replay *r, const pdt_view *v, double w, double h,
+                                uint32_t *lo, uint32_t *hi);
+
 /* The timeline's window and the view following the story (tlview.c). */
 /* Zoom the timeline's events by factor f (> 1: in) keeping the event under
  * x fixed. */

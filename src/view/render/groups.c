@@ -134,3 +134,24 @@ int pdt_draw_group_labels(ctx *c)
     }
     return 1;
 }
+
+size_t pdt_render_screen_groups(const pdt_replay *r, const pdt_view *v, double w, double h,
+                                uint32_t *lo, uint32_t *hi)
+{
+    ctx c;
+    memset(&c, 0, sizeof c);
+    c.r = r;
+    c.v = v;
+    c.nranks = pdt_replay_nranks(r);
+    pdt_render_layout_view(w, h, c.nranks, v, &c.L);
+    c.X = pdt_geo_xform(r, v, w, h);
+    pdt_frame_groups(&c);
+    size_t n = c.hue ? c.ngroups : 0, nn;
+    for (size_t i = 0; i < n; i++) {
+        const pdt_rtnode *d = &pdt_ranktree_nodes(c.tree, &nn)[c.groups[i]];
+        lo[i] = d->lo;
+        hi[i] = d->hi;
+    }
+    pdt_frame_groups_done(&c);
+    return n;
+}

@@ -20,6 +20,7 @@ void pdt_view_defaults(pdt_view *v)
     v->font_scale = 1;
     v->theme = PDT_THEME_LIGHT;
     v->tl_t1 = 1;
+    v->follow = 1; /* applied while playing */
 }
 
 int pdt_theme_parse(const char *name, int *theme)
