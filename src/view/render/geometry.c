@@ -555,9 +555,41 @@ static void square_mark(ctx *c, uint32_t p, double rad, const double col[3], dou
     cairo_stroke(c->cr);
 }
 
+/* A popped point: its ring crossed out. */
+static void popped_cross(ctx *c, uint32_t p, const double col[3])
+{
+    double x, y;
+    wpt(c, p, &x, &y);
+    cross(c->cr, x, y, 0.5 * c->L.font);
+    rgb(c->cr, col, 1);
+    cairo_set_line_width(c->cr, 2);
+    cairo_stroke(c->cr);
+}
+
+/* Labels placed so far (G_L, G_R of the merges in progress). */
+typedef struct mlabels {
+    pdt_rect r[64];
+    int n;
+} mlabels;
+
+/* A group's label at (x, y) (right-aligned when right), unless it would
+ * overlap one already placed: with many merges at once they are thinned. */
+static void merge_label(ctx *c, mlabels *P, double x, double y, int right, const char *lab)
+{
+    double fs = 0.8 * c->L.font, tw = text_wb(c->cr, SANS, 1, fs, lab);
+    pdt_rect a = {right ? x - tw : x, y - fs, tw, 1.2 * fs};
+    for (int i = 0; i < P->n; i++)
+        if (a.x < P->r[i].x + P->r[i].w && P->r[i].x < a.x + a.w && a.y < P->r[i].y + P->r[i].h &&
+            P->r[i].y < a.y + a.h)
+            return;
+    if (P->n < 64) P->r[P->n++] = a;
+    text_at(c->cr, SANS, 1, fs, a.x, y, lab);
+}
+
 /* The merge step in progress on some rank: border set rings and group boxes. */
 static void draw_merge(ctx *c)
 {
+    mlabels P = {.n = 0};
     size_t ng;
     const pdt_rmerge *M = pdt_replay_merges(c->r, &ng);
     for (int q = 0; q < c->nranks; q++) {
@@ -589,10 +621,7 @@ static void draw_merge(ctx *c)
             cairo_set_dash(c->cr, d, 2, 0);
             cairo_stroke(c->cr);
             cairo_set_dash(c->cr, NULL, 0, 0);
-            char lab[64];
-            snprintf(lab, sizeof lab, "%s", side ? "G_R" : "G_L");
-            double tw = text_wb(c->cr, SANS, 1, 0.8 * c->L.font, lab);
-            text_at(c->cr, SANS, 1, 0.8 * c->L.font, side ? x1 - tw : x0, y0 - 0.3 * c->L.font, lab);
+            merge_label(c, &P, side ? x1 : x0, y0 - 0.3 * c->L.font, side, side ? "G_R" : "G_L");
         }
         /* the border set B: points the merge rank lifted since the merge began */
         size_t from = mg->begin_ev, to = c->s->k;
@@ -636,14 +665,7 @@ static void draw_current(ctx *c, uint32_t *buf, size_t cap)
     if ((ev->kind == PDT_EV_PUSH || ev->kind == PDT_EV_POP || ev->kind == PDT_EV_LIFT ||
          ev->kind == PDT_EV_SORT || ev->kind == PDT_EV_DELETE) && ev->a < c->n) {
         ring(c, ev->a, 0.75 * c->L.font, hl, 2.5);
-        if (ev->kind == PDT_EV_POP) { /* popped: the ring crossed out */
-            double x, y, a = 0.5 * c->L.font;
-            wpt(c, ev->a, &x, &y);
-            cross(cr, x, y, a);
-            rgb(cr, hl, 1);
-            cairo_set_line_width(cr, 2);
-            cairo_stroke(cr);
-        }
+        if (ev->kind == PDT_EV_POP) popped_cross(c, ev->a, hl);
         if (ev->kind == PDT_EV_POP && ev->c < c->n) {
             /* the turn that caused the pop: below -> popped -> new point */
             int32_t top = pdt_rstate_slot(c->r, c->s, (int)e->rank, PDT_SLOT_STACK0 + ev->sub);

@@ -9,10 +9,11 @@ size_t pdt_timeline_rows(const pdt_ranktree *t, const pdt_view *v, int32_t **row
 {
     int32_t cut[PDT_PALETTE_HUES];
     size_t nc = pdt_ranktree_cut(t, NULL, PDT_PALETTE_HUES, cut);
-    size_t n = pdt_ranktree_rows(t, cut, nc, v->tl_open, NULL, 0);
+    const uint8_t *open = v ? v->tl_open : NULL;
+    size_t n = pdt_ranktree_rows(t, cut, nc, open, NULL, 0);
     *rows = malloc((n ? n : 1) * sizeof **rows);
     if (!*rows) return 0;
-    return pdt_ranktree_rows(t, cut, nc, v->tl_open, *rows, n);
+    return pdt_ranktree_rows(t, cut, nc, open, *rows, n);
 }
 
 /* Ranks whose strip box meets the picture's view (or that have none). */

@@ -371,7 +371,7 @@ static size_t tl_setup(const pdt_replay *r, const pdt_view *v, double w, double 
     pdt_render_layout_view(w, h, pdt_replay_nranks(r), v, L);
     *own = NULL;
     *rows = NULL;
-    *tree = v->tree;
+    *tree = v ? v->tree : NULL;
     if (L->timeline.w <= 0 || L->timeline.h <= 0) return 0;
     if (!*tree) *tree = *own = pdt_ranktree_new(r);
     if (!*tree) return 0;

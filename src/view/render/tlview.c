@@ -63,7 +63,7 @@ static int follow_timeline(const pdt_replay *r, const pdt_rstate *s, pdt_view *v
     int nshow, n = pdt_render_timeline_rows(r, v, w, h, &nshow);
     if (n <= nshow) return changed;
     pdt_ranktree *own = NULL;
-    const pdt_ranktree *t = v->tree ? v->tree : (own = pdt_ranktree_new(r));
+    const pdt_ranktree *t = v && v->tree ? v->tree : (own = pdt_ranktree_new(r));
     int32_t *rows = NULL;
     size_t nr = t ? pdt_timeline_rows(t, v, &rows) : 0, nn;
     uint32_t q = pdt_replay_rank_of(r, s->k - 1);

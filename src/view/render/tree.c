@@ -188,7 +188,7 @@ int pdt_render_tree_at(const pdt_replay *r, const pdt_view *v, double w, double 
     pdt_rect R = L.tree;
     if (R.w <= 0 || sx < R.x || sx > R.x + R.w || sy < R.y || sy > R.y + R.h) return -1;
     pdt_ranktree *own = NULL;
-    const pdt_ranktree *t = v->tree ? v->tree : (own = pdt_ranktree_new(r));
+    const pdt_ranktree *t = v && v->tree ? v->tree : (own = pdt_ranktree_new(r));
     if (!t) return -1;
     tgeom g;
     tree_geom(R, L.font, t, &g);
