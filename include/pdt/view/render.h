@@ -13,6 +13,7 @@
 
 #include <cairo.h>
 
+#include "pdt/view/ranktree.h"
 #include "pdt/view/replay.h"
 
 /* What the viewer shows and how (owned by the caller). */
@@ -45,12 +46,20 @@ typedef struct pdt_view {
                            * out.  NULL: the viewer's keys only */
     int help_nmore;
     const char *help_more_title;
+    /* many ranks: groups of the merge tree (pdt/view/ranktree.h) */
+    const pdt_ranktree *tree; /* the replay's rank tree, or NULL (then made per frame) */
+    const uint8_t *tl_open;   /* per tree node: opened into its subgroups in the
+                               * timeline (NULL: none) */
+    double tl_t0, tl_t1;      /* the timeline's window, as fractions of the events
+                               * (0 and 1: all of them) */
+    int tl_row0;              /* the timeline's first row shown */
+    int follow;               /* keep the current event's region in view (pdt_view_follow) */
     struct pdt_text_log *texts; /* the layout report of the last frame drawn
                            * (pdt/view/textlog.h), or NULL */
 } pdt_view;
 
-/* Colour themes (pdt_view.theme).  Every theme keeps the colour-blind-safe
- * rank palette (pdt_rank_rgb). */
+/* Colour themes (pdt_view.theme).  Every theme keeps the rank palette
+ * (pdt_palette_rgb), checked for colour-blind viewers. */
 enum {
     PDT_THEME_LIGHT = 0,  /* dark ink on white */
     PDT_THEME_DARK,       /* light ink on near-black (dim rooms) */
@@ -68,7 +77,8 @@ enum {
     PDT_PANEL_STACK = 2,    /* stacks being built */
     PDT_PANEL_LIFTED = 4,   /* lifted view */
     PDT_PANEL_TIMELINE = 8, /* timeline */
-    PDT_PANEL_ALL = 15
+    PDT_PANEL_ALL = 15,     /* the panels "all" names (the tree is named on its own) */
+    PDT_PANEL_TREE = 16     /* the merge tree */
 };
 
 /* Parse a comma-separated list of panel names ("code,stack,lifted,timeline",
@@ -85,6 +95,7 @@ typedef struct pdt_layout {
     double body;          /* panel text (legend, stacks, code), pixels */
     double label;         /* point and box labels, pixels */
     pdt_rect top, geo, legend, code, stack, lifted, timeline;
+    pdt_rect tree;        /* the merge tree (PDT_PANEL_TREE), or zero-sized */
 } pdt_layout;
 
 /* Defaults: fit, all ranks, yaw 30°, pitch 25°, fade 400 events, font scale 1,
@@ -120,8 +131,17 @@ pdt_status pdt_render_file(const char *path, int w, int h, const pdt_replay *r,
 pdt_status pdt_render_file_ex(const char *path, int flags, int w, int h, const pdt_replay *r,
                               const pdt_rstate *s, const pdt_view *v, pdt_err *err);
 
-/* The colour of a rank (Okabe–Ito for 0..7; beyond, the same hues darker or
- * lighter), components in [0,1]. */
+/* The palette (palette.c): PDT_PALETTE_HUES hues for the groups of ranks a
+ * screen shows, every pair of them and of the status colours at least
+ * CIEDE2000 10 apart for normal, deuteranope and protanope vision.
+ * pdt_palette_rgb: hue i (out of range: a neutral grey). */
+enum { PDT_PALETTE_HUES = 8 };
+void pdt_palette_rgb(int i, double rgb[3]);
+/* Every colour a screen can show together (the hues, then the status
+ * colours), into out[0..cap); returns their number. */
+size_t pdt_palette_screen(double (*out)[3], size_t cap);
+/* The colour of a rank drawn on its own, without groups (hue rank % 8;
+ * beyond 8, the same hues darker or lighter), components in [0,1]. */
 void pdt_rank_rgb(int rank, double rgb[3]);
 
 /* Screen <-> world for the geometry area of a w x h picture. */
@@ -154,5 +174,34 @@ void pdt_render_pick(const pdt_replay *r, const pdt_rstate *s, const pdt_view *v
  * (size_t)-1 when (sx,sy) is not in the timeline. */
 size_t pdt_render_timeline_at(const pdt_replay *r, const pdt_view *v, double w, double h, double sx,
                               double sy);
+/* The tree node of the timeline row at (sx,sy) (in its label column only,
+ * when label_only), or -1. */
+int32_t pdt_render_timeline_row_at(const pdt_replay *r, const pdt_view *v, double w, double h,
+                                   double sx, double sy, int label_only);
+/* The timeline's rows: their number; *nshow: how many fit on screen. */
+int pdt_render_timeline_rows(const pdt_replay *r, const pdt_view *v, double w, double h,
+                             int *nshow);
+
+/* The groups of ranks a w x h frame of view v shows (at most
+ * PDT_PALETTE_HUES; the legend's, in its order): group i is the ranks
+ * [lo[i], hi[i]).  Returns their number (0 when out of memory). */
+size_t pdt_render_screen_groups(const pdt_replay *r, const pdt_view *v, double w, double h,
+                                uint32_t *lo, uint32_t *hi);
+
+/* The timeline's window and the view following the story (tlview.c). */
+/* Zoom the timeline's events by factor f (> 1: in) keeping the event under
+ * x fixed. */
+void pdt_view_timeline_zoom(const pdt_replay *r, pdt_view *v, double w, double h, double x, double f);
+/* Move the timeline's window by dx pixels in time and drow rows. */
+void pdt_view_timeline_pan(const pdt_replay *r, pdt_view *v, double w, double h, double dx, int drow);
+/* Keep the current event of state s in view (when v->follow): the picture
+ * centred on its points when they left the picture, the timeline's window on
+ * its event and its rank's row among those shown.  Returns 1 if the view
+ * changed. */
+int pdt_view_follow(const pdt_replay *r, const pdt_rstate *s, pdt_view *v, double w, double h);
+/* The merge step (index into pdt_replay_merges) whose node of the tree
+ * panel is at (sx,sy), or -1 (tree.c). */
+int pdt_render_tree_at(const pdt_replay *r, const pdt_view *v, double w, double h, double sx,
+                       double sy);
 
 #endif

@@ -6,6 +6,7 @@
  * One quit path (shell_quit).  The frame is drawn at the drawable size, so
  * it is sharp on high-DPI screens; mouse positions are scaled to match. */
 #include "shell.h"
+#include "cluster.h"
 #include "pdt/view/query.h"
 
 #include "pdt/view/anim.h"
@@ -55,6 +56,7 @@ typedef struct shell {
     int fullscreen;
     pdt_window_saved saved; /* what full screen replaced */
     char title[480];        /* the hook's title last set */
+    pdt_cluster *cl;        /* many ranks: groups, the timeline's window, the tree */
 } shell;
 
 static void set_status(shell *sh)
@@ -304,14 +306,27 @@ static int view_key(shell *sh, SDL_Keycode k, int shift)
     }
 }
 
+/* After a key or click of cluster.c: seek if it asked to, redraw. */
+static void cluster_seek(shell *sh, size_t k)
+{
+    if (k != SIZE_MAX) {
+        sh->playing = 0;
+        seek(sh, k);
+    }
+    sh->dirty = 1;
+}
+
 static void key(shell *sh, SDL_Keycode k, Uint16 mod)
 {
     int shift = (mod & KMOD_SHIFT) != 0, ctrl = (mod & KMOD_CTRL) != 0;
+    size_t to;
     if (sh->typing) {
         goto_key(sh, k);
         sh->dirty = 1;
         return;
     }
+    if (pdt_cluster_key(sh->cl, sh->r, sh->s, sh->v, k, shift, ctrl, sh->tw, sh->th, sh->hidden, &to))
+        return cluster_seek(sh, to);
     if (ctrl) {
         ctrl_key(sh, k);
         return;
@@ -355,6 +370,9 @@ static int in_rect(pdt_rect R, double x, double y)
 
 static void mouse(shell *sh, const SDL_Event *e)
 {
+    size_t to;
+    if (pdt_cluster_mouse(sh->cl, sh->r, sh->v, e, sh->sx, sh->sy, sh->tw, sh->th, &to))
+        return cluster_seek(sh, to);
     pdt_layout L;
     pdt_render_layout_view(sh->tw, sh->th, sh->nranks, sh->v, &L);
     switch (e->type) {
@@ -614,6 +632,7 @@ static int make_texture(shell *sh)
     sh->sx = ww > 0 ? (double)w / ww : 1;
     sh->sy = wh > 0 ? (double)h / wh : 1;
     if (sh->tex && w == sh->tw && h == sh->th) return 1;
+    pdt_cluster_free(sh->cl, sh->v);
     if (sh->tex) SDL_DestroyTexture(sh->tex);
     sh->tex = SDL_CreateTexture(sh->ren, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, w, h);
     sh->tw = w;
@@ -658,6 +677,7 @@ static void tick(shell *sh)
         size_t adv = (size_t)sh->acc;
         sh->acc -= (double)adv;
         if (adv) seek(sh, sh->s->k + adv);
+        if (adv) pdt_view_follow(sh->r, sh->s, sh->v, sh->tw, sh->th);
         if (sh->s->k >= pdt_replay_count(sh->r)) sh->playing = 0;
         sh->dirty = 1;
     }
@@ -761,6 +781,7 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
     if (v->hidden) memcpy(sh.hidden, v->hidden, (size_t)sh.nranks);
     v->hidden = sh.hidden;
     v->texts = o->layout_report ? pdt_text_log_new() : NULL;
+    if (!o->hook) sh.cl = pdt_cluster_new(r, v); /* the editor's replays change */
     SDL_SetHint(SDL_HINT_VIDEO_X11_NET_WM_BYPASS_COMPOSITOR, "0");
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
         fprintf(stderr, "pdtview: SDL_Init: %s\n", SDL_GetError());

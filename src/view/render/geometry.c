@@ -33,6 +33,7 @@ static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
 {
     cairo_t *cr = c->cr;
     int cur_rank = c->cur ? (int)c->cur->rank : -1;
+    if (labels && pdt_draw_group_labels(c)) return;
     for (int q = 0; q < c->nranks; q++) {
         pdt_point lo, hi;
         if (!shown(c, (uint32_t)q) || !pdt_replay_box(c->r, q, &lo, &hi)) continue;
@@ -47,11 +48,11 @@ static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
             /* opaque tint (rank colour over white): much cheaper than alpha on big areas */
             double col[3], a = (touched ? 0.16 : 0.05) * c->T->tint;
             const double *bg = c->T->bg;
-            pdt_rank_rgb(q, col);
+            ctx_rank_rgb(c, q, col);
             cairo_set_source_rgb(cr, (1 - a) * bg[0] + a * col[0], (1 - a) * bg[1] + a * col[1],
                                  (1 - a) * bg[2] + a * col[2]);
             cairo_fill_preserve(cr);
-            set_rank(cr, q, touched ? 0.95 : 0.5);
+            set_rank(c, q, touched ? 0.95 : 0.5);
             double d[2] = {4, 3};
             cairo_set_dash(cr, touched ? NULL : d, touched ? 0 : 2, 0);
             cairo_set_line_width(cr, touched ? 2.5 * c->lw : 1);
@@ -79,7 +80,7 @@ static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
         cairo_rectangle(cr, x0 - pad - 0.1 * fs, ly - 0.85 * fs, tw + 0.2 * fs, 1.1 * fs);
         rgb(cr, c->T->bg, 0.8);
         cairo_fill(cr);
-        set_rank(cr, q, 1);
+        set_rank(c, q, 1);
         text_at(cr, SANS, touched, fs, x0 - pad, ly, lab);
     }
 }
@@ -138,7 +139,7 @@ static void draw_discarded(ctx *c, int q, const uint32_t *order, size_t from, si
         if (a <= 0.02) continue;
         pdt_status_style(cr, PDT_TS_DISCARDED, c->lw);
         tri_path(c, T[t].v);
-        set_rank(cr, q, 0.6 * a);
+        set_rank(c, q, 0.6 * a);
         cairo_stroke(cr);
         double x = 0, y = 0, px, py;
         for (int j = 0; j < 3; j++) {
@@ -204,11 +205,11 @@ static void draw_bucket(ctx *c, int st, int q, const uint32_t *order, size_t fro
     if (c->v->clean && !dense) { /* T* filled by rank */
         const pdt_rtri *T = pdt_replay_tris(c->r, &(size_t){0});
         for (size_t i = from; i < to; i++) tri_path(c, T[order[i]].v);
-        set_rank(cr, q, 0.16);
+        set_rank(c, q, 0.16);
         cairo_fill(cr);
     }
     pdt_status_style(cr, st, dense ? 0.8 : c->lw);
-    set_rank(cr, q, st == PDT_TS_CANDIDATE ? 0.75 : 1);
+    set_rank(c, q, st == PDT_TS_CANDIDATE ? 0.75 : 1);
     stroke_bucket_edges(c, order, from, to, edges);
 }
 
@@ -284,7 +285,7 @@ static void draw_kernel_edges(ctx *c)
             any = 1;
         }
         if (any) {
-            set_rank(cr, q, 0.45);
+            set_rank(c, q, 0.45);
             cairo_stroke(cr);
         }
     }
@@ -338,7 +339,7 @@ static void draw_hulls_and_stacks(ctx *c, uint32_t *buf, size_t cap)
                 cairo_stroke(cr);
                 continue;
             }
-            set_rank(cr, q, 0.9);
+            set_rank(c, q, 0.9);
             cairo_set_line_width(cr, 2.6 * c->lw);
             cairo_stroke(cr);
             if (k) { /* top marker: a filled triangle above the top point */
@@ -566,9 +567,53 @@ static void ring(ctx *c, uint32_t p, double rad, const double col[3], double lwf
     cairo_stroke(c->cr);
 }
 
+/* A square around point p: the point a pop or a delete keeps (a ring is the
+ * point the event names; shape as well as colour tells them apart). */
+static void square_mark(ctx *c, uint32_t p, double rad, const double col[3], double lwf)
+{
+    double x, y;
+    wpt(c, p, &x, &y);
+    cairo_rectangle(c->cr, x - 0.85 * rad, y - 0.85 * rad, 1.7 * rad, 1.7 * rad);
+    rgb(c->cr, col, 1);
+    cairo_set_line_width(c->cr, lwf);
+    cairo_stroke(c->cr);
+}
+
+/* A popped point: its ring crossed out. */
+static void popped_cross(ctx *c, uint32_t p, const double col[3])
+{
+    double x, y;
+    wpt(c, p, &x, &y);
+    cross(c->cr, x, y, 0.5 * c->L.font);
+    rgb(c->cr, col, 1);
+    cairo_set_line_width(c->cr, 2);
+    cairo_stroke(c->cr);
+}
+
+/* Labels placed so far (G_L, G_R of the merges in progress). */
+typedef struct mlabels {
+    pdt_rect r[64];
+    int n;
+} mlabels;
+
+/* A group's label at (x, y) (right-aligned when right), unless it would
+ * overlap one already placed: with many merges at once they are thinned. */
+static void merge_label(ctx *c, mlabels *P, double x, double y, int right, const char *lab)
+{
+    double fs = c->L.label, tw = text_wb(c->cr, SANS, 1, fs, lab);
+    pdt_rect a = {right ? x - tw : x, y - fs, tw, 1.2 * fs};
+    for (int i = 0; i < P->n; i++)
+        if (a.x < P->r[i].x + P->r[i].w && P->r[i].x < a.x + a.w && a.y < P->r[i].y + P->r[i].h &&
+            P->r[i].y < a.y + a.h)
+            return;
+    if (P->n < 64) P->r[P->n++] = a;
+    text_at(c->cr, SANS, 1, fs, a.x, y, lab);
+}
+
 /* The merge step in progress on some rank: border set rings and group boxes. */
 static void draw_merge(ctx *c)
 {
+    mlabels P = {.n = 0};
     size_t ng;
     const pdt_rmerge *M = pdt_replay_merges(c->r, &ng);
     for (int q = 0; q < c->nranks; q++) {
@@ -600,10 +645,7 @@ static void draw_merge(ctx *c)
             cairo_set_dash(c->cr, d, 2, 0);
             cairo_stroke(c->cr);
             cairo_set_dash(c->cr, NULL, 0, 0);
-            char lab[64];
-            snprintf(lab, sizeof lab, "%s", side ? "G_R" : "G_L");
-            double tw = text_wb(c->cr, SANS, 1, c->L.label, lab);
-            text_at(c->cr, SANS, 1, c->L.label, side ? x1 - tw : x0, y0 - 0.3 * c->L.font, lab);
+            merge_label(c, &P, side ? x1 : x0, y0 - 0.3 * c->L.font, side, side ? "G_R" : "G_L");
         }
         /* the border set B: points the merge rank lifted since the merge began */
         size_t from = mg->begin_ev, to = c->s->k;
@@ -629,7 +671,7 @@ static void draw_current(ctx *c, uint32_t *buf, size_t cap)
         uint32_t v[3] = {ev->a, ev->b, ev->c};
         double ox, oy, rr;
         tri_path(c, v);
-        set_rank(cr, (int)e->rank, 0.25);
+        set_rank(c, (int)e->rank, 0.25);
         cairo_fill(cr);
         if (circum(c->P, v, &ox, &oy, &rr)) {
             cairo_new_sub_path(cr);
@@ -647,6 +689,7 @@ static void draw_current(ctx *c, uint32_t *buf, size_t cap)
     if ((ev->kind == PDT_EV_PUSH || ev->kind == PDT_EV_POP || ev->kind == PDT_EV_LIFT ||
          ev->kind == PDT_EV_SORT || ev->kind == PDT_EV_DELETE) && ev->a < c->n) {
         ring(c, ev->a, 0.75 * c->L.font, hl, 2.5);
+        if (ev->kind == PDT_EV_POP) popped_cross(c, ev->a, hl);
         if (ev->kind == PDT_EV_POP && ev->c < c->n) {
             /* the turn that caused the pop: below -> popped -> new point */
             int32_t top = pdt_rstate_slot(c->r, c->s, (int)e->rank, PDT_SLOT_STACK0 + ev->sub);
@@ -666,10 +709,10 @@ static void draw_current(ctx *c, uint32_t *buf, size_t cap)
                 cairo_stroke(cr);
                 cairo_set_dash(cr, NULL, 0, 0);
             }
-            ring(c, ev->c, 0.75 * c->L.font, (double[3]){0.0, 0.45, 0.0}, 2.5);
+            square_mark(c, ev->c, 0.75 * c->L.font, (double[3]){0.0, 0.45, 0.0}, 2.5);
         }
         if (ev->kind == PDT_EV_DELETE && ev->b < c->n)
-            ring(c, ev->b, 0.75 * c->L.font, (double[3]){0.0, 0.45, 0.0}, 2.5);
+            square_mark(c, ev->b, 0.75 * c->L.font, (double[3]){0.0, 0.45, 0.0}, 2.5);
     }
     if ((ev->kind == PDT_EV_EDGE_ADD || ev->kind == PDT_EV_EDGE_DEL) && ev->a < c->n && ev->b < c->n) {
         double x, y;
@@ -795,7 +838,7 @@ static void draw_circles(ctx *c)
             cairo_arc(cr, c->X.ox + c->X.s * ox, c->X.oy - c->X.s * oy, c->X.s * rr, 0, 2 * M_PI);
             drawn++;
         }
-        set_rank(cr, q, 0.45);
+        set_rank(c, q, 0.45);
         cairo_stroke(cr);
     }
 }

@@ -3,8 +3,8 @@
 #include "render_int.h"
 
 static void layout_round(pdt_layout *L);
-static void layout_column(double w, double h, double top, double tl, int has_code, int has_stack,
-                          int has_lifted, pdt_layout *L);
+static void layout_column(double w, double h, double top, double tl, int nranks, unsigned panels,
+                          pdt_layout *L);
 
 /* ---- view and layout ----------------------------------------------------------- */
 
@@ -21,6 +21,8 @@ void pdt_view_defaults(pdt_view *v)
     v->panels = PDT_PANEL_ALL;
     v->font_scale = 1;
     v->theme = PDT_THEME_LIGHT;
+    v->tl_t1 = 1;
+    v->follow = 1; /* applied while playing */
 }
 
 int pdt_theme_parse(const char *name, int *theme)
@@ -38,7 +40,8 @@ int pdt_panels_parse(const char *list, unsigned *panels)
 {
     static const struct { const char *name; unsigned bit; } names[] = {
         {"code", PDT_PANEL_CODE}, {"stack", PDT_PANEL_STACK}, {"lifted", PDT_PANEL_LIFTED},
-        {"timeline", PDT_PANEL_TIMELINE}, {"all", PDT_PANEL_ALL}, {"none", 0}};
+        {"timeline", PDT_PANEL_TIMELINE}, {"tree", PDT_PANEL_TREE}, {"all", PDT_PANEL_ALL},
+        {"none", 0}};
     unsigned bits = 0;
     const char *p = list;
     while (*p) {
@@ -139,10 +142,10 @@ static void column_split(double rest, const column *C, int code, int stack, int 
 
 /* No side column: the picture takes the whole width, the legend is a strip
  * under it (its items flow in rows). */
-static void layout_strip(double w, double h, double top, double tl, pdt_layout *L)
+static void layout_strip(double w, double h, double top, double tl, int nranks, pdt_layout *L)
 {
     double f = L->font;
-    int lrows = (int)ceil(64 * f / fmax(w - f, f));
+    int lrows = (int)ceil((nranks > PDT_PALETTE_HUES ? 100 : 64) * f / fmax(w - f, f));
     if (lrows < 1) lrows = 1;
     if (lrows > 4) lrows = 4;
     double leg = lrows * 1.45 * f + 0.6 * f;
@@ -167,22 +170,26 @@ void pdt_render_layout_scaled(double w, double h, int nranks, unsigned panels, d
     int has_code = (panels & PDT_PANEL_CODE) != 0, has_stack = (panels & PDT_PANEL_STACK) != 0,
         has_lifted = (panels & PDT_PANEL_LIFTED) != 0;
     if (!has_code && !has_stack && !has_lifted) {
-        layout_strip(w, h, top, tl, L);
+        layout_strip(w, h, top, tl, nranks, L);
+        pdt_layout_tree_strip(L, panels, w, h);
         layout_round(L);
         return;
     }
-    layout_column(w, h, top, tl, has_code, has_stack, has_lifted, L);
+    layout_column(w, h, top, tl, nranks, panels, L);
     layout_round(L);
 }
 
 /* The side column (legend, code, stacks, lifted view) beside the picture,
  * the timeline under both.  When the column cannot hold the legend, four
  * code rows and a stack, the timeline gives its room, then the stacks. */
-static void layout_column(double w, double h, double top, double tl, int has_code, int has_stack,
-                          int has_lifted, pdt_layout *L)
+static void layout_column(double w, double h, double top, double tl, int nranks, unsigned panels,
+                          pdt_layout *L)
 {
+    int has_code = (panels & PDT_PANEL_CODE) != 0, has_stack = (panels & PDT_PANEL_STACK) != 0,
+        has_lifted = (panels & PDT_PANEL_LIFTED) != 0;
     double f = L->font, side = fmin(fmax(0.34 * w, 19 * f), 0.5 * w);
     column C = column_needs(L);
+    C.legend += pdt_legend_extra(nranks, f, side); /* the groups' lines */
     double need = C.legend + (has_code ? C.code_min : 0) + (has_stack ? C.stack_min : 0);
     if (h - top - tl < need && tl > 0) {
         tl = h - top - need;
@@ -194,11 +201,16 @@ static void layout_column(double w, double h, double top, double tl, int has_cod
     L->timeline = (pdt_rect){0, h - tl, tl > 0 ? w : 0, tl};
     L->geo = (pdt_rect){0, top, w - side, mid};
     double x = w - side, y = top, leg = fmin(C.legend, mid), code, stk, lifted;
-    column_split(mid - leg, &C, has_code, has_stack, has_lifted, &code, &stk, &lifted);
+    /* the merge tree: a third of the column beside other panels, else all */
+    double tree = 0;
+    if (panels & PDT_PANEL_TREE)
+        tree = has_code || has_stack || has_lifted ? fmax(6 * f, 0.34 * (mid - leg)) : mid - leg;
+    column_split(mid - leg - tree, &C, has_code, has_stack, has_lifted, &code, &stk, &lifted);
     L->legend = (pdt_rect){x, y, side, leg};
     L->code = (pdt_rect){x, y + leg, code > 0 ? side : 0, code};
     L->stack = (pdt_rect){x, y + leg + code, stk > 0 ? side : 0, stk};
     L->lifted = (pdt_rect){x, y + leg + code + stk, lifted > 0 ? side : 0, lifted};
+    L->tree = (pdt_rect){x, y + leg + code + stk + lifted, tree > 0 ? side : 0, tree};
 }
 
 double pdt_layout_top_height(const pdt_layout *L)
@@ -214,7 +226,8 @@ double pdt_layout_code_row(const pdt_layout *L)
 /* Whole pixels: clipping to them stays a fast box clip. */
 static void layout_round(pdt_layout *L)
 {
-    pdt_rect *all[] = {&L->top, &L->geo, &L->legend, &L->code, &L->stack, &L->lifted, &L->timeline};
+    pdt_rect *all[] = {&L->top,    &L->geo,    &L->legend,   &L->code,
+                       &L->stack,  &L->lifted, &L->timeline, &L->tree};
     for (size_t i = 0; i < sizeof all / sizeof *all; i++) {
         double x1 = round(all[i]->x + all[i]->w), y1 = round(all[i]->y + all[i]->h);
         all[i]->x = round(all[i]->x);

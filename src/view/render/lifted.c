@@ -149,7 +149,7 @@ static void draw_rank_faces(const ctx *c, const proj *J, int q, uint64_t *edges)
         cairo_close_path(cr);
     }
     if (!ne) return;
-    set_rank(cr, q, 0.22);
+    set_rank(c, q, 0.22);
     cairo_fill(cr);
     ne = pdt_unique_edges(edges, ne);
     for (size_t i = 0; i < ne; i++) {
@@ -159,7 +159,7 @@ static void draw_rank_faces(const ctx *c, const proj *J, int q, uint64_t *edges)
         cairo_move_to(cr, x0, y0);
         cairo_line_to(cr, x1, y1);
     }
-    set_rank(cr, q, 0.7);
+    set_rank(c, q, 0.7);
     cairo_set_line_width(cr, 0.8);
     cairo_stroke(cr);
 }
@@ -304,9 +304,9 @@ static void draw_plane_triangle(const ctx *c, const proj *J, const pdt_rec *e, c
         else cairo_move_to(cr, sx, sy);
     }
     cairo_close_path(cr);
-    set_rank(cr, (int)e->rank, 0.5);
+    set_rank(c, (int)e->rank, 0.5);
     cairo_fill_preserve(cr);
-    set_rank(cr, (int)e->rank, 1);
+    set_rank(c, (int)e->rank, 1);
     cairo_set_line_width(cr, 2);
     cairo_stroke(cr);
     char lab[128], lab2[64];

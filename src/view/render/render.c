@@ -5,45 +5,24 @@
 
 /* ---- colours ------------------------------------------------------------------ */
 
-/* Okabe & Ito's colour-blind-safe palette, black left out (used for hulls
- * and text), yellow darkened to stay visible on white. */
-static const double okabe_ito[8][3] = {
-    {0.000, 0.447, 0.698}, /* blue */
-    {0.902, 0.624, 0.000}, /* orange */
-    {0.000, 0.620, 0.451}, /* bluish green */
-    {0.800, 0.475, 0.655}, /* reddish purple */
-    {0.337, 0.706, 0.914}, /* sky blue */
-    {0.835, 0.369, 0.000}, /* vermillion */
-    {0.741, 0.690, 0.000}, /* yellow, darkened */
-    {0.400, 0.400, 0.400}, /* grey */
-};
-
-void pdt_rank_rgb(int rank, double rgb[3])
-{
-    if (rank < 0) rank = 0;
-    const double *c = okabe_ito[rank % 8];
-    int cycle = (rank / 8) % 3; /* 0 as is, 1 darker, 2 lighter */
-    for (int i = 0; i < 3; i++)
-        rgb[i] = cycle == 0 ? c[i] : cycle == 1 ? 0.55 * c[i] : c[i] + 0.5 * (1 - c[i]);
-}
-
+/* select and disk: PDT_SELECT and PDT_DISK of palette.c, in every theme */
 static const pdt_theme themes[PDT_THEME_COUNT] = {
     {   /* light */
         .bg = {1, 1, 1}, .panel = {0.975, 0.975, 0.97}, .border = {0.72, 0.72, 0.72},
         .topbar = {0.93, 0.94, 0.96}, .ink = {0.1, 0.1, 0.12}, .hollow = {0.55, 0.55, 0.55},
-        .label = {0.0, 0.25, 0.55}, .select = {0.0, 0.3, 0.9}, .disk = {0.8, 0.45, 0.0},
+        .label = {0.0, 0.25, 0.55}, .select = {0.041, 0.793, 0.939}, .disk = {0.824, 0.395, 0.039},
         .mark = {1.0, 0.85, 0.2}, .hull = 0.4, .tint = 1, .lwf = 1,
     },
     {   /* dark */
         .bg = {0.09, 0.09, 0.11}, .panel = {0.14, 0.14, 0.17}, .border = {0.35, 0.35, 0.4},
         .topbar = {0.17, 0.18, 0.22}, .ink = {0.93, 0.93, 0.9}, .hollow = {0.6, 0.6, 0.62},
-        .label = {0.65, 0.85, 1.0}, .select = {0.35, 0.75, 1.0}, .disk = {1.0, 0.65, 0.2},
+        .label = {0.65, 0.85, 1.0}, .select = {0.041, 0.793, 0.939}, .disk = {0.824, 0.395, 0.039},
         .mark = {0.75, 0.6, 0.1}, .hull = 0.35, .tint = 1.6, .lwf = 1.15,
     },
     {   /* contrast */
         .bg = {1, 1, 1}, .panel = {1, 1, 1}, .border = {0, 0, 0},
         .topbar = {1, 1, 1}, .ink = {0, 0, 0}, .hollow = {0.25, 0.25, 0.25},
-        .label = {0, 0, 0}, .select = {0.0, 0.2, 0.8}, .disk = {0.6, 0.3, 0.0},
+        .label = {0, 0, 0}, .select = {0.041, 0.793, 0.939}, .disk = {0.824, 0.395, 0.039},
         .mark = {1.0, 0.8, 0.0}, .hull = 0.55, .tint = 0, .lwf = 1.6,
     },
 };
@@ -103,6 +82,8 @@ static void draw_parts(ctx *c, double w, double h)
     if (c->L.lifted.w > 0) pdt_draw_lifted(c);
     pdt_text_log_panel(cr, "timeline");
     if (c->L.timeline.w > 0) pdt_draw_timeline(c);
+    pdt_text_log_panel(cr, "tree");
+    if (c->L.tree.w > 0) pdt_draw_tree(c);
     pdt_text_log_panel(cr, "help");
     if (c->v->help) pdt_draw_help(c, w, h);
 }
@@ -139,6 +120,7 @@ pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, cons
         spacing = c.X.s * sqrt(fmax(1.0, ((double)hi.x - lo.x) * ((double)hi.y - lo.y)) / (double)(c.n ? c.n : 1));
     c.lw = fmax(0.5, fmin(0.16 * c.L.font, spacing / 9)) * c.T->lwf;
     c.spacing = spacing;
+    pdt_frame_groups(&c);
 
     cairo_save(cr);
     if (v->texts) {
@@ -152,6 +134,7 @@ pdt_status pdt_render(cairo_t *cr, double w, double h, const pdt_replay *r, cons
     draw_parts(&c, w, h);
     pdt_text_log_panel(cr, NULL); /* a hook's overlay: found from where it lies */
     cairo_restore(cr);
+    pdt_frame_groups_done(&c);
     pdt_replay_give_back(r, s);  /* a big run's pages the frame read */
     cairo_status_t cs = cairo_status(cr);
     if (cs != CAIRO_STATUS_SUCCESS)

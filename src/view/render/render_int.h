@@ -5,7 +5,8 @@
  *   layout.c    view defaults, panel rectangles, screen <-> world
  *   geometry.c  the world picture (boxes, triangles, hulls, stacks, points,
  *               merges, the current event, the selection)
- *   panels.c    text panels: event line, legend, pseudo-code, stacks, help
+ *   panels.c    text panels: event line, pseudo-code, stacks, help
+ *   legend.c    the legend
  *   lifted.c    the lifted view (paraboloid)
  *   timeline.c  the timeline and seeking by a click on it
  *   export.c    pdt_render_file(): PNG, SVG, PDF
@@ -31,7 +32,9 @@
 #define MONO "DejaVu Sans Mono"
 
 #define PDT_UNUSED __attribute__((unused))
-static const double RED[3] PDT_UNUSED = {0.85, 0.0, 0.0};
+/* The status colours of palette.c (checked against the hues there). */
+extern const double PDT_RED[3], PDT_SELECT[3], PDT_DISK[3];
+#define RED PDT_RED
 
 /* The colours of a theme (pdt_view.theme).  Rank colours are the same in
  * every theme (pdt_rank_rgb). */
@@ -90,6 +93,15 @@ typedef struct ctx {
     const pdt_theme *T;  /* colours */
     lbox taken[TAKEN_MAX]; /* the strip labels placed: point labels keep off them */
     int ntaken;
+    /* groups of ranks (groups.c) */
+    const pdt_ranktree *tree;  /* v->tree, or own_tree */
+    pdt_ranktree *own_tree;
+    int32_t groups[PDT_PALETTE_HUES]; /* the groups on screen, in rank order: hue i */
+    size_t ngroups;
+    uint8_t *hue;              /* per rank: its group's hue, or 255 (no group on
+                                * screen); NULL: hue = rank */
+    int32_t *rows;             /* the timeline's rows (tree nodes) */
+    size_t nrows;
 } ctx;
 
 /* The top bar's height (event line and status rows) and the height of a
@@ -114,23 +126,57 @@ void pdt_draw_top(ctx *c);                      /* panels.c */
 /* The event line's rows that spill under the top bar, as a box the
  * picture's labels keep off (c->taken). */
 void pdt_top_spill(ctx *c);
-void pdt_draw_legend(ctx *c);
+void pdt_draw_legend(ctx *c);                   /* legend.c */
+/* How much taller than one line of ranks the side legend's groups are, for
+ * nranks ranks, base font f, a legend width wide (layout.c sizes by it). */
+double pdt_legend_extra(int nranks, double f, double width);
 void pdt_draw_code(ctx *c);
 void pdt_draw_stack_panel(ctx *c);
 void pdt_draw_help(ctx *c, double w, double h);
 void pdt_draw_lifted(ctx *c);                   /* lifted.c */
 void pdt_draw_timeline(ctx *c);                 /* timeline.c */
-/* Timeline geometry shared by the drawing and the click: the x range of the
- * event axis in R for base font f. */
-void pdt_timeline_axis(pdt_rect R, double f, double *x0, double *x1);
+void pdt_draw_tree(ctx *c);                     /* tree.c */
+/* The tree's rectangle when there is no side column (layout.c calls it). */
+void pdt_layout_tree_strip(pdt_layout *L, unsigned panels, double w, double h);
+
+/* The timeline's geometry, shared by the drawing, the click and the groups
+ * on screen (timeline.c). */
+typedef struct tl_geom {
+    double x0, x1;       /* the event axis */
+    double y0, y1;       /* the rows' band */
+    double rh;           /* row height */
+    double fs;           /* row label size */
+    int row0, nshow;     /* the rows shown: row0 .. row0 + nshow - 1 */
+    double k0, k1;       /* the events at x0 and x1 */
+} tl_geom;
+void pdt_timeline_geom(pdt_rect R, double f, int nranks, size_t nrows, size_t m, const pdt_view *v,
+                       tl_geom *g);
+
+/* The groups on screen and the timeline's rows (groups.c): fills c->tree,
+ * c->groups, c->hue, c->rows; pdt_frame_groups_done frees them. */
+void pdt_frame_groups(ctx *c);
+void pdt_frame_groups_done(ctx *c);
+/* When the groups on screen are not single ranks: one label per group over
+ * the boxes of its ranks, instead of a label per box; returns 1 if drawn. */
+int pdt_draw_group_labels(ctx *c);
+/* The timeline rows of tree t for view v (all groups of the first cut, opened
+ * by v->tl_open) into a new array *rows (the caller frees it); their number. */
+size_t pdt_timeline_rows(const pdt_ranktree *t, const pdt_view *v, int32_t **rows);
 
 /* ---- small drawing helpers ------------------------------------------------------ */
 
-static inline void set_rank(cairo_t *cr, int rank, double alpha)
+/* The colour of rank q on this screen: its group's hue. */
+static inline void ctx_rank_rgb(const ctx *c, int q, double col[3])
 {
-    double c[3];
-    pdt_rank_rgb(rank, c);
-    cairo_set_source_rgba(cr, c[0], c[1], c[2], alpha);
+    if (!c->hue) pdt_rank_rgb(q, col);
+    else pdt_palette_rgb(q >= 0 && q < c->nranks ? c->hue[q] : 255, col);
+}
+
+static inline void set_rank(const ctx *c, int rank, double alpha)
+{
+    double col[3];
+    ctx_rank_rgb(c, rank, col);
+    cairo_set_source_rgba(c->cr, col[0], col[1], col[2], alpha);
 }
 
 static inline void rgb(cairo_t *cr, const double c[3], double a)
@@ -254,7 +300,7 @@ static inline void cross(cairo_t *cr, double x, double y, double a)
 static inline void set_hull(const ctx *c, int q, double alpha)
 {
     double col[3];
-    pdt_rank_rgb(q, col);
+    ctx_rank_rgb(c, q, col);
     double m = c->T->hull;
     cairo_set_source_rgba(c->cr, (1 - m) * col[0] + m * c->T->ink[0], (1 - m) * col[1] + m * c->T->ink[1],
                           (1 - m) * col[2] + m * c->T->ink[2], alpha);

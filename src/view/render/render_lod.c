@@ -18,10 +18,10 @@
 #define LOD_CELL_PX 2         /* cell size in pixels */
 
 /* The colour of a cell (premultiplied ARGB32). */
-static uint32_t cell_argb(const pdt_cov_cell *cell)
+static uint32_t cell_argb(const ctx *cx, const pdt_cov_cell *cell)
 {
     double c[3] = {0.25, 0.25, 0.28};
-    if (cell->rank != PDT_COV_MIXED) pdt_rank_rgb((int)cell->rank, c);
+    if (cell->rank != PDT_COV_MIXED) ctx_rank_rgb(cx, (int)cell->rank, c);
     double n = cell->n;
     double pale = (cell->by_status[PDT_TS_CANDIDATE] + cell->by_status[PDT_TS_SHIPPED] +
                    cell->by_status[PDT_TS_DEFERRED]) / n;
@@ -68,7 +68,7 @@ int pdt_draw_lod(ctx *c)
             for (int j = 0; j < rows; j++) {  /* image row 0 is the top: world row rows-1 */
                 uint32_t *px = (uint32_t *)(void *)(data + (size_t)j * (size_t)stride);
                 const pdt_cov_cell *row = cells + (size_t)(rows - 1 - j) * (size_t)cols;
-                for (int i = 0; i < cols; i++) px[i] = row[i].n ? cell_argb(&row[i]) : 0;
+                for (int i = 0; i < cols; i++) px[i] = row[i].n ? cell_argb(c, &row[i]) : 0;
             }
             cairo_surface_mark_dirty(img);
             cairo_t *cr = c->cr;

@@ -81,6 +81,7 @@ static const char *panel_at(const pdt_text_log *log, double x, double y)
     const struct { pdt_rect R; const char *name; } parts[] = {
         {L->top, "event"},   {L->legend, "legend"},     {L->code, "code"},
         {L->stack, "stack"}, {L->lifted, "lifted"},     {L->timeline, "timeline"},
+        {L->tree, "tree"},
     };
     for (size_t i = 0; i < sizeof parts / sizeof *parts; i++)
         if (inside(parts[i].R, x, y)) return parts[i].name;
