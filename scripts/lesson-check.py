@@ -61,6 +61,12 @@ scripts/lesson.sh into RUNS_DIR/RUN/describe.txt: the window's own functions):
                                 RANK `*`: every rank, the same list; `any`: the phases
                                 any rank begins, in the order they first begin)
     start = K                   the lesson's start position (lesson.conf) is cursor K
+    begun POS RANK = A B ...    at POS rank RANK (`*`: every rank) has begun phases A, B, ...
+                                (where the lesson opens, every rank is where the text says)
+    pgdn = A B C ...            PgDn from Home stops at phases A, B, C, in order (a merge
+                                level above 0 as merge:1), each where every rank that goes
+                                through the phase has begun it (the same in every run)
+    strips from PHASE           no rank's strip box is drawn before that rank begins PHASE
     listing LISTING             the text holds the panel's pseudo-code LISTING line for line
                                 (an indented block, numbers and all)
 
@@ -280,8 +286,10 @@ def incircle(a, b, c, d):
 
 
 def read_describe(path):
-    """pdtview --describe output: (start, {K: (listing, line, text)}, {listing: [lines]})."""
+    """pdtview --describe output: (start, {K: (listing, line, text)}, {listing: [lines]},
+    {'pgdn': [(K, NAME)], 'box': {rank: K}})."""
     start, ev, lst = None, {}, {}
+    more = {'pgdn': [], 'box': {}}
     with open(path, encoding='utf-8') as f:
         for raw in f:
             t = raw.rstrip('\n').split('\t')
@@ -291,7 +299,11 @@ def read_describe(path):
                 lst.setdefault(t[1], []).append(t[3])
             elif t[0] == 'event':
                 ev[int(t[1])] = (t[2], int(t[3]) if t[3] != '-' else None, t[4])
-    return start, ev, lst
+            elif t[0] == 'pgdn':
+                more['pgdn'].append((int(t[1]), t[2]))
+            elif t[0] == 'box':
+                more['box'][t[1]] = int(t[2])
+    return start, ev, lst, more
 
 
 def resolve_pos(toks, events, order, start):
@@ -353,6 +365,63 @@ def phases_begun(events, order, rank):
         if rank == 'any' or f['@rank'] == rank:
             seen.append(name)
     return seen
+
+
+def phase_key(fields):
+    """`merge:1` for a merge level above 0, else the phase name."""
+    name = fields['_words'][0] if fields['_words'] else '?'
+    lv = fields.get('level', '0')
+    return name if lv == '0' else '%s:%s' % (name, lv)
+
+
+def begins(events, order):
+    """{phase key: {rank: index of its first phase-begin}}."""
+    got = {}
+    for i in order:
+        kind, f, _ = events[i]
+        if kind == 'phase-begin':
+            got.setdefault(phase_key(f), {}).setdefault(f['@rank'], i)
+    return got
+
+
+def check_begun(k, ranks, names, events, order):
+    """At cursor k (events 0..k-1 applied) the ranks have begun every phase."""
+    b = begins(events, order)
+    allranks = sorted({events[i][1]['@rank'] for i in order}, key=int)
+    for name in names:
+        for rk in (allranks if ranks == '*' else [ranks]):
+            i = b.get(name, {}).get(rk)
+            if i is None or i + 1 > k:
+                raise AssertionError('at %d rank %s has not begun %s%s' % (
+                    k, rk, name, '' if i is None else ' (it does at %d)' % (i + 1)))
+
+
+def check_pgdn(want, more, events, order):
+    """PgDn's stops have these names, each after every rank's begin."""
+    got = [n for _, n in more['pgdn']]
+    if not got:
+        raise AssertionError('pdtview --describe lists no PgDn stops')
+    if got != want:
+        raise AssertionError('PgDn stops at: %s' % ' '.join(got))
+    b = begins(events, order)
+    for k, name in more['pgdn']:
+        late = [rk for rk, i in b.get(name, {}).items() if i + 1 > k]
+        if late:
+            raise AssertionError('PgDn stops at %d for %s before rank %s begins it' % (
+                k, name, ', '.join(late)))
+
+
+def check_strips(phase, more, events, order):
+    """No strip box is drawn before its rank begins `phase`."""
+    b = begins(events, order).get(phase, {})
+    for rk, k in sorted(more['box'].items()):
+        i = b.get(rk)
+        if i is None or k < i + 1:
+            raise AssertionError('rank %s\'s strip is drawn from %d, %s' % (
+                rk, k, 'it never begins %s' % phase if i is None else
+                'before it begins %s (%d)' % (phase, i + 1)))
+    if not more['box']:
+        raise AssertionError('pdtview --describe lists no strip boxes')
 
 
 def quoted(rhs):
@@ -418,12 +487,24 @@ def main():
             nchecks += 1
             events, order, out, pts, desc = run_data(run)
             ltoks, rhs = toks, None
-            if toks[0] in ('line', 'code', 'start', 'listing'):
+            if toks[0] in ('line', 'code', 'start', 'listing', 'begun', 'pgdn', 'strips'):
                 if desc is None:
                     skipped += 1
                     print('SKIP %s\n     no describe.txt (pdtview is not built)' % where)
                     continue
-                dstart, dev, dlst = desc
+                dstart, dev, dlst, dmore = desc
+                if toks[0] == 'pgdn':
+                    check_pgdn(line.partition(' = ')[2].split(), dmore, events, order)
+                    continue
+                if toks[0] == 'strips':
+                    check_strips(toks[2], dmore, events, order)
+                    continue
+                if toks[0] == 'begun':
+                    lhs, _, rhs = line.partition(' = ')
+                    lt = lhs.split()
+                    k = resolve_pos(lt[1:-1], events, order, dstart)
+                    check_begun(k, lt[-1], rhs.split(), events, order)
+                    continue
                 if toks[0] == 'listing':
                     block = [l[4:].rstrip() for l in text_lines if l.startswith('    ')]
                     want = dlst.get(toks[1])

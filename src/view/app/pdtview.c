@@ -221,7 +221,7 @@ static pdt_status start_cursor(const opts *o, const pdt_replay *r, size_t *k, pd
     if (o->have_at) *k = o->at;
     if (o->end) *k = pdt_replay_count(r);
     if (o->phase) {
-        *k = pdt_replay_find_phase_name(r, o->phase);
+        *k = pdt_replay_phase_stop_named(r, o->phase);
         if (*k == (size_t)-1)
             return pdt_err_set(err, PDT_ERR_ARG, "%s: no phase named \"%s\" in this run", o->run,
                                o->phase);

@@ -206,8 +206,8 @@ static int move_key(shell *sh, SDL_Keycode k, int shift)
         return 1;
     case SDLK_RIGHT:
     case SDLK_LEFT: arrow_key(sh, k, shift); return 1;
-    case SDLK_PAGEDOWN: seek(sh, pdt_replay_find_phase(sh->r, cur, 1)); return 1;
-    case SDLK_PAGEUP: seek(sh, pdt_replay_find_phase(sh->r, cur, -1)); return 1;
+    case SDLK_PAGEDOWN: seek(sh, pdt_replay_find_phase_stop(sh->r, cur, 1)); return 1;
+    case SDLK_PAGEUP: seek(sh, pdt_replay_find_phase_stop(sh->r, cur, -1)); return 1;
     case SDLK_HOME: seek(sh, 0); return 1;
     case SDLK_END: seek(sh, m); return 1;
     case SDLK_PLUS:
