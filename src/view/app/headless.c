@@ -165,8 +165,8 @@ int pdt_app_describe(const pdt_replay *r, size_t start)
         return PDT_EXIT_USAGE;
     }
     char line[512];
-    for (size_t k = 1; k <= pdt_replay_count(r); k++) {
-        pdt_replay_step(r, s, 1);
+    for (size_t k = 0; k <= pdt_replay_count(r); k++) {
+        if (k) pdt_replay_step(r, s, 1);
         int id = -1, cl = pdt_replay_code_line(r, s, &id);
         pdt_replay_describe_state(r, s, k, line, sizeof line);
         const char *nm = id >= 0 && id < PDT_CODE_COUNT ? names[id] : "-";

@@ -68,7 +68,10 @@ size_t pdt_replay_inside_count(const pdt_replay *r, const uint32_t v[3])
 int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
 {
     if (!s->k || s->k > pdt_replay_count(r)) {
-        *id = PDT_CODE_SRM;
+        /* before the first event: the listing of the run (a hull run's Graham) */
+        int graham_run = pdt_replay_kind_count(r, PDT_EV_SORT) > 0 &&
+                         pdt_replay_kind_count(r, PDT_EV_TRI_NEW) == 0;
+        *id = graham_run ? PDT_CODE_GRAHAM : PDT_CODE_SRM;
         return -1;
     }
     const pdt_rec held = *pdt_replay_rec(r, s->k - 1); /* (a kept index's pointer is short-lived) */
