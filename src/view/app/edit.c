@@ -569,14 +569,11 @@ static int edit_key(pdt_editor *ed, const pdt_shell_input *in, double w, double 
         static const char *const names[] = {"circle: 20 cocircular points", "6 x 6 grid",
                                             "8 collinear points and 3 more", "duplicates"};
         int p = in->key - K_F1;
-        v->centred = 0;
-        v->zoom = 1;
-        {
         pdt_err e = {0};
-        frame_begin(ed, w, h, v);
         pdt_status st = pdt_editor_preset(ed, (pdt_preset)p, &e);
-        frame_end(ed, w, h, v, st, &e, names[p]);
-    }
+        v->centred = 0;  /* refit: the preset's points fill the view */
+        v->zoom = 1;
+        report(ed, st, &e, names[p]);
         return 1;
     }
     return 0;
