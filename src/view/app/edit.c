@@ -1,5 +1,6 @@
 /* pdt — the viewer's point editor (edit.h). */
 #include "edit.h"
+#include "editnotes.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -26,6 +27,7 @@ typedef struct history {
 
 struct pdt_editor {
     char *path;
+    pdt_edit_notes *notes; /* the file's comments, kept on every save (NULL: none) */
     pdt_point *pts;
     size_t n, cap;
     history undo, redo;
@@ -146,7 +148,7 @@ static pdt_status rerun(pdt_editor *ed, pdt_err *err)
 
 static pdt_status save(pdt_editor *ed, pdt_err *err)
 {
-    return pdt_write_points(ed->path, ed->pts, ed->n, err);
+    return pdt_edit_notes_write(ed->notes, ed->path, ed->pts, ed->n, err);
 }
 
 /* After a change to ed->pts: save, re-run. */
@@ -197,6 +199,7 @@ pdt_status pdt_editor_open(const char *path, const pdt_live_opts *o, pdt_editor 
         size_t coll = 0;
         st = pdt_read_points(path, 0, &ed->pts, &ed->n, &coll, err);
         ed->cap = ed->n;
+        if (st == PDT_OK && !ed->mode.node) st = pdt_edit_notes_read(path, &ed->notes, err);
     }
     if (st == PDT_OK) st = rerun(ed, err);
     if (st != PDT_OK) {
@@ -216,6 +219,7 @@ void pdt_editor_free(pdt_editor *ed)
     pdt_rstate_free(ed->s);
     pdt_replay_free(ed->r);
     pdt_live_free(&ed->run);
+    pdt_edit_notes_free(ed->notes);
     free(ed->pts);
     free(ed->path);
     free(ed);
@@ -241,6 +245,7 @@ pdt_status pdt_editor_move(pdt_editor *ed, size_t i, int64_t x, int64_t y, pdt_e
                            (long long)x, (long long)y);
     pdt_status st = begin_change(ed, err);
     if (st != PDT_OK) return st;
+    pdt_edit_notes_moved(ed->notes, ed->pts[i], (pdt_point){(int32_t)x, (int32_t)y});
     ed->pts[i] = (pdt_point){(int32_t)x, (int32_t)y};
     return commit(ed, err);
 }
@@ -482,17 +487,36 @@ static void frame_end(pdt_editor *ed, double w, double h, pdt_view *v, pdt_statu
 const char *const pdt_editor_keys[][2] = {
     {"click", "add a point (integer coordinates)"},
     {"drag", "move a point (elsewhere: pan)"},
-    {"right click", "delete a point"},
+    {"right click", "delete a point (later points' labels move down one)"},
     {"Ctrl + Z  Y", "undo / redo"},
     {"g", "grid snap on / off"},
     {"n", "add 10 random points in the view"},
     {"F1 … F4", "presets: circle, grid, collinear, duplicates"},
-    {"x", "Graham's scan only / the triangulation"},
+    {"x", "Graham's scan only (pdt hull)"},
     {"1 … 8", "simulated ranks of the live run"},
     {"0", "show all ranks"},
     {"9", "show / hide rank 8"},
 };
 const int pdt_editor_nkeys = (int)(sizeof pdt_editor_keys / sizeof *pdt_editor_keys);
+
+/* In Graham's mode: one rank, the keys that differ say so. */
+static const char *const hull_keys[][2] = {
+    {"click", "add a point (integer coordinates)"},
+    {"drag", "move a point (elsewhere: pan)"},
+    {"right click", "delete a point (later points' labels move down one)"},
+    {"Ctrl + Z  Y", "undo / redo"},
+    {"g", "grid snap on / off"},
+    {"n", "add 10 random points in the view"},
+    {"F1 … F4", "presets: circle, grid, collinear, duplicates"},
+    {"x", "back to the triangulation (pdt triangulate)"},
+    {"1 … 8", "ranks the triangulation will use (Graham's scan runs on one)"},
+};
+
+const char *const (*pdt_editor_help(const pdt_editor *ed, int *n))[2]
+{
+    *n = ed->mode.hull ? (int)(sizeof hull_keys / sizeof *hull_keys) : pdt_editor_nkeys;
+    return ed->mode.hull ? hull_keys : pdt_editor_keys;
+}
 
 static int edit_key(pdt_editor *ed, const pdt_shell_input *in, double w, double h, pdt_view *v)
 {
@@ -579,6 +603,20 @@ static int edit_key(pdt_editor *ed, const pdt_shell_input *in, double w, double 
     return 0;
 }
 
+/* What deleting point i does to the labels: every later point moves down one. */
+static void delete_message(const pdt_editor *ed, size_t i, char *buf, size_t cap)
+{
+    int n = snprintf(buf, cap, "deleted point %zu (%d, %d)", i, ed->pts[i].x, ed->pts[i].y);
+    if (n < 0 || (size_t)n >= cap) return;
+    if (i + 1 == ed->n)
+        snprintf(buf + n, cap - (size_t)n, ", the last: no other label changes");
+    else if (i + 2 == ed->n)
+        snprintf(buf + n, cap - (size_t)n, ": point %zu is now %zu", i + 1, i);
+    else
+        snprintf(buf + n, cap - (size_t)n, ": points %zu … %zu are now %zu … %zu", i + 1, ed->n - 1,
+                 i, ed->n - 2);
+}
+
 static int edit_mouse(pdt_editor *ed, const pdt_shell_input *in, double w, double h, pdt_view *v)
 {
     int geo = in_geo(w, h, ed->r, v, in->x, in->y);
@@ -589,14 +627,12 @@ static int edit_mouse(pdt_editor *ed, const pdt_shell_input *in, double w, doubl
         if (in->button == 3) {
             int64_t i = point_at(ed, w, h, v, in->x, in->y);
             if (i >= 0) {
-                char ok[96];
-                snprintf(ok, sizeof ok, "deleted (%d, %d)", ed->pts[i].x, ed->pts[i].y);
-                {
-        pdt_err e = {0};
-        frame_begin(ed, w, h, v);
-        pdt_status st = pdt_editor_delete(ed, (size_t)i, &e);
-        frame_end(ed, w, h, v, st, &e, ok);
-    }
+                char ok[200];
+                delete_message(ed, (size_t)i, ok, sizeof ok);
+                pdt_err e = {0};
+                frame_begin(ed, w, h, v);
+                pdt_status st = pdt_editor_delete(ed, (size_t)i, &e);
+                frame_end(ed, w, h, v, st, &e, ok);
             }
             return 1;
         }
@@ -670,7 +706,9 @@ static int edit_mouse(pdt_editor *ed, const pdt_shell_input *in, double w, doubl
 static int hook_input(void *user, const pdt_shell_input *in, double w, double h, pdt_view *v)
 {
     pdt_editor *ed = user;
-    return in->type == PDT_IN_KEY ? edit_key(ed, in, w, h, v) : edit_mouse(ed, in, w, h, v);
+    int took = in->type == PDT_IN_KEY ? edit_key(ed, in, w, h, v) : edit_mouse(ed, in, w, h, v);
+    if (v->help_more) v->help_more = pdt_editor_help(ed, &v->help_nmore); /* the mode's keys */
+    return took;
 }
 
 static int hook_current(void *user, const pdt_replay **r, pdt_rstate **s)
