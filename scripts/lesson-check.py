@@ -2,6 +2,9 @@
 """pdt — verify a lesson's `checks` file against its recorded run(s).
 
     scripts/lesson-check.py LESSON_DIR RUNS_DIR
+    scripts/lesson-check.py --moments LESSON_DIR RUNS_DIR RUN
+        (the bookmarks of run RUN for `pdtview --bookmarks`: one line per moment,
+        "K<TAB>TITLE<TAB>TEXT": where the lesson opens and every `step` of its checks)
     scripts/lesson-check.py --find DUMP first|last KIND [W ...] [F=V ...]
         (prints the viewer cursor K that shows that event; scripts/lesson.sh
         uses it for the positions `first ...` / `last ...` of lesson.conf)
@@ -67,10 +70,13 @@ scripts/lesson.sh into RUNS_DIR/RUN/describe.txt: the window's own functions):
                                 level above 0 as merge:1), each where every rank that goes
                                 through the phase has begun it (the same in every run)
     strips from PHASE           no rank's strip box is drawn before that rank begins PHASE
+    step N POS                  step N of the text's "In the viewer" list is about the moment
+                                POS: a bookmark of the window (b / Shift+b) whose notes pane
+                                shows that step's text (`--moments` writes them)
     listing LISTING             the text holds the panel's pseudo-code LISTING line for line
                                 (an indented block, numbers and all)
 
-POS is a counter K (the viewer at "K / total"), `start` (where the lesson opens) or
+POS is a counter K (the viewer at "K / total"), `start` (where the lesson opens), `end` or
 `first KIND [W..] [F=V..]` / `last ...` (as in lesson.conf: stable across runs of
 several ranks).
 
@@ -312,6 +318,8 @@ def resolve_pos(toks, events, order, start):
         if start is None:
             raise AssertionError('no start position recorded')
         return start
+    if toks[0] == 'end':
+        return len(order)
     if toks[0] in ('first', 'last'):
         want = parse_fields(toks[2:])
         hits = [i for i in order if match(events[i][0], events[i][1], toks[1], want)]
@@ -424,6 +432,51 @@ def check_strips(phase, more, events, order):
         raise AssertionError('pdtview --describe lists no strip boxes')
 
 
+def viewer_steps(text_lines):
+    """The "In the viewer" section: (intro, {N: text of numbered item N}), each
+    flattened to one line."""
+    intro, steps, cur, on = [], {}, None, False
+    for l in text_lines:
+        if l.startswith('## '):
+            on = l.strip() == '## In the viewer'
+            continue
+        if not on:
+            continue
+        m = re.match(r'^(\d+)\.\s+(.*)$', l)
+        if m:
+            cur = int(m.group(1))
+            steps[cur] = [m.group(2)]
+        elif cur is not None and l.strip():
+            steps[cur].append(l.strip())
+        elif cur is None and l.strip() and not l.startswith('|'):
+            intro.append(l.strip())
+    return ' '.join(intro), {k: ' '.join(v) for k, v in steps.items()}
+
+
+def moments(ldir, rdir, run):
+    """Print the bookmarks of run `run`: the start and every `step`."""
+    with open(os.path.join(ldir, 'README.md'), encoding='utf-8') as f:
+        intro, steps = viewer_steps(f.read().split('\n'))
+    d = os.path.join(rdir, run)
+    events, order = read_dump(os.path.join(d, 'dump.txt'))
+    dstart = read_describe(os.path.join(d, 'describe.txt'))[0]
+    out = [(dstart, 'start', intro)] if dstart is not None else []
+    cur_run = read_conf(os.path.join(ldir, 'lesson.conf'))[1][0]
+    with open(os.path.join(ldir, 'checks'), encoding='utf-8') as f:
+        for raw in f:
+            toks = raw.split('#', 1)[0].split()
+            if toks[:1] == ['run']:
+                cur_run = toks[1]
+            elif toks[:1] == ['step'] and cur_run == run and int(toks[1]) in steps:
+                k = resolve_pos(toks[2:], events, order, dstart)
+                out.append((k, 'step %s' % toks[1], steps[int(toks[1])]))
+    out[1:] = sorted(out[1:], key=lambda t: int(t[1].split()[1])) if dstart is not None else \
+        sorted(out, key=lambda t: int(t[1].split()[1]))
+    for k, title, text in out:  # the start, then the steps in the text's order
+        print('%d\t%s\t%s' % (k, title, text.replace('\t', ' ')))
+    return 0
+
+
 def quoted(rhs):
     rhs = rhs.strip()
     if len(rhs) < 2 or rhs[0] != '"' or rhs[-1] != '"':
@@ -432,6 +485,8 @@ def quoted(rhs):
 
 
 def main():
+    if len(sys.argv) == 5 and sys.argv[1] == '--moments':
+        return moments(sys.argv[2], sys.argv[3], sys.argv[4])
     if len(sys.argv) >= 5 and sys.argv[1] == '--find':
         k = find(sys.argv[2], sys.argv[3], sys.argv[4:])
         if k is None:
@@ -487,6 +542,15 @@ def main():
             nchecks += 1
             events, order, out, pts, desc = run_data(run)
             ltoks, rhs = toks, None
+            if toks[0] == 'step':
+                n_step = int(toks[1])
+                if n_step not in viewer_steps(text_lines)[1]:
+                    raise AssertionError('the text has no step %d under "In the viewer"' % n_step)
+                desc = run_data(run)[4]
+                k = resolve_pos(toks[2:], events, order, desc[0] if desc else None)
+                if not 0 <= k <= len(order):
+                    raise AssertionError('step %d: no cursor %d' % (n_step, k))
+                continue
             if toks[0] in ('line', 'code', 'start', 'listing', 'begun', 'pgdn', 'strips'):
                 if desc is None:
                     skipped += 1

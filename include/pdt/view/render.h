@@ -66,7 +66,8 @@ enum {
     PDT_PANEL_STACK = 2,    /* stacks being built */
     PDT_PANEL_LIFTED = 4,   /* lifted view */
     PDT_PANEL_TIMELINE = 8, /* timeline */
-    PDT_PANEL_ALL = 15
+    PDT_PANEL_ALL = 15,
+    PDT_PANEL_NOTES = 16    /* the lesson's notes (drawn by the window's lecture tools) */
 };
 
 /* Parse a comma-separated list of panel names ("code,stack,lifted,timeline",

@@ -31,6 +31,7 @@ typedef struct opts {
     int theme, fullscreen, clean, circles, voronoi;
     uint64_t mem;      /* --mem BYTES (or $PDTVIEW_MEM): the viewer's memory budget */
     int index;         /* --index on|off|auto: 1, 0, -1 */
+    const char *bookmarks; /* --bookmarks FILE: a lesson's key moments (lecture.h) */
 } opts;
 
 /* ---- the run ----------------------------------------------------------------- */

@@ -37,6 +37,7 @@
 #include "pdt/exit.h"
 #include "pdt/opts.h"
 #include "app.h"
+#include "lecture.h"
 #include "edit.h"
 #include "shell.h"
 
@@ -263,9 +264,16 @@ static int act(const opts *o, const pdt_replay *r, pdt_rstate *s, pdt_view *v, s
         return PDT_EXIT_USAGE;
     }
     if (o->headless) return pdt_app_headless(r, s, v, o, err);
+    pdt_lecture *lec = NULL;
+    if (pdt_lecture_new(r, s, o->bookmarks, &lec, err) != PDT_OK) {
+        fprintf(stderr, "pdtview: %s\n", err->msg);
+        return PDT_EXIT_USAGE;
+    }
     pdt_shell_opts so = {o->w, o->h, o->run, o->script, o->screenshot, o->speed,
-                         o->record, o->fps, o->every, NULL, o->fullscreen};
-    return pdt_shell_run(r, s, v, &so);
+                         o->record, o->fps, o->every, pdt_lecture_hook(lec), o->fullscreen};
+    int rc = pdt_shell_run(r, s, v, &so);
+    pdt_lecture_free(lec);
+    return rc;
 }
 
 /* SDL hands the window title (UTF-8) to X11 through the C library's

@@ -438,9 +438,9 @@ static int script_key(const char *tok)
     }
     if (strncmp(tok, "key:", 4)) return 0;
     const char *name = tok + 4;
-    int ctrl = !strncmp(name, "C-", 2);
-    e.key.keysym.sym = SDL_GetKeyFromName(ctrl ? name + 2 : name);
-    e.key.keysym.mod = ctrl ? KMOD_LCTRL : 0;
+    int ctrl = !strncmp(name, "C-", 2), shift = !strncmp(name, "S-", 2); /* key:S-b: Shift+b */
+    e.key.keysym.sym = SDL_GetKeyFromName(ctrl || shift ? name + 2 : name);
+    e.key.keysym.mod = ctrl ? KMOD_LCTRL : shift ? KMOD_LSHIFT : 0;
     if (e.key.keysym.sym == SDLK_UNKNOWN) return 0;
     SDL_PushEvent(&e);
     return 1;

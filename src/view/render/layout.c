@@ -36,7 +36,8 @@ int pdt_panels_parse(const char *list, unsigned *panels)
 {
     static const struct { const char *name; unsigned bit; } names[] = {
         {"code", PDT_PANEL_CODE}, {"stack", PDT_PANEL_STACK}, {"lifted", PDT_PANEL_LIFTED},
-        {"timeline", PDT_PANEL_TIMELINE}, {"all", PDT_PANEL_ALL}, {"none", 0}};
+        {"timeline", PDT_PANEL_TIMELINE}, {"all", PDT_PANEL_ALL}, {"none", 0},
+        {"notes", PDT_PANEL_NOTES}};
     unsigned bits = 0;
     const char *p = list;
     while (*p) {
