@@ -38,6 +38,14 @@ printf '40\tstart\tok\nforty\tbad\n' >"$TMP/bad.tsv"
 if [ "$rc" = 2 ] && grep -q "bad.tsv:2" "$TMP/bad.err"; then ok bad_bookmarks_refused_with_line
 else fail bad_bookmarks_refused_with_line "exit $rc: $(cat "$TMP/bad.err")"; fi
 
+# ---- --beside: a second run beside the first; a run that does not open is refused -----------
+"$V" "$RUN" --beside synth:srm:12:6:1 --size ${W}x${H} --panels none \
+     --script "pgdn pgdn pgdn wait:3 s q" --screenshot "$TMP/bs.png" >/dev/null 2>"$TMP/bs.err"; rc=$?
+if [ "$rc" = 0 ] && [ -s "$TMP/bs.png" ]; then ok beside_opens_and_steps; else fail beside_opens_and_steps "exit $rc: $(cat "$TMP/bs.err")"; fi
+"$V" "$RUN" --beside "$TMP/no-such-run" --script q >/dev/null 2>"$TMP/bs2.err"; rc=$?
+if [ "$rc" = 2 ] && grep -q "no-such-run" "$TMP/bs2.err"; then ok beside_bad_run_refused
+else fail beside_bad_run_refused "exit $rc: $(cat "$TMP/bs2.err")"; fi
+
 # ---- notes pane, pen, pointer, erase: what the screen shows ---------------------------------
 "$V" "$RUN" --size ${W}x${H} --bookmarks "$TMP/bm.tsv" --script "wait:1000000" >/dev/null 2>"$TMP/w.err" &
 VPID=$!

@@ -32,6 +32,7 @@ typedef struct opts {
     uint64_t mem;      /* --mem BYTES (or $PDTVIEW_MEM): the viewer's memory budget */
     int index;         /* --index on|off|auto: 1, 0, -1 */
     const char *bookmarks; /* --bookmarks FILE: a lesson's key moments (lecture.h) */
+    const char *beside;    /* --beside RUN2: a second run beside the first (beside.h) */
 } opts;
 
 /* ---- the run ----------------------------------------------------------------- */

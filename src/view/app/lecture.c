@@ -6,6 +6,7 @@
  * while the pen is on) and lets the others through, remembering the key so
  * that the overlay can say what it did, from the state the frame shows. */
 #include "lecture.h"
+#include "beside.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -36,6 +37,7 @@ struct pdt_lecture {
     size_t np, cap;
     int key, shift, ctrl;  /* the last key the shell handled (0: none) */
     char msg[200];         /* what the last key of the hook did */
+    pdt_beside *beside;    /* a second run drawn beside the first, or NULL */
     pdt_shell_hook hook;
 };
 
@@ -110,6 +112,7 @@ void pdt_lecture_free(pdt_lecture *L)
     }
     free(L->m);
     free(L->pts);
+    pdt_beside_free(L->beside);
     free(L);
 }
 
@@ -236,6 +239,12 @@ static int hook_current(void *user, const pdt_replay **r, pdt_rstate **s)
     return moved;
 }
 
+pdt_status pdt_lecture_beside(pdt_lecture *L, const pdt_replay *r2, pdt_rstate *s2, pdt_err *err)
+{
+    if (!(L->beside = pdt_beside_new(r2, s2))) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+    return PDT_OK;
+}
+
 const pdt_shell_hook *pdt_lecture_hook(pdt_lecture *L)
 {
     L->hook.user = L;
@@ -354,7 +363,9 @@ static double wrap(cairo_t *cr, const char *text, double x, double y, double wd,
             y += lh;
             snprintf(line, sizeof line, "%s", word);
         } else {
-            snprintf(line, sizeof line, "%s", next);
+            size_t n2 = strlen(next) < sizeof line ? strlen(next) : sizeof line - 1;
+            memcpy(line, next, n2); /* (a line wider than the pane is cut: 1300 bytes) */
+            line[n2] = 0;
         }
     }
     if (*line && draw && y <= ymax) say(cr, x, y, fs, 0, line);
@@ -442,6 +453,7 @@ void pdt_lecture_overlay(void *user, cairo_t *cr, double w, double h, const pdt_
     pdt_render_layout_view(w, h, pdt_replay_nranks(L->r), v, &Ly);
     double fs = fmax(16, Ly.body);
     int dark = v->theme != PDT_THEME_LIGHT;
+    if (L->beside) pdt_beside_draw(L->beside, cr, w, h, L->r, L->s, v);
     cairo_save(cr);
     if (v->panels & PDT_PANEL_NOTES) draw_notes(cr, L, Ly.geo, fs, dark);
     char eff[240];

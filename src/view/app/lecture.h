@@ -26,6 +26,9 @@ typedef struct pdt_lecture pdt_lecture;
 pdt_status pdt_lecture_new(const pdt_replay *r, pdt_rstate *s, const char *bookmarks,
                            pdt_lecture **out, pdt_err *err);
 void pdt_lecture_free(pdt_lecture *L);
+/* Draw a second run beside the first, following it phase by phase
+ * (beside.h); r2 and s2 are the caller's. */
+pdt_status pdt_lecture_beside(pdt_lecture *L, const pdt_replay *r2, pdt_rstate *s2, pdt_err *err);
 /* The shell hook; valid while L is. */
 const pdt_shell_hook *pdt_lecture_hook(pdt_lecture *L);
 /* The hook's overlay (the notes pane, the pen, the pointer, the key line). */

@@ -246,6 +246,39 @@ static void view_of(const opts *o, uint8_t *hidden, pdt_view *v)
     v->voronoi = o->voronoi;
 }
 
+/* The window with the lecturer's tools (lecture.h), and --beside's run. */
+static int window(const opts *o, const pdt_replay *r, pdt_rstate *s, pdt_view *v, pdt_err *err)
+{
+    pdt_lecture *lec = NULL;
+    loaded L2;
+    memset(&L2, 0, sizeof L2);
+    pdt_replay *r2 = NULL;
+    pdt_rstate *s2 = NULL;
+    pdt_replay_open_info info2;
+    opts o2 = *o;
+    o2.run = o->beside;
+    int rc = PDT_EXIT_USAGE;
+    if (pdt_lecture_new(r, s, o->bookmarks, &lec, err) != PDT_OK ||
+        (o->beside && (pdt_app_load(o->beside, &L2, err) != PDT_OK ||
+                       pdt_app_open_replay(&L2, &o2, &r2, &info2, err) != PDT_OK)))
+        goto out;
+    if (o->beside && (!(s2 = pdt_rstate_new(r2)) || pdt_lecture_beside(lec, r2, s2, err) != PDT_OK)) {
+        if (!s2) pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+        goto out;
+    }
+    pdt_shell_opts so = {o->w, o->h, o->run, o->script, o->screenshot, o->speed,
+                         o->record, o->fps, o->every, pdt_lecture_hook(lec), o->fullscreen};
+    rc = pdt_shell_run(r, s, v, &so);
+out:
+    if (err->code != PDT_OK) fprintf(stderr, "pdtview: %s\n", err->msg);
+    pdt_err_clear(err);
+    pdt_lecture_free(lec);
+    pdt_rstate_free(s2);
+    pdt_replay_free(r2);
+    pdt_app_unload(&L2);
+    return rc;
+}
+
 /* Do what the options ask with the replay at cursor k: an exit status. */
 static int act(const opts *o, const pdt_replay *r, pdt_rstate *s, pdt_view *v, size_t k,
                pdt_err *err)
@@ -264,16 +297,7 @@ static int act(const opts *o, const pdt_replay *r, pdt_rstate *s, pdt_view *v, s
         return PDT_EXIT_USAGE;
     }
     if (o->headless) return pdt_app_headless(r, s, v, o, err);
-    pdt_lecture *lec = NULL;
-    if (pdt_lecture_new(r, s, o->bookmarks, &lec, err) != PDT_OK) {
-        fprintf(stderr, "pdtview: %s\n", err->msg);
-        return PDT_EXIT_USAGE;
-    }
-    pdt_shell_opts so = {o->w, o->h, o->run, o->script, o->screenshot, o->speed,
-                         o->record, o->fps, o->every, pdt_lecture_hook(lec), o->fullscreen};
-    int rc = pdt_shell_run(r, s, v, &so);
-    pdt_lecture_free(lec);
-    return rc;
+    return window(o, r, s, v, err);
 }
 
 /* SDL hands the window title (UTF-8) to X11 through the C library's
