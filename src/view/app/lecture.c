@@ -405,7 +405,7 @@ static double mark_row(cairo_t *cr, const pdt_lecture *L, const mark *now, doubl
 static void draw_notes(cairo_t *cr, const pdt_lecture *L, pdt_rect G, double fs, int dark)
 {
     const mark *now = note_now(L);
-    double pad = 0.6 * fs, wd = G.w - 2 * pad, hmax = 0.45 * G.h;
+    double pad = 0.6 * fs, wd = G.w - 2 * pad, hmax = 0.4 * G.h;
     const char *text = now && *now->text ? now->text
                                          : "(no step of the lesson before this moment)";
     double need = mark_row(cr, L, now, 0, -1e9, wd, fs) + 1e9 +
