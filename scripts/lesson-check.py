@@ -70,6 +70,8 @@ scripts/lesson.sh into RUNS_DIR/RUN/describe.txt: the window's own functions):
                                 level above 0 as merge:1), each where every rank that goes
                                 through the phase has begun it (the same in every run)
     strips from PHASE           no rank's strip box is drawn before that rank begins PHASE
+    legend hull POS = RANK      at POS the legend's "hull / stack" swatch has rank RANK's colour
+                                (that of the hull drawn thickest: the last one built)
     step N POS                  step N of the text's "In the viewer" list is about the moment
                                 POS: a bookmark of the window (b / Shift+b) whose notes pane
                                 shows that step's text (`--moments` writes them)
@@ -295,7 +297,7 @@ def read_describe(path):
     """pdtview --describe output: (start, {K: (listing, line, text)}, {listing: [lines]},
     {'pgdn': [(K, NAME)], 'box': {rank: K}})."""
     start, ev, lst = None, {}, {}
-    more = {'pgdn': [], 'box': {}}
+    more = {'pgdn': [], 'box': {}, 'legend': []}
     with open(path, encoding='utf-8') as f:
         for raw in f:
             t = raw.rstrip('\n').split('\t')
@@ -309,6 +311,8 @@ def read_describe(path):
                 more['pgdn'].append((int(t[1]), t[2]))
             elif t[0] == 'box':
                 more['box'][t[1]] = int(t[2])
+            elif t[0] == 'legend':
+                more['legend'].append((t[1], int(t[2]), int(t[3])))
     return start, ev, lst, more
 
 
@@ -551,7 +555,7 @@ def main():
                 if not 0 <= k <= len(order):
                     raise AssertionError('step %d: no cursor %d' % (n_step, k))
                 continue
-            if toks[0] in ('line', 'code', 'start', 'listing', 'begun', 'pgdn', 'strips'):
+            if toks[0] in ('line', 'code', 'start', 'listing', 'begun', 'pgdn', 'strips', 'legend'):
                 if desc is None:
                     skipped += 1
                     print('SKIP %s\n     no describe.txt (pdtview is not built)' % where)
@@ -559,6 +563,15 @@ def main():
                 dstart, dev, dlst, dmore = desc
                 if toks[0] == 'pgdn':
                     check_pgdn(line.partition(' = ')[2].split(), dmore, events, order)
+                    continue
+                if toks[0] == 'legend':
+                    lhs, _, rhs = line.partition(' = ')
+                    lt = lhs.split()
+                    k = resolve_pos(lt[2:], events, order, dstart)
+                    got = [q for what, kk, q in dmore['legend'] if what == lt[1] and kk <= k]
+                    if not got or got[-1] != int(rhs):
+                        raise AssertionError('at %d the legend\'s %s swatch has rank %s\'s colour'
+                                             % (k, lt[1], got[-1] if got else '(no legend line)'))
                     continue
                 if toks[0] == 'strips':
                     check_strips(toks[2], dmore, events, order)

@@ -397,6 +397,10 @@ size_t pdt_replay_phase_stops(const pdt_replay *r, pdt_phase_stop *out, size_t c
 size_t pdt_replay_find_phase_stop(const pdt_replay *r, size_t k, int dir);
 /* The stop of the phase named `name` ("classify", "merge:1"), or (size_t)-1. */
 size_t pdt_replay_phase_stop_named(const pdt_replay *r, const char *name);
+/* The rank of the last hull reported before cursor k (the hull drawn
+ * thickest, whose colour the legend's hull swatch takes), else 0
+ * (hullrank.c). */
+int pdt_replay_hull_rank(const pdt_replay *r, size_t k);
 /* The cursor from which rank `rank`'s strip box is drawn: just after it
  * begins its partition phase (0 for a run without one). */
 size_t pdt_replay_box_from(const pdt_replay *r, int rank);

@@ -130,7 +130,9 @@ void pdt_app_counts(const pdt_replay *r, const pdt_rstate *s)
  * 1-based, or "-" for none; the event line).  Tab-separated, one record per line. */
 /* The cursors PgDn visits from Home, each with its phase ("pgdn\tK\tNAME",
  * NAME:LEVEL for a merge level above 0), and where each rank's strip box is
- * first drawn ("box\tRANK\tK"): what a lesson's checks compare with its text. */
+ * first drawn ("box\tRANK\tK"), and from which cursor the legend's hull
+ * swatch takes which rank's colour ("legend\thull\tK\tRANK"): what a
+ * lesson's checks compare with its text. */
 static void describe_stops(const pdt_replay *r)
 {
     pdt_phase_stop st[128];
@@ -148,6 +150,16 @@ static void describe_stops(const pdt_replay *r)
     for (int q = 0; q < pdt_replay_nranks(r); q++) {
         pdt_point lo, hi;
         if (pdt_replay_box(r, q, &lo, &hi)) printf("box\t%d\t%zu\n", q, pdt_replay_box_from(r, q));
+    }
+    /* the legend's hull swatch: from cursor K on, rank RANK's colour */
+    size_t nh;
+    const pdt_rhull *H = pdt_replay_hulls(r, &nh);
+    int last = pdt_replay_hull_rank(r, 0);
+    printf("legend\thull\t0\t%d\n", last);
+    for (size_t i = 0; i < nh; i++) {
+        int q = pdt_replay_hull_rank(r, (size_t)H[i].ev + 1);
+        if (q != last) printf("legend\thull\t%zu\t%d\n", (size_t)H[i].ev + 1, q);
+        last = q;
     }
 }
 

@@ -227,16 +227,8 @@ static inline void set_hull(const ctx *c, int q, double alpha)
                           (1 - m) * col[2] + m * c->T->ink[2], alpha);
 }
 
-/* The rank whose colour the legend's hull swatch takes: the rank of the last
- * hull reported before the cursor (the hull drawn thickest), else 0. */
-static inline int pdt_legend_hull_rank(const ctx *c)
-{
-    size_t n;
-    const pdt_rhull *H = pdt_replay_hulls(c->r, &n);
-    int q = 0;
-    for (size_t i = 0; i < n && H[i].ev < c->s->k; i++) q = (int)H[i].rank;
-    return q;
-}
+/* The rank whose colour the legend's hull swatch takes (the last hull's). */
+static inline int pdt_legend_hull_rank(const ctx *c) { return pdt_replay_hull_rank(c->r, c->s->k); }
 
 /* Line style of a triangle status: width and dash (render.c). */
 void pdt_status_style(cairo_t *cr, int st, double lw);
