@@ -398,7 +398,7 @@ static void report(pdt_editor *ed, pdt_status st, const pdt_err *err, const char
 static int in_geo(double w, double h, const pdt_replay *r, const pdt_view *v, double x, double y)
 {
     pdt_layout L;
-    pdt_render_layout_panels(w, h, pdt_replay_nranks(r), v->panels, &L);
+    pdt_render_layout_view(w, h, pdt_replay_nranks(r), v, &L);
     return x >= L.geo.x && x <= L.geo.x + L.geo.w && y >= L.geo.y && y <= L.geo.y + L.geo.h;
 }
 
@@ -406,7 +406,7 @@ static int in_geo(double w, double h, const pdt_replay *r, const pdt_view *v, do
 static int64_t point_at(pdt_editor *ed, double w, double h, const pdt_view *v, double x, double y)
 {
     pdt_layout L;
-    pdt_render_layout_panels(w, h, pdt_replay_nranks(ed->r), v->panels, &L);
+    pdt_render_layout_view(w, h, pdt_replay_nranks(ed->r), v, &L);
     int64_t best = -1;
     double bd = 0.8 * L.font * 0.8 * L.font;
     for (size_t i = 0; i < ed->n; i++) {
@@ -441,7 +441,7 @@ static void freeze_frame(pdt_editor *ed, double w, double h, pdt_view *v)
 {
     if (v->centred) return;
     pdt_layout L;
-    pdt_render_layout_panels(w, h, pdt_replay_nranks(ed->r), v->panels, &L);
+    pdt_render_layout_view(w, h, pdt_replay_nranks(ed->r), v, &L);
     double cx, cy, ax, ay, bx, by;
     pdt_view_to_world(ed->r, v, w, h, L.geo.x + L.geo.w / 2, L.geo.y + L.geo.h / 2, &cx, &cy);
     pdt_view_to_world(ed->r, v, w, h, 0, 0, &ax, &ay);
@@ -542,7 +542,7 @@ static void snap_key(pdt_editor *ed, double w, double h, pdt_view *v)
 static void random_key(pdt_editor *ed, double w, double h, pdt_view *v)
 {
     pdt_layout L;
-    pdt_render_layout_panels(w, h, pdt_replay_nranks(ed->r), v->panels, &L);
+    pdt_render_layout_view(w, h, pdt_replay_nranks(ed->r), v, &L);
     freeze_frame(ed, w, h, v);
     int64_t x0, y0, x1, y1;
     world_at(ed, w, h, v, L.geo.x + 0.1 * L.geo.w, L.geo.y + 0.9 * L.geo.h, &x0, &y0);
@@ -754,7 +754,7 @@ static void hook_overlay(void *user, cairo_t *cr, double w, double h, const pdt_
     pdt_editor *ed = user;
     if (v->help) return; /* the help box is on top */
     pdt_layout L;
-    pdt_render_layout_panels(w, h, pdt_replay_nranks(ed->r), v->panels, &L);
+    pdt_render_layout_view(w, h, pdt_replay_nranks(ed->r), v, &L);
     cairo_save(cr);
     cairo_rectangle(cr, L.geo.x, L.geo.y, L.geo.w, L.geo.h);
     cairo_clip(cr);

@@ -7,40 +7,6 @@
 
 /* ---- the geometry --------------------------------------------------------------------- */
 
-/* Is the label box [x, x+w] x [y-h, y] clear of every point and its label
- * (a point's label sits within ~2 label sizes of it)? */
-static int label_clear(ctx *c, double x, double y, double w, double h)
-{
-    double f = c->L.label;
-    if (c->n > 400) return 1;
-    for (size_t p = 0; p < c->n; p++) {
-        double px, py;
-        wpt(c, (uint32_t)p, &px, &py);
-        if (px + 2.2 * f >= x && px - 2.2 * f <= x + w && py + 1.6 * f >= y - h && py - 1.6 * f <= y)
-            return 0;
-    }
-    return 1;
-}
-
-/* Where a strip's label goes: the first of above / below the box, at its
- * left or right end, one or two rows further out if need be, that covers no
- * point label; else (*lx, *ly) as given. */
-static void box_label_place(ctx *c, double xr, double ya, double yb, double tw, double fs,
-                            double *lx, double *ly)
-{
-    const double xs[4] = {*lx, *lx, xr - tw, xr - tw};
-    const double ys[4] = {*ly, *ly == ya ? yb : ya, *ly, *ly == ya ? yb : ya};
-    for (int row = 0; row < 3; row++)
-        for (int i = 0; i < 4; i++) {
-            double y = ys[i] + (ys[i] == ya ? -1.0 : 1.0) * row * 1.2 * fs;
-            if (label_clear(c, xs[i] - 0.1 * fs, y + 0.25 * fs, tw + 0.2 * fs, 1.1 * fs)) {
-                *lx = xs[i];
-                *ly = y;
-                return;
-            }
-        }
-}
-
 /* The strip boxes (labels = 0) or their labels (labels = 1, drawn last, on a
  * white ground so that edges and hulls do not hide them). */
 static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
@@ -89,11 +55,8 @@ static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
             snprintf(lab, sizeof lab, touched ? "r%d touched" : "r%d", q);
         if (text_wb(cr, SANS, touched, fs, lab) > room)
             snprintf(lab, sizeof lab, touched ? "r%d!" : "r%d", q); /* very narrow strips */
-        double tw = text_wb(cr, SANS, touched, fs, lab), lx = x0 - pad;
+        double tw = text_wb(cr, SANS, touched, fs, lab);
         double ly = q % 2 ? y1 + pad + 0.95 * c->L.font : y0 - pad - 0.25 * c->L.font;
-        box_label_place(c, x1 + pad, y0 - pad - 0.25 * c->L.font,
-                        y1 + pad + 0.95 * c->L.font, tw, fs, &lx, &ly);
-        x0 = lx + pad;
         cairo_rectangle(cr, x0 - pad - 0.1 * fs, ly - 0.85 * fs, tw + 0.2 * fs, 1.1 * fs);
         rgb(cr, c->T->bg, 0.8);
         cairo_fill(cr);
