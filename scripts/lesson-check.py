@@ -2,6 +2,9 @@
 """pdt — verify a lesson's `checks` file against its recorded run(s).
 
     scripts/lesson-check.py LESSON_DIR RUNS_DIR
+    scripts/lesson-check.py --moments LESSON_DIR RUNS_DIR RUN
+        (the bookmarks of run RUN for `pdtview --bookmarks`: one line per moment,
+        "K<TAB>TITLE<TAB>TEXT": where the lesson opens and every `step` of its checks)
     scripts/lesson-check.py --find DUMP first|last KIND [W ...] [F=V ...]
         (prints the viewer cursor K that shows that event; scripts/lesson.sh
         uses it for the positions `first ...` / `last ...` of lesson.conf)
@@ -61,10 +64,21 @@ scripts/lesson.sh into RUNS_DIR/RUN/describe.txt: the window's own functions):
                                 RANK `*`: every rank, the same list; `any`: the phases
                                 any rank begins, in the order they first begin)
     start = K                   the lesson's start position (lesson.conf) is cursor K
+    begun POS RANK = A B ...    at POS rank RANK (`*`: every rank) has begun phases A, B, ...
+                                (where the lesson opens, every rank is where the text says)
+    pgdn = A B C ...            PgDn from Home stops at phases A, B, C, in order (a merge
+                                level above 0 as merge:1), each where every rank that goes
+                                through the phase has begun it (the same in every run)
+    strips from PHASE           no rank's strip box is drawn before that rank begins PHASE
+    legend hull POS = RANK      at POS the legend's "hull / stack" swatch has rank RANK's colour
+                                (that of the hull drawn thickest: the last one built)
+    step N POS                  step N of the text's "In the viewer" list is about the moment
+                                POS: a bookmark of the window (b / Shift+b) whose notes pane
+                                shows that step's text (`--moments` writes them)
     listing LISTING             the text holds the panel's pseudo-code LISTING line for line
                                 (an indented block, numbers and all)
 
-POS is a counter K (the viewer at "K / total"), `start` (where the lesson opens) or
+POS is a counter K (the viewer at "K / total"), `start` (where the lesson opens), `end` or
 `first KIND [W..] [F=V..]` / `last ...` (as in lesson.conf: stable across runs of
 several ranks).
 
@@ -280,8 +294,10 @@ def incircle(a, b, c, d):
 
 
 def read_describe(path):
-    """pdtview --describe output: (start, {K: (listing, line, text)}, {listing: [lines]})."""
+    """pdtview --describe output: (start, {K: (listing, line, text)}, {listing: [lines]},
+    {'pgdn': [(K, NAME)], 'box': {rank: K}})."""
     start, ev, lst = None, {}, {}
+    more = {'pgdn': [], 'box': {}, 'legend': []}
     with open(path, encoding='utf-8') as f:
         for raw in f:
             t = raw.rstrip('\n').split('\t')
@@ -291,7 +307,13 @@ def read_describe(path):
                 lst.setdefault(t[1], []).append(t[3])
             elif t[0] == 'event':
                 ev[int(t[1])] = (t[2], int(t[3]) if t[3] != '-' else None, t[4])
-    return start, ev, lst
+            elif t[0] == 'pgdn':
+                more['pgdn'].append((int(t[1]), t[2]))
+            elif t[0] == 'box':
+                more['box'][t[1]] = int(t[2])
+            elif t[0] == 'legend':
+                more['legend'].append((t[1], int(t[2]), int(t[3])))
+    return start, ev, lst, more
 
 
 def resolve_pos(toks, events, order, start):
@@ -300,6 +322,8 @@ def resolve_pos(toks, events, order, start):
         if start is None:
             raise AssertionError('no start position recorded')
         return start
+    if toks[0] == 'end':
+        return len(order)
     if toks[0] in ('first', 'last'):
         want = parse_fields(toks[2:])
         hits = [i for i in order if match(events[i][0], events[i][1], toks[1], want)]
@@ -355,6 +379,108 @@ def phases_begun(events, order, rank):
     return seen
 
 
+def phase_key(fields):
+    """`merge:1` for a merge level above 0, else the phase name."""
+    name = fields['_words'][0] if fields['_words'] else '?'
+    lv = fields.get('level', '0')
+    return name if lv == '0' else '%s:%s' % (name, lv)
+
+
+def begins(events, order):
+    """{phase key: {rank: index of its first phase-begin}}."""
+    got = {}
+    for i in order:
+        kind, f, _ = events[i]
+        if kind == 'phase-begin':
+            got.setdefault(phase_key(f), {}).setdefault(f['@rank'], i)
+    return got
+
+
+def check_begun(k, ranks, names, events, order):
+    """At cursor k (events 0..k-1 applied) the ranks have begun every phase."""
+    b = begins(events, order)
+    allranks = sorted({events[i][1]['@rank'] for i in order}, key=int)
+    for name in names:
+        for rk in (allranks if ranks == '*' else [ranks]):
+            i = b.get(name, {}).get(rk)
+            if i is None or i + 1 > k:
+                raise AssertionError('at %d rank %s has not begun %s%s' % (
+                    k, rk, name, '' if i is None else ' (it does at %d)' % (i + 1)))
+
+
+def check_pgdn(want, more, events, order):
+    """PgDn's stops have these names, each after every rank's begin."""
+    got = [n for _, n in more['pgdn']]
+    if not got:
+        raise AssertionError('pdtview --describe lists no PgDn stops')
+    if got != want:
+        raise AssertionError('PgDn stops at: %s' % ' '.join(got))
+    b = begins(events, order)
+    for k, name in more['pgdn']:
+        late = [rk for rk, i in b.get(name, {}).items() if i + 1 > k]
+        if late:
+            raise AssertionError('PgDn stops at %d for %s before rank %s begins it' % (
+                k, name, ', '.join(late)))
+
+
+def check_strips(phase, more, events, order):
+    """No strip box is drawn before its rank begins `phase`."""
+    b = begins(events, order).get(phase, {})
+    for rk, k in sorted(more['box'].items()):
+        i = b.get(rk)
+        if i is None or k < i + 1:
+            raise AssertionError('rank %s\'s strip is drawn from %d, %s' % (
+                rk, k, 'it never begins %s' % phase if i is None else
+                'before it begins %s (%d)' % (phase, i + 1)))
+    if not more['box']:
+        raise AssertionError('pdtview --describe lists no strip boxes')
+
+
+def viewer_steps(text_lines):
+    """The "In the viewer" section: (intro, {N: text of numbered item N}), each
+    flattened to one line."""
+    intro, steps, cur, on = [], {}, None, False
+    for l in text_lines:
+        if l.startswith('## '):
+            on = l.strip() == '## In the viewer'
+            continue
+        if not on:
+            continue
+        m = re.match(r'^(\d+)\.\s+(.*)$', l)
+        if m:
+            cur = int(m.group(1))
+            steps[cur] = [m.group(2)]
+        elif cur is not None and l.strip():
+            steps[cur].append(l.strip())
+        elif cur is None and l.strip() and not l.startswith('|'):
+            intro.append(l.strip())
+    return ' '.join(intro), {k: ' '.join(v) for k, v in steps.items()}
+
+
+def moments(ldir, rdir, run):
+    """Print the bookmarks of run `run`: the start and every `step`."""
+    with open(os.path.join(ldir, 'README.md'), encoding='utf-8') as f:
+        intro, steps = viewer_steps(f.read().split('\n'))
+    d = os.path.join(rdir, run)
+    events, order = read_dump(os.path.join(d, 'dump.txt'))
+    dstart = read_describe(os.path.join(d, 'describe.txt'))[0]
+    out = [(dstart, 'start', intro)] if dstart is not None else []
+    cur_run = read_conf(os.path.join(ldir, 'lesson.conf'))[1][0]
+    with open(os.path.join(ldir, 'checks'), encoding='utf-8') as f:
+        for raw in f:
+            toks = raw.split('#', 1)[0].split()
+            if toks[:1] == ['run']:
+                cur_run = toks[1]
+            elif toks[:1] == ['step'] and cur_run == run and int(toks[1]) in steps:
+                k = resolve_pos(toks[2:], events, order, dstart)
+                out.append((k, 'step %s' % toks[1], steps[int(toks[1])]))
+    out[1:] = sorted(out[1:], key=lambda t: int(t[1].split()[1])) if dstart is not None else \
+        sorted(out, key=lambda t: int(t[1].split()[1]))
+    for k, title, text in out:  # the start, then the steps in the text's order
+        print('%d\t%s\t%s' % (k, title, text.replace('\t', ' ')))
+    return 0
+
+
 def quoted(rhs):
     rhs = rhs.strip()
     if len(rhs) < 2 or rhs[0] != '"' or rhs[-1] != '"':
@@ -363,6 +489,8 @@ def quoted(rhs):
 
 
 def main():
+    if len(sys.argv) == 5 and sys.argv[1] == '--moments':
+        return moments(sys.argv[2], sys.argv[3], sys.argv[4])
     if len(sys.argv) >= 5 and sys.argv[1] == '--find':
         k = find(sys.argv[2], sys.argv[3], sys.argv[4:])
         if k is None:
@@ -418,12 +546,42 @@ def main():
             nchecks += 1
             events, order, out, pts, desc = run_data(run)
             ltoks, rhs = toks, None
-            if toks[0] in ('line', 'code', 'start', 'listing'):
+            if toks[0] == 'step':
+                n_step = int(toks[1])
+                if n_step not in viewer_steps(text_lines)[1]:
+                    raise AssertionError('the text has no step %d under "In the viewer"' % n_step)
+                desc = run_data(run)[4]
+                k = resolve_pos(toks[2:], events, order, desc[0] if desc else None)
+                if not 0 <= k <= len(order):
+                    raise AssertionError('step %d: no cursor %d' % (n_step, k))
+                continue
+            if toks[0] in ('line', 'code', 'start', 'listing', 'begun', 'pgdn', 'strips', 'legend'):
                 if desc is None:
                     skipped += 1
                     print('SKIP %s\n     no describe.txt (pdtview is not built)' % where)
                     continue
-                dstart, dev, dlst = desc
+                dstart, dev, dlst, dmore = desc
+                if toks[0] == 'pgdn':
+                    check_pgdn(line.partition(' = ')[2].split(), dmore, events, order)
+                    continue
+                if toks[0] == 'legend':
+                    lhs, _, rhs = line.partition(' = ')
+                    lt = lhs.split()
+                    k = resolve_pos(lt[2:], events, order, dstart)
+                    got = [q for what, kk, q in dmore['legend'] if what == lt[1] and kk <= k]
+                    if not got or got[-1] != int(rhs):
+                        raise AssertionError('at %d the legend\'s %s swatch has rank %s\'s colour'
+                                             % (k, lt[1], got[-1] if got else '(no legend line)'))
+                    continue
+                if toks[0] == 'strips':
+                    check_strips(toks[2], dmore, events, order)
+                    continue
+                if toks[0] == 'begun':
+                    lhs, _, rhs = line.partition(' = ')
+                    lt = lhs.split()
+                    k = resolve_pos(lt[1:-1], events, order, dstart)
+                    check_begun(k, lt[-1], rhs.split(), events, order)
+                    continue
                 if toks[0] == 'listing':
                     block = [l[4:].rstrip() for l in text_lines if l.startswith('    ')]
                     want = dlst.get(toks[1])

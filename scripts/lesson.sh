@@ -11,7 +11,10 @@
 #   2. checks the recording with `pdt trace check` and writes `pdt trace dump`
 #      into build/lessons/NN/RUN/dump.txt, and what the viewer says about every
 #      event (`pdtview --describe`: event line, lit code line, the start) into
-#      build/lessons/NN/RUN/describe.txt (when pdtview is built);
+#      build/lessons/NN/RUN/describe.txt (when pdtview is built), and the
+#      lesson's key moments (its start, the `step` lines of its checks) into
+#      build/lessons/NN/RUN/moments.tsv: the window's bookmarks (b, Shift+b)
+#      and the text of its notes pane (n);
 #   3. with a display ($DISPLAY or $WAYLAND_DISPLAY set): opens `pdtview` on the
 #      run at the lesson's start point; without one (or with --headless): renders
 #      the start frame and the key frames into build/lessons/NN/RUN/frames/.
@@ -225,9 +228,17 @@ for run in "${RUNS[@]}"; do
         "$PDTVIEW" "$trace" $startargs --describe >"$rdir/describe.txt" 2>>"$rdir/log.txt" ||
             { echo "lesson: [$run] pdtview --describe failed (see $rdir/log.txt)" >&2; status=1; continue; }
     fi
+    # the lesson's key moments (its start and each step of "In the viewer"):
+    # the window's bookmarks (b / Shift+b) and its notes pane (n)
+    bm=""
+    if [ -s "$rdir/describe.txt" ] && [ -z "$own_points" ] &&
+        python3 -B "$CHECKPY" --moments "$LDIR" "$out" "$run" >"$rdir/moments.tsv" 2>>"$rdir/log.txt" &&
+        [ -s "$rdir/moments.tsv" ]; then
+        bm="--bookmarks $rdir/moments.tsv"
+    fi
     [ "$record_only" = 1 ] && continue
     if [ "$have_display" = 1 ]; then
-        VIEW_QUEUE+=("$trace|$startargs $view|$run")
+        VIEW_QUEUE+=("$trace|$startargs $bm $view|$run")
         continue
     fi
     if [ ! -x "$PDTVIEW" ]; then

@@ -72,7 +72,7 @@ for ldir in "$ROOT"/lessons/[0-9][0-9]-*/; do
     if grep -qE '"rank [0-9]+: [^"]*$' "$ldir/README.md"; then missing="$missing [a quoted event line broken over two lines]"; fi
     # every "lights line N" of the text is a `code` check of line N (at a counter,
     # a range K..M or `each` event of a kind), and every phase the text has
-    # PgDn go through, or quotes as a phase ("output"), is in a check (`phases`,
+    # PgDn go through, or quotes as a phase ("output"), is in a check (`phases`, `pgdn`,
     # `at K phase-begin NAME`, `@phase=NAME`, ...)
     flat=$(tr '\n' ' ' <"$ldir/README.md")
     for n in $(echo "$flat" | grep -oE 'lights line [0-9]+' | awk '{print $3}' | sort -u); do
@@ -82,8 +82,18 @@ for ldir in "$ROOT"/lessons/[0-9][0-9]-*/; do
     for ph in $( { echo "$flat" | grep -oE '[^.]*PgDn[^.]*' | grep -owE "$phnames"
                    echo "$flat" | grep -oE "phase [\"\`]($phnames)[\"\`]|[\"\`]($phnames)[\"\`] phases?" |
                        grep -oE "[\"\`]($phnames)[\"\`]" | tr -d '"\`'; } | sort -u); do
-        grep -qE "^phases .*= (.* )?$ph( |\$)|phase-(begin|end) $ph( |\$)|@phase=$ph( |\$)" "$ldir/checks" ||
+        grep -qE "^phases .*= (.* )?$ph( |\$)|^pgdn = (.* )?$ph( |\$)|phase-(begin|end) $ph( |\$)|@phase=$ph( |\$)" "$ldir/checks" ||
             missing="$missing [phase $ph]"
+    done
+    # where a lesson on several ranks opens is a checked state (`begun start`),
+    # a text that has PgDn go through phases lists its stops (`pgdn`), and every
+    # step of "In the viewer" is a bookmark (`step N POS`)
+    if grep -qE '^[[:space:]]*ranks[[:space:]]*=[[:space:]]*([2-9]|[1-9][0-9])' "$ldir/lesson.conf"; then
+        grep -qE '^begun start ' "$ldir/checks" || missing="$missing [begun start]"
+    fi
+    grep -q 'PgDn' "$ldir/README.md" && ! grep -qE '^pgdn = ' "$ldir/checks" && missing="$missing [pgdn]"
+    for n in $(sed -n '/^## In the viewer/,/^## /p' "$ldir/README.md" | grep -oE '^[0-9]+\.' | tr -d .); do
+        grep -qE "^step $n " "$ldir/checks" || missing="$missing [step $n]"
     done
     if [ -z "$missing" ] && ! grep -qE 'TODO|FACTS|ANSWERS|ANSWER[0-9_]|RECORDED|CLUSTER|EXAMPLE$' "$ldir/README.md"; then
         ok "$name: every event the text names is checked; no placeholders left"

@@ -154,6 +154,39 @@ TEST(unparsable_file_is_never_written)
     free(f);
 }
 
+/* The whole text of a file (static buffer). */
+static const char *slurp(const char *p)
+{
+    static char buf[4096];
+    FILE *fp = fopen(p, "r");
+    size_t got = fp ? fread(buf, 1, sizeof buf - 1, fp) : 0;
+    if (fp) fclose(fp);
+    buf[got] = 0;
+    return buf;
+}
+
+TEST(comments_kept_after_edits)
+{
+    char *f = strdup(path("notes.txt"));
+    FILE *fp = fopen(f, "w");
+    fputs("# lesson points\n0 0\n10 0\n# the witness:\n5 9  # inside\n0 10\n# end\n", fp);
+    fclose(fp);
+    pdt_live_opts lo = {0, 1, 1, 0};
+    pdt_editor *ed = NULL;
+    pdt_err err = {0};
+    CHECK(pdt_editor_open(f, &lo, &ed, &err) == PDT_OK);
+    CHECK(pdt_editor_delete(ed, 1, &err) == PDT_OK);   /* 10 0 */
+    CHECK(pdt_editor_add(ed, 20, 20, &err) == PDT_OK);
+    CHECK(pdt_editor_move(ed, 1, 6, 8, &err) == PDT_OK); /* the witness moves: its notes too */
+    CHECK_MSG(!strcmp(slurp(f), "# lesson points\n0 0\n# the witness:\n6 8  # inside\n0 10\n"
+                                "20 20\n# end\n"), "%s", slurp(f));
+    CHECK(pdt_editor_undo(ed, &err) == PDT_OK && pdt_editor_undo(ed, &err) == PDT_OK);
+    CHECK_MSG(strstr(slurp(f), "# the witness:\n") && strstr(slurp(f), "# lesson points\n0 0\n"),
+              "%s", slurp(f));
+    pdt_editor_free(ed);
+    free(f);
+}
+
 /* Rank q's events in a merged list: q's own order, its seq 0, 1, 2, ...; the
  * frame `mpirun -np P pdt triangulate --trace` records around the library
  * (run, read ... write, run); every RECV after its SEND. */
@@ -242,6 +275,7 @@ int main(void)
     RUN(add_move_delete_saved_and_rerun);
     RUN(hull_mode_and_presets);
     RUN(unparsable_file_is_never_written);
+    RUN(comments_kept_after_edits);
     RUN(simulated_ranks_give_the_same_triangles);
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf %s", dir);

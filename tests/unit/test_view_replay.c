@@ -217,6 +217,46 @@ TEST(srm_end_state)
 }
 
 /* Hand-made events: stacks, phases, messages and triangle statuses. */
+/* Two ranks out of step: rank 0 runs ahead into classify while rank 1 has
+ * not lifted.  A stop is where the last rank begins the phase; PgDn goes
+ * through them in order; a rank's box is drawn from its partition on. */
+TEST(phase_stops_wait_for_every_rank)
+{
+    pdt_point pts[2] = {{0, 0}, {10, 0}};
+    pdt_rec ev[] = {
+        rec(0, PDT_EV_PHASE_BEGIN, PDT_PH_PARTITION, 0, 0, 0, 0), /* 0 */
+        rec(0, PDT_EV_PHASE_END, PDT_PH_PARTITION, 0, 0, 0, 0),   /* 1 */
+        rec(0, PDT_EV_PHASE_BEGIN, PDT_PH_LIFT, 0, 0, 0, 0),      /* 2 */
+        rec(0, PDT_EV_LIFT, 0, 0, 0, 0, 0),                       /* 3 */
+        rec(0, PDT_EV_PHASE_END, PDT_PH_LIFT, 0, 0, 0, 0),        /* 4 */
+        rec(0, PDT_EV_PHASE_BEGIN, PDT_PH_CLASSIFY, 0, 0, 0, 0),  /* 5 */
+        rec(1, PDT_EV_PHASE_BEGIN, PDT_PH_PARTITION, 0, 0, 0, 0), /* 6 */
+        rec(1, PDT_EV_PHASE_END, PDT_PH_PARTITION, 0, 0, 0, 0),   /* 7 */
+        rec(1, PDT_EV_PHASE_BEGIN, PDT_PH_LIFT, 0, 0, 0, 0),      /* 8 */
+        rec(1, PDT_EV_LIFT, 0, 1, 0, 0, 0),                       /* 9 */
+        rec(1, PDT_EV_PHASE_END, PDT_PH_LIFT, 0, 0, 0, 0),        /* 10 */
+        rec(1, PDT_EV_PHASE_BEGIN, PDT_PH_CLASSIFY, 0, 0, 0, 0),  /* 11 */
+        rec(0, PDT_EV_PHASE_END, PDT_PH_CLASSIFY, 0, 0, 0, 0),    /* 12 */
+        rec(1, PDT_EV_PHASE_END, PDT_PH_CLASSIFY, 0, 0, 0, 0),    /* 13 */
+    };
+    pdt_replay *r = NULL;
+    pdt_err err = {0};
+    CHECK(pdt_replay_new(pts, 2, ev, sizeof ev / sizeof *ev, 2, &r, &err) == PDT_OK);
+    if (!r) return;
+    CHECK(pdt_replay_phase_stop_named(r, "classify") == 12);
+    CHECK(pdt_replay_phase_stop_named(r, "lift") == 9);
+    CHECK(pdt_replay_phase_stop_named(r, "merge") == (size_t)-1);
+    size_t k = 0, want[] = {7, 9, 12, 14};
+    for (int i = 0; i < 4; i++) {
+        k = pdt_replay_find_phase_stop(r, k, 1);
+        CHECK_MSG(k == want[i], "PgDn %d: %zu, want %zu", i + 1, k, want[i]);
+    }
+    CHECK(pdt_replay_find_phase_stop(r, 12, -1) == 9);
+    CHECK(pdt_replay_find_phase_stop(r, 7, -1) == 0);
+    CHECK(pdt_replay_box_from(r, 0) == 1 && pdt_replay_box_from(r, 1) == 7);
+    pdt_replay_free(r);
+}
+
 TEST(hand_made_story)
 {
     pdt_point pts[5] = {{0, 0}, {10, 0}, {5, 8}, {5, 3}, {0, 10}};
@@ -468,5 +508,6 @@ int main(void)
     RUN(code_listings);
     RUN(graham_words);
     RUN(bucket_plan_bounded);
+    RUN(phase_stops_wait_for_every_rank);
     return test_summary();
 }

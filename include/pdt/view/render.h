@@ -78,7 +78,8 @@ enum {
     PDT_PANEL_LIFTED = 4,   /* lifted view */
     PDT_PANEL_TIMELINE = 8, /* timeline */
     PDT_PANEL_ALL = 15,     /* the panels "all" names (the tree is named on its own) */
-    PDT_PANEL_TREE = 16     /* the merge tree */
+    PDT_PANEL_TREE = 16,    /* the merge tree */
+    PDT_PANEL_NOTES = 32    /* the lesson's notes (drawn by the window's lecture tools) */
 };
 
 /* Parse a comma-separated list of panel names ("code,stack,lifted,timeline",

@@ -377,4 +377,27 @@ size_t pdt_replay_find_phase(const pdt_replay *r, size_t k, int dir);
  * (size_t)-1 when none. */
 size_t pdt_replay_find_phase_name(const pdt_replay *r, const char *name);
 
+/* Phase stops (phasestops.c): one per phase (name and merge level), at the
+ * cursor just after the last rank that goes through it has begun it — every
+ * such rank is then in it or past it, whatever the timing of the run.  In
+ * the order the phases first begin ("run" left out), sorted by cursor.
+ * Fills up to `cap` stops, returns how many there are. */
+typedef struct pdt_phase_stop {
+    size_t k;
+    uint32_t phase, sub;  /* pdt_phase; merge level */
+} pdt_phase_stop;
+size_t pdt_replay_phase_stops(const pdt_replay *r, pdt_phase_stop *out, size_t cap);
+/* The next stop after k (dir > 0; else the end) or the previous one before k
+ * (dir < 0; else 0): PgDn / PgUp. */
+size_t pdt_replay_find_phase_stop(const pdt_replay *r, size_t k, int dir);
+/* The stop of the phase named `name` ("classify", "merge:1"), or (size_t)-1. */
+size_t pdt_replay_phase_stop_named(const pdt_replay *r, const char *name);
+/* The rank of the last hull reported before cursor k (the hull drawn
+ * thickest, whose colour the legend's hull swatch takes), else 0
+ * (hullrank.c). */
+int pdt_replay_hull_rank(const pdt_replay *r, size_t k);
+/* The cursor from which rank `rank`'s strip box is drawn: just after it
+ * begins its partition phase (0 for a run without one). */
+size_t pdt_replay_box_from(const pdt_replay *r, int rank);
+
 #endif

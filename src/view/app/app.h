@@ -32,6 +32,8 @@ typedef struct opts {
     uint64_t mem;      /* --mem BYTES (or $PDTVIEW_MEM): the viewer's memory budget */
     int index;         /* --index on|off|auto: 1, 0, -1 */
     const char *layout_report; /* --layout-report F.json: the texts of the frame drawn */
+    const char *bookmarks; /* --bookmarks FILE: a lesson's key moments (lecture.h) */
+    const char *beside;    /* --beside RUN2: a second run beside the first (beside.h) */
 } opts;
 
 /* ---- the run ----------------------------------------------------------------- */

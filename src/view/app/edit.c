@@ -1,5 +1,6 @@
 /* pdt — the viewer's point editor (edit.h). */
 #include "edit.h"
+#include "editnotes.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -27,6 +28,7 @@ typedef struct history {
 
 struct pdt_editor {
     char *path;
+    pdt_edit_notes *notes; /* the file's comments, kept on every save (NULL: none) */
     pdt_point *pts;
     size_t n, cap;
     history undo, redo;
@@ -147,7 +149,7 @@ static pdt_status rerun(pdt_editor *ed, pdt_err *err)
 
 static pdt_status save(pdt_editor *ed, pdt_err *err)
 {
-    return pdt_write_points(ed->path, ed->pts, ed->n, err);
+    return pdt_edit_notes_write(ed->notes, ed->path, ed->pts, ed->n, err);
 }
 
 /* After a change to ed->pts: save, re-run. */
@@ -198,6 +200,7 @@ pdt_status pdt_editor_open(const char *path, const pdt_live_opts *o, pdt_editor 
         size_t coll = 0;
         st = pdt_read_points(path, 0, &ed->pts, &ed->n, &coll, err);
         ed->cap = ed->n;
+        if (st == PDT_OK && !ed->mode.node) st = pdt_edit_notes_read(path, &ed->notes, err);
     }
     if (st == PDT_OK) st = rerun(ed, err);
     if (st != PDT_OK) {
@@ -217,6 +220,7 @@ void pdt_editor_free(pdt_editor *ed)
     pdt_rstate_free(ed->s);
     pdt_replay_free(ed->r);
     pdt_live_free(&ed->run);
+    pdt_edit_notes_free(ed->notes);
     free(ed->pts);
     free(ed->path);
     free(ed);
@@ -242,6 +246,7 @@ pdt_status pdt_editor_move(pdt_editor *ed, size_t i, int64_t x, int64_t y, pdt_e
                            (long long)x, (long long)y);
     pdt_status st = begin_change(ed, err);
     if (st != PDT_OK) return st;
+    pdt_edit_notes_moved(ed->notes, ed->pts[i], (pdt_point){(int32_t)x, (int32_t)y});
     ed->pts[i] = (pdt_point){(int32_t)x, (int32_t)y};
     return commit(ed, err);
 }
@@ -483,22 +488,106 @@ static void frame_end(pdt_editor *ed, double w, double h, pdt_view *v, pdt_statu
 const char *const pdt_editor_keys[][2] = {
     {"click", "add a point (integer coordinates)"},
     {"drag", "move a point (elsewhere: pan)"},
-    {"right click", "delete a point"},
+    {"right click", "delete a point (later points' labels move down one)"},
     {"Ctrl + Z  Y", "undo / redo"},
     {"g", "grid snap on / off"},
     {"n", "add 10 random points in the view"},
     {"F1 … F4", "presets: circle, grid, collinear, duplicates"},
-    {"x", "Graham's scan only / the triangulation"},
+    {"x", "Graham's scan only (pdt hull)"},
     {"1 … 8", "simulated ranks of the live run"},
     {"0", "show all ranks"},
     {"9", "show / hide rank 8"},
 };
 const int pdt_editor_nkeys = (int)(sizeof pdt_editor_keys / sizeof *pdt_editor_keys);
 
-static int edit_key(pdt_editor *ed, const pdt_shell_input *in, double w, double h, pdt_view *v)
+/* In Graham's mode: one rank, the keys that differ say so. */
+static const char *const hull_keys[][2] = {
+    {"click", "add a point (integer coordinates)"},
+    {"drag", "move a point (elsewhere: pan)"},
+    {"right click", "delete a point (later points' labels move down one)"},
+    {"Ctrl + Z  Y", "undo / redo"},
+    {"g", "grid snap on / off"},
+    {"n", "add 10 random points in the view"},
+    {"F1 … F4", "presets: circle, grid, collinear, duplicates"},
+    {"x", "back to the triangulation (pdt triangulate)"},
+    {"1 … 8", "ranks the triangulation will use (Graham's scan runs on one)"},
+};
+
+const char *const (*pdt_editor_help(const pdt_editor *ed, int *n))[2]
+{
+    *n = ed->mode.hull ? (int)(sizeof hull_keys / sizeof *hull_keys) : pdt_editor_nkeys;
+    return ed->mode.hull ? hull_keys : pdt_editor_keys;
+}
+
+/* g: grid snap off, or on with a 1-2-5 step of about 25 pixels. */
+static void snap_key(pdt_editor *ed, double w, double h, pdt_view *v)
+{
+    if (ed->snap) {
+        ed->snap = 0;
+    } else {
+        double ax, ay, bx, by;
+        freeze_frame(ed, w, h, v);
+        pdt_view_to_world(ed->r, v, w, h, 0, 0, &ax, &ay);
+        pdt_view_to_world(ed->r, v, w, h, 25, 0, &bx, &by);
+        double want = fabs(bx - ax), step = 1;
+        while (step * 10 <= want) step *= 10;
+        if (step * 5 <= want) step *= 5;
+        else if (step * 2 <= want) step *= 2;
+        ed->snap = step > 1e9 ? 1000000000 : (int)step;
+    }
+    if (ed->snap) snprintf(ed->msg, sizeof ed->msg, "grid snap on: step %d", ed->snap);
+    else snprintf(ed->msg, sizeof ed->msg, "grid snap off");
+}
+
+/* n: 10 random points in the middle of the view. */
+static void random_key(pdt_editor *ed, double w, double h, pdt_view *v)
+{
+    pdt_layout L;
+    pdt_render_layout_view(w, h, pdt_replay_nranks(ed->r), v, &L);
+    freeze_frame(ed, w, h, v);
+    int64_t x0, y0, x1, y1;
+    world_at(ed, w, h, v, L.geo.x + 0.1 * L.geo.w, L.geo.y + 0.9 * L.geo.h, &x0, &y0);
+    world_at(ed, w, h, v, L.geo.x + 0.9 * L.geo.w, L.geo.y + 0.1 * L.geo.h, &x1, &y1);
+    pdt_err e = {0};
+    frame_begin(ed, w, h, v);
+    pdt_status st = pdt_editor_random(ed, 10, x0, y0, x1, y1, &e);
+    frame_end(ed, w, h, v, st, &e, "10 random points added");
+}
+
+/* x, 1 … 8: Graham's scan only or the triangulation, on `ranks` ranks. */
+static void mode_key(pdt_editor *ed, int hull, int ranks, double w, double h, pdt_view *v)
 {
     char ok[160];
+    if (hull == ed->mode.hull && hull)
+        snprintf(ok, sizeof ok, "%d rank%s for the triangulation (x); Graham's scan runs on one",
+                 ranks, ranks > 1 ? "s" : "");
+    else if (hull == ed->mode.hull)
+        snprintf(ok, sizeof ok, "%d simulated rank%s", ranks, ranks > 1 ? "s" : "");
+    else
+        snprintf(ok, sizeof ok, "%s", hull ? "Graham's scan only (pdt hull)"
+                                           : "Delaunay triangulation (pdt triangulate)");
+    pdt_err e = {0};
+    frame_begin(ed, w, h, v);
+    pdt_status st = pdt_editor_set_mode(ed, hull, ranks, &e);
+    frame_end(ed, w, h, v, st, &e, ok);
+}
+
+/* F1 … F4: a preset, the view fitted to its points. */
+static void preset_key(pdt_editor *ed, int p, pdt_view *v)
+{
+    static const char *const names[] = {"circle: 20 cocircular points", "6 x 6 grid",
+                                        "8 collinear points and 3 more", "duplicates"};
+    pdt_err e = {0};
+    pdt_status st = pdt_editor_preset(ed, (pdt_preset)p, &e);
+    v->centred = 0;
+    v->zoom = 1;
+    report(ed, st, &e, names[p]);
+}
+
+static int edit_key(pdt_editor *ed, const pdt_shell_input *in, double w, double h, pdt_view *v)
+{
     if (in->ctrl && (in->key == 'z' || in->key == 'y')) {
+        char ok[160];
         int redo = in->key == 'y' || in->shift;
         pdt_err e = {0};
         frame_begin(ed, w, h, v);
@@ -508,165 +597,116 @@ static int edit_key(pdt_editor *ed, const pdt_shell_input *in, double w, double 
         return 1;
     }
     if (in->ctrl) return 0;
-    if (in->key == 'g') {
-        if (ed->snap) {
-            ed->snap = 0;
-        } else { /* a 1-2-5 step of about 25 pixels */
-            double ax, ay, bx, by;
-            freeze_frame(ed, w, h, v);
-            pdt_view_to_world(ed->r, v, w, h, 0, 0, &ax, &ay);
-            pdt_view_to_world(ed->r, v, w, h, 25, 0, &bx, &by);
-            double want = fabs(bx - ax), step = 1;
-            while (step * 10 <= want) step *= 10;
-            if (step * 5 <= want) step *= 5;
-            else if (step * 2 <= want) step *= 2;
-            ed->snap = step > 1e9 ? 1000000000 : (int)step;
-        }
-        if (ed->snap) snprintf(ed->msg, sizeof ed->msg, "grid snap on: step %d", ed->snap);
-        else snprintf(ed->msg, sizeof ed->msg, "grid snap off");
-        return 1;
-    }
-    if (in->key == 'n') {
-        pdt_layout L;
-        pdt_render_layout_view(w, h, pdt_replay_nranks(ed->r), v, &L);
-        freeze_frame(ed, w, h, v);
-        int64_t x0, y0, x1, y1;
-        world_at(ed, w, h, v, L.geo.x + 0.1 * L.geo.w, L.geo.y + 0.9 * L.geo.h, &x0, &y0);
-        world_at(ed, w, h, v, L.geo.x + 0.9 * L.geo.w, L.geo.y + 0.1 * L.geo.h, &x1, &y1);
-        {
-        pdt_err e = {0};
-        frame_begin(ed, w, h, v);
-        pdt_status st = pdt_editor_random(ed, 10, x0, y0, x1, y1, &e);
-        frame_end(ed, w, h, v, st, &e, "10 random points added");
-    }
-        return 1;
-    }
-    if (in->key == 'x') {
-        int hull = !ed->mode.hull;
-        {
-        pdt_err e = {0};
-        frame_begin(ed, w, h, v);
-        pdt_status st = pdt_editor_set_mode(ed, hull, ed->mode.ranks, &e);
-        frame_end(ed, w, h, v, st, &e, hull ? "Graham's scan only (pdt hull)" : "Delaunay triangulation (pdt triangulate)");
-    }
-        return 1;
-    }
-    if (in->key >= '1' && in->key <= '8') {
-        int p = in->key - '0';
-        if (ed->mode.hull)
-            snprintf(ok, sizeof ok, "%d rank%s for the triangulation (x); Graham's scan runs on one",
-                     p, p > 1 ? "s" : "");
-        else
-            snprintf(ok, sizeof ok, "%d simulated rank%s", p, p > 1 ? "s" : "");
-        {
-        pdt_err e = {0};
-        frame_begin(ed, w, h, v);
-        pdt_status st = pdt_editor_set_mode(ed, ed->mode.hull, p, &e);
-        frame_end(ed, w, h, v, st, &e, ok);
-    }
-        return 1;
-    }
-    if (in->key >= K_F1 && in->key <= K_F4) {
-        static const char *const names[] = {"circle: 20 cocircular points", "6 x 6 grid",
-                                            "8 collinear points and 3 more", "duplicates"};
-        int p = in->key - K_F1;
-        v->centred = 0;
-        v->zoom = 1;
-        {
-        pdt_err e = {0};
-        frame_begin(ed, w, h, v);
-        pdt_status st = pdt_editor_preset(ed, (pdt_preset)p, &e);
-        frame_end(ed, w, h, v, st, &e, names[p]);
-    }
-        return 1;
-    }
-    return 0;
+    if (in->key == 'g') snap_key(ed, w, h, v);
+    else if (in->key == 'n') random_key(ed, w, h, v);
+    else if (in->key == 'x') mode_key(ed, !ed->mode.hull, ed->mode.ranks, w, h, v);
+    else if (in->key >= '1' && in->key <= '8') mode_key(ed, ed->mode.hull, in->key - '0', w, h, v);
+    else if (in->key >= K_F1 && in->key <= K_F4) preset_key(ed, in->key - K_F1, v);
+    else return 0;
+    return 1;
 }
 
-static int edit_mouse(pdt_editor *ed, const pdt_shell_input *in, double w, double h, pdt_view *v)
+/* What deleting point i does to the labels: every later point moves down one. */
+static void delete_message(const pdt_editor *ed, size_t i, char *buf, size_t cap)
 {
-    int geo = in_geo(w, h, ed->r, v, in->x, in->y);
-    switch (in->type) {
-    case PDT_IN_DOWN:
-        if (!geo || (in->button != 1 && in->button != 3)) return 0;
-        freeze_frame(ed, w, h, v);
-        if (in->button == 3) {
-            int64_t i = point_at(ed, w, h, v, in->x, in->y);
-            if (i >= 0) {
-                char ok[96];
-                snprintf(ok, sizeof ok, "deleted (%d, %d)", ed->pts[i].x, ed->pts[i].y);
-                {
-        pdt_err e = {0};
-        frame_begin(ed, w, h, v);
-        pdt_status st = pdt_editor_delete(ed, (size_t)i, &e);
-        frame_end(ed, w, h, v, st, &e, ok);
-    }
-            }
-            return 1;
-        }
-        ed->down = 1;
-        ed->moved = 0;
-        ed->mx0 = ed->mx = in->x;
-        ed->my0 = ed->my = in->y;
-        ed->drag = point_at(ed, w, h, v, in->x, in->y);
-        return 1;
-    case PDT_IN_MOVE:
-        if (!ed->down) return 0;
-        if (fabs(in->x - ed->mx0) + fabs(in->y - ed->my0) > 4) ed->moved = 1;
-        if (ed->moved && ed->drag >= 0 && (size_t)ed->drag < ed->n) {
-            /* the point follows the mouse; one undo step for the whole drag */
-            int64_t x, y;
-            world_at(ed, w, h, v, in->x, in->y, &x, &y);
-            if (in_int32(x) && in_int32(y) &&
-                (x != ed->pts[ed->drag].x || y != ed->pts[ed->drag].y)) {
-                if (ed->moved == 1) {
-                    pdt_err e = {0};
-                    if (begin_change(ed, &e) != PDT_OK) return 1;
-                    ed->moved = 2;
-                }
-                ed->pts[ed->drag] = (pdt_point){(int32_t)x, (int32_t)y};
-                {
-        pdt_err e = {0};
-        frame_begin(ed, w, h, v);
-        pdt_status st = rerun(ed, &e);
-        frame_end(ed, w, h, v, st, &e, "moving");
-    }
-            }
-        } else if (ed->moved) { /* pan */
-            double ax, ay, bx, by;
-            pdt_view_to_world(ed->r, v, w, h, ed->mx, ed->my, &ax, &ay);
-            pdt_view_to_world(ed->r, v, w, h, in->x, in->y, &bx, &by);
-            v->cx -= bx - ax;
-            v->cy -= by - ay;
-        }
-        ed->mx = in->x;
-        ed->my = in->y;
-        return 1;
-    case PDT_IN_UP:
-        if (!ed->down || in->button != 1) return 0;
-        ed->down = 0;
-        if (ed->drag >= 0 && ed->moved == 2) {
+    int n = snprintf(buf, cap, "deleted point %zu (%d, %d)", i, ed->pts[i].x, ed->pts[i].y);
+    if (n < 0 || (size_t)n >= cap) return;
+    if (i + 1 == ed->n)
+        snprintf(buf + n, cap - (size_t)n, ", the last: no other label changes");
+    else if (i + 2 == ed->n)
+        snprintf(buf + n, cap - (size_t)n, ": point %zu is now %zu", i + 1, i);
+    else
+        snprintf(buf + n, cap - (size_t)n, ": points %zu … %zu are now %zu … %zu", i + 1, ed->n - 1,
+                 i, ed->n - 2);
+}
+
+/* A right click deletes the point under it; a left press starts a drag. */
+static int mouse_down(pdt_editor *ed, const pdt_shell_input *in, double w, double h, pdt_view *v)
+{
+    freeze_frame(ed, w, h, v);
+    if (in->button == 3) {
+        int64_t i = point_at(ed, w, h, v, in->x, in->y);
+        if (i >= 0) {
+            char ok[200];
+            delete_message(ed, (size_t)i, ok, sizeof ok);
             pdt_err e = {0};
-            pdt_status st = save(ed, &e);
-            char ok[96];
-            snprintf(ok, sizeof ok, "moved point %lld to (%d, %d)", (long long)ed->drag,
-                     ed->pts[ed->drag].x, ed->pts[ed->drag].y);
-            report(ed, st, &e, ok);
-        } else if (!ed->moved && ed->drag < 0) {
-            int64_t x, y;
-            world_at(ed, w, h, v, in->x, in->y, &x, &y);
-            char ok[96];
-            snprintf(ok, sizeof ok, "added (%lld, %lld): %zu points", (long long)x, (long long)y,
-                     ed->n + 1);
-            {
-        pdt_err e = {0};
+            frame_begin(ed, w, h, v);
+            pdt_status st = pdt_editor_delete(ed, (size_t)i, &e);
+            frame_end(ed, w, h, v, st, &e, ok);
+        }
+        return 1;
+    }
+    ed->down = 1;
+    ed->moved = 0;
+    ed->mx0 = ed->mx = in->x;
+    ed->my0 = ed->my = in->y;
+    ed->drag = point_at(ed, w, h, v, in->x, in->y);
+    return 1;
+}
+
+/* A drag moves the point under the press (one undo step for the whole
+ * drag), or pans. */
+static int mouse_move(pdt_editor *ed, const pdt_shell_input *in, double w, double h, pdt_view *v)
+{
+    if (fabs(in->x - ed->mx0) + fabs(in->y - ed->my0) > 4) ed->moved = 1;
+    if (ed->moved && ed->drag >= 0 && (size_t)ed->drag < ed->n) {
+        int64_t x, y;
+        world_at(ed, w, h, v, in->x, in->y, &x, &y);
+        if (in_int32(x) && in_int32(y) && (x != ed->pts[ed->drag].x || y != ed->pts[ed->drag].y)) {
+            pdt_err e = {0};
+            if (ed->moved == 1 && begin_change(ed, &e) != PDT_OK) return 1;
+            ed->moved = 2;
+            pdt_point to = {(int32_t)x, (int32_t)y};
+            pdt_edit_notes_moved(ed->notes, ed->pts[ed->drag], to);
+            ed->pts[ed->drag] = to;
+            frame_begin(ed, w, h, v);
+            pdt_status st = rerun(ed, &e);
+            frame_end(ed, w, h, v, st, &e, "moving");
+        }
+    } else if (ed->moved) { /* pan */
+        double ax, ay, bx, by;
+        pdt_view_to_world(ed->r, v, w, h, ed->mx, ed->my, &ax, &ay);
+        pdt_view_to_world(ed->r, v, w, h, in->x, in->y, &bx, &by);
+        v->cx -= bx - ax;
+        v->cy -= by - ay;
+    }
+    ed->mx = in->x;
+    ed->my = in->y;
+    return 1;
+}
+
+/* The end of a drag saves the moved point; a click without a drag adds one. */
+static int mouse_up(pdt_editor *ed, const pdt_shell_input *in, double w, double h, pdt_view *v)
+{
+    ed->down = 0;
+    char ok[96];
+    pdt_err e = {0};
+    if (ed->drag >= 0 && ed->moved == 2) {
+        pdt_status st = save(ed, &e);
+        snprintf(ok, sizeof ok, "moved point %lld to (%d, %d)", (long long)ed->drag,
+                 ed->pts[ed->drag].x, ed->pts[ed->drag].y);
+        report(ed, st, &e, ok);
+    } else if (!ed->moved && ed->drag < 0) {
+        int64_t x, y;
+        world_at(ed, w, h, v, in->x, in->y, &x, &y);
+        snprintf(ok, sizeof ok, "added (%lld, %lld): %zu points", (long long)x, (long long)y,
+                 ed->n + 1);
         frame_begin(ed, w, h, v);
         pdt_status st = pdt_editor_add(ed, x, y, &e);
         frame_end(ed, w, h, v, st, &e, ok);
     }
-        }
-        ed->drag = -1;
-        return 1;
+    ed->drag = -1;
+    return 1;
+}
+
+static int edit_mouse(pdt_editor *ed, const pdt_shell_input *in, double w, double h, pdt_view *v)
+{
+    switch (in->type) {
+    case PDT_IN_DOWN:
+        if (!in_geo(w, h, ed->r, v, in->x, in->y) || (in->button != 1 && in->button != 3)) return 0;
+        return mouse_down(ed, in, w, h, v);
+    case PDT_IN_MOVE: return ed->down ? mouse_move(ed, in, w, h, v) : 0;
+    case PDT_IN_UP: return ed->down && in->button == 1 ? mouse_up(ed, in, w, h, v) : 0;
     default: return 0;
     }
 }
@@ -674,7 +714,9 @@ static int edit_mouse(pdt_editor *ed, const pdt_shell_input *in, double w, doubl
 static int hook_input(void *user, const pdt_shell_input *in, double w, double h, pdt_view *v)
 {
     pdt_editor *ed = user;
-    return in->type == PDT_IN_KEY ? edit_key(ed, in, w, h, v) : edit_mouse(ed, in, w, h, v);
+    int took = in->type == PDT_IN_KEY ? edit_key(ed, in, w, h, v) : edit_mouse(ed, in, w, h, v);
+    if (v->help_more) v->help_more = pdt_editor_help(ed, &v->help_nmore); /* the mode's keys */
+    return took;
 }
 
 static int hook_current(void *user, const pdt_replay **r, pdt_rstate **s)

@@ -64,6 +64,9 @@ double pdt_editor_last_run_s(const pdt_editor *ed);
  * they do}, pdt_editor_nkeys rows. */
 extern const char *const pdt_editor_keys[][2];
 extern const int pdt_editor_nkeys;
+/* The keys of ed's current mode (Graham's scan only, or the triangulation):
+ * the table, *n rows. */
+const char *const (*pdt_editor_help(const pdt_editor *ed, int *n))[2];
 
 /* The shell hook (input, current replay, overlay) for ed; valid while ed is. */
 const pdt_shell_hook *pdt_editor_hook(pdt_editor *ed);

@@ -139,10 +139,46 @@ void pdt_app_counts(const pdt_replay *r, const pdt_rstate *s)
  * "listing NAME I TEXT" (the code panel's lines), and per event K
  * "event K LISTING LINE TEXT" (the listing the panel shows, the lit line,
  * 1-based, or "-" for none; the event line).  Tab-separated, one record per line. */
+/* The cursors PgDn visits from Home, each with its phase ("pgdn\tK\tNAME",
+ * NAME:LEVEL for a merge level above 0), and where each rank's strip box is
+ * first drawn ("box\tRANK\tK"), and from which cursor the legend's hull
+ * swatch takes which rank's colour ("legend\thull\tK\tRANK"): what a
+ * lesson's checks compare with its text. */
+static void describe_stops(const pdt_replay *r)
+{
+    pdt_phase_stop st[128];
+    size_t n = pdt_replay_phase_stops(r, st, 128), m = pdt_replay_count(r);
+    for (size_t k = pdt_replay_find_phase_stop(r, 0, 1); k < m || (k == m && n && st[n - 1].k == m);
+         k = pdt_replay_find_phase_stop(r, k, 1)) {
+        const char *nm = "?";
+        uint32_t sub = 0;
+        for (size_t i = 0; i < n && i < 128; i++)
+            if (st[i].k == k) nm = pdt_phase_name((int)st[i].phase), sub = st[i].sub;
+        if (sub) printf("pgdn\t%zu\t%s:%u\n", k, nm ? nm : "?", sub);
+        else printf("pgdn\t%zu\t%s\n", k, nm ? nm : "?");
+        if (k == m) break;
+    }
+    for (int q = 0; q < pdt_replay_nranks(r); q++) {
+        pdt_point lo, hi;
+        if (pdt_replay_box(r, q, &lo, &hi)) printf("box\t%d\t%zu\n", q, pdt_replay_box_from(r, q));
+    }
+    /* the legend's hull swatch: from cursor K on, rank RANK's colour */
+    size_t nh;
+    const pdt_rhull *H = pdt_replay_hulls(r, &nh);
+    int last = pdt_replay_hull_rank(r, 0);
+    printf("legend\thull\t0\t%d\n", last);
+    for (size_t i = 0; i < nh; i++) {
+        int q = pdt_replay_hull_rank(r, (size_t)H[i].ev + 1);
+        if (q != last) printf("legend\thull\t%zu\t%d\n", (size_t)H[i].ev + 1, q);
+        last = q;
+    }
+}
+
 int pdt_app_describe(const pdt_replay *r, size_t start)
 {
     static const char *const names[PDT_CODE_COUNT] = {"graham", "srm"};
     printf("start\t%zu\n", start);
+    describe_stops(r);
     for (int id = 0; id < PDT_CODE_COUNT; id++)
         for (size_t i = 0; i < pdt_code_count(id); i++)
             printf("listing\t%s\t%zu\t%s\n", names[id], i + 1, pdt_code_text(id, i));
@@ -152,8 +188,8 @@ int pdt_app_describe(const pdt_replay *r, size_t start)
         return PDT_EXIT_USAGE;
     }
     char line[512];
-    for (size_t k = 1; k <= pdt_replay_count(r); k++) {
-        pdt_replay_step(r, s, 1);
+    for (size_t k = 0; k <= pdt_replay_count(r); k++) {
+        if (k) pdt_replay_step(r, s, 1);
         int id = -1, cl = pdt_replay_code_line(r, s, &id);
         pdt_replay_describe_state(r, s, k, line, sizeof line);
         const char *nm = id >= 0 && id < PDT_CODE_COUNT ? names[id] : "-";

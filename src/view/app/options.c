@@ -24,7 +24,9 @@
 
 static const char help_text[] =
     "usage: pdtview RUN [--size WxH] [--at N|--phase NAME|--end] [--hide R,R..]\n"
-    "               [--panels code,stack,lifted,timeline|all|none]\n"
+    "               [--panels code,stack,lifted,timeline,notes|all|none]\n"
+    "               [--bookmarks FILE]   (a lesson's moments: b / Shift+b, notes pane n)\n"
+    "               [--beside RUN2]   (RUN2 beside RUN, following it phase by phase)\n"
     "               [--script KEYS] [--screenshot FILE.png] [--speed EV_PER_S]\n"
     "               [--record FILE.gif|.mp4|.webm] [--fps F] [--every K]\n"
     "               [--font-scale F] [--theme light|dark|contrast] [--fullscreen]\n"
@@ -133,6 +135,8 @@ static int parse_table(int argc, char **argv, opts *o, raw *w)
         {"--clean", NULL, PDT_OPT_FLAG, &o->clean},
         {"--circles", NULL, PDT_OPT_FLAG, &o->circles},
         {"--voronoi", NULL, PDT_OPT_FLAG, &o->voronoi},
+        {"--bookmarks", NULL, PDT_OPT_STR, &o->bookmarks},
+        {"--beside", NULL, PDT_OPT_STR, &o->beside},
         {"--mem", NULL, PDT_OPT_STR, &w->mem},
         {"--index", NULL, PDT_OPT_STR, &w->index},
         {"--layout-report", NULL, PDT_OPT_STR, &o->layout_report},

@@ -36,6 +36,7 @@
 #include "pdt/exit.h"
 #include "pdt/opts.h"
 #include "app.h"
+#include "lecture.h"
 #include "edit.h"
 #include "shell.h"
 
@@ -190,7 +191,7 @@ static pdt_status start_cursor(const opts *o, const pdt_replay *r, size_t *k, pd
     if (o->have_at) *k = o->at;
     if (o->end) *k = pdt_replay_count(r);
     if (o->phase) {
-        *k = pdt_replay_find_phase_name(r, o->phase);
+        *k = pdt_replay_phase_stop_named(r, o->phase);
         if (*k == (size_t)-1)
             return pdt_err_set(err, PDT_ERR_ARG, "%s: no phase named \"%s\" in this run", o->run,
                                o->phase);
@@ -214,6 +215,40 @@ static void view_of(const opts *o, uint8_t *hidden, pdt_view *v)
     v->voronoi = o->voronoi;
 }
 
+/* The window with the lecturer's tools (lecture.h), and --beside's run. */
+static int window(const opts *o, const pdt_replay *r, pdt_rstate *s, pdt_view *v, pdt_err *err)
+{
+    pdt_lecture *lec = NULL;
+    loaded L2;
+    memset(&L2, 0, sizeof L2);
+    pdt_replay *r2 = NULL;
+    pdt_rstate *s2 = NULL;
+    pdt_replay_open_info info2;
+    opts o2 = *o;
+    o2.run = o->beside;
+    int rc = PDT_EXIT_USAGE;
+    if (pdt_lecture_new(r, s, o->bookmarks, &lec, err) != PDT_OK ||
+        (o->beside && (pdt_app_load(o->beside, &L2, err) != PDT_OK ||
+                       pdt_app_open_replay(&L2, &o2, &r2, &info2, err) != PDT_OK)))
+        goto out;
+    if (o->beside && (!(s2 = pdt_rstate_new(r2)) || pdt_lecture_beside(lec, r2, s2, err) != PDT_OK)) {
+        if (!s2) pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+        goto out;
+    }
+    pdt_shell_opts so = {o->w, o->h, o->run, o->script, o->screenshot, o->speed,
+                         o->record, o->fps, o->every, pdt_lecture_hook(lec), o->fullscreen,
+                         o->layout_report};
+    rc = pdt_shell_run(r, s, v, &so);
+out:
+    if (err->code != PDT_OK) fprintf(stderr, "pdtview: %s\n", err->msg);
+    pdt_err_clear(err);
+    pdt_lecture_free(lec);
+    pdt_rstate_free(s2);
+    pdt_replay_free(r2);
+    pdt_app_unload(&L2);
+    return rc;
+}
+
 /* Do what the options ask with the replay at cursor k: an exit status. */
 static int act(const opts *o, const pdt_replay *r, pdt_rstate *s, pdt_view *v, size_t k,
                pdt_err *err)
@@ -232,9 +267,7 @@ static int act(const opts *o, const pdt_replay *r, pdt_rstate *s, pdt_view *v, s
         return PDT_EXIT_USAGE;
     }
     if (o->headless) return pdt_app_headless(r, s, v, o, err);
-    pdt_shell_opts so = {o->w, o->h, o->run, o->script, o->screenshot, o->speed,
-                         o->record, o->fps, o->every, NULL, o->fullscreen, o->layout_report};
-    return pdt_shell_run(r, s, v, &so);
+    return window(o, r, s, v, err);
 }
 
 /* SDL hands the window title (UTF-8) to X11 through the C library's

@@ -57,7 +57,23 @@ typedef struct shell {
     pdt_window_saved saved; /* what full screen replaced */
     char title[480];        /* the hook's title last set */
     pdt_cluster *cl;        /* many ranks: groups, the timeline's window, the tree */
+    /* the view before a click zoomed out to a selected triangle's circle:
+     * given back at the next move of the cursor or click (auto_zoom 1) */
+    int auto_zoom, az_centred;
+    double az_zoom, az_cx, az_cy;
 } shell;
+
+/* Give back the view a click's zoom to a circle replaced (if it still stands). */
+static void unzoom(shell *sh)
+{
+    if (!sh->auto_zoom) return;
+    sh->auto_zoom = 0;
+    sh->v->zoom = sh->az_zoom;
+    sh->v->cx = sh->az_cx;
+    sh->v->cy = sh->az_cy;
+    sh->v->centred = sh->az_centred;
+    sh->dirty = 1;
+}
 
 static void set_status(shell *sh)
 {
@@ -83,6 +99,7 @@ static void seek(shell *sh, size_t k)
 {
     size_t m = pdt_replay_count(sh->r);
     if (k > m) k = m;
+    unzoom(sh); /* a move of the cursor gives the view back */
     /* a few steps are cheaper than a seek; either gives the same state */
     if (k > sh->s->k && k - sh->s->k <= 64) {
         while (sh->s->k < k) pdt_replay_step(sh->r, sh->s, 1);
@@ -246,8 +263,8 @@ static int move_key(shell *sh, SDL_Keycode k, int shift)
         return 1;
     case SDLK_RIGHT:
     case SDLK_LEFT: arrow_key(sh, k, shift); return 1;
-    case SDLK_PAGEDOWN: seek(sh, pdt_replay_find_phase(sh->r, cur, 1)); return 1;
-    case SDLK_PAGEUP: seek(sh, pdt_replay_find_phase(sh->r, cur, -1)); return 1;
+    case SDLK_PAGEDOWN: seek(sh, pdt_replay_find_phase_stop(sh->r, cur, 1)); return 1;
+    case SDLK_PAGEUP: seek(sh, pdt_replay_find_phase_stop(sh->r, cur, -1)); return 1;
     case SDLK_HOME: seek(sh, 0); return 1;
     case SDLK_END: seek(sh, m); return 1;
     case SDLK_PLUS:
@@ -278,6 +295,7 @@ static int view_key(shell *sh, SDL_Keycode k, int shift)
     case SDLK_k: sh->v->ev_class = sh->v->ev_class % (PDT_EVC_COUNT - 1) + 1; return 1;
     case SDLK_0: memset(sh->hidden, 0, (size_t)sh->nranks); return 1;
     case SDLK_f:
+        sh->auto_zoom = 0;
         sh->v->zoom = 1;
         sh->v->centred = 0;
         return 1;
@@ -345,6 +363,7 @@ static void click(shell *sh, double x, double y)
     pdt_layout L;
     pdt_render_layout_view(sh->tw, sh->th, sh->nranks, sh->v, &L);
     if (x < L.geo.x || x > L.geo.x + L.geo.w || y < L.geo.y || y > L.geo.y + L.geo.h) return;
+    unzoom(sh);
     pdt_render_pick(sh->r, sh->s, sh->v, sh->tw, sh->th, x, y, 0.8 * L.font, &sh->v->sel_point,
                     &sh->v->sel_tri, &sh->v->sel_edge);
     if (sh->v->sel_tri >= 0) { /* a large circle: zoom out to show it whole */
@@ -355,6 +374,9 @@ static void click(shell *sh, double x, double y)
         double ax = P[v[0]].x, ay = P[v[0]].y, bx = P[v[1]].x - ax, by = P[v[1]].y - ay;
         double cx = P[v[2]].x - ax, cy = P[v[2]].y - ay, d = 2 * (bx * cy - by * cx);
         if (d != 0) {
+            sh->auto_zoom = 1;
+            sh->az_zoom = sh->v->zoom, sh->az_cx = sh->v->cx, sh->az_cy = sh->v->cy;
+            sh->az_centred = sh->v->centred;
             double ux = (cy * (bx * bx + by * by) - by * (cx * cx + cy * cy)) / d;
             double uy = (bx * (cx * cx + cy * cy) - cx * (bx * bx + by * by)) / d;
             pdt_view_fit_circle(sh->r, sh->v, sh->tw, sh->th, ax + ux, ay + uy, sqrt(ux * ux + uy * uy));
@@ -402,6 +424,7 @@ static void mouse(shell *sh, const SDL_Event *e)
                     sh->v->cx = cx - (bx - ax);
                     sh->v->cy = cy - (by - ay);
                     sh->v->centred = 1;
+                    sh->auto_zoom = 0;
                 }
                 sh->dirty = 1;
             }
@@ -421,6 +444,7 @@ static void mouse(shell *sh, const SDL_Event *e)
         double x = mx * sh->sx, y = my * sh->sy;
         if (!in_rect(L.geo, x, y)) return;
         pdt_view_zoom_at(sh->r, sh->v, sh->tw, sh->th, x, y, pow(1.2, e->wheel.y));
+        sh->auto_zoom = 0; /* the user's zoom from now on */
         sh->dirty = 1;
         return;
     }
@@ -471,9 +495,9 @@ static int script_key(const char *tok)
     }
     if (strncmp(tok, "key:", 4)) return 0;
     const char *name = tok + 4;
-    int ctrl = !strncmp(name, "C-", 2);
-    e.key.keysym.sym = SDL_GetKeyFromName(ctrl ? name + 2 : name);
-    e.key.keysym.mod = ctrl ? KMOD_LCTRL : 0;
+    int ctrl = !strncmp(name, "C-", 2), shift = !strncmp(name, "S-", 2); /* key:S-b: Shift+b */
+    e.key.keysym.sym = SDL_GetKeyFromName(ctrl || shift ? name + 2 : name);
+    e.key.keysym.mod = ctrl ? KMOD_LCTRL : shift ? KMOD_LSHIFT : 0;
     if (e.key.keysym.sym == SDLK_UNKNOWN) return 0;
     SDL_PushEvent(&e);
     return 1;

@@ -342,8 +342,9 @@ void pdt_replay_describe_state(const pdt_replay *r, const pdt_rstate *s, size_t 
     if (s) k = s->k;
     size_t m = pdt_replay_count(r);
     if (k == 0 || k > m) {
-        snprintf(buf, cap, "start — %zu events, %d ranks; press Space or → to begin", m,
-                 pdt_replay_nranks(r));
+        int q = pdt_replay_nranks(r);
+        snprintf(buf, cap, "start — %zu events, %d rank%s; press Space or → to begin", m, q,
+                 q == 1 ? "" : "s");
         return;
     }
     const pdt_rec held = *pdt_replay_rec(r, k - 1); /* (a kept index's pointer is short-lived) */

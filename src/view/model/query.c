@@ -149,7 +149,11 @@ static int srm_phase_line(int phase)
 
 int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
 {
-    *id = PDT_CODE_SRM;
+    /* a hull run keeps Graham's listing from before its first event to its
+     * last ("run" lights no line) */
+    int graham_run = pdt_replay_kind_count(r, PDT_EV_SORT) > 0 &&
+                     pdt_replay_kind_count(r, PDT_EV_TRI_NEW) == 0;
+    *id = graham_run ? PDT_CODE_GRAHAM : PDT_CODE_SRM;
     if (!s->k || s->k > pdt_replay_count(r)) return -1;
     const pdt_rec held = *pdt_replay_rec(r, s->k - 1); /* (a kept index's pointer is short-lived) */
     const pdt_event *ev = &held.ev;
@@ -158,10 +162,7 @@ int pdt_replay_code_line(const pdt_replay *r, const pdt_rstate *s, int *id)
     int gr = phase == PDT_PH_GRAHAM_SORT || phase == PDT_PH_GRAHAM_SCAN || ev->kind == PDT_EV_SORT ||
              ev->kind == PDT_EV_DELETE ||
              ((ev->kind == PDT_EV_PUSH || ev->kind == PDT_EV_POP) && ev->sub == PDT_STACK_GRAHAM);
-    /* a hull run keeps Graham's listing to its last event ("run" lights no line) */
-    int graham_run = pdt_replay_kind_count(r, PDT_EV_SORT) > 0 &&
-                     pdt_replay_kind_count(r, PDT_EV_TRI_NEW) == 0;
-    if (graham_run || gr) *id = PDT_CODE_GRAHAM;
+    if (gr) *id = PDT_CODE_GRAHAM;
     if (graham_run && !gr) return -1;
     if (gr) return graham_line(ev, phase);
     int line = srm_event_line(ev, phase, in_merge);

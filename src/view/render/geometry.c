@@ -37,11 +37,13 @@ static void draw_boxes(ctx *c, int cur_tri_ok, int labels)
     for (int q = 0; q < c->nranks; q++) {
         pdt_point lo, hi;
         if (!shown(c, (uint32_t)q) || !pdt_replay_box(c->r, q, &lo, &hi)) continue;
+        if (c->s->k < pdt_replay_box_from(c->r, q)) continue; /* not before its partition */
         double x0 = c->X.ox + c->X.s * lo.x, x1 = c->X.ox + c->X.s * hi.x;
         double y0 = c->X.oy - c->X.s * hi.y, y1 = c->X.oy - c->X.s * lo.y;
         double pad = 0.4 * c->L.font;
-        /* the same test as the event line's (a deferral names these ranks) */
-        int touched = cur_tri_ok && q != cur_rank &&
+        /* the same test as the event line's: a deferral names these ranks (on
+         * other events, a discard say, nothing is "touched") */
+        int touched = cur_tri_ok && c->cur->ev.kind == PDT_EV_RA_DEFER && q != cur_rank &&
                       pdt_replay_disk_touches(c->r, (const uint32_t[3]){c->cur->ev.a, c->cur->ev.b, c->cur->ev.c}, q);
         if (!labels) {
             cairo_rectangle(cr, x0 - pad, y0 - pad, x1 - x0 + 2 * pad, y1 - y0 + 2 * pad);

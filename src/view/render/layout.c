@@ -41,7 +41,7 @@ int pdt_panels_parse(const char *list, unsigned *panels)
     static const struct { const char *name; unsigned bit; } names[] = {
         {"code", PDT_PANEL_CODE}, {"stack", PDT_PANEL_STACK}, {"lifted", PDT_PANEL_LIFTED},
         {"timeline", PDT_PANEL_TIMELINE}, {"tree", PDT_PANEL_TREE}, {"all", PDT_PANEL_ALL},
-        {"none", 0}};
+        {"none", 0}, {"notes", PDT_PANEL_NOTES}};
     unsigned bits = 0;
     const char *p = list;
     while (*p) {

@@ -111,7 +111,7 @@ static void draw_legend_strip(ctx *c)
     cairo_set_line_width(cr, 3.2 * lw);
     cairo_move_to(cr, F.x, F.y - 0.3 * f);
     cairo_line_to(cr, F.x + 2.2 * f, F.y - 0.3 * f);
-    set_hull(c, 0, 1);
+    set_hull(c, pdt_legend_hull_rank(c), 1);
     cairo_stroke(cr);
     F.x += 2.6 * f;
     flow_text(&F, "hull / stack", 1);
@@ -206,7 +206,7 @@ void pdt_draw_legend(ctx *c)
         cairo_set_line_width(cr, 3.2 * lw);
         cairo_move_to(cr, lx, ly - 0.3 * f);
         cairo_line_to(cr, lx + 2.2 * f, ly - 0.3 * f);
-        set_hull(c, 0, 1);
+        set_hull(c, pdt_legend_hull_rank(c), 1);
         cairo_stroke(cr);
         rgb(cr, c->T->ink, 1);
         text_at(cr, SANS, 0, fs, lx + 2.6 * f, ly, "hull / stack");

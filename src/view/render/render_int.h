@@ -306,6 +306,9 @@ static inline void set_hull(const ctx *c, int q, double alpha)
                           (1 - m) * col[2] + m * c->T->ink[2], alpha);
 }
 
+/* The rank whose colour the legend's hull swatch takes (the last hull's). */
+static inline int pdt_legend_hull_rank(const ctx *c) { return pdt_replay_hull_rank(c->r, c->s->k); }
+
 /* Line style of a triangle status: width and dash (render.c). */
 void pdt_status_style(cairo_t *cr, int st, double lw);
 
