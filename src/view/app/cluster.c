@@ -127,7 +127,7 @@ int pdt_cluster_key(pdt_cluster *cl, const pdt_replay *r, const pdt_rstate *s, p
         if (shift) pdt_view_timeline_pan(r, v, w, h, 0, k == SDLK_LEFTBRACKET ? -1 : 1);
         else pdt_view_timeline_zoom(r, v, w, h, 0.5 * w, k == SDLK_RIGHTBRACKET ? 2 : 0.5);
         return 1;
-    case SDLK_e:
+    case SDLK_u:
         if (cl && s->k) toggle_row(cl, row_of(cl, pdt_replay_rank_of(r, s->k - 1)));
         return 1;
     case SDLK_w: v->follow = !v->follow; return 1;

@@ -19,7 +19,7 @@ pdt_cluster *pdt_cluster_new(const pdt_replay *r, pdt_view *v);
 void pdt_cluster_free(pdt_cluster *cl, pdt_view *v);
 
 /* A key: [ ] zoom the timeline's events out / in, Shift+[ ] scroll its rows,
- * e opens (or closes) the current event's group in the timeline, w turns
+ * u opens (or closes) the current event's group in the timeline, w turns
  * following on or off; beyond eight ranks also the digits (hide or show a
  * legend's group) and Ctrl+arrows (the next event of the current group).
  * hidden: the shell's per-rank flags.  1 if taken; *seek_to: the cursor to

@@ -314,7 +314,7 @@ static void draw_axis(tl *t)
     if (all && c->nrows == (size_t)c->nranks && c->nranks <= PDT_PALETTE_HUES)
         snprintf(ax, sizeof ax, "timeline: events 0 … %zu (bars = phases, arrows = messages; click to seek)", m);
     else
-        snprintf(ax, sizeof ax, "events %.0f … %.0f of %zu · rows %d–%d of %zu (wheel, drag, [ ] zoom; e opens)",
+        snprintf(ax, sizeof ax, "events %.0f … %.0f of %zu · rows %d–%d of %zu (wheel, drag, [ ] zoom; u opens)",
                  t->g.k0, t->g.k1, m, t->g.row0 + 1, t->g.row0 + t->g.nshow, c->nrows);
     double fs = 0.7 * f, room = t->g.x1 - t->g.x0;
     if (text_w(cr, SANS, fs, ax) > room) fs = fmax(12, fs * room / text_w(cr, SANS, fs, ax));
