@@ -107,6 +107,9 @@ int pdt_draw_group_labels(ctx *c)
     cairo_t *cr = c->cr;
     double f = c->L.font, fs = 0.8 * f, pad = 0.4 * f;
     pdt_rect last[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}}; /* the last label above, below */
+    int merging = 0; /* a merge's G_L, G_R labels are above its boxes: groups' go below */
+    for (int q = 0; q < c->nranks && !merging; q++)
+        merging = pdt_rstate_slot(c->r, c->s, q, PDT_SLOT_MERGE) >= 0;
     for (size_t i = 0; i < c->ngroups; i++) {
         double x0, y0, x1, y1;
         if (!group_box(c, i, &x0, &y0, &x1, &y1)) continue;
@@ -120,7 +123,7 @@ int pdt_draw_group_labels(ctx *c)
             snprintf(lab, sizeof lab, "%u–%u", d->lo, d->hi - 1);
             tw = text_w(cr, SANS, fs, lab);
         }
-        int side = (int)(i % 2);
+        int side = merging ? 1 : (int)(i % 2);
         double lx = fmax(x0 - pad, (x0 + x1) / 2 - tw / 2);
         if (last[side].w > 0 && lx < last[side].x + last[side].w + 0.3 * f) continue; /* thinned */
         double ly = side ? y1 + pad + 0.95 * f : y0 - pad - 0.25 * f;
