@@ -814,7 +814,7 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
     char title[512];
     snprintf(title, sizeof title, "pdtview — %s", o->title ? o->title : "");
     sh.fullscreen = o->fullscreen;
-    sh.win = pdt_window_open(title, o->w, o->h, o->fullscreen, &sh.saved);
+    sh.win = pdt_window_open(title, o->w, o->h, &sh.saved);
     if (!sh.win) {
         fprintf(stderr, "pdtview: window: %s\n", SDL_GetError());
         return shell_quit(&sh, 1);
@@ -825,6 +825,7 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
         fprintf(stderr, "pdtview: renderer: %s\n", SDL_GetError());
         return shell_quit(&sh, 1);
     }
+    pdt_window_settle(sh.win, o->fullscreen, &sh.saved);
     SDL_StartTextInput();
     sh.last = SDL_GetPerformanceCounter();
     sh.dirty = 1;

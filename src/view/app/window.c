@@ -49,7 +49,7 @@ static void fit_usable(SDL_Window *win)
     if (nx != x || ny != y) SDL_SetWindowPosition(win, nx, ny);
 }
 
-SDL_Window *pdt_window_open(const char *title, int w, int h, int fullscreen, pdt_window_saved *sv)
+SDL_Window *pdt_window_open(const char *title, int w, int h, pdt_window_saved *sv)
 {
     SDL_Rect D, U;
     display_of(NULL, &D, &U);
@@ -58,11 +58,14 @@ SDL_Window *pdt_window_open(const char *title, int w, int h, int fullscreen, pdt
     memset(sv, 0, sizeof *sv);
     SDL_Window *win = SDL_CreateWindow(title, U.x + (U.w - w) / 2, U.y + (U.h - h) / 2, w, h,
                                        SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI);
-    if (!win) return NULL;
+    return win;
+}
+
+void pdt_window_settle(SDL_Window *win, int fullscreen, pdt_window_saved *sv)
+{
     settle(win, 300, framed); /* a window manager's frame, if there is one */
     fit_usable(win);
     if (fullscreen) pdt_window_fullscreen(win, 1, sv);
-    return win;
 }
 
 static int covers_display(SDL_Window *win)

@@ -11,12 +11,15 @@ typedef struct pdt_window_saved {
     int x, y, w, h;     /* the window before */
 } pdt_window_saved;
 
-/* A resizable window of w x h logical pixels (fullscreen: the whole display)
- * on the display under the mouse, never larger than that display's usable
- * area (the screen less the panels and the window's frame): a window asked
- * larger is shrunk to it, keeping nothing off-screen.  NULL on failure
- * (SDL_GetError says why). */
-SDL_Window *pdt_window_open(const char *title, int w, int h, int fullscreen, pdt_window_saved *sv);
+/* A resizable window of w x h logical pixels on the first display, never
+ * larger than its usable area (the screen less the panels).  NULL on
+ * failure (SDL_GetError says why). */
+SDL_Window *pdt_window_open(const char *title, int w, int h, pdt_window_saved *sv);
+
+/* Once the window has its renderer (which may make SDL recreate it): wait
+ * for a window manager's frame, shrink and move the window so that frame
+ * and all lie in the usable area, and go full screen if asked. */
+void pdt_window_settle(SDL_Window *win, int fullscreen, pdt_window_saved *sv);
 
 /* Full screen on or off.  With a window manager, SDL's desktop full screen;
  * without one (it would do nothing), a borderless window covering the
