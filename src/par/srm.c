@@ -25,36 +25,6 @@
  * instead of 12 and 12. */
 typedef srm_msg_head msg_head;
 
-static size_t put_varint(unsigned char *b, uint64_t v)
-{
-    size_t n = 0;
-    while (v >= 0x80) {
-        b[n++] = (unsigned char)(v | 0x80);
-        v >>= 7;
-    }
-    b[n++] = (unsigned char)v;
-    return n;
-}
-
-static uint64_t zigzag(int64_t v)
-{
-    return ((uint64_t)v << 1) ^ (uint64_t)(v >> 63);
-}
-
-/* Read one varint at *p (< end); 0 on a truncated or over-long one. */
-static int get_varint(const unsigned char **p, const unsigned char *end, uint64_t *v)
-{
-    uint64_t r = 0;
-    for (int shift = 0; shift < 64 && *p < end; shift += 7) {
-        unsigned char c = *(*p)++;
-        r |= (uint64_t)(c & 0x7f) << shift;
-        if (!(c & 0x80)) {
-            *v = r;
-            return 1;
-        }
-    }
-    return 0;
-}
 enum { MSG_HAS_HULL = 1, MSG_HULL_DEGENERATE = 2 };
 
 /* ---- small helpers ------------------------------------------------------- */
@@ -540,10 +510,10 @@ pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err
     unsigned char *w = b + sizeof(msg_head);
     uint32_t prev = 0;
     for (size_t i = 0; i < np; i++) {
-        w += put_varint(w, tab[i].gid - prev);
+        w += pdt_srm_put_varint(w, tab[i].gid - prev);
         prev = tab[i].gid;
-        w += put_varint(w, zigzag(tab[i].x));
-        w += put_varint(w, zigzag(tab[i].y));
+        w += pdt_srm_put_varint(w, pdt_srm_zigzag(tab[i].x));
+        w += pdt_srm_put_varint(w, pdt_srm_zigzag(tab[i].y));
     }
     size_t keep = 0;
     for (size_t i = 0; i < s->npend; i++) {
@@ -552,13 +522,13 @@ pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err
             s->pend[keep++] = *t;
             continue;
         }
-        for (int j = 0; j < 3; j++) w += put_varint(w, find_gid(tab, np, t->p[j].gid));
+        for (int j = 0; j < 3; j++) w += pdt_srm_put_varint(w, find_gid(tab, np, t->p[j].gid));
         PDT_TRACE(s->tr, 1, PDT_EV_SHIP, 0, t->p[0].gid, t->p[1].gid, t->p[2].gid,
                   (int64_t)((s->rank >> (level + 1) << (level + 1)) + (1 << level)));
     }
     s->npend = keep;
     s->cnt.shipped += nt;
-    for (size_t i = 0; i < nh; i++) w += put_varint(w, find_gid(tab, np, s->hull[i].gid));
+    for (size_t i = 0; i < nh; i++) w += pdt_srm_put_varint(w, find_gid(tab, np, s->hull[i].gid));
     msg_head hd = {SRM_MSG_MAGIC,
                    (uint32_t)level,
                    (send_hull ? MSG_HAS_HULL : 0u) |
@@ -623,7 +593,7 @@ static pdt_status decode(const void *buf, size_t len, int level, const char *fro
     const unsigned char *p = (const unsigned char *)buf + sizeof(msg_head), *end = p + h->payload;
     uint64_t gid = 0, a, x, y;
     for (size_t i = 0; i < h->npts; i++) {
-        if (!get_varint(&p, end, &a) || !get_varint(&p, end, &x) || !get_varint(&p, end, &y))
+        if (!pdt_srm_get_varint(&p, end, &a) || !pdt_srm_get_varint(&p, end, &x) || !pdt_srm_get_varint(&p, end, &y))
             goto bad;
         gid += a;
         int64_t sx = (int64_t)(x >> 1) ^ -(int64_t)(x & 1), sy = (int64_t)(y >> 1) ^ -(int64_t)(y & 1);
@@ -632,7 +602,7 @@ static pdt_status decode(const void *buf, size_t len, int level, const char *fro
         v->pts[i] = (srm_pt){(int32_t)sx, (int32_t)sy, (uint32_t)gid};
     }
     for (size_t i = 0; i < ni; i++) {
-        if (!get_varint(&p, end, &a) || a >= h->npts) goto bad;
+        if (!pdt_srm_get_varint(&p, end, &a) || a >= h->npts) goto bad;
         v->tri[i] = (uint32_t)a;
     }
     if (p != end) goto bad;

@@ -354,4 +354,12 @@ pdt_status pdt_srm_plain(pdt_point *pts, size_t n, int k, int prefault, pdt_tri 
  * for fewer than 16384 points. */
 int pdt_srm_plain_pays(const pdt_point *pts, size_t n);
 
+/* The message codec (srm_codec.c): LEB128 varints.  put writes v at b (at
+ * most 10 bytes) and returns their count; get reads one at *p (< end) and
+ * returns 0 on a truncated or over-long one; zigzag maps a signed value to
+ * an unsigned one that is small when |v| is. */
+size_t pdt_srm_put_varint(unsigned char *b, uint64_t v);
+int pdt_srm_get_varint(const unsigned char **p, const unsigned char *end, uint64_t *v);
+uint64_t pdt_srm_zigzag(int64_t v);
+
 #endif
