@@ -7,8 +7,7 @@
 #   cold            3 s of pause before the run: the VM has handed its free
 #                   memory back to the host, and every page the run touches
 #                   first costs about 1.25 s per GiB (this project's VMs);
-#   asis            neither (the state the previous commands left: what
-#                   these benchmarks did before 26 Nov 2026).
+#   asis            neither (the state the previous commands left).
 # See warm.c beside this file and docs/geometry.md, "Fresh memory".
 MEMSTATE=${MEMSTATE:-warm}
 case "$MEMSTATE" in
