@@ -48,6 +48,10 @@ Every line of `checks` states one fact the lesson text relies on.  Lines:
                                 lift is below the plane of the lifted A, B, C (the
                                 thesis' H has the opposite sign: H > 0 means outside)
     output-same RUN             this run printed exactly what run RUN printed
+    elapsed POS .. POS = V ms   the recorded clock (the dump's t=) advances by V ms from the
+                                first event to the second, rounded to V's decimals as the
+                                merge-tree panel prints it (a merge's time: from its
+                                merge-begin to its merge-end)
 
 What the viewer itself shows (from `pdtview --describe`, written by
 scripts/lesson.sh into RUNS_DIR/RUN/describe.txt: the window's own functions):
@@ -333,6 +337,29 @@ def resolve_pos(toks, events, order, start):
     return int(toks[0])
 
 
+UNIT_MS = {'ns': 1e-6, 'us': 1e-3, 'µs': 1e-3, 'ms': 1.0, 's': 1e3}
+
+
+def event_ms(text):
+    """The t= of a dump line, in milliseconds."""
+    m = re.search(r' t=([0-9.]+)(ns|us|µs|ms|s) ', text + ' ')
+    if not m:
+        raise AssertionError('no time in "%s"' % text)
+    return float(m.group(1)) * UNIT_MS[m.group(2)]
+
+
+def check_elapsed(line, events, order):
+    """elapsed POS .. POS = V ms: the clock between two events, as printed."""
+    lhs, _, rhs = line.partition(' = ')
+    a, _, b = lhs.split(None, 1)[1].partition(' .. ')
+    ka, kb = (resolve_pos(x.split(), events, order, None) for x in (a, b))
+    want = rhs.split()[0]
+    dec = len(want.partition('.')[2])
+    ms = event_ms(events[kb - 1 + DUMP_FIRST][2]) - event_ms(events[ka - 1 + DUMP_FIRST][2])
+    if '%.*f' % (dec, ms) != want:
+        raise AssertionError('from %d to %d the clock advances by %.4f ms' % (ka, kb, ms))
+
+
 def lit(want, listing, cl):
     """Does the panel state (listing, line cl) match the wanted [LISTING] N?"""
     got = '%s %s' % (listing, cl if cl else '-')
@@ -615,6 +642,9 @@ def main():
                     if (len(r) == 1 and str(cl) != r[0]) or (len(r) == 2 and got != ' '.join(r)):
                         raise AssertionError('at %d the code panel lights %s line %s' % (
                             k, listing, cl if cl else '(none)'))
+                continue
+            if toks[0] == 'elapsed':
+                check_elapsed(line, events, order)
                 continue
             if ' = ' in line and toks[0] != 'sum':
                 lhs, rhs = line.rsplit(' = ', 1)

@@ -36,6 +36,10 @@
 #   command    hull | triangulate
 #   points     the input file, relative to the lesson folder
 #   ranks      number of MPI ranks (default 1: no mpirun)
+#   simulate   P: record on P simulated ranks instead (scripts/simulate.sh, SimGrid's
+#              SMPI on the bundled 10 Gb/s cluster; needs bin/smpi/pdt, which is
+#              built with `make smpi` first when missing: that installs
+#              libsimgrid-dev if needed); the trace's clock is the simulated one
 #   level      trace level, 1 or 2 (default 1)
 #   start      where the viewer starts: `at N` (the viewer's counter: N events
 #              applied), `phase NAME` (just after the phase first begins), `end`,
@@ -43,7 +47,8 @@
 #              that kind, words and fields: see scripts/lesson-check.py)
 #   frames     key frames rendered headless, separated by `;` (same forms as start)
 #   view       extra pdtview options, passed as they are (e.g. --panels code,stack)
-#   recorded   a run folder recorded ahead (relative to the lesson folder): not re-recorded
+#   recorded   a run folder recorded ahead (relative to the lesson folder): not re-recorded;
+#              or a tar archive of one (NAME.tar.xz, .tar.gz), unpacked into the run's folder
 #
 # Exit status: 0 when every run was recorded, checked and shown/rendered; 1 otherwise.
 set -u
@@ -157,6 +162,18 @@ pos_args() {
 # file-name form of a position: "at 12" -> at-12
 pos_name() { echo "$1" | tr ' ' '-' | tr -cd 'A-Za-z0-9_-'; }
 
+# need_smpi: the simulated build bin/smpi/pdt (scripts/simulate.sh), made
+# with `make smpi` in a checkout when missing
+need_smpi() {
+    [ -f "${PDT_SMPI_BIN:-$ROOT/bin/smpi/pdt}" ] && command -v smpirun >/dev/null && return 0
+    if [ -f "$ROOT/Makefile" ] && [ -f "$ROOT/scripts/simulate.sh" ]; then
+        say "  building the simulated pdt (make smpi: installs libsimgrid-dev when missing)"
+        make -C "$ROOT" --no-print-directory smpi >&2 && return 0
+    fi
+    echo "lesson: this lesson simulates a cluster and needs bin/smpi/pdt: run 'make smpi' in a checkout of pdt" >&2
+    return 1
+}
+
 have_display=0
 if [ -n "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then have_display=1; fi
 [ "$headless" = 1 ] && have_display=0
@@ -176,6 +193,7 @@ for run in "${RUNS[@]}"; do
         points=$(cd "$(dirname "$own_points")" && pwd)/$(basename "$own_points")
     fi
     ranks=$(conf "$run" ranks 1)
+    simulate=$(conf "$run" simulate "")
     level=$(conf "$run" level 1)
     start=$(conf "$run" start end)
     frames=$(conf "$run" frames "")
@@ -188,16 +206,27 @@ for run in "${RUNS[@]}"; do
     # 1. record (or use the recorded run)
     if [ -n "$recorded" ]; then
         trace=$LDIR/$recorded
-        say "  [$run] using the run recorded ahead: $trace"
+        case $recorded in *.tar|*.tar.*)
+            rm -rf "$rdir/recorded"; mkdir -p "$rdir/recorded"
+            tar -xf "$trace" -C "$rdir/recorded" ||
+                { echo "lesson: [$run] cannot unpack $trace" >&2; status=1; continue; }
+            trace=$(dirname "$(find "$rdir/recorded" -name manifest | head -1)") ;;
+        esac
+        say "  [$run] using the run recorded ahead: $LDIR/$recorded"
     else
         trace=$rdir/trace
         rm -rf "$trace"
         case $points in /*) pfile=$points ;; *) pfile=$LDIR/$points ;; esac
         cmd=("$PDT" "$command" "$pfile" --trace "$trace" --trace-level "$level")
-        if [ "$ranks" -gt 1 ]; then
+        if [ -n "$simulate" ]; then
+            need_smpi || { status=1; continue; }
+            ranks=$simulate
+            cmd=(bash "$ROOT/scripts/simulate.sh" -np "$ranks" -- "$command" "$pfile" --trace "$trace" --trace-level "$level")
+            say "  [$run] simulating: $command of $points on $ranks simulated rank(s) (scripts/simulate.sh)"
+        elif [ "$ranks" -gt 1 ]; then
             cmd=(mpirun -np "$ranks" --oversubscribe "${cmd[@]}")
         fi
-        say "  [$run] recording: $command of $points on $ranks rank(s), trace level $level"
+        [ -n "$simulate" ] || say "  [$run] recording: $command of $points on $ranks rank(s), trace level $level"
         if ! "${cmd[@]}" >"$rdir/output.txt" 2>"$rdir/log.txt"; then
             echo "lesson: [$run] the run failed: ${cmd[*]}" >&2
             sed 's/^/    /' "$rdir/log.txt" >&2
