@@ -64,4 +64,18 @@ for sz in 1024x768 1920x1080; do
     done
 done
 
+# the legend's groups and the timeline's rows of a 64-rank run, held to the
+# same rules: the legend flows its groups into rows and is given their height
+# (at font scale 2 the timeline gives its room to the column)
+for sz in 1024x768 1920x1080; do
+    for fs in 1 1.5 2; do
+        n=ranks_64_${sz}_$(echo $fs | tr . _)
+        tl="--panel timeline"; [ $fs = 2 ] && tl=
+        "$V" --headless synth:srm:128:4:64 --end -o "$TMP/$n.png" --size $sz --font-scale $fs --layout-report "$TMP/$n.json" --quiet
+        if $CHECK --min-px 16 --min-big 18 --panel legend $tl "$TMP/$n.json" >"$TMP/$n.out"; then
+            ok "readable_legend_timeline_$n"
+        else fail "readable_legend_timeline_$n" "$(head -4 "$TMP/$n.out")"; fi
+    done
+done
+
 summary
