@@ -186,7 +186,9 @@ static void layout_column(double w, double h, double top, double tl, int nranks,
     double f = L->font, side = fmin(fmax(0.34 * w, 19 * f), 0.5 * w);
     column C = column_needs(L);
     C.legend = pdt_legend_height(L, nranks, side, 0); /* what its text needs */
-    double strip = 0; /* a legend too tall for the column: a strip across */
+    /* a legend too tall for the column beside four code lines and the
+     * timeline: a strip across (the timeline keeps its rows) */
+    double strip = 0;
     if (C.legend + (has_code ? C.code_min : 0) > h - top - tl) {
         strip = pdt_legend_height(L, nranks, w, 2);
         C.legend = 0;
