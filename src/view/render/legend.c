@@ -23,7 +23,10 @@ static int legend_group(const ctx *c, int i, uint32_t *lo, uint32_t *hi)
         *hi = (uint32_t)i + 1;
         return c->nranks < 64 ? c->nranks : 64;
     }
-    if (i < 0 || (size_t)i >= c->ngroups) return (int)c->ngroups; /* past the last */
+    if (i < 0 || (size_t)i >= c->ngroups) { /* past the last */
+        *lo = *hi = 0;
+        return (int)c->ngroups;
+    }
     size_t n;
     const pdt_rtnode *d = &pdt_ranktree_nodes(c->tree, &n)[c->groups[i]];
     *lo = d->lo;
