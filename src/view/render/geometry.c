@@ -485,6 +485,40 @@ static size_t points_in_view(const ctx *c)
     return nvis;
 }
 
+/* Where point p's label (tw wide, at fs) goes beside it at (x, y): the
+ * first free spot right-up, left-up (the others' labels); a named point's
+ * (prio) also right-down, left-down, above, below, right, left, then as
+ * much again one and two font sizes further out, else right-up.  A label
+ * placed is added to B; P (may be NULL): the points, kept clear too. */
+static int label_spot(const ctx *c, lbox *B, size_t *nb, const lbox *P, size_t np, uint32_t p,
+                      double x, double y, double tw, double fs, int prio, double *lx, double *ly)
+{
+    double f = c->L.label, th = 0.8 * fs;
+    const double ox[8] = {0.55 * f, -0.55 * f - tw, 0.55 * f, -0.55 * f - tw,
+                          -0.5 * tw, -0.5 * tw, 0.7 * f, -0.7 * f - tw};
+    const double oy[8] = {-0.4 * f, -0.4 * f, 0.4 * f + th, 0.4 * f + th,
+                          -0.6 * f, 0.6 * f + th, 0.5 * th, 0.5 * th};
+    const double dx[8] = {1, -1, 1, -1, 0, 0, 1, -1}, dy[8] = {-1, -1, 1, 1, -1, 1, 0, 0};
+    for (int k = 0; k < (prio ? 24 : 2); k++) {
+        double ax = x + ox[k % 8] + (k / 8) * dx[k % 8] * f,
+               ay = y + oy[k % 8] + (k / 8) * dy[k % 8] * f;
+        lbox b = {ax - 1, ay - th - 1, ax + tw + 1, ay + 0.2 * fs + 1};
+        if (overlaps(B, *nb, b) || b.x1 > c->L.geo.x + c->L.geo.w || b.x0 < c->L.geo.x ||
+            b.y0 < c->L.geo.y)
+            continue;
+        int hit = 0; /* not over another point */
+        for (size_t q = 0; P && q < np && !hit; q++) hit = q != p && overlaps(&P[q], 1, b);
+        if (hit) continue;
+        B[(*nb)++] = b;
+        *lx = ax;
+        *ly = ay;
+        return 1;
+    }
+    *lx = x + ox[0]; /* the named points always get theirs */
+    *ly = y + oy[0];
+    return prio;
+}
+
 static void draw_labels(ctx *c)
 {
     size_t nvis = points_in_view(c);
@@ -530,28 +564,10 @@ static void draw_labels(ctx *c)
         pdt_point_label(c->r, c->s, p, lab, sizeof lab);
         int prio = i < first_other;
         double fs = prio ? 1.15 * f : f;
-        double tw = text_wb(c->cr, SANS, prio, fs, lab), th = 0.8 * fs;
-        /* right-up, left-up, right-down, left-down */
-        double ox[4] = {0.55 * f, -0.55 * f - tw, 0.55 * f, -0.55 * f - tw};
-        double oy[4] = {-0.4 * f, -0.4 * f, 0.4 * f + th, 0.4 * f + th};
-        int placed = -1;
-        for (int k = 0; k < (prio ? 4 : 2) && placed < 0; k++) {
-            lbox b = {x + ox[k] - 1, y + oy[k] - th - 1, x + ox[k] + tw + 1, y + oy[k] + 0.2 * fs + 1};
-            if (overlaps(B, nb, b) || b.x1 > c->L.geo.x + c->L.geo.w || b.x0 < c->L.geo.x ||
-                b.y0 < c->L.geo.y)
-                continue;
-            if (!prio && P) { /* not over another point */
-                lbox bp = b;
-                int hit = 0;
-                for (size_t q = 0; q < np && !hit; q++) hit = q != p && overlaps(&P[q], 1, bp);
-                if (hit) continue;
-            }
-            placed = k;
-            B[nb++] = b;
-        }
-        if (placed < 0 && prio) placed = 0; /* the named points always get theirs */
-        if (placed < 0) continue;
-        halo_text(c, prio, fs, x + ox[placed], y + oy[placed], lab, prio ? c->T->ink : c->T->label);
+        double tw = text_wb(c->cr, SANS, prio, fs, lab);
+        double lx, ly;
+        if (!label_spot(c, B, &nb, prio ? NULL : P, np, p, x, y, tw, fs, prio, &lx, &ly)) continue;
+        halo_text(c, prio, fs, lx, ly, lab, prio ? c->T->ink : c->T->label);
     }
     free(P);
     free(B);

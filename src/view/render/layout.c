@@ -97,7 +97,7 @@ typedef struct column {
 static column column_needs(const pdt_layout *L)
 {
     double f = L->font, title = 1.8 * f, row = pdt_layout_code_row(L);
-    return (column){7.6 * f, title + 16 * row, title + 7 * row, title + 4 * row,
+    return (column){0, title + 16 * row, title + 7 * row, title + 4 * row,
                     title + 1.95 * 1.3 * L->body, 6 * f};
 }
 
@@ -144,11 +144,7 @@ static void column_split(double rest, const column *C, int code, int stack, int 
  * under it (its items flow in rows). */
 static void layout_strip(double w, double h, double top, double tl, int nranks, pdt_layout *L)
 {
-    double f = L->font;
-    int lrows = (int)ceil((nranks > PDT_PALETTE_HUES ? 100 : 64) * f / fmax(w - f, f));
-    if (lrows < 1) lrows = 1;
-    if (lrows > 4) lrows = 4;
-    double leg = lrows * 1.45 * f + 0.6 * f;
+    double leg = pdt_legend_height(L, nranks, w, 1);
     double mid = h - tl - top - leg;
     L->top = (pdt_rect){0, 0, w, top};
     L->geo = (pdt_rect){0, top, w, mid};
@@ -189,14 +185,21 @@ static void layout_column(double w, double h, double top, double tl, int nranks,
         has_lifted = (panels & PDT_PANEL_LIFTED) != 0;
     double f = L->font, side = fmin(fmax(0.34 * w, 19 * f), 0.5 * w);
     column C = column_needs(L);
-    C.legend += pdt_legend_extra(nranks, f, side); /* the groups' lines */
+    C.legend = pdt_legend_height(L, nranks, side, 0); /* what its text needs */
+    /* a legend too tall for the column beside four code lines and the
+     * timeline: a strip across (the timeline keeps its rows) */
+    double strip = 0;
+    if (C.legend + (has_code ? C.code_min : 0) > h - top - tl) {
+        strip = pdt_legend_height(L, nranks, w, 2);
+        C.legend = 0;
+    }
     double need = C.legend + (has_code ? C.code_min : 0) + (has_stack ? C.stack_min : 0);
-    if (h - top - tl < need && tl > 0) {
-        tl = h - top - need;
+    if (h - top - tl - strip < need && tl > 0) {
+        tl = h - top - strip - need;
         if (tl < 2.2 * f + 1.7 * L->label) tl = 0;
     }
-    if (h - top - tl < need) has_stack = 0;
-    double mid = h - tl - top;
+    if (h - top - tl - strip < need) has_stack = 0;
+    double mid = h - tl - top - strip;
     L->top = (pdt_rect){0, 0, w, top};
     L->timeline = (pdt_rect){0, h - tl, tl > 0 ? w : 0, tl};
     L->geo = (pdt_rect){0, top, w - side, mid};
@@ -206,7 +209,7 @@ static void layout_column(double w, double h, double top, double tl, int nranks,
     if (panels & PDT_PANEL_TREE)
         tree = has_code || has_stack || has_lifted ? fmax(6 * f, 0.34 * (mid - leg)) : mid - leg;
     column_split(mid - leg - tree, &C, has_code, has_stack, has_lifted, &code, &stk, &lifted);
-    L->legend = (pdt_rect){x, y, side, leg};
+    L->legend = strip > 0 ? (pdt_rect){0, top + mid, w, strip} : (pdt_rect){x, y, side, leg};
     L->code = (pdt_rect){x, y + leg, code > 0 ? side : 0, code};
     L->stack = (pdt_rect){x, y + leg + code, stk > 0 ? side : 0, stk};
     L->lifted = (pdt_rect){x, y + leg + code + stk, lifted > 0 ? side : 0, lifted};

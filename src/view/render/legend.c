@@ -14,30 +14,6 @@ static void legend_line(cairo_t *cr, double x, double y, double len, int st, dou
     cairo_set_dash(cr, NULL, 0, 0);
 }
 
-/* The legend as a strip (no side column): its items flow left to right,
- * wrapping into rows. */
-typedef struct flow {
-    ctx *c;
-    pdt_rect R;
-    double x, y, f, fs;
-} flow;
-
-/* Room for an item of width w (swatch + text); wraps to the next row. */
-static void flow_room(flow *F, double w)
-{
-    if (F->x + w > F->R.x + F->R.w - 0.5 * F->f && F->x > F->R.x + 0.6 * F->f) {
-        F->x = F->R.x + 0.5 * F->f;
-        F->y += 1.45 * F->f;
-    }
-}
-
-static void flow_text(flow *F, const char *s, double alpha)
-{
-    rgb(F->c->cr, F->c->T->ink, alpha);
-    text_at(F->c->cr, SANS, 0, F->fs, F->x, F->y, s);
-    F->x += text_w(F->c->cr, SANS, F->fs, s) + 0.9 * F->f;
-}
-
 /* The groups the legend lists: those on screen (groups.c), or every rank
  * when there are none; group i's ranks [*lo, *hi).  Returns their number. */
 static int legend_group(const ctx *c, int i, uint32_t *lo, uint32_t *hi)
@@ -46,6 +22,10 @@ static int legend_group(const ctx *c, int i, uint32_t *lo, uint32_t *hi)
         *lo = (uint32_t)i;
         *hi = (uint32_t)i + 1;
         return c->nranks < 64 ? c->nranks : 64;
+    }
+    if (i < 0 || (size_t)i >= c->ngroups) { /* past the last */
+        *lo = *hi = 0;
+        return (int)c->ngroups;
     }
     size_t n;
     const pdt_rtnode *d = &pdt_ranktree_nodes(c->tree, &n)[c->groups[i]];
@@ -69,197 +49,251 @@ static void group_label(uint32_t lo, uint32_t hi, int first, char *lab, size_t c
     else snprintf(lab, cap, first ? "ranks %u–%u" : "%u–%u", lo, hi - 1);
 }
 
-static void draw_legend_strip(ctx *c)
+/* The legend's items flow into rows: each a swatch `sw` wide, then its
+ * text at the label size.  One pass measures (c NULL: for the layout, which
+ * reserves the height) or measures and draws, so both agree. */
+typedef struct flow {
+    ctx *c;          /* NULL: measure only */
+    cairo_t *cr;
+    int nranks;
+    double x0, x1;   /* a row's left and right edges */
+    double x, y;     /* the pen; y is the baseline */
+    double f, fs, pitch;
+    int in_row, row; /* items in the current row; rows begun */
+} flow;
+
+static void flow_newline(flow *F, double x0)
 {
-    cairo_t *cr = c->cr;
-    pdt_rect R = c->L.legend;
-    double f = c->L.font;
-    panel(cr, c->T, R, NULL, f);
-    cairo_save(cr);
-    clip_rect(cr, R);
-    flow F = {c, R, R.x + 0.5 * f, R.y + 1.3 * f, f, c->L.body};
-    char lab[40];
+    F->x0 = F->x = x0;
+    F->y += F->pitch;
+    F->in_row = 0;
+    F->row++;
+}
+
+/* Width of an item: its swatch, its text. */
+static double item_w(const flow *F, double sw, const char *s)
+{
+    return sw + text_w(F->cr, SANS, F->fs, s);
+}
+
+/* Places an item (drawing its text); returns the swatch's x. */
+static double flow_item(flow *F, double sw, const char *s, double alpha)
+{
+    double w = item_w(F, sw, s);
+    if (F->in_row && F->x + w > F->x1) flow_newline(F, F->x0);
+    double x = F->x;
+    if (F->c) {
+        rgb(F->cr, F->c->T->ink, alpha);
+        text_at(F->cr, SANS, 0, F->fs, x + sw, F->y, s);
+    }
+    F->x += w + 0.8 * F->fs;
+    F->in_row++;
+    return x;
+}
+
+/* Item i of the groups (ranks) and their count: those on screen, or when
+ * measuring the widest a run of F->nranks ranks can show. */
+static int group_item(const flow *F, int i, int first, char *lab, size_t cap, uint32_t *lo,
+                      uint32_t *hi)
+{
+    if (F->c) {
+        int n = legend_group(F->c, i, lo, hi);
+        if (i < n) group_label(*lo, *hi, first, lab, cap);
+        return n;
+    }
+    int n = F->nranks < 1 ? 1 : F->nranks;
+    *lo = (uint32_t)i;
+    *hi = (uint32_t)i + 1;
+    if (n <= PDT_PALETTE_HUES) group_label(*lo, *hi, first, lab, cap);
+    else snprintf(lab, cap, first ? "ranks %d–%d" : "%d–%d", n - 1, n - 1);
+    return n < PDT_PALETTE_HUES ? n : PDT_PALETTE_HUES;
+}
+
+/* The groups' items, a swatch of their colour each; at most `rows` rows
+ * (those the layout reserved: a "…" ends a longer list). */
+static void flow_groups(flow *F, int strip, int rows)
+{
+    char lab[48];
     uint32_t lo, hi;
-    for (int i = 0; i < legend_group(c, i, &lo, &hi); i++) {
-        group_label(lo, hi, i == 0, lab, sizeof lab);
-        flow_room(&F, 1.1 * f + text_w(cr, SANS, F.fs, lab));
-        cairo_rectangle(cr, F.x, F.y - 0.75 * f, 0.8 * f, 0.8 * f);
-        set_rank(c, (int)lo, group_shown(c, lo, hi) ? 1 : 0.2);
-        cairo_fill(cr);
-        F.x += 1.0 * f;
-        flow_text(&F, lab, group_shown(c, lo, hi) ? 1 : 0.4);
-    }
-    static const char *const names[] = {"candidate", "final", "deferred (RA)", "shipped", "discarded"};
-    static const int sts[] = {PDT_TS_CANDIDATE, PDT_TS_FINAL, PDT_TS_DEFERRED, PDT_TS_SHIPPED,
-                              PDT_TS_DISCARDED};
-    double col0[3], lw = fmax(1.5, 0.14 * f);
-    pdt_rank_rgb(0, col0);
-    for (int i = 0; i < 5; i++) {
-        if (c->v->clean && sts[i] != PDT_TS_FINAL) continue;
-        flow_room(&F, 2.6 * f + text_w(cr, SANS, F.fs, names[i]));
-        legend_line(cr, F.x, F.y - 0.3 * f, 2.2 * f, sts[i], lw, col0);
-        if (sts[i] == PDT_TS_DISCARDED) {
-            cairo_set_line_width(cr, lw);
-            cross(cr, F.x + 1.1 * f, F.y - 0.3 * f, 0.35 * f);
-            rgb(cr, RED, 1);
-            cairo_stroke(cr);
+    double sw = 1.2 * F->fs;
+    for (int i = 0; i < group_item(F, i, strip && i == 0, lab, sizeof lab, &lo, &hi); i++) {
+        if (F->in_row && F->x + item_w(F, sw, lab) > F->x1 && F->row + 1 >= rows) {
+            if (F->c && F->x + item_w(F, 0, "…") <= F->x1) flow_item(F, 0, "…", 1);
+            return;
         }
-        F.x += 2.6 * f;
-        flow_text(&F, names[i], 1);
+        int on = F->c ? group_shown(F->c, lo, hi) : 1;
+        double x = flow_item(F, sw, lab, on ? 1 : 0.4);
+        if (!F->c) continue;
+        cairo_rectangle(F->cr, x, F->y - 0.92 * F->fs, F->fs, F->fs);
+        set_rank(F->c, (int)lo, on ? 1 : 0.2);
+        cairo_fill(F->cr);
     }
-    flow_room(&F, 2.6 * f + text_w(cr, SANS, F.fs, "hull / stack"));
-    cairo_set_line_width(cr, 3.2 * lw);
-    cairo_move_to(cr, F.x, F.y - 0.3 * f);
-    cairo_line_to(cr, F.x + 2.2 * f, F.y - 0.3 * f);
-    set_hull(c, pdt_legend_hull_rank(c), 1);
+}
+
+static const char *const st_names[] = {"candidate", "final", "deferred (RA)", "shipped",
+                                       "discarded", "hull / stack"};
+static const int st_kind[] = {PDT_TS_CANDIDATE, PDT_TS_FINAL, PDT_TS_DEFERRED, PDT_TS_SHIPPED,
+                              PDT_TS_DISCARDED, -1};
+
+/* A status's (or, kind -1, the hull's) line swatch at x. */
+static void status_swatch(flow *F, double x, int kind)
+{
+    ctx *c = F->c;
+    cairo_t *cr = F->cr;
+    double f = F->f, lw = fmax(1.5, 0.14 * f), ym = F->y - 0.3 * F->fs, col0[3];
+    if (kind < 0) {
+        cairo_set_line_width(cr, 3.2 * lw);
+        cairo_move_to(cr, x, ym);
+        cairo_line_to(cr, x + 2.2 * f, ym);
+        set_hull(c, pdt_legend_hull_rank(c), 1);
+        cairo_stroke(cr);
+        return;
+    }
+    pdt_rank_rgb(0, col0);
+    legend_line(cr, x, ym, 2.2 * f, kind, lw, col0);
+    if (kind != PDT_TS_DISCARDED) return;
+    cairo_set_line_width(cr, lw);
+    cross(cr, x + 1.1 * f, ym, 0.35 * f);
+    rgb(cr, RED, 1);
     cairo_stroke(cr);
-    F.x += 2.6 * f;
-    flow_text(&F, "hull / stack", 1);
-    if (!c->v->clean) {
-        flow_room(&F, 1.0 * f + text_w(cr, SANS, F.fs, "circumdisk (RA)"));
-        cairo_new_sub_path(cr);
-        cairo_arc(cr, F.x + 0.4 * f, F.y - 0.3 * f, 0.35 * f, 0, 2 * M_PI);
+}
+
+/* The statuses and the hull: flowing (a strip), or in as many equal
+ * columns as fit, at most two (the side panel). */
+static void flow_statuses(flow *F, int columns)
+{
+    double sw = 2.6 * F->f, colw = 0;
+    int clean = F->c && F->c->v->clean && !columns;
+    for (int i = 0; i < 6; i++) colw = fmax(colw, item_w(F, sw, st_names[i]) + 0.8 * F->fs);
+    int ncol = columns && F->x0 + 2 * colw - 0.8 * F->fs <= F->x1 ? 2 : 1;
+    for (int i = 0, k = 0; i < 6; i++) {
+        if (clean && st_kind[i] >= 0 && st_kind[i] != PDT_TS_FINAL) continue;
+        if (columns) {
+            if (k > 0 && k % ncol == 0) flow_newline(F, F->x0);
+            F->x = F->x0 + (k % ncol) * colw;
+            F->in_row = 0;
+        }
+        k++;
+        double x = flow_item(F, sw, st_names[i], 1);
+        if (F->c) status_swatch(F, x, st_kind[i]);
+    }
+}
+
+/* A point marker's swatch at x: 0 lifted, 1 not yet, 2 deleted, 3 disk. */
+static void marker_swatch(flow *F, double x, int kind)
+{
+    ctx *c = F->c;
+    cairo_t *cr = F->cr;
+    double f = F->f, cx = x + 0.4 * f, cy = F->y - 0.3 * F->fs;
+    cairo_new_sub_path(cr);
+    if (kind == 2) {
+        cairo_set_line_width(cr, 0.15 * f);
+        cross(cr, cx, cy, 0.3 * f);
+        rgb(cr, RED, 1);
+        cairo_stroke(cr);
+        return;
+    }
+    cairo_arc(cr, cx, cy, (kind == 3 ? 0.35 : 0.25) * f, 0, 2 * M_PI);
+    cairo_set_line_width(cr, 1);
+    if (kind == 0) {
+        rgb(cr, c->T->ink, 1);
+        cairo_fill(cr);
+    } else if (kind == 1) {
+        rgb(cr, c->T->hollow, 1);
+        cairo_stroke(cr);
+    } else {
         rgb(cr, c->T->mark, 0.4);
         cairo_fill_preserve(cr);
         rgb(cr, c->T->disk, 1);
-        cairo_set_line_width(cr, 1);
         cairo_stroke(cr);
-        F.x += 1.0 * f;
-        flow_text(&F, "circumdisk (RA)", 1);
     }
-    cairo_restore(cr);
 }
 
-/* The side legend's groups, after "ranks:", in up to three lines when the
- * run has more ranks than hues (the layout gives it the room); returns how
- * much lower than one line the statuses go. */
-static double legend_side_groups(ctx *c, double fs)
+/* The point markers (a strip shows only the circumdisk, not when clean). */
+static void flow_markers(flow *F, int strip)
 {
-    cairo_t *cr = c->cr;
-    pdt_rect R = c->L.legend;
-    double f = c->L.font, y0 = R.y + 2.3 * f, y = y0;
-    int lines = c->nranks > PDT_PALETTE_HUES ? 3 : 1, line = 1;
-    rgb(cr, c->T->ink, 1);
-    const char *head = c->hue && c->tree && c->nranks > PDT_PALETTE_HUES ? "groups:" : "ranks:";
-    text_at(cr, SANS, 0, fs, R.x + 0.5 * f, y, head);
-    double x = R.x + 0.9 * f + text_w(cr, SANS, fs, head), xl = x;
-    uint32_t lo, hi;
-    for (int i = 0; i < legend_group(c, i, &lo, &hi); i++) {
-        char lab[40];
-        group_label(lo, hi, 0, lab, sizeof lab);
-        double tw = text_w(cr, SANS, fs, lab);
-        if (x + 1.2 * f + tw > R.x + R.w - 0.5 * f) {
-            if (line == lines) {
-                rgb(cr, c->T->ink, 1);
-                text_at(cr, SANS, 0, fs, x, y, "…");
-                break;
-            }
-            line++;
-            x = xl;
-            y += 1.3 * f;
-        }
-        cairo_rectangle(cr, x, y - 0.75 * f, 0.8 * f, 0.8 * f);
-        set_rank(c, (int)lo, group_shown(c, lo, hi) ? 1 : 0.2);
-        cairo_fill(cr);
-        rgb(cr, c->T->ink, group_shown(c, lo, hi) ? 1 : 0.4);
-        text_at(cr, SANS, 0, fs, x + 0.95 * f, y, lab);
-        x += 1.3 * f + tw;
+    static const char *const names[] = {"lifted", "not yet", "deleted", "circumdisk (RA)"};
+    for (int i = strip ? 3 : 0; i < 4; i++) {
+        if (strip && F->c && F->c->v->clean) return;
+        double x = flow_item(F, (i == 3 ? 0.95 : 0.9) * F->f, names[i], 1);
+        if (F->c) marker_swatch(F, x, i);
     }
-    return lines > 1 ? pdt_legend_extra(c->nranks, f, R.w) : y - y0;
+}
+
+/* The whole legend in R (strip: items in one flow, the point markers but
+ * the circumdisk only when 2; side: a title, the groups after their
+ * heading, the statuses in columns, the markers);
+ * returns its height.  `rows`: the rows the groups may take (0: all). */
+static double legend_pass(flow *F, pdt_rect R, int strip, int rows)
+{
+    double f = F->f, fs = F->fs;
+    F->pitch = 1.5 * fs;
+    F->x0 = F->x = R.x + 0.5 * f;
+    F->x1 = R.x + R.w - 0.5 * f;
+    F->y = R.y + (strip ? 0.35 * f + 0.95 * fs : 1.3 * f + 1.1 * fs);
+    F->in_row = F->row = 0;
+    if (!rows) rows = 1 << 20;
+    if (strip) {
+        flow_groups(F, 1, rows);
+        flow_statuses(F, 0);
+        flow_markers(F, strip == 1);
+        return F->y + 0.3 * fs + 0.35 * f - R.y;
+    }
+    int grouped = F->c ? F->c->hue && F->c->tree && F->c->nranks > PDT_PALETTE_HUES
+                       : F->nranks > PDT_PALETTE_HUES;
+    flow_item(F, 0, grouped ? "groups:" : "ranks:", 1);
+    F->x0 = F->x; /* the groups' rows line up after the heading */
+    flow_groups(F, 0, rows);
+    flow_newline(F, R.x + 0.5 * f);
+    flow_statuses(F, 1);
+    flow_newline(F, R.x + 0.5 * f);
+    flow_markers(F, 0);
+    return F->y + 0.3 * fs + 0.5 * f - R.y;
+}
+
+/* The rows the groups of a run of `nranks` ranks may take in a legend
+ * `width` wide, and the legend's height (a context only measures). */
+static double legend_measure(cairo_t *cr, int nranks, double f, double fs, double width,
+                             int strip, int *rows)
+{
+    flow F = {.cr = cr, .nranks = nranks, .f = f, .fs = fs};
+    pdt_rect R = {0, 0, width, 0};
+    F.pitch = 1.5 * fs;
+    F.x0 = F.x = 0.5 * f;
+    F.x1 = width - 0.5 * f;
+    if (!strip) {
+        flow_item(&F, 0, nranks > PDT_PALETTE_HUES ? "groups:" : "ranks:", 1);
+        F.x0 = F.x;
+    }
+    flow_groups(&F, strip, 1 << 20);
+    *rows = F.row + 1;
+    return legend_pass(&F, R, strip, 0);
+}
+
+double pdt_legend_height(const pdt_layout *L, int nranks, double width, int strip)
+{
+    cairo_surface_t *s = cairo_image_surface_create(CAIRO_FORMAT_A8, 1, 1);
+    cairo_t *cr = cairo_create(s);
+    int rows;
+    double h = legend_measure(cr, nranks, L->font, L->label, width, strip, &rows);
+    cairo_destroy(cr);
+    cairo_surface_destroy(s);
+    return h;
 }
 
 void pdt_draw_legend(ctx *c)
 {
     cairo_t *cr = c->cr;
     pdt_rect R = c->L.legend;
-    double f = c->L.font, fs = 0.8 * f;
-    if (R.w >= c->L.geo.w && R.y >= c->L.geo.y + c->L.geo.h) { /* under the picture */
-        draw_legend_strip(c);
-        return;
-    }
-    panel(cr, c->T, R, "Legend", f);
+    double f = c->L.font;
+    int strip = R.w >= c->L.geo.w && R.y >= c->L.geo.y + c->L.geo.h; /* under the picture */
+    if (strip && R.w > c->L.geo.w) strip = 2; /* under the column too: instead of the side one */
+    panel(cr, c->T, R, strip ? NULL : "Legend", f);
     cairo_save(cr);
     clip_rect(cr, R);
-    double dy = legend_side_groups(c, fs);
-    /* statuses, two columns */
-    static const char *const names[] = {"candidate", "final", "deferred (RA)", "shipped",
-                                        "discarded"};
-    static const int sts[] = {PDT_TS_CANDIDATE, PDT_TS_FINAL, PDT_TS_DEFERRED, PDT_TS_SHIPPED,
-                              PDT_TS_DISCARDED};
-    double col0[3];
-    pdt_rank_rgb(0, col0);
-    double lw = fmax(1.5, 0.14 * f), colw = (R.w - f) / 2;
-    for (int i = 0; i < 5; i++) {
-        double lx = R.x + 0.5 * f + (i % 2) * colw, ly = R.y + dy + (3.6 + 1.25 * (i / 2)) * f;
-        legend_line(cr, lx, ly - 0.3 * f, 2.2 * f, sts[i], lw, col0);
-        if (sts[i] == PDT_TS_DISCARDED) {
-            cairo_set_line_width(cr, lw);
-            cross(cr, lx + 1.1 * f, ly - 0.3 * f, 0.35 * f);
-            rgb(cr, RED, 1);
-            cairo_stroke(cr);
-        }
-        rgb(cr, c->T->ink, 1);
-        text_at(cr, SANS, 0, fs, lx + 2.6 * f, ly, names[i]);
-    }
-    {   /* hull, in the sixth cell */
-        double lx = R.x + 0.5 * f + colw, ly = R.y + dy + (3.6 + 1.25 * 2) * f;
-        cairo_set_line_width(cr, 3.2 * lw);
-        cairo_move_to(cr, lx, ly - 0.3 * f);
-        cairo_line_to(cr, lx + 2.2 * f, ly - 0.3 * f);
-        set_hull(c, pdt_legend_hull_rank(c), 1);
-        cairo_stroke(cr);
-        rgb(cr, c->T->ink, 1);
-        text_at(cr, SANS, 0, fs, lx + 2.6 * f, ly, "hull / stack");
-    }
-    /* markers */
-    double ly = R.y + dy + 7.05 * f, lx = R.x + 0.5 * f;
-    cairo_new_sub_path(cr);
-    cairo_arc(cr, lx + 0.4 * f, ly - 0.3 * f, 0.25 * f, 0, 2 * M_PI);
-    rgb(cr, c->T->ink, 1);
-    cairo_fill(cr);
-    text_at(cr, SANS, 0, fs, lx + 0.9 * f, ly, "lifted");
-    lx += 0.9 * f + text_w(cr, SANS, fs, "lifted") + 0.8 * f;
-    cairo_new_sub_path(cr);
-    cairo_arc(cr, lx + 0.4 * f, ly - 0.3 * f, 0.25 * f, 0, 2 * M_PI);
-    rgb(cr, c->T->hollow, 1);
-    cairo_set_line_width(cr, 1);
-    cairo_stroke(cr);
-    rgb(cr, c->T->ink, 1);
-    text_at(cr, SANS, 0, fs, lx + 0.9 * f, ly, "not yet");
-    lx += 0.9 * f + text_w(cr, SANS, fs, "not yet") + 0.8 * f;
-    cairo_set_line_width(cr, 0.15 * f);
-    cross(cr, lx + 0.4 * f, ly - 0.3 * f, 0.3 * f);
-    rgb(cr, RED, 1);
-    cairo_stroke(cr);
-    rgb(cr, c->T->ink, 1);
-    text_at(cr, SANS, 0, fs, lx + 0.9 * f, ly, "deleted");
-    lx += 0.9 * f + text_w(cr, SANS, fs, "deleted") + 0.8 * f;
-    cairo_new_sub_path(cr);
-    cairo_arc(cr, lx + 0.4 * f, ly - 0.3 * f, 0.35 * f, 0, 2 * M_PI);
-    rgb(cr, c->T->mark, 0.4);
-    cairo_fill_preserve(cr);
-    rgb(cr, c->T->disk, 1);
-    cairo_stroke(cr);
-    rgb(cr, c->T->ink, 1);
-    text_at(cr, SANS, 0, fs, lx + 0.95 * f, ly, "circumdisk (RA)");
+    int rows;
+    legend_measure(cr, c->nranks, f, c->L.label, R.w, strip, &rows);
+    flow F = {.c = c, .cr = cr, .nranks = c->nranks, .f = f, .fs = c->L.label};
+    legend_pass(&F, R, strip, rows);
     cairo_restore(cr);
-}
-
-double pdt_legend_extra(int nranks, double f, double width)
-{
-    if (nranks <= PDT_PALETTE_HUES) return 0;
-    double fs = 0.8 * f, x = 0.9 * f + 3.9 * fs, right = width - 0.5 * f; /* after "groups:" */
-    int lines = 1;
-    for (int i = 0; i < PDT_PALETTE_HUES; i++) { /* eight even groups, digits 0.64 em, dash 0.5 */
-        int lo = i * nranks / PDT_PALETTE_HUES, hi = (i + 1) * nranks / PDT_PALETTE_HUES - 1;
-        char lab[40];
-        snprintf(lab, sizeof lab, "%d%d", lo, hi);
-        double tw = 0.64 * fs * (double)strlen(lab) + 0.5 * fs + 0.1 * f;
-        if (x + 1.2 * f + tw > right) {
-            lines++;
-            x = 0.9 * f + 3.9 * fs;
-        }
-        x += 1.3 * f + tw;
-    }
-    return (lines > 3 ? 2 : lines - 1) * 1.3 * f;
 }

@@ -129,7 +129,10 @@ void pdt_top_spill(ctx *c);
 void pdt_draw_legend(ctx *c);                   /* legend.c */
 /* How much taller than one line of ranks the side legend's groups are, for
  * nranks ranks, base font f, a legend width wide (layout.c sizes by it). */
-double pdt_legend_extra(int nranks, double f, double width);
+/* The height the legend needs `width` wide for a run of `nranks` ranks at
+ * the layout's font sizes (legend.c); strip 0: the side panel, 1: a strip
+ * under the picture, 2: a strip under picture and column (all markers). */
+double pdt_legend_height(const pdt_layout *L, int nranks, double width, int strip);
 void pdt_draw_code(ctx *c);
 void pdt_draw_stack_panel(ctx *c);
 void pdt_draw_help(ctx *c, double w, double h);

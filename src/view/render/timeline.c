@@ -38,7 +38,7 @@ static int digits(int n)
 void pdt_timeline_geom(pdt_rect R, double f, int nranks, size_t nrows, size_t m, const pdt_view *v,
                        tl_geom *g)
 {
-    g->fs = fmax(12, 0.75 * f);
+    g->fs = 0.82 * f; /* the layout's label size (pdt_layout.label) */
     double rmin = fmax(16, 1.2 * g->fs);
     /* the label column: "r3" up to eight ranks, "r512–1023" beyond */
     int len = nranks <= 10 ? 3 : 2 + 2 * digits(nranks - 1);
@@ -97,8 +97,8 @@ static double ev_x(const tl *t, double k)
 static void bar_label(tl *t, double bx0, double bx1, double ry, const char *lb)
 {
     cairo_t *cr = t->c->cr;
-    double fs = fmin(0.7 * t->c->L.font, 0.75 * t->g.rh);
-    if (fs < 12) return;
+    double fs = t->c->L.label;
+    if (fs > 0.8 * t->g.rh) return; /* the row is too thin for it */
     double lx = fmax(bx0, t->g.x0) + 2, tw = text_w(cr, SANS, fs, lb);
     if (fmin(bx1, t->g.x1) - lx < tw + 2) return;
     double by = ry + t->g.rh / 2 + 0.35 * fs;
@@ -246,7 +246,7 @@ static void draw_bundle(tl *t, int a, int b, const bundle *B)
     if (B->n < 2) return;
     char lb[24];
     snprintf(lb, sizeof lb, "×%u", B->n);
-    double fs = fmax(12, 0.6 * f), tw = text_w(cr, SANS, fs, lb);
+    double fs = t->c->L.label, tw = text_w(cr, SANS, fs, lb);
     double lx = (ax + bx) / 2 + 3, ly = (ay + by) / 2 - 2;
     if (lx + tw > t->g.x1 || ly - fs < t->g.y0 || ly > t->g.y1) return;
     if (!place(&t->P, lx - 1, ly - 0.8 * fs - 1, tw + 2, fs + 2)) return;
@@ -309,19 +309,24 @@ static void draw_axis(tl *t)
         cairo_stroke(cr);
     }
     size_t m = pdt_replay_count(c->r);
-    char ax[160];
+    char ax[3][160];
     int all = t->g.k0 <= 0 && t->g.k1 >= (double)m;
     if (all && c->nrows == (size_t)c->nranks && c->nranks <= PDT_PALETTE_HUES)
-        snprintf(ax, sizeof ax, "timeline: events 0 … %zu (bars = phases, arrows = messages; click to seek)", m);
+        snprintf(ax[0], sizeof ax[0], "timeline: events 0 … %zu (bars = phases, arrows = messages; click to seek)", m);
     else
-        snprintf(ax, sizeof ax, "events %.0f … %.0f of %zu · rows %d–%d of %zu (wheel, drag, [ ] zoom; u opens)",
+        snprintf(ax[0], sizeof ax[0], "events %.0f … %.0f of %zu · rows %d–%d of %zu (wheel, drag, [ ] zoom; u opens)",
                  t->g.k0, t->g.k1, m, t->g.row0 + 1, t->g.row0 + t->g.nshow, c->nrows);
-    double fs = 0.7 * f, room = t->g.x1 - t->g.x0;
-    if (text_w(cr, SANS, fs, ax) > room) fs = fmax(12, fs * room / text_w(cr, SANS, fs, ax));
+    snprintf(ax[1], sizeof ax[1], "events %.0f … %.0f of %zu · rows %d–%d of %zu", t->g.k0, t->g.k1, m,
+             t->g.row0 + 1, t->g.row0 + t->g.nshow, c->nrows);
+    snprintf(ax[2], sizeof ax[2], "%.0f … %.0f / %zu", t->g.k0, t->g.k1, m);
+    /* at the label size: the longest form that fits */
+    double fs = c->L.label, room = t->g.x1 - t->g.x0;
+    int i = 0;
+    while (i < 2 && text_w(cr, SANS, fs, ax[i]) > room) i++;
     rgb(cr, c->T->ink, 0.75);
     cairo_save(cr);
     clip_rect(cr, (pdt_rect){t->g.x0, R.y, room, R.h});
-    text_at(cr, SANS, 0, fs, t->g.x0, R.y + R.h - 0.35 * f, ax);
+    text_at(cr, SANS, 0, fs, t->g.x0, R.y + R.h - 0.35 * f, ax[i]);
     cairo_restore(cr);
 }
 

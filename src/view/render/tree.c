@@ -141,7 +141,7 @@ static void draw_labels(ctx *c, const tgeom *g, const pdt_rtnode *N, size_t n, t
             fmt_bytes(d->bytes, b, sizeof b);
             snprintf(lb, sizeof lb, "%.1f ms · |B| %u · %s", (double)d->t_ns / 1e6,
                      pdt_replay_merges(c->r, &(size_t){0})[d->merge].border, b);
-            double x, y, tw = text_w(cr, SANS, fs, lb);
+            double x, y, tw = text_wb(cr, SANS, d->critical, fs, lb); /* bold: critical */
             node_xy(g, d, &x, &y);
             pdt_rect a = {x - tw / 2, y + 1.4 * g->r, tw, 1.1 * fs};
             if (!tplace(P, c->L.tree, a)) continue;
