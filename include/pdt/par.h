@@ -331,9 +331,11 @@ void pdt_par_write_abandon(void);
  * atomic load of a string constant). */
 const char *pdt_par_phase(void);
 
-/* Test-only: create the file named by PDT_TEST_MARK (if set), so that a test
- * knows a rank has reached one of the test sleeps (PDT_TEST_SLEEP_*). */
-void pdt_par_test_mark(void);
+/* Test-only (a test build's hooks, include/pdt/testhook.h): when the hook
+ * `var` is "RANK:SECONDS" and RANK is `rank`, create the file named by
+ * PDT_TEST_MARK (if set), so that a test knows the rank got there, then sleep
+ * SECONDS (PDT_TEST_SLEEP_BEFORE_MERGE, PDT_TEST_SLEEP_IN_WRITE). */
+void pdt_par_test_sleep(const char *var, int rank);
 
 /* Collective: gather every rank's figures at rank 0 into *all (other ranks:
  * *all zeroed).  Free with pdt_par_stats_free. */

@@ -103,32 +103,24 @@ static pdt_status write_gathered(pdt_comm *c, const char *path, pdt_tri_format f
 static char pending[2][4096];
 static volatile sig_atomic_t npending;
 
-void pdt_par_test_mark(void)
+void pdt_par_test_sleep(const char *var, int rank)
 {
+    const char *e = pdt_test_hook(var);
+    int r;
+    double sec;
+    if (!e || sscanf(e, "%d:%lf", &r, &sec) != 2 || r != rank || !(sec > 0)) return;
     const char *m = pdt_test_hook("PDT_TEST_MARK");
-    if (!m || !*m) return;
-    int fd = open(m, O_WRONLY | O_CREAT, 0644);
-    if (fd >= 0) close(fd);
+    if (m && *m) {
+        int fd = open(m, O_WRONLY | O_CREAT, 0644);
+        if (fd >= 0) close(fd);
+    }
+    struct timespec ts = {(time_t)sec, (long)((sec - (double)(time_t)sec) * 1e9)};
+    nanosleep(&ts, NULL);
 }
 
 void pdt_par_write_abandon(void)
 {
     for (int k = 0; k < npending && k < 2; k++) unlink(pending[k]);
-}
-
-/* Test-only: PDT_TEST_SLEEP_IN_WRITE="RANK:SECONDS" makes RANK sleep once its
- * temporary is open (to kill a rank in the middle of the write in a test);
- * PDT_TEST_MARK=FILE is created when the sleep begins. */
-static void test_sleep_in_write(int rank)
-{
-    const char *e = pdt_test_hook("PDT_TEST_SLEEP_IN_WRITE");
-    int r;
-    double sec;
-    if (e && sscanf(e, "%d:%lf", &r, &sec) == 2 && r == rank && sec > 0) {
-        pdt_par_test_mark();
-        struct timespec ts = {(time_t)sec, (long)((sec - (double)(time_t)sec) * 1e9)};
-        nanosleep(&ts, NULL);
-    }
 }
 
 /* Test-only: PDT_TEST_FAIL_WRITE=RANK makes RANK fail its share of the
@@ -202,7 +194,7 @@ static pdt_status write_file(pdt_comm *c, outfile *o, pdt_err *err)
         if (r == 0) cannot_create(o->path, err);
         return pdt_par_agree(c, r == 0 ? PDT_ERR_IO : PDT_OK, NULL, err);
     }
-    test_sleep_in_write(r);
+    pdt_par_test_sleep("PDT_TEST_SLEEP_IN_WRITE", r); /* kill a rank mid-write */
     pdt_err werr;
     pdt_err_clear(&werr);
     pdt_status wst = test_fail_write(r, o->path, &werr);

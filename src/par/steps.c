@@ -7,21 +7,6 @@
 #include "pdt/testhook.h"
 #include "driver.h"
 
-/* Test-only: PDT_TEST_SLEEP_BEFORE_MERGE="RANK:SECONDS" makes RANK sleep
- * before its first merge step (to kill it there in a test); PDT_TEST_MARK=FILE
- * is created when the sleep begins. */
-static void test_sleep(int rank)
-{
-    const char *e = pdt_test_hook("PDT_TEST_SLEEP_BEFORE_MERGE");
-    int r;
-    double sec;
-    if (e && sscanf(e, "%d:%lf", &r, &sec) == 2 && r == rank && sec > 0) {
-        pdt_par_test_mark();
-        struct timespec ts = {(time_t)sec, (long)((sec - (double)(time_t)sec) * 1e9)};
-        nanosleep(&ts, NULL);
-    }
-}
-
 static double wclock(void *user)
 {
     return pdt_comm_wtime(user);
@@ -135,7 +120,7 @@ static pdt_status merge_at(drv *d, int level, int j, int gl, int ge, void **own,
                            pdt_err *err)
 {
     int k = d->k, nm = ge - gl;
-    test_sleep(d->rank);
+    pdt_par_test_sleep("PDT_TEST_SLEEP_BEFORE_MERGE", d->rank); /* kill before a merge */
     void **msg = calloc((size_t)nm, sizeof *msg);
     size_t *lens = calloc((size_t)nm, sizeof *lens);
     pdt_status st = msg && lens ? PDT_OK : pdt_drv_nomem(d, "merge");
