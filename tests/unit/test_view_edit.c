@@ -135,6 +135,34 @@ TEST(hull_mode_and_presets)
     free(f);
 }
 
+/* The row of key k in the help table of ed's mode, or NULL. */
+static const char *help_row(pdt_editor *ed, const char *k)
+{
+    int n;
+    const char *const(*rows)[2] = pdt_editor_help(ed, &n);
+    for (int i = 0; i < n; i++)
+        if (!strcmp(rows[i][0], k)) return rows[i][1];
+    return NULL;
+}
+
+TEST(help_lists_the_keys_of_the_mode)
+{
+    pdt_live_opts lo = {0, 1, 1, 0};
+    pdt_editor *ed;
+    pdt_err err = {0};
+    char *f = strdup(path("help.txt"));
+    CHECK(pdt_editor_open(f, &lo, &ed, &err) == PDT_OK);
+    CHECK(pdt_editor_set_mode(ed, 0, 4, &err) == PDT_OK);
+    CHECK(help_row(ed, "0") && help_row(ed, "g") && strstr(help_row(ed, "x"), "Graham"));
+    CHECK(!help_row(ed, "g N Enter"));
+    CHECK(pdt_editor_set_mode(ed, 1, 4, &err) == PDT_OK);
+    CHECK(!help_row(ed, "0") && !help_row(ed, "9")); /* one rank: nothing to show or hide */
+    CHECK(strstr(help_row(ed, "x"), "back to the triangulation"));
+    CHECK(help_row(ed, "g") && !strcmp(help_row(ed, "g"), "grid snap on / off"));
+    pdt_editor_free(ed);
+    free(f);
+}
+
 TEST(unparsable_file_is_never_written)
 {
     char *f = strdup(path("bad.txt"));
@@ -274,6 +302,7 @@ int main(void)
     if (!mkdtemp(dir)) return 1;
     RUN(add_move_delete_saved_and_rerun);
     RUN(hull_mode_and_presets);
+    RUN(help_lists_the_keys_of_the_mode);
     RUN(unparsable_file_is_never_written);
     RUN(comments_kept_after_edits);
     RUN(simulated_ranks_give_the_same_triangles);

@@ -48,6 +48,7 @@ struct pdt_editor {
     double per_px;        /* world units per pixel kept across a change */
     char msg[1100];
     char title[470];      /* the window title (hook_title) */
+    const char *help[16][2]; /* the mode's keys (pdt_editor_help) */
 };
 
 /* ---- points and history --------------------------------------------------------- */
@@ -485,38 +486,38 @@ static void frame_end(pdt_editor *ed, double w, double h, pdt_view *v, pdt_statu
     report(ed, st, err, ok);
 }
 
-const char *const pdt_editor_keys[][2] = {
-    {"click", "add a point (integer coordinates)"},
-    {"drag", "move a point (elsewhere: pan)"},
-    {"right click", "delete a point (later points' labels move down one)"},
-    {"Ctrl + Z  Y", "undo / redo"},
-    {"g", "grid snap on / off"},
-    {"n", "add 10 random points in the view"},
-    {"F1 … F4", "presets: circle, grid, collinear, duplicates"},
-    {"x", "Graham's scan only (pdt hull)"},
-    {"1 … 8", "simulated ranks of the live run"},
-    {"0", "show all ranks"},
-    {"9", "show / hide rank 8"},
+/* The editor's keys: what each does while triangulating and in Graham's
+ * mode (x).  `hull` NULL: the same in both; "": not a key of Graham's mode. */
+static const struct {
+    const char *key, *tri, *hull;
+} editor_keys[] = {
+    {"click", "add a point (integer coordinates)", NULL},
+    {"drag", "move a point (elsewhere: pan)", NULL},
+    {"right click", "delete a point (later points' labels move down one)", NULL},
+    {"Ctrl + Z  Y", "undo / redo", NULL},
+    {"g", "grid snap on / off", NULL},
+    {"n", "add 10 random points in the view", NULL},
+    {"F1 … F4", "presets: circle, grid, collinear, duplicates", NULL},
+    {"x", "Graham's scan only (pdt hull)", "back to the triangulation (pdt triangulate)"},
+    {"1 … 8", "simulated ranks of the live run",
+     "ranks the triangulation will use (Graham's scan runs on one)"},
+    {"0", "show all ranks", ""},
+    {"9", "show / hide rank 8", ""},
 };
-const int pdt_editor_nkeys = (int)(sizeof pdt_editor_keys / sizeof *pdt_editor_keys);
+enum { EDITOR_NKEYS = (int)(sizeof editor_keys / sizeof *editor_keys) };
 
-/* In Graham's mode: one rank, the keys that differ say so. */
-static const char *const hull_keys[][2] = {
-    {"click", "add a point (integer coordinates)"},
-    {"drag", "move a point (elsewhere: pan)"},
-    {"right click", "delete a point (later points' labels move down one)"},
-    {"Ctrl + Z  Y", "undo / redo"},
-    {"g", "grid snap on / off"},
-    {"n", "add 10 random points in the view"},
-    {"F1 … F4", "presets: circle, grid, collinear, duplicates"},
-    {"x", "back to the triangulation (pdt triangulate)"},
-    {"1 … 8", "ranks the triangulation will use (Graham's scan runs on one)"},
-};
-
-const char *const (*pdt_editor_help(const pdt_editor *ed, int *n))[2]
+const char *const (*pdt_editor_help(pdt_editor *ed, int *n))[2]
 {
-    *n = ed->mode.hull ? (int)(sizeof hull_keys / sizeof *hull_keys) : pdt_editor_nkeys;
-    return ed->mode.hull ? hull_keys : pdt_editor_keys;
+    int hull = ed->mode.hull, k = 0;
+    for (int i = 0; i < EDITOR_NKEYS; i++) {
+        const char *what = hull && editor_keys[i].hull ? editor_keys[i].hull : editor_keys[i].tri;
+        if (!*what) continue;
+        ed->help[k][0] = editor_keys[i].key;
+        ed->help[k][1] = what;
+        k++;
+    }
+    *n = k;
+    return (const char *const (*)[2])ed->help;
 }
 
 /* g: grid snap off, or on with a 1-2-5 step of about 25 pixels. */

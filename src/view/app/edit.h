@@ -60,13 +60,10 @@ pdt_rstate *pdt_editor_state(pdt_editor *ed);
 /* Seconds the last re-run took (algorithm + replay index + seek). */
 double pdt_editor_last_run_s(const pdt_editor *ed);
 
-/* The editor's keys for the help overlay (pdt_view.help_more): {keys, what
- * they do}, pdt_editor_nkeys rows. */
-extern const char *const pdt_editor_keys[][2];
-extern const int pdt_editor_nkeys;
-/* The keys of ed's current mode (Graham's scan only, or the triangulation):
- * the table, *n rows. */
-const char *const (*pdt_editor_help(const pdt_editor *ed, int *n))[2];
+/* The keys of ed's current mode (Graham's scan only, or the triangulation)
+ * for the help overlay (pdt_view.help_more): {keys, what they do}, *n rows,
+ * held by ed until its mode changes or it is freed. */
+const char *const (*pdt_editor_help(pdt_editor *ed, int *n))[2];
 
 /* The shell hook (input, current replay, overlay) for ed; valid while ed is. */
 const pdt_shell_hook *pdt_editor_hook(pdt_editor *ed);

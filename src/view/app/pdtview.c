@@ -73,8 +73,7 @@ int pdt_app_edit(const opts *o)
     v.clean = o->clean;
     v.circles = o->circles;
     v.voronoi = o->voronoi;
-    v.help_more = pdt_editor_keys;
-    v.help_nmore = pdt_editor_nkeys;
+    v.help_more = pdt_editor_help(ed, &v.help_nmore);
     v.help_more_title = "Editor";
     char title[512];
     snprintf(title, sizeof title, "editing %s", o->edit);
