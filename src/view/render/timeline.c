@@ -326,15 +326,21 @@ static void fmt_time(double ns, double step, char *s, size_t cap)
     snprintf(s, cap, "%.*f %s", dec, ns / unit, u);
 }
 
-/* Ticks of the clock along the bottom: a round step, about one every 8
- * label sizes; returns the step in ns (0: no ticks). */
-static double draw_ticks(tl *t, double span_ns, double fs, double base)
+/* The ticks' step: a round number of ns, about one tick every 8 label sizes. */
+static double tick_step(const tl *t, double span_ns, double fs)
+{
+    double a = t->g.k0 / t->m * span_ns, b = t->g.k1 / t->m * span_ns;
+    double want = (b - a) / fmax(1, (t->g.x1 - t->g.x0) / (8 * fs)), step = pow(10, floor(log10(want)));
+    if (!(step > 0)) return 0;
+    return step * (want / step > 5 ? 5 : want / step > 2 ? 2 : 1);
+}
+
+/* Ticks of the clock along the bottom, labelled where there is room. */
+static void draw_ticks(tl *t, double span_ns, double step, double fs, double base)
 {
     cairo_t *cr = t->c->cr;
     double a = t->g.k0 / t->m * span_ns, b = t->g.k1 / t->m * span_ns, px = t->g.x1 - t->g.x0;
-    double want = (b - a) / fmax(1, px / (8 * fs)), step = pow(10, floor(log10(want)));
-    if (!(step > 0)) return 0;
-    step *= want / step > 5 ? 5 : want / step > 2 ? 2 : 1;
+    if (!(step > 0)) return;
     double lastx = -1e9;
     for (double v = ceil(a / step) * step; v <= b; v += step) {
         double x = t->g.x0 + (v - a) / (b - a) * px;
@@ -352,7 +358,6 @@ static double draw_ticks(tl *t, double span_ns, double fs, double base)
         text_at(cr, SANS, 0, fs, lx, base, lb);
         lastx = lx + tw;
     }
-    return step;
 }
 
 /* The axis: ticks in time (or the events' numbers for a trace without
@@ -371,7 +376,7 @@ static void draw_axis(tl *t)
     cairo_save(cr);
     clip_rect(cr, (pdt_rect){t->g.x0, R.y, room, R.h});
     if (m && pdt_ranktree_timed(c->tree, &span)) {
-        double st = draw_ticks(t, span, fs, base);
+        double st = tick_step(t, span, fs);
         char a[32], b[32];
         fmt_time(t->g.k0 / t->m * span, st, a, sizeof a);
         fmt_time(t->g.k1 / t->m * span, st, b, sizeof b);
@@ -384,7 +389,9 @@ static void draw_axis(tl *t)
             cairo_fill(cr);
             rgb(cr, c->T->ink, 0.75);
             text_at(cr, SANS, 0, fs, lx, base, ax[0]);
+            place(&t->P, lx - 4, base - 0.8 * fs, tw + 4, fs);
         }
+        draw_ticks(t, span, st, fs, base);
         cairo_restore(cr);
         return;
     }
