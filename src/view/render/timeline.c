@@ -326,13 +326,21 @@ static void fmt_time(double ns, double step, char *s, size_t cap)
     snprintf(s, cap, "%.*f %s", dec, ns / unit, u);
 }
 
-/* The ticks' step: a round number of ns, about one tick every 8 label sizes. */
+/* The ticks' step: a round number of ns (1, 2 or 5 times a power of ten),
+ * the smallest whose labels keep 1.5 label sizes apart. */
 static double tick_step(const tl *t, double span_ns, double fs)
 {
-    double a = t->g.k0 / t->m * span_ns, b = t->g.k1 / t->m * span_ns;
-    double want = (b - a) / fmax(1, (t->g.x1 - t->g.x0) / (8 * fs)), step = pow(10, floor(log10(want)));
-    if (!(step > 0)) return 0;
-    return step * (want / step > 5 ? 5 : want / step > 2 ? 2 : 1);
+    double a = t->g.k0 / t->m * span_ns, b = t->g.k1 / t->m * span_ns, px = t->g.x1 - t->g.x0;
+    if (!(b > a) || px <= 0) return 0;
+    double step = pow(10, floor(log10((b - a) / fmax(1, px / (3 * fs)))));
+    for (int i = 0; i < 12; i++) {
+        char lb[32];
+        fmt_time(b, step, lb, sizeof lb);
+        if (step / (b - a) * px >= text_w(t->c->cr, SANS, fs, lb) + 1.5 * fs) break;
+        double d = step / pow(10, floor(log10(step)) + 1e-9); /* 1, 2 or 5 */
+        step *= d < 1.5 ? 2 : d < 3 ? 2.5 : 2;
+    }
+    return step;
 }
 
 /* Ticks of the clock along the bottom, labelled where there is room. */

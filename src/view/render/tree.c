@@ -46,7 +46,7 @@ static void tree_geom(pdt_rect R, double f, double label, const pdt_ranktree *t,
     if (depth > TREE_LEVELS - 1) depth = TREE_LEVELS - 1;
     g->levels = depth + 1;
     g->nranks = pdt_ranktree_nranks(t);
-    g->fs = fmax(16, label);
+    g->fs = fmax(16, 0.8 * label);
     g->x0 = R.x + 0.8 * f;
     g->w = R.w - 1.6 * f;
     g->r = fmax(4, 0.3 * g->fs);
