@@ -224,14 +224,14 @@ static void draw_foot(ctx *c, const tgeom *g, const pdt_rtnode *N, size_t n)
     if (best) {
         pdt_ranktree_name(c->tree, (int32_t)(best - N), name, sizeof name);
         step_text(c, best, 1, facts, sizeof facts);
-        snprintf(lb, sizeof lb, "now: merge level %u of %s · %s", M[best->merge].level, name + 1, facts);
+        snprintf(lb, sizeof lb, "now: merge level %u of %s · %s", M[best->merge].level, name, facts);
     } else snprintf(lb, sizeof lb, "%s", nm ? "click a step to go to it" : "no merge steps in this run");
     double fs = g->fs, room = R.w - 1.2 * c->L.font;
     if (text_wb(cr, SANS, 0, fs, lb) > room && best) {
-        snprintf(lb, sizeof lb, "now: %s · %s", name + 1, facts);
+        snprintf(lb, sizeof lb, "now: %s · %s", name, facts);
         if (text_wb(cr, SANS, 0, fs, lb) > room) {
             step_text(c, best, 0, facts, sizeof facts);
-            snprintf(lb, sizeof lb, "now: %s · %s", name + 1, facts);
+            snprintf(lb, sizeof lb, "now: %s · %s", name, facts);
         }
     }
     if (text_wb(cr, SANS, 0, fs, lb) > room) return;
