@@ -3,7 +3,9 @@
 # this machine, the 64 on 5000 points; 256 and 1024 synthetic): headless
 # frames at 1024x768 and 1920x1080, at the end and in the merges, checked by
 # their layout report (--layout-report): no two texts overlap, none is cut by
-# the frame, none is under 12 px (scripts/layout-check.py); every rank or
+# the frame, none is under 12 px, none under 16 px at 1024x768
+# (scripts/layout-check.py); the timeline's axis is labelled in time
+# (ms) in the real runs; every rank or
 # group on screen (a timeline row, a label in the picture) is in the legend;
 # the timeline's rows are at least as tall as their labels.
 . "$(dirname "$0")/lib.sh"
@@ -54,6 +56,31 @@ sys.exit(1 if bad else 0)
 EOF
 }
 
+# The timeline's axis in time: at least three tick labels in ms (or µs, s)
+# under the rows, their centres at x proportional to their times.
+axis_check() {
+    python3 - "$1" <<'EOF'
+import json, re, sys
+T = json.load(open(sys.argv[1]))["texts"]
+unit = {"µs": 1e-3, "ms": 1.0, "s": 1e3}
+ticks = []
+for t in T:
+    m = re.fullmatch(r"(\d+(?:\.\d+)?) (µs|ms|s)", t["text"]) if t["panel"] == "timeline" else None
+    if m:
+        ticks.append((float(m.group(1)) * unit[m.group(2)], t["x"] + t["w"] / 2))
+ticks.sort()
+if len(ticks) < 3:
+    print(f"{len(ticks)} tick labels in time: {ticks}")
+    sys.exit(1)
+(v0, x0), (v1, x1) = ticks[0], ticks[-1]
+for v, x in ticks:
+    want = x0 + (v - v0) / (v1 - v0) * (x1 - x0)
+    if abs(x - want) > 2:
+        print(f"tick {v} ms at x {x:.1f}, {want:.1f} for a linear axis")
+        sys.exit(1)
+EOF
+}
+
 # frames NAME RUN LEVEL: at the end and in the merges (level 1 and LEVEL),
 # at both sizes, with every panel and with code, timeline and tree.
 frames() {
@@ -68,10 +95,12 @@ frames() {
                 --layout-report "$out.json" --quiet 2>"$out.err"; then
             lbad=1; msg="$msg [$f] $(head -1 "$out.err")"; continue
         fi
-        python3 "$CHECK" "$out.json" >"$out.chk" || { lbad=1; msg="$msg [$f] $(head -2 "$out.chk")"; }
+        local min=12
+        [ "$size" = 1024x768 ] && min=16
+        python3 "$CHECK" --min-px "$min" "$out.json" >"$out.chk" || { lbad=1; msg="$msg [$f] $(head -2 "$out.chk")"; }
         groups_check "$out.json" >"$out.grp" || { gbad=1; gmsg="$gmsg [$f] $(head -2 "$out.grp")"; }
     done
-    if [ $lbad = 0 ]; then ok "${name}_frames_no_overlap_cut_or_small_text"; else fail "${name}_frames_no_overlap_cut_or_small_text" "$msg"; fi
+    if [ $lbad = 0 ]; then ok "${name}_frames_no_overlap_cut_or_small_text_16px_at_1024"; else fail "${name}_frames_no_overlap_cut_or_small_text_16px_at_1024" "$msg"; fi
     if [ $gbad = 0 ]; then ok "${name}_groups_on_screen_in_legend_rows_tall_enough"; else fail "${name}_groups_on_screen_in_legend_rows_tall_enough" "$gmsg"; fi
 }
 
@@ -84,6 +113,8 @@ else fail ranks_8_run "$(head -3 "$TMP/r8.err" 2>/dev/null)"; fi
 if command -v mpirun >/dev/null &&
    mpirun --oversubscribe -np 64 "$BIN/pdt" triangulate "$TMP/u5k.txt" -o "$TMP/r64.tri" --trace "$TMP/r64" >/dev/null 2>"$TMP/r64.err"; then
     frames ranks_64_real_5000_points "$TMP/r64" 4
+    if axis_check "$TMP/ranks_64_real_5000_points-5.json" >"$TMP/axis.txt"; then ok timeline_axis_in_ms_linear
+    else fail timeline_axis_in_ms_linear "$(head -2 "$TMP/axis.txt")"; fi
 else fail ranks_64_run "$(head -3 "$TMP/r64.err" 2>/dev/null)"; fi
 frames ranks_256 synth:srm:512:4:256 5
 frames ranks_1024 synth:srm:2048:4:1024 7

@@ -8,6 +8,7 @@
 #include "pdt/view/query.h"
 
 struct pdt_cluster {
+    const pdt_replay *r;    /* the replay it was made for */
     pdt_ranktree *tree;
     uint8_t *open;          /* per tree node */
     int down, dragged;      /* a press in the timeline, and whether it moved */
@@ -26,9 +27,17 @@ pdt_cluster *pdt_cluster_new(const pdt_replay *r, pdt_view *v)
         pdt_cluster_free(cl, v);
         return NULL;
     }
+    cl->r = r;
     v->tree = cl->tree;
     v->tl_open = cl->open;
     return cl;
+}
+
+void pdt_cluster_take(pdt_cluster **cl, const pdt_replay *r, pdt_view *v)
+{
+    if (*cl && (*cl)->r == r) return;
+    pdt_cluster_free(*cl, v);
+    *cl = pdt_cluster_new(r, v);
 }
 
 void pdt_cluster_free(pdt_cluster *cl, pdt_view *v)

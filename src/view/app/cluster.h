@@ -17,6 +17,9 @@ typedef struct pdt_cluster pdt_cluster;
  * frame). */
 pdt_cluster *pdt_cluster_new(const pdt_replay *r, pdt_view *v);
 void pdt_cluster_free(pdt_cluster *cl, pdt_view *v);
+/* Keep *cl made for r: when it was made for another replay (a hook's
+ * replay changed) or is NULL, a new one (the old one freed). */
+void pdt_cluster_take(pdt_cluster **cl, const pdt_replay *r, pdt_view *v);
 
 /* A key: [ ] zoom the timeline's events out / in, Shift+[ ] scroll its rows,
  * u opens (or closes) the current event's group in the timeline, w turns

@@ -643,6 +643,7 @@ static void hook_current(shell *sh)
     const pdt_shell_hook *hk = sh->o->hook;
     hook_title(sh);
     if (!hk || !hk->current || !hk->current(hk->user, &sh->r, &sh->s)) return;
+    pdt_cluster_take(&sh->cl, sh->r, sh->v);
     int n = pdt_replay_nranks(sh->r);
     sh->nranks = n < sh->cap_ranks ? n : sh->cap_ranks;
     sh->dirty = 1;
@@ -656,7 +657,6 @@ static int make_texture(shell *sh)
     sh->sx = ww > 0 ? (double)w / ww : 1;
     sh->sy = wh > 0 ? (double)h / wh : 1;
     if (sh->tex && w == sh->tw && h == sh->th) return 1;
-    pdt_cluster_free(sh->cl, sh->v);
     if (sh->tex) SDL_DestroyTexture(sh->tex);
     sh->tex = SDL_CreateTexture(sh->ren, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, w, h);
     sh->tw = w;
@@ -779,6 +779,8 @@ static int shell_quit(shell *sh, int rc)
     else if (rc == 0 && sh->v->texts && sh->tex) write_report(sh);
     pdt_text_log_free(sh->v->texts);
     sh->v->texts = NULL;
+    pdt_cluster_free(sh->cl, sh->v);
+    sh->cl = NULL;
     if (sh->tex) SDL_DestroyTexture(sh->tex);
     if (sh->ren) SDL_DestroyRenderer(sh->ren);
     if (sh->win) SDL_DestroyWindow(sh->win);
@@ -805,7 +807,7 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
     if (v->hidden) memcpy(sh.hidden, v->hidden, (size_t)sh.nranks);
     v->hidden = sh.hidden;
     v->texts = o->layout_report ? pdt_text_log_new() : NULL;
-    if (!o->hook) sh.cl = pdt_cluster_new(r, v); /* the editor's replays change */
+    pdt_cluster_take(&sh.cl, r, v); /* made again when a hook's replay changes */
     SDL_SetHint(SDL_HINT_VIDEO_X11_NET_WM_BYPASS_COMPOSITOR, "0");
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
         fprintf(stderr, "pdtview: SDL_Init: %s\n", SDL_GetError());

@@ -16,6 +16,11 @@ struct pdt_ranktree {
     int32_t *leaf;      /* per rank */
     int32_t *of_merge;  /* per merge step */
     size_t nmerge;
+    /* the run's clock: times as fractions of [t_lo, t_hi] */
+    const pdt_replay *r;
+    uint64_t t_lo, t_hi;  /* t_hi == t_lo: no times, event order instead */
+    double *ph_at;        /* per phase: begin, end */
+    double *msg_at;       /* per message: send, receive */
 };
 
 typedef struct mkey {
@@ -170,6 +175,117 @@ static void mark_critical(pdt_ranktree *t)
     }
 }
 
+/* ---- the run's clock ---- */
+
+/* The span of the run's times: the first and last events, every phase's
+ * ends and every message's ends (a trace's clocks are aligned, but the
+ * merged order is causal, not sorted by time). */
+static void clock_span(pdt_ranktree *t, const pdt_replay *r, const uint64_t *pt, size_t np,
+                       const uint64_t *mt, size_t ng)
+{
+    size_t m = pdt_replay_count(r);
+    uint64_t lo = UINT64_MAX, hi = 0;
+    uint64_t ends[2] = {m ? ev_time(r, 0) : 0, m ? ev_time(r, (uint32_t)(m - 1)) : 0};
+    for (int i = 0; i < 2; i++) {
+        if (ends[i] < lo) lo = ends[i];
+        if (ends[i] > hi) hi = ends[i];
+    }
+    for (size_t i = 0; i < 2 * np; i++) {
+        if (pt[i] < lo) lo = pt[i];
+        if (pt[i] > hi) hi = pt[i];
+    }
+    for (size_t i = 0; i < 2 * ng; i++) {
+        if (mt[i] < lo) lo = mt[i];
+        if (mt[i] > hi) hi = mt[i];
+    }
+    t->t_lo = lo <= hi ? lo : 0;
+    t->t_hi = lo <= hi ? hi : 0;
+}
+
+static double clock_frac(const pdt_ranktree *t, uint64_t ns)
+{
+    return ((double)ns - (double)t->t_lo) / ((double)t->t_hi - (double)t->t_lo);
+}
+
+/* Each phase's and message's ends on the clock: their events' times, or,
+ * in a run without times, their events' places in the merged order. */
+static int clock_build(pdt_ranktree *t, const pdt_replay *r)
+{
+    size_t np, ng, m = pdt_replay_count(r);
+    const pdt_rphase *P = pdt_replay_phases(r, &np);
+    const pdt_rmsg *G = pdt_replay_msgs(r, &ng);
+    uint64_t *pt = malloc((2 * np + 1) * sizeof *pt), *mt = malloc((2 * ng + 1) * sizeof *mt);
+    t->ph_at = malloc((2 * np + 1) * sizeof *t->ph_at);
+    t->msg_at = malloc((2 * ng + 1) * sizeof *t->msg_at);
+    t->r = r;
+    if (!pt || !mt || !t->ph_at || !t->msg_at) {
+        free(pt);
+        free(mt);
+        return 0;
+    }
+    uint32_t last = m ? (uint32_t)(m - 1) : 0;
+    for (size_t i = 0; i < np; i++) {
+        pt[2 * i] = ev_time(r, P[i].begin_ev);
+        pt[2 * i + 1] = ev_time(r, P[i].end_ev == NONE32 ? last : P[i].end_ev);
+    }
+    for (size_t i = 0; i < ng; i++) { /* a missing end: the other's time */
+        uint32_t s = G[i].send_ev, d = G[i].recv_ev;
+        uint32_t any = s != NONE32 ? s : d != NONE32 ? d : 0;
+        mt[2 * i] = ev_time(r, s != NONE32 ? s : any);
+        mt[2 * i + 1] = ev_time(r, d != NONE32 ? d : any);
+    }
+    clock_span(t, r, pt, np, mt, ng);
+    double em = m ? (double)m : 1;
+    for (size_t i = 0; i < np; i++) {
+        double e1 = P[i].end_ev == NONE32 ? em : P[i].end_ev + 1.0;
+        t->ph_at[2 * i] = t->t_hi > t->t_lo ? clock_frac(t, pt[2 * i]) : P[i].begin_ev / em;
+        t->ph_at[2 * i + 1] = t->t_hi > t->t_lo ? clock_frac(t, pt[2 * i + 1]) : e1 / em;
+    }
+    for (size_t i = 0; i < ng; i++) {
+        t->msg_at[2 * i] = t->t_hi > t->t_lo ? clock_frac(t, mt[2 * i]) : (G[i].send_ev + 0.5) / em;
+        t->msg_at[2 * i + 1] = t->t_hi > t->t_lo ? clock_frac(t, mt[2 * i + 1]) : (G[i].recv_ev + 0.5) / em;
+    }
+    free(pt);
+    free(mt);
+    return 1;
+}
+
+int pdt_ranktree_timed(const pdt_ranktree *t, double *span_ns)
+{
+    if (span_ns) *span_ns = (double)(t->t_hi - t->t_lo);
+    return t->t_hi > t->t_lo;
+}
+
+double pdt_ranktree_at(const pdt_ranktree *t, size_t e)
+{
+    size_t m = pdt_replay_count(t->r);
+    if (e >= m) return 1;
+    if (t->t_hi <= t->t_lo) return (double)e / (double)m;
+    double u = clock_frac(t, ev_time(t->r, (uint32_t)e));
+    return u < 0 ? 0 : u > 1 ? 1 : u;
+}
+
+const double *pdt_ranktree_phase_at(const pdt_ranktree *t)
+{
+    return t->ph_at;
+}
+
+const double *pdt_ranktree_msg_at(const pdt_ranktree *t)
+{
+    return t->msg_at;
+}
+
+size_t pdt_ranktree_event_at(const pdt_ranktree *t, double u)
+{
+    size_t a = 0, b = pdt_replay_count(t->r);
+    while (a < b) { /* the merged order is by time but for causality: near enough */
+        size_t mid = a + (b - a) / 2;
+        if (pdt_ranktree_at(t, mid) < u) a = mid + 1;
+        else b = mid;
+    }
+    return a;
+}
+
 pdt_ranktree *pdt_ranktree_new(const pdt_replay *r)
 {
     int P = pdt_replay_nranks(r);
@@ -200,6 +316,10 @@ pdt_ranktree *pdt_ranktree_new(const pdt_replay *r)
     merge_facts(t, r);
     leaf_ready(t, r);
     mark_critical(t);
+    if (!clock_build(t, r)) {
+        pdt_ranktree_free(t);
+        return NULL;
+    }
     return t;
 }
 
@@ -209,6 +329,8 @@ void pdt_ranktree_free(pdt_ranktree *t)
     free(t->nd);
     free(t->leaf);
     free(t->of_merge);
+    free(t->ph_at);
+    free(t->msg_at);
     free(t);
 }
 

@@ -4,7 +4,10 @@
  *
  * A row is never shorter than its label (16 px at least): when the rows do
  * not fit they scroll (pdt_view.tl_row0).  The events shown are a window of
- * the run (pdt_view.tl_t0 .. tl_t1).  A group's row shows each of its ranks'
+ * run's time (pdt_view.tl_t0 .. tl_t1, fractions of the span of its times:
+ * pdt_ranktree_at; of its events when the trace has no times).  The window is
+ * measured in "event units" (tl_geom.k0, k1: the fraction times the number of
+ * events), so that zooming in stops at about eight events across.  A group's row shows each of its ranks'
  * phases as a thin strip; when the arrows between groups would be denser
  * than a few per row they are bundled, one arrow per pair of rows and
  * stretch of time, with its count. */
@@ -84,7 +87,9 @@ typedef struct tl {
     tl_geom g;
     const pdt_rtnode *N;
     int32_t *rowof;   /* per rank: its row among those shown, or -1 */
-    double scale;     /* pixels per event */
+    double scale;     /* pixels per event unit */
+    double m;         /* events: a time u of the clock is at u * m units */
+    const double *pa, *ma;  /* the phases' and messages' ends on the clock */
     placed P;
 } tl;
 
@@ -120,13 +125,12 @@ static int phase_depth(const pdt_rphase *Ph, const pdt_rphase *p)
 static void draw_bars(tl *t)
 {
     ctx *c = t->c;
-    size_t np, m = pdt_replay_count(c->r);
+    size_t np;
     const pdt_rphase *Ph = pdt_replay_phases(c->r, &np);
     for (size_t i = 0; i < np; i++) {
         const pdt_rphase *p = &Ph[i];
         if (p->phase == PDT_PH_RUN || p->rank >= (uint32_t)c->nranks || t->rowof[p->rank] < 0) continue;
-        double bx0 = ev_x(t, p->begin_ev);
-        double bx1 = ev_x(t, (double)(p->end_ev == NONE32 ? m : (size_t)p->end_ev + 1));
+        double bx0 = ev_x(t, t->m * t->pa[2 * i]), bx1 = ev_x(t, t->m * t->pa[2 * i + 1]);
         if (bx1 < t->g.x0 || bx0 > t->g.x1) continue;
         const pdt_rtnode *d = &t->N[c->rows[t->rowof[p->rank] + t->g.row0]];
         double ry = t->g.y0 + t->g.rh * t->rowof[p->rank], col[3];
@@ -162,8 +166,9 @@ static void group_merges(tl *t)
         const pdt_rmerge *g = &M[d->merge];
         char lb[32];
         snprintf(lb, sizeof lb, "merge %u", g->level);
-        double bx1 = ev_x(t, g->end_ev == NONE32 ? (double)pdt_replay_count(t->c->r) : g->end_ev + 1.0);
-        bar_label(t, ev_x(t, g->begin_ev), bx1, t->g.y0 + t->g.rh * i, lb);
+        double bx0 = ev_x(t, t->m * pdt_ranktree_at(t->c->tree, g->begin_ev));
+        double bx1 = ev_x(t, t->m * pdt_ranktree_at(t->c->tree, g->end_ev == NONE32 ? (size_t)t->m : g->end_ev));
+        bar_label(t, bx0, bx1, t->g.y0 + t->g.rh * i, lb);
     }
 }
 
@@ -204,14 +209,14 @@ static void arrow(cairo_t *cr, double ax, double ay, double bx, double by, doubl
 
 /* A message's arrow is shown when both ends are in rows shown, the rows
  * differ and it crosses the events shown. */
-static int msg_shown(const tl *t, const pdt_rmsg *g)
+static int msg_shown(const tl *t, const pdt_rmsg *g, size_t i)
 {
     if (g->send_ev == NONE32 || g->recv_ev == NONE32) return 0;
     if (g->src >= (uint32_t)t->c->nranks || g->dst >= (uint32_t)t->c->nranks) return 0;
     int a = t->rowof[g->src], b = t->rowof[g->dst];
     if (a < 0 || b < 0 || a == b) return 0;
-    double lo = fmin(g->send_ev, g->recv_ev), hi = fmax(g->send_ev, g->recv_ev);
-    return hi + 1 >= t->g.k0 && lo <= t->g.k1;
+    double lo = t->m * fmin(t->ma[2 * i], t->ma[2 * i + 1]), hi = t->m * fmax(t->ma[2 * i], t->ma[2 * i + 1]);
+    return hi >= t->g.k0 && lo <= t->g.k1;
 }
 
 static void draw_msgs_each(tl *t, const pdt_rmsg *Ms, size_t nm)
@@ -220,11 +225,12 @@ static void draw_msgs_each(tl *t, const pdt_rmsg *Ms, size_t nm)
     cairo_set_line_width(cr, 1);
     for (size_t i = 0; i < nm; i++) {
         const pdt_rmsg *g = &Ms[i];
-        if (!msg_shown(t, g)) continue;
+        if (!msg_shown(t, g, i)) continue;
         if (t->c->s->mflight[i]) rgb(cr, RED, 1);
         else rgb(cr, t->c->T->ink, 0.6);
-        arrow(cr, ev_x(t, g->send_ev + 0.5), t->g.y0 + t->g.rh * (t->rowof[g->src] + 0.5),
-              ev_x(t, g->recv_ev + 0.5), t->g.y0 + t->g.rh * (t->rowof[g->dst] + 0.5), 0.35 * t->c->L.font);
+        arrow(cr, ev_x(t, t->m * t->ma[2 * i]), t->g.y0 + t->g.rh * (t->rowof[g->src] + 0.5),
+              ev_x(t, t->m * t->ma[2 * i + 1]), t->g.y0 + t->g.rh * (t->rowof[g->dst] + 0.5),
+              0.35 * t->c->L.font);
     }
 }
 
@@ -238,11 +244,11 @@ static void draw_bundle(tl *t, int a, int b, const bundle *B)
 {
     cairo_t *cr = t->c->cr;
     double f = t->c->L.font;
-    double ax = ev_x(t, B->sx / B->n + 0.5), bx = ev_x(t, B->rx / B->n + 0.5);
+    double ax = ev_x(t, B->sx / B->n), bx = ev_x(t, B->rx / B->n);
     double ay = t->g.y0 + t->g.rh * (a + 0.5), by = t->g.y0 + t->g.rh * (b + 0.5);
-    rgb(cr, t->c->T->ink, 0.4);
-    cairo_set_line_width(cr, fmin(1 + 0.5 * log2((double)B->n), 0.15 * t->g.rh));
-    arrow(cr, ax, ay, bx, by, 0.45 * f);
+    rgb(cr, t->c->T->ink, B->n > 1 ? 0.45 : 0.3); /* light: a thin line, a small head */
+    cairo_set_line_width(cr, B->n > 1 ? 1.5 : 1);
+    arrow(cr, ax, ay, bx, by, 0.3 * f);
     if (B->n < 2) return;
     char lb[24];
     snprintf(lb, sizeof lb, "×%u", B->n);
@@ -251,28 +257,29 @@ static void draw_bundle(tl *t, int a, int b, const bundle *B)
     if (lx + tw > t->g.x1 || ly - fs < t->g.y0 || ly > t->g.y1) return;
     if (!place(&t->P, lx - 1, ly - 0.8 * fs - 1, tw + 2, fs + 2)) return;
     cairo_rectangle(cr, lx - 1, ly - 0.8 * fs - 1, tw + 2, fs + 2);
-    rgb(cr, t->c->T->panel, 0.85);
+    rgb(cr, t->c->T->panel, 0.7);
     cairo_fill(cr);
-    rgb(cr, t->c->T->ink, 1);
+    rgb(cr, t->c->T->ink, 0.85);
     text_at(cr, SANS, 0, fs, lx, ly, lb);
 }
 
-/* Bundles per (sending row, receiving row, stretch of 6 font sizes). */
+/* Bundles per (sending row, receiving row, stretch of 12 font sizes): one
+ * arrow from the mean send to the mean receive, with its count. */
 static void draw_msgs_bundled(tl *t, const pdt_rmsg *Ms, size_t nm)
 {
-    int R = t->g.nshow, nb = (int)ceil((t->g.x1 - t->g.x0) / (6 * t->c->L.font));
+    int R = t->g.nshow, nb = (int)ceil((t->g.x1 - t->g.x0) / (12 * t->c->L.font));
     if (nb < 1) nb = 1;
     bundle *B = calloc((size_t)R * (size_t)R * (size_t)nb, sizeof *B);
     if (!B) return;
     for (size_t i = 0; i < nm; i++) {
         const pdt_rmsg *g = &Ms[i];
-        if (!msg_shown(t, g)) continue;
-        int s = (int)((ev_x(t, g->send_ev) - t->g.x0) / (t->g.x1 - t->g.x0) * nb);
+        if (!msg_shown(t, g, i)) continue;
+        int s = (int)((ev_x(t, t->m * t->ma[2 * i]) - t->g.x0) / (t->g.x1 - t->g.x0) * nb);
         s = s < 0 ? 0 : s >= nb ? nb - 1 : s;
         bundle *b = &B[((size_t)t->rowof[g->src] * (size_t)R + (size_t)t->rowof[g->dst]) * (size_t)nb + (size_t)s];
         b->n++;
-        b->sx += g->send_ev;
-        b->rx += g->recv_ev;
+        b->sx += t->m * t->ma[2 * i];
+        b->rx += t->m * t->ma[2 * i + 1];
     }
     for (int a = 0; a < R; a++)
         for (int b = 0; b < R; b++)
@@ -287,30 +294,115 @@ static void draw_msgs(tl *t)
 {
     size_t nm, shown_n = 0;
     const pdt_rmsg *Ms = pdt_replay_msgs(t->c->r, &nm);
-    for (size_t i = 0; i < nm; i++) shown_n += msg_shown(t, &Ms[i]) != 0;
+    for (size_t i = 0; i < nm; i++) shown_n += msg_shown(t, &Ms[i], i) != 0;
     if ((t->c->nranks > PDT_PALETTE_HUES && shown_n > 4 * (size_t)t->g.nshow) || shown_n > 3000)
         draw_msgs_bundled(t, Ms, nm);
     else draw_msgs_each(t, Ms, nm);
 }
 
-/* The cursor and the axis text. */
+/* The cursor: at the current event's time (the start before any event). */
+static void draw_cursor(tl *t)
+{
+    ctx *c = t->c;
+    cairo_t *cr = c->cr;
+    double cx = ev_x(t, c->s->k ? t->m * pdt_ranktree_at(c->tree, c->s->k - 1) : 0);
+    if (cx >= t->g.x0 - 1 && cx <= t->g.x1 + 1) {
+        cairo_move_to(cr, cx, c->L.timeline.y + 0.2 * c->L.font);
+        cairo_line_to(cr, cx, t->g.y1 + 0.2 * c->L.font);
+        cairo_set_source_rgb(cr, 0.85, 0.0, 0.0);
+        cairo_set_line_width(cr, 2);
+        cairo_stroke(cr);
+    }
+}
+
+/* "12.5 ms" (or µs, s) for ns nanoseconds; digits enough for step. */
+static void fmt_time(double ns, double step, char *s, size_t cap)
+{
+    double unit = 1e6;
+    const char *u = "ms";
+    if (step < 1e3) unit = 1e3, u = "µs";
+    else if (step >= 1e9) unit = 1e9, u = "s";
+    int dec = step / unit >= 1 ? 0 : step / unit >= 0.1 ? 1 : step / unit >= 0.01 ? 2 : 3;
+    snprintf(s, cap, "%.*f %s", dec, ns / unit, u);
+}
+
+/* The ticks' step: a round number of ns (1, 2 or 5 times a power of ten),
+ * the smallest whose labels keep 1.5 label sizes apart. */
+static double tick_step(const tl *t, double span_ns, double fs)
+{
+    double a = t->g.k0 / t->m * span_ns, b = t->g.k1 / t->m * span_ns, px = t->g.x1 - t->g.x0;
+    if (!(b > a) || px <= 0) return 0;
+    double step = pow(10, floor(log10((b - a) / fmax(1, px / (3 * fs)))));
+    for (int i = 0; i < 12; i++) {
+        char lb[32];
+        fmt_time(b, step, lb, sizeof lb);
+        if (step / (b - a) * px >= text_w(t->c->cr, SANS, fs, lb) + 1.5 * fs) break;
+        double d = step / pow(10, floor(log10(step)) + 1e-9); /* 1, 2 or 5 */
+        step *= d < 1.5 ? 2 : d < 3 ? 2.5 : 2;
+    }
+    return step;
+}
+
+/* Ticks of the clock along the bottom, labelled where there is room. */
+static void draw_ticks(tl *t, double span_ns, double step, double fs, double base)
+{
+    cairo_t *cr = t->c->cr;
+    double a = t->g.k0 / t->m * span_ns, b = t->g.k1 / t->m * span_ns, px = t->g.x1 - t->g.x0;
+    if (!(step > 0)) return;
+    double lastx = -1e9;
+    for (double v = ceil(a / step) * step; v <= b; v += step) {
+        double x = t->g.x0 + (v - a) / (b - a) * px;
+        rgb(cr, t->c->T->ink, 0.5);
+        cairo_set_line_width(cr, 1);
+        cairo_move_to(cr, x, t->g.y1);
+        cairo_line_to(cr, x, t->g.y1 + 0.25 * fs);
+        cairo_stroke(cr);
+        char lb[32];
+        fmt_time(v, step, lb, sizeof lb);
+        double tw = text_w(cr, SANS, fs, lb), lx = x - tw / 2;
+        if (lx < lastx + 0.8 * fs || lx < t->g.x0 || lx + tw > t->g.x1) continue;
+        if (!place(&t->P, lx, base - 0.8 * fs, tw, fs)) continue;
+        rgb(cr, t->c->T->ink, 0.75);
+        text_at(cr, SANS, 0, fs, lx, base, lb);
+        lastx = lx + tw;
+    }
+}
+
+/* The axis: ticks in time (or the events' numbers for a trace without
+ * times), and what the window shows where the ticks leave room. */
 static void draw_axis(tl *t)
 {
     ctx *c = t->c;
     cairo_t *cr = c->cr;
     pdt_rect R = c->L.timeline;
-    double f = c->L.font;
-    double cx = ev_x(t, (double)c->s->k);
-    if (cx >= t->g.x0 - 1 && cx <= t->g.x1 + 1) {
-        cairo_move_to(cr, cx, R.y + 0.2 * f);
-        cairo_line_to(cr, cx, t->g.y1 + 0.2 * f);
-        cairo_set_source_rgb(cr, 0.85, 0.0, 0.0);
-        cairo_set_line_width(cr, 2);
-        cairo_stroke(cr);
-    }
+    double f = c->L.font, fs = c->L.label, span, room = t->g.x1 - t->g.x0;
+    double base = R.y + R.h - 0.35 * f;
+    draw_cursor(t);
     size_t m = pdt_replay_count(c->r);
     char ax[3][160];
     int all = t->g.k0 <= 0 && t->g.k1 >= (double)m;
+    cairo_save(cr);
+    clip_rect(cr, (pdt_rect){t->g.x0, R.y, room, R.h});
+    if (m && pdt_ranktree_timed(c->tree, &span)) {
+        double st = tick_step(t, span, fs);
+        char a[32], b[32];
+        fmt_time(t->g.k0 / t->m * span, st, a, sizeof a);
+        fmt_time(t->g.k1 / t->m * span, st, b, sizeof b);
+        if (!all) { /* the window at the right end, if the ticks leave room */
+            snprintf(ax[0], sizeof ax[0], "%s … %s · rows %d–%d of %zu", a, b, t->g.row0 + 1,
+                     t->g.row0 + t->g.nshow, c->nrows);
+            double tw = text_w(cr, SANS, fs, ax[0]), lx = t->g.x1 - tw;
+            rgb(cr, c->T->panel, 0.9);
+            cairo_rectangle(cr, lx - 4, base - 0.85 * fs, tw + 4, 1.05 * fs);
+            cairo_fill(cr);
+            rgb(cr, c->T->ink, 0.75);
+            text_at(cr, SANS, 0, fs, lx, base, ax[0]);
+            place(&t->P, lx - 4, base - 0.8 * fs, tw + 4, fs);
+        }
+        draw_ticks(t, span, st, fs, base);
+        cairo_restore(cr);
+        return;
+    }
     if (all && c->nrows == (size_t)c->nranks && c->nranks <= PDT_PALETTE_HUES)
         snprintf(ax[0], sizeof ax[0], "timeline: events 0 … %zu (bars = phases, arrows = messages; click to seek)", m);
     else
@@ -319,14 +411,10 @@ static void draw_axis(tl *t)
     snprintf(ax[1], sizeof ax[1], "events %.0f … %.0f of %zu · rows %d–%d of %zu", t->g.k0, t->g.k1, m,
              t->g.row0 + 1, t->g.row0 + t->g.nshow, c->nrows);
     snprintf(ax[2], sizeof ax[2], "%.0f … %.0f / %zu", t->g.k0, t->g.k1, m);
-    /* at the label size: the longest form that fits */
-    double fs = c->L.label, room = t->g.x1 - t->g.x0;
-    int i = 0;
+    int i = 0; /* at the label size: the longest form that fits */
     while (i < 2 && text_w(cr, SANS, fs, ax[i]) > room) i++;
     rgb(cr, c->T->ink, 0.75);
-    cairo_save(cr);
-    clip_rect(cr, (pdt_rect){t->g.x0, R.y, room, R.h});
-    text_at(cr, SANS, 0, fs, t->g.x0, R.y + R.h - 0.35 * f, ax[i]);
+    text_at(cr, SANS, 0, fs, t->g.x0, base, ax[i]);
     cairo_restore(cr);
 }
 
@@ -343,6 +431,9 @@ void pdt_draw_timeline(ctx *c)
     size_t nn;
     t->N = pdt_ranktree_nodes(c->tree, &nn);
     t->scale = (t->g.x1 - t->g.x0) / (t->g.k1 - t->g.k0);
+    t->m = (double)pdt_replay_count(c->r);
+    t->pa = pdt_ranktree_phase_at(c->tree);
+    t->ma = pdt_ranktree_msg_at(c->tree);
     t->rowof = malloc((size_t)c->nranks * sizeof *t->rowof);
     if (!t->rowof) {
         free(t);
@@ -410,10 +501,9 @@ size_t pdt_render_timeline_at(const pdt_replay *r, const pdt_view *v, double w, 
     size_t n = tl_setup(r, v, w, h, &L, &g, &own, &tree, &rows), k = (size_t)-1;
     pdt_rect R = L.timeline;
     if (n && sx >= R.x && sx <= R.x + R.w && sy >= R.y && sy <= R.y + R.h) {
-        double t = (sx - g.x0) / (g.x1 - g.x0);
+        double t = (sx - g.x0) / (g.x1 - g.x0), m = (double)pdt_replay_count(r);
         t = t < 0 ? 0 : t > 1 ? 1 : t;
-        k = (size_t)(g.k0 + t * (g.k1 - g.k0) + 0.5);
-        if (k > pdt_replay_count(r)) k = pdt_replay_count(r);
+        k = m > 0 ? pdt_ranktree_event_at(tree, (g.k0 + t * (g.k1 - g.k0)) / m) : 0;
         /* in a row: that row's ranks' event nearest the clicked time */
         int i = (int)floor((sy - g.y0) / g.rh);
         if (sy >= g.y0 && i >= 0 && i < g.nshow) {
