@@ -305,6 +305,7 @@ static void key_effect(const pdt_lecture *L, const pdt_view *v, char *buf, size_
     case 'c': snprintf(buf, cap, "c: clean picture %s", on_off(v->clean)); break;
     case 'o': snprintf(buf, cap, "o: every circumcircle %s", on_off(v->circles)); break;
     case 'v': snprintf(buf, cap, "v: Voronoi diagram %s", on_off(v->voronoi)); break;
+    case '\t': snprintf(buf, cap, "Tab: %s", v->overflow ? "the panels with no room, over the picture" : "the picture again"); break;
     case 'h': snprintf(buf, cap, "h: help %s", on_off(v->help)); break;
     case 's': snprintf(buf, cap, "s: screenshot written (the terminal names the file)"); break;
     case 'm': snprintf(buf, cap, "m: mark set at event %zu (r records from here)", k); break;
@@ -459,13 +460,18 @@ void pdt_lecture_overlay(void *user, cairo_t *cr, double w, double h, const pdt_
     char eff[240];
     if (L->msg[0]) snprintf(eff, sizeof eff, "%s", L->msg);
     else key_effect(L, v, eff, sizeof eff);
-    if (eff[0]) {
-        double tw = say(cr, 0, -1, fs, 0, eff), pad = 0.4 * fs;
-        tw = fmin(tw, Ly.geo.w - 2 * pad);
+    if (eff[0] && !Ly.covered) { /* (covered: the `more` line says what Tab did) */
+        double pad = 0.4 * fs, tw = say(cr, 0, -1, fs, 0, eff), room = Ly.geo.w - 2 * pad;
+        double es = tw > room ? fmax(16, fs * room / tw) : fs; /* smaller, not under 16 px */
+        tw = fmin(say(cr, 0, -1, es, 0, eff), room);
         box(cr, Ly.geo.x, Ly.geo.y, tw + 2 * pad, 1.5 * fs, dark);
+        cairo_save(cr);
+        cairo_rectangle(cr, Ly.geo.x, Ly.geo.y, tw + 2 * pad, 1.5 * fs);
+        cairo_clip(cr);
         if (dark) cairo_set_source_rgb(cr, 0.95, 0.95, 0.95);
         else cairo_set_source_rgb(cr, 0.1, 0.1, 0.12);
-        say(cr, Ly.geo.x + pad, Ly.geo.y + 1.1 * fs, fs, 0, eff);
+        say(cr, Ly.geo.x + pad, Ly.geo.y + 0.75 * fs + 0.36 * es, es, 0, eff);
+        cairo_restore(cr);
     }
     draw_marks(cr, L, fs);
     cairo_restore(cr);

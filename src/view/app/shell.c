@@ -314,6 +314,12 @@ static int view_key(shell *sh, SDL_Keycode k, int shift)
     case SDLK_c: sh->v->clean = !sh->v->clean; return 1;
     case SDLK_o: sh->v->circles = !sh->v->circles; return 1;
     case SDLK_v: sh->v->voronoi = !sh->v->voronoi; return 1;
+    case SDLK_TAB: { /* the next page of the panels with no room, then the picture */
+        pdt_layout L;
+        pdt_render_layout_view(sh->tw, sh->th, sh->nranks, sh->v, &L);
+        sh->v->overflow = sh->v->overflow >= L.pages ? 0 : sh->v->overflow + 1;
+        return 1;
+    }
     default:
         if (k >= SDLK_1 && k <= SDLK_9) {
             int q = (int)(k - SDLK_1);
@@ -352,6 +358,8 @@ static void key(shell *sh, SDL_Keycode k, Uint16 mod)
     sh->dirty = move_key(sh, k, shift) || view_key(sh, k, shift);
 }
 
+static int in_rect(pdt_rect R, double x, double y);
+
 static void click(shell *sh, double x, double y)
 {
     size_t k = pdt_render_timeline_at(sh->r, sh->v, sh->tw, sh->th, x, y);
@@ -362,7 +370,7 @@ static void click(shell *sh, double x, double y)
     }
     pdt_layout L;
     pdt_render_layout_view(sh->tw, sh->th, sh->nranks, sh->v, &L);
-    if (x < L.geo.x || x > L.geo.x + L.geo.w || y < L.geo.y || y > L.geo.y + L.geo.h) return;
+    if (L.covered || !in_rect(L.geo, x, y)) return; /* (covered: the picture is not shown) */
     unzoom(sh);
     pdt_render_pick(sh->r, sh->s, sh->v, sh->tw, sh->th, x, y, 0.8 * L.font, &sh->v->sel_point,
                     &sh->v->sel_tri, &sh->v->sel_edge);
@@ -442,7 +450,7 @@ static void mouse(shell *sh, const SDL_Event *e)
         int mx, my;
         SDL_GetMouseState(&mx, &my);
         double x = mx * sh->sx, y = my * sh->sy;
-        if (!in_rect(L.geo, x, y)) return;
+        if (L.covered || !in_rect(L.geo, x, y)) return;
         pdt_view_zoom_at(sh->r, sh->v, sh->tw, sh->th, x, y, pow(1.2, e->wheel.y));
         sh->auto_zoom = 0; /* the user's zoom from now on */
         sh->dirty = 1;
