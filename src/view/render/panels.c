@@ -319,7 +319,7 @@ void pdt_draw_stack_panel(ctx *c)
 /* Is base row `key` one the layer of v->help_more takes over? */
 static int help_taken(const pdt_view *v, const char *key)
 {
-    static const char *const taken[] = {"1 … 9", "0", "click", "drag", "g N Enter", "b  n  p  d  e"};
+    static const char *const taken[] = {"1 … 9", "0", "click", "drag", "g N Enter", "b  n  j  p  d  e"};
     if (!v->help_more) return 0;
     for (size_t i = 0; i < sizeof taken / sizeof *taken; i++)
         if (!strcmp(key, taken[i])) return 1;
@@ -371,7 +371,7 @@ void pdt_draw_help(ctx *c, double w, double h)
         {"o  v", "all circumcircles / Voronoi diagram"},
         {"h  ?", "this help"},
         {"s", "screenshot (PNG)"},
-        {"b  n  p  d  e", "bookmark (Shift: back), notes, pointer, pen, erase"},
+        {"b  n  j  p  d  e", "bookmark (Shift: back), notes, notes page, pointer, pen, erase"},
         {"m  r", "mark an event; record mark → current as GIF/video"},
         {"Esc  q", "quit"},
     };
