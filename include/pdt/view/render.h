@@ -145,6 +145,14 @@ pdt_status pdt_render_file(const char *path, int w, int h, const pdt_replay *r,
  * pdtview names itself inside a folder: --frames). */
 pdt_status pdt_render_file_ex(const char *path, int flags, int w, int h, const pdt_replay *r,
                               const pdt_rstate *s, const pdt_view *v, pdt_err *err);
+/* What a window draws over the frame (its lecture tools, a layer): called
+ * with the frame's cairo context, size and view after pdt_render. */
+typedef void (*pdt_render_over)(void *user, cairo_t *cr, double w, double h, const pdt_view *v);
+/* pdt_render_file_ex with over(user, ...) drawn over the frame (NULL: none),
+ * so that a screenshot holds what the window shows. */
+pdt_status pdt_render_file_over(const char *path, int flags, int w, int h, const pdt_replay *r,
+                                const pdt_rstate *s, const pdt_view *v, pdt_render_over over,
+                                void *user, pdt_err *err);
 
 /* The palette (palette.c): PDT_PALETTE_HUES hues for the groups of ranks a
  * screen shows, every pair of them and of the status colours at least

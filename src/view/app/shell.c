@@ -9,6 +9,7 @@
 #include "cluster.h"
 #include "pdt/view/query.h"
 
+#include "pdt/safefile.h"
 #include "pdt/view/anim.h"
 #include "pdt/view/textlog.h"
 #include "window.h"
@@ -128,7 +129,10 @@ static int screenshot(shell *sh, const char *path)
     pdt_err err = {0};
     pdt_text_log *log = sh->v->texts; /* the report is the window's frame's */
     sh->v->texts = NULL;
-    pdt_status st = pdt_render_file(path, sh->tw, sh->th, sh->r, sh->s, sh->v, &err);
+    const pdt_shell_hook *hk = sh->o->hook; /* what the window draws over the frame too */
+    pdt_status st = pdt_render_file_over(path, PDT_SAFE_DIRECT, sh->tw, sh->th, sh->r, sh->s,
+                                         sh->v, hk ? hk->overlay : NULL, hk ? hk->user : NULL,
+                                         &err);
     sh->v->texts = log;
     if (st == PDT_OK && log) st = pdt_text_log_write(log, sh->o->layout_report, &err);
     if (st != PDT_OK) {

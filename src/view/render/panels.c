@@ -455,7 +455,8 @@ void pdt_draw_more(ctx *c)
     shown |= Ly->timeline.w > 0 ? PDT_PANEL_TIMELINE : 0;
     shown |= Ly->stack.w > 0 ? PDT_PANEL_STACK : 0;
     shown |= Ly->lifted.w > 0 ? PDT_PANEL_LIFTED : 0;
-    hidden_names(Ly->covered ? shown : Ly->hidden, names, sizeof names);
+    int n = hidden_names(Ly->covered ? shown : Ly->hidden, names, sizeof names);
+    const char *them = n > 1 ? "them" : "it";
     if (c->L.covered) {
         const char *next = c->L.covered < c->L.pages ? "Tab: next page" : "Tab: the picture";
         char pg[32] = "";
@@ -464,8 +465,8 @@ void pdt_draw_more(ctx *c)
         snprintf(t[1], sizeof t[1], "Shown%s: %s — %s", pg, names, next);
         snprintf(t[2], sizeof t[2], "%s", next);
     } else {
-        snprintf(t[0], sizeof t[0], "No room for the %s — Tab shows them over the picture", names);
-        snprintf(t[1], sizeof t[1], "No room: %s — Tab shows them", names);
+        snprintf(t[0], sizeof t[0], "No room for the %s — Tab shows %s over the picture", names, them);
+        snprintf(t[1], sizeof t[1], "No room: %s — Tab shows %s", names, them);
         snprintf(t[2], sizeof t[2], "Hidden: %s (Tab)", names);
     }
     int i = 0;
