@@ -38,6 +38,7 @@ struct pdt_lecture {
     int key, shift, ctrl;  /* the last key the shell handled (0: none) */
     char msg[200];         /* what the last key of the hook did */
     pdt_beside *beside;    /* a second run drawn beside the first, or NULL */
+    double dx, dy;         /* beside: where the left button went down */
     int page, pages;       /* the notes pane's page (j, Shift+j) and how many the step takes */
     const void *page_of;   /* the step that page is of (another step: page 0) */
     pdt_shell_hook hook;
@@ -212,15 +213,36 @@ static int own_key(pdt_lecture *L, const pdt_shell_input *in, pdt_view *v)
     }
 }
 
+/* Beside: a click (the left button down and up in place) goes to the half
+ * it falls in (pdt_beside_click), not to the whole window's layout; a drag
+ * is the shell's (it pans both). */
+static int beside_mouse(pdt_lecture *L, const pdt_shell_input *in, double w, double h, pdt_view *v)
+{
+    if (in->button != 1) return 0;
+    if (in->type == PDT_IN_DOWN) {
+        L->dx = in->x;
+        L->dy = in->y;
+        return 0;
+    }
+    if (in->type != PDT_IN_UP || fabs(in->x - L->dx) + fabs(in->y - L->dy) > 4) return 0;
+    size_t k;
+    if (pdt_beside_click(L->beside, L->r, L->s, v, w, h, in->x, in->y, &k)) {
+        pdt_replay_seek(L->r, L->s, k);
+        L->moved = 1;
+    }
+    L->down = 0;
+    return 1; /* (the shell's own click would use the whole window's layout) */
+}
+
 static int hook_input(void *user, const pdt_shell_input *in, double w, double h, pdt_view *v)
 {
     pdt_lecture *L = user;
-    (void)w, (void)h;
     if (in->type != PDT_IN_KEY) {
         int follow = L->pointer && (in->x != L->mx || in->y != L->my);
         L->mx = in->x;
         L->my = in->y;
         if (L->pen && pen_mouse(L, in)) return 1;
+        if (L->beside && beside_mouse(L, in, w, h, v)) return 1;
         if (in->type == PDT_IN_DOWN) L->down = 1;
         if (in->type == PDT_IN_UP) L->down = 0;
         /* the pointer follows the mouse: a frame for every move (while a

@@ -633,6 +633,7 @@ static int hook_input(shell *sh, const SDL_Event *e)
     in.ctrl = (mod & KMOD_CTRL) != 0;
     in.shift = (mod & KMOD_SHIFT) != 0;
     if (!hk->input(hk->user, &in, sh->tw, sh->th, sh->v)) return 0;
+    if (in.type == PDT_IN_UP && in.button == 1) sh->down = 0; /* (its click: no drag after) */
     sh->dirty = 1;
     return 1;
 }
