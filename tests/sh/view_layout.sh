@@ -65,17 +65,50 @@ for sz in 1024x768 1920x1080; do
 done
 
 # the legend's groups and the timeline's rows of a 64-rank run, held to the
-# same rules: the legend flows its groups into rows and is given their height
-# (at font scale 2 the timeline gives its room to the column)
+# same rules: the legend flows its groups into rows and is given their height,
+# or, with no room for it, is named on the bottom line (Tab shows it)
 for sz in 1024x768 1920x1080; do
     for fs in 1 1.5 2; do
         n=ranks_64_${sz}_$(echo $fs | tr . _)
-        tl="--panel timeline"; [ $fs = 2 ] && tl=
         "$V" --headless synth:srm:128:4:64 --end -o "$TMP/$n.png" --size $sz --font-scale $fs --layout-report "$TMP/$n.json" --quiet
-        if $CHECK --min-px 16 --min-big 18 --panel legend $tl "$TMP/$n.json" >"$TMP/$n.out"; then
+        want=$(python3 - "$TMP/$n.json" <<'EOF2'
+import json, sys
+d = json.load(open(sys.argv[1]))
+more = " ".join(t["text"] for t in d["texts"] if t["panel"] == "more")
+for p in ("legend", "timeline"):
+    if p in d["hidden"]:
+        assert p in more and "Tab" in more, f"{p} hidden, not named: {more!r}"
+        assert p not in d["panels"], p
+    else:
+        print("--panel", p)
+EOF2
+) || { fail "readable_legend_timeline_$n" "hidden panel not named"; continue; }
+        if $CHECK --min-px 16 --min-big 18 $want "$TMP/$n.json" >"$TMP/$n.out"; then
             ok "readable_legend_timeline_$n"
         else fail "readable_legend_timeline_$n" "$(head -4 "$TMP/$n.out")"; fi
     done
+done
+
+# a projector at font scale 2, every panel asked for: the picture keeps a
+# fair share (a third of the room under the top bar), the panels with no
+# room are named on the bottom line with the key that shows them
+for spec in "synth:srm:8:8:4 --phase merge" "synth:graham:40 --at 60" "synth:srm:128:4:64 --end"; do
+    n=share_$(echo "$spec" | tr -c 'a-z0-9\n' _)
+    "$V" --headless $spec -o "$TMP/$n.png" --size 1024x768 --font-scale 2 --layout-report "$TMP/$n.json" --quiet
+    if python3 - "$TMP/$n.json" >"$TMP/$n.out" 2>&1 <<'EOF2'
+import json, sys
+d = json.load(open(sys.argv[1]))
+P = d["panels"]
+top = P["event"][3]
+x, y, w, h = P["picture"]
+assert w * h >= 0.33 * d["width"] * (d["height"] - top), f"picture {w}x{h}"
+more = " ".join(t["text"] for t in d["texts"] if t["panel"] == "more")
+names = {"legend": "legend", "timeline": "timeline", "stack": "stacks", "lifted": "lifted"}
+for p in d["hidden"]:
+    assert names[p] in more and "Tab" in more, (p, more)
+assert not d["hidden"] or "more" in P
+EOF2
+    then ok "fair_share_$n"; else fail "fair_share_$n" "$(tail -2 "$TMP/$n.out")"; fi
 done
 
 summary

@@ -42,6 +42,17 @@ else fail bad_bookmarks_refused_with_line "exit $rc: $(cat "$TMP/bad.err")"; fi
 "$V" "$RUN" --beside synth:srm:12:6:1 --size ${W}x${H} --panels none \
      --script "pgdn pgdn pgdn wait:3 s q" --screenshot "$TMP/bs.png" >/dev/null 2>"$TMP/bs.err"; rc=$?
 if [ "$rc" = 0 ] && [ -s "$TMP/bs.png" ]; then ok beside_opens_and_steps; else fail beside_opens_and_steps "exit $rc: $(cat "$TMP/bs.err")"; fi
+# a click goes to the half it falls in: near the right end of the left half's
+# timeline is near the end of the run (the whole window's timeline would put
+# it near the middle); on the right half's timeline, the left run follows to
+# that phase; on the right picture, it does not move
+"$V" "$RUN" --beside synth:srm:12:6:1 --size ${W}x${H} --panels timeline --screenshot "$TMP/bc.png" \
+     --script "end wait:2 s home wait:2 click:$((W / 2 - 30)),$((H - 40)) wait:2 s click:$((W - 30)),$((H - 40)) wait:2 s click:$((W * 3 / 4)),$((H / 3)) wait:2 s q" \
+     >/dev/null 2>"$TMP/bc.err"
+set -- $(events "$TMP/bc.err")
+if [ $# -ge 4 ] && [ "$2" -ge $(($1 * 7 / 10)) ] && [ "$2" -lt "$1" ] && [ "$3" -gt 0 ] && [ "$4" = "$3" ]
+then ok beside_click_in_its_half
+else fail beside_click_in_its_half "events: $* (end, left timeline, right timeline, right picture)"; fi
 "$V" "$RUN" --beside "$TMP/no-such-run" --script q >/dev/null 2>"$TMP/bs2.err"; rc=$?
 if [ "$rc" = 2 ] && grep -q "no-such-run" "$TMP/bs2.err"; then ok beside_bad_run_refused
 else fail beside_bad_run_refused "exit $rc: $(cat "$TMP/bs2.err")"; fi

@@ -54,6 +54,9 @@ typedef struct pdt_view {
                                * (0 and 1: all of them) */
     int tl_row0;              /* the timeline's first row shown */
     int follow;               /* keep the current event's region in view (pdt_view_follow) */
+    int overflow;             /* 0, or page 1 .. pdt_layout.pages of the panels that got no
+                               * room (pdt_layout.hidden), shown over the picture and the
+                               * column in place of them (Tab) */
     struct pdt_text_log *texts; /* the layout report of the last frame drawn
                            * (pdt/view/textlog.h), or NULL */
 } pdt_view;
@@ -79,7 +82,8 @@ enum {
     PDT_PANEL_TIMELINE = 8, /* timeline */
     PDT_PANEL_ALL = 15,     /* the panels "all" names (the tree is named on its own) */
     PDT_PANEL_TREE = 16,    /* the merge tree */
-    PDT_PANEL_NOTES = 32    /* the lesson's notes (drawn by the window's lecture tools) */
+    PDT_PANEL_NOTES = 32,   /* the lesson's notes (drawn by the window's lecture tools) */
+    PDT_PANEL_LEGEND = 64   /* the legend: always asked for; only pdt_layout.hidden has it */
 };
 
 /* Parse a comma-separated list of panel names ("code,stack,lifted,timeline",
@@ -97,6 +101,16 @@ typedef struct pdt_layout {
     double label;         /* point and box labels, pixels */
     pdt_rect top, geo, legend, code, stack, lifted, timeline;
     pdt_rect tree;        /* the merge tree (PDT_PANEL_TREE), or zero-sized */
+    unsigned hidden;      /* PDT_PANEL_* bits asked for (the legend always) that got no
+                           * room at this size and font: named in `more` */
+    pdt_rect more;        /* the line naming the hidden panels and the key (Tab) that
+                           * shows them, at the bottom; zero-sized when none is hidden */
+    int covered;          /* 0, or the page of hidden panels drawn over the picture and
+                           * the column (pdt_view.overflow): the picture is then neither
+                           * drawn nor clicked */
+    int pages;            /* how many pages the hidden panels take (0: none hidden) */
+    int legend_mode;      /* the legend: 0 a side panel, 1 a strip under the picture,
+                           * 2 a strip across the picture and the column */
 } pdt_layout;
 
 /* Defaults: fit, all ranks, yaw 30°, pitch 25°, fade 400 events, font scale 1,
@@ -131,6 +145,14 @@ pdt_status pdt_render_file(const char *path, int w, int h, const pdt_replay *r,
  * pdtview names itself inside a folder: --frames). */
 pdt_status pdt_render_file_ex(const char *path, int flags, int w, int h, const pdt_replay *r,
                               const pdt_rstate *s, const pdt_view *v, pdt_err *err);
+/* What a window draws over the frame (its lecture tools, a layer): called
+ * with the frame's cairo context, size and view after pdt_render. */
+typedef void (*pdt_render_over)(void *user, cairo_t *cr, double w, double h, const pdt_view *v);
+/* pdt_render_file_ex with over(user, ...) drawn over the frame (NULL: none),
+ * so that a screenshot holds what the window shows. */
+pdt_status pdt_render_file_over(const char *path, int flags, int w, int h, const pdt_replay *r,
+                                const pdt_rstate *s, const pdt_view *v, pdt_render_over over,
+                                void *user, pdt_err *err);
 
 /* The palette (palette.c): PDT_PALETTE_HUES hues for the groups of ranks a
  * screen shows, every pair of them and of the status colours at least

@@ -23,6 +23,8 @@ struct pdt_beside {
     pdt_phase_stop a[MAX_STOPS], b[MAX_STOPS];
     size_t na, nb;
     const pdt_replay *ra; /* the replay a[] belongs to */
+    int64_t sel_point, sel_tri; /* the right run's selection (a click on its half) */
+    int sel_edge;
 };
 
 pdt_beside *pdt_beside_new(const pdt_replay *r2, pdt_rstate *s2)
@@ -31,6 +33,8 @@ pdt_beside *pdt_beside_new(const pdt_replay *r2, pdt_rstate *s2)
     if (!B) return NULL;
     B->r = r2;
     B->s = s2;
+    B->sel_point = B->sel_tri = -1;
+    B->sel_edge = -1;
     B->nb = pdt_replay_phase_stops(r2, B->b, MAX_STOPS);
     if (B->nb > MAX_STOPS) B->nb = MAX_STOPS;
     return B;
@@ -74,6 +78,51 @@ static size_t follow(const pdt_beside *B, size_t k, size_t ma)
     return from_b + (size_t)floor(f * (double)(to_b - from_b));
 }
 
+/* The stops of r (into st, at most MAX_STOPS). */
+static size_t stops_of(const pdt_replay *r, pdt_phase_stop *st)
+{
+    size_t n = pdt_replay_phase_stops(r, st, MAX_STOPS);
+    return n > MAX_STOPS ? MAX_STOPS : n;
+}
+
+int pdt_beside_click(pdt_beside *B, const pdt_replay *ra, const pdt_rstate *sa, pdt_view *v,
+                     double w, double h, double x, double y, size_t *seek)
+{
+    double hw = floor(w / 2);
+    int side = x >= hw;
+    const pdt_replay *r = side ? B->r : ra;
+    double lx = side ? x - hw : x;
+    size_t k = pdt_render_timeline_at(r, v, hw, h, lx, y);
+    if (k != (size_t)-1) {
+        if (!side) {
+            *seek = k;
+            return 1;
+        }
+        /* the right run's phase at k: the first run goes to that phase */
+        if (B->ra != ra) B->ra = ra, B->na = stops_of(ra, B->a);
+        long j = -1;
+        for (size_t i = 0; i < B->nb && B->b[i].k <= k; i++) j = (long)i;
+        *seek = 0;
+        for (size_t i = 0; j >= 0 && i < B->na; i++)
+            if (match(B, i) == j) {
+                *seek = B->a[i].k;
+                break;
+            }
+        return 1;
+    }
+    pdt_layout L;
+    pdt_render_layout_view(hw, h, pdt_replay_nranks(r), v, &L);
+    if (L.covered || lx < L.geo.x || lx > L.geo.x + L.geo.w || y < L.geo.y || y > L.geo.y + L.geo.h)
+        return 0;
+    if (side)
+        pdt_render_pick(B->r, B->s, v, hw, h, lx, y, 0.8 * L.font, &B->sel_point, &B->sel_tri,
+                        &B->sel_edge);
+    else
+        pdt_render_pick(ra, sa, v, hw, h, lx, y, 0.8 * L.font, &v->sel_point, &v->sel_tri,
+                        &v->sel_edge);
+    return 0;
+}
+
 void pdt_beside_draw(pdt_beside *B, cairo_t *cr, double w, double h, const pdt_replay *ra,
                      const pdt_rstate *sa, const pdt_view *v)
 {
@@ -88,10 +137,12 @@ void pdt_beside_draw(pdt_beside *B, cairo_t *cr, double w, double h, const pdt_r
     pdt_err err = {0};
     for (int side = 0; side < 2; side++) {
         pdt_view vv = *v;
-        if (side) { /* the selection and hidden ranks belong to the first run */
+        if (side) { /* the hidden ranks belong to the first run; the right has its own
+                     * selection */
             vv.hidden = NULL;
-            vv.sel_point = vv.sel_tri = -1;
-            vv.sel_edge = -1;
+            vv.sel_point = B->sel_point;
+            vv.sel_tri = B->sel_tri;
+            vv.sel_edge = B->sel_edge;
         }
         cairo_save(cr);
         cairo_rectangle(cr, side * hw, 0, hw, h);

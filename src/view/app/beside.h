@@ -20,4 +20,14 @@ void pdt_beside_free(pdt_beside *B);
 void pdt_beside_draw(pdt_beside *B, cairo_t *cr, double w, double h, const pdt_replay *ra,
                      const pdt_rstate *sa, const pdt_view *v);
 
+/* A left-button click at (x, y) of the w x h window, routed to the half it
+ * falls in, laid out as that half is drawn: a click on a timeline seeks
+ * (the right run's timeline: the first run goes to the phase stop of the
+ * same name at or before the event clicked), a click on a picture selects a
+ * point, edge or triangle of that half's run (the right run's selection is
+ * its own).  Returns 1 and sets *seek (the first run's new cursor) when the
+ * cursor moves, 0 when it does not. */
+int pdt_beside_click(pdt_beside *B, const pdt_replay *ra, const pdt_rstate *sa, pdt_view *v,
+                     double w, double h, double x, double y, size_t *seek);
+
 #endif

@@ -2,7 +2,7 @@
  * the notes pane, a pointer, a pen, and a line that says what each key did.
  *
  * They are a shell hook (shell.h) like the editor: the hook sees every key
- * and mouse event first, takes its own (b, Shift+b, n, p, d, e; the mouse
+ * and mouse event first, takes its own (b, Shift+b, n, j, p, d, e; the mouse
  * while the pen is on) and lets the others through, remembering the key so
  * that the overlay can say what it did, from the state the frame shows. */
 #include "lecture.h"
@@ -38,6 +38,9 @@ struct pdt_lecture {
     int key, shift, ctrl;  /* the last key the shell handled (0: none) */
     char msg[200];         /* what the last key of the hook did */
     pdt_beside *beside;    /* a second run drawn beside the first, or NULL */
+    double dx, dy;         /* beside: where the left button went down */
+    int page, pages;       /* the notes pane's page (j, Shift+j) and how many the step takes */
+    const void *page_of;   /* the step that page is of (another step: page 0) */
     pdt_shell_hook hook;
 };
 
@@ -197,6 +200,11 @@ static int own_key(pdt_lecture *L, const pdt_shell_input *in, pdt_view *v)
         L->pen = !L->pen;
         snprintf(L->msg, sizeof L->msg, "d: pen %s", L->pen ? "on: drag to draw (e erases, d again: off)" : "off: drag pans again");
         return 1;
+    case 'j':
+        if (L->pages > 1) L->page = (L->page + (in->shift ? L->pages - 1 : 1)) % L->pages;
+        snprintf(L->msg, sizeof L->msg, "%s: notes page %d of %d", in->shift ? "Shift+j" : "j",
+                 L->page + 1, L->pages > 0 ? L->pages : 1);
+        return 1;
     case 'e':
         L->np = 0;
         snprintf(L->msg, sizeof L->msg, "e: drawing erased");
@@ -205,15 +213,36 @@ static int own_key(pdt_lecture *L, const pdt_shell_input *in, pdt_view *v)
     }
 }
 
+/* Beside: a click (the left button down and up in place) goes to the half
+ * it falls in (pdt_beside_click), not to the whole window's layout; a drag
+ * is the shell's (it pans both). */
+static int beside_mouse(pdt_lecture *L, const pdt_shell_input *in, double w, double h, pdt_view *v)
+{
+    if (in->button != 1) return 0;
+    if (in->type == PDT_IN_DOWN) {
+        L->dx = in->x;
+        L->dy = in->y;
+        return 0;
+    }
+    if (in->type != PDT_IN_UP || fabs(in->x - L->dx) + fabs(in->y - L->dy) > 4) return 0;
+    size_t k;
+    if (pdt_beside_click(L->beside, L->r, L->s, v, w, h, in->x, in->y, &k)) {
+        pdt_replay_seek(L->r, L->s, k);
+        L->moved = 1;
+    }
+    L->down = 0;
+    return 1; /* (the shell's own click would use the whole window's layout) */
+}
+
 static int hook_input(void *user, const pdt_shell_input *in, double w, double h, pdt_view *v)
 {
     pdt_lecture *L = user;
-    (void)w, (void)h;
     if (in->type != PDT_IN_KEY) {
         int follow = L->pointer && (in->x != L->mx || in->y != L->my);
         L->mx = in->x;
         L->my = in->y;
         if (L->pen && pen_mouse(L, in)) return 1;
+        if (L->beside && beside_mouse(L, in, w, h, v)) return 1;
         if (in->type == PDT_IN_DOWN) L->down = 1;
         if (in->type == PDT_IN_UP) L->down = 0;
         /* the pointer follows the mouse: a frame for every move (while a
@@ -305,6 +334,7 @@ static void key_effect(const pdt_lecture *L, const pdt_view *v, char *buf, size_
     case 'c': snprintf(buf, cap, "c: clean picture %s", on_off(v->clean)); break;
     case 'o': snprintf(buf, cap, "o: every circumcircle %s", on_off(v->circles)); break;
     case 'v': snprintf(buf, cap, "v: Voronoi diagram %s", on_off(v->voronoi)); break;
+    case '\t': snprintf(buf, cap, "Tab: %s", v->overflow ? "the panels with no room, over the picture" : "the picture again"); break;
     case 'h': snprintf(buf, cap, "h: help %s", on_off(v->help)); break;
     case 's': snprintf(buf, cap, "s: screenshot written (the terminal names the file)"); break;
     case 'm': snprintf(buf, cap, "m: mark set at event %zu (r records from here)", k); break;
@@ -339,13 +369,15 @@ static double say(cairo_t *cr, double x, double y, double fs, int bold, const ch
     return te.x_advance;
 }
 
-/* The text wrapped into width wd from (x, y), lines lh apart, no lower
- * than ymax; the y after the last line (draw = 0: only measure). */
-static double wrap(cairo_t *cr, const char *text, double x, double y, double wd, double fs,
-                   double ymax, int draw)
+/* The text wrapped into width wd from (x, y), lines lh apart: its lines
+ * from `skip` on drawn, no lower than ymax (draw = 0: only measure); the
+ * number of lines in *nlines (NULL: not wanted). */
+static void wrap(cairo_t *cr, const char *text, double x, double y, double wd, double fs,
+                 double ymax, int draw, int skip, int *nlines)
 {
     char line[1300] = "", word[256];
     double lh = 1.3 * fs;
+    int no = 0;
     const char *p = text;
     while (*p) {
         size_t n = strcspn(p, " ");
@@ -359,8 +391,10 @@ static double wrap(cairo_t *cr, const char *text, double x, double y, double wd,
         char next[1600];
         snprintf(next, sizeof next, "%s%s%s", line, *line ? " " : "", word);
         if (*line && say(cr, 0, -1, fs, 0, next) > wd) {
-            if (draw && y <= ymax) say(cr, x, y, fs, 0, line);
-            y += lh;
+            if (no++ >= skip) {
+                if (draw && y <= ymax) say(cr, x, y, fs, 0, line);
+                y += lh;
+            }
             snprintf(line, sizeof line, "%s", word);
         } else {
             size_t n2 = strlen(next) < sizeof line ? strlen(next) : sizeof line - 1;
@@ -368,8 +402,8 @@ static double wrap(cairo_t *cr, const char *text, double x, double y, double wd,
             line[n2] = 0;
         }
     }
-    if (*line && draw && y <= ymax) say(cr, x, y, fs, 0, line);
-    return *line ? y + lh : y;
+    if (*line && no++ >= skip && draw && y <= ymax) say(cr, x, y, fs, 0, line);
+    if (nlines) *nlines = no;
 }
 
 static void box(cairo_t *cr, double x, double y, double w, double h, int dark)
@@ -383,11 +417,26 @@ static void box(cairo_t *cr, double x, double y, double w, double h, int dark)
     cairo_stroke(cr);
 }
 
-/* The bookmarks in a row, the current one bold; the y of the next row. */
+/* The bookmarks in a row, the current one bold; the y of the next row.
+ * When they would take more than two rows: only the current one. */
 static double mark_row(cairo_t *cr, const pdt_lecture *L, const mark *now, double x, double y,
                        double wd, double fs)
 {
-    double cx = x + say(cr, x, y, fs, 1, "Bookmarks (b, Shift+b):  ");
+    double y1 = y, cx = x + say(cr, x, -1, fs, 1, "Bookmarks (b, Shift+b):  ");
+    for (size_t i = 0; i < L->nm; i++) { /* measure */
+        char t[96];
+        snprintf(t, sizeof t, "%s%s", L->m[i].title, i + 1 < L->nm ? " · " : "");
+        double tw = say(cr, 0, -1, fs, &L->m[i] == now, t);
+        if (cx + tw > x + wd) y1 += 1.3 * fs, cx = x;
+        cx += tw;
+    }
+    if (y1 - y > 1.5 * fs) { /* three rows or more */
+        char t[160];
+        snprintf(t, sizeof t, "bookmark %zu of %zu (b)", now ? (size_t)(now - L->m) + 1 : 0, L->nm);
+        if (y >= 0) say(cr, x, y, fs, 1, t);
+        return y + 1.5 * fs;
+    }
+    cx = x + say(cr, x, y, fs, 1, "Bookmarks (b, Shift+b):  ");
     for (size_t i = 0; i < L->nm; i++) {
         char t[96];
         snprintf(t, sizeof t, "%s%s", L->m[i].title, i + 1 < L->nm ? " · " : "");
@@ -401,16 +450,27 @@ static double mark_row(cairo_t *cr, const pdt_lecture *L, const mark *now, doubl
     return y + 1.5 * fs;
 }
 
-/* The notes pane: the bookmarks, then the text of the step shown. */
-static void draw_notes(cairo_t *cr, const pdt_lecture *L, pdt_rect G, double fs, int dark)
+/* The notes pane: the bookmarks, then the text of the step shown, in at
+ * most 40 % of the picture's height: a longer text goes in pages (j,
+ * Shift+j), its last line saying so. */
+static void draw_notes(cairo_t *cr, pdt_lecture *L, pdt_rect G, double fs, int dark)
 {
     const mark *now = note_now(L);
-    double pad = 0.6 * fs, wd = G.w - 2 * pad, hmax = 0.4 * G.h;
+    double pad = 0.6 * fs, wd = G.w - 2 * pad, hmax = 0.4 * G.h, lh = 1.3 * fs;
     const char *text = now && *now->text ? now->text
                                          : "(no step of the lesson before this moment)";
-    double need = mark_row(cr, L, now, 0, -1e9, wd, fs) + 1e9 +
-                  wrap(cr, text, 0, 0, wd, fs, 1e9, 0) + 2 * pad;
+    if (L->page_of != now) L->page = 0, L->page_of = now;
+    int total;
+    wrap(cr, text, 0, 0, wd, fs, 1e9, 0, 0, &total);
+    double head = mark_row(cr, L, now, 0, -1e9, wd, fs) + 1e9 + (now ? lh : 0);
+    double need = head + total * lh + 2 * pad;
+    hmax = fmin(G.h, fmax(hmax, head + 4 * lh + 2 * pad)); /* four text lines at least */
     double h = fmin(need, hmax), y0 = G.y + G.h - h;
+    int fit = (int)floor((h - pad - 1.3 * fs - head) / lh) + 1; /* text lines that fit */
+    if (fit < 2) fit = 2;
+    int per = total > fit ? fit - 1 : fit; /* one line says "more…" */
+    L->pages = (total + per - 1) / per;
+    if (L->page >= L->pages) L->page = 0;
     box(cr, G.x, y0, G.w, h, dark);
     cairo_save(cr);
     cairo_rectangle(cr, G.x, y0, G.w, h);
@@ -418,8 +478,16 @@ static void draw_notes(cairo_t *cr, const pdt_lecture *L, pdt_rect G, double fs,
     if (dark) cairo_set_source_rgb(cr, 0.95, 0.95, 0.95);
     else cairo_set_source_rgb(cr, 0.1, 0.1, 0.12);
     double y = mark_row(cr, L, now, G.x + pad, y0 + pad + fs, wd, fs);
-    if (now) say(cr, G.x + pad, y, fs, 1, now->title), y += 1.3 * fs;
-    wrap(cr, text, G.x + pad, y, wd, fs, y0 + h - 0.3 * fs, 1);
+    if (now) say(cr, G.x + pad, y, fs, 1, now->title), y += lh;
+    double ytext = y;
+    wrap(cr, text, G.x + pad, y, wd, fs, ytext + (per - 1) * lh + 1, 1, L->page * per, NULL);
+    if (L->pages > 1) {
+        char more[96];
+        snprintf(more, sizeof more, L->page + 1 < L->pages ? "more… j (page %d of %d)"
+                                                          : "j: first page (%d of %d)",
+                 L->page + 1, L->pages);
+        say(cr, G.x + pad, ytext + per * lh, fs, 1, more);
+    }
     cairo_restore(cr);
 }
 
@@ -455,17 +523,25 @@ void pdt_lecture_overlay(void *user, cairo_t *cr, double w, double h, const pdt_
     int dark = v->theme != PDT_THEME_LIGHT;
     if (L->beside) pdt_beside_draw(L->beside, cr, w, h, L->r, L->s, v);
     cairo_save(cr);
-    if (v->panels & PDT_PANEL_NOTES) draw_notes(cr, L, Ly.geo, fs, dark);
+    pdt_rect G = Ly.geo; /* a narrow picture: the notes over the column too */
+    if (G.w < 0.6 * w) G.w = w - G.x;
+    if (v->panels & PDT_PANEL_NOTES) draw_notes(cr, L, G, fs, dark);
+    else L->pages = 0;
     char eff[240];
     if (L->msg[0]) snprintf(eff, sizeof eff, "%s", L->msg);
     else key_effect(L, v, eff, sizeof eff);
-    if (eff[0]) {
-        double tw = say(cr, 0, -1, fs, 0, eff), pad = 0.4 * fs;
-        tw = fmin(tw, Ly.geo.w - 2 * pad);
+    if (eff[0] && !Ly.covered) { /* (covered: the `more` line says what Tab did) */
+        double pad = 0.4 * fs, tw = say(cr, 0, -1, fs, 0, eff), room = Ly.geo.w - 2 * pad;
+        double es = tw > room ? fmax(16, fs * room / tw) : fs; /* smaller, not under 16 px */
+        tw = fmin(say(cr, 0, -1, es, 0, eff), room);
         box(cr, Ly.geo.x, Ly.geo.y, tw + 2 * pad, 1.5 * fs, dark);
+        cairo_save(cr);
+        cairo_rectangle(cr, Ly.geo.x, Ly.geo.y, tw + 2 * pad, 1.5 * fs);
+        cairo_clip(cr);
         if (dark) cairo_set_source_rgb(cr, 0.95, 0.95, 0.95);
         else cairo_set_source_rgb(cr, 0.1, 0.1, 0.12);
-        say(cr, Ly.geo.x + pad, Ly.geo.y + 1.1 * fs, fs, 0, eff);
+        say(cr, Ly.geo.x + pad, Ly.geo.y + 0.75 * fs + 0.36 * es, es, 0, eff);
+        cairo_restore(cr);
     }
     draw_marks(cr, L, fs);
     cairo_restore(cr);

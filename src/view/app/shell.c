@@ -9,6 +9,7 @@
 #include "cluster.h"
 #include "pdt/view/query.h"
 
+#include "pdt/safefile.h"
 #include "pdt/view/anim.h"
 #include "pdt/view/textlog.h"
 #include "window.h"
@@ -128,7 +129,10 @@ static int screenshot(shell *sh, const char *path)
     pdt_err err = {0};
     pdt_text_log *log = sh->v->texts; /* the report is the window's frame's */
     sh->v->texts = NULL;
-    pdt_status st = pdt_render_file(path, sh->tw, sh->th, sh->r, sh->s, sh->v, &err);
+    const pdt_shell_hook *hk = sh->o->hook; /* what the window draws over the frame too */
+    pdt_status st = pdt_render_file_over(path, PDT_SAFE_DIRECT, sh->tw, sh->th, sh->r, sh->s,
+                                         sh->v, hk ? hk->overlay : NULL, hk ? hk->user : NULL,
+                                         &err);
     sh->v->texts = log;
     if (st == PDT_OK && log) st = pdt_text_log_write(log, sh->o->layout_report, &err);
     if (st != PDT_OK) {
@@ -314,6 +318,12 @@ static int view_key(shell *sh, SDL_Keycode k, int shift)
     case SDLK_c: sh->v->clean = !sh->v->clean; return 1;
     case SDLK_o: sh->v->circles = !sh->v->circles; return 1;
     case SDLK_v: sh->v->voronoi = !sh->v->voronoi; return 1;
+    case SDLK_TAB: { /* the next page of the panels with no room, then the picture */
+        pdt_layout L;
+        pdt_render_layout_view(sh->tw, sh->th, sh->nranks, sh->v, &L);
+        sh->v->overflow = sh->v->overflow >= L.pages ? 0 : sh->v->overflow + 1;
+        return 1;
+    }
     default:
         if (k >= SDLK_1 && k <= SDLK_9) {
             int q = (int)(k - SDLK_1);
@@ -352,6 +362,8 @@ static void key(shell *sh, SDL_Keycode k, Uint16 mod)
     sh->dirty = move_key(sh, k, shift) || view_key(sh, k, shift);
 }
 
+static int in_rect(pdt_rect R, double x, double y);
+
 static void click(shell *sh, double x, double y)
 {
     size_t k = pdt_render_timeline_at(sh->r, sh->v, sh->tw, sh->th, x, y);
@@ -362,7 +374,7 @@ static void click(shell *sh, double x, double y)
     }
     pdt_layout L;
     pdt_render_layout_view(sh->tw, sh->th, sh->nranks, sh->v, &L);
-    if (x < L.geo.x || x > L.geo.x + L.geo.w || y < L.geo.y || y > L.geo.y + L.geo.h) return;
+    if (L.covered || !in_rect(L.geo, x, y)) return; /* (covered: the picture is not shown) */
     unzoom(sh);
     pdt_render_pick(sh->r, sh->s, sh->v, sh->tw, sh->th, x, y, 0.8 * L.font, &sh->v->sel_point,
                     &sh->v->sel_tri, &sh->v->sel_edge);
@@ -442,7 +454,7 @@ static void mouse(shell *sh, const SDL_Event *e)
         int mx, my;
         SDL_GetMouseState(&mx, &my);
         double x = mx * sh->sx, y = my * sh->sy;
-        if (!in_rect(L.geo, x, y)) return;
+        if (L.covered || !in_rect(L.geo, x, y)) return;
         pdt_view_zoom_at(sh->r, sh->v, sh->tw, sh->th, x, y, pow(1.2, e->wheel.y));
         sh->auto_zoom = 0; /* the user's zoom from now on */
         sh->dirty = 1;
@@ -621,6 +633,7 @@ static int hook_input(shell *sh, const SDL_Event *e)
     in.ctrl = (mod & KMOD_CTRL) != 0;
     in.shift = (mod & KMOD_SHIFT) != 0;
     if (!hk->input(hk->user, &in, sh->tw, sh->th, sh->v)) return 0;
+    if (in.type == PDT_IN_UP && in.button == 1) sh->down = 0; /* (its click: no drag after) */
     sh->dirty = 1;
     return 1;
 }

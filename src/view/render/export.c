@@ -62,6 +62,13 @@ static pdt_status cairo_failed(const char *path, cairo_status_t cs, const sink *
 pdt_status pdt_render_file_ex(const char *path, int flags, int w, int h, const pdt_replay *r,
                               const pdt_rstate *s, const pdt_view *v, pdt_err *err)
 {
+    return pdt_render_file_over(path, flags, w, h, r, s, v, NULL, NULL, err);
+}
+
+pdt_status pdt_render_file_over(const char *path, int flags, int w, int h, const pdt_replay *r,
+                                const pdt_rstate *s, const pdt_view *v, pdt_render_over over,
+                                void *user, pdt_err *err)
+{
     sink k = {-1, 0};
     int png;
     if (!ends_with(path, ".png") && !ends_with(path, ".svg") && !ends_with(path, ".pdf"))
@@ -80,6 +87,7 @@ pdt_status pdt_render_file_ex(const char *path, int flags, int w, int h, const p
     }
     cairo_t *cr = cairo_create(sf);
     st = pdt_render(cr, w, h, r, s, v, err);
+    if (st == PDT_OK && over) over(user, cr, w, h, v);
     cairo_destroy(cr);
     if (st == PDT_OK && png) {
         cairo_status_t cs = cairo_surface_write_to_png_stream(sf, sink_write, &k);

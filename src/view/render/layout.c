@@ -4,7 +4,9 @@
 
 static void layout_round(pdt_layout *L);
 static void layout_column(double w, double h, double top, double tl, int nranks, unsigned panels,
-                          pdt_layout *L);
+                          int strip_ok, pdt_layout *L);
+static void layout_all(double w, double h, int nranks, unsigned panels, double scale,
+                       int overflow, pdt_layout *L);
 
 /* ---- view and layout ----------------------------------------------------------- */
 
@@ -70,7 +72,8 @@ void pdt_render_layout_panels(double w, double h, int nranks, unsigned panels, p
 
 void pdt_render_layout_view(double w, double h, int nranks, const pdt_view *v, pdt_layout *L)
 {
-    pdt_render_layout_scaled(w, h, nranks, v ? v->panels : PDT_PANEL_ALL, v ? v->font_scale : 1, L);
+    layout_all(w, h, nranks, v ? v->panels : PDT_PANEL_ALL, v ? v->font_scale : 1,
+               v ? v->overflow : 0, L);
 }
 
 /* The text sizes for a w x h picture at font scale `scale`: the base font
@@ -140,46 +143,137 @@ static void column_split(double rest, const column *C, int code, int stack, int 
     else *hc += extra;
 }
 
+/* A legend strip taller than this share of the height would leave a small
+ * picture: the legend is hidden instead (named on the `more` line, Tab). */
+#define STRIP_MAX 0.2
+/* The picture's fair share of the room under the top bar (area). */
+#define PICTURE_SHARE 0.35
+
 /* No side column: the picture takes the whole width, the legend is a strip
  * under it (its items flow in rows). */
 static void layout_strip(double w, double h, double top, double tl, int nranks, pdt_layout *L)
 {
     double leg = pdt_legend_height(L, nranks, w, 1);
+    if (leg > STRIP_MAX * h) {
+        leg = 0;
+        L->hidden |= PDT_PANEL_LEGEND;
+    }
     double mid = h - tl - top - leg;
+    L->legend_mode = 1;
     L->top = (pdt_rect){0, 0, w, top};
     L->geo = (pdt_rect){0, top, w, mid};
-    L->legend = (pdt_rect){0, top + mid, w, leg};
+    L->legend = (pdt_rect){0, top + mid, leg > 0 ? w : 0, leg};
     L->timeline = (pdt_rect){0, h - tl, tl > 0 ? w : 0, tl};
     L->code = L->stack = L->lifted = (pdt_rect){w, top, 0, 0};
+}
+
+/* The timeline's height: its rows hold their labels (1.7 x the label
+ * size), up to 16 rows, within 30 % of the height. */
+static double timeline_height(const pdt_layout *L, int nranks, double h)
+{
+    int rows = nranks < 1 ? 1 : nranks > 16 ? 16 : nranks;
+    return fmin(1.7 * L->font + rows * 1.7 * L->label, 0.3 * h);
+}
+
+/* The whole layout for h high (the `more` line under it excluded). */
+static void layout_pass(double w, double h, int nranks, unsigned panels, pdt_layout *L)
+{
+    double top = pdt_layout_top_height(L);
+    double tl = panels & PDT_PANEL_TIMELINE ? timeline_height(L, nranks, h) : 0;
+    L->hidden = 0;
+    if (!(panels & (PDT_PANEL_CODE | PDT_PANEL_STACK | PDT_PANEL_LIFTED))) {
+        layout_strip(w, h, top, tl, nranks, L);
+        pdt_layout_tree_strip(L, panels, w, h);
+        return;
+    }
+    layout_column(w, h, top, tl, nranks, panels, 1, L);
+    /* a legend strip that leaves the picture less than its fair share of
+     * the room under the top bar: the legend is hidden instead */
+    if (L->legend.w > 0 && L->legend_mode == 2 &&
+        L->geo.w * L->geo.h < PICTURE_SHARE * w * (h - top)) {
+        L->hidden = 0;
+        layout_column(w, h, top, tl, nranks, panels, 0, L);
+    }
+}
+
+/* The pages Tab shows the hidden panels on, over the picture and the
+ * column (from under the top bar to the `more` line): the legend, the
+ * stacks and the lifted view on the first, the timeline on its own page
+ * when other panels are hidden too. */
+static int cover_pages(unsigned hid)
+{
+    int others = (hid & (PDT_PANEL_LEGEND | PDT_PANEL_STACK | PDT_PANEL_LIFTED)) != 0;
+    return others && (hid & PDT_PANEL_TIMELINE) ? 2 : hid ? 1 : 0;
+}
+
+/* Page `page` (1 ..) of the hidden panels: the legend (its items flowing)
+ * at the left, the stacks over the lifted view at the right; the timeline
+ * across.  The panels that had room give theirs. */
+static void layout_cover(double w, int page, pdt_layout *L, int nranks)
+{
+    unsigned hid = L->hidden;
+    double y0 = L->top.h, y1 = L->more.y;
+    pdt_rect none = {w, y0, 0, 0};
+    L->covered = page;
+    L->legend = L->code = L->stack = L->lifted = L->timeline = L->tree = none;
+    if (cover_pages(hid) == 2) hid = page == 2 ? PDT_PANEL_TIMELINE : hid & ~PDT_PANEL_TIMELINE;
+    if (hid & PDT_PANEL_TIMELINE) {
+        double th = hid == PDT_PANEL_TIMELINE ? y1 - y0 : fmin(0.4 * (y1 - y0), 0.3 * w);
+        L->timeline = (pdt_rect){0, y1 - th, w, th};
+        y1 -= th;
+    }
+    double x = 0;
+    int right = (hid & (PDT_PANEL_STACK | PDT_PANEL_LIFTED)) != 0;
+    if (hid & PDT_PANEL_LEGEND) { /* its items flowing, in half the width if they fit */
+        double lw = right ? w / 2 : w, lh = pdt_legend_height(L, nranks, lw, 2);
+        L->legend_mode = 2;
+        if (right && lh > y1 - y0) { /* across, above the others */
+            lh = fmin(pdt_legend_height(L, nranks, w, 2), 0.5 * (y1 - y0));
+            L->legend = (pdt_rect){0, y0, w, lh};
+            y0 += lh;
+        } else {
+            L->legend = (pdt_rect){0, y0, lw, right ? y1 - y0 : fmin(lh, y1 - y0)};
+            x = right ? lw : w;
+        }
+    }
+    double sh = 0;
+    if (hid & PDT_PANEL_STACK)
+        sh = hid & PDT_PANEL_LIFTED ? fmin(0.4 * (y1 - y0), column_needs(L).stack_min * 1.4)
+                                    : y1 - y0;
+    if (hid & PDT_PANEL_STACK) L->stack = (pdt_rect){x, y0, w - x, sh};
+    if (hid & PDT_PANEL_LIFTED) L->lifted = (pdt_rect){x, y0 + sh, w - x, y1 - y0 - sh};
+}
+
+static void layout_all(double w, double h, int nranks, unsigned panels, double scale,
+                       int overflow, pdt_layout *L)
+{
+    memset(L, 0, sizeof *L);
+    layout_fonts(w, h, scale, L);
+    layout_pass(w, h, nranks, panels, L);
+    if (L->hidden) { /* a line at the bottom names them: the panels share the rest */
+        double bar = 1.6 * L->label;
+        layout_pass(w, h - bar, nranks, panels, L);
+        L->more = (pdt_rect){0, h - bar, L->hidden ? w : 0, bar};
+        L->pages = cover_pages(L->hidden);
+        if (overflow > 0 && L->pages) layout_cover(w, overflow > L->pages ? L->pages : overflow, L, nranks);
+    }
+    L->top.w = w;
+    layout_round(L);
 }
 
 void pdt_render_layout_scaled(double w, double h, int nranks, unsigned panels, double scale,
                               pdt_layout *L)
 {
-    layout_fonts(w, h, scale, L);
-    double f = L->font, top = pdt_layout_top_height(L);
-    /* timeline rows hold their labels (1.7 x the label size), up to 16 rows */
-    int rows = nranks < 1 ? 1 : nranks > 16 ? 16 : nranks;
-    double tl = 1.7 * f + rows * 1.7 * L->label;
-    if (tl > 0.3 * h) tl = 0.3 * h;
-    if (!(panels & PDT_PANEL_TIMELINE)) tl = 0;
-    int has_code = (panels & PDT_PANEL_CODE) != 0, has_stack = (panels & PDT_PANEL_STACK) != 0,
-        has_lifted = (panels & PDT_PANEL_LIFTED) != 0;
-    if (!has_code && !has_stack && !has_lifted) {
-        layout_strip(w, h, top, tl, nranks, L);
-        pdt_layout_tree_strip(L, panels, w, h);
-        layout_round(L);
-        return;
-    }
-    layout_column(w, h, top, tl, nranks, panels, L);
-    layout_round(L);
+    layout_all(w, h, nranks, panels, scale, 0, L);
 }
 
 /* The side column (legend, code, stacks, lifted view) beside the picture,
  * the timeline under both.  When the column cannot hold the legend, four
- * code rows and a stack, the timeline gives its room, then the stacks. */
+ * code rows and a stack, the legend becomes a strip across (or is hidden
+ * when that strip would be tall), then the timeline gives its room, then
+ * the stacks; each panel left out is named in L->hidden. */
 static void layout_column(double w, double h, double top, double tl, int nranks, unsigned panels,
-                          pdt_layout *L)
+                          int strip_ok, pdt_layout *L)
 {
     int has_code = (panels & PDT_PANEL_CODE) != 0, has_stack = (panels & PDT_PANEL_STACK) != 0,
         has_lifted = (panels & PDT_PANEL_LIFTED) != 0;
@@ -187,18 +281,24 @@ static void layout_column(double w, double h, double top, double tl, int nranks,
     column C = column_needs(L);
     C.legend = pdt_legend_height(L, nranks, side, 0); /* what its text needs */
     /* a legend too tall for the column beside four code lines and the
-     * timeline: a strip across (the timeline keeps its rows) */
+     * timeline: a strip across (the timeline keeps its rows), or hidden */
     double strip = 0;
+    L->legend_mode = 0;
     if (C.legend + (has_code ? C.code_min : 0) > h - top - tl) {
         strip = pdt_legend_height(L, nranks, w, 2);
         C.legend = 0;
+        L->legend_mode = 2;
+        if (strip > STRIP_MAX * h || !strip_ok) {
+            strip = 0;
+            L->hidden |= PDT_PANEL_LEGEND;
+        }
     }
     double need = C.legend + (has_code ? C.code_min : 0) + (has_stack ? C.stack_min : 0);
     if (h - top - tl - strip < need && tl > 0) {
         tl = h - top - strip - need;
-        if (tl < 2.2 * f + 1.7 * L->label) tl = 0;
+        if (tl < 2.2 * f + 1.7 * L->label) tl = 0, L->hidden |= PDT_PANEL_TIMELINE;
     }
-    if (h - top - tl - strip < need) has_stack = 0;
+    if (h - top - tl - strip < need && has_stack) has_stack = 0, L->hidden |= PDT_PANEL_STACK;
     double mid = h - tl - top - strip;
     L->top = (pdt_rect){0, 0, w, top};
     L->timeline = (pdt_rect){0, h - tl, tl > 0 ? w : 0, tl};
@@ -209,7 +309,10 @@ static void layout_column(double w, double h, double top, double tl, int nranks,
     if (panels & PDT_PANEL_TREE)
         tree = has_code || has_stack || has_lifted ? fmax(6 * f, 0.34 * (mid - leg)) : mid - leg;
     column_split(mid - leg - tree, &C, has_code, has_stack, has_lifted, &code, &stk, &lifted);
-    L->legend = strip > 0 ? (pdt_rect){0, top + mid, w, strip} : (pdt_rect){x, y, side, leg};
+    if (has_stack && !(stk > 0)) L->hidden |= PDT_PANEL_STACK;
+    if (has_lifted && !(lifted > 0)) L->hidden |= PDT_PANEL_LIFTED;
+    L->legend = strip > 0 ? (pdt_rect){0, top + mid, w, strip}
+                          : (pdt_rect){x, y, leg > 0 ? side : 0, leg};
     L->code = (pdt_rect){x, y + leg, code > 0 ? side : 0, code};
     L->stack = (pdt_rect){x, y + leg + code, stk > 0 ? side : 0, stk};
     L->lifted = (pdt_rect){x, y + leg + code + stk, lifted > 0 ? side : 0, lifted};
@@ -230,7 +333,7 @@ double pdt_layout_code_row(const pdt_layout *L)
 static void layout_round(pdt_layout *L)
 {
     pdt_rect *all[] = {&L->top,    &L->geo,    &L->legend,   &L->code,
-                       &L->stack,  &L->lifted, &L->timeline, &L->tree};
+                       &L->stack,  &L->lifted, &L->timeline, &L->tree, &L->more};
     for (size_t i = 0; i < sizeof all / sizeof *all; i++) {
         double x1 = round(all[i]->x + all[i]->w), y1 = round(all[i]->y + all[i]->h);
         all[i]->x = round(all[i]->x);

@@ -286,8 +286,8 @@ void pdt_draw_legend(ctx *c)
     cairo_t *cr = c->cr;
     pdt_rect R = c->L.legend;
     double f = c->L.font;
-    int strip = R.w >= c->L.geo.w && R.y >= c->L.geo.y + c->L.geo.h; /* under the picture */
-    if (strip && R.w > c->L.geo.w) strip = 2; /* under the column too: instead of the side one */
+    if (!(R.w > 0 && R.h > 0)) return; /* no room: named on the `more` line */
+    int strip = c->L.legend_mode; /* 1: under the picture, 2: under the column too */
     panel(cr, c->T, R, strip ? NULL : "Legend", f);
     cairo_save(cr);
     clip_rect(cr, R);

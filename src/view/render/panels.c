@@ -319,7 +319,7 @@ void pdt_draw_stack_panel(ctx *c)
 /* Is base row `key` one the layer of v->help_more takes over? */
 static int help_taken(const pdt_view *v, const char *key)
 {
-    static const char *const taken[] = {"1 … 9", "0", "click", "drag", "g N Enter", "b  n  p  d  e"};
+    static const char *const taken[] = {"1 … 9", "0", "click", "drag", "g N Enter", "b  n  j  p  d  e"};
     if (!v->help_more) return 0;
     for (size_t i = 0; i < sizeof taken / sizeof *taken; i++)
         if (!strcmp(key, taken[i])) return 1;
@@ -365,12 +365,13 @@ void pdt_draw_help(ctx *c, double w, double h)
         {"f", "fit the points in the window"},
         {"Ctrl + =  −  0", "larger / smaller / default text"},
         {"F11", "full screen"},
+        {"Tab", "the panels with no room, over the picture / back"},
         {"t", "theme: light, dark, high contrast"},
         {"c", "clean picture (final triangles by rank)"},
         {"o  v", "all circumcircles / Voronoi diagram"},
         {"h  ?", "this help"},
         {"s", "screenshot (PNG)"},
-        {"b  n  p  d  e", "bookmark (Shift: back), notes, pointer, pen, erase"},
+        {"b  n  j  p  d  e", "bookmark (Shift: back), notes, notes page, pointer, pen, erase"},
         {"m  r", "mark an event; record mark → current as GIF/video"},
         {"Esc  q", "quit"},
     };
@@ -417,4 +418,67 @@ void pdt_draw_help(ctx *c, double w, double h)
         help_column(cr, f, x2 + 0.25 * f, by, kw2 * f, v->help_more_title ? v->help_more_title : "More",
                     NULL, v->help_more, nm, v);
     }
+}
+
+/* ---- the panels with no room ------------------------------------------------------ */
+
+/* "legend, timeline, stacks" from the hidden bits; the number named. */
+static int hidden_names(unsigned hid, char *b, size_t cap)
+{
+    static const struct { unsigned bit; const char *name; } names[] = {
+        {PDT_PANEL_LEGEND, "legend"},     {PDT_PANEL_TIMELINE, "timeline"},
+        {PDT_PANEL_STACK, "stacks"},      {PDT_PANEL_LIFTED, "lifted view"},
+        {PDT_PANEL_CODE, "pseudo-code"},
+    };
+    int n = 0;
+    b[0] = 0;
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++)
+        if (hid & names[i].bit) {
+            size_t len = strlen(b);
+            snprintf(b + len, cap - len, "%s%s", n++ ? ", " : "", names[i].name);
+        }
+    return n;
+}
+
+/* The `more` line: which panels got no room at this size and font, and
+ * Tab, which shows them over the picture (and back).  The longest wording
+ * that fits at the label size; the shortest one, smaller, down to 16 px. */
+void pdt_draw_more(ctx *c)
+{
+    cairo_t *cr = c->cr;
+    pdt_rect R = c->L.more;
+    double f = c->L.font, fs = c->L.label, room = R.w - f;
+    char names[128], t[3][200];
+    unsigned shown = 0; /* covered: the page's panels */
+    const pdt_layout *Ly = &c->L;
+    shown |= Ly->legend.w > 0 ? PDT_PANEL_LEGEND : 0;
+    shown |= Ly->timeline.w > 0 ? PDT_PANEL_TIMELINE : 0;
+    shown |= Ly->stack.w > 0 ? PDT_PANEL_STACK : 0;
+    shown |= Ly->lifted.w > 0 ? PDT_PANEL_LIFTED : 0;
+    int n = hidden_names(Ly->covered ? shown : Ly->hidden, names, sizeof names);
+    const char *them = n > 1 ? "them" : "it";
+    if (c->L.covered) {
+        const char *next = c->L.covered < c->L.pages ? "Tab: next page" : "Tab: the picture";
+        char pg[32] = "";
+        if (c->L.pages > 1) snprintf(pg, sizeof pg, " (%d of %d)", c->L.covered, c->L.pages);
+        snprintf(t[0], sizeof t[0], "Over the picture%s: %s — %s", pg, names, next);
+        snprintf(t[1], sizeof t[1], "Shown%s: %s — %s", pg, names, next);
+        snprintf(t[2], sizeof t[2], "%s", next);
+    } else {
+        snprintf(t[0], sizeof t[0], "No room for the %s — Tab shows %s over the picture", names, them);
+        snprintf(t[1], sizeof t[1], "No room: %s — Tab shows %s", names, them);
+        snprintf(t[2], sizeof t[2], "Hidden: %s (Tab)", names);
+    }
+    int i = 0;
+    while (i < 2 && text_w(cr, SANS, fs, t[i]) > room) i++;
+    double w = text_w(cr, SANS, fs, t[i]);
+    if (w > room) fs = fmax(fmin(16, fs), fs * room / w);
+    cairo_rectangle(cr, R.x, R.y, R.w, R.h);
+    rgb(cr, c->T->topbar, 1);
+    cairo_fill(cr);
+    cairo_save(cr);
+    clip_rect(cr, R);
+    rgb(cr, c->T->ink, 1);
+    text_at(cr, SANS, 0, fs, R.x + 0.5 * f, R.y + 0.5 * (R.h + 0.72 * fs), t[i]);
+    cairo_restore(cr);
 }

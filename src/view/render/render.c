@@ -68,8 +68,10 @@ static void draw_parts(ctx *c, double w, double h)
 {
     cairo_t *cr = c->cr;
     pdt_text_log_panel(cr, "picture");
-    pdt_top_spill(c);
-    pdt_draw_geometry(c);
+    if (!c->L.covered) {
+        pdt_top_spill(c);
+        pdt_draw_geometry(c);
+    }
     pdt_text_log_panel(cr, "event");
     pdt_draw_top(c);
     pdt_text_log_panel(cr, "legend");
@@ -84,6 +86,8 @@ static void draw_parts(ctx *c, double w, double h)
     if (c->L.timeline.w > 0) pdt_draw_timeline(c);
     pdt_text_log_panel(cr, "tree");
     if (c->L.tree.w > 0) pdt_draw_tree(c);
+    pdt_text_log_panel(cr, "more");
+    if (c->L.more.w > 0) pdt_draw_more(c);
     pdt_text_log_panel(cr, "help");
     if (c->v->help) pdt_draw_help(c, w, h);
 }

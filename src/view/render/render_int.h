@@ -136,6 +136,8 @@ double pdt_legend_height(const pdt_layout *L, int nranks, double width, int stri
 void pdt_draw_code(ctx *c);
 void pdt_draw_stack_panel(ctx *c);
 void pdt_draw_help(ctx *c, double w, double h);
+/* The line naming the panels with no room and the key that shows them. */
+void pdt_draw_more(ctx *c);
 void pdt_draw_lifted(ctx *c);                   /* lifted.c */
 void pdt_draw_timeline(ctx *c);                 /* timeline.c */
 void pdt_draw_tree(ctx *c);                     /* tree.c */

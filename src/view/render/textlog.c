@@ -81,7 +81,7 @@ static const char *panel_at(const pdt_text_log *log, double x, double y)
     const struct { pdt_rect R; const char *name; } parts[] = {
         {L->top, "event"},   {L->legend, "legend"},     {L->code, "code"},
         {L->stack, "stack"}, {L->lifted, "lifted"},     {L->timeline, "timeline"},
-        {L->tree, "tree"},
+        {L->tree, "tree"},   {L->more, "more"},
     };
     for (size_t i = 0; i < sizeof parts / sizeof *parts; i++)
         if (inside(parts[i].R, x, y)) return parts[i].name;
@@ -191,9 +191,42 @@ static void put_string(buf *B, const char *s)
     put(B, "\"");
 }
 
+/* The frame's panels (those with room) and the names of the hidden ones. */
+static void put_panels(buf *B, const pdt_layout *L)
+{
+    const struct { pdt_rect R; const char *name; } parts[] = {
+        {L->top, "event"},     {L->geo, "picture"},   {L->legend, "legend"}, {L->code, "code"},
+        {L->stack, "stack"},   {L->lifted, "lifted"}, {L->timeline, "timeline"},
+        {L->tree, "tree"},     {L->more, "more"},
+    };
+    static const struct { unsigned bit; const char *name; } bits[] = {
+        {PDT_PANEL_LEGEND, "legend"}, {PDT_PANEL_CODE, "code"}, {PDT_PANEL_STACK, "stack"},
+        {PDT_PANEL_LIFTED, "lifted"}, {PDT_PANEL_TIMELINE, "timeline"},
+    };
+    put(B, "\"panels\": {");
+    int first = 1;
+    for (size_t i = 0; i < sizeof parts / sizeof *parts; i++) {
+        pdt_rect R = parts[i].R;
+        if (!(R.w > 0 && R.h > 0) || (L->covered && !strcmp(parts[i].name, "picture"))) continue;
+        put(B, "%s\"%s\": [%.0f, %.0f, %.0f, %.0f]", first ? "" : ", ", parts[i].name, R.x, R.y,
+            R.w, R.h);
+        first = 0;
+    }
+    put(B, "}, \"hidden\": [");
+    first = 1;
+    for (size_t i = 0; i < sizeof bits / sizeof *bits; i++)
+        if (L->hidden & bits[i].bit) {
+            put(B, "%s\"%s\"", first ? "" : ", ", bits[i].name);
+            first = 0;
+        }
+    put(B, "], \"covered\": %s, ", L->covered ? "true" : "false");
+}
+
 static void put_log(buf *B, const pdt_text_log *log)
 {
-    put(B, "{\"width\": %.0f, \"height\": %.0f, \"texts\": [", log->w, log->h);
+    put(B, "{\"width\": %.0f, \"height\": %.0f, ", log->w, log->h);
+    if (log->have_layout) put_panels(B, &log->L);
+    put(B, "\"texts\": [");
     for (size_t i = 0; i < log->n; i++) {
         const pdt_text_rec *t = &log->t[i];
         put(B, "%s\n  {\"text\": ", i ? "," : "");
