@@ -503,7 +503,8 @@ size_t pdt_render_timeline_at(const pdt_replay *r, const pdt_view *v, double w, 
     if (n && sx >= R.x && sx <= R.x + R.w && sy >= R.y && sy <= R.y + R.h) {
         double t = (sx - g.x0) / (g.x1 - g.x0), m = (double)pdt_replay_count(r);
         t = t < 0 ? 0 : t > 1 ? 1 : t;
-        k = m > 0 ? pdt_ranktree_event_at(tree, (g.k0 + t * (g.k1 - g.k0)) / m) : 0;
+        double u = m > 0 ? (g.k0 + t * (g.k1 - g.k0)) / m : 0; /* the clicked time */
+        k = u >= 1 ? (size_t)m : pdt_ranktree_event_at(tree, u); /* the events before it applied */
         /* in a row: that row's ranks' event nearest the clicked time */
         int i = (int)floor((sy - g.y0) / g.rh);
         if (sy >= g.y0 && i >= 0 && i < g.nshow) {
