@@ -389,8 +389,10 @@ static void draw_axis(tl *t)
         fmt_time(t->g.k0 / t->m * span, st, a, sizeof a);
         fmt_time(t->g.k1 / t->m * span, st, b, sizeof b);
         if (!all) { /* the window at the right end, if the ticks leave room */
-            snprintf(ax[0], sizeof ax[0], "%s … %s · rows %d–%d of %zu", a, b, t->g.row0 + 1,
-                     t->g.row0 + t->g.nshow, c->nrows);
+            if ((size_t)t->g.nshow < c->nrows)
+                snprintf(ax[0], sizeof ax[0], "%s … %s · rows %d–%d of %zu", a, b, t->g.row0 + 1,
+                         t->g.row0 + t->g.nshow, c->nrows);
+            else snprintf(ax[0], sizeof ax[0], "%s … %s", a, b);
             double tw = text_w(cr, SANS, fs, ax[0]), lx = t->g.x1 - tw;
             rgb(cr, c->T->panel, 0.9);
             cairo_rectangle(cr, lx - 4, base - 0.85 * fs, tw + 4, 1.05 * fs);
