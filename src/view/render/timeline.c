@@ -219,18 +219,22 @@ static int msg_shown(const tl *t, const pdt_rmsg *g, size_t i)
     return hi >= t->g.k0 && lo <= t->g.k1;
 }
 
-static void draw_msgs_each(tl *t, const pdt_rmsg *Ms, size_t nm)
+/* Each message its arrow; light when they are many (dense lines would
+ * make a dark mass over the collectives). */
+static void draw_msgs_each(tl *t, const pdt_rmsg *Ms, size_t nm, size_t shown_n)
 {
     cairo_t *cr = t->c->cr;
-    cairo_set_line_width(cr, 1);
+    int many = shown_n > 8 * (size_t)t->g.nshow;
+    double ink = many ? 0.3 : 0.6, head = many ? 0.25 : 0.35;
+    cairo_set_line_width(cr, many ? 0.8 : 1);
     for (size_t i = 0; i < nm; i++) {
         const pdt_rmsg *g = &Ms[i];
         if (!msg_shown(t, g, i)) continue;
         if (t->c->s->mflight[i]) rgb(cr, RED, 1);
-        else rgb(cr, t->c->T->ink, 0.6);
+        else rgb(cr, t->c->T->ink, ink);
         arrow(cr, ev_x(t, t->m * t->ma[2 * i]), t->g.y0 + t->g.rh * (t->rowof[g->src] + 0.5),
               ev_x(t, t->m * t->ma[2 * i + 1]), t->g.y0 + t->g.rh * (t->rowof[g->dst] + 0.5),
-              0.35 * t->c->L.font);
+              head * t->c->L.font);
     }
 }
 
@@ -297,7 +301,7 @@ static void draw_msgs(tl *t)
     for (size_t i = 0; i < nm; i++) shown_n += msg_shown(t, &Ms[i], i) != 0;
     if ((t->c->nranks > PDT_PALETTE_HUES && shown_n > 4 * (size_t)t->g.nshow) || shown_n > 3000)
         draw_msgs_bundled(t, Ms, nm);
-    else draw_msgs_each(t, Ms, nm);
+    else draw_msgs_each(t, Ms, nm, shown_n);
 }
 
 /* The cursor: at the current event's time (the start before any event). */
