@@ -14,9 +14,10 @@
 #define W 1024
 #define H 768
 
-/* 100 lifts on one rank: the first 90 within 89 µs, the last 10 a whole
- * millisecond later.  In time, the right half of the axis holds only the
- * last ten; in event order it would hold fifty. */
+/* 100 lifts on 10 ranks (a cluster run: the timeline in time): the first
+ * 90 within 89 µs, the last 10 a whole millisecond later.  In time, the
+ * right half of the axis holds only the last ten; in event order it would
+ * hold fifty.  A run of one rank keeps the order of its events. */
 TEST(timeline_axis_is_time)
 {
     enum { N = 100 };
@@ -28,11 +29,12 @@ TEST(timeline_axis_is_time)
         recs[i].ev.kind = PDT_EV_LIFT;
         recs[i].ev.a = (uint32_t)i;
         recs[i].ev.t = i < 90 ? 1000u * (uint64_t)i : 1000000u + 1000u * (uint64_t)i;
-        recs[i].seq = (uint32_t)i;
+        recs[i].rank = (uint32_t)(i % 10);
+        recs[i].seq = (uint32_t)(i / 10);
     }
     pdt_replay *r = NULL;
     pdt_err err = {0};
-    CHECK(pdt_replay_new(pts, N, recs, N, 1, &r, &err) == PDT_OK);
+    CHECK(pdt_replay_new(pts, N, recs, N, 10, &r, &err) == PDT_OK);
     if (!r) return;
     pdt_ranktree *t = pdt_ranktree_new(r);
     CHECK(t != NULL);
@@ -52,11 +54,19 @@ TEST(timeline_axis_is_time)
     v.panels |= PDT_PANEL_TIMELINE;
     v.tree = t;
     pdt_layout L;
-    pdt_render_layout_view(W, H, 1, &v, &L);
+    pdt_render_layout_view(W, H, 10, &v, &L);
     CHECK(L.timeline.w > 0);
     size_t k = pdt_render_timeline_at(r, &v, W, H, L.timeline.x + 0.6 * L.timeline.w,
                                       L.timeline.y + 0.5 * L.timeline.h);
     CHECK_MSG(k >= 90 && k <= N, "clicked at 60 %%: cursor %zu", k);
+    pdt_ranktree_free(t);
+    pdt_replay_free(r);
+    /* the same events on one rank: event order */
+    for (int i = 0; i < N; i++) recs[i].rank = 0, recs[i].seq = (uint32_t)i;
+    r = NULL;
+    CHECK(pdt_replay_new(pts, N, recs, N, 1, &r, &err) == PDT_OK);
+    t = r ? pdt_ranktree_new(r) : NULL;
+    CHECK(t && !pdt_ranktree_timed(t, NULL) && fabs(pdt_ranktree_at(t, 50) - 0.5) < 1e-9);
     pdt_ranktree_free(t);
     pdt_replay_free(r);
 }

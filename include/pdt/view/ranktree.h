@@ -55,8 +55,10 @@ size_t pdt_ranktree_rows(const pdt_ranktree *t, const int32_t *cut, size_t ncut,
                          const uint8_t *open, int32_t *rows, size_t cap);
 
 /* The run's clock, for the timeline: every time as a fraction u of the
- * span of the run's times (0 at the first, 1 at the last), or, when the
- * trace has no times (all equal), of the merged order (event e at e / count).
+ * span of the run's times (0 at the first, 1 at the last), or, for a run of
+ * fewer than PDT_RANKTREE_TIMED_RANKS ranks (the lessons' small runs, told
+ * a step per event) or a trace without times (all equal), of the merged
+ * order (event e at e / count).
  * pdt_ranktree_timed: 1 when times are known (and *span_ns, if not NULL, the
  * span in the trace's nanoseconds; simulated or synthetic runs have their
  * own clocks), else 0.  pdt_ranktree_at: event e's u (1 past the end).
@@ -64,6 +66,7 @@ size_t pdt_ranktree_rows(const pdt_ranktree *t, const int32_t *cut, size_t ncut,
  * and end's u, per message (pdt_replay_msgs) its send's and receive's, two
  * doubles each, owned by t.  pdt_ranktree_event_at: the first event whose u is
  * at least u (count when none). */
+#define PDT_RANKTREE_TIMED_RANKS 9
 int pdt_ranktree_timed(const pdt_ranktree *t, double *span_ns);
 double pdt_ranktree_at(const pdt_ranktree *t, size_t e);
 const double *pdt_ranktree_phase_at(const pdt_ranktree *t);

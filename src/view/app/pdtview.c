@@ -258,15 +258,22 @@ static int act(const opts *o, const pdt_replay *r, pdt_rstate *s, pdt_view *v, s
         pdt_app_counts(r, s);
         return PDT_EXIT_OK;
     }
-    if (o->bench) return pdt_app_bench(r, s, v, o);
-    if (o->headless && (o->gif || o->video)) {
-        if (!pdt_app_animate(r, s, v, o, err)) return PDT_EXIT_OK;
-        fprintf(stderr, "pdtview: %s\n", err->msg);
-        pdt_err_clear(err);
-        return PDT_EXIT_USAGE;
-    }
-    if (o->headless) return pdt_app_headless(r, s, v, o, err);
-    return window(o, r, s, v, err);
+    if (!o->bench && !o->headless) return window(o, r, s, v, err);
+    pdt_ranktree *tree = v->tree ? NULL : pdt_ranktree_new(r); /* one for every frame */
+    if (tree) v->tree = tree;
+    int rc;
+    if (o->bench) rc = pdt_app_bench(r, s, v, o);
+    else if (o->gif || o->video) {
+        rc = PDT_EXIT_OK;
+        if (pdt_app_animate(r, s, v, o, err)) {
+            fprintf(stderr, "pdtview: %s\n", err->msg);
+            pdt_err_clear(err);
+            rc = PDT_EXIT_USAGE;
+        }
+    } else rc = pdt_app_headless(r, s, v, o, err);
+    if (tree) v->tree = NULL;
+    pdt_ranktree_free(tree);
+    return rc;
 }
 
 /* SDL hands the window title (UTF-8) to X11 through the C library's

@@ -235,6 +235,7 @@ static int clock_build(pdt_ranktree *t, const pdt_replay *r)
         mt[2 * i + 1] = ev_time(r, d != NONE32 ? d : any);
     }
     clock_span(t, r, pt, np, mt, ng);
+    if (t->nranks < PDT_RANKTREE_TIMED_RANKS) t->t_hi = t->t_lo; /* a step per event */
     double em = m ? (double)m : 1;
     for (size_t i = 0; i < np; i++) {
         double e1 = P[i].end_ev == NONE32 ? em : P[i].end_ev + 1.0;

@@ -19,6 +19,8 @@ static int place_box_label(ctx *c, int below, double x, double y0, double y1, do
         int under = k ? !below : below;
         double y = under ? y1 + 1.05 * fs : y0 - 0.3 * fs;
         lbox b = {x - 0.1 * fs, y - 0.95 * fs, x + tw + 0.1 * fs, y + 0.3 * fs};
+        const pdt_rect *G = &c->L.geo; /* zoomed in, a side may be off the picture */
+        if (b.x0 < G->x || b.x1 > G->x + G->w || b.y0 < G->y || b.y1 > G->y + G->h) continue;
         if (overlaps(c->taken, (size_t)c->ntaken, b)) continue;
         if (c->ntaken < TAKEN_MAX) c->taken[c->ntaken++] = b;
         *ly = y;

@@ -219,18 +219,22 @@ static int msg_shown(const tl *t, const pdt_rmsg *g, size_t i)
     return hi >= t->g.k0 && lo <= t->g.k1;
 }
 
-static void draw_msgs_each(tl *t, const pdt_rmsg *Ms, size_t nm)
+/* Each message its arrow; light when they are many (dense lines would
+ * make a dark mass over the collectives). */
+static void draw_msgs_each(tl *t, const pdt_rmsg *Ms, size_t nm, size_t shown_n)
 {
     cairo_t *cr = t->c->cr;
-    cairo_set_line_width(cr, 1);
+    int many = shown_n > 8 * (size_t)t->g.nshow;
+    double ink = many ? 0.3 : 0.6, head = many ? 0.25 : 0.35;
+    cairo_set_line_width(cr, many ? 0.8 : 1);
     for (size_t i = 0; i < nm; i++) {
         const pdt_rmsg *g = &Ms[i];
         if (!msg_shown(t, g, i)) continue;
         if (t->c->s->mflight[i]) rgb(cr, RED, 1);
-        else rgb(cr, t->c->T->ink, 0.6);
+        else rgb(cr, t->c->T->ink, ink);
         arrow(cr, ev_x(t, t->m * t->ma[2 * i]), t->g.y0 + t->g.rh * (t->rowof[g->src] + 0.5),
               ev_x(t, t->m * t->ma[2 * i + 1]), t->g.y0 + t->g.rh * (t->rowof[g->dst] + 0.5),
-              0.35 * t->c->L.font);
+              head * t->c->L.font);
     }
 }
 
@@ -297,7 +301,7 @@ static void draw_msgs(tl *t)
     for (size_t i = 0; i < nm; i++) shown_n += msg_shown(t, &Ms[i], i) != 0;
     if ((t->c->nranks > PDT_PALETTE_HUES && shown_n > 4 * (size_t)t->g.nshow) || shown_n > 3000)
         draw_msgs_bundled(t, Ms, nm);
-    else draw_msgs_each(t, Ms, nm);
+    else draw_msgs_each(t, Ms, nm, shown_n);
 }
 
 /* The cursor: at the current event's time (the start before any event). */
@@ -389,8 +393,10 @@ static void draw_axis(tl *t)
         fmt_time(t->g.k0 / t->m * span, st, a, sizeof a);
         fmt_time(t->g.k1 / t->m * span, st, b, sizeof b);
         if (!all) { /* the window at the right end, if the ticks leave room */
-            snprintf(ax[0], sizeof ax[0], "%s … %s · rows %d–%d of %zu", a, b, t->g.row0 + 1,
-                     t->g.row0 + t->g.nshow, c->nrows);
+            if ((size_t)t->g.nshow < c->nrows)
+                snprintf(ax[0], sizeof ax[0], "%s … %s · rows %d–%d of %zu", a, b, t->g.row0 + 1,
+                         t->g.row0 + t->g.nshow, c->nrows);
+            else snprintf(ax[0], sizeof ax[0], "%s … %s", a, b);
             double tw = text_w(cr, SANS, fs, ax[0]), lx = t->g.x1 - tw;
             rgb(cr, c->T->panel, 0.9);
             cairo_rectangle(cr, lx - 4, base - 0.85 * fs, tw + 4, 1.05 * fs);
@@ -503,7 +509,8 @@ size_t pdt_render_timeline_at(const pdt_replay *r, const pdt_view *v, double w, 
     if (n && sx >= R.x && sx <= R.x + R.w && sy >= R.y && sy <= R.y + R.h) {
         double t = (sx - g.x0) / (g.x1 - g.x0), m = (double)pdt_replay_count(r);
         t = t < 0 ? 0 : t > 1 ? 1 : t;
-        k = m > 0 ? pdt_ranktree_event_at(tree, (g.k0 + t * (g.k1 - g.k0)) / m) : 0;
+        double u = m > 0 ? (g.k0 + t * (g.k1 - g.k0)) / m : 0; /* the clicked time */
+        k = u >= 1 ? (size_t)m : pdt_ranktree_event_at(tree, u); /* the events before it applied */
         /* in a row: that row's ranks' event nearest the clicked time */
         int i = (int)floor((sy - g.y0) / g.rh);
         if (sy >= g.y0 && i >= 0 && i < g.nshow) {

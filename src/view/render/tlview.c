@@ -70,9 +70,11 @@ static void story_of(const pdt_replay *r, const pdt_rstate *s, story *st)
     st->wide = kd == PDT_EV_MERGE_BEGIN || kd == PDT_EV_MERGE_END || kd == PDT_EV_SEND || kd == PDT_EV_RECV ||
                kd == PDT_EV_PHASE_BEGIN || kd == PDT_EV_PHASE_END || kd == PDT_EV_HULL;
     int32_t ph = pdt_rstate_slot(r, s, (int)st->e.rank, PDT_SLOT_PHASE);
-    /* PHASE_BEGIN: the phase begun is the slot; PHASE_END: the slot is its parent */
+    /* PHASE_BEGIN: the phase begun is the slot; PHASE_END: the slot is its
+     * parent.  The end of one rank's merge phase is not top-level: other
+     * ranks' merges of that level go on (the next phase's begin backs out). */
     st->top = (kd == PDT_EV_PHASE_BEGIN && is_top(P, ph)) ||
-              (kd == PDT_EV_PHASE_END && (ph < 0 || P[ph].phase == PDT_PH_RUN));
+              (kd == PDT_EV_PHASE_END && st->e.ev.sub != PDT_PH_MERGE && (ph < 0 || P[ph].phase == PDT_PH_RUN));
     st->merge_ph = -1;
     for (int32_t i = ph; i >= 0 && (size_t)i < np; i = P[i].parent)
         if (P[i].phase == PDT_PH_MERGE) {
