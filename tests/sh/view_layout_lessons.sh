@@ -8,6 +8,7 @@
 # under 16 px at 1024x768, the code and the event line at least 18 px, the
 # event line present; a panel with no room is named on the bottom line.
 # (The real window, with and without a window manager: view_layout_window.)
+# PDT_LESSONS="07 08" runs only those lessons.
 . "$(dirname "$0")/lib.sh"
 unset DISPLAY WAYLAND_DISPLAY
 V=$BIN/pdtview
@@ -45,6 +46,7 @@ EOF
 for ldir in "$ROOT"/lessons/[0-9][0-9]-*/; do
     ldir=${ldir%/}
     name=$(basename "$ldir")
+    case " ${PDT_LESSONS:-${name%%-*}} " in *" ${name%%-*} "*) ;; *) continue ;; esac # (one or a few)
     if [ "$have_par" = 0 ] && grep -qE '^[[:space:]]*ranks[[:space:]]*=[[:space:]]*([2-9]|[1-9][0-9])' "$ldir/lesson.conf"; then
         ok "$name # SKIP pdt does not run in parallel under mpirun in this build"
         continue

@@ -132,7 +132,7 @@ static int tplace(tplaced *P, pdt_rect R, pdt_rect a)
 static void draw_labels(ctx *c, const tgeom *g, const pdt_rtnode *N, size_t n, tplaced *P)
 {
     cairo_t *cr = c->cr;
-    double fs = fmax(12, 0.62 * c->L.font);
+    double fs = fmax(fmin(16, c->L.label), 0.62 * c->L.font); /* 16 px on a projector */
     for (uint32_t depth = 0; depth < 12; depth++)
         for (size_t i = 0; i < n; i++) {
             const pdt_rtnode *d = &N[i];
