@@ -12,14 +12,8 @@ for t in Xvfb xdotool import compare; do
 done
 W=1024; H=768
 RUN=synth:srm:12:6:4
-d=91
-while [ -e /tmp/.X$d-lock ] || [ -e /tmp/.X11-unix/X$d ]; do d=$((d + 1)); done
-Xvfb :$d -screen 0 ${W}x${H}x24 -nolisten tcp >"$TMP/xvfb.log" 2>&1 &
-XPID=$!
-export DISPLAY=:$d
-for i in $(seq 50); do xdotool getdisplaygeometry >/dev/null 2>&1 && break; sleep 0.1; done
-cleanup() { [ -n "${VPID:-}" ] && kill "$VPID" 2>/dev/null; kill "$XPID" 2>/dev/null; rm -rf "$TMP"; }
-trap cleanup EXIT
+xvfb_start ${W}x${H}
+trap xvfb_cleanup EXIT
 
 # the cursor of each screenshot the window wrote (its stderr)
 events() { sed -n 's/.*screenshot .*event \([0-9]*\)).*/\1/p' "$1" | tr '\n' ' ' | sed 's/ $//'; }
