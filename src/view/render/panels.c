@@ -77,6 +77,18 @@ static void plan_top(ctx *c, top_plan *P)
     snprintf(word, sizeof word, "%.*s", (int)strcspn(rest, " "), rest);
     if (*rest && text_wb(cr, SANS, 1, fs, word) <= room2) /* beside the status */
         rest = plan_row(c, P, rest, room2, R.y + 2.75 * f);
+    if (*rest && c->L.covered && P->nrows > 0) { /* panels under the bar: the rest gives way */
+        char *t = P->row[P->nrows - 1];
+        double room_last = P->nrows > 1 ? room2 : R.w - P->x - 0.5 * f;
+        size_t n = strlen(t);
+        snprintf(t + n, sizeof P->row[0] - n, " …");
+        while (n > 0 && text_wb(cr, SANS, 1, fs, t) > room_last) {
+            while (n > 0 && t[n - 1] != ' ') n--; /* a word less */
+            while (n > 0 && t[n - 1] == ' ') n--;
+            snprintf(t + n, sizeof P->row[0] - n, " …");
+        }
+        return;
+    }
     /* under the bar, over the picture: from under the event line, or from
      * the picture's left edge when the picture is narrow */
     double x0 = P->x, room = c->L.geo.x + c->L.geo.w - P->x - 0.5 * f;
