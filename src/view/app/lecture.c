@@ -340,6 +340,13 @@ static void key_effect(const pdt_lecture *L, const pdt_view *v, char *buf, size_
     case 'm': snprintf(buf, cap, "m: mark set at event %zu (r records from here)", k); break;
     case 'r': snprintf(buf, cap, "r: recording written (the terminal names the file)"); break;
     case '0': snprintf(buf, cap, "0: every rank shown"); break;
+    case 'w': snprintf(buf, cap, "w: follow the current event %s", on_off(v->follow)); break;
+    case 'u': snprintf(buf, cap, "u: the current event's group opened / closed in the timeline"); break;
+    case '[': case ']':
+        snprintf(buf, cap, "%s%c: timeline %s (events %.0f %% … %.0f %%)", sh, L->key,
+                 L->shift ? "panned" : L->key == ']' ? "zoomed in" : "zoomed out", 100 * v->tl_t0,
+                 100 * v->tl_t1);
+        break;
     case '+': case '=': case '-':
         if (L->ctrl) snprintf(buf, cap, "Ctrl+%c: text size ×%.2f", L->key, v->font_scale);
         else snprintf(buf, cap, "%c: playback speed changed", L->key);
