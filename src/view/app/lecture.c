@@ -7,6 +7,7 @@
  * that the overlay can say what it did, from the state the frame shows. */
 #include "lecture.h"
 #include "beside.h"
+#include "pdt/view/textlog.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -370,6 +371,7 @@ static double say(cairo_t *cr, double x, double y, double fs, int bold, const ch
     cairo_set_font_size(cr, fs);
     cairo_text_extents(cr, t, &te);
     if (y >= 0) {
+        pdt_text_log_note(cr, fs, x, y, t); /* the layout report has it too */
         cairo_move_to(cr, x, y);
         cairo_show_text(cr, t);
     }
@@ -532,8 +534,10 @@ void pdt_lecture_overlay(void *user, cairo_t *cr, double w, double h, const pdt_
     cairo_save(cr);
     pdt_rect G = Ly.geo; /* a narrow picture: the notes over the column too */
     if (G.w < 0.6 * w) G.w = w - G.x;
+    pdt_text_log_panel(cr, "notes");
     if (v->panels & PDT_PANEL_NOTES) draw_notes(cr, L, G, fs, dark);
     else L->pages = 0;
+    pdt_text_log_panel(cr, "keys");
     char eff[240];
     if (L->msg[0]) snprintf(eff, sizeof eff, "%s", L->msg);
     else key_effect(L, v, eff, sizeof eff);
@@ -551,5 +555,6 @@ void pdt_lecture_overlay(void *user, cairo_t *cr, double w, double h, const pdt_
         cairo_restore(cr);
     }
     draw_marks(cr, L, fs);
+    pdt_text_log_panel(cr, NULL);
     cairo_restore(cr);
 }
