@@ -6,8 +6,10 @@
 The report lists every text the frame placed: its ink box (x, y, w, h in
 pixels), its font size px, its panel and whether a clip cut it.  Checked:
 
-  * no two texts overlap (by more than --slack pixels each way; texts under
-    the help overlay are not compared with it);
+  * no two texts overlap (by more than --slack pixels each way; the texts of
+    a layer drawn over the frame (the help overlay; the window's notes pane
+    and key-effect line, panels notes and keys) are not compared with the
+    texts under them);
   * no text is cut: neither by the frame nor by its panel's clip;
   * no text is smaller than --min-px;
   * the texts of the panels --big names (default code, event) are at least
@@ -29,6 +31,15 @@ def overlap(a, b, slack):
             and a["y"] + slack < b["y"] + b["h"] and b["y"] + slack < a["y"] + a["h"])
 
 
+# Layers drawn over the frame: a text in one is not compared with the texts
+# it covers (the help overlay; the window's notes pane and key-effect line).
+LAYERS = {"help": "help", "notes": "lecture", "keys": "lecture"}
+
+
+def layer(t):
+    return LAYERS.get(t["panel"], "frame")
+
+
 def overlaps(texts, slack):
     """Pairs of overlapping texts (sorted by x so that the scan stays short)."""
     order = sorted(range(len(texts)), key=lambda i: texts[i]["x"])
@@ -39,7 +50,7 @@ def overlaps(texts, slack):
             b = texts[j]
             if b["x"] >= a["x"] + a["w"] - slack:
                 break
-            if (a["panel"] == "help") != (b["panel"] == "help"):
+            if layer(a) != layer(b):
                 continue
             if overlap(a, b, slack):
                 found.append((a, b))

@@ -44,3 +44,21 @@ pdtview_window() {
     done
     return 1
 }
+
+# xvfb_start WxH: a fresh Xvfb screen of that size on a display it picks free
+# (-displayfd: no race with a test beside); sets DISPLAY and XPID (its pid).
+# xvfb_cleanup (for `trap xvfb_cleanup EXIT`) ends VPID (a pdtview the test
+# left running) and the Xvfb, and removes TMP.
+xvfb_start() {
+    rm -f "$TMP/xvfb.num"
+    Xvfb -displayfd 3 -screen 0 "$1"x24 -nolisten tcp 3>"$TMP/xvfb.num" >"$TMP/xvfb.log" 2>&1 &
+    XPID=$!
+    for _ in $(seq 100); do [ -s "$TMP/xvfb.num" ] && break; sleep 0.1; done
+    export DISPLAY=:$(head -1 "$TMP/xvfb.num")
+    for _ in $(seq 50); do xdotool getdisplaygeometry >/dev/null 2>&1 && break; sleep 0.1; done
+}
+xvfb_cleanup() {
+    [ -n "${VPID:-}" ] && kill "$VPID" 2>/dev/null
+    [ -n "${XPID:-}" ] && kill "$XPID" 2>/dev/null
+    rm -rf "$TMP"
+}

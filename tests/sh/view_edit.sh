@@ -50,14 +50,8 @@ same_events live_1_rank_records_what_pdt_triangulate_records "$TMP/one" "$TMP/li
 same_events live_hull_records_what_pdt_hull_records "$TMP/hull" "$TMP/live-hull" 1
 
 W=900; H=600
-d=130
-while [ -e /tmp/.X$d-lock ] || [ -e /tmp/.X11-unix/X$d ]; do d=$((d + 1)); done
-Xvfb :$d -screen 0 ${W}x${H}x24 -nolisten tcp >"$TMP/xvfb.log" 2>&1 &
-XPID=$!
-export DISPLAY=:$d
-for i in $(seq 50); do xdotool getdisplaygeometry >/dev/null 2>&1 && break; sleep 0.1; done
-cleanup() { [ -n "${VPID:-}" ] && kill "$VPID" 2>/dev/null; kill "$XPID" 2>/dev/null; rm -rf "$TMP"; }
-trap cleanup EXIT
+xvfb_start ${W}x${H}
+trap xvfb_cleanup EXIT
 
 F=$TMP/mine.txt
 "$V" --edit "$F" --size ${W}x${H} --screenshot "$TMP/edit.png" >"$TMP/out.log" 2>"$TMP/err.log" &

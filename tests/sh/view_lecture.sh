@@ -12,14 +12,8 @@ for t in Xvfb xdotool import compare; do
 done
 W=1024; H=768
 RUN=synth:srm:12:6:4
-d=91
-while [ -e /tmp/.X$d-lock ] || [ -e /tmp/.X11-unix/X$d ]; do d=$((d + 1)); done
-Xvfb :$d -screen 0 ${W}x${H}x24 -nolisten tcp >"$TMP/xvfb.log" 2>&1 &
-XPID=$!
-export DISPLAY=:$d
-for i in $(seq 50); do xdotool getdisplaygeometry >/dev/null 2>&1 && break; sleep 0.1; done
-cleanup() { [ -n "${VPID:-}" ] && kill "$VPID" 2>/dev/null; kill "$XPID" 2>/dev/null; rm -rf "$TMP"; }
-trap cleanup EXIT
+xvfb_start ${W}x${H}
+trap xvfb_cleanup EXIT
 
 # the cursor of each screenshot the window wrote (its stderr)
 events() { sed -n 's/.*screenshot .*event \([0-9]*\)).*/\1/p' "$1" | tr '\n' ' ' | sed 's/ $//'; }
@@ -56,6 +50,31 @@ else fail beside_click_in_its_half "events: $* (end, left timeline, right timeli
 "$V" "$RUN" --beside "$TMP/no-such-run" --script q >/dev/null 2>"$TMP/bs2.err"; rc=$?
 if [ "$rc" = 2 ] && grep -q "no-such-run" "$TMP/bs2.err"; then ok beside_bad_run_refused
 else fail beside_bad_run_refused "exit $rc: $(cat "$TMP/bs2.err")"; fi
+
+# ---- a projector at font scale 2: the panels with no room named, Tab shows them ------------
+for tabs in 0 1 2; do
+    keys=$(for i in $(seq $tabs); do printf 'key:Tab wait:2 '; done)
+    "$V" "$RUN" --size ${W}x${H} --panels all --font-scale 2 --layout-report "$TMP/tab$tabs.json" \
+         --script "wait:2 ${keys}wait:2 q" >/dev/null 2>"$TMP/tab$tabs.err"
+done
+if python3 - "$TMP"/tab0.json "$TMP"/tab1.json "$TMP"/tab2.json >"$TMP/tab.out" 2>&1 <<'EOF2'
+import json, sys
+d0, d1, d2 = (json.load(open(f)) for f in sys.argv[1:])
+hid = set(d0["hidden"])
+assert hid and not d0["covered"], d0["hidden"]
+more = " ".join(t["text"] for t in d0["texts"] if t["panel"] == "more")
+assert "Tab" in more, more
+shown = set()
+for d in (d1, d2):
+    assert d["covered"] and "picture" not in d["panels"], d["panels"]
+    shown |= {p for p in d["panels"] if p in hid}
+    assert any(t["panel"] in hid for t in d["texts"]), "no text of a hidden panel"
+assert shown == hid, (shown, hid)
+EOF2
+then ok tab_shows_the_panels_with_no_room
+else fail tab_shows_the_panels_with_no_room "$(tail -2 "$TMP/tab.out") $(cat "$TMP"/tab*.err | head -3)"; fi
+if python3 "$ROOT/scripts/layout-check.py" --min-px 16 --min-big 18 --status "$TMP"/tab[012].json >"$TMP/tabc.out"
+then ok tab_pages_readable; else fail tab_pages_readable "$(grep -v '^ok' "$TMP/tabc.out" | head -3)"; fi
 
 # ---- notes pane, pen, pointer, erase: what the screen shows ---------------------------------
 "$V" "$RUN" --size ${W}x${H} --bookmarks "$TMP/bm.tsv" --script "wait:1000000" >/dev/null 2>"$TMP/w.err" &

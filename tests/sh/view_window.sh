@@ -13,15 +13,8 @@ done
 W=1024; H=640
 RUN=synth:srm:12:6:4
 
-# a free display number
-d=90
-while [ -e /tmp/.X$d-lock ] || [ -e /tmp/.X11-unix/X$d ]; do d=$((d + 1)); done
-Xvfb :$d -screen 0 ${W}x${H}x24 -nolisten tcp >"$TMP/xvfb.log" 2>&1 &
-XPID=$!
-export DISPLAY=:$d
-for i in $(seq 50); do xdotool getdisplaygeometry >/dev/null 2>&1 && break; sleep 0.1; done
-cleanup() { [ -n "${VPID:-}" ] && kill "$VPID" 2>/dev/null; kill "$XPID" 2>/dev/null; rm -rf "$TMP"; }
-trap cleanup EXIT
+xvfb_start ${W}x${H}
+trap xvfb_cleanup EXIT
 
 # script: 5 events, next phase twice, the next rejection (Shift+→ after
 # selecting "rejection" with k k), then a screenshot; then wait for xdotool.

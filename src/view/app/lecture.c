@@ -7,6 +7,7 @@
  * that the overlay can say what it did, from the state the frame shows. */
 #include "lecture.h"
 #include "beside.h"
+#include "pdt/view/textlog.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -340,6 +341,13 @@ static void key_effect(const pdt_lecture *L, const pdt_view *v, char *buf, size_
     case 'm': snprintf(buf, cap, "m: mark set at event %zu (r records from here)", k); break;
     case 'r': snprintf(buf, cap, "r: recording written (the terminal names the file)"); break;
     case '0': snprintf(buf, cap, "0: every rank shown"); break;
+    case 'w': snprintf(buf, cap, "w: follow the current event %s", on_off(v->follow)); break;
+    case 'u': snprintf(buf, cap, "u: the current event's group opened / closed in the timeline"); break;
+    case '[': case ']':
+        snprintf(buf, cap, "%s%c: timeline %s (events %.0f %% … %.0f %%)", sh, L->key,
+                 L->shift ? "panned" : L->key == ']' ? "zoomed in" : "zoomed out", 100 * v->tl_t0,
+                 100 * v->tl_t1);
+        break;
     case '+': case '=': case '-':
         if (L->ctrl) snprintf(buf, cap, "Ctrl+%c: text size ×%.2f", L->key, v->font_scale);
         else snprintf(buf, cap, "%c: playback speed changed", L->key);
@@ -363,6 +371,7 @@ static double say(cairo_t *cr, double x, double y, double fs, int bold, const ch
     cairo_set_font_size(cr, fs);
     cairo_text_extents(cr, t, &te);
     if (y >= 0) {
+        pdt_text_log_note(cr, fs, x, y, t); /* the layout report has it too */
         cairo_move_to(cr, x, y);
         cairo_show_text(cr, t);
     }
@@ -525,8 +534,10 @@ void pdt_lecture_overlay(void *user, cairo_t *cr, double w, double h, const pdt_
     cairo_save(cr);
     pdt_rect G = Ly.geo; /* a narrow picture: the notes over the column too */
     if (G.w < 0.6 * w) G.w = w - G.x;
+    pdt_text_log_panel(cr, "notes");
     if (v->panels & PDT_PANEL_NOTES) draw_notes(cr, L, G, fs, dark);
     else L->pages = 0;
+    pdt_text_log_panel(cr, "keys");
     char eff[240];
     if (L->msg[0]) snprintf(eff, sizeof eff, "%s", L->msg);
     else key_effect(L, v, eff, sizeof eff);
@@ -544,5 +555,6 @@ void pdt_lecture_overlay(void *user, cairo_t *cr, double w, double h, const pdt_
         cairo_restore(cr);
     }
     draw_marks(cr, L, fs);
+    pdt_text_log_panel(cr, NULL);
     cairo_restore(cr);
 }

@@ -616,18 +616,32 @@ typedef struct mlabels {
     int n;
 } mlabels;
 
-/* A group's label at (x, y) (right-aligned when right), unless it would
- * overlap one already placed: with many merges at once they are thinned. */
+static int rect_meets(pdt_rect a, double x0, double y0, double x1, double y1)
+{
+    return a.x < x1 && x0 < a.x + a.w && a.y < y1 && y0 < a.y + a.h;
+}
+
+/* A group's label at (x, y) (right-aligned when right), or a row higher,
+ * unless both would overlap one already placed or a label the picture keeps
+ * (c->taken: box labels, the event line's spill): with many merges at once
+ * they are thinned. */
 static void merge_label(ctx *c, mlabels *P, double x, double y, int right, const char *lab)
 {
     double fs = c->L.label, tw = text_wb(c->cr, SANS, 1, fs, lab);
-    pdt_rect a = {right ? x - tw : x, y - fs, tw, 1.2 * fs};
-    for (int i = 0; i < P->n; i++)
-        if (a.x < P->r[i].x + P->r[i].w && P->r[i].x < a.x + a.w && a.y < P->r[i].y + P->r[i].h &&
-            P->r[i].y < a.y + a.h)
-            return;
-    if (P->n < 64) P->r[P->n++] = a;
-    text_at(c->cr, SANS, 1, fs, a.x, y, lab);
+    for (int up = 0; up < 2; up++, y -= 1.3 * fs) {
+        pdt_rect a = {right ? x - tw : x, y - fs, tw, 1.2 * fs};
+        int hit = 0;
+        for (int i = 0; i < P->n && !hit; i++)
+            hit = rect_meets(a, P->r[i].x, P->r[i].y, P->r[i].x + P->r[i].w, P->r[i].y + P->r[i].h);
+        for (int i = 0; i < c->ntaken && !hit; i++)
+            hit = rect_meets(a, c->taken[i].x0, c->taken[i].y0, c->taken[i].x1, c->taken[i].y1);
+        if (hit) continue;
+        if (P->n < 64) P->r[P->n++] = a;
+        if (c->ntaken < TAKEN_MAX) /* the box labels, placed later, keep off it */
+            c->taken[c->ntaken++] = (lbox){a.x, a.y, a.x + a.w, a.y + a.h};
+        text_at(c->cr, SANS, 1, fs, a.x, y, lab);
+        return;
+    }
 }
 
 /* The merge step in progress on some rank: border set rings and group boxes. */

@@ -129,6 +129,11 @@ int pdt_draw_group_labels(ctx *c)
         double ly = side ? y1 + pad + 0.95 * f : y0 - pad - 0.25 * f;
         if (lx < c->L.geo.x || lx + tw > c->L.geo.x + c->L.geo.w) continue;
         if (ly - fs < c->L.geo.y || ly + 0.3 * fs > c->L.geo.y + c->L.geo.h) continue;
+        int hit = 0; /* the event line's rows under the bar, the merges' G_L, G_R */
+        for (int t = 0; t < c->ntaken && !hit; t++)
+            hit = lx < c->taken[t].x1 && c->taken[t].x0 < lx + tw && ly - fs < c->taken[t].y1 &&
+                  c->taken[t].y0 < ly + 0.3 * fs;
+        if (hit) continue;
         last[side] = (pdt_rect){lx, ly - fs, tw, fs};
         cairo_rectangle(cr, lx - 0.1 * fs, ly - 0.85 * fs, tw + 0.2 * fs, 1.1 * fs);
         rgb(cr, c->T->bg, 0.8);

@@ -255,9 +255,9 @@ static void layout_all(double w, double h, int nranks, unsigned panels, double s
         layout_pass(w, h - bar, nranks, panels, L);
         L->more = (pdt_rect){0, h - bar, L->hidden ? w : 0, bar};
         L->pages = cover_pages(L->hidden);
-        if (overflow > 0 && L->pages) layout_cover(w, overflow > L->pages ? L->pages : overflow, L, nranks);
+        if (overflow > 0 && L->pages)
+            layout_cover(w, overflow > L->pages ? L->pages : overflow, L, nranks);
     }
-    L->top.w = w;
     layout_round(L);
 }
 

@@ -245,7 +245,7 @@ static int label_place(double (*bx)[4], int nb, double sx, double sy, double tw,
 
 /* Labels of the lifted points (few points): the current event's point and
  * the plane's corners first, then the others in index order; a label that
- * would overlap one already placed (or the panel's lines at the bottom)
+ * would overlap one already placed (or the title, or the lines at the bottom)
  * moves, else gives way (the panel is small). */
 static void draw_point_labels(const ctx *c, const proj *J, const pdt_rec *e, int have_plane,
                               const uint32_t tv[3])
@@ -255,8 +255,10 @@ static void draw_point_labels(const ctx *c, const proj *J, const pdt_rec *e, int
     pdt_rect R = c->L.lifted;
     uint32_t first[4] = {event_point(e), NONE32, NONE32, NONE32};
     for (int j = 0; j < 3 && have_plane; j++) first[j + 1] = tv[j];
-    double bx[64][4] = {{R.x, R.y + R.h - 0.5 * f - 2.3 * fs, R.x + R.w, R.y + R.h}};
-    int nb = have_plane ? 1 : 0;
+    /* the title row, and the plane's lines at the bottom (when drawn) */
+    double bx[64][4] = {{R.x, R.y, R.x + R.w, R.y + 0.3 * f + 1.25 * 0.82 * f},
+                        {R.x, R.y + R.h - 0.5 * f - 2.3 * fs, R.x + R.w, R.y + R.h}};
+    int nb = have_plane ? 2 : 1;
     for (size_t i = 0; i < 4 + c->n; i++) {
         uint32_t p = i < 4 ? first[i] : (uint32_t)(i - 4);
         if (p >= c->n) continue;

@@ -35,7 +35,7 @@ enum { TOP_ROWS = 8 };
 typedef struct top_plan {
     char head[64], status[512], row[TOP_ROWS][512];
     int nrows;
-    double x, sx, y[TOP_ROWS];
+    double x, sx, y[TOP_ROWS], xr[TOP_ROWS]; /* xr: where each row starts */
 } top_plan;
 
 /* The status, ended by "…" when wider than the bar (a very narrow window). */
@@ -55,6 +55,7 @@ static const char *plan_row(ctx *c, top_plan *P, const char *rest, double room, 
 {
     size_t n = fit_words(c->cr, rest, c->L.font, room);
     snprintf(P->row[P->nrows], sizeof P->row[0], "%.*s", (int)n, rest);
+    P->xr[P->nrows] = P->x;
     P->y[P->nrows++] = y;
     return rest + n + (rest[n] == ' ');
 }
@@ -76,9 +77,26 @@ static void plan_top(ctx *c, top_plan *P)
     snprintf(word, sizeof word, "%.*s", (int)strcspn(rest, " "), rest);
     if (*rest && text_wb(cr, SANS, 1, fs, word) <= room2) /* beside the status */
         rest = plan_row(c, P, rest, room2, R.y + 2.75 * f);
-    double room = fmax(c->L.geo.x + c->L.geo.w - P->x - 0.5 * f, 4 * f); /* over the picture */
-    for (double y = R.y + R.h + 1.05 * fs; *rest && P->nrows < TOP_ROWS; y += 1.4 * fs)
-        rest = plan_row(c, P, rest, room, y); /* under the bar */
+    if (*rest && c->L.covered && P->nrows > 0) { /* panels under the bar: the rest gives way */
+        char *t = P->row[P->nrows - 1];
+        double room_last = P->nrows > 1 ? room2 : R.w - P->x - 0.5 * f;
+        size_t n = strlen(t);
+        snprintf(t + n, sizeof P->row[0] - n, " …");
+        while (n > 0 && text_wb(cr, SANS, 1, fs, t) > room_last) {
+            while (n > 0 && t[n - 1] != ' ') n--; /* a word less */
+            while (n > 0 && t[n - 1] == ' ') n--;
+            snprintf(t + n, sizeof P->row[0] - n, " …");
+        }
+        return;
+    }
+    /* under the bar, over the picture: from under the event line, or from
+     * the picture's left edge when the picture is narrow */
+    double x0 = P->x, room = c->L.geo.x + c->L.geo.w - P->x - 0.5 * f;
+    if (room < 8 * f) x0 = c->L.geo.x + 0.5 * f, room = c->L.geo.w - f;
+    for (double y = R.y + R.h + 1.05 * fs; *rest && P->nrows < TOP_ROWS; y += 1.4 * fs) {
+        rest = plan_row(c, P, rest, room, y);
+        P->xr[P->nrows - 1] = x0;
+    }
 }
 
 void pdt_top_spill(ctx *c)
@@ -86,14 +104,15 @@ void pdt_top_spill(ctx *c)
     top_plan *P = malloc(sizeof *P);
     if (!P) return;
     plan_top(c, P);
-    double f = c->L.font, bottom = c->L.top.y + c->L.top.h, w = 0;
+    double f = c->L.font, bottom = c->L.top.y + c->L.top.h, w = 0, x0 = P->x;
     for (int i = 0; i < P->nrows; i++)
         if (P->y[i] > bottom) {
             w = fmax(w, text_wb(c->cr, SANS, 1, f, P->row[i]));
             bottom = P->y[i] + 0.35 * f;
+            x0 = P->xr[i];
         }
     if (w > 0 && c->ntaken < TAKEN_MAX)
-        c->taken[c->ntaken++] = (lbox){P->x - 0.3 * f, c->L.top.y + c->L.top.h, P->x + w + 0.3 * f, bottom};
+        c->taken[c->ntaken++] = (lbox){x0 - 0.3 * f, c->L.top.y + c->L.top.h, x0 + w + 0.3 * f, bottom};
     free(P);
 }
 
@@ -126,13 +145,13 @@ void pdt_draw_top(ctx *c)
     }
     for (int i = 0; i < P->nrows; i++) {
         if (P->y[i] > R.y + R.h) {
-            cairo_rectangle(cr, P->x - 0.3 * f, P->y[i] - 1.05 * f,
+            cairo_rectangle(cr, P->xr[i] - 0.3 * f, P->y[i] - 1.05 * f,
                             text_wb(cr, SANS, 1, f, P->row[i]) + 0.6 * f, 1.4 * f);
             rgb(cr, c->T->topbar, 0.92);
             cairo_fill(cr);
         }
         rgb(cr, c->T->ink, 1);
-        text_at(cr, SANS, 1, f, P->x, P->y[i], P->row[i]);
+        text_at(cr, SANS, 1, f, P->xr[i], P->y[i], P->row[i]);
     }
     free(P);
     if (c->v->prompt) draw_prompt(c);
