@@ -117,7 +117,7 @@ static pdt_status live_rank(pdt_comm *c, void *arg, pdt_err *err)
     pdt_par_input in = {malloc((size_t)(hi - lo) * sizeof(pdt_point) + 1), (size_t)(hi - lo), lo,
                         n, 0, 0, 0, PDT_PART_STRIPS};
     pdt_status st = in.pts ? PDT_OK : pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: out of memory", r);
-    if (st == PDT_OK) memcpy(in.pts, J->pts + lo, in.n * sizeof *in.pts);
+    if (st == PDT_OK && in.n) memcpy(in.pts, J->pts + lo, in.n * sizeof *in.pts); /* J->pts: NULL when empty */
     st = pdt_par_agree(c, st, NULL, err);
     PDT_TRACE(&tr, 1, PDT_EV_PHASE_END, PDT_PH_READ, 0, 0, 0, 0);
     pdt_par_rank_stats me;
