@@ -48,9 +48,8 @@ static size_t count_le(const srm_rec *r, size_t n, uint64_t v)
 
 /* out[j] = keys <= the j-th cut of [lo, hi] in r[0..n), j < w - 1: the cuts
  * increase, so each search gallops on from the last count and ends in a
- * short binary search near it (one binary search of the whole run per cut
- * missed the cache at every step: the largest part of a bisection's
- * partition, which counts at every depth). */
+ * short binary search near it, in memory the last one touched (a binary
+ * search of the whole run per cut risks a cache miss at every step). */
 static void count_cuts(const srm_rec *r, size_t n, uint64_t lo, uint64_t hi, uint64_t step,
                        size_t w, uint64_t *out)
 {
