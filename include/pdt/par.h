@@ -180,7 +180,7 @@ typedef struct pdt_par_input {
                           * rank, the partition's block with more): for
                           * ranks not sharing a CPU with another rank */
     int partition;       /* pdt_par_partition: how the ranks' regions are cut
-                          * (0: strips) */
+                          * (0: strips; PDT_PART_AUTO is resolved in place) */
 } pdt_par_input;
 
 /* This rank's share of T*: triangles first .. first + ntri - 1 of the
@@ -204,11 +204,26 @@ void pdt_par_output_free(pdt_par_output *out);
 /* How the ranks' regions are cut (algorithm.md §3.2, §3.12). */
 typedef enum pdt_par_partition {
     PDT_PART_STRIPS = 0, /* lexicographic blocks: every seam as tall as the input */
-    PDT_PART_BISECT = 1  /* boxes by recursive bisection across the longer side */
+    PDT_PART_BISECT = 1, /* boxes by recursive bisection across the longer side */
+    PDT_PART_AUTO = 2    /* pdt_par_partition_for the run (the default) */
 } pdt_par_partition;
 
-/* The partition a run uses when none is asked for. */
-#define PDT_PART_DEFAULT PDT_PART_STRIPS
+/* The partition a run uses when none is asked for: PDT_PART_AUTO, which
+ * pdt_par_triangulate resolves by pdt_par_partition_for. */
+#define PDT_PART_DEFAULT PDT_PART_AUTO
+
+/* From this many ranks an untraced run is bisected (docs/simulation.md: on
+ * the simulated 10 Gb/s cluster the bisection is faster from P = 16 at 10^7
+ * uniform points, and its lead grows with P and n). */
+#define PDT_PART_BISECT_FROM 16
+
+/* The partition PDT_PART_AUTO stands for on p ranks: bisection from
+ * PDT_PART_BISECT_FROM ranks on, strips below and for a traced run (the
+ * lessons' traces teach strips; --partition bisect traces bisection). */
+static inline pdt_par_partition pdt_par_partition_for(int p, int traced)
+{
+    return p >= PDT_PART_BISECT_FROM && !traced ? PDT_PART_BISECT : PDT_PART_STRIPS;
+}
 
 /* Figures of one rank. */
 typedef struct pdt_par_rank_stats {

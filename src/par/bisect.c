@@ -3,9 +3,9 @@
  * Every rank range of the tree cuts its points at the exact key that leaves
  * ceil(s/2)/s of them (s ranks) on the left, along the longer side of its
  * cell.  The ranges of one depth are cut together: each rank holds its
- * records of a range as one run of w (sorted by the range's axis key, its
- * index in rec alongside), the searches share the rounds of select_keys,
- * and a cut splits each run in two in place. */
+ * records of a range as one run in each of two orders (bis_ord), the
+ * searches share the rounds of select_keys on the run of the range's axis,
+ * and a cut splits both runs in two in place. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -16,7 +16,6 @@ typedef struct bis_range {
     int64_t x0, x1, y0, y1;  /* its cell (closed; the input's box at the root), in
                               * coordinates biased by 2^31 as in the key */
     size_t s, e;             /* its records here: w[s, e) */
-    int inorder;             /* w[s, e) is in rec's order (the (x, y) key's) */
 } bis_range;
 
 /* The input's box, (x0, y0) and (x1, y1), over all ranks (rec key-sorted). */
@@ -34,35 +33,46 @@ static pdt_status bis_root(drv *d, const srm_rec *rec, size_t n, bis_range *root
     if (st != PDT_OK) return st;
     pdt_drv_note_all(d, TAG_SAMPLES, sizeof v);
     *root = (bis_range){0, d->p, 0, (int64_t)v[0], (int64_t)(uint32_t)~v[1], (int64_t)v[2],
-                        (int64_t)(uint32_t)~v[3], 0, n, 1};
+                        (int64_t)(uint32_t)~v[3], 0, n};
     return PDT_OK;
 }
 
-/* The axis of every range (its cell's longer side; x on a tie) and its run
- * of w sorted by that axis' key (a run already in rec's order needs no sort
- * for an x-cut: the first cut of a wide input, every cut of strips-like
- * ones).  *scratch: n records, allocated at the first sort. */
-static pdt_status bis_sort(drv *d, const srm_rec *rec, srm_rec *w, size_t n, srm_rec **scratch,
-                           bis_range *r, int nr)
+/* A record's key on the other axis: (x, y) <-> (y, x), the key's halves
+ * swapped (srm_axis_key). */
+static inline uint64_t swap_key(uint64_t k)
 {
+    return k << 32 | k >> 32;
+}
+
+/* The bisection's two orders of this rank's records: x[] by the (x, y) key
+ * (rec's order), y[] the same records keyed and sorted by (y, x) -- built at
+ * the first y-cut.  A range's records are x[s, e) and y[s, e) alike; a cut
+ * splits the array of its axis where it falls and stably partitions the
+ * other (one pass), so both stay sorted and no range is ever sorted again.
+ * tmp: scratch of n records. */
+typedef struct bis_ord {
+    srm_rec *x, *y, *tmp;
+} bis_ord;
+
+/* The axis of every range (its cell's longer side; x on a tie); at the
+ * first y-cut, y[] of every range built (swapped keys, radix-sorted). */
+static pdt_status bis_axes(drv *d, bis_ord *o, size_t n, bis_range *r, int nr)
+{
+    int any_y = 0;
     for (int i = 0; i < nr; i++) {
         int axis = r[i].x1 - r[i].x0 >= r[i].y1 - r[i].y0 ? 0 : 1;
         d->tree.cut[r[i].at].axis = axis;
-        if (axis == 0 && r[i].inorder) continue;
-        if (!*scratch && !(*scratch = srm_big((n + 1) * sizeof **scratch)))
-            return pdt_drv_nomem(d, "partition");
-        for (size_t k = r[i].s; k < r[i].e; k++) {
-            pdt_point q = srm_key_point(rec[w[k].idx].key);
-            w[k].key = srm_axis_key(axis, q.x, q.y);
-        }
-        pdt_srm_radix_sort(w + r[i].s, *scratch, r[i].e - r[i].s);
-        r[i].inorder = axis == 0; /* (rec's keys are distinct: x order is rec's) */
+        any_y |= axis;
     }
+    if (!any_y || o->y) return PDT_OK;
+    if (!(o->y = srm_big((n + 1) * sizeof *o->y))) return pdt_drv_nomem(d, "partition");
+    for (size_t k = 0; k < n; k++) o->y[k] = (srm_rec){swap_key(o->x[k].key), o->x[k].idx, 0};
+    for (int i = 0; i < nr; i++) pdt_srm_radix_sort(o->y + r[i].s, o->tmp, r[i].e - r[i].s);
     return PDT_OK;
 }
 
 /* The cuts of the nr ranges of one depth (every rank the same). */
-static pdt_status bis_select(drv *d, const srm_rec *w, const bis_range *r, int nr, pdt_err *err)
+static pdt_status bis_select(drv *d, const bis_ord *o, const bis_range *r, int nr, pdt_err *err)
 {
     size_t z = (size_t)nr; /* (lo and hi side by side: one allreduce) */
     uint64_t *v = malloc(3 * z * sizeof *v), *t = malloc(z * sizeof *t);
@@ -71,7 +81,7 @@ static pdt_status bis_select(drv *d, const srm_rec *w, const bis_range *r, int n
     pdt_status st = v && t && arr && len ? PDT_OK : pdt_drv_nomem(d, "partition");
     uint64_t *cntr = v, *lo = v + z, *hi = v + 2 * z; /* hi: ~ of the largest key first */
     for (int i = 0; st == PDT_OK && i < nr; i++) {
-        arr[i] = w + r[i].s;
+        arr[i] = (d->tree.cut[r[i].at].axis ? o->y : o->x) + r[i].s;
         len[i] = r[i].e - r[i].s;
         cntr[i] = len[i];
         lo[i] = len[i] ? arr[i][0].key : UINT64_MAX;
@@ -97,17 +107,31 @@ static pdt_status bis_select(drv *d, const srm_rec *w, const bis_range *r, int n
     return st;
 }
 
+/* The records of the other axis' array o[s, e) whose key on the cut's axis
+ * is below split first, each side in its order (through tmp). */
+static void bis_partition(srm_rec *o, srm_rec *tmp, size_t s, size_t e, uint64_t split)
+{
+    size_t l = s, r = e;
+    for (size_t k = s; k < e; k++) { /* left from the front, right from the back */
+        if (swap_key(o[k].key) < split) tmp[l++] = o[k];
+        else tmp[--r] = o[k];
+    }
+    memcpy(o + s, tmp + s, (l - s) * sizeof *o);
+    for (size_t k = l; k < e; k++) o[k] = tmp[e - 1 - (k - l)];
+}
+
 /* Each range cut in two at its split: halves of two ranks or more into
- * next[] (their number returned), a single rank's run counted in sc[] (and
- * whether it is in rec's order in inorder[]). */
-static int bis_split(drv *d, const srm_rec *w, const bis_range *r, int nr, bis_range *next,
-                     uint64_t *sc, unsigned char *inorder)
+ * next[] (their number returned), a single rank's run counted in sc[]. */
+static int bis_split(drv *d, bis_ord *o, const bis_range *r, int nr, bis_range *next,
+                     uint64_t *sc)
 {
     int nn = 0;
     for (int i = 0; i < nr; i++) {
         srm_cut c = d->tree.cut[r[i].at];
         int mid = srm_bis_mid(r[i].lo, r[i].hi);
-        size_t at = r[i].s + pdt_srm_count_lt(w + r[i].s, r[i].e - r[i].s, c.split);
+        const srm_rec *a = (c.axis ? o->y : o->x) + r[i].s;
+        size_t at = r[i].s + pdt_srm_count_lt(a, r[i].e - r[i].s, c.split);
+        if (o->y) bis_partition(c.axis ? o->x : o->y, o->tmp, r[i].s, r[i].e, c.split);
         int64_t v = (int64_t)(c.split >> 32); /* the cut's own coordinate (biased) */
         bis_range h[2] = {r[i], r[i]};
         h[0].hi = h[1].lo = mid;
@@ -118,10 +142,7 @@ static int bis_split(drv *d, const srm_rec *w, const bis_range *r, int nr, bis_r
         else h[0].x1 = h[1].x0 = v;
         for (int k = 0; k < 2; k++) {
             if (h[k].hi - h[k].lo >= 2) next[nn++] = h[k];
-            else {
-                sc[h[k].lo] = h[k].e - h[k].s;
-                inorder[h[k].lo] = (unsigned char)h[k].inorder;
-            }
+            else sc[h[k].lo] = h[k].e - h[k].s;
         }
     }
     return nn;
@@ -130,9 +151,9 @@ static int bis_split(drv *d, const srm_rec *w, const bis_range *r, int nr, bis_r
 /* The bisection of the key-sorted rec[0..n) into the ranks' regions: the
  * cuts in d->tree (every rank the same), sc[q] the records for rank q, and
  * w[0..n) the records grouped by rank, key-sorted within each group (the
- * send buffer).  scratch: n records. */
-pdt_status pdt_drv_bisect(drv *d, const srm_rec *rec, srm_rec *w, size_t n, uint64_t *sc,
-                         pdt_err *err)
+ * send buffer).  rec is scratch afterwards. */
+pdt_status pdt_drv_bisect(drv *d, srm_rec *rec, srm_rec *w, size_t n, uint64_t *sc,
+                          pdt_err *err)
 {
     int p = d->p;
     d->tree.p = p;
@@ -140,33 +161,22 @@ pdt_status pdt_drv_bisect(drv *d, const srm_rec *rec, srm_rec *w, size_t n, uint
     d->tree.levels_p = pdt_srm_ceil_log2(p);
     d->tree.cut = calloc((size_t)p, sizeof *d->tree.cut);
     bis_range *cur = malloc((size_t)p * sizeof *cur), *next = malloc((size_t)p * sizeof *next);
-    unsigned char *inorder = malloc((size_t)p);
-    srm_rec *scratch = NULL;
-    pdt_status st = d->tree.cut && cur && next && inorder ? PDT_OK : pdt_drv_nomem(d, "partition");
-    for (size_t i = 0; i < n; i++) w[i] = (srm_rec){rec[i].key, (uint32_t)i, 0};
+    pdt_status st = d->tree.cut && cur && next ? PDT_OK : pdt_drv_nomem(d, "partition");
+    if (n) memcpy(w, rec, n * sizeof *w);
+    bis_ord o = {w, NULL, rec};
     int nr = 1;
-    if (st == PDT_OK) st = bis_root(d, rec, n, &cur[0], err);
+    if (st == PDT_OK) st = bis_root(d, w, n, &cur[0], err);
     while (st == PDT_OK && nr > 0) {
-        st = bis_sort(d, rec, w, n, &scratch, cur, nr);
-        if (st == PDT_OK) st = bis_select(d, w, cur, nr, err);
+        st = bis_axes(d, &o, n, cur, nr);
+        if (st == PDT_OK) st = bis_select(d, &o, cur, nr, err);
         if (st != PDT_OK) break;
-        nr = bis_split(d, w, cur, nr, next, sc, inorder);
+        nr = bis_split(d, &o, cur, nr, next, sc);
         bis_range *t = cur;
         cur = next;
         next = t;
     }
-    /* each rank's run back in key order (if a y-cut moved it), as records */
-    for (size_t q = 0, at = 0; st == PDT_OK && q < (size_t)p; at += sc[q++]) {
-        if (!inorder[q]) {
-            for (size_t i = at; i < at + sc[q]; i++) w[i].key = w[i].idx;
-            pdt_srm_radix_sort(w + at, scratch, sc[q]);
-        }
-        for (size_t i = at; i < at + sc[q]; i++) w[i] = rec[w[i].idx];
-    }
     free(cur);
     free(next);
-    free(inorder);
-    free(scratch);
+    free(o.y);
     return st;
 }
-

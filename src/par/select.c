@@ -46,6 +46,31 @@ static size_t count_le(const srm_rec *r, size_t n, uint64_t v)
     return v == UINT64_MAX ? n : pdt_srm_count_lt(r, n, v + 1);
 }
 
+/* out[j] = keys <= the j-th cut of [lo, hi] in r[0..n), j < w - 1: the cuts
+ * increase, so each search gallops on from the last count and ends in a
+ * short binary search near it, in memory the last one touched (a binary
+ * search of the whole run per cut risks a cache miss at every step). */
+static void count_cuts(const srm_rec *r, size_t n, uint64_t lo, uint64_t hi, uint64_t step,
+                       size_t w, uint64_t *out)
+{
+    size_t at = 0; /* every key before r[at] is <= the last cut */
+    for (size_t j = 0; j + 1 < w; j++) {
+        uint64_t v = sel_cut(lo, hi, step, j);
+        size_t g = 1;
+        while (at + g <= n && r[at + g - 1].key <= v) {
+            at += g;
+            g *= 2;
+        }
+        size_t e = at + g - 1 < n ? at + g - 1 : n; /* the first key > v is in [at, e] */
+        while (at < e) {
+            size_t mid = at + (e - at) / 2;
+            if (r[mid].key <= v) at = mid + 1;
+            else e = mid;
+        }
+        out[j] = at;
+    }
+}
+
 static uint64_t sel_step(uint64_t lo, uint64_t hi, size_t ways)
 {
     return (hi - lo) / ways + 1;
@@ -130,8 +155,7 @@ static pdt_status sel_count(drv *d, sel *s, pdt_err *err)
     for (int q = 0; q < s->ns; q++) {
         if (!sel_open(s, q) || s->g[q] != (size_t)q) continue;
         uint64_t step = sel_step(s->lo[q], s->hi[q], s->w[q]);
-        for (size_t j = 0; j + 1 < s->w[q]; j++)
-            cnt[s->at[q] + j] = count_le(s->arr[q], s->len[q], sel_cut(s->lo[q], s->hi[q], step, j));
+        count_cuts(s->arr[q], s->len[q], s->lo[q], s->hi[q], step, s->w[q], &cnt[s->at[q]]);
     }
     pdt_status st = pdt_comm_allreduce_u64(d->c, cnt, nc, PDT_COMM_SUM, err);
     if (st != PDT_OK) return st;

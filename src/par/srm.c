@@ -495,7 +495,10 @@ pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err
         if (s->pend[i].level == level)
             for (int k = 0; k < 3; k++) tab[np++] = s->pend[i].p[k];
     for (size_t i = 0; i < nh; i++) tab[np++] = s->hull[i];
-    qsort(tab, np, sizeof *tab, cmp_gid);
+    if (pdt_srm_sort_pts(tab, np, 1) != PDT_OK) {
+        free(tab);
+        return nomem(err, s->who, "pack");
+    }
     size_t u = 0;
     for (size_t i = 0; i < np; i++)
         if (u == 0 || tab[i].gid != tab[u - 1].gid) tab[u++] = tab[i];
@@ -614,9 +617,7 @@ bad:
 
 /* ---- the merge step ------------------------------------------------------------ */
 
-typedef struct gtri {
-    uint32_t v[3];
-} gtri;
+typedef srm_gtri gtri;
 
 /* rotate so that the smallest gid comes first (keeps the orientation) */
 static gtri canon3(uint32_t a, uint32_t b, uint32_t c)
@@ -634,11 +635,6 @@ static int cmp_gtri(const void *x, const void *y)
     for (int k = 0; k < 3; k++)
         if (a->v[k] != b->v[k]) return a->v[k] < b->v[k] ? -1 : 1;
     return 0;
-}
-
-static int has_gtri(const gtri *set, size_t n, gtri t)
-{
-    return bsearch(&t, set, n, sizeof t, cmp_gtri) != NULL;
 }
 
 static int cmp_key(const void *a, const void *b)
@@ -678,7 +674,8 @@ typedef struct merge_job {
     msg_view *mv;            /* the decoded messages, one per rank of the pair */
     int hl, hr;              /* message holding the hull of G_L / G_R, or -1 */
     double cp_in, cpu_in;    /* longest critical path among the senders */
-    gtri *shipped;           /* R_L ∪ R_R, canonical, sorted */
+    gtri *shipped;           /* R_L ∪ R_R, canonical (sorted when traced) */
+    srm_tset sset, tset;     /* the shipped set and T*(B), for look-ups */
     size_t ns;
     srm_pt *B;               /* the border set, key-sorted, distinct */
     size_t nb;
@@ -695,6 +692,8 @@ static void merge_job_free(merge_job *j)
     for (int i = 0; j->mv && i < j->nm; i++) msg_view_free(&j->mv[i]);
     free(j->mv);
     free(j->shipped);
+    pdt_srm_tset_free(&j->sset);
+    pdt_srm_tset_free(&j->tset);
     free(j->tb);
     free(j->B);
     free(j->bp);
@@ -757,10 +756,13 @@ static pdt_status border_set(merge_job *j)
             B[nb++] = c;
         }
     }
-    qsort(j->shipped, ns, sizeof *j->shipped, cmp_gtri);
+    if (PDT_TRACING(s->tr, 1)) /* (the discards are traced in this order) */
+        qsort(j->shipped, ns, sizeof *j->shipped, cmp_gtri);
     if (j->hl >= 0) nb += facing(s, &j->mv[j->hl], j->gr, j->ge, B + nb);
     if (j->hr >= 0) nb += facing(s, &j->mv[j->hr], j->gl, j->gr, B + nb);
-    qsort(B, nb, sizeof *B, cmp_key);
+    if (pdt_srm_tset_init(&j->sset, j->shipped, ns) != PDT_OK ||
+        pdt_srm_sort_pts(B, nb, 0) != PDT_OK)
+        return nomem(j->err, s->who, "merge");
     size_t u = 0;
     for (size_t i = 0; i < nb; i++)
         if (u == 0 || B[i].gid != B[u - 1].gid) B[u++] = B[i];
@@ -839,7 +841,7 @@ static pdt_status select_kept(merge_job *j)
         int nl = 0;
         for (int k = 0; k < 3; k++) nl += in_left(cut, B[v[k]]);
         int multi = nl > 0 && nl < 3;
-        if (!multi && !has_gtri(j->shipped, j->ns, g)) continue;
+        if (!multi && !pdt_srm_tset_has(&j->sset, g)) continue;
         j->kept++;
         int who;
         int lev = j->level + 1 < s->levels
@@ -879,10 +881,11 @@ static int64_t witness(const srm_pt *byg, size_t nb, gtri t)
 
 /* Discards: the shipped triangles T*(B) does not contain (traced with a
  * witness when tracing). */
-static void note_discards(merge_job *j)
+static pdt_status note_discards(merge_job *j)
 {
     pdt_trace *tr = j->s->tr;
-    qsort(j->tb, j->ntb, sizeof *j->tb, cmp_gtri);
+    if (pdt_srm_tset_init(&j->tset, j->tb, j->ntb) != PDT_OK)
+        return nomem(j->err, j->s->who, "merge");
     srm_pt *byg = NULL;
     if (PDT_TRACING(tr, 1)) {
         byg = malloc((j->nb + 1) * sizeof *byg);
@@ -893,7 +896,7 @@ static void note_discards(merge_job *j)
     }
     for (size_t i = 0; i < j->ns; i++) {
         gtri t = j->shipped[i];
-        if (has_gtri(j->tb, j->ntb, t)) continue;
+        if (pdt_srm_tset_has(&j->tset, t)) continue;
         j->ndisc++;
         if (!PDT_TRACING(tr, 1)) continue;
         int64_t wit = byg ? witness(byg, j->nb, t) : -1;
@@ -901,6 +904,7 @@ static void note_discards(merge_job *j)
     }
     free(byg);
     j->s->cnt.discarded += j->ndisc;
+    return PDT_OK;
 }
 
 /* The hull of the merged group: monotone chain over both hulls
@@ -971,7 +975,7 @@ pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t 
     if (st == PDT_OK) st = border_set(&j);
     if (st == PDT_OK) st = border_kernel(&j);
     if (st == PDT_OK) st = select_kept(&j);
-    if (st == PDT_OK) note_discards(&j);
+    if (st == PDT_OK) st = note_discards(&j);
     if (st == PDT_OK) st = merge_hulls(&j);
 
     if (st == PDT_OK) {

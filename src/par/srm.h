@@ -135,6 +135,29 @@ static inline uint64_t srm_key(srm_pt p)
     return pdt_key(q);
 }
 
+/* ---- srm_sets.c: the merge step's sorts and look-ups -------------------- */
+
+/* p[0..n) sorted by key (by_gid 0) or by global index (1); stable.
+ * PDT_ERR_NOMEM (p unchanged) or PDT_OK. */
+pdt_status pdt_srm_sort_pts(srm_pt *p, size_t n, int by_gid);
+
+/* A triangle by its vertices' global indices, rotated to start at the
+ * smallest (orientation kept). */
+typedef struct srm_gtri {
+    uint32_t v[3];
+} srm_gtri;
+
+/* A set of such triangles (open addressing; built once, then only asked). */
+typedef struct srm_tset {
+    srm_gtri *slot;
+    size_t mask;
+} srm_tset;
+
+/* The set of t[0..n): PDT_OK or PDT_ERR_NOMEM (then free it all the same). */
+pdt_status pdt_srm_tset_init(srm_tset *s, const srm_gtri *t, size_t n);
+int pdt_srm_tset_has(const srm_tset *s, srm_gtri t);
+void pdt_srm_tset_free(srm_tset *s);
+
 /* ---- touch.c: the restricted-area tests (§3.4) ------------------------- */
 
 /* The closed circumdisk of a triangle, as touch.c computes it: centre and a
