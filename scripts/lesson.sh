@@ -41,6 +41,8 @@
 #              built with `make smpi` first when missing: that installs
 #              libsimgrid-dev if needed); the trace's clock is the simulated one
 #   level      trace level, 1 or 2 (default 1)
+#   partition  strips | bisect: how the ranks' regions are cut (pdt --partition;
+#              default: pdt's own, which bisects from 16 ranks on)
 #   start      where the viewer starts: `at N` (the viewer's counter: N events
 #              applied), `phase NAME` (just after the phase first begins), `end`,
 #              or `first KIND ...` / `last KIND ...` (the first/last event of
@@ -195,6 +197,7 @@ for run in "${RUNS[@]}"; do
     ranks=$(conf "$run" ranks 1)
     simulate=$(conf "$run" simulate "")
     level=$(conf "$run" level 1)
+    partition=$(conf "$run" partition "")
     start=$(conf "$run" start end)
     frames=$(conf "$run" frames "")
     view="$(conf "$run" view "") $user_view"
@@ -217,11 +220,13 @@ for run in "${RUNS[@]}"; do
         trace=$rdir/trace
         rm -rf "$trace"
         case $points in /*) pfile=$points ;; *) pfile=$LDIR/$points ;; esac
-        cmd=("$PDT" "$command" "$pfile" --trace "$trace" --trace-level "$level")
+        popt=()
+        [ -n "$partition" ] && [ "$command" = triangulate ] && popt=(--partition "$partition")
+        cmd=("$PDT" "$command" "$pfile" --trace "$trace" --trace-level "$level" "${popt[@]}")
         if [ -n "$simulate" ]; then
             need_smpi || { status=1; continue; }
             ranks=$simulate
-            cmd=(bash "$ROOT/scripts/simulate.sh" -np "$ranks" -- "$command" "$pfile" --trace "$trace" --trace-level "$level")
+            cmd=(bash "$ROOT/scripts/simulate.sh" -np "$ranks" -- "$command" "$pfile" --trace "$trace" --trace-level "$level" "${popt[@]}")
             say "  [$run] simulating: $command of $points on $ranks simulated rank(s) (scripts/simulate.sh)"
         elif [ "$ranks" -gt 1 ]; then
             cmd=(mpirun -np "$ranks" --oversubscribe "${cmd[@]}")

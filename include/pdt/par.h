@@ -212,17 +212,18 @@ typedef enum pdt_par_partition {
  * pdt_par_triangulate resolves by pdt_par_partition_for. */
 #define PDT_PART_DEFAULT PDT_PART_AUTO
 
-/* From this many ranks an untraced run is bisected (docs/simulation.md: on
- * the simulated 10 Gb/s cluster the bisection is faster from P = 16 at 10^7
+/* From this many ranks a run is bisected (docs/simulation.md: on the
+ * simulated 10 Gb/s cluster the bisection is faster from P = 16 at 10^7
  * uniform points, and its lead grows with P and n). */
 #define PDT_PART_BISECT_FROM 16
 
 /* The partition PDT_PART_AUTO stands for on p ranks: bisection from
- * PDT_PART_BISECT_FROM ranks on, strips below and for a traced run (the
- * lessons' traces teach strips; --partition bisect traces bisection). */
-static inline pdt_par_partition pdt_par_partition_for(int p, int traced)
+ * PDT_PART_BISECT_FROM ranks on, strips below.  Tracing does not change it:
+ * a trace shows the run as it is made (lessons that teach strips on many
+ * ranks ask for them with --partition strips). */
+static inline pdt_par_partition pdt_par_partition_for(int p)
 {
-    return p >= PDT_PART_BISECT_FROM && !traced ? PDT_PART_BISECT : PDT_PART_STRIPS;
+    return p >= PDT_PART_BISECT_FROM ? PDT_PART_BISECT : PDT_PART_STRIPS;
 }
 
 /* Figures of one rank. */

@@ -50,7 +50,7 @@ static const char help[] =
     "                (lexicographic blocks, every seam as tall as the input)\n"
     "                or bisect (boxes by recursive bisection across the longer\n"
     "                side: deeper seams are shorter).  Default: bisect from 16\n"
-    "                ranks on, strips below and for a traced run.  The output\n"
+    "                ranks on, strips below, traced or not.  The output\n"
     "                is the same bytes either way.\n"
     "\n"
     "Output (.tri): one triangle per line, 'i j k', 0-based input indices,\n"

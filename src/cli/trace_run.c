@@ -72,7 +72,9 @@ static pdt_status fill_manifest(const pdt_run_opts *o, int p, const int64_t *off
     m->n = n;
     m->nranks = p;
     m->level = o->trace_level;
-    m->partition = p > 1 && o->partition == PDT_PART_BISECT; /* (one rank: no regions) */
+    pdt_par_partition part = o->partition == PDT_PART_AUTO ? pdt_par_partition_for(p)
+                                                           : (pdt_par_partition)o->partition;
+    m->partition = p > 1 && part == PDT_PART_BISECT; /* (one rank: no regions) */
     m->clock_offset_ns = (int64_t *)offsets;
     m->wall_start_ns = pdt_wall_ns();
     return m->command_line ? PDT_OK : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");

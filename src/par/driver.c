@@ -332,7 +332,7 @@ pdt_status pdt_par_triangulate(pdt_comm *c, pdt_par_input *in, pdt_par_output *o
     if (tr) tr->gid = NULL; /* the driver reports global indices itself */
     pdt_status st;
     if (in->partition == PDT_PART_AUTO)
-        in->partition = (int)pdt_par_partition_for(pdt_comm_size(c), tr != NULL);
+        in->partition = (int)pdt_par_partition_for(pdt_comm_size(c));
     if (pdt_comm_size(c) == 1) {
         st = sequential(c, in, out, me, tr, err);
     } else {

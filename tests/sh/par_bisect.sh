@@ -45,6 +45,12 @@ else fail strips_regions_are_bisect_regions_too "$(cat ok4.out)"; fi
 mpirun -np 16 "$PDT" triangulate u.txt -o b16.tri --partition bisect --trace run16 2> /dev/null
 if cmp -s ref.tri b16.tri && "$PDT" trace check run16 > /dev/null 2>&1; then ok trace_check_bisect_16_ranks
 else fail trace_check_bisect_16_ranks "$("$PDT" trace check run16 2>&1 | head -3)"; fi
+# no --partition: 16 ranks are bisected, traced or not, and the manifest says so
+mpirun -np 16 "$PDT" triangulate u.txt -o a16.tri --trace runa16 --stats 2> a16.json > /dev/null
+if cmp -s ref.tri a16.tri && grep -qx 'partition = bisect' runa16/manifest &&
+   grep -q '"partition": "bisect"' a16.json && "$PDT" trace check runa16 > /dev/null 2>&1; then
+    ok default_16_ranks_bisected_and_traced_as_such
+else fail default_16_ranks_bisected_and_traced_as_such "$(grep partition runa16/manifest a16.json | head -3)"; fi
 "$PDT" gen uniform 6 --seed 1 -o six.txt
 "$PDT" triangulate six.txt -o six.tri
 mpirun -np 9 "$PDT" triangulate six.txt -o six9.tri --partition bisect --trace run9 2> /dev/null
