@@ -256,6 +256,23 @@ size_t pdt_run_rank_blocks(const pdt_run *run, int rank, const pdt_block_ref **b
 int pdt_block_decode(const uint8_t *payload, uint32_t len, uint32_t count, uint64_t base_t,
                      pdt_event *out);
 
+/* A block payload decoded one event at a time (what pdt_block_decode
+ * decodes, without a room for the whole block): started on a payload as
+ * pdt_block_decode is called; each pdt_block_cursor_next decodes the next
+ * event into *out (out may be NULL: skipped) and returns 1, or 0 once the
+ * block's count events are out, or -1 when the payload is malformed there
+ * (the last event is refused when bytes are left after it).  The payload
+ * stays the caller's; the cursor is a value (copied freely). */
+typedef struct pdt_block_cursor {
+    const uint8_t *p, *end;
+    uint64_t t, v;        /* the previous time and v (time: from base_t) */
+    uint32_t a, b, c;     /* the previous a, b, c */
+    uint32_t left;        /* events not decoded yet */
+} pdt_block_cursor;
+void pdt_block_cursor_start(pdt_block_cursor *c, const uint8_t *payload, uint32_t len,
+                            uint32_t count, uint64_t base_t);
+int pdt_block_cursor_next(pdt_block_cursor *c, pdt_event *out);
+
 /* ---- export ------------------------------------------------------------------ */
 
 /* What pdt_run_export_otf2 wrote (over all ranks). */

@@ -84,53 +84,79 @@ static inline const uint8_t *get_varint(const uint8_t *p, const uint8_t *end, in
     return NULL;
 }
 
+/* Decode the next event at c->p into *e (the fields' previous values in c);
+ * 0, or -1 when the payload is malformed there. */
+static inline int decode_one(pdt_block_cursor *c, pdt_event *e)
+{
+    const uint8_t *p = c->p, *end = c->end;
+    uint64_t z;
+    if (end - p < 2) return -1;
+    e->kind = p[0];
+    uint8_t mask = p[1];
+    p += 2;
+    if (mask & ~(TF_SUB | TF_A | TF_B | TF_C | TF_V)) return -1;
+    if (!(p = get_varint(p, end, 10, &z))) return -1;
+    c->t += unzz(z);
+    e->t = c->t;
+    e->sub = 0;
+    e->reserved = 0;
+    e->a = e->b = e->c = 0;
+    e->v = 0;
+    if (mask & TF_SUB) {
+        if (p == end) return -1;
+        e->sub = *p++;
+    }
+    if (mask & TF_A) {
+        if (!(p = get_varint(p, end, 5, &z)) || z > UINT32_MAX) return -1;
+        c->a += (uint32_t)unzz(z);
+        e->a = c->a;
+    }
+    if (mask & TF_B) {
+        if (!(p = get_varint(p, end, 5, &z)) || z > UINT32_MAX) return -1;
+        c->b += (uint32_t)unzz(z);
+        e->b = c->b;
+    }
+    if (mask & TF_C) {
+        if (!(p = get_varint(p, end, 5, &z)) || z > UINT32_MAX) return -1;
+        c->c += (uint32_t)unzz(z);
+        e->c = c->c;
+    }
+    if (mask & TF_V) {
+        if (!(p = get_varint(p, end, 10, &z))) return -1;
+        c->v += unzz(z);
+        e->v = (int64_t)c->v;
+    }
+    c->p = p;
+    return 0;
+}
+
+void pdt_block_cursor_start(pdt_block_cursor *c, const uint8_t *payload, uint32_t len,
+                            uint32_t count, uint64_t base_t)
+{
+    *c = (pdt_block_cursor){payload, payload + len, base_t, 0, 0, 0, 0, count};
+}
+
+int pdt_block_cursor_next(pdt_block_cursor *c, pdt_event *out)
+{
+    if (!c->left) return c->p == c->end ? 0 : -1;
+    pdt_event e;
+    if (decode_one(c, &e) != 0) return -1;
+    c->left--;
+    if (!c->left && c->p != c->end) return -1;
+    if (out) *out = e;
+    return 1;
+}
+
 int pdt_tf_decode(const uint8_t *p, size_t len, uint32_t count, uint64_t base_t,
                   pdt_event *out)
 {
-    const uint8_t *end = p + len;
-    uint64_t pt = base_t, pv = 0, z;
-    uint32_t pa = 0, pb = 0, pc = 0;
+    pdt_block_cursor c = {p, p + len, base_t, 0, 0, 0, 0, count};
     for (uint32_t i = 0; i < count; i++) {
         pdt_event e;
-        if (end - p < 2) return -1;
-        e.kind = p[0];
-        uint8_t mask = p[1];
-        p += 2;
-        if (mask & ~(TF_SUB | TF_A | TF_B | TF_C | TF_V)) return -1;
-        if (!(p = get_varint(p, end, 10, &z))) return -1;
-        pt += unzz(z);
-        e.t = pt;
-        e.sub = 0;
-        e.reserved = 0;
-        e.a = e.b = e.c = 0;
-        e.v = 0;
-        if (mask & TF_SUB) {
-            if (p == end) return -1;
-            e.sub = *p++;
-        }
-        if (mask & TF_A) {
-            if (!(p = get_varint(p, end, 5, &z)) || z > UINT32_MAX) return -1;
-            pa += (uint32_t)unzz(z);
-            e.a = pa;
-        }
-        if (mask & TF_B) {
-            if (!(p = get_varint(p, end, 5, &z)) || z > UINT32_MAX) return -1;
-            pb += (uint32_t)unzz(z);
-            e.b = pb;
-        }
-        if (mask & TF_C) {
-            if (!(p = get_varint(p, end, 5, &z)) || z > UINT32_MAX) return -1;
-            pc += (uint32_t)unzz(z);
-            e.c = pc;
-        }
-        if (mask & TF_V) {
-            if (!(p = get_varint(p, end, 10, &z))) return -1;
-            pv += unzz(z);
-            e.v = (int64_t)pv;
-        }
+        if (decode_one(&c, &e) != 0) return -1;
         if (out) out[i] = e;
     }
-    return p == end ? 0 : -1;
+    return c.p == c.end ? 0 : -1;
 }
 
 void pdt_tf_block_header(uint8_t *h, uint32_t magic, const uint8_t *payload, uint32_t len,

@@ -180,9 +180,31 @@ TEST(codec_extremes)
     for (size_t i = 0; i < n; i++)
         if (!ev_eq(&ev[i], &back[i]) || ev[i].t != back[i].t) bad++;
     CHECK_MSG(bad == 0, "%zu events differ", bad);
+    /* one event at a time (some skipped): the same events, then the end */
+    pdt_block_cursor c;
+    pdt_block_cursor_start(&c, buf, (uint32_t)len, (uint32_t)n, 777);
+    size_t cbad = 0, got = 0;
+    for (size_t i = 0; i < n; i++) {
+        pdt_event e;
+        int skip = i % 5 == 3;
+        if (pdt_block_cursor_next(&c, skip ? NULL : &e) != 1) break;
+        got++;
+        if (!skip && (!ev_eq(&ev[i], &e) || ev[i].t != e.t)) cbad++;
+    }
+    CHECK(got == n);
+    CHECK_MSG(cbad == 0, "%zu events differ one at a time", cbad);
+    CHECK(pdt_block_cursor_next(&c, NULL) == 0);
     /* malformed: one byte short, one event too many, garbage mask */
     CHECK(pdt_tf_decode(buf, len - 1, (uint32_t)n, 777, back) != 0);
     CHECK(pdt_tf_decode(buf, len, (uint32_t)n + 1, 777, back) != 0);
+    pdt_block_cursor_start(&c, buf, (uint32_t)len - 1, (uint32_t)n, 777);
+    int rc = 1;
+    for (size_t i = 0; i < n && rc == 1; i++) rc = pdt_block_cursor_next(&c, NULL);
+    CHECK(rc == -1);  /* the last event runs past the payload */
+    pdt_block_cursor_start(&c, buf, (uint32_t)len, (uint32_t)n - 1, 777);
+    rc = 1;
+    for (size_t i = 0; i < n && rc == 1; i++) rc = pdt_block_cursor_next(&c, NULL);
+    CHECK(rc == -1);  /* bytes left after the count */
     buf[1] = 0xff;
     CHECK(pdt_tf_decode(buf, len, (uint32_t)n, 777, NULL) != 0);
     free(buf);

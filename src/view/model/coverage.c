@@ -72,6 +72,20 @@ typedef struct cov_job {
     size_t t0, t1, binned;
 } cov_job;
 
+/* The least and greatest of three finite numbers (fmin and fmax are calls
+ * here, a few per triangle of millions). */
+static inline double min3(double a, double b, double c)
+{
+    double m = a < b ? a : b;
+    return m < c ? m : c;
+}
+
+static inline double max3(double a, double b, double c)
+{
+    double m = a > b ? a : b;
+    return m > c ? m : c;
+}
+
 static void cov_range(cov_job *J)
 {
     const pdt_replay *r = J->r;
@@ -106,8 +120,8 @@ static void cov_range(cov_job *J)
             x[k] = (r->pts[tr->v[k]].x - J->x0) * J->sx;
             y[k] = (r->pts[tr->v[k]].y - J->y0) * J->sy;
         }
-        double xlo = fmin(x[0], fmin(x[1], x[2])), xhi = fmax(x[0], fmax(x[1], x[2]));
-        double ylo = fmin(y[0], fmin(y[1], y[2])), yhi = fmax(y[0], fmax(y[1], y[2]));
+        double xlo = min3(x[0], x[1], x[2]), xhi = max3(x[0], x[1], x[2]);
+        double ylo = min3(y[0], y[1], y[2]), yhi = max3(y[0], y[1], y[2]);
         if (xhi < 0 || xlo >= cols || yhi < 0 || ylo >= rows) continue;  /* outside the box */
         uint8_t st = r->hist[h].status;
         binned++;

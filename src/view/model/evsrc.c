@@ -30,6 +30,14 @@ typedef struct evslot {
 
 #define RELEASE_STEP ((uint64_t)16 << 20) /* drop_behind: pages given back in steps of this */
 
+/* Where rank q's decoding one event at a time is: in block blk (SIZE_MAX:
+ * nowhere), its next event `next` (of the rank) at c. */
+typedef struct evcur {
+    size_t blk;
+    uint64_t next;
+    pdt_block_cursor c;
+} evcur;
+
 /* What a damaged block gives (never reached on a verified index): an event
  * of no known kind, which every table ignores. */
 static const pdt_rec bad_rec = {{.kind = 0xff}, 0, 0};
@@ -39,8 +47,10 @@ void pdt_evsrc_clear(pdt_evsrc *s)
     for (size_t k = 0; k < s->nslot; k++) free(s->slot[k].rec);
     free(s->slot);
     free(s->released);
+    free(s->cur);
     s->slot = NULL;
     s->released = NULL;
+    s->cur = NULL;
     s->nslot = 0;
 }
 
@@ -143,6 +153,79 @@ static evslot *load(pdt_evsrc *s, size_t b, uint32_t q)
     return v;
 }
 
+/* Rank q's cursor (the table made when first needed), or NULL when out of
+ * memory. */
+static evcur *cur_of(pdt_evsrc *s, uint32_t q)
+{
+    if (!s->cur) {
+        s->cur = malloc((size_t)s->nranks * sizeof *s->cur);
+        if (!s->cur) return NULL;
+        for (int k = 0; k < s->nranks; k++) s->cur[k].blk = SIZE_MAX;
+    }
+    return &s->cur[q];
+}
+
+/* Start cursor c at the first event of block b of rank q: 1, or 0 (c
+ * nowhere) when the block is not in its file or, checked, damaged. */
+static int cur_start(pdt_evsrc *s, evcur *c, size_t b, uint32_t q)
+{
+    c->blk = SIZE_MAX;
+    if (!block_inside(s, b, q)) return 0;
+    if (s->verify && !pdt_evsrc_block_ok(s, b, q)) {
+        if (s->damaged) s->damaged(s->damaged_ctx, q);
+        return 0;
+    }
+    const pdt_block_ref *bk = &s->blk[b];
+    pdt_block_cursor_start(&c->c, s->file[q] + bk->off, bk->len, bk->count, bk->base_t);
+    if (s->drop_behind) drop_behind(s, q, bk->off);
+    c->blk = b;
+    c->next = bk->first;
+    return 1;
+}
+
+/* Event seq of rank q (in c's block, not before c->next) decoded by c,
+ * into the ring. */
+static const pdt_rec *cur_get(pdt_evsrc *s, evcur *c, uint32_t q, uint64_t seq)
+{
+    pdt_event e;
+    for (; c->next < seq; c->next++)
+        if (pdt_block_cursor_next(&c->c, NULL) != 1) break;
+    if (c->next != seq || pdt_block_cursor_next(&c->c, &e) != 1) {
+        c->blk = SIZE_MAX;  /* (malformed: as a block that does not decode) */
+        return &bad_rec;
+    }
+    c->next++;
+    pdt_rec *out = &s->ring[s->ring_at++ % PDT_EVSRC_KEEP];
+    *out = (pdt_rec){e, q, (uint32_t)seq};
+    return out;
+}
+
+/* Event seq of rank q from its cursor when that is just before it (in its
+ * block, or at the end of it with seq the next block's first), else NULL. */
+static const pdt_rec *cur_next(pdt_evsrc *s, evcur *c, uint32_t q, uint64_t seq)
+{
+    if (!c || c->blk == SIZE_MAX || c->next != seq) return NULL;
+    if (seq - s->blk[c->blk].first < s->blk[c->blk].count) return cur_get(s, c, q, seq);
+    size_t b = c->blk + 1;
+    if (b < s->rank_blk[q + 1] && s->blk[b].first == seq && cur_start(s, c, b, q))
+        return cur_get(s, c, q, seq);
+    return NULL;
+}
+
+/* The slot holding event seq of rank q, or NULL. */
+static evslot *slot_hit(pdt_evsrc *s, uint32_t q, uint64_t seq)
+{
+    for (size_t j = 0; j < s->nslot; j++) { /* the slot used last first */
+        size_t k = (s->hot + j) % s->nslot;
+        evslot *v = &s->slot[k];
+        if (v->blk != SIZE_MAX && v->rank == q && seq - v->first < v->count) {
+            s->hot = k;
+            return v;
+        }
+    }
+    return NULL;
+}
+
 const pdt_rec *pdt_evsrc_get(pdt_evsrc *s, size_t i)
 {
     if (i >= s->m || !s->nseg) return NULL;
@@ -150,16 +233,15 @@ const pdt_rec *pdt_evsrc_get(pdt_evsrc *s, size_t i)
     uint32_t q = g->rank;
     uint64_t seq = (uint64_t)g->seq0 + (i - g->start);
     s->tick++;
-    for (size_t j = 0; j < s->nslot; j++) { /* the slot used last first */
-        size_t k = (s->hot + j) % s->nslot;
-        evslot *v = &s->slot[k];
-        if (v->blk != SIZE_MAX && v->rank == q && seq - v->first < v->count) {
-            v->used = s->tick;
-            s->hot = k;
-            return &v->rec[seq - v->first];
-        }
-    }
     if (q >= (uint32_t)s->nranks) return &bad_rec;
+    evcur *c = cur_of(s, q);
+    const pdt_rec *got = cur_next(s, c, q, seq);  /* a forward pass: one event decoded */
+    if (got) return got;
+    evslot *v = slot_hit(s, q, seq);
+    if (v) {
+        v->used = s->tick;
+        return &v->rec[seq - v->first];
+    }
     size_t lo = (size_t)s->rank_blk[q], hi = (size_t)s->rank_blk[q + 1];
     if (lo >= hi || hi > s->nblk || seq < s->blk[lo].first) return &bad_rec;
     while (hi - lo > 1) { /* the last block with first <= seq */
@@ -168,7 +250,12 @@ const pdt_rec *pdt_evsrc_get(pdt_evsrc *s, size_t i)
         else hi = mid;
     }
     if (seq - s->blk[lo].first >= s->blk[lo].count) return &bad_rec;
-    evslot *v = load(s, lo, q);
+    /* ahead in the cursor's block, or in another block: the cursor decodes
+     * up to it (no more than the block would, and without its room); back
+     * in the cursor's block: the block into the cache */
+    if (c && (c->blk != lo || c->next <= seq))
+        return c->blk == lo || cur_start(s, c, lo, q) ? cur_get(s, c, q, seq) : &bad_rec;
+    v = load(s, lo, q);
     if (!v) return &bad_rec;
     v->used = s->tick;
     s->hot = (size_t)(v - s->slot);

@@ -23,6 +23,9 @@ typedef struct pdt_evseg {
     uint32_t start, rank, seq0;
 } pdt_evseg;
 
+struct evcur;
+#define PDT_EVSRC_KEEP 8  /* (pdt_evsrc_get) */
+
 typedef struct pdt_evsrc {
     const uint8_t **file;        /* per rank: its file's bytes (mapped), or NULL */
     uint64_t *file_len;          /* per rank */
@@ -42,6 +45,11 @@ typedef struct pdt_evsrc {
     int drop_behind;             /* give back the mapped pages behind a forward pass
                                   * (madvise; the build's one-way passes) */
     uint64_t *released;          /* (per rank, made when needed) */
+    struct evcur *cur;           /* per rank: where its forward decoding is (made
+                                  * when needed; owned) */
+    pdt_rec ring[PDT_EVSRC_KEEP]; /* the events decoded one at a time, the last
+                                   * PDT_EVSRC_KEEP of them */
+    unsigned ring_at;
     int verify;                  /* check each block's checksum when it is decoded;
                                   * on a mismatch call damaged(damaged_ctx, rank) */
     void (*damaged)(void *ctx, uint32_t rank);
@@ -49,8 +57,10 @@ typedef struct pdt_evsrc {
 } pdt_evsrc;
 
 /* Event i (< m) of the merged order, decoded: a pointer into the cache,
- * valid at least until PDT_EVSRC_KEEP - 1 more calls. */
-#define PDT_EVSRC_KEEP 8
+ * valid at least until PDT_EVSRC_KEEP - 1 more calls.  Each rank's events
+ * asked for in their order (a forward pass: every rank's in turn, at any
+ * interleaving) are decoded one at a time from where the rank's last one
+ * was; the others with their block, into the cache. */
 const pdt_rec *pdt_evsrc_get(pdt_evsrc *s, size_t i);
 /* The rank of event i (no decoding). */
 uint32_t pdt_evsrc_rank(pdt_evsrc *s, size_t i);
