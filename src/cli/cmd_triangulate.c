@@ -416,7 +416,7 @@ static void json_rank(int q, const pdt_par_rank_stats *r)
 }
 
 /* The communication figures of an MPI run and per_rank[] again (what make
- * table1 and scripts/projection.py read). */
+ * table1 and scripts/simulate-scaling.sh read). */
 static void json_parallel(const pdt_par_stats *s)
 {
     fprintf(stderr,
