@@ -121,6 +121,6 @@ frames ranks_1024 synth:srm:2048:4:1024 7
 
 # the legend lists eight groups of a 1024-rank run, not "…" after rank 8
 "$V" --headless synth:srm:2048:4:1024 --end --size 1024x768 -o "$TMP/l.png" --layout-report "$TMP/l.json" --quiet
-nleg=$(python3 -c 'import json,re,sys; print(sum(1 for t in json.load(open(sys.argv[1]))["texts"] if t["panel"]=="legend" and re.fullmatch(r"\d+–\d+", t["text"])))' "$TMP/l.json")
+nleg=$(python3 -c 'import json,re,sys; print(sum(1 for t in json.load(open(sys.argv[1]))["texts"] if t["panel"]=="legend" and re.fullmatch(r"(?:ranks )?\d+–\d+", t["text"])))' "$TMP/l.json")
 if [ "$nleg" = 8 ]; then ok legend_lists_eight_groups_of_1024_ranks; else fail legend_lists_eight_groups_of_1024_ranks "$nleg group labels"; fi
 summary

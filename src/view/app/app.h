@@ -19,6 +19,7 @@ typedef struct opts {
     size_t at;
     double speed;
     unsigned panels; /* PDT_PANEL_* bits (--panels) */
+    int panels_given; /* --panels was given (else a cluster run gets its own default) */
     /* animation export (--gif / --video) and the window's record key */
     const char *gif, *video, *record;
     double fps, hold;

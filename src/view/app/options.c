@@ -24,7 +24,7 @@
 
 static const char help_text[] =
     "usage: pdtview RUN [--size WxH] [--at N|--phase NAME|--end] [--hide R,R..]\n"
-    "               [--panels code,stack,lifted,timeline,notes|all|none]\n"
+    "               [--panels code,stack,lifted,timeline,tree,notes|all|none]\n"
     "               [--bookmarks FILE]   (a lesson's moments: b / Shift+b, notes pane n)\n"
     "               [--beside RUN2]   (RUN2 beside RUN, following it phase by phase)\n"
     "               [--script KEYS] [--screenshot FILE.png] [--speed EV_PER_S]\n"
@@ -203,8 +203,9 @@ static int check_view(opts *o, raw *w)
     if (w->size && !parse_size(w->size, &o->w, &o->h))
         return pdt_cli_usage(PROG, "--size needs WxH, each 64 .. 16384, not '%s'", w->size);
     if (w->panels && pdt_panels_parse(w->panels, &o->panels) != 0)
-        return pdt_cli_usage(PROG, "--panels needs a list of code, stack, lifted, timeline (or all, "
-                                   "none), not '%s'", w->panels);
+        return pdt_cli_usage(PROG, "--panels needs a list of code, stack, lifted, timeline, "
+                                   "tree, notes (or all, none), not '%s'", w->panels);
+    o->panels_given = w->panels != NULL;
     if (o->font_scale < 0.4 || o->font_scale > 4)
         return pdt_cli_usage(PROG, "--font-scale needs a number 0.4 .. 4, not '%g'", o->font_scale);
     if (w->theme && pdt_theme_parse(w->theme, &o->theme) != 0)

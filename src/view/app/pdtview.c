@@ -29,6 +29,7 @@
 #include "pdt/view/anim.h"
 #include "pdt/view/describe.h"
 #include "pdt/view/query.h"
+#include "pdt/view/ranktree.h"
 #include "pdt/view/render.h"
 #include "pdt/view/replay.h"
 #include "pdt/tracefile.h"
@@ -201,12 +202,17 @@ static pdt_status start_cursor(const opts *o, const pdt_replay *r, size_t *k, pd
     return PDT_OK;
 }
 
-/* The view the options ask for. */
-static void view_of(const opts *o, uint8_t *hidden, pdt_view *v)
+/* The view the options ask for.  Without --panels, a cluster run (as many
+ * ranks as make the timeline one of time) shows the timeline and the merge
+ * tree, as lesson 12 does: the stacks, the lifted view and the code line of
+ * hundreds of ranks at once say little, and the tree needs the room. */
+static void view_of(const opts *o, int nranks, uint8_t *hidden, pdt_view *v)
 {
     pdt_view_defaults(v);
     v->hidden = hidden;
     v->panels = o->panels;
+    if (!o->panels_given && nranks >= PDT_RANKTREE_TIMED_RANKS)
+        v->panels = PDT_PANEL_TIMELINE | PDT_PANEL_TREE;
     v->font_scale = o->font_scale;
     v->theme = o->theme;
     v->clean = o->clean;
@@ -340,7 +346,7 @@ int main(int argc, char **argv)
         goto out;
     pdt_replay_seek(r, s, k);
     pdt_view v;
-    view_of(&o, hidden, &v);
+    view_of(&o, pdt_replay_nranks(r), hidden, &v);
     rc = act(&o, r, s, &v, k, &err);
 out:
     if (err.code != PDT_OK) { /* unreadable run, bad argument: 2, as for pdt */

@@ -623,14 +623,15 @@ static int rect_meets(pdt_rect a, double x0, double y0, double x1, double y1)
 
 /* A group's label at (x, y) (right-aligned when right), or a row higher,
  * unless both would overlap one already placed or a label the picture keeps
- * (c->taken: box labels, the event line's spill): with many merges at once
- * they are thinned. */
+ * (c->taken: box labels, the event line's spill), or leave the picture:
+ * with many merges at once they are thinned. */
 static void merge_label(ctx *c, mlabels *P, double x, double y, int right, const char *lab)
 {
     double fs = c->L.label, tw = text_wb(c->cr, SANS, 1, fs, lab);
     for (int up = 0; up < 2; up++, y -= 1.3 * fs) {
         pdt_rect a = {right ? x - tw : x, y - fs, tw, 1.2 * fs};
-        int hit = 0;
+        const pdt_rect G = c->L.geo;
+        int hit = a.x < G.x || a.y < G.y || a.x + a.w > G.x + G.w || a.y + a.h > G.y + G.h;
         for (int i = 0; i < P->n && !hit; i++)
             hit = rect_meets(a, P->r[i].x, P->r[i].y, P->r[i].x + P->r[i].w, P->r[i].y + P->r[i].h);
         for (int i = 0; i < c->ntaken && !hit; i++)

@@ -304,10 +304,14 @@ static void layout_column(double w, double h, double top, double tl, int nranks,
     L->timeline = (pdt_rect){0, h - tl, tl > 0 ? w : 0, tl};
     L->geo = (pdt_rect){0, top, w - side, mid};
     double x = w - side, y = top, leg = fmin(C.legend, mid), code, stk, lifted;
-    /* the merge tree: a third of the column beside other panels, else all */
+    /* the merge tree: a third of the column beside the stacks or the lifted
+     * view, all but the code's four lines beside the code alone, else all */
     double tree = 0;
-    if (panels & PDT_PANEL_TREE)
-        tree = has_code || has_stack || has_lifted ? fmax(6 * f, 0.34 * (mid - leg)) : mid - leg;
+    if (panels & PDT_PANEL_TREE) {
+        tree = mid - leg;
+        if (has_stack || has_lifted) tree = fmax(6 * f, 0.34 * (mid - leg));
+        else if (has_code) tree = fmax(6 * f, mid - leg - C.code_min);
+    }
     column_split(mid - leg - tree, &C, has_code, has_stack, has_lifted, &code, &stk, &lifted);
     if (has_stack && !(stk > 0)) L->hidden |= PDT_PANEL_STACK;
     if (has_lifted && !(lifted > 0)) L->hidden |= PDT_PANEL_LIFTED;
