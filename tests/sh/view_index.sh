@@ -281,6 +281,23 @@ rm -f "$RS/.pdtview-index"
 PDTVIEW_BUCKETS=4096 "$V" "$RS" --counts --mem 1M >/dev/null
 same_pictures "$RS" 1M 27777 end && ok many_buckets_same_pictures || fail many_buckets_same_pictures
 
+# a run of 16 ranks (its timeline in time, the merge tree with each step's
+# time): the times the index keeps for the phases, merge steps and messages
+# draw the same timeline and tree as the events' own times held in memory
+R16=$TMP/run16
+"$V" --write-run "$R16" synth:srm:40:12:16 --quiet
+for at in 900 end; do
+    a="--at $at"; [ "$at" = end ] && a=--end
+    "$V" --headless "$R16" $a -o "$TMP/t16m.png" --size 1024x768 --panels timeline,tree --quiet --index off \
+        --layout-report "$TMP/t16m.json"
+    "$V" --headless "$R16" $a -o "$TMP/t16i.png" --size 1024x768 --panels timeline,tree --quiet --mem 1M \
+        --layout-report "$TMP/t16i.json"
+    if [ -s "$R16/.pdtview-index" ] && cmp -s "$TMP/t16m.png" "$TMP/t16i.png" &&
+        cmp -s "$TMP/t16m.json" "$TMP/t16i.json" && grep -q '"panel": *"tree"' "$TMP/t16i.json"
+    then ok "ranks16_times_kept_same_frame_$at"
+    else fail "ranks16_times_kept_same_frame_$at" "frames or texts differ, or no tree drawn"; fi
+done
+
 # bad budgets
 for bad in 0 12Q -5 ''; do
     "$V" "$R" --counts --mem "$bad" >/dev/null 2>"$TMP/eb"; rc=$?

@@ -138,9 +138,55 @@ out:
     pdt_synth_free(&syn);
 }
 
+/* The times the replay's tables hold (phases, merge steps, messages: the
+ * clock of the timeline and the merge tree reads them, and a kept index
+ * keeps them, so that its opening decodes no event for them) are their
+ * events' times. */
+TEST(table_times_are_events_times)
+{
+    pdt_synth syn;
+    pdt_err err = {0};
+    CHECK(pdt_synth_srm(40, 12, 16, 2, &syn, &err) == PDT_OK);
+    pdt_replay *r = NULL;
+    CHECK(pdt_replay_new(syn.pts, syn.n, syn.recs, syn.m, 16, &r, &err) == PDT_OK);
+    if (!r) {
+        pdt_synth_free(&syn);
+        return;
+    }
+    size_t np, nm, ng, bad = 0, ended = 0, both = 0;
+    const pdt_rphase *P = pdt_replay_phases(r, &np);
+    const pdt_rmerge *M = pdt_replay_merges(r, &nm);
+    const pdt_rmsg *G = pdt_replay_msgs(r, &ng);
+    CHECK(np > 16 && nm >= 15 && ng > 0);
+    for (size_t i = 0; i < np; i++) {
+        bad += P[i].begin_t != pdt_replay_rec(r, P[i].begin_ev)->ev.t;
+        if (P[i].end_ev != UINT32_MAX) {
+            ended++;
+            bad += P[i].end_t != pdt_replay_rec(r, P[i].end_ev)->ev.t;
+        }
+    }
+    for (size_t i = 0; i < nm; i++) {
+        bad += M[i].begin_t != pdt_replay_rec(r, M[i].begin_ev)->ev.t;
+        bad += M[i].end_ev == UINT32_MAX ? M[i].end_t != 0
+                                         : M[i].end_t != pdt_replay_rec(r, M[i].end_ev)->ev.t;
+    }
+    for (size_t i = 0; i < ng; i++) {
+        if (G[i].send_ev != UINT32_MAX && G[i].recv_ev != UINT32_MAX) both++;
+        bad += G[i].send_ev == UINT32_MAX ? G[i].send_t != 0
+                                          : G[i].send_t != pdt_replay_rec(r, G[i].send_ev)->ev.t;
+        bad += G[i].recv_ev == UINT32_MAX ? G[i].recv_t != 0
+                                          : G[i].recv_t != pdt_replay_rec(r, G[i].recv_ev)->ev.t;
+    }
+    CHECK_MSG(bad == 0, "%zu times differ from their events'", bad);
+    CHECK(ended > 0 && both > 0);
+    pdt_replay_free(r);
+    pdt_synth_free(&syn);
+}
+
 int main(void)
 {
     RUN(timeline_axis_is_time);
+    RUN(table_times_are_events_times);
     RUN(follow_zooms_into_merge_and_out);
     return test_summary();
 }

@@ -98,6 +98,8 @@ typedef struct pdt_rphase {
     int32_t parent;     /* enclosing phase of the same rank, or -1 */
     uint8_t first;      /* 1 if no other rank was already in the same phase
                          * (same id and level) when it began: PgUp/PgDn stops */
+    uint64_t begin_t, end_t;  /* their events' times (end_t 0 while it never ended):
+                               * the clock reads them without decoding the events */
 } pdt_rphase;
 
 /* A merge step, from MERGE_BEGIN to MERGE_END on the merge rank. */
@@ -105,6 +107,7 @@ typedef struct pdt_rmerge {
     uint32_t rank, level, gl, gr, gend;
     uint32_t begin_ev, end_ev;
     uint32_t shipped, border, kept, discarded;  /* from MERGE_END (0 before) */
+    uint64_t begin_t, end_t;  /* their events' times (end_t 0 while it never ended) */
 } pdt_rmerge;
 
 /* A message: SEND on src and the matching RECV on dst. */
@@ -112,6 +115,7 @@ typedef struct pdt_rmsg {
     uint32_t src, dst, tag;
     uint64_t bytes;
     uint32_t send_ev, recv_ev;  /* UINT32_MAX when that side is missing */
+    uint64_t send_t, recv_t;    /* their events' times (0 when that side is missing) */
 } pdt_rmsg;
 
 /* A hull reported by a HULL event: the stack that was just built. */

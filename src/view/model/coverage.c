@@ -27,35 +27,44 @@ static void cov_add(pdt_cov_cell *cell, uint32_t q, uint8_t st)
 
 /* The x range of triangle (grid coordinates x[], y[]) within the band
  * lo <= y <= hi: from its vertices in the band and its edges' crossings of
- * the band's two lines.  0 if it does not reach the band. */
+ * the band's two lines.  0 if it does not reach the band.  (The numbers are
+ * finite: plain comparisons, not calls to fmin and fmax, for the millions of
+ * triangles across a cell's edge.) */
 static int band_range(const double x[3], const double y[3], double lo, double hi, double *xmin,
                       double *xmax)
 {
     int any = 0;
-    *xmin = INFINITY;
-    *xmax = -INFINITY;
+    double mn = INFINITY, mx = -INFINITY;
     for (int k = 0; k < 3; k++) {
-        double ax = x[k], ay = y[k], bx = x[(k + 1) % 3], by = y[(k + 1) % 3];
+        int k1 = k == 2 ? 0 : k + 1;
+        double ax = x[k], ay = y[k], bx = x[k1], by = y[k1];
         if (ay >= lo && ay <= hi) {
-            *xmin = fmin(*xmin, ax);
-            *xmax = fmax(*xmax, ax);
+            mn = ax < mn ? ax : mn;
+            mx = ax > mx ? ax : mx;
             any = 1;
         }
-        const double lines[2] = {lo, hi};
-        for (int l = 0; l < 2; l++) {
-            double yl = lines[l];
-            if ((ay < yl && by > yl) || (ay > yl && by < yl)) {
-                double xc = ax + (bx - ax) * (yl - ay) / (by - ay);
-                *xmin = fmin(*xmin, xc);
-                *xmax = fmax(*xmax, xc);
-                any = 1;
-            }
+        if ((ay < lo && by > lo) || (ay > lo && by < lo)) {
+            double xc = ax + (bx - ax) * (lo - ay) / (by - ay);
+            mn = xc < mn ? xc : mn;
+            mx = xc > mx ? xc : mx;
+            any = 1;
+        }
+        if ((ay < hi && by > hi) || (ay > hi && by < hi)) {
+            double xc = ax + (bx - ax) * (hi - ay) / (by - ay);
+            mn = xc < mn ? xc : mn;
+            mx = xc > mx ? xc : mx;
+            any = 1;
         }
     }
+    *xmin = mn;
+    *xmax = mx;
     return any;
 }
 
 #define COV_AHEAD 16  /* triangles ahead whose points are fetched (pdt_replay_coverage) */
+#define COV_AHEAD_CELL 8  /* ... and whose first corner's cell is fetched (its point
+                           * is in the cache by then): the grid is megabytes, and
+                           * triangles in the order they were born hit it at random */
 #define COV_RELEASE ((size_t)1 << 16) /* triangles between givings back of a kept
                                        * index's pages (pdt_index_release) */
 
@@ -110,6 +119,12 @@ static void cov_range(cov_job *J)
             const pdt_rtri *ahead = &r->tris[t + COV_AHEAD];
             for (int k = 0; k < 3; k++) __builtin_prefetch(&r->pts[ahead->v[k]]);
             __builtin_prefetch(&r->hist[ahead->h0 + s->tcur[t + COV_AHEAD]]);
+        }
+        if (t + COV_AHEAD_CELL < nt && s->tcur[t + COV_AHEAD_CELL] != PDT_TCUR_NONE) {
+            const pdt_point *p = &r->pts[r->tris[t + COV_AHEAD_CELL].v[0]];
+            double gx = (p->x - J->x0) * J->sx, gy = (p->y - J->y0) * J->sy;
+            if (gx >= 0 && gx < cols && gy >= 0 && gy < rows)
+                __builtin_prefetch(&cells[(size_t)(int)gy * (size_t)cols + (size_t)(int)gx], 1);
         }
         uint32_t h = pdt_rstate_tri_entry(r, s, t);
         if (h == NONE32) continue;

@@ -48,7 +48,8 @@ static int ix_phase_begin(IX_ARGS)
     pdt_replay *r = b->r;
     const pdt_event *e = &rec->ev;
     if (!pdt_rp_tab_grow(r, (void **)&r->phases, &r->cap_phase, r->nphase + 1, sizeof *r->phases)) return 0;
-    r->phases[r->nphase] = (pdt_rphase){rec->rank, e->sub, e->a, i, NONE32, IX_CUR[PDT_SLOT_PHASE], 0};
+    r->phases[r->nphase] = (pdt_rphase){rec->rank, e->sub, e->a, i, NONE32, IX_CUR[PDT_SLOT_PHASE], 0,
+                                              e->t, 0};
     r->nphase++;
     return set_slot(b, i, (int)rec->rank, PDT_SLOT_PHASE, (int32_t)(r->nphase - 1));
 }
@@ -63,6 +64,7 @@ static int ix_phase_end(IX_ARGS)
         return 1;
     }
     r->phases[p].end_ev = i;
+    r->phases[p].end_t = rec->ev.t;
     return set_slot(b, i, (int)rec->rank, PDT_SLOT_PHASE, r->phases[p].parent);
 }
 
@@ -71,7 +73,8 @@ static int ix_merge_begin(IX_ARGS)
     pdt_replay *r = b->r;
     const pdt_event *e = &rec->ev;
     if (!pdt_rp_tab_grow(r, (void **)&r->merges, &r->cap_merge, r->nmerge + 1, sizeof *r->merges)) return 0;
-    r->merges[r->nmerge] = (pdt_rmerge){rec->rank, e->sub, e->a, e->b, e->c, i, NONE32, 0, 0, 0, 0};
+    r->merges[r->nmerge] = (pdt_rmerge){rec->rank, e->sub, e->a, e->b, e->c, i, NONE32, 0, 0, 0, 0,
+                                              e->t, 0};
     r->nmerge++;
     return set_slot(b, i, (int)rec->rank, PDT_SLOT_MERGE, (int32_t)(r->nmerge - 1));
 }
@@ -87,6 +90,7 @@ static int ix_merge_end(IX_ARGS)
     }
     pdt_rmerge *mg = &r->merges[g];
     mg->end_ev = i;
+    mg->end_t = e->t;
     mg->shipped = e->a;
     mg->border = e->b;
     mg->kept = e->c;
@@ -228,12 +232,17 @@ static int ix_msg(IX_ARGS)
     int32_t id;
     if (!pdt_rp_km_get(&b->msg_map, hi, lo, &id) || (send ? r->msgs[id].send_ev : r->msgs[id].recv_ev) != NONE32) {
         if (!pdt_rp_tab_grow(r, (void **)&r->msgs, &r->cap_msg, r->nmsg + 1, sizeof *r->msgs)) return 0;
-        r->msgs[r->nmsg] = (pdt_rmsg){src, dst, e->sub, pdt_event_bytes(e), NONE32, NONE32};
+        r->msgs[r->nmsg] = (pdt_rmsg){src, dst, e->sub, pdt_event_bytes(e), NONE32, NONE32, 0, 0};
         id = (int32_t)r->nmsg++;
         if (!pdt_rp_km_put(&b->msg_map, hi, lo, id, r->tab_limit)) return 0;
     }
-    if (send) r->msgs[id].send_ev = i;
-    else r->msgs[id].recv_ev = i;
+    if (send) {
+        r->msgs[id].send_ev = i;
+        r->msgs[id].send_t = e->t;
+    } else {
+        r->msgs[id].recv_ev = i;
+        r->msgs[id].recv_t = e->t;
+    }
     set_obj(b, i, id);
     return 1;
 }

@@ -89,37 +89,6 @@ static uint64_t ev_time(const pdt_replay *r, uint32_t ev)
     return e ? e->ev.t : 0;
 }
 
-typedef struct evq {
-    uint32_t ev, at;
-} evq;
-
-static int by_ev(const void *a, const void *b)
-{
-    const evq *x = a, *y = b;
-    return x->ev != y->ev ? (x->ev < y->ev ? -1 : 1) : (x->at > y->at) - (x->at < y->at);
-}
-
-/* The times of events ev[0 .. n) (0 for NONE32) into out, asked for in the
- * merged order (a kept index then decodes each rank's events forwards,
- * once, instead of a block for every event); one at a time when out of
- * memory.  ev and out may be the same array. */
-static void times_of(const pdt_replay *r, const uint32_t *ev, size_t n, uint64_t *out)
-{
-    evq *q = malloc((n ? n : 1) * sizeof *q);
-    if (!q) {
-        for (size_t i = 0; i < n; i++) out[i] = ev_time(r, ev[i]);
-        return;
-    }
-    for (size_t i = 0; i < n; i++) q[i] = (evq){ev[i], (uint32_t)i};
-    qsort(q, n, sizeof *q, by_ev);
-    uint64_t t = 0;
-    for (size_t i = 0; i < n; i++) {
-        if (i == 0 || q[i].ev != q[i - 1].ev) t = ev_time(r, q[i].ev);
-        out[q[i].at] = t;
-    }
-    free(q);
-}
-
 /* The first event of a merge step's phase on its merge rank (its shipping
  * and receiving come before MERGE_BEGIN), or its MERGE_BEGIN. */
 static void merge_starts(const pdt_ranktree *t, const pdt_replay *r, uint32_t *from)
@@ -149,31 +118,13 @@ static void merge_facts(pdt_ranktree *t, const pdt_replay *r)
     uint32_t *from = malloc((nm ? nm : 1) * sizeof *from);
     if (!from) return;
     merge_starts(t, r, from);
-    uint64_t *mt = malloc((2 * nm + 1) * sizeof *mt);
-    if (!mt) {
-        free(from);
-        return;
-    }
-    for (size_t i = 0; i < nm; i++) {
-        mt[2 * i] = M[i].begin_ev;
-        mt[2 * i + 1] = M[i].end_ev;
-    }
-    uint32_t *ids = malloc((2 * nm + 1) * sizeof *ids);
-    if (ids) {
-        for (size_t i = 0; i < 2 * nm; i++) ids[i] = (uint32_t)mt[i];
-        times_of(r, ids, 2 * nm, mt);
-        free(ids);
-    } else {
-        for (size_t i = 0; i < 2 * nm; i++) mt[i] = ev_time(r, (uint32_t)mt[i]);
-    }
     for (size_t i = 0; i < nm; i++) {
         int32_t id = t->of_merge[i];
         if (id < 0) continue;
-        uint64_t b = mt[2 * i], e = mt[2 * i + 1];
+        uint64_t b = M[i].begin_t, e = M[i].end_t;  /* (0 when it never ended) */
         t->nd[id].t_ns = e > b ? e - b : 0;
         t->nd[id].ready_ns = e;
     }
-    free(mt);
     for (size_t j = 0; j < ng; j++) {
         if (G[j].recv_ev == NONE32 || G[j].dst >= (uint32_t)t->nranks) continue;
         /* the merge steps led by the receiver: walk up from its leaf */
@@ -197,21 +148,28 @@ static void leaf_ready(pdt_ranktree *t, const pdt_replay *r)
     const pdt_rphase *P = pdt_replay_phases(r, &np);
     const pdt_rmerge *M = pdt_replay_merges(r, &nm);
     uint32_t *last = malloc((size_t)t->nranks * sizeof *last);
-    if (!last) return;
-    for (int q = 0; q < t->nranks; q++) last[q] = NONE32;
+    uint64_t *at = malloc((size_t)t->nranks * sizeof *at);  /* its time (0: none) */
+    if (!last || !at) {
+        free(last);
+        free(at);
+        return;
+    }
+    for (int q = 0; q < t->nranks; q++) {
+        last[q] = NONE32;
+        at[q] = 0;
+    }
     for (size_t i = 0; i < np; i++) {
         const pdt_rphase *p = &P[i];
         if (p->rank >= (uint32_t)t->nranks || p->end_ev == NONE32) continue;
         if (p->phase == PDT_PH_MERGE || p->phase == PDT_PH_RUN) continue;
         int32_t up = t->nd[t->leaf[p->rank]].parent;
         uint32_t bound = up >= 0 && t->nd[up].merge >= 0 ? M[t->nd[up].merge].begin_ev : NONE32;
-        if (p->end_ev < bound && (last[p->rank] == NONE32 || p->end_ev > last[p->rank]))
+        if (p->end_ev < bound && (last[p->rank] == NONE32 || p->end_ev > last[p->rank])) {
             last[p->rank] = p->end_ev;
+            at[p->rank] = p->end_t;
+        }
     }
-    uint64_t *at = malloc((size_t)t->nranks * sizeof *at);
-    if (at) times_of(r, last, (size_t)t->nranks, at);
-    for (int q = 0; q < t->nranks; q++)
-        t->nd[t->leaf[q]].ready_ns = at ? at[q] : ev_time(r, last[q]);
+    for (int q = 0; q < t->nranks; q++) t->nd[t->leaf[q]].ready_ns = at[q];
     free(at);
     free(last);
 }
@@ -276,34 +234,19 @@ static int clock_build(pdt_ranktree *t, const pdt_replay *r)
         free(mt);
         return 0;
     }
-    uint32_t last = m ? (uint32_t)(m - 1) : 0;
-    uint32_t *ids = malloc((2 * np + 2 * ng + 1) * sizeof *ids);
-    if (!ids) {
-        free(pt);
-        free(mt);
-        return 0;
-    }
+    /* the times the tables hold (read when they were made): no event decoded
+     * but the first and the last */
+    uint64_t t_first = m ? ev_time(r, 0) : 0, t_last = m ? ev_time(r, (uint32_t)(m - 1)) : 0;
     for (size_t i = 0; i < np; i++) {
-        ids[2 * i] = P[i].begin_ev;
-        ids[2 * i + 1] = P[i].end_ev == NONE32 ? last : P[i].end_ev;
+        pt[2 * i] = P[i].begin_t;
+        pt[2 * i + 1] = P[i].end_ev == NONE32 ? t_last : P[i].end_t;
     }
     for (size_t i = 0; i < ng; i++) { /* a missing end: the other's time */
         uint32_t s = G[i].send_ev, d = G[i].recv_ev;
-        uint32_t any = s != NONE32 ? s : d != NONE32 ? d : 0;
-        ids[2 * np + 2 * i] = s != NONE32 ? s : any;
-        ids[2 * np + 2 * i + 1] = d != NONE32 ? d : any;
+        uint64_t any = s != NONE32 ? G[i].send_t : d != NONE32 ? G[i].recv_t : t_first;
+        mt[2 * i] = s != NONE32 ? G[i].send_t : any;
+        mt[2 * i + 1] = d != NONE32 ? G[i].recv_t : any;
     }
-    uint64_t *all = malloc((2 * np + 2 * ng + 1) * sizeof *all);  /* (one pass for both) */
-    if (all) {
-        times_of(r, ids, 2 * np + 2 * ng, all);
-        memcpy(pt, all, 2 * np * sizeof *pt);
-        memcpy(mt, all + 2 * np, 2 * ng * sizeof *mt);
-        free(all);
-    } else {
-        times_of(r, ids, 2 * np, pt);
-        times_of(r, ids + 2 * np, 2 * ng, mt);
-    }
-    free(ids);
     clock_span(t, r, pt, np, mt, ng);
     if (t->nranks < PDT_RANKTREE_TIMED_RANKS) t->t_hi = t->t_lo; /* a step per event */
     double em = m ? (double)m : 1;
