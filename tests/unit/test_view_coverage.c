@@ -52,31 +52,39 @@ TEST(cells_by_status_and_rank)
     if (!r) return;
     pdt_rstate *s = pdt_rstate_new(r);
     pdt_cov_cell cells[9];
-    CHECK(pdt_replay_coverage(r, s, 0, 0, 3.5, 3.5, 3, 3, NULL, cells) == 0);  /* cursor 0 */
+    CHECK(pdt_replay_coverage(r, s, 0, 0, 3.5, 3.5, 3, 3, NULL, 0, cells) == 0);  /* cursor 0 */
     pdt_replay_seek(r, s, m);
-    CHECK(pdt_replay_coverage(r, s, 0, 0, 3.5, 3.5, 3, 3, NULL, cells) == 4);
+    CHECK(pdt_replay_coverage(r, s, 0, 0, 3.5, 3.5, 3, 3, NULL, 0, cells) == 4);
     CHECK(cells[0].n == 2 && cells[0].rank == PDT_COV_MIXED &&
           cells[0].by_status[PDT_TS_CANDIDATE] == 2);
+    CHECK(cells[0].rank_lo == 0 && cells[0].rank_hi == 1);  /* the makers' range */
+    CHECK(cells[2].rank_lo == 0 && cells[2].rank_hi == 0);
     CHECK(cells[2].n == 1 && cells[2].rank == 0 && cells[2].by_status[PDT_TS_FINAL] == 1);
     CHECK(cells[1].n == 1 && cells[1].rank == 0);
     CHECK(cells[8].n == 1 && cells[8].rank == 1 && cells[8].by_status[PDT_TS_DISCARDED] == 1);
     CHECK(cells[4].n == 1 && cells[3].n == 0 && cells[6].n == 0);
+    /* the discard (event 5) one event back: kept while the fade is longer,
+     * left out once it has faded */
+    CHECK(pdt_replay_coverage(r, s, 0, 0, 3.5, 3.5, 3, 3, NULL, 2, cells) == 4);
+    CHECK(cells[8].by_status[PDT_TS_DISCARDED] == 1);
+    CHECK(pdt_replay_coverage(r, s, 0, 0, 3.5, 3.5, 3, 3, NULL, 1, cells) == 3);
+    CHECK(cells[8].n == 0 && cells[2].by_status[PDT_TS_FINAL] == 1);
     /* the cursor before the final and the discard: candidates */
     pdt_replay_seek(r, s, 4);
-    pdt_replay_coverage(r, s, 0, 0, 3.5, 3.5, 3, 3, NULL, cells);
+    pdt_replay_coverage(r, s, 0, 0, 3.5, 3.5, 3, 3, NULL, 0, cells);
     CHECK(cells[2].by_status[PDT_TS_CANDIDATE] == 1 && cells[2].by_status[PDT_TS_FINAL] == 0);
     CHECK(cells[8].by_status[PDT_TS_CANDIDATE] == 1);
     /* rank 1 hidden: cell (0, 0) holds rank 0's triangle alone */
     pdt_replay_seek(r, s, m);
     uint8_t vis[2] = {1, 0};
-    CHECK(pdt_replay_coverage(r, s, 0, 0, 3.5, 3.5, 3, 3, vis, cells) == 2);
+    CHECK(pdt_replay_coverage(r, s, 0, 0, 3.5, 3.5, 3, 3, vis, 0, cells) == 2);
     CHECK(cells[0].n == 1 && cells[0].rank == 0 && cells[8].n == 0 && cells[4].n == 0);
     /* a box holding only the upper right: the rest left out */
-    CHECK(pdt_replay_coverage(r, s, 2.5, 2.5, 3.5, 3.5, 1, 1, NULL, cells) == 1);
+    CHECK(pdt_replay_coverage(r, s, 2.5, 2.5, 3.5, 3.5, 1, 1, NULL, 0, cells) == 1);
     CHECK(cells[0].n == 1 && cells[0].rank == 1);
     /* an empty box or grid bins nothing */
-    CHECK(pdt_replay_coverage(r, s, 1, 1, 1, 2, 2, 2, NULL, cells) == 0);
-    CHECK(pdt_replay_coverage(r, s, 0, 0, 3, 3, 0, 3, NULL, cells) == 0);
+    CHECK(pdt_replay_coverage(r, s, 1, 1, 1, 2, 2, 2, NULL, 0, cells) == 0);
+    CHECK(pdt_replay_coverage(r, s, 0, 0, 3, 3, 0, 3, NULL, 0, cells) == 0);
     pdt_rstate_free(s);
     pdt_replay_free(r);
 }
@@ -112,7 +120,7 @@ TEST(synthetic_run_counts_add_up)
     CHECK(pdt_replay_bbox(r, &lo, &hi));
     enum { C = 97, R = 83 };
     pdt_cov_cell *cells = calloc(C * R, sizeof *cells);
-    size_t binned = pdt_replay_coverage(r, s, lo.x, lo.y, hi.x + 1e-9, hi.y + 1e-9, C, R, NULL,
+    size_t binned = pdt_replay_coverage(r, s, lo.x, lo.y, hi.x + 1e-9, hi.y + 1e-9, C, R, NULL, 0,
                                         cells);
     size_t sum = 0, sum_st = 0, mixed = 0, empty = 0;
     for (int i = 0; i < C * R; i++) {
@@ -148,9 +156,11 @@ TEST(two_threads_same_cells)
     for (size_t k = 0; k < sizeof at / sizeof *at; k++) {
         pdt_replay_seek(r, s, at[k]);
         pdt_replay_set_cov_split(SIZE_MAX);
-        size_t b1 = pdt_replay_coverage(r, s, lo.x, lo.y, hi.x + 1e-9, hi.y + 1e-9, C, R, NULL, one);
+        size_t b1 = pdt_replay_coverage(r, s, lo.x, lo.y, hi.x + 1e-9, hi.y + 1e-9, C, R, NULL, 0,
+                                        one);
         pdt_replay_set_cov_split(1);
-        size_t b2 = pdt_replay_coverage(r, s, lo.x, lo.y, hi.x + 1e-9, hi.y + 1e-9, C, R, NULL, two);
+        size_t b2 = pdt_replay_coverage(r, s, lo.x, lo.y, hi.x + 1e-9, hi.y + 1e-9, C, R, NULL, 0,
+                                        two);
         size_t mixed = 0;
         for (int i = 0; i < C * R; i++) mixed += one[i].n && one[i].rank == PDT_COV_MIXED;
         CHECK_MSG(b1 > 100 && b1 == b2 && memcmp(one, two, C * R * sizeof *one) == 0 &&

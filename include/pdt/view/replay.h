@@ -273,20 +273,25 @@ typedef struct pdt_cov_cell {
     uint32_t rank;                       /* the maker rank of all of them, or
                                           * PDT_COV_MIXED when makers differ (seams,
                                           * merge regions); meaningless when n == 0 */
+    uint32_t rank_lo, rank_hi;           /* the least and greatest maker rank (a
+                                          * mixed cell within one group of ranks
+                                          * can wear the group's colour) */
 } pdt_cov_cell;
 #define PDT_COV_MIXED UINT32_MAX
 
 /* Aggregate the triangles of state s over a cols x rows grid covering the
  * world box [x0, x1) x [y0, y1) (cell (0, 0) holds x0, y0; row-major, cell
  * (i, j) at cells[j * cols + i]).  Triangles of ranks with rank_visible[q] ==
- * 0 are left out (rank_visible NULL: all shown).  cells must hold cols * rows
+ * 0 are left out (rank_visible NULL: all shown), and so are triangles
+ * discarded fade events or more before the cursor (the picture has faded
+ * them out; fade 0: every discarded one counts).  cells must hold cols * rows
  * entries; they are overwritten.  Returns the number of triangles that touch
  * the box.  Cost O(triangles + cells touched): for drawing runs of millions of triangles as a
  * picture of their density, ranks and statuses when they are too many to
  * draw one by one (pdt_draw_lod). */
 size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, double y0,
                            double x1, double y1, int cols, int rows,
-                           const uint8_t *rank_visible, pdt_cov_cell *cells);
+                           const uint8_t *rank_visible, uint64_t fade, pdt_cov_cell *cells);
 
 /* ---- run folders and the kept index (index.c) -------------------------------- */
 

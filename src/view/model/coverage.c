@@ -20,6 +20,9 @@
 /* Add triangle t (status st, maker q) to cell (i, j). */
 static void cov_add(pdt_cov_cell *cell, uint32_t q, uint8_t st)
 {
+    if (cell->n == 0) cell->rank_lo = cell->rank_hi = q;
+    cell->rank_lo = q < cell->rank_lo ? q : cell->rank_lo;
+    cell->rank_hi = q > cell->rank_hi ? q : cell->rank_hi;
     cell->rank = cell->n == 0 || cell->rank == q ? q : PDT_COV_MIXED;
     cell->n++;
     cell->by_status[st]++;
@@ -77,6 +80,7 @@ typedef struct cov_job {
     double x0, y0, sx, sy;
     int cols, rows;
     const uint8_t *vis;
+    uint64_t fade; /* discarded this many events before the cursor: left out (0: never) */
     pdt_cov_cell *cells;
     size_t t0, t1, binned;
 } cov_job;
@@ -139,6 +143,7 @@ static void cov_range(cov_job *J)
         double ylo = min3(y[0], y[1], y[2]), yhi = max3(y[0], y[1], y[2]);
         if (xhi < 0 || xlo >= cols || yhi < 0 || ylo >= rows) continue;  /* outside the box */
         uint8_t st = r->hist[h].status;
+        if (st == PDT_TS_DISCARDED && J->fade && s->k - r->hist[h].ev >= J->fade) continue;
         binned++;
         int j0 = ylo < 0 ? 0 : (int)ylo, j1 = yhi >= rows ? rows - 1 : (int)yhi;
         if ((int)xlo == (int)xhi && j0 == j1 && xlo >= 0) {  /* the usual case: one cell */
@@ -168,6 +173,9 @@ static void *cov_thread(void *arg)
 static void cov_merge(pdt_cov_cell *to, const pdt_cov_cell *from)
 {
     if (!from->n) return;
+    if (to->n == 0) to->rank_lo = from->rank_lo, to->rank_hi = from->rank_hi;
+    to->rank_lo = from->rank_lo < to->rank_lo ? from->rank_lo : to->rank_lo;
+    to->rank_hi = from->rank_hi > to->rank_hi ? from->rank_hi : to->rank_hi;
     to->rank = to->n == 0 || to->rank == from->rank ? from->rank : PDT_COV_MIXED;
     to->n += from->n;
     for (int k = 0; k < PDT_TS_COUNT; k++) to->by_status[k] += from->by_status[k];
@@ -182,7 +190,7 @@ void pdt_replay_set_cov_split(size_t tris) { cov_split = tris; }
 
 size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, double y0,
                            double x1, double y1, int cols, int rows,
-                           const uint8_t *rank_visible, pdt_cov_cell *cells)
+                           const uint8_t *rank_visible, uint64_t fade, pdt_cov_cell *cells)
 {
     if (cols <= 0 || rows <= 0) return 0;
     size_t ncell = (size_t)cols * (size_t)rows;
@@ -191,7 +199,7 @@ size_t pdt_replay_coverage(const pdt_replay *r, const pdt_rstate *s, double x0, 
     size_t nt = pdt_replay_born_at_most(r, s->k);
     cov_job J[2];
     J[0] = (cov_job){r, s, x0, y0, cols / (x1 - x0), rows / (y1 - y0), cols, rows, rank_visible,
-                     cells, 0, nt, 0};
+                     fade, cells, 0, nt, 0};
     J[1] = J[0];
     pthread_t th;
     int two = 0;

@@ -6,9 +6,10 @@
  * LOD_MIN_TRIS of them), the area is cut into cells of LOD_CELL_PX pixels,
  * the model aggregates the visible triangles per cell (pdt_replay_coverage:
  * how many, by status, one maker rank or mixed), and each cell is painted:
- * the maker's rank colour (dark grey where ranks mix: seams and merge
- * regions), pale while its triangles are mostly candidates, shipped or
- * deferred, red where most were discarded.  Zoomed in far enough, the real
+ * the maker's rank colour (its group's where the makers are ranks of one
+ * group, dark grey where groups mix: seams and merge regions), pale while its triangles are mostly candidates, shipped or
+ * deferred, red where most were discarded lately (discarded triangles fade
+ * out as the edges' do: at a run's end none is left).  Zoomed in far enough, the real
  * edges come back.  Classroom runs (thousands of triangles) never reach
  * LOD_MIN_TRIS: their picture is unchanged. */
 #include "render_int.h"
@@ -17,11 +18,19 @@
 #define LOD_PX_PER_TRI 6.0    /* denser than a triangle per this many pixels: aggregate */
 #define LOD_CELL_PX 2         /* cell size in pixels */
 
+/* Ranks lo and hi in one group of the colours shown (a group is a run of
+ * consecutive ranks: a subtree of the merge tree). */
+static int same_group(const ctx *cx, uint32_t lo, uint32_t hi)
+{
+    return cx->hue && hi < (uint32_t)cx->nranks && cx->hue[lo] != 255 && cx->hue[lo] == cx->hue[hi];
+}
+
 /* The colour of a cell (premultiplied ARGB32). */
 static uint32_t cell_argb(const ctx *cx, const pdt_cov_cell *cell)
 {
     double c[3] = {0.25, 0.25, 0.28};
     if (cell->rank != PDT_COV_MIXED) ctx_rank_rgb(cx, (int)cell->rank, c);
+    else if (same_group(cx, cell->rank_lo, cell->rank_hi)) ctx_rank_rgb(cx, (int)cell->rank_lo, c);
     double n = cell->n;
     double pale = (cell->by_status[PDT_TS_CANDIDATE] + cell->by_status[PDT_TS_SHIPPED] +
                    cell->by_status[PDT_TS_DEFERRED]) / n;
@@ -57,7 +66,8 @@ int pdt_draw_lod(ctx *c)
         return 0;  /* draw the edges instead */
     }
     for (int q = 0; q < c->nranks; q++) vis[q] = !(c->v->hidden && c->v->hidden[q]);
-    size_t binned = pdt_replay_coverage(c->r, c->s, x0, y0, x1, y1, cols, rows, vis, cells);
+    size_t binned = pdt_replay_coverage(c->r, c->s, x0, y0, x1, y1, cols, rows, vis,
+                                        c->v->fade > 0 ? (uint64_t)c->v->fade : 0, cells);
     int drew = 0;
     if ((double)binned * LOD_PX_PER_TRI >= G.w * G.h) {
         cairo_surface_t *img = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, cols, rows);
