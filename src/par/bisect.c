@@ -71,101 +71,189 @@ typedef struct bis_cell {
     int64_t x0, x1, y0, y1;
 } bis_cell;
 
-/* The sample of a rank range in two orders: x[0..m) by the (x, y) key,
- * y[0..m) the same points keyed and sorted by (y, x); tmp: scratch. */
-typedef struct bis_ord {
-    srm_rec *x, *y, *tmp;
-    size_t m;
-} bis_ord;
-
-/* The records of o[0..m) (the order across the cut's axis) whose key on the
- * cut's axis is below split first, each side in its order (through tmp). */
-static void bis_partition(srm_rec *o, srm_rec *tmp, size_t m, uint64_t split)
+/* The t-th smallest of a[0..n) (t < n), a reordered so that the keys below
+ * it come first and the others after; *below gets their number.
+ * Quickselect with three-way partitions (many equal keys are common:
+ * grids, copies). */
+static uint64_t bis_kth(uint64_t *a, size_t n, size_t t, size_t *below)
 {
-    size_t l = 0, r = m;
-    for (size_t k = 0; k < m; k++) { /* left from the front, right from the back */
-        if (swap_key(o[k].key) < split) tmp[l++] = o[k];
-        else tmp[--r] = o[k];
-    }
-    memcpy(o, tmp, l * sizeof *o);
-    for (size_t k = l; k < m; k++) o[k] = tmp[m - 1 - (k - l)];
-}
-
-/* The cuts of the rank range [lo, hi) (the cut of the range at preorder
- * number `at` first) from its sample o: the key of the sample's point of
- * rank ceil(s/2)/s along the axis; the run of that axis splits where the
- * key falls, the other is partitioned stably, and each half recurses. */
-static void bis_cut(srm_cut *cut, int lo, int hi, int at, bis_ord o, bis_cell c)
-{
-    if (hi - lo < 2) return;
-    int axis = c.x1 - c.x0 >= c.y1 - c.y0 ? 0 : 1, mid = srm_bis_mid(lo, hi);
-    uint64_t split = 0; /* (no sample: any cut) */
-    size_t left = 0;
-    if (o.m) {
-        const srm_rec *a = axis ? o.y : o.x;
-        left = (size_t)((uint64_t)o.m * (uint64_t)(mid - lo) / (uint64_t)(hi - lo));
-        split = a[left].key;
-        while (left > 0 && a[left - 1].key == split) left--; /* (copies go right) */
-        bis_partition(axis ? o.x : o.y, o.tmp, o.m, split);
-    }
-    cut[at] = (srm_cut){split, axis};
-    int64_t v = (int64_t)(split >> 32); /* the cut's own coordinate (biased) */
-    bis_cell l = c, r = c;
-    if (axis) l.y1 = r.y0 = v;
-    else l.x1 = r.x0 = v;
-    bis_ord ol = {o.x, o.y, o.tmp, left}, orr = {o.x + left, o.y + left, o.tmp, o.m - left};
-    bis_cut(cut, lo, mid, at + 1, ol, l);
-    bis_cut(cut, mid, hi, at + mid - lo, orr, r);
-}
-
-/* Rank 0: the samples of every rank (slots of `slot` words) in two sorted
- * orders, their box, the cuts. */
-static pdt_status bis_root(drv *d, const uint64_t *all, size_t slot)
-{
-    int p = d->p;
-    size_t m = 0;
-    for (int q = 0; q < p; q++) m += (size_t)all[(size_t)q * slot];
-    srm_rec *buf = srm_big((3 * m + 3) * sizeof *buf);
-    if (!buf) return pdt_drv_nomem(d, "partition");
-    bis_ord o = {buf, buf + m + 1, buf + 2 * m + 2, m};
-    bis_cell c = {INT64_MAX, INT64_MIN, INT64_MAX, INT64_MIN};
-    size_t k = 0;
-    for (int q = 0; q < p; q++) {
-        const uint64_t *s = all + (size_t)q * slot;
-        for (size_t i = 0; i < (size_t)s[0]; i++, k++) {
-            uint64_t key = s[1 + i];
-            int64_t x = (int64_t)(key >> 32), y = (int64_t)(key & 0xffffffffu);
-            c.x0 = x < c.x0 ? x : c.x0;
-            c.x1 = x > c.x1 ? x : c.x1;
-            c.y0 = y < c.y0 ? y : c.y0;
-            c.y1 = y > c.y1 ? y : c.y1;
-            o.x[k] = (srm_rec){key, 0, 0};
-            o.y[k] = (srm_rec){swap_key(key), 0, 0};
+    size_t lo = 0, hi = n; /* a[0, lo) < a[lo, hi) < a[hi, n) */
+    for (;;) {
+        if (hi - lo <= 16) { /* insertion sort of the rest */
+            for (size_t i = lo + 1; i < hi; i++) {
+                uint64_t v = a[i];
+                size_t j = i;
+                for (; j > lo && a[j - 1] > v; j--) a[j] = a[j - 1];
+                a[j] = v;
+            }
+            size_t b = t;
+            while (b > lo && a[b - 1] == a[t]) b--;
+            *below = b;
+            return a[t];
+        }
+        uint64_t x = a[lo], y = a[lo + (hi - lo) / 2], z = a[hi - 1];
+        uint64_t piv = x < y ? (y < z ? y : x < z ? z : x) : (x < z ? x : y < z ? z : y);
+        size_t lt = lo, i = lo, gt = hi; /* [lo, lt) < piv, [lt, i) = piv, [gt, hi) > piv */
+        while (i < gt) {
+            uint64_t v = a[i];
+            if (v < piv) {
+                a[i++] = a[lt];
+                a[lt++] = v;
+            } else if (v > piv) {
+                a[i] = a[--gt];
+                a[gt] = v;
+            } else {
+                i++;
+            }
+        }
+        if (t < lt) hi = lt;
+        else if (t >= gt) lo = gt;
+        else {
+            *below = lt;
+            return piv;
         }
     }
-    if (!m) c = (bis_cell){0, 0, 0, 0};
-    pdt_srm_radix_sort(o.x, o.tmp, m);
-    pdt_srm_radix_sort(o.y, o.tmp, m);
-    bis_cut(d->tree.cut, 0, p, 0, o, c);
-    free(buf);
+}
+
+/* The cut of a range of s = hi - lo ranks from its sample a[0..m), (x, y)
+ * keys, in its cell c: across the longer side, at the key of the sample's
+ * point of rank m ceil(s/2)/s along that axis (copies of it go right); a
+ * reordered, the left side's *left keys first.  No sample: any cut. */
+static srm_cut bis_cut_of(int lo, int hi, uint64_t *a, size_t m, bis_cell c, size_t *left)
+{
+    srm_cut cut = {0, c.x1 - c.x0 >= c.y1 - c.y0 ? 0 : 1};
+    *left = 0;
+    if (!m) return cut;
+    if (cut.axis)
+        for (size_t i = 0; i < m; i++) a[i] = swap_key(a[i]);
+    uint64_t t = (uint64_t)m * (uint64_t)(srm_bis_mid(lo, hi) - lo) / (uint64_t)(hi - lo);
+    cut.split = bis_kth(a, m, (size_t)t, left);
+    if (cut.axis)
+        for (size_t i = 0; i < m; i++) a[i] = swap_key(a[i]);
+    return cut;
+}
+
+/* A range's sample on its way to the range's first rank: its cell (4
+ * words) and its keys. */
+static pdt_status bis_send(drv *d, int to, const uint64_t *a, size_t m, bis_cell c,
+                           pdt_err *err)
+{
+    uint64_t *b = malloc((m + 4) * sizeof *b);
+    if (!b) return pdt_drv_nomem(d, "partition");
+    b[0] = (uint64_t)c.x0;
+    b[1] = (uint64_t)c.x1;
+    b[2] = (uint64_t)c.y0;
+    b[3] = (uint64_t)c.y1;
+    if (m) memcpy(b + 4, a, m * sizeof *a);
+    size_t bytes = (m + 4) * sizeof *b;
+    pdt_status st = pdt_comm_send(d->c, to, TAG_CUTS, b, bytes, err);
+    if (st == PDT_OK) pdt_drv_note_send(d, TAG_CUTS, to, bytes);
+    free(b);
+    return st;
+}
+
+/* The same received: *buf holds it (the keys from *buf + 4). */
+static pdt_status bis_recv(drv *d, int from, uint64_t **buf, size_t *m, bis_cell *c,
+                           pdt_err *err)
+{
+    void *b = NULL;
+    size_t bytes = 0;
+    pdt_status st = pdt_comm_recv(d->c, from, TAG_CUTS, &b, &bytes, err);
+    if (st != PDT_OK) return st;
+    pdt_drv_note_recv(d, TAG_CUTS, from, bytes);
+    *buf = b;
+    if (bytes < 4 * sizeof **buf)
+        return pdt_err_set(err, PDT_ERR_CHECK, "rank %d: partition: a sample of %zu bytes",
+                           d->rank, bytes);
+    *m = bytes / sizeof **buf - 4;
+    *c = (bis_cell){(int64_t)(*buf)[0], (int64_t)(*buf)[1], (int64_t)(*buf)[2],
+                    (int64_t)(*buf)[3]};
     return PDT_OK;
 }
 
-/* The cuts in d->tree, the same on every rank: samples gathered at rank 0,
- * cut there, broadcast. */
+/* The cuts, computed down the tree by the ranges' first ranks: rank 0
+ * holds the whole sample (buf, keys from a, m of them, cell c); the first
+ * rank of a range cuts its sample, keeps the left side's and sends the
+ * right side's to the right half's first rank, which goes on there.  So
+ * the work on the critical path is about twice the sample, not once per
+ * depth, and the messages follow the tree.  v[2 at], v[2 at + 1]: the
+ * split and axis of each cut this rank made (zero elsewhere). */
+static pdt_status bis_down(drv *d, uint64_t *buf, uint64_t *a, size_t m, bis_cell c,
+                           uint64_t *v, pdt_err *err)
+{
+    int lo = 0, hi = d->p, at = 0, r = d->rank, lead = r == 0;
+    pdt_status st = PDT_OK;
+    while (st == PDT_OK && hi - lo >= 2) {
+        int mid = srm_bis_mid(lo, hi);
+        if (lead) { /* r == lo */
+            size_t left;
+            srm_cut cut = bis_cut_of(lo, hi, a, m, c, &left);
+            v[2 * at] = cut.split;
+            v[2 * at + 1] = (uint64_t)cut.axis;
+            bis_cell l = c, rc = c;
+            int64_t x = (int64_t)(cut.split >> 32); /* the cut's own coordinate (biased) */
+            if (cut.axis) l.y1 = rc.y0 = x;
+            else l.x1 = rc.x0 = x;
+            st = bis_send(d, mid, a + left, m - left, rc, err);
+            m = left;
+            c = l;
+        } else if (r == mid) {
+            free(buf);
+            st = bis_recv(d, lo, &buf, &m, &c, err);
+            a = buf + 4;
+            lead = 1;
+        }
+        if (r < mid) {
+            hi = mid;
+            at += 1;
+        } else {
+            at += mid - lo;
+            lo = mid;
+        }
+    }
+    free(buf);
+    return st;
+}
+
+/* Rank 0: the samples of every rank (slots of `slot` words) packed to the
+ * front of all, their number and box. */
+static size_t bis_pack(uint64_t *all, int p, size_t slot, bis_cell *c)
+{
+    size_t m = 0;
+    for (int q = 0; q < p; q++) {
+        const uint64_t *s = all + (size_t)q * slot;
+        size_t k = (size_t)s[0]; /* (before the move: s[0] may be all[m]) */
+        memmove(all + m, s + 1, k * sizeof *all);
+        m += k;
+    }
+    *c = (bis_cell){INT64_MAX, INT64_MIN, INT64_MAX, INT64_MIN};
+    for (size_t i = 0; i < m; i++) {
+        int64_t x = (int64_t)(all[i] >> 32), y = (int64_t)(all[i] & 0xffffffffu);
+        c->x0 = x < c->x0 ? x : c->x0;
+        c->x1 = x > c->x1 ? x : c->x1;
+        c->y0 = y < c->y0 ? y : c->y0;
+        c->y1 = y > c->y1 ? y : c->y1;
+    }
+    if (!m) *c = (bis_cell){0, 0, 0, 0};
+    return m;
+}
+
+/* The cuts in d->tree, the same on every rank: the samples gathered at
+ * rank 0, cut down the tree (bis_down), every cut summed into every rank
+ * by one allreduce (each made by one rank, zero elsewhere). */
 static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t first, pdt_err *err)
 {
     int p = d->p;
-    size_t share = bis_share(p), slot = share + 1;
+    size_t share = bis_share(p), slot = share + 1, nv = 2 * (size_t)p;
     d->tree.p = p;
     d->tree.k = 1;
     d->tree.levels_p = pdt_srm_ceil_log2(p);
     d->tree.cut = calloc((size_t)p, sizeof *d->tree.cut);
-    uint64_t *mine = malloc(slot * sizeof *mine);
+    uint64_t *mine = malloc(slot * sizeof *mine), *v = calloc(nv, sizeof *v);
     uint64_t *all = d->rank == 0 ? malloc((size_t)p * slot * sizeof *all) : NULL;
     size_t *cnt = malloc((size_t)p * sizeof *cnt);
-    pdt_status st = d->tree.cut && mine && cnt && (d->rank || all) ? PDT_OK
-                                                                    : pdt_drv_nomem(d, "partition");
+    pdt_status st = d->tree.cut && mine && v && cnt && (d->rank || all)
+                        ? PDT_OK : pdt_drv_nomem(d, "partition");
     if (st == PDT_OK) {
         bis_sample(pts, n, first, share, mine);
         for (int q = 0; q < p; q++) cnt[q] = slot * sizeof *mine;
@@ -173,14 +261,18 @@ static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t firs
     }
     if (st == PDT_OK) {
         pdt_drv_note_all(d, TAG_SAMPLES, (size_t)(mine[0] + 1) * sizeof *mine);
-        if (d->rank == 0) st = bis_root(d, all, slot);
+        bis_cell c = {0, 0, 0, 0};
+        size_t m = d->rank == 0 ? bis_pack(all, p, slot, &c) : 0;
+        st = bis_down(d, all, all, m, c, v, err); /* (all is bis_down's: freed there) */
+        all = NULL;
     }
-    if (st == PDT_OK) { /* (a failure at rank 0 ends the job: no agreement here) */
-        size_t bytes = (size_t)(p - 1) * sizeof *d->tree.cut;
-        st = pdt_comm_bcast(d->c, d->tree.cut, bytes, 0, err);
-        if (st == PDT_OK) pdt_drv_note_all(d, TAG_SAMPLES, bytes);
+    if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, v, nv, PDT_COMM_SUM, err);
+    if (st == PDT_OK) {
+        pdt_drv_note_all(d, TAG_SAMPLES, nv * sizeof *v);
+        for (int i = 0; i + 1 < p; i++) d->tree.cut[i] = (srm_cut){v[2 * i], (int)v[2 * i + 1]};
     }
     free(mine);
+    free(v);
     free(all);
     free(cnt);
     return st;
