@@ -260,7 +260,7 @@ static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t firs
         st = pdt_comm_gatherv(d->c, mine, slot * sizeof *mine, all, cnt, 0, err);
     }
     if (st == PDT_OK) {
-        pdt_drv_note_all(d, TAG_SAMPLES, (size_t)(mine[0] + 1) * sizeof *mine);
+        pdt_drv_note_all(d, TAG_SAMPLES, slot * sizeof *mine); /* (uniform: the checker pairs them) */
         bis_cell c = {0, 0, 0, 0};
         size_t m = d->rank == 0 ? bis_pack(all, p, slot, &c) : 0;
         st = bis_down(d, all, all, m, c, v, err); /* (all is bis_down's: freed there) */
