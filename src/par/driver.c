@@ -16,8 +16,7 @@
  * With one rank the sequential pipeline does all of it: pdt_triangulate_inplace,
  * or for a large untraced .tri run the same SRM on two strips one after the
  * other in one process (pdt_srm_plain, plain.c), to hold less memory.  By the
- * same rule a rank that holds 2^21 points or more of an untraced .tri run
- * holds two strips (rank_strips):
+ * same rule a rank of a large untraced .tri run holds two strips (rank_strips):
  * the SRM then runs on 2P strips, rank r holding strips 2r and 2r + 1, which
  * it triangulates one after the other in its block and merges first, at
  * level 0, with no message; the levels above are the P ranks' own. */

@@ -246,15 +246,10 @@ pdt_status pdt_drv_strips(drv *d, pdt_err *err)
     return st;
 }
 
-/* How many strips each rank holds: 2 for an untraced run whose ranks hold
- * 2^21 points or more each (n / p), and whose points may be spent (a .tri
- * output), as a plain run of that many points does (strips_for), when
- * every rank's sample says the merge pays (pdt_srm_plain_pays: one vote
- * each, summed); else 1.  (The rule once looked at the whole input, n: at
- * 10^7 points and 64 ranks each rank's 156,250 points went as two strips,
- * to save memory no rank was short of, with a kernel some 8 % slower, a
- * merge more and a vote -- a sample triangulated on every rank -- that took
- * 6-9 ms of a 70 ms partition under simulation.)
+/* How many strips each rank holds: 2 for an untraced run of at least 2^21
+ * points whose points may be spent (a .tri output), as a plain run's
+ * (strips_for), when every rank's sample says the merge pays
+ * (pdt_srm_plain_pays: one vote each, summed); else 1.
  * $PDT_RANK_STRIPS=1|2 decides for every size and output format of an
  * untraced run (tests). */
 pdt_status pdt_drv_rank_strips(drv *d, const pdt_par_input *in, pdt_err *err)
@@ -262,8 +257,7 @@ pdt_status pdt_drv_rank_strips(drv *d, const pdt_par_input *in, pdt_err *err)
     const char *t = getenv("PDT_RANK_STRIPS");
     int want = t && *t ? atoi(t) : 0;
     int k = d->tr ? 1 /* (a traced run's events are the lessons': one strip a rank) */
-            : want ? want
-            : in->release_pts && d->n_total / (uint64_t)d->p >= ((uint64_t)1 << 21) ? 2 : 1;
+            : want ? want : in->release_pts && d->n_total >= ((uint64_t)1 << 21) ? 2 : 1;
     k = k >= 2 ? 2 : 1;
     if (!want && k == 2) {
         uint64_t votes = (uint64_t)pdt_srm_plain_pays(block_pts(d), d->m);
