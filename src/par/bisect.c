@@ -1,40 +1,38 @@
 /* pdt — the bisection partition's cuts (algorithm.md §3.12, driver.h).
  *
- * Every rank range of the tree cuts its points at the exact key that leaves
- * ceil(s/2)/s of them (s ranks) on the left, along the longer side of its
- * cell.  The ranges of one depth are cut together: each rank holds its
- * records of a range as one run in each of two orders (bis_ord), the
- * searches share the rounds of select_keys on the run of the range's axis,
- * and a cut splits both runs in two in place. */
+ * The cuts come from a sample, not from exact medians: the output is T*(P)
+ * for every choice of cuts (algorithm.md §3.8), so a cut only has to
+ * balance the regions well enough, and to be the same on every rank and in
+ * every run.  Each rank draws a fixed share of its input block (one point
+ * from each of s equal stretches of it, at a place a hash of the stretch's
+ * global position chooses: a regular sample that no periodic input order
+ * aliases; all the block's points when it has at most s), rank 0 gathers
+ * the samples, and the cuts are made down the tree (bis_down): each rank
+ * range across its cell's longer side, at the key that leaves ceil(s/2)/s
+ * of the range's sample on the left.  Every rank then sends each of its
+ * points to the region the cuts put it in, unsorted: the receiver sorts
+ * its region once (spread.c).
+ *
+ * (The first version selected exact medians: every rank sorted its block,
+ * kept it in two orders, (x, y) and (y, x), and ran rounds of counts and
+ * allreduces for every depth of the tree; at 10^7 points and 64 ranks that
+ * was most of the partition's time.)  A sample of 2^17 points in all puts a
+ * region within a few per cent of n / p: about 1/sqrt(s) of it, s = 2^17 / p
+ * sample points a region (at p = 64 the largest of 10^7 uniform points'
+ * regions held 4.3 % more than n / p). */
 #include <stdlib.h>
 #include <string.h>
 
 #include "driver.h"
 
-typedef struct bis_range {
-    int lo, hi, at;          /* ranks [lo, hi), the preorder number of its cut */
-    int64_t x0, x1, y0, y1;  /* its cell (closed; the input's box at the root), in
-                              * coordinates biased by 2^31 as in the key */
-    size_t s, e;             /* its records here: w[s, e) */
-} bis_range;
+/* Sample points over all ranks (a rank draws BIS_SAMPLE / p of its block,
+ * at least BIS_MIN_SHARE). */
+enum { BIS_SAMPLE = 1 << 17, BIS_MIN_SHARE = 64 };
 
-/* The input's box, (x0, y0) and (x1, y1), over all ranks (rec key-sorted). */
-static pdt_status bis_root(drv *d, const srm_rec *rec, size_t n, bis_range *root, pdt_err *err)
+static size_t bis_share(int p)
 {
-    uint64_t v[4] = {UINT64_MAX, UINT64_MAX, UINT64_MAX, UINT64_MAX};
-    for (size_t i = 0; i < n; i++) {
-        uint64_t x = rec[i].key >> 32, y = rec[i].key & 0xffffffffu;
-        if (x < v[0]) v[0] = x;
-        if (~x < v[1]) v[1] = ~x;
-        if (y < v[2]) v[2] = y;
-        if (~y < v[3]) v[3] = ~y;
-    }
-    pdt_status st = pdt_comm_allreduce_u64(d->c, v, 4, PDT_COMM_MIN, err);
-    if (st != PDT_OK) return st;
-    pdt_drv_note_all(d, TAG_SAMPLES, sizeof v);
-    *root = (bis_range){0, d->p, 0, (int64_t)v[0], (int64_t)(uint32_t)~v[1], (int64_t)v[2],
-                        (int64_t)(uint32_t)~v[3], 0, n};
-    return PDT_OK;
+    size_t s = (size_t)BIS_SAMPLE / (size_t)p;
+    return s < BIS_MIN_SHARE ? BIS_MIN_SHARE : s;
 }
 
 /* A record's key on the other axis: (x, y) <-> (y, x), the key's halves
@@ -44,139 +42,281 @@ static inline uint64_t swap_key(uint64_t k)
     return k << 32 | k >> 32;
 }
 
-/* The bisection's two orders of this rank's records: x[] by the (x, y) key
- * (rec's order), y[] the same records keyed and sorted by (y, x) -- built at
- * the first y-cut.  A range's records are x[s, e) and y[s, e) alike; a cut
- * splits the array of its axis where it falls and stably partitions the
- * other (one pass), so both stay sorted and no range is ever sorted again.
- * tmp: scratch of n records. */
-typedef struct bis_ord {
-    srm_rec *x, *y, *tmp;
-} bis_ord;
-
-/* The axis of every range (its cell's longer side; x on a tie); at the
- * first y-cut, y[] of every range built (swapped keys, radix-sorted). */
-static pdt_status bis_axes(drv *d, bis_ord *o, size_t n, bis_range *r, int nr)
+/* splitmix64's finaliser: a fixed hash of a stretch's number. */
+static uint64_t bis_mix(uint64_t z)
 {
-    int any_y = 0;
-    for (int i = 0; i < nr; i++) {
-        int axis = r[i].x1 - r[i].x0 >= r[i].y1 - r[i].y0 ? 0 : 1;
-        d->tree.cut[r[i].at].axis = axis;
-        any_y |= axis;
-    }
-    if (!any_y || o->y) return PDT_OK;
-    if (!(o->y = srm_big((n + 1) * sizeof *o->y))) return pdt_drv_nomem(d, "partition");
-    for (size_t k = 0; k < n; k++) o->y[k] = (srm_rec){swap_key(o->x[k].key), o->x[k].idx, 0};
-    for (int i = 0; i < nr; i++) pdt_srm_radix_sort(o->y + r[i].s, o->tmp, r[i].e - r[i].s);
-    return PDT_OK;
+    z += 0x9e3779b97f4a7c15u;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
+    return z ^ (z >> 31);
 }
 
-/* The cuts of the nr ranges of one depth (every rank the same). */
-static pdt_status bis_select(drv *d, const bis_ord *o, const bis_range *r, int nr, pdt_err *err)
+/* This rank's sample of pts[0..n) (global indices from `first`) into
+ * slot[1..]: one point from each of s equal stretches, s = min(n, share);
+ * slot[0] = s. */
+static void bis_sample(const pdt_point *pts, size_t n, uint64_t first, size_t share,
+                       uint64_t *slot)
 {
-    size_t z = (size_t)nr; /* (lo and hi side by side: one allreduce) */
-    uint64_t *v = malloc(3 * z * sizeof *v), *t = malloc(z * sizeof *t);
-    const srm_rec **arr = malloc(z * sizeof *arr);
-    size_t *len = malloc(z * sizeof *len);
-    pdt_status st = v && t && arr && len ? PDT_OK : pdt_drv_nomem(d, "partition");
-    uint64_t *cntr = v, *lo = v + z, *hi = v + 2 * z; /* hi: ~ of the largest key first */
-    for (int i = 0; st == PDT_OK && i < nr; i++) {
-        arr[i] = (d->tree.cut[r[i].at].axis ? o->y : o->x) + r[i].s;
-        len[i] = r[i].e - r[i].s;
-        cntr[i] = len[i];
-        lo[i] = len[i] ? arr[i][0].key : UINT64_MAX;
-        hi[i] = len[i] ? ~arr[i][len[i] - 1].key : UINT64_MAX;
+    size_t s = n < share ? n : share;
+    slot[0] = s;
+    for (size_t j = 0; j < s; j++) {
+        size_t a = n * j / s, b = n * (j + 1) / s; /* (b > a: s <= n) */
+        size_t at = a + (size_t)(bis_mix(first + a) % (uint64_t)(b - a));
+        slot[1 + j] = pdt_key(pts[at]);
     }
-    if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, cntr, (size_t)nr, PDT_COMM_SUM, err);
-    if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, lo, 2 * (size_t)nr, PDT_COMM_MIN, err);
-    if (st == PDT_OK) {
-        pdt_drv_note_all(d, TAG_SAMPLES, 3 * (size_t)nr * sizeof *v);
-        for (int i = 0; i < nr; i++) {
-            uint64_t s = (uint64_t)(r[i].hi - r[i].lo), left = (uint64_t)(srm_bis_mid(r[i].lo, r[i].hi) - r[i].lo);
-            t[i] = cntr[i] * left / s;
-            hi[i] = cntr[i] ? ~hi[i] : 0;
-            if (!cntr[i]) lo[i] = 0; /* no points: any cut */
+}
+
+/* A rank range's cell (closed; the sample's box at the root), in
+ * coordinates biased by 2^31 as in the key. */
+typedef struct bis_cell {
+    int64_t x0, x1, y0, y1;
+} bis_cell;
+
+/* The t-th smallest of a[0..n) (t < n), a reordered so that the keys below
+ * it come first and the others after; *below gets their number.
+ * Quickselect with three-way partitions (many equal keys are common:
+ * grids, copies). */
+static uint64_t bis_kth(uint64_t *a, size_t n, size_t t, size_t *below)
+{
+    size_t lo = 0, hi = n; /* a[0, lo) < a[lo, hi) < a[hi, n) */
+    for (;;) {
+        if (hi - lo <= 16) { /* insertion sort of the rest */
+            for (size_t i = lo + 1; i < hi; i++) {
+                uint64_t v = a[i];
+                size_t j = i;
+                for (; j > lo && a[j - 1] > v; j--) a[j] = a[j - 1];
+                a[j] = v;
+            }
+            size_t b = t;
+            while (b > lo && a[b - 1] == a[t]) b--;
+            *below = b;
+            return a[t];
         }
-        st = pdt_drv_select_keys(d, nr, arr, len, t, lo, hi, err);
+        uint64_t x = a[lo], y = a[lo + (hi - lo) / 2], z = a[hi - 1];
+        uint64_t piv = x < y ? (y < z ? y : x < z ? z : x) : (x < z ? x : y < z ? z : y);
+        size_t lt = lo, i = lo, gt = hi; /* [lo, lt) < piv, [lt, i) = piv, [gt, hi) > piv */
+        while (i < gt) {
+            uint64_t v = a[i];
+            if (v < piv) {
+                a[i++] = a[lt];
+                a[lt++] = v;
+            } else if (v > piv) {
+                a[i] = a[--gt];
+                a[gt] = v;
+            } else {
+                i++;
+            }
+        }
+        if (t < lt) hi = lt;
+        else if (t >= gt) lo = gt;
+        else {
+            *below = lt;
+            return piv;
+        }
     }
-    for (int i = 0; st == PDT_OK && i < nr; i++) d->tree.cut[r[i].at].split = lo[i];
-    free(v);
-    free(t);
-    free((void *)arr);
-    free(len);
+}
+
+/* The cut of a range of s = hi - lo ranks from its sample a[0..m), (x, y)
+ * keys, in its cell c: across the longer side, at the key of the sample's
+ * point of rank m ceil(s/2)/s along that axis (copies of it go right); a
+ * reordered, the left side's *left keys first.  No sample: any cut. */
+static srm_cut bis_cut_of(int lo, int hi, uint64_t *a, size_t m, bis_cell c, size_t *left)
+{
+    srm_cut cut = {0, c.x1 - c.x0 >= c.y1 - c.y0 ? 0 : 1};
+    *left = 0;
+    if (!m) return cut;
+    if (cut.axis)
+        for (size_t i = 0; i < m; i++) a[i] = swap_key(a[i]);
+    uint64_t t = (uint64_t)m * (uint64_t)(srm_bis_mid(lo, hi) - lo) / (uint64_t)(hi - lo);
+    cut.split = bis_kth(a, m, (size_t)t, left);
+    if (cut.axis)
+        for (size_t i = 0; i < m; i++) a[i] = swap_key(a[i]);
+    return cut;
+}
+
+/* A range's sample on its way to the range's first rank: its cell (4
+ * words) and its keys. */
+static pdt_status bis_send(drv *d, int to, const uint64_t *a, size_t m, bis_cell c,
+                           pdt_err *err)
+{
+    uint64_t *b = malloc((m + 4) * sizeof *b);
+    if (!b) return pdt_drv_nomem(d, "partition");
+    b[0] = (uint64_t)c.x0;
+    b[1] = (uint64_t)c.x1;
+    b[2] = (uint64_t)c.y0;
+    b[3] = (uint64_t)c.y1;
+    if (m) memcpy(b + 4, a, m * sizeof *a);
+    size_t bytes = (m + 4) * sizeof *b;
+    pdt_status st = pdt_comm_send(d->c, to, TAG_CUTS, b, bytes, err);
+    if (st == PDT_OK) pdt_drv_note_send(d, TAG_CUTS, to, bytes);
+    free(b);
     return st;
 }
 
-/* The records of the other axis' array o[s, e) whose key on the cut's axis
- * is below split first, each side in its order (through tmp). */
-static void bis_partition(srm_rec *o, srm_rec *tmp, size_t s, size_t e, uint64_t split)
+/* The same received: *buf holds it (the keys from *buf + 4). */
+static pdt_status bis_recv(drv *d, int from, uint64_t **buf, size_t *m, bis_cell *c,
+                           pdt_err *err)
 {
-    size_t l = s, r = e;
-    for (size_t k = s; k < e; k++) { /* left from the front, right from the back */
-        if (swap_key(o[k].key) < split) tmp[l++] = o[k];
-        else tmp[--r] = o[k];
-    }
-    memcpy(o + s, tmp + s, (l - s) * sizeof *o);
-    for (size_t k = l; k < e; k++) o[k] = tmp[e - 1 - (k - l)];
+    void *b = NULL;
+    size_t bytes = 0;
+    pdt_status st = pdt_comm_recv(d->c, from, TAG_CUTS, &b, &bytes, err);
+    if (st != PDT_OK) return st;
+    pdt_drv_note_recv(d, TAG_CUTS, from, bytes);
+    *buf = b;
+    if (bytes < 4 * sizeof **buf)
+        return pdt_err_set(err, PDT_ERR_CHECK, "rank %d: partition: a sample of %zu bytes",
+                           d->rank, bytes);
+    *m = bytes / sizeof **buf - 4;
+    *c = (bis_cell){(int64_t)(*buf)[0], (int64_t)(*buf)[1], (int64_t)(*buf)[2],
+                    (int64_t)(*buf)[3]};
+    return PDT_OK;
 }
 
-/* Each range cut in two at its split: halves of two ranks or more into
- * next[] (their number returned), a single rank's run counted in sc[]. */
-static int bis_split(drv *d, bis_ord *o, const bis_range *r, int nr, bis_range *next,
-                     uint64_t *sc)
+/* The cuts, computed down the tree by the ranges' first ranks: rank 0
+ * holds the whole sample (buf, keys from a, m of them, cell c); the first
+ * rank of a range cuts its sample, keeps the left side's and sends the
+ * right side's to the right half's first rank, which goes on there.  So
+ * the work on the critical path is about twice the sample, not once per
+ * depth, and the messages follow the tree.  v[2 at], v[2 at + 1]: the
+ * split and axis of each cut this rank made (zero elsewhere). */
+static pdt_status bis_down(drv *d, uint64_t *buf, uint64_t *a, size_t m, bis_cell c,
+                           uint64_t *v, pdt_err *err)
 {
-    int nn = 0;
-    for (int i = 0; i < nr; i++) {
-        srm_cut c = d->tree.cut[r[i].at];
-        int mid = srm_bis_mid(r[i].lo, r[i].hi);
-        const srm_rec *a = (c.axis ? o->y : o->x) + r[i].s;
-        size_t at = r[i].s + pdt_srm_count_lt(a, r[i].e - r[i].s, c.split);
-        if (o->y) bis_partition(c.axis ? o->x : o->y, o->tmp, r[i].s, r[i].e, c.split);
-        int64_t v = (int64_t)(c.split >> 32); /* the cut's own coordinate (biased) */
-        bis_range h[2] = {r[i], r[i]};
-        h[0].hi = h[1].lo = mid;
-        h[0].at = r[i].at + 1;
-        h[1].at = r[i].at + mid - r[i].lo;
-        h[0].e = h[1].s = at;
-        if (c.axis) h[0].y1 = h[1].y0 = v;
-        else h[0].x1 = h[1].x0 = v;
-        for (int k = 0; k < 2; k++) {
-            if (h[k].hi - h[k].lo >= 2) next[nn++] = h[k];
-            else sc[h[k].lo] = h[k].e - h[k].s;
+    int lo = 0, hi = d->p, at = 0, r = d->rank, lead = r == 0;
+    pdt_status st = PDT_OK;
+    while (st == PDT_OK && hi - lo >= 2) {
+        int mid = srm_bis_mid(lo, hi);
+        if (lead) { /* r == lo */
+            size_t left;
+            srm_cut cut = bis_cut_of(lo, hi, a, m, c, &left);
+            v[2 * at] = cut.split;
+            v[2 * at + 1] = (uint64_t)cut.axis;
+            bis_cell l = c, rc = c;
+            int64_t x = (int64_t)(cut.split >> 32); /* the cut's own coordinate (biased) */
+            if (cut.axis) l.y1 = rc.y0 = x;
+            else l.x1 = rc.x0 = x;
+            st = bis_send(d, mid, a + left, m - left, rc, err);
+            m = left;
+            c = l;
+        } else if (r == mid) {
+            free(buf);
+            st = bis_recv(d, lo, &buf, &m, &c, err);
+            a = buf + 4;
+            lead = 1;
+        }
+        if (r < mid) {
+            hi = mid;
+            at += 1;
+        } else {
+            at += mid - lo;
+            lo = mid;
         }
     }
-    return nn;
+    free(buf);
+    return st;
 }
 
-/* The bisection of the key-sorted rec[0..n) into the ranks' regions: the
- * cuts in d->tree (every rank the same), sc[q] the records for rank q, and
- * w[0..n) the records grouped by rank, key-sorted within each group (the
- * send buffer).  rec is scratch afterwards. */
-pdt_status pdt_drv_bisect(drv *d, srm_rec *rec, srm_rec *w, size_t n, uint64_t *sc,
-                          pdt_err *err)
+/* Rank 0: the samples of every rank (slots of `slot` words) packed to the
+ * front of all, their number and box. */
+static size_t bis_pack(uint64_t *all, int p, size_t slot, bis_cell *c)
+{
+    size_t m = 0;
+    for (int q = 0; q < p; q++) {
+        const uint64_t *s = all + (size_t)q * slot;
+        size_t k = (size_t)s[0]; /* (before the move: s[0] may be all[m]) */
+        memmove(all + m, s + 1, k * sizeof *all);
+        m += k;
+    }
+    *c = (bis_cell){INT64_MAX, INT64_MIN, INT64_MAX, INT64_MIN};
+    for (size_t i = 0; i < m; i++) {
+        int64_t x = (int64_t)(all[i] >> 32), y = (int64_t)(all[i] & 0xffffffffu);
+        c->x0 = x < c->x0 ? x : c->x0;
+        c->x1 = x > c->x1 ? x : c->x1;
+        c->y0 = y < c->y0 ? y : c->y0;
+        c->y1 = y > c->y1 ? y : c->y1;
+    }
+    if (!m) *c = (bis_cell){0, 0, 0, 0};
+    return m;
+}
+
+/* The cuts in d->tree, the same on every rank: the samples gathered at
+ * rank 0, cut down the tree (bis_down), every cut summed into every rank
+ * by one allreduce (each made by one rank, zero elsewhere). */
+static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t first, pdt_err *err)
 {
     int p = d->p;
+    size_t share = bis_share(p), slot = share + 1, nv = 2 * (size_t)p;
     d->tree.p = p;
     d->tree.k = 1;
     d->tree.levels_p = pdt_srm_ceil_log2(p);
     d->tree.cut = calloc((size_t)p, sizeof *d->tree.cut);
-    bis_range *cur = malloc((size_t)p * sizeof *cur), *next = malloc((size_t)p * sizeof *next);
-    pdt_status st = d->tree.cut && cur && next ? PDT_OK : pdt_drv_nomem(d, "partition");
-    if (n) memcpy(w, rec, n * sizeof *w);
-    bis_ord o = {w, NULL, rec};
-    int nr = 1;
-    if (st == PDT_OK) st = bis_root(d, w, n, &cur[0], err);
-    while (st == PDT_OK && nr > 0) {
-        st = bis_axes(d, &o, n, cur, nr);
-        if (st == PDT_OK) st = bis_select(d, &o, cur, nr, err);
-        if (st != PDT_OK) break;
-        nr = bis_split(d, &o, cur, nr, next, sc);
-        bis_range *t = cur;
-        cur = next;
-        next = t;
+    uint64_t *mine = malloc(slot * sizeof *mine), *v = calloc(nv, sizeof *v);
+    uint64_t *all = d->rank == 0 ? malloc((size_t)p * slot * sizeof *all) : NULL;
+    size_t *cnt = malloc((size_t)p * sizeof *cnt);
+    pdt_status st = d->tree.cut && mine && v && cnt && (d->rank || all)
+                        ? PDT_OK : pdt_drv_nomem(d, "partition");
+    if (st == PDT_OK) {
+        bis_sample(pts, n, first, share, mine);
+        for (int q = 0; q < p; q++) cnt[q] = slot * sizeof *mine;
+        st = pdt_comm_gatherv(d->c, mine, slot * sizeof *mine, all, cnt, 0, err);
     }
-    free(cur);
-    free(next);
-    free(o.y);
+    if (st == PDT_OK) {
+        pdt_drv_note_all(d, TAG_SAMPLES, slot * sizeof *mine); /* (uniform: the checker pairs them) */
+        bis_cell c = {0, 0, 0, 0};
+        size_t m = d->rank == 0 ? bis_pack(all, p, slot, &c) : 0;
+        st = bis_down(d, all, all, m, c, v, err); /* (all is bis_down's: freed there) */
+        all = NULL;
+    }
+    if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, v, nv, PDT_COMM_SUM, err);
+    if (st == PDT_OK) {
+        pdt_drv_note_all(d, TAG_SAMPLES, nv * sizeof *v);
+        for (int i = 0; i + 1 < p; i++) d->tree.cut[i] = (srm_cut){v[2 * i], (int)v[2 * i + 1]};
+    }
+    free(mine);
+    free(v);
+    free(all);
+    free(cnt);
     return st;
+}
+
+/* The rank whose region holds the point of key `key`: down the tree from
+ * the root, left when the key on the cut's axis is below the cut. */
+static inline uint32_t bis_dest(const srm_cut *cut, int p, uint64_t key)
+{
+    int lo = 0, hi = p, at = 0;
+    while (hi - lo >= 2) {
+        int mid = srm_bis_mid(lo, hi);
+        srm_cut c = cut[at];
+        uint64_t k = c.axis ? swap_key(key) : key;
+        int left = k < c.split;
+        at = left ? at + 1 : at + (mid - lo);
+        lo = left ? lo : mid;
+        hi = left ? mid : hi;
+    }
+    return (uint32_t)lo;
+}
+
+pdt_status pdt_drv_bisect(drv *d, const pdt_point *pts, size_t n, uint64_t first, srm_rec *send,
+                          srm_rec *tmp, uint64_t *sc, pdt_err *err)
+{
+    pdt_status st = bis_tree(d, pts, n, first, err);
+    if (st != PDT_OK) return st;
+    int p = d->p;
+    const srm_cut *cut = d->tree.cut;
+    uint64_t *at = calloc((size_t)p, sizeof *at);
+    if (!at) return pdt_drv_nomem(d, "partition");
+    for (size_t i = 0; i < n; i++) { /* (the region in the record's spare word) */
+        uint64_t key = pdt_key(pts[i]);
+        uint32_t q = bis_dest(cut, p, key);
+        tmp[i] = (srm_rec){key, (uint32_t)(first + i), q};
+        sc[q]++;
+    }
+    uint64_t sum = 0;
+    for (int q = 0; q < p; q++) {
+        at[q] = sum;
+        sum += sc[q];
+    }
+    for (size_t i = 0; i < n; i++) send[at[tmp[i].pad]++] = tmp[i];
+    free(at);
+    return PDT_OK;
 }

@@ -4,7 +4,7 @@
  *
  *   driver.c   the run (pdt_par_triangulate), its figures, the one-rank run
  *   select.c   the exact splitters of the strips (a few rounds of counts)
- *   bisect.c   the bisection partition's cuts (algorithm.md §3.12)
+ *   bisect.c   the bisection partition's cuts, from a sample (algorithm.md §3.12)
  *   spread.c   the partition: sort, cut, exchange, strip descriptors
  *   steps.c    the local phase and the merge tree
  *   order.c    the final triangles in canonical order across the ranks */
@@ -21,6 +21,7 @@ enum {
     TAG_GATHER = 6,
     TAG_STATS = 7,
     TAG_ORDER = 8,
+    TAG_CUTS = 9,
     TAG_MERGE = 100 /* + level */
 };
 
@@ -67,13 +68,14 @@ pdt_status pdt_drv_nomem(drv *d, const char *phase);
 
 /* select.c: the p - 1 exact splitters of the strips partition. */
 pdt_status pdt_drv_splitters(drv *d, const srm_rec *rec, size_t n, uint64_t *split, pdt_err *err);
-/* select.c: ns exact selections sharing the rounds (see there). */
-pdt_status pdt_drv_select_keys(drv *d, int ns, const srm_rec *const *arr, const size_t *len,
-                               const uint64_t *t, uint64_t *lo, uint64_t *hi, pdt_err *err);
-/* bisect.c: the bisection of the key-sorted rec[0..n) into the ranks' regions
- * (into w; rec is scratch afterwards). */
-pdt_status pdt_drv_bisect(drv *d, srm_rec *rec, srm_rec *w, size_t n, uint64_t *sc,
-                          pdt_err *err);
+/* bisect.c: the bisection's cuts (into d->tree, the same on every rank, from
+ * a sample of every rank's block) and this rank's points pts[0..n) (global
+ * indices from `first`, in input order) as records grouped by the rank of
+ * their region into send[0..n), input order kept within each group; sc[q]
+ * (zeroed by the caller) gets the records for rank q; tmp: n records of
+ * scratch. */
+pdt_status pdt_drv_bisect(drv *d, const pdt_point *pts, size_t n, uint64_t first, srm_rec *send,
+                          srm_rec *tmp, uint64_t *sc, pdt_err *err);
 /* spread.c: the partition phase's three steps. */
 pdt_status pdt_drv_partition(drv *d, pdt_par_input *in, pdt_err *err);
 pdt_status pdt_drv_rank_strips(drv *d, const pdt_par_input *in, pdt_err *err);

@@ -1,5 +1,5 @@
-/* pdt — exact selection across the ranks: the strips' splitters and the
- * bisection's cuts (driver.h).
+/* pdt — exact selection across the ranks: the strips' splitters (driver.h;
+ * the bisection's cuts come from a sample, bisect.c).
  *
  * A search looks for the smallest key v with more than t keys <= v among
  * the key-sorted runs of all ranks, known to lie in [lo, hi].  Many
@@ -175,8 +175,8 @@ static pdt_status sel_count(drv *d, sel *s, pdt_err *err)
 /* For each of ns searches, the smallest key v with more than t[i] keys <= v
  * among the key-sorted runs arr[i][0..len[i]) of all ranks, known to lie in
  * [lo[i], hi[i]] (every rank the same bounds); the answer in lo[i]. */
-pdt_status pdt_drv_select_keys(drv *d, int ns, const srm_rec *const *arr, const size_t *len,
-                               const uint64_t *t, uint64_t *lo, uint64_t *hi, pdt_err *err)
+static pdt_status select_keys(drv *d, int ns, const srm_rec *const *arr, const size_t *len,
+                              const uint64_t *t, uint64_t *lo, uint64_t *hi, pdt_err *err)
 {
     size_t z = (size_t)ns + 1, nv = SEL_BASE + 2 * SEL_MIN_WAYS * z;
     sel s = {ns, arr, len, t, lo, hi, malloc(nv * sizeof *s.v), malloc(z * sizeof *s.g),
@@ -218,7 +218,7 @@ pdt_status pdt_drv_splitters(drv *d, const srm_rec *rec, size_t n, uint64_t *spl
         arr[q] = rec;
         len[q] = n;
     }
-    if (st == PDT_OK) st = pdt_drv_select_keys(d, q1, arr, len, t, split, hi, err);
+    if (st == PDT_OK) st = select_keys(d, q1, arr, len, t, split, hi, err);
     free(hi);
     free(t);
     free(len);

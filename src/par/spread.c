@@ -1,6 +1,9 @@
-/* pdt — the partition phase (driver.h): every rank's input block sorted by
- * key, cut by the splitters (strips) or the bisection's cuts, exchanged, and
- * merged into the rank's strip; the strip descriptors allgathered. */
+/* pdt — the partition phase (driver.h).  Strips: every rank's input block
+ * sorted by key, cut by the exact splitters, exchanged, and the runs
+ * received merged into the rank's strip.  Bisection: the cuts from a sample
+ * (bisect.c), every rank's points sent unsorted to their regions, and each
+ * region sorted once where it arrives.  Then the strip descriptors
+ * allgathered. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -33,7 +36,7 @@ typedef struct part {
     unsigned char *blk, *more;  /* the block; a larger one when more arrive */
     size_t cap;                 /* its room, in points */
     srm_rec *rec, *tmp;
-    const srm_rec *send;        /* rec (strips) or tmp (bisection) */
+    const srm_rec *send;        /* rec: the records grouped by destination */
     srm_rec *got, *scratch;
     uint64_t *sc, *rc;          /* records to / from each rank */
     size_t *cnt, *rcnt, *start; /* bytes to / from each rank; runs received */
@@ -92,16 +95,11 @@ static pdt_status part_sort(drv *d, pdt_par_input *in, part *x, size_t *n)
     return PDT_OK;
 }
 
-/* How many records go to each rank (x->sc), and from where: the strips'
- * splitters cut the sorted records in consecutive blocks; the bisection
- * regroups them by rank, in tmp. */
-static pdt_status part_cut(drv *d, const pdt_par_input *in, part *x, size_t n, pdt_err *err)
+/* The strips: how many records go to each rank (x->sc), the splitters
+ * cutting the sorted records in consecutive blocks. */
+static pdt_status part_cut(drv *d, part *x, size_t n, pdt_err *err)
 {
     size_t p = (size_t)d->p;
-    if (in->partition == PDT_PART_BISECT) {
-        x->send = x->tmp;
-        return pdt_drv_bisect(d, x->rec, x->tmp, n, x->sc, err);
-    }
     x->send = x->rec;
     pdt_status st = pdt_drv_splitters(d, x->rec, n, x->split, err);
     for (size_t q = 0, at = 0; st == PDT_OK && q < p; q++) {
@@ -109,6 +107,21 @@ static pdt_status part_cut(drv *d, const pdt_par_input *in, part *x, size_t n, p
         if (end < at) end = at;
         x->sc[q] = end - at;
         at = end;
+    }
+    return st;
+}
+
+/* The bisection: the cuts from a sample, and this rank's points, unsorted,
+ * grouped by region into rec (x->sc of them for each rank; through tmp);
+ * in->pts freed once the records hold it if in->release_pts. */
+static pdt_status part_regions(drv *d, pdt_par_input *in, part *x, pdt_err *err)
+{
+    x->send = x->rec;
+    pdt_status st = pdt_drv_bisect(d, in->pts, in->n, in->first, x->rec, x->tmp, x->sc, err);
+    d->local_dups = 0;
+    if (st == PDT_OK && in->release_pts) {
+        free(in->pts);
+        in->pts = NULL;
     }
     return st;
 }
@@ -130,8 +143,8 @@ static pdt_status part_room(drv *d, part *x, pdt_err *err)
     }
     x->start[p] = x->total = total;
     if (total < x->cap) {
-        x->got = x->send == x->rec ? x->tmp : x->rec;
-        x->scratch = x->send == x->rec ? x->rec : x->tmp;
+        x->got = x->tmp;
+        x->scratch = x->rec;
         return PDT_OK;
     }
     size_t M = total + 1;
@@ -139,6 +152,34 @@ static pdt_status part_room(drv *d, part *x, pdt_err *err)
     x->got = (srm_rec *)(void *)x->more;
     x->scratch = x->got + M;
     x->cap = M;
+    return PDT_OK;
+}
+
+/* The bisection's region: the records received -- in global index order
+ * (from the ranks in rank order, each in input order) -- sorted by the plain
+ * run's sort, the first of equal keys kept (the smallest index), into the
+ * strip's points and global indices.  The block (cap M) holds the records
+ * at 0 or 16 M (bytes); their points and indices go in the other of [0,
+ * 16 M) and [16 M, 32 M), the sort's scratch from 32 M. */
+static pdt_status part_sort_region(drv *d, part *x)
+{
+    size_t T = x->total, M = d->blk_cap, nu = 0;
+    unsigned char *b = d->blk;
+    size_t half = M * sizeof(srm_rec), goff = (size_t)((unsigned char *)x->got - b);
+    pdt_point *pt = (pdt_point *)(void *)(b + (goff ? 0 : half));
+    uint32_t *idx = (uint32_t *)(void *)(pt + M);
+    for (size_t i = 0; i < T; i++) {
+        pt[i] = srm_key_point(x->got[i].key);
+        idx[i] = x->got[i].idx;
+    }
+    size_t need = PDT_SORT_WORK(T), at = 2 * half;
+    void *work = at + need <= PDT_DELAUNAY_WORK(M) ? (void *)(b + at) : malloc(need);
+    uint32_t *g = block_gid(d);
+    pdt_status st = work ? pdt_sort_unique_on(pt, T, work, g, block_pts(d), &nu) : PDT_ERR_NOMEM;
+    if (work != b + at) free(work);
+    if (st != PDT_OK) return pdt_drv_nomem(d, "partition");
+    for (size_t i = 0; i < nu; i++) g[i] = idx[g[i]];
+    d->m = nu;
     return PDT_OK;
 }
 
@@ -162,6 +203,7 @@ static pdt_status part_move(drv *d, part *x, pdt_err *err)
     d->blk_bytes = block_bytes(x->cap);
     x->blk = NULL;
     d->nrecv = x->total;
+    if (d->tree.cut) return part_sort_region(d, x);
     d->m = pdt_srm_runs_to_strip(x->got, x->scratch, x->start, d->p, block_pts(d), block_gid(d));
     return PDT_OK;
 }
@@ -174,8 +216,12 @@ pdt_status pdt_drv_partition(drv *d, pdt_par_input *in, pdt_err *err)
     part x = {0};
     size_t n = 0;
     pdt_status st = part_alloc(d, in, &x);
-    if (st == PDT_OK) st = part_sort(d, in, &x, &n);
-    if (st == PDT_OK) st = part_cut(d, in, &x, n, err);
+    if (in->partition == PDT_PART_BISECT) {
+        if (st == PDT_OK) st = part_regions(d, in, &x, err);
+    } else {
+        if (st == PDT_OK) st = part_sort(d, in, &x, &n);
+        if (st == PDT_OK) st = part_cut(d, &x, n, err);
+    }
     if (st == PDT_OK) st = part_room(d, &x, err);
     if (st == PDT_OK) st = part_move(d, &x, err);
     part_free(&x);
