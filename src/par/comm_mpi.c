@@ -19,7 +19,9 @@
  * is a step of the simulator for every waiting rank, and nanosleep is
  * simulated time); the world communicator is used as it is (SMPI sets up a
  * new one with O(P^2) simulated messages); exscan and waitall avoid SMPI's
- * O(P^2)-per-rank versions; the output file is written with pwrite (SMPI's
+ * O(P^2)-per-rank versions; an exchange posts its requests a window of
+ * peers at a time, with synchronous sends (SimGrid walks lists of every
+ * pending request); the output file is written with pwrite (SMPI's
  * MPI-IO opens files on simulated disks only); the launcher tweaks for Open
  * MPI are skipped (docs/simulation.md). */
 #include "comm_int.h"
