@@ -64,9 +64,14 @@ trap 'rm -rf "$work"' EXIT
 seq "${radical%-*}" "${radical#*-}" | sed "s/^/$prefix/; s/\$/$suffix/" > "$work/hosts"
 
 # smpirun copies the program once per rank into $TMPDIR (each rank its own
-# globals; its -tmpdir option takes the next word for the program); the collectives are Open MPI's algorithms (SMPI's defaults are
-# linear in P); SimGrid's own messages only when something is wrong.
+# globals; its -tmpdir option takes the next word for the program); the
+# collectives are Open MPI's algorithms (SMPI's defaults are linear in P)
+# but for the broadcast: SMPI's k-nomial one (Open MPI's choice for most
+# sizes from 16 ranks on) first runs a ring allgather over the whole
+# communicator, P^2 messages (a third of a 1024-rank simulation), so the
+# binomial tree instead; SimGrid's own messages only when something is wrong.
 TMPDIR=$work smpirun -np "$np" -platform "$platform" -hostfile "$work/hosts" \
     --cfg=smpi/host-speed:"$speed" --cfg=smpi/coll-selector:ompi \
+    --cfg=smpi/bcast:binomial_tree \
     --log=root.thres:warning --log=smpi_config.thres:error "${extra[@]}" \
     "$PDT_SMPI_BIN" "$@"

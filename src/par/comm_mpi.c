@@ -19,7 +19,9 @@
  * is a step of the simulator for every waiting rank, and nanosleep is
  * simulated time); the world communicator is used as it is (SMPI sets up a
  * new one with O(P^2) simulated messages); exscan and waitall avoid SMPI's
- * O(P^2)-per-rank versions; the output file is written with pwrite (SMPI's
+ * O(P^2)-per-rank versions; an exchange posts its requests a window of
+ * peers at a time, with synchronous sends (SimGrid walks lists of every
+ * pending request); the output file is written with pwrite (SMPI's
  * MPI-IO opens files on simulated disks only); the launcher tweaks for Open
  * MPI are skipped (docs/simulation.md). */
 #include "comm_int.h"
@@ -292,33 +294,77 @@ static pdt_status wait_all(pdt_comm *c, int nrq, MPI_Request *rq, pdt_err *err)
     return s;
 }
 
+/* Post the receives then the sends of chunk `off` of every pair i whose
+ * peer is listed in rfrom[0..n) (receive) and sto[0..n) (send); returns the
+ * number of requests in *nrq.  Under SMPI a send is synchronous (see
+ * xchg_run). */
+static pdt_status xchg_post(pdt_comm *c, const xchg *x, const int *rfrom, const int *sto, int n,
+                            size_t off, MPI_Request *rq, int *nrq, pdt_err *err)
+{
+    pdt_status s = PDT_OK;
+    *nrq = 0;
+    for (int j = 0; j < n && s == PDT_OK; j++) {
+        int i = rfrom[j];
+        if (off >= x->rn[i]) continue;
+        int len = (int)min_size(c->chunk, x->rn[i] - off);
+        s = mpi_check(MPI_Irecv(x->rp[i] + off, len, MPI_BYTE, i, 0, xcomm_of(c), &rq[(*nrq)++]),
+                      "MPI_Irecv", c, err);
+    }
+    for (int j = 0; j < n && s == PDT_OK; j++) {
+        int i = sto[j];
+        if (off >= x->sn[i]) continue;
+        int len = (int)min_size(c->chunk, x->sn[i] - off);
+        const char *b = x->sp[i] + off;
+        s = PDT_SMPI ? mpi_check(MPI_Issend(b, len, MPI_BYTE, i, 0, xcomm_of(c), &rq[(*nrq)++]),
+                                 "MPI_Issend", c, err)
+                     : mpi_check(MPI_Isend(b, len, MPI_BYTE, i, 0, xcomm_of(c), &rq[(*nrq)++]),
+                                 "MPI_Isend", c, err);
+    }
+    return s;
+}
+
+/* The exchange: the peers in windows of the pairwise schedule (step k:
+ * send to rank me + k, receive from me - k, mod P), all P - 1 steps in one
+ * window for a real run (every request posted at once, MPI's progress
+ * engine does the rest), SMPI_WINDOW steps at a time under SMPI.  There
+ * every pending request of a rank, and every small send in flight of all
+ * ranks (SMPI "detaches" sends under 64 KiB), sits in a list of SimGrid's
+ * that each completion and each stretch of computation walks: with all
+ * requests posted at once that was O(P) per request, O(P^3) per exchange
+ * in all, most of a 1024-rank simulation's time.  In windows, with
+ * synchronous sends (kept with their rank, never detached), a rank has at
+ * most 2 * SMPI_WINDOW requests pending.  A pair's messages go in the one
+ * window of its step, at both ends, chunk round by chunk round, so the
+ * windows match and cannot deadlock: each rank posts a window's requests
+ * before waiting for any. */
+#define SMPI_WINDOW 32
 static pdt_status xchg_run(pdt_comm *c, const xchg *x, const char *what, pdt_err *err)
 {
     int P = c->size, me = c->rank;
     if (x->sn[me] != x->rn[me])
         return pdt_err_set(err, PDT_ERR_MPI, "rank %d: %s: count mismatch with itself", me, what);
     if (x->sn[me]) memmove(x->rp[me], x->sp[me], x->sn[me]);
-    MPI_Request *rq = malloc(2 * (size_t)P * sizeof *rq);
-    if (!rq) return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", me, what);
-    pdt_status s = PDT_OK;
-    for (size_t off = 0; s == PDT_OK; off += c->chunk) {
-        int nrq = 0;
-        for (int i = 0; i < P && s == PDT_OK; i++) {
-            if (i == me || off >= x->rn[i]) continue;
-            int len = (int)min_size(c->chunk, x->rn[i] - off);
-            s = mpi_check(MPI_Irecv(x->rp[i] + off, len, MPI_BYTE, i, 0, xcomm_of(c), &rq[nrq++]),
-                          "MPI_Irecv", c, err);
+    int win = PDT_SMPI && P - 1 > SMPI_WINDOW ? SMPI_WINDOW : (P > 1 ? P - 1 : 1);
+    MPI_Request *rq = malloc(2 * (size_t)win * sizeof *rq);
+    int *peer = malloc(2 * (size_t)win * sizeof *peer);
+    pdt_status s = rq && peer ? PDT_OK
+                              : pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", me,
+                                            what);
+    for (int k0 = 1; k0 < P && s == PDT_OK; k0 += win) {
+        int n = P - k0 < win ? P - k0 : win;
+        for (int j = 0; j < n; j++) {
+            peer[j] = (me - (k0 + j) + P) % P;   /* receive from */
+            peer[win + j] = (me + k0 + j) % P;   /* send to */
         }
-        for (int i = 0; i < P && s == PDT_OK; i++) {
-            if (i == me || off >= x->sn[i]) continue;
-            int len = (int)min_size(c->chunk, x->sn[i] - off);
-            s = mpi_check(MPI_Isend(x->sp[i] + off, len, MPI_BYTE, i, 0, xcomm_of(c), &rq[nrq++]),
-                          "MPI_Isend", c, err);
+        for (size_t off = 0; s == PDT_OK; off += c->chunk) {
+            int nrq = 0;
+            s = xchg_post(c, x, peer, peer + win, n, off, rq, &nrq, err);
+            if (nrq == 0) break;
+            pdt_status w = wait_all(c, nrq, rq, err);
+            if (s == PDT_OK) s = w;
         }
-        if (nrq == 0) break;
-        pdt_status w = wait_all(c, nrq, rq, err);
-        if (s == PDT_OK) s = w;
     }
+    free(peer);
     free(rq);
     return s;
 }
@@ -456,18 +502,27 @@ static pdt_status mpi_allreduce_u64(pdt_comm *c, uint64_t *v, size_t n, pdt_comm
 
 /* SMPI's MPI_Exscan is linear: every rank sends to every later rank and
  * waits on them one MPI_Waitany at a time, O(P^3) steps of the simulator (at
- * P = 256 a single call ran for minutes).  Under SMPI the prefix comes from
- * an allgather of the P values instead. */
+ * P = 256 a single call ran for minutes); an allgather of the P values
+ * instead is still P^2 messages.  Under SMPI the prefix comes from
+ * recursive doubling (as MPI libraries do it): in round d every rank sends
+ * its sum of ranks (me - 2d, me] to me + d and adds what me - d sends it,
+ * log2 P rounds of one message each.  Tag 0 is the exchanges': every rank
+ * has finished the previous collective's receives from a peer before that
+ * peer can send it anything here, and a pair meets in one round only. */
 static pdt_status smpi_exscan_u64(pdt_comm *c, uint64_t v, uint64_t *out, pdt_err *err)
 {
-    uint64_t *all = malloc((size_t)c->size * sizeof *all);
-    if (!all) return pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: exscan: out of memory", c->rank);
-    pdt_status s = mpi_check(MPI_Allgather(&v, 1, MPI_UINT64_T, all, 1, MPI_UINT64_T, comm_of(c)),
-                             "MPI_Allgather", c, err);
-    uint64_t sum = 0;
-    for (int q = 0; s == PDT_OK && q < c->rank; q++) sum += all[q];
-    free(all);
-    *out = sum;
+    uint64_t incl = v;
+    pdt_status s = PDT_OK;
+    for (int d = 1; d < c->size && s == PDT_OK; d *= 2) {
+        int to = c->rank + d < c->size ? c->rank + d : MPI_PROC_NULL;
+        int from = c->rank >= d ? c->rank - d : MPI_PROC_NULL;
+        uint64_t mine = incl, got = 0;
+        s = mpi_check(MPI_Sendrecv(&mine, 1, MPI_UINT64_T, to, 0, &got, 1, MPI_UINT64_T, from, 0,
+                                   comm_of(c), MPI_STATUS_IGNORE),
+                      "MPI_Sendrecv", c, err);
+        if (from != MPI_PROC_NULL) incl += got;
+    }
+    *out = incl - v;
     return s;
 }
 
