@@ -13,10 +13,8 @@
  * points to the region the cuts put it in, unsorted: the receiver sorts
  * its region once (spread.c).
  *
- * (The first version selected exact medians: every rank sorted its block,
- * kept it in two orders, (x, y) and (y, x), and ran rounds of counts and
- * allreduces for every depth of the tree; at 10^7 points and 64 ranks that
- * was most of the partition's time.)  A sample of 2^17 points in all puts a
+ * Exact medians would need every rank's block sorted and rounds of counts
+ * and allreduces at every depth of the tree.  A sample of 2^17 points in all puts a
  * region within a few per cent of n / p: about 1/sqrt(s) of it, s = 2^17 / p
  * sample points a region (at p = 64 the largest of 10^7 uniform points'
  * regions held 4.3 % more than n / p). */
