@@ -7,6 +7,8 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <inttypes.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -189,12 +191,92 @@ static void end_marker(pdt_run *run, tf_rank *rk, const char *name, uint64_t off
                      rk->size - (off + TF_BLOCK_HEADER_SIZE + len));
 }
 
-/* Block k at byte *off: checked (its header, checksum and events), then
- * noted in rk->blk and *off moved past it (BLK_NEXT); the end marker
- * (BLK_END); or damage, said in a warning (BLK_DAMAGED).  -1 when out of
- * memory. */
+/* ---- the costly checks of a window of blocks, made ahead on several threads ----
+ *
+ * A block's checksum and the decode of its events are most of the cost of
+ * opening a run.  They are made ahead for the blocks of a window of the
+ * file (found by their headers alone), on up to PRE_THREADS threads; the
+ * scan then takes their answers, so that what it checks, in what order,
+ * and what it says are the same as when it checks each block itself. */
+#define PRE_THREADS 4
+#define PRE_MIN_BYTES ((uint64_t)4 << 20) /* a window smaller than this: checked on one thread */
+enum { PRE_SUM = 1, PRE_DATA = 2 };  /* a block's checks that passed */
+
+typedef struct precheck {
+    const uint8_t *map;
+    uint64_t *off;          /* the window's blocks */
+    uint8_t *ok;            /* per block: PRE_SUM | PRE_DATA when they passed */
+    size_t n, cap, at;      /* at: the next block the scan asks about */
+    _Atomic size_t next;    /* the next block to check */
+} precheck;
+
+static void *pre_worker(void *arg)
+{
+    precheck *P = arg;
+    for (size_t k; (k = P->next++) < P->n;) {
+        const uint8_t *h = P->map + P->off[k];
+        uint32_t len = tf_get32(h + 4), count = tf_get32(h + 24);
+        uint8_t ok = 0;
+        if (pdt_crc32c(pdt_crc32c(0, h, 28), h + TF_BLOCK_HEADER_SIZE, len) == tf_get32(h + 28))
+            ok |= PRE_SUM;
+        if (count && pdt_tf_decode(h + TF_BLOCK_HEADER_SIZE, len, count, tf_get64(h + 16), NULL) == 0)
+            ok |= PRE_DATA;
+        P->ok[k] = ok;
+    }
+    return NULL;
+}
+
+/* The event blocks of rk's file from byte off, by their headers, up to
+ * RELEASE_STEP bytes (at least one block), checked ahead.  0 when out of
+ * memory (then the scan checks every block itself). */
+static int pre_window(precheck *P, const tf_rank *rk, uint64_t off)
+{
+    P->map = rk->map;
+    P->n = P->at = 0;
+    P->next = 0;
+    uint64_t start = off;
+    while (rk->size - off >= TF_BLOCK_HEADER_SIZE && (P->n == 0 || off - start < RELEASE_STEP)) {
+        const uint8_t *h = rk->map + off;
+        uint32_t len = tf_get32(h + 4);
+        if (tf_get32(h) != TF_BLOCK_MAGIC || len > rk->size - off - TF_BLOCK_HEADER_SIZE) break;
+        if (P->n == P->cap) {
+            size_t nc = P->cap ? 2 * P->cap : 256;
+            uint64_t *o = realloc(P->off, nc * sizeof *o);
+            if (o) P->off = o;
+            uint8_t *k = o ? realloc(P->ok, nc) : NULL;
+            if (!k) return 0;
+            P->ok = k;
+            P->cap = nc;
+        }
+        P->off[P->n++] = off;
+        off += TF_BLOCK_HEADER_SIZE + len;
+    }
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    int threads = off - start < PRE_MIN_BYTES ? 1 : cpus < PRE_THREADS ? (int)cpus : PRE_THREADS;
+    pthread_t th[PRE_THREADS];
+    int started = 0;
+    for (int t = 1; t < threads && (size_t)t < P->n; t++)
+        if (pthread_create(&th[t], NULL, pre_worker, P) == 0) started |= 1 << t;
+    pre_worker(P);
+    for (int t = 1; t < PRE_THREADS; t++)
+        if (started & (1 << t)) pthread_join(th[t], NULL);
+    return 1;
+}
+
+/* What the window knows of the block at byte off: PRE_SUM | PRE_DATA as
+ * they passed, or -1 when it was not checked ahead. */
+static int pre_known(precheck *P, uint64_t off)
+{
+    if (!P || P->at >= P->n || P->off[P->at] != off) return -1;
+    return P->ok[P->at++];
+}
+
+/* Block k at byte *off: checked (its header, checksum and events; known:
+ * the checks made ahead, or -1), then noted in rk->blk and *off moved past
+ * it (BLK_NEXT); the end marker (BLK_END); or damage, said in a warning
+ * (BLK_DAMAGED).  -1 when out of memory. */
 static int scan_block(pdt_run *run, tf_rank *rk, const char *name, size_t k, uint64_t *off,
-                      size_t *cap)
+                      size_t *cap, int known)
 {
     uint64_t left = rk->size - *off, at = *off, expect = rk->nev;
     if (left < TF_BLOCK_HEADER_SIZE) {
@@ -215,7 +297,8 @@ static int scan_block(pdt_run *run, tf_rank *rk, const char *name, size_t k, uin
                           " left)", name, k, at, len, left - TF_BLOCK_HEADER_SIZE);
         return BLK_DAMAGED;
     }
-    if (pdt_crc32c(pdt_crc32c(0, h, 28), h + TF_BLOCK_HEADER_SIZE, len) != tf_get32(h + 28)) {
+    if (known >= 0 ? !(known & PRE_SUM)
+                   : pdt_crc32c(pdt_crc32c(0, h, 28), h + TF_BLOCK_HEADER_SIZE, len) != tf_get32(h + 28)) {
         pdt_tf_warnf(run, "%s: block %zu at byte %" PRIu64 ": checksum mismatch", name, k, at);
         return BLK_DAMAGED;
     }
@@ -228,7 +311,8 @@ static int scan_block(pdt_run *run, tf_rank *rk, const char *name, size_t k, uin
                           ", expected %" PRIu64, name, k, at, first, expect);
         return BLK_DAMAGED;
     }
-    if (count == 0 || pdt_tf_decode(h + TF_BLOCK_HEADER_SIZE, len, count, base, NULL) != 0) {
+    if (count == 0 || (known >= 0 ? !(known & PRE_DATA)
+                                  : pdt_tf_decode(h + TF_BLOCK_HEADER_SIZE, len, count, base, NULL) != 0)) {
         pdt_tf_warnf(run, "%s: block %zu at byte %" PRIu64 ": malformed event data", name, k, at);
         return BLK_DAMAGED;
     }
@@ -258,11 +342,16 @@ static pdt_status scan_rank(pdt_run *run, int r, pdt_err *err)
     uint64_t off = tf_get32(rk->map + 12);
     int how = BLK_NEXT;
     rk->nev = 0;
+    precheck pre = {0}, *P = &pre;
     for (size_t k = 0; how == BLK_NEXT && off < rk->size; k++) {
         if (off - released >= RELEASE_STEP) released = release_pages(rk->map, released, off);
-        how = scan_block(run, rk, name, k, &off, &cap);
-        if (how < 0) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
+        if (P && P->at == P->n && !pre_window(P, rk, off)) P = NULL;
+        how = scan_block(run, rk, name, k, &off, &cap, pre_known(P, off));
+        if (how < 0) break;
     }
+    free(pre.off);
+    free(pre.ok);
+    if (how < 0) return pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
     release_pages(rk->map, released, rk->size);
     if (how == BLK_DAMAGED)
         pdt_tf_warnf(run, "%s: read %" PRIu64 " events in %zu intact blocks before the damage", name,
