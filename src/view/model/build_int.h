@@ -124,12 +124,33 @@ typedef struct tri_rec {
 
 /* A streamed build's spill record: what the history entry needs besides
  * the key and the event travels with it (the build keeps nothing per
- * event): x = XREC_BORDER | (merge step + 1) for a border kernel's
- * candidate (TRI_NEW, sub 1), else kind | sub << 8. */
+ * event): in x, XREC_BORDER | (merge step + 1) for a border kernel's
+ * candidate (TRI_NEW, sub 1; a step past XREC_STEP_MAX is not kept), else
+ * kind | sub << 8; and where each corner of the event is in the key
+ * (xrec_corners), so that numbering the triangles need not decode their
+ * first events. */
 typedef struct tri_xrec {
     uint32_t s[3], ev, x;
 } tri_xrec;
 #define XREC_BORDER 0x80000000u
+#define XREC_ORDER_SHIFT 24
+#define XREC_ORDER_MASK (0x3fu << XREC_ORDER_SHIFT)
+#define XREC_STEP_MAX ((1u << XREC_ORDER_SHIFT) - 2)
+
+/* The corners' places in key s (2 bits each), for x. */
+static inline uint32_t xrec_order(const uint32_t s[3], const uint32_t in[3])
+{
+    uint32_t o = 0;
+    for (int k = 0; k < 3; k++) o |= (in[k] == s[0] ? 0u : in[k] == s[1] ? 1u : 2u) << (2 * k);
+    return o << XREC_ORDER_SHIFT;
+}
+
+/* The event's corners as it reported them, from its record. */
+static inline void xrec_corners(const tri_xrec *t, uint32_t v[3])
+{
+    uint32_t o = (t->x & XREC_ORDER_MASK) >> XREC_ORDER_SHIFT;
+    for (int k = 0; k < 3; k++) v[k] = t->s[(o >> (2 * k)) & 3u];
+}
 
 #define FINE_BITS 8
 #define NFINE ((size_t)1 << FINE_BITS)
@@ -234,9 +255,10 @@ typedef struct tri_ev {
 } tri_ev;
 #define TEV_FIRST 0x80000000u
 
-/* A triangle's record in PDT_SCR_TRIS: its first event, its entries. */
+/* A triangle's record in PDT_SCR_TRIS: its first event, its entries, its
+ * corners as that event reported them. */
 typedef struct tri_first {
-    uint32_t ev, n;
+    uint32_t ev, n, v[3];
 } tri_first;
 
 /* ---- the streamed build's numbering, in windows of events -------------------------

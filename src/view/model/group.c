@@ -232,8 +232,9 @@ static pdt_rtri_hist hist_of_x(const pdt_replay *r, const tri_xrec *t)
     int kind = PDT_EV_TRI_NEW;
     uint8_t sub = 1;
     int32_t g = -1;
-    if (t->x & XREC_BORDER) g = (int32_t)(t->x & ~XREC_BORDER) - 1;
-    else kind = (int)(t->x & 0xff), sub = (uint8_t)(t->x >> 8);
+    uint32_t x = t->x & ~XREC_ORDER_MASK;
+    if (x & XREC_BORDER) g = (int32_t)(x & ~XREC_BORDER) - 1;
+    else kind = (int)(x & 0xff), sub = (uint8_t)(x >> 8);
     pdt_rtri_hist h = {t->ev, NONE32, tri_status_of(kind), sub, {0, 0}};
     if (kind == PDT_EV_TRI_NEW && sub == 1 && g >= 0 && (size_t)g < r->nmerge)
         h.until = r->merges[g].end_ev;
@@ -281,9 +282,11 @@ static int write_run(group_job *J, size_t k, group_scratch *S, const tri_xrec *b
             uint32_t q = S->gid[j], ev = buf[j].ev, at = S->gfill[q]++;
             if (q >= g1) g1 = q + 1;
             out[at - base] = hist_of_x(r, &buf[j]);
-            eout[j] = (tri_ev){ev, (q - g0) | (ev == S->gfirst[q] ? TEV_FIRST : 0)};
+            int first = ev == S->gfirst[q];
+            eout[j] = (tri_ev){ev, (q - g0) | (first ? TEV_FIRST : 0)};
+            if (first) xrec_corners(&buf[j], tout[q - g0].v);
         }
-        for (uint32_t q = g0; q < g1; q++) tout[q - g0] = (tri_first){S->gfirst[q], S->gn[q]};
+        for (uint32_t q = g0; q < g1; q++) tout[q - g0].ev = S->gfirst[q], tout[q - g0].n = S->gn[q];
         b->tcount[f] = g1 - g0;
         if (g1 > g0 && !pl->sput(pl->ctx, PDT_SCR_TRIS, (uint64_t)b->fine_off[f] * sizeof *tout,
                                  tout, (g1 - g0) * sizeof *tout))
