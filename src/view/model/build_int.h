@@ -200,7 +200,7 @@ typedef struct builder {
     pdt_rec *win;         /* streamed: events win_lo .. win_lo + win_n - 1 of the stream */
     size_t win_lo, win_n;
     uint32_t *fbn;        /* records in each buffer */
-    int failed;           /* a put or get failed */
+    _Atomic int failed;   /* a put or get failed (on any of the build's threads) */
     /* the per-event tables as pass 1 writes them: the replay's (in memory)
      * or a window of EVW events from wlo (streamed: then to the place) */
     int32_t *wobj;

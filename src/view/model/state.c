@@ -221,6 +221,7 @@ int pdt_rp_step(const pdt_replay *r, pdt_rstate *s, int dir)
 /* ---- a forward pass over a streamed replay ------------------------------------------ */
 
 #define FWD_EVENTS 65536u  /* events per window of the per-event tables */
+#define FWD_AHEAD 24        /* events ahead whose object the pass fetches */
 
 struct pdt_fwd {
     const pdt_replay *r;
@@ -269,6 +270,14 @@ int pdt_fwd_to(pdt_fwd *f, pdt_rstate *s, size_t k)
                 return 0;
             f->lo = i;
             f->n = n;
+        }
+        if (i + FWD_AHEAD < f->lo + f->n) { /* (what the step ahead writes, fetched now:
+                                              * random places in tables of megabytes) */
+            int32_t ao = f->obj[i + FWD_AHEAD - f->lo];
+            int ak = f->kind[i + FWD_AHEAD - f->lo] & KIND_MASK;
+            if (ao >= 0 && is_tri_kind(ak)) __builtin_prefetch(&s->tcur[ao], 1);
+            else if (ao >= 0 && (ak == PDT_EV_LIFT || ak == PDT_EV_SORT || ak == PDT_EV_DELETE))
+                __builtin_prefetch(&s->pflags[ao], 1);
         }
         s->k++;
         /* (a paged build's tables go back as it goes; the state's pages, which
