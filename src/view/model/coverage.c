@@ -107,12 +107,11 @@ static void cov_range(cov_job *J)
     pdt_cov_cell *cells = J->cells;
     size_t binned = 0, nt = J->t1;
     for (size_t t = J->t0; t < nt; t++) {
-        if (t > J->t0 && (t - J->t0) % COV_RELEASE == 0) { /* the triangles read and their
-                                          * entries (a kept index holds them in
-                                          * the triangles' order): behind the pass */
+        if (t > J->t0 && (t - J->t0) % COV_RELEASE == 0) { /* the triangles read: behind
+                                          * the pass (their entries are where the
+                                          * build grouped them: not in this order) */
             const pdt_rtri *from = &r->tris[t - COV_RELEASE];
             pdt_index_release(r, from, COV_RELEASE * sizeof *r->tris);
-            pdt_index_release(r, &r->hist[from->h0], (r->tris[t].h0 - from->h0) * sizeof *r->hist);
             /* a paged state's entries behind too (the corners' points, read at
              * random, are kept until the frame is done: pdt_render) */
             if (s->paged[1]) pdt_release_pages(&s->tcur[t - COV_RELEASE], COV_RELEASE * sizeof *s->tcur);

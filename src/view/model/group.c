@@ -264,9 +264,11 @@ static int read_run(group_job *J, size_t k, tri_xrec *buf, size_t nb)
 }
 
 /* Run k grouped (S, its records buf from base on): bucket by bucket, its
- * triangles are the groups first seen in it; their first events and the
- * entries and per-event marks of the run written to the scratch.  1, or 0
- * when a write failed. */
+ * triangles are the groups first seen in it; their first events and
+ * corners, and the run's per-event marks, written to the scratch, its
+ * entries to the history table (from base: a bucket's entries from its
+ * fine_off, its triangles' one after the other).  1, or 0 when a write
+ * failed. */
 static int write_run(group_job *J, size_t k, group_scratch *S, const tri_xrec *buf,
                      pdt_rtri_hist *out, tri_ev *eout, tri_first *tout, size_t base)
 {
@@ -293,7 +295,7 @@ static int write_run(group_job *J, size_t k, group_scratch *S, const tri_xrec *b
             return 0;
         g0 = g1;
     }
-    return pl->sput(pl->ctx, PDT_SCR_HIST, base * sizeof *out, out, nb * sizeof *out) &&
+    return pl->put(pl->ctx, r->hist_at + (uint64_t)base * sizeof *out, out, nb * sizeof *out) &&
            pl->sput(pl->ctx, PDT_SCR_TRIEV, (uint64_t)base * sizeof *eout, eout, nb * sizeof *eout);
 }
 
@@ -419,7 +421,6 @@ int pdt_rp_tri_histories(builder *b)
         return 0;
     pl->sdrop(pl->ctx, PDT_SCR_TRIS);
     pl->sdrop(pl->ctx, PDT_SCR_IDS);
-    pl->sdrop(pl->ctx, PDT_SCR_HIST);
     if (!pdt_rp_ev_tables(b)) return 0;
     pl->sdrop(pl->ctx, PDT_SCR_TRIEV);
     return 1;

@@ -14,9 +14,11 @@
  *                    stay in the rank files: the table of their encoded
  *                    blocks is a section below; decoded on demand, each
  *                    block's checksum checked: evsrc.c); then the points'
- *                    first lifts, the triangles and their histories, in the
- *                    triangles' order (streamed here while they are built:
- *                    pdt_replay_build), then every other table of
+ *                    first lifts, the triangles (in the order of their
+ *                    first events) and their histories (as the build
+ *                    grouped them: a bucket of triangles after the other,
+ *                    each triangle's entries together), streamed here while
+ *                    they are built (pdt_replay_build), then every other table of
  *                    the replay (replay_int.h), the points and the reader's
  *                    warnings about the run, each at a 64-byte boundary
  *                    (so that a valid index opens without reading the run),
@@ -41,7 +43,7 @@
 #include "replay_int.h"
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 11u /* raised whenever the layout changes: an index of another
+#define INDEX_VERSION 12u /* raised whenever the layout changes: an index of another
                              * version is rebuilt */
 #define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/8 events, at least this */
 #define ICK_PARTS 8u

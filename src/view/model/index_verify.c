@@ -222,10 +222,10 @@ int pdt_ix_need_born(const pdt_replay *r, size_t k)
     lazy *L = r->lazy;
     size_t born = pdt_replay_born_at_most(r, k);
     if (born <= L->tris_upto) return !L->bad;  /* (none born: tris_upto 0) */
-    if (!pdt_ix_need(r, S_TRIS, 0, born * sizeof *r->tris)) return 0;
-    const pdt_rtri *last = &r->tris[born - 1];
-    uint64_t hend = (uint64_t)last->h0 + last->hn;
-    if (!pdt_ix_need(r, S_HIST, 0, hend * sizeof *r->hist)) return 0;
+    /* (their entries are where the build grouped them: anywhere in the table) */
+    if (!pdt_ix_need(r, S_TRIS, 0, born * sizeof *r->tris) ||
+        !pdt_ix_need(r, S_HIST, 0, r->nhist * sizeof *r->hist))
+        return 0;
     L->tris_upto = born;
     return 1;
 }

@@ -127,103 +127,68 @@ static void bcurs_free(builder *b, bcur *c, size_t rec)
     pdt_rp_bfree(b, c, b->nfine * sizeof *c);
 }
 
-/* Number the triangles by their first events: the triangle table and the
- * history table in the triangles' order (streamed to tris_at and hist_at:
- * a pass over the triangles reads their entries in order), a bucket's
- * numbers in PDT_SCR_IDS (from fine_off[f]); a triangle's corners as the
- * grouping found them in its first event, its maker that event's rank.
- * Each bucket's entries (PDT_SCR_HIST, from its fine_off) are its
- * triangles' in order.
- *
- * A window of events at a time: the numbering thread finds the window's
- * triangles (num_window) and writes them and their ids (num_emit); a
- * second thread copies their entries (num_copy), a window behind, so the
- * windows' tables are two (NUM_SLOTS). */
-#define NUM_SLOTS 2
-
-/* A window's triangles by event: wn, its entries (0 for none); wf, its
- * bucket; wv, its corners. */
-typedef struct num_slot {
+/* Number the triangles by their first events: the triangle table (streamed
+ * to tris_at), a bucket's numbers in PDT_SCR_IDS (from fine_off[f]); a
+ * triangle's corners as the grouping found them in its first event, its
+ * maker that event's rank, its entries where the grouping wrote them (the
+ * history table in the buckets' order: a bucket's triangles' entries one
+ * triangle after the other, from its fine_off). */
+/* The numbering pass's cursors: per fine bucket, its triangles' first
+ * events (tc), their ids (ic, written) and where its next triangle's
+ * entries are (hpos); the triangle table written in order (tw); the
+ * window's triangles by event (wn: entries, 0 for none; wf: their bucket;
+ * wv: their corners). */
+typedef struct numbering {
+    bcur *tc, *ic, tw;
+    size_t *hpos;
     uint32_t *wn, (*wv)[3];
     uint16_t *wf;
-    size_t lo, hi;
-} num_slot;
-
-/* The numbering pass's cursors: per fine bucket, its triangles' first
- * events (tc), their ids (ic, written) and their entries (hc); the
- * triangle table and the entries written in order (tw, hw); the windows;
- * and between the two threads, the windows found (found) and copied
- * (copied), and whether the numbering stopped (stop). */
-typedef struct numbering {
-    builder *b;
-    bcur *tc, *ic, *hc, tw, hw;
-    num_slot w[NUM_SLOTS];
     size_t h0;  /* entries numbered */
-    size_t found, copied;
-    int stop, copy_failed;
-    pthread_mutex_t mu;
-    pthread_cond_t cv;
 } numbering;
 
 static int num_open(builder *b, numbering *N)
 {
     pdt_replay *r = b->r;
     memset(N, 0, sizeof *N);
-    N->b = b;
     N->tc = bcurs_new(b, sizeof(tri_first));
     N->ic = bcurs_new(b, sizeof(uint32_t));
-    N->hc = bcurs_new(b, sizeof(pdt_rtri_hist));
+    N->hpos = pdt_rp_bmalloc(b, b->nfine * sizeof *N->hpos);
+    N->wn = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *N->wn);
+    N->wf = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *N->wf);
+    N->wv = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *N->wv);
     N->tw.buf = pdt_rp_bmalloc(b, CUR_RECS * sizeof(pdt_rtri));
-    N->hw.buf = pdt_rp_bmalloc(b, CUR_RECS * sizeof(pdt_rtri_hist));
-    int ok = N->tc && N->ic && N->hc && N->tw.buf && N->hw.buf;
-    for (int k = 0; k < NUM_SLOTS; k++) {
-        num_slot *w = &N->w[k];
-        w->wn = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *w->wn);
-        w->wf = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *w->wf);
-        w->wv = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *w->wv);
-        ok = ok && w->wn && w->wf && w->wv;
-    }
-    if (!ok) return 0;
+    if (!N->tc || !N->ic || !N->hpos || !N->wn || !N->wf || !N->wv || !N->tw.buf) return 0;
     for (size_t f = 0; f < b->nfine; f++) {
         N->tc[f].file = PDT_SCR_TRIS;
         N->tc[f].at = (uint64_t)b->fine_off[f] * sizeof(tri_first);
         N->tc[f].left = b->tcount[f];
         N->ic[f].file = PDT_SCR_IDS;
         N->ic[f].at = (uint64_t)b->fine_off[f] * sizeof(uint32_t);
-        N->hc[f].file = PDT_SCR_HIST;
-        N->hc[f].at = (uint64_t)b->fine_off[f] * sizeof(pdt_rtri_hist);
-        N->hc[f].left = b->fine_off[f + 1] - b->fine_off[f];
+        N->hpos[f] = b->fine_off[f];
     }
-    N->tw.file = N->hw.file = -1;
+    N->tw.file = -1;
     N->tw.at = r->tris_at;
     N->tw.rec = sizeof(pdt_rtri);
-    N->tw.cap = N->hw.cap = CUR_RECS;
-    N->hw.at = r->hist_at;
-    N->hw.rec = sizeof(pdt_rtri_hist);
+    N->tw.cap = CUR_RECS;
     return 1;
 }
 
 static void num_close(builder *b, numbering *N)
 {
     pdt_rp_bfree(b, N->tw.buf, CUR_RECS * sizeof(pdt_rtri));
-    pdt_rp_bfree(b, N->hw.buf, CUR_RECS * sizeof(pdt_rtri_hist));
-    for (int k = 0; k < NUM_SLOTS; k++) {
-        pdt_rp_bfree(b, N->w[k].wn, NUM_WINDOW * sizeof *N->w[k].wn);
-        pdt_rp_bfree(b, N->w[k].wf, NUM_WINDOW * sizeof *N->w[k].wf);
-        pdt_rp_bfree(b, N->w[k].wv, NUM_WINDOW * sizeof *N->w[k].wv);
-    }
+    pdt_rp_bfree(b, N->hpos, b->nfine * sizeof *N->hpos);
+    pdt_rp_bfree(b, N->wn, NUM_WINDOW * sizeof *N->wn);
+    pdt_rp_bfree(b, N->wf, NUM_WINDOW * sizeof *N->wf);
+    pdt_rp_bfree(b, N->wv, NUM_WINDOW * sizeof *N->wv);
     bcurs_free(b, N->tc, sizeof(tri_first));
     bcurs_free(b, N->ic, sizeof(uint32_t));
-    bcurs_free(b, N->hc, sizeof(pdt_rtri_hist));
 }
 
 /* The triangles whose first event is in [lo, hi), from every bucket, by
- * event (w). */
-static void num_window(builder *b, numbering *N, num_slot *w, size_t lo, size_t hi)
+ * event (N->wn, N->wf, N->wv). */
+static void num_window(builder *b, numbering *N, size_t lo, size_t hi)
 {
-    w->lo = lo;
-    w->hi = hi;
-    memset(w->wn, 0, (hi - lo) * sizeof *w->wn);
+    memset(N->wn, 0, (hi - lo) * sizeof *N->wn);
     for (size_t f = 0; f < b->nfine; f++) {
         const tri_first *t;
         while ((t = bcur_peek(b, &N->tc[f])) && t->ev < hi) {
@@ -231,9 +196,9 @@ static void num_window(builder *b, numbering *N, num_slot *w, size_t lo, size_t 
                 b->failed = 1;
                 break;
             }
-            w->wn[t->ev - lo] = t->n;
-            w->wf[t->ev - lo] = (uint16_t)f;
-            memcpy(w->wv[t->ev - lo], t->v, sizeof t->v);
+            N->wn[t->ev - lo] = t->n;
+            N->wf[t->ev - lo] = (uint16_t)f;
+            memcpy(N->wv[t->ev - lo], t->v, sizeof t->v);
             N->tc[f].i++;
         }
     }
@@ -250,92 +215,21 @@ static int put_tri(builder *b, numbering *N, bcur *ic, const pdt_rtri *t, uint32
 
 /* The window's triangles numbered in the order of their first events:
  * each written to the table, its id to its bucket's. */
-static int num_emit(builder *b, numbering *N, const num_slot *w)
+static int num_emit(builder *b, numbering *N, size_t lo, size_t hi)
 {
     pdt_replay *r = b->r;
     int ok = 1;
-    for (size_t k = 0; ok && k < w->hi - w->lo; k++) {
-        uint32_t nk = w->wn[k];
+    for (size_t k = 0; ok && k < hi - lo; k++) {
+        uint32_t nk = N->wn[k];
         if (!nk) continue;
-        const uint32_t *v = w->wv[k];
-        pdt_rtri t = {{v[0], v[1], v[2]}, pdt_replay_rank_of(r, w->lo + k), (uint32_t)N->h0, nk};
-        ok = put_tri(b, N, &N->ic[w->wf[k]], &t, (uint32_t)r->ntri++);
+        const uint32_t *v = N->wv[k];
+        size_t f = N->wf[k];
+        pdt_rtri t = {{v[0], v[1], v[2]}, pdt_replay_rank_of(r, lo + k), (uint32_t)N->hpos[f], nk};
+        ok = put_tri(b, N, &N->ic[f], &t, (uint32_t)r->ntri++);
+        N->hpos[f] += nk;
         N->h0 += nk;
     }
     return ok;
-}
-
-/* The next nk entries of cursor hc to the history table, as many at a time
- * as both buffers allow. */
-static int put_entries(builder *b, numbering *N, bcur *hc, uint32_t nk)
-{
-    while (nk) {
-        if (!bcur_peek(b, hc)) return 0;
-        size_t k = hc->n - hc->i, room = N->hw.cap - N->hw.n;
-        if (k > nk) k = nk;
-        if (k > room) k = room;
-        memcpy(N->hw.buf + N->hw.n * sizeof(pdt_rtri_hist), hc->buf + hc->i * sizeof(pdt_rtri_hist),
-               k * sizeof(pdt_rtri_hist));
-        hc->i += k;
-        N->hw.n += k;
-        nk -= (uint32_t)k;
-        if (N->hw.n == N->hw.cap && !bput_flush(b, &N->hw)) return 0;
-    }
-    return 1;
-}
-
-/* The window's triangles' entries, from their buckets', in their order. */
-static int num_copy(builder *b, numbering *N, const num_slot *w)
-{
-    int ok = 1;
-    for (size_t k = 0; ok && k < w->hi - w->lo; k++)
-        if (w->wn[k]) ok = put_entries(b, N, &N->hc[w->wf[k]], w->wn[k]);
-    return ok;
-}
-
-/* The copying thread: each window once found, until the numbering stops
- * (N->stop) and every window found is copied. */
-static void *num_copier(void *arg)
-{
-    numbering *N = arg;
-    for (size_t k = 0;; k++) {
-        pthread_mutex_lock(&N->mu);
-        while (N->found <= k && !N->stop) pthread_cond_wait(&N->cv, &N->mu);
-        int have = N->found > k;
-        pthread_mutex_unlock(&N->mu);
-        if (!have) break;
-        int ok = num_copy(N->b, N, &N->w[k % NUM_SLOTS]);
-        pthread_mutex_lock(&N->mu);
-        N->copied = k + 1;
-        if (!ok) N->copy_failed = N->stop = 1;
-        pthread_cond_broadcast(&N->cv);
-        pthread_mutex_unlock(&N->mu);
-        if (!ok) break;
-    }
-    return NULL;
-}
-
-/* Window slot for the k-th window, once the copier is done with the one it
- * held (always, without a copier); NULL when the copying failed. */
-static num_slot *num_slot_free(numbering *N, size_t k, int copier)
-{
-    if (!copier) return &N->w[k % NUM_SLOTS];
-    pthread_mutex_lock(&N->mu);
-    while (N->copied + NUM_SLOTS <= k && !N->copy_failed) pthread_cond_wait(&N->cv, &N->mu);
-    int failed = N->copy_failed;
-    pthread_mutex_unlock(&N->mu);
-    return failed ? NULL : &N->w[k % NUM_SLOTS];
-}
-
-/* Window k (in w) found and numbered: to the copier (or copied here). */
-static int num_found(numbering *N, size_t k, const num_slot *w, int copier)
-{
-    if (!copier) return num_copy(N->b, N, w);
-    pthread_mutex_lock(&N->mu);
-    N->found = k + 1;
-    pthread_cond_broadcast(&N->cv);
-    pthread_mutex_unlock(&N->mu);
-    return 1;
 }
 
 int pdt_rp_tri_number(builder *b)
@@ -343,31 +237,15 @@ int pdt_rp_tri_number(builder *b)
     pdt_replay *r = b->r;
     numbering N;
     int ok = num_open(b, &N);
-    pthread_t th;
-    pthread_mutex_init(&N.mu, NULL);
-    pthread_cond_init(&N.cv, NULL);
-    int copier = ok && sysconf(_SC_NPROCESSORS_ONLN) > 1 && pthread_create(&th, NULL, num_copier, &N) == 0;
     r->ntri = 0;
-    size_t k = 0;
-    for (size_t lo = 0; ok && lo < r->m; lo += NUM_WINDOW, k++) {
+    for (size_t lo = 0; ok && lo < r->m; lo += NUM_WINDOW) {
         size_t hi = r->m - lo < NUM_WINDOW ? r->m : lo + NUM_WINDOW;
-        num_slot *w = num_slot_free(&N, k, copier);
-        if (!w) break;
-        num_window(b, &N, w, lo, hi);
-        ok = !b->failed && num_emit(b, &N, w) && num_found(&N, k, w, copier);
+        num_window(b, &N, lo, hi);
+        ok = num_emit(b, &N, lo, hi) && !b->failed;
     }
-    if (copier) {
-        pthread_mutex_lock(&N.mu);
-        N.stop = 1;
-        pthread_cond_broadcast(&N.cv);
-        pthread_mutex_unlock(&N.mu);
-        pthread_join(th, NULL);
-        ok = ok && !N.copy_failed;
-    }
-    for (size_t f = 0; ok && f < b->nfine; f++) ok = bput_flush(b, &N.ic[f]);
-    ok = ok && bput_flush(b, &N.tw) && bput_flush(b, &N.hw) && N.h0 == r->nhist && !b->failed;
-    pthread_mutex_destroy(&N.mu);
-    pthread_cond_destroy(&N.cv);
+    for (size_t f = 0; ok && f < b->nfine; f++)
+        ok = bput_flush(b, &N.ic[f]) && N.hpos[f] == b->fine_off[f + 1];
+    ok = ok && bput_flush(b, &N.tw) && N.h0 == r->nhist;
     num_close(b, &N);
     if (!ok) b->failed = 1;
     return ok;

@@ -177,10 +177,9 @@ enum {
     PDT_SCR_SPILL,   /* the triangle events by fine bucket, 20 bytes each */
     PDT_SCR_TRIEV,   /* per triangle event, by fine bucket: the event and its
                       * triangle (8 bytes) */
-    PDT_SCR_TRIS,    /* per triangle, by fine bucket: its first event and
-                      * its entries (8 bytes) */
+    PDT_SCR_TRIS,    /* per triangle, by fine bucket: its first event, its
+                      * entries and its corners (tri_first, 20 bytes) */
     PDT_SCR_IDS,     /* per triangle, by fine bucket: its number (4 bytes) */
-    PDT_SCR_HIST,    /* the history entries by fine bucket (12 bytes each) */
     PDT_SCR_POINTS,  /* lifts and pushes by window of points (replay.c: pt_rec) */
     PDT_SCR_COUNT
 };
