@@ -130,6 +130,60 @@ static inline int decode_one(pdt_block_cursor *c, pdt_event *e)
     return 0;
 }
 
+/* The length of the varint at p (within end, at most maxbytes long), or 0
+ * where get_varint would fail; for a 32-bit field (maxbytes 5) also 0 when
+ * its value is over UINT32_MAX (a fifth byte above 0x0f).  Eight bytes at
+ * a time where they are there. */
+static inline size_t varint_len(const uint8_t *p, const uint8_t *end, int maxbytes)
+{
+    size_t n = 0;
+    if (end - p >= 8) {
+        uint64_t w;
+        memcpy(&w, p, 8);
+        uint64_t stop = ~w & UINT64_C(0x8080808080808080);
+        if (stop) {  /* (the host is little-endian: the first byte is the lowest) */
+            const uint16_t one = 1;
+            if (*(const uint8_t *)&one) n = (size_t)__builtin_ctzll(stop) / 8 + 1;
+        }
+    }
+    if (!n) {
+        while (p + n < end && n < (size_t)maxbytes && (p[n] & 0x80)) n++;
+        if (p + n == end || n == (size_t)maxbytes) return 0;
+        n++;
+    }
+    if (n > (size_t)maxbytes) return 0;
+    if (maxbytes == 5 && n == 5 && p[4] > 0x0f) return 0;
+    return n;
+}
+
+int pdt_tf_validate(const uint8_t *p, size_t len, uint32_t count)
+{
+    const uint8_t *end = p + len;
+    for (uint32_t i = 0; i < count; i++) {
+        if (end - p < 2) return -1;
+        uint8_t mask = p[1];
+        p += 2;
+        if (mask & ~(TF_SUB | TF_A | TF_B | TF_C | TF_V)) return -1;
+        size_t k = varint_len(p, end, 10);
+        if (!k) return -1;
+        p += k;
+        if (mask & TF_SUB) {
+            if (p == end) return -1;
+            p++;
+        }
+        for (int f = TF_A; f <= TF_C; f <<= 1)
+            if (mask & f) {
+                if (!(k = varint_len(p, end, 5))) return -1;
+                p += k;
+            }
+        if (mask & TF_V) {
+            if (!(k = varint_len(p, end, 10))) return -1;
+            p += k;
+        }
+    }
+    return p == end ? 0 : -1;
+}
+
 void pdt_block_cursor_start(pdt_block_cursor *c, const uint8_t *payload, uint32_t len,
                             uint32_t count, uint64_t base_t)
 {

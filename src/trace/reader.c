@@ -219,7 +219,7 @@ static void *pre_worker(void *arg)
         uint8_t ok = 0;
         if (pdt_crc32c(pdt_crc32c(0, h, 28), h + TF_BLOCK_HEADER_SIZE, len) == tf_get32(h + 28))
             ok |= PRE_SUM;
-        if (count && pdt_tf_decode(h + TF_BLOCK_HEADER_SIZE, len, count, tf_get64(h + 16), NULL) == 0)
+        if (count && pdt_tf_validate(h + TF_BLOCK_HEADER_SIZE, len, count) == 0)
             ok |= PRE_DATA;
         P->ok[k] = ok;
     }
@@ -312,7 +312,7 @@ static int scan_block(pdt_run *run, tf_rank *rk, const char *name, size_t k, uin
         return BLK_DAMAGED;
     }
     if (count == 0 || (known >= 0 ? !(known & PRE_DATA)
-                                  : pdt_tf_decode(h + TF_BLOCK_HEADER_SIZE, len, count, base, NULL) != 0)) {
+                                  : pdt_tf_validate(h + TF_BLOCK_HEADER_SIZE, len, count) != 0)) {
         pdt_tf_warnf(run, "%s: block %zu at byte %" PRIu64 ": malformed event data", name, k, at);
         return BLK_DAMAGED;
     }

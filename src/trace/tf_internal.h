@@ -59,6 +59,12 @@ size_t pdt_tf_encode(const pdt_event *ev, size_t n, uint64_t base_t, uint8_t *ou
 int pdt_tf_decode(const uint8_t *p, size_t len, uint32_t count, uint64_t base_t,
                   pdt_event *out);
 
+/* Whether a block payload of `len` bytes holds exactly `count` events that
+ * pdt_tf_decode accepts (0), or not (-1), without decoding them: each
+ * field's length and range checked, no value computed (opening a run
+ * checks every block this way). */
+int pdt_tf_validate(const uint8_t *p, size_t len, uint32_t count);
+
 /* Fill a block header at h (TF_BLOCK_HEADER_SIZE bytes) for the payload that
  * follows it in memory; computes the checksum. */
 void pdt_tf_block_header(uint8_t *h, uint32_t magic, const uint8_t *payload, uint32_t len,

@@ -151,6 +151,63 @@ TEST(points_checksum_is_crc64_of_the_bytes)
     CHECK(pdt_points_checksum(pts, 0) == 0);
 }
 
+/* The validator that opening a run uses accepts exactly the payloads the
+ * decoder accepts: encoded blocks of extreme events, each cut short, with
+ * one byte changed (every place, several values), grown by a byte, with
+ * one event more or less counted, and random bytes. */
+TEST(validate_agrees_with_decode)
+{
+    enum { N = 300 };
+    pdt_event ev[N];
+    const uint32_t u[] = {0, 1, 127, 128, 16383, 16384, 0x0fffffff, 0x10000000, UINT32_MAX};
+    const int64_t v[] = {0, -1, 63, -64, INT64_MAX, INT64_MIN};
+    for (int i = 0; i < N; i++) {
+        memset(&ev[i], 0, sizeof ev[i]);
+        ev[i].kind = (uint8_t)(i % 40);
+        ev[i].sub = (uint8_t)(i % 3 ? 0 : i);
+        ev[i].a = u[i % 9];
+        ev[i].b = i % 2 ? u[(i / 2) % 9] : 0;
+        ev[i].c = i % 5 ? 0 : u[(i / 5) % 9];
+        ev[i].v = i % 7 ? 0 : v[(i / 7) % 6];
+        ev[i].t = (uint64_t)i * (i % 4 ? 1000003u : UINT64_C(0x123456789abcd));
+    }
+    uint8_t *buf = malloc(N * TF_MAX_EVENT_BYTES + 16), *mut = malloc(N * TF_MAX_EVENT_BYTES + 16);
+    size_t len = pdt_tf_encode(ev, N, 5, buf), cases = 0, differ = 0;
+#define SAME(P, L, C)                                                                         \
+    do {                                                                                      \
+        cases++;                                                                              \
+        if ((pdt_tf_validate(P, L, C) == 0) != (pdt_tf_decode(P, L, C, 5, NULL) == 0)) differ++; \
+    } while (0)
+    SAME(buf, len, N);
+    SAME(buf, len, N - 1);
+    SAME(buf, len, N + 1);
+    for (size_t k = 0; k < len; k++) SAME(buf, k, N);
+    memcpy(mut, buf, len);
+    mut[len] = 0;
+    SAME(mut, len + 1, N);
+    const uint8_t vals[] = {0x00, 0x0f, 0x10, 0x7f, 0x80, 0xff, 0x1f, 0x20};
+    for (size_t k = 0; k < len; k++)
+        for (size_t j = 0; j < sizeof vals; j++) {
+            memcpy(mut, buf, len);
+            mut[k] = vals[j];
+            SAME(mut, len, N);
+        }
+    for (int r = 0; r < 20000; r++) {
+        size_t l = (size_t)(next_rand() % 64);
+        uint32_t c = (uint32_t)(next_rand() % 8);
+        for (size_t k = 0; k < l; k++) {
+            uint64_t x = next_rand();  /* (mostly small bytes: events that parse) */
+            mut[k] = (uint8_t)(x % 4 == 0 ? x >> 8 : (x >> 8) % 24);
+        }
+        SAME(mut, l, c);
+    }
+#undef SAME
+    CHECK_MSG(differ == 0, "%zu of %zu payloads judged differently", differ, cases);
+    CHECK(pdt_tf_validate(buf, len, N) == 0);
+    free(buf);
+    free(mut);
+}
+
 TEST(codec_extremes)
 {
     /* every kind, extreme field values, times going backwards too */
@@ -643,6 +700,7 @@ int main(void)
     RUN(crc_combine_any_split);
     RUN(points_checksum_is_crc64_of_the_bytes);
     RUN(codec_extremes);
+    RUN(validate_agrees_with_decode);
     RUN(writer_reader_round_trip);
     RUN(damage_is_reported_with_offsets);
     RUN(missing_rank_and_bad_version);
