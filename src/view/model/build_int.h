@@ -117,6 +117,23 @@ static inline void sort3(uint32_t v[3], const uint32_t in[3])
  * the caller's, e.g. a mapping of the index file) and a working set bounded
  * by the budget. */
 
+/* A hash of a key of two words (the keymaps', the triangles' buckets):
+ * inline, for the tens of millions of events a big run's build hashes. */
+static inline uint64_t pdt_rp_mix(uint64_t hi, uint64_t lo)
+{
+    uint64_t h = hi * 0x9E3779B97F4A7C15ull ^ (lo + 0x632BE59BD9B4E019ull + (hi << 6));
+    h ^= h >> 31;
+    h *= 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 29;
+    return h;
+}
+
+/* The fine bucket (of 2^bits) of a triangle's key s (its corners sorted). */
+static inline size_t pdt_rp_fine_of(const uint32_t s[3], unsigned bits)
+{
+    return (size_t)(pdt_rp_mix(((uint64_t)s[0] << 32) | s[1], s[2]) >> (64 - bits));
+}
+
 typedef struct tri_rec {
     uint32_t s[3];  /* corners, sorted: the triangle's key */
     uint32_t ev;
@@ -288,7 +305,6 @@ typedef struct tri_first {
 
 /* containers.c */
 int pdt_rp_grow(void **p, size_t *cap, size_t need, size_t elem);
-uint64_t pdt_rp_mix(uint64_t hi, uint64_t lo);
 int pdt_rp_km_alloc(keymap *km, size_t n, uint64_t limit);
 void pdt_rp_km_free(keymap *km);
 void pdt_rp_km_give_back(const keymap *km);
@@ -300,7 +316,6 @@ int pdt_rp_tab_grow(pdt_replay *r, void **p, size_t *cap, size_t need, size_t el
 void pdt_rp_tabs_give_back(const pdt_replay *r);
 
 /* group.c */
-size_t pdt_rp_fine_of(const uint32_t s[3], unsigned bits);
 int pdt_rp_spill_put(builder *b, int scr, spill_log *lg, const void *buf, size_t k, size_t rec,
                      size_t f);
 int pdt_rp_spill_group(spill_log *lg, size_t nb, size_t *start);

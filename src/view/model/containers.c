@@ -34,15 +34,6 @@ int pdt_rp_grow(void **p, size_t *cap, size_t need, size_t elem)
     return 1;
 }
 
-uint64_t pdt_rp_mix(uint64_t hi, uint64_t lo)
-{
-    uint64_t h = hi * 0x9E3779B97F4A7C15ull ^ (lo + 0x632BE59BD9B4E019ull + (hi << 6));
-    h ^= h >> 31;
-    h *= 0xBF58476D1CE4E5B9ull;
-    h ^= h >> 29;
-    return h;
-}
-
 /* Room for at least `n` keys at load <= 3/4: in a temporary file's mapping
  * beyond `limit` bytes (0: no limit), else in memory.  Big tables in memory
  * ask for huge pages: lookups are random, and TLB misses otherwise

@@ -19,7 +19,6 @@ static uint64_t key_hash(const uint32_t s[3])
     return pdt_rp_mix(((uint64_t)s[0] << 32) | s[1], s[2]);
 }
 
-size_t pdt_rp_fine_of(const uint32_t s[3], unsigned bits) { return (size_t)(key_hash(s) >> (64 - bits)); }
 
 size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks)
 {
