@@ -133,31 +133,52 @@ static void bcurs_free(builder *b, bcur *c, size_t rec)
  * maker that event's rank, its entries where the grouping wrote them (the
  * history table in the buckets' order: a bucket's triangles' entries one
  * triangle after the other, from its fine_off). */
-/* The numbering pass's cursors: per fine bucket, its triangles' first
- * events (tc), their ids (ic, written) and where its next triangle's
- * entries are (hpos); the triangle table written in order (tw); the
- * window's triangles by event (wn: entries, 0 for none; wf: their bucket;
- * wv: their corners). */
-typedef struct numbering {
-    bcur *tc, *ic, tw;
-    size_t *hpos;
+/* The windows of the numbering: the triangles whose first event is in
+ * [lo, hi), by event (wn: entries, 0 for none; wf: their bucket; wv:
+ * their corners).  One thread finds them (num_window) a window ahead of
+ * the one that numbers them (num_emit), so they are NUM_SLOTS. */
+#define NUM_SLOTS 2
+typedef struct num_slot {
     uint32_t *wn, (*wv)[3];
     uint16_t *wf;
+    size_t lo, hi;
+} num_slot;
+
+/* The numbering pass's cursors: per fine bucket, its triangles' first
+ * events (tc, read by the finding thread), their ids (ic, written) and
+ * where its next triangle's entries are (hpos); the triangle table written
+ * in order (tw); the windows, and between the two threads the windows
+ * found and numbered, and whether the numbering stopped. */
+typedef struct numbering {
+    builder *b;
+    bcur *tc, *ic, tw;
+    size_t *hpos;
+    num_slot w[NUM_SLOTS];
     size_t h0;  /* entries numbered */
+    size_t found, done;
+    int stop;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
 } numbering;
 
 static int num_open(builder *b, numbering *N)
 {
     pdt_replay *r = b->r;
     memset(N, 0, sizeof *N);
+    N->b = b;
     N->tc = bcurs_new(b, sizeof(tri_first));
     N->ic = bcurs_new(b, sizeof(uint32_t));
     N->hpos = pdt_rp_bmalloc(b, b->nfine * sizeof *N->hpos);
-    N->wn = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *N->wn);
-    N->wf = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *N->wf);
-    N->wv = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *N->wv);
     N->tw.buf = pdt_rp_bmalloc(b, CUR_RECS * sizeof(pdt_rtri));
-    if (!N->tc || !N->ic || !N->hpos || !N->wn || !N->wf || !N->wv || !N->tw.buf) return 0;
+    int ok = N->tc && N->ic && N->hpos && N->tw.buf;
+    for (int k = 0; k < NUM_SLOTS; k++) {
+        num_slot *w = &N->w[k];
+        w->wn = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *w->wn);
+        w->wf = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *w->wf);
+        w->wv = pdt_rp_bmalloc(b, NUM_WINDOW * sizeof *w->wv);
+        ok = ok && w->wn && w->wf && w->wv;
+    }
+    if (!ok) return 0;
     for (size_t f = 0; f < b->nfine; f++) {
         N->tc[f].file = PDT_SCR_TRIS;
         N->tc[f].at = (uint64_t)b->fine_off[f] * sizeof(tri_first);
@@ -177,18 +198,22 @@ static void num_close(builder *b, numbering *N)
 {
     pdt_rp_bfree(b, N->tw.buf, CUR_RECS * sizeof(pdt_rtri));
     pdt_rp_bfree(b, N->hpos, b->nfine * sizeof *N->hpos);
-    pdt_rp_bfree(b, N->wn, NUM_WINDOW * sizeof *N->wn);
-    pdt_rp_bfree(b, N->wf, NUM_WINDOW * sizeof *N->wf);
-    pdt_rp_bfree(b, N->wv, NUM_WINDOW * sizeof *N->wv);
+    for (int k = 0; k < NUM_SLOTS; k++) {
+        pdt_rp_bfree(b, N->w[k].wn, NUM_WINDOW * sizeof *N->w[k].wn);
+        pdt_rp_bfree(b, N->w[k].wf, NUM_WINDOW * sizeof *N->w[k].wf);
+        pdt_rp_bfree(b, N->w[k].wv, NUM_WINDOW * sizeof *N->w[k].wv);
+    }
     bcurs_free(b, N->tc, sizeof(tri_first));
     bcurs_free(b, N->ic, sizeof(uint32_t));
 }
 
 /* The triangles whose first event is in [lo, hi), from every bucket, by
- * event (N->wn, N->wf, N->wv). */
-static void num_window(builder *b, numbering *N, size_t lo, size_t hi)
+ * event (into w). */
+static void num_window(builder *b, numbering *N, num_slot *w, size_t lo, size_t hi)
 {
-    memset(N->wn, 0, (hi - lo) * sizeof *N->wn);
+    w->lo = lo;
+    w->hi = hi;
+    memset(w->wn, 0, (hi - lo) * sizeof *w->wn);
     for (size_t f = 0; f < b->nfine; f++) {
         const tri_first *t;
         while ((t = bcur_peek(b, &N->tc[f])) && t->ev < hi) {
@@ -196,9 +221,9 @@ static void num_window(builder *b, numbering *N, size_t lo, size_t hi)
                 b->failed = 1;
                 break;
             }
-            N->wn[t->ev - lo] = t->n;
-            N->wf[t->ev - lo] = (uint16_t)f;
-            memcpy(N->wv[t->ev - lo], t->v, sizeof t->v);
+            w->wn[t->ev - lo] = t->n;
+            w->wf[t->ev - lo] = (uint16_t)f;
+            memcpy(w->wv[t->ev - lo], t->v, sizeof t->v);
             N->tc[f].i++;
         }
     }
@@ -213,18 +238,18 @@ static int put_tri(builder *b, numbering *N, bcur *ic, const pdt_rtri *t, uint32
     return (++N->tw.n < N->tw.cap || bput_flush(b, &N->tw)) && (++ic->n < ic->cap || bput_flush(b, ic));
 }
 
-/* The window's triangles numbered in the order of their first events:
- * each written to the table, its id to its bucket's. */
-static int num_emit(builder *b, numbering *N, size_t lo, size_t hi)
+/* Window w's triangles numbered in the order of their first events: each
+ * written to the table, its id to its bucket's. */
+static int num_emit(builder *b, numbering *N, const num_slot *w)
 {
     pdt_replay *r = b->r;
     int ok = 1;
-    for (size_t k = 0; ok && k < hi - lo; k++) {
-        uint32_t nk = N->wn[k];
+    for (size_t k = 0; ok && k < w->hi - w->lo; k++) {
+        uint32_t nk = w->wn[k];
         if (!nk) continue;
-        const uint32_t *v = N->wv[k];
-        size_t f = N->wf[k];
-        pdt_rtri t = {{v[0], v[1], v[2]}, pdt_replay_rank_of(r, lo + k), (uint32_t)N->hpos[f], nk};
+        const uint32_t *v = w->wv[k];
+        size_t f = w->wf[k];
+        pdt_rtri t = {{v[0], v[1], v[2]}, pdt_replay_rank_of(r, w->lo + k), (uint32_t)N->hpos[f], nk};
         ok = put_tri(b, N, &N->ic[f], &t, (uint32_t)r->ntri++);
         N->hpos[f] += nk;
         N->h0 += nk;
@@ -232,20 +257,77 @@ static int num_emit(builder *b, numbering *N, size_t lo, size_t hi)
     return ok;
 }
 
+/* The finding thread: window k into slot k % NUM_SLOTS once the numbering
+ * is done with the window that slot held, until the last or a stop. */
+static void *num_finder(void *arg)
+{
+    numbering *N = arg;
+    builder *b = N->b;
+    size_t m = b->r->m;
+    for (size_t k = 0, lo = 0; lo < m; k++, lo += NUM_WINDOW) {
+        pthread_mutex_lock(&N->mu);
+        while (N->done + NUM_SLOTS <= k && !N->stop) pthread_cond_wait(&N->cv, &N->mu);
+        int stop = N->stop;
+        pthread_mutex_unlock(&N->mu);
+        if (stop) break;
+        num_window(b, N, &N->w[k % NUM_SLOTS], lo, m - lo < NUM_WINDOW ? m : lo + NUM_WINDOW);
+        pthread_mutex_lock(&N->mu);
+        N->found = k + 1;
+        pthread_cond_broadcast(&N->cv);
+        pthread_mutex_unlock(&N->mu);
+    }
+    return NULL;
+}
+
+/* Window k, found (by the finder, or here without one): its slot. */
+static const num_slot *num_found(numbering *N, size_t k, int finder)
+{
+    num_slot *w = &N->w[k % NUM_SLOTS];
+    if (!finder) {
+        size_t lo = k * NUM_WINDOW, m = N->b->r->m;
+        num_window(N->b, N, w, lo, m - lo < NUM_WINDOW ? m : lo + NUM_WINDOW);
+        return w;
+    }
+    pthread_mutex_lock(&N->mu);
+    while (N->found <= k) pthread_cond_wait(&N->cv, &N->mu);
+    pthread_mutex_unlock(&N->mu);
+    return w;
+}
+
+/* Window k numbered: its slot back to the finder. */
+static void num_done(numbering *N, size_t k, int stop)
+{
+    pthread_mutex_lock(&N->mu);
+    N->done = k + 1;
+    if (stop) N->stop = 1;
+    pthread_cond_broadcast(&N->cv);
+    pthread_mutex_unlock(&N->mu);
+}
+
 int pdt_rp_tri_number(builder *b)
 {
     pdt_replay *r = b->r;
     numbering N;
     int ok = num_open(b, &N);
+    pthread_mutex_init(&N.mu, NULL);
+    pthread_cond_init(&N.cv, NULL);
+    pthread_t th;
+    int finder = ok && sysconf(_SC_NPROCESSORS_ONLN) > 1 && pthread_create(&th, NULL, num_finder, &N) == 0;
     r->ntri = 0;
-    for (size_t lo = 0; ok && lo < r->m; lo += NUM_WINDOW) {
-        size_t hi = r->m - lo < NUM_WINDOW ? r->m : lo + NUM_WINDOW;
-        num_window(b, &N, lo, hi);
-        ok = num_emit(b, &N, lo, hi) && !b->failed;
+    for (size_t k = 0, lo = 0; ok && lo < r->m; k++, lo += NUM_WINDOW) {
+        const num_slot *w = num_found(&N, k, finder);
+        ok = !b->failed && num_emit(b, &N, w) && !b->failed;
+        if (finder) num_done(&N, k, !ok);
+    }
+    if (finder) {
+        num_done(&N, N.done, 1);  /* (stopped early: the finder stops too) */
+        pthread_join(th, NULL);
     }
     for (size_t f = 0; ok && f < b->nfine; f++)
         ok = bput_flush(b, &N.ic[f]) && N.hpos[f] == b->fine_off[f + 1];
-    ok = ok && bput_flush(b, &N.tw) && N.h0 == r->nhist;
+    ok = ok && bput_flush(b, &N.tw) && N.h0 == r->nhist && !b->failed;
+    pthread_mutex_destroy(&N.mu);
+    pthread_cond_destroy(&N.cv);
     num_close(b, &N);
     if (!ok) b->failed = 1;
     return ok;
