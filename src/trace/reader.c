@@ -415,6 +415,56 @@ static uint64_t points_sum(const pdt_manifest *m, const pdt_point *pts, size_t n
                                                           : pdt_points_checksum(pts, n);
 }
 
+/* ---- the points' checksum, made beside the rank files' scan ----------------------- */
+
+static void *sum_worker(void *arg)
+{
+    pdt_run *run = arg;
+    run->sum.value = points_sum(&run->m, run->pts, run->npts);
+    return NULL;
+}
+
+/* The points' checksum started on a thread of its own (made here when
+ * none can be started), its warning's place among the warnings noted. */
+static void sum_start(pdt_run *run)
+{
+    run->sum.warn_at = run->wlen;
+    if (pthread_create(&run->sum.th, NULL, sum_worker, run) == 0) {
+        run->sum.started = 1;
+        return;
+    }
+    sum_worker(run);
+    run->sum.done = 1;
+}
+
+/* The checksum done: compared with the manifest's, a mismatch said where
+ * read_points would have said it; the points' pages given back. */
+static void sum_finish(pdt_run *run)
+{
+    if (run->sum.started) {
+        pthread_join(run->sum.th, NULL);
+        run->sum.started = 0;
+        run->sum.done = 1;
+        if (run->pts_map) release_pages(run->pts_map, 0, run->pts_map_size);
+    }
+    if (!run->sum.done) return;
+    run->sum.done = 0;
+    if (run->sum.value == run->m.input_checksum) return;
+    size_t tail = run->wlen - run->sum.warn_at;
+    char *after = malloc(tail + 1);
+    if (!after) return;  /* (a lost warning is better than a failed open) */
+    if (tail) memcpy(after, run->warn + run->sum.warn_at, tail);
+    run->wlen = run->sum.warn_at;
+    pdt_tf_warnf(run, "points.bin: points do not match the manifest's input_checksum");
+    for (size_t at = 0; at < tail;) { /* the later warnings again, one line at a time */
+        const char *nl = memchr(after + at, '\n', tail - at);
+        size_t len = nl ? (size_t)(nl - (after + at)) : tail - at;
+        pdt_tf_warnf(run, "%.*s", (int)len, after + at);
+        at += len + 1;
+    }
+    free(after);
+}
+
 /* The largest clock offset taken as one (10^18 ns, about 31 years): the
  * differences of offsets in this range, and times shifted by them, are
  * computed without overflow. */
@@ -488,12 +538,15 @@ static pdt_status read_points(pdt_run *run, const char *dir, pdt_err *err)
             else pdt_tf_warnf(run, "%s", perr.msg);
         } else if (run->npts != run->m.n) {
             pdt_tf_warnf(run, "points.bin: %zu points, manifest says %" PRIu64, run->npts, run->m.n);
-        } else if (points_sum(&run->m, run->pts, run->npts) != run->m.input_checksum) {
-            pdt_tf_warnf(run, "points.bin: points do not match the manifest's input_checksum");
+        } else {
+            sum_start(run);  /* (its warning, if any, goes here: sum_finish) */
         }
     }
-    if (run->pts_map) release_pages(map, 0, size); /* (the checksums read every page) */
-    else if (map) munmap(map, size);
+    if (run->pts_map) { /* (the checks read every page; the sum gives them back) */
+        if (!run->sum.started) release_pages(map, 0, size);
+    } else if (map) {
+        munmap(map, size);
+    }
     free(ppath);
     return st;
 }
@@ -551,6 +604,7 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
     if (st == PDT_OK) run->nranks = run->m.nranks;
     if (st == PDT_OK && run->m.command[0]) st = read_points(run, dir, err);
     if (st == PDT_OK) st = scan_ranks(run, err);
+    sum_finish(run);
     if (st != PDT_OK) {
         pdt_run_close(run);
         return st;
@@ -562,6 +616,7 @@ pdt_status pdt_run_open(const char *dir, pdt_run **out, pdt_err *err)
 void pdt_run_close(pdt_run *run)
 {
     if (!run) return;
+    if (run->sum.started) pthread_join(run->sum.th, NULL);
     for (int r = 0; run->rk && r < run->nranks; r++) {
         tf_rank *rk = &run->rk[r];
         if (rk->map) munmap(rk->map, rk->size);

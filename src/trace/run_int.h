@@ -3,6 +3,8 @@
 #ifndef PDT_TRACE_RUN_INT_H
 #define PDT_TRACE_RUN_INT_H
 
+#include <pthread.h>
+
 #include "tf_internal.h"
 
 typedef pdt_block_ref tf_block;  /* off: of the block header; first: its first event */
@@ -31,6 +33,12 @@ struct pdt_run {
     tf_rank *rk;
     char *warn;
     size_t wlen, wcap;
+    struct {             /* the points' checksum, made while the ranks are scanned */
+        pthread_t th;
+        int started, done;
+        uint64_t value;
+        size_t warn_at;  /* its warning's place in warn */
+    } sum;
     pdt_rec *merged;
     size_t nmerged;
     int merged_done;

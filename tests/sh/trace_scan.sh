@@ -70,4 +70,18 @@ damaged_case() {
 damaged_case flipped_block_second_window flip "checksum mismatch"
 damaged_case malformed_block_second_window malformed "malformed event data"
 
+# The points' checksum is made while the rank files are scanned; its
+# warning still comes first, before the rank files' (as the reading goes).
+cp -r run both
+python3 blocks.py both/rank-0000.trace flip >/dev/null
+sed -i 's/^input_checksum = crc64:.*/input_checksum = crc64:0000000000000001/' both/manifest
+w=$("$PDT" trace info both 2>&1 | grep '^warning')
+first=$(echo "$w" | head -1); n=$(echo "$w" | wc -l)
+if [[ "$first" == *"points.bin: points do not match the manifest's input_checksum"* ]] && [ "$n" -ge 3 ] &&
+    echo "$w" | sed -n 2p | grep -q "checksum mismatch"; then
+    ok points_warning_before_rank_warnings
+else
+    fail points_warning_before_rank_warnings "$w"
+fi
+
 summary
