@@ -56,7 +56,12 @@ enum {
 typedef struct pdt_rtri {
     uint32_t v[3];
     uint32_t maker;     /* rank of the first TRI_NEW (or first event) */
-    uint32_t h0, hn;    /* its history entries: hist[h0 .. h0+hn) */
+    uint32_t h0;        /* its history entries: hist[h0 .. h0+hn) */
+    uint16_t hn;        /* (at most PDT_TRI_HIST_MAX) */
+    uint8_t last;       /* the status of its last entry (hist[h0 + hn - 1].status):
+                         * a triangle at its last entry needs no look at the
+                         * histories, which are where the build grouped them */
+    uint8_t pad;
 } pdt_rtri;
 
 /* One change of a triangle's status (12 bytes: a kept index holds one per

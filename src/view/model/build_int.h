@@ -272,11 +272,15 @@ typedef struct tri_ev {
 } tri_ev;
 #define TEV_FIRST 0x80000000u
 
-/* A triangle's record in PDT_SCR_TRIS: its first event, its entries, its
- * corners as that event reported them. */
+/* A triangle's record in PDT_SCR_TRIS: its first event, its entries and
+ * the status of its last (n: TF_N_MASK and TF_LAST_SHIFT), its corners as
+ * that event reported them. */
 typedef struct tri_first {
     uint32_t ev, n, v[3];
 } tri_first;
+#define TF_N_MASK 0xffffu  /* (PDT_TRI_HIST_MAX) */
+#define TF_LAST_SHIFT 16
+_Static_assert(PDT_TRI_HIST_MAX <= TF_N_MASK, "a triangle's entries fit tri_first's n");
 
 /* ---- the streamed build's numbering, in windows of events -------------------------
  *

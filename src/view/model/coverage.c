@@ -116,12 +116,15 @@ static void cov_range(cov_job *J)
              * random, are kept until the frame is done: pdt_render) */
             if (s->paged[1]) pdt_release_pages(&s->tcur[t - COV_RELEASE], COV_RELEASE * sizeof *s->tcur);
         }
-        /* the corners' points and the history entry of a triangle a few
-         * ahead: random places in tables of 10^8 bytes (a hint only) */
+        /* the corners' points and the history entry (unless it is the last)
+         * of a triangle a few ahead: random places in tables of 10^8 bytes
+         * (a hint only) */
         if (t + COV_AHEAD < nt && s->tcur[t + COV_AHEAD] != PDT_TCUR_NONE) {
             const pdt_rtri *ahead = &r->tris[t + COV_AHEAD];
             for (int k = 0; k < 3; k++) __builtin_prefetch(&r->pts[ahead->v[k]]);
-            __builtin_prefetch(&r->hist[ahead->h0 + s->tcur[t + COV_AHEAD]]);
+            if (s->tcur[t + COV_AHEAD] + 1u != ahead->hn || ahead->last == PDT_TS_CANDIDATE ||
+                (ahead->last == PDT_TS_DISCARDED && J->fade))
+                __builtin_prefetch(&r->hist[ahead->h0 + s->tcur[t + COV_AHEAD]]);
         }
         if (t + COV_AHEAD_CELL < nt && s->tcur[t + COV_AHEAD_CELL] != PDT_TCUR_NONE) {
             const pdt_point *p = &r->pts[r->tris[t + COV_AHEAD_CELL].v[0]];
@@ -132,6 +135,7 @@ static void cov_range(cov_job *J)
         uint32_t h = pdt_rstate_tri_entry(r, s, t);
         if (h == NONE32) continue;
         const pdt_rtri *tr = &r->tris[t];
+        uint8_t st = h + 1 == tr->h0 + tr->hn ? tr->last : r->hist[h].status;
         if (J->vis && !J->vis[tr->maker]) continue;
         double x[3], y[3];
         for (int k = 0; k < 3; k++) {
@@ -141,7 +145,6 @@ static void cov_range(cov_job *J)
         double xlo = min3(x[0], x[1], x[2]), xhi = max3(x[0], x[1], x[2]);
         double ylo = min3(y[0], y[1], y[2]), yhi = max3(y[0], y[1], y[2]);
         if (xhi < 0 || xlo >= cols || yhi < 0 || ylo >= rows) continue;  /* outside the box */
-        uint8_t st = r->hist[h].status;
         if (st == PDT_TS_DISCARDED && J->fade && s->k - r->hist[h].ev >= J->fade) continue;
         binned++;
         int j0 = ylo < 0 ? 0 : (int)ylo, j1 = yhi >= rows ? rows - 1 : (int)yhi;

@@ -287,7 +287,10 @@ static int write_run(group_job *J, size_t k, group_scratch *S, const tri_xrec *b
             eout[j] = (tri_ev){ev, (q - g0) | (first ? TEV_FIRST : 0)};
             if (first) xrec_corners(&buf[j], tout[q - g0].v);
         }
-        for (uint32_t q = g0; q < g1; q++) tout[q - g0].ev = S->gfirst[q], tout[q - g0].n = S->gn[q];
+        for (uint32_t q = g0; q < g1; q++) { /* (gfill: past the group's last entry) */
+            tout[q - g0].ev = S->gfirst[q];
+            tout[q - g0].n = S->gn[q] | (uint32_t)out[S->gfill[q] - 1 - base].status << TF_LAST_SHIFT;
+        }
         b->tcount[f] = g1 - g0;
         if (g1 > g0 && !pl->sput(pl->ctx, PDT_SCR_TRIS, (uint64_t)b->fine_off[f] * sizeof *tout,
                                  tout, (g1 - g0) * sizeof *tout))

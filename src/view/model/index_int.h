@@ -43,7 +43,7 @@
 #include "replay_int.h"
 
 #define INDEX_NAME ".pdtview-index"
-#define INDEX_VERSION 12u /* raised whenever the layout changes: an index of another
+#define INDEX_VERSION 13u /* raised whenever the layout changes: an index of another
                              * version is rebuilt */
 #define ICK_MIN_EVERY 1024u  /* checkpoints in the index: every m/8 events, at least this */
 #define ICK_PARTS 8u

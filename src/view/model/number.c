@@ -51,8 +51,9 @@ int pdt_rp_tri_ids(builder *b)
             continue;
         }
         const pdt_rec *rec = rec_at(r, i);
-        to[b->pl ? nb++ : r->ntri] = (pdt_rtri){{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank,
-                                               r->ev_ent[i], (uint32_t)(-1 - o)};
+        uint32_t h0 = r->ev_ent[i], hn = (uint32_t)(-1 - o);
+        to[b->pl ? nb++ : r->ntri] = (pdt_rtri){{rec->ev.a, rec->ev.b, rec->ev.c}, rec->rank, h0,
+                                               (uint16_t)hn, r->hist[h0 + hn - 1].status, 0};
         r->ev_kind[i] |= KIND_FIRST;
         r->ev_obj[i] = (int32_t)r->ntri++;
         if (nb == TBUF) {
@@ -217,7 +218,7 @@ static void num_window(builder *b, numbering *N, num_slot *w, size_t lo, size_t 
     for (size_t f = 0; f < b->nfine; f++) {
         const tri_first *t;
         while ((t = bcur_peek(b, &N->tc[f])) && t->ev < hi) {
-            if (t->ev < lo || !t->n) { /* (not in event order: never written so) */
+            if (t->ev < lo || !(t->n & TF_N_MASK)) { /* (not in event order: never written so) */
                 b->failed = 1;
                 break;
             }
@@ -245,11 +246,12 @@ static int num_emit(builder *b, numbering *N, const num_slot *w)
     pdt_replay *r = b->r;
     int ok = 1;
     for (size_t k = 0; ok && k < w->hi - w->lo; k++) {
-        uint32_t nk = w->wn[k];
+        uint32_t nk = w->wn[k] & TF_N_MASK;
         if (!nk) continue;
         const uint32_t *v = w->wv[k];
         size_t f = w->wf[k];
-        pdt_rtri t = {{v[0], v[1], v[2]}, pdt_replay_rank_of(r, w->lo + k), (uint32_t)N->hpos[f], nk};
+        pdt_rtri t = {{v[0], v[1], v[2]}, pdt_replay_rank_of(r, w->lo + k), (uint32_t)N->hpos[f],
+                      (uint16_t)nk, (uint8_t)(w->wn[k] >> TF_LAST_SHIFT), 0};
         ok = put_tri(b, N, &N->ic[f], &t, (uint32_t)r->ntri++);
         N->hpos[f] += nk;
         N->h0 += nk;

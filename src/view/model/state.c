@@ -317,13 +317,17 @@ int32_t pdt_rstate_slot(const pdt_replay *r, const pdt_rstate *s, int rank, int 
 pdt_tri_status pdt_rstate_tri_status(const pdt_replay *r, const pdt_rstate *s, size_t t)
 {
     if (t >= r->ntri || s->tcur[t] == PDT_TCUR_NONE) return PDT_TS_NONE;
-    return (pdt_tri_status)r->hist[r->tris[t].h0 + s->tcur[t]].status;
+    const pdt_rtri *tr = &r->tris[t];
+    if (s->tcur[t] + 1u == tr->hn) return (pdt_tri_status)tr->last;
+    return (pdt_tri_status)r->hist[tr->h0 + s->tcur[t]].status;
 }
 
 uint32_t pdt_rstate_tri_entry(const pdt_replay *r, const pdt_rstate *s, size_t t)
 {
     if (t >= r->ntri || s->tcur[t] == PDT_TCUR_NONE) return NONE32;
-    uint32_t h = r->tris[t].h0 + s->tcur[t];
+    const pdt_rtri *tr = &r->tris[t];
+    uint32_t h = tr->h0 + s->tcur[t];
+    if (s->tcur[t] + 1u == tr->hn && tr->last != PDT_TS_CANDIDATE) return h;  /* (no look) */
     while (r->hist[h].status == PDT_TS_CANDIDATE && r->hist[h].until < s->k) {
         if (h == r->tris[t].h0) return NONE32;
         h--;
