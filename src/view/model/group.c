@@ -145,6 +145,7 @@ typedef struct group_scratch {
     void *buf;
     gslot *slot;
     uint32_t *gid, *gfirst, *gn, *gfill;
+    uint8_t *glast;  /* streamed: per group, the status of its latest entry */
     size_t most, hcap, rec;
 } group_scratch;
 
@@ -159,7 +160,8 @@ static int scratch_get(builder *b, group_scratch *s, size_t most, size_t rec)
     s->gfirst = pdt_rp_bmalloc(b, most * sizeof *s->gfirst);
     s->gn = pdt_rp_bmalloc(b, most * sizeof *s->gn);
     s->gfill = pdt_rp_bmalloc(b, most * sizeof *s->gfill);
-    if (!(s->buf && s->slot && s->gid && s->gfirst && s->gn && s->gfill)) return 0;
+    s->glast = pdt_rp_bmalloc(b, most);
+    if (!(s->buf && s->slot && s->gid && s->gfirst && s->gn && s->gfill && s->glast)) return 0;
     pdt_big_advise(s->buf, most * rec);
     pdt_big_advise(s->slot, hcap * sizeof *s->slot);
     return 1;
@@ -173,6 +175,7 @@ static void scratch_put(builder *b, group_scratch *s)
     pdt_rp_bfree(b, s->gfirst, s->most * sizeof *s->gfirst);
     pdt_rp_bfree(b, s->gn, s->most * sizeof *s->gn);
     pdt_rp_bfree(b, s->gfill, s->most * sizeof *s->gfill);
+    pdt_rp_bfree(b, s->glast, s->most);
 }
 
 /* Group the nb records in s->buf; gfill[g] = base + the entries of groups
@@ -283,14 +286,13 @@ static int write_run(group_job *J, size_t k, group_scratch *S, const tri_xrec *b
             uint32_t q = S->gid[j], ev = buf[j].ev, at = S->gfill[q]++;
             if (q >= g1) g1 = q + 1;
             out[at - base] = hist_of_x(r, &buf[j]);
+            S->glast[q] = out[at - base].status;  /* (the last written is the last entry's) */
             int first = ev == S->gfirst[q];
             eout[j] = (tri_ev){ev, (q - g0) | (first ? TEV_FIRST : 0)};
             if (first) xrec_corners(&buf[j], tout[q - g0].v);
         }
-        for (uint32_t q = g0; q < g1; q++) { /* (gfill: past the group's last entry) */
-            tout[q - g0].ev = S->gfirst[q];
-            tout[q - g0].n = S->gn[q] | (uint32_t)out[S->gfill[q] - 1 - base].status << TF_LAST_SHIFT;
-        }
+        for (uint32_t q = g0; q < g1; q++)
+            tout[q - g0].ev = S->gfirst[q], tout[q - g0].n = S->gn[q] | (uint32_t)S->glast[q] << TF_LAST_SHIFT;
         b->tcount[f] = g1 - g0;
         if (g1 > g0 && !pl->sput(pl->ctx, PDT_SCR_TRIS, (uint64_t)b->fine_off[f] * sizeof *tout,
                                  tout, (g1 - g0) * sizeof *tout))
