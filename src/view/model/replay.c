@@ -225,6 +225,17 @@ static int builder_open(builder *b, pdt_replay *r, const pdt_replay_place *pl)
            pdt_rp_tab_grow(r, (void **)&r->nodes, &r->cap_node, cnt[PDT_EV_PUSH], sizeof *r->nodes);
 }
 
+/* Whether an event of this kind has a place to fetch ahead
+ * (pdt_rp_probe_addr): a point's first lift, sort or deletion where those
+ * tables are held, an edge.  (Checked here, without a call for every
+ * event: most are triangles'.) */
+static inline int probe_wanted(const pdt_replay *r, int kind)
+{
+    return (kind == PDT_EV_LIFT && r->lift_ev) ||
+           ((kind == PDT_EV_SORT || kind == PDT_EV_DELETE) && r->sort_ev) ||
+           kind == PDT_EV_EDGE_ADD || kind == PDT_EV_EDGE_DEL;
+}
+
 /* Pass 1: every event once, in order (streamed: from pl's stream, a window
  * at a time, the per-event tables written out a window at a time). */
 static int first_pass(builder *b, pdt_err *err)
@@ -244,7 +255,7 @@ static int first_pass(builder *b, pdt_err *err)
         }
         if (pl ? i + PREFETCH_AHEAD < b->win_lo + b->win_n : i + PREFETCH_AHEAD < r->m) {
             const pdt_rec *ahead = pl ? &b->win[i + PREFETCH_AHEAD - b->win_lo] : rec_at(r, i + PREFETCH_AHEAD);
-            const void *also, *p = pdt_rp_probe_addr(b, ahead, &also);
+            const void *also = NULL, *p = probe_wanted(r, ahead->ev.kind) ? pdt_rp_probe_addr(b, ahead, &also) : NULL;
             if (p) __builtin_prefetch(p);
             if (also) __builtin_prefetch(also);
         }
