@@ -19,7 +19,6 @@ static uint64_t key_hash(const uint32_t s[3])
     return pdt_rp_mix(((uint64_t)s[0] << 32) | s[1], s[2]);
 }
 
-
 size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks)
 {
     const pdt_event *e = &rec->ev;
@@ -291,8 +290,10 @@ static int write_run(group_job *J, size_t k, group_scratch *S, const tri_xrec *b
             eout[j] = (tri_ev){ev, (q - g0) | (first ? TEV_FIRST : 0)};
             if (first) xrec_corners(&buf[j], tout[q - g0].v);
         }
-        for (uint32_t q = g0; q < g1; q++)
-            tout[q - g0].ev = S->gfirst[q], tout[q - g0].n = S->gn[q] | (uint32_t)S->glast[q] << TF_LAST_SHIFT;
+        for (uint32_t q = g0; q < g1; q++) {
+            tout[q - g0].ev = S->gfirst[q];
+            tout[q - g0].n = S->gn[q] | (uint32_t)S->glast[q] << TF_LAST_SHIFT;
+        }
         b->tcount[f] = g1 - g0;
         if (g1 > g0 && !pl->sput(pl->ctx, PDT_SCR_TRIS, (uint64_t)b->fine_off[f] * sizeof *tout,
                                  tout, (g1 - g0) * sizeof *tout))

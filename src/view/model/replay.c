@@ -255,7 +255,8 @@ static int first_pass(builder *b, pdt_err *err)
         }
         if (pl ? i + PREFETCH_AHEAD < b->win_lo + b->win_n : i + PREFETCH_AHEAD < r->m) {
             const pdt_rec *ahead = pl ? &b->win[i + PREFETCH_AHEAD - b->win_lo] : rec_at(r, i + PREFETCH_AHEAD);
-            const void *also = NULL, *p = probe_wanted(r, ahead->ev.kind) ? pdt_rp_probe_addr(b, ahead, &also) : NULL;
+            const void *also = NULL, *p = NULL;
+            if (probe_wanted(r, ahead->ev.kind)) p = pdt_rp_probe_addr(b, ahead, &also);
             if (p) __builtin_prefetch(p);
             if (also) __builtin_prefetch(also);
         }
