@@ -193,8 +193,8 @@ static void end_marker(pdt_run *run, tf_rank *rk, const char *name, uint64_t off
 
 /* ---- the costly checks of a window of blocks, made ahead on several threads ----
  *
- * A block's checksum and the decode of its events are most of the cost of
- * opening a run.  They are made ahead for the blocks of a window of the
+ * A block's checksum and the check of its events (pdt_tf_validate) are most
+ * of the cost of opening a run.  They are made ahead for the blocks of a window of the
  * file (found by their headers alone), on up to PRE_THREADS threads; the
  * scan then takes their answers, so that what it checks, in what order,
  * and what it says are the same as when it checks each block itself. */
