@@ -128,10 +128,17 @@ static inline uint64_t pdt_rp_mix(uint64_t hi, uint64_t lo)
     return h;
 }
 
-/* The fine bucket (of 2^bits) of a triangle's key s (its corners sorted). */
+/* The hash of a triangle's key s (its corners sorted): its fine bucket is
+ * the top bits, its slot in the grouping's table the low ones. */
+static inline uint64_t pdt_rp_key_hash(const uint32_t s[3])
+{
+    return pdt_rp_mix(((uint64_t)s[0] << 32) | s[1], s[2]);
+}
+
+/* The fine bucket (of 2^bits) of a triangle's key s. */
 static inline size_t pdt_rp_fine_of(const uint32_t s[3], unsigned bits)
 {
-    return (size_t)(pdt_rp_mix(((uint64_t)s[0] << 32) | s[1], s[2]) >> (64 - bits));
+    return (size_t)(pdt_rp_key_hash(s) >> (64 - bits));
 }
 
 typedef struct tri_rec {

@@ -14,11 +14,6 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
-static uint64_t key_hash(const uint32_t s[3])
-{
-    return pdt_rp_mix(((uint64_t)s[0] << 32) | s[1], s[2]);
-}
-
 size_t pdt_replay_fine_of(const pdt_rec *rec, size_t n, int nranks)
 {
     const pdt_event *e = &rec->ev;
@@ -118,9 +113,9 @@ static uint32_t group_keys(const void *buf, size_t stride, size_t nb, gslot *slo
     uint32_t ng = 0;
     for (size_t j = 0; j < nb; j++) {
         if (j + PREFETCH_AHEAD < nb)
-            __builtin_prefetch(&slot[(size_t)key_hash(KREC(j + PREFETCH_AHEAD)->s) & mask]);
+            __builtin_prefetch(&slot[(size_t)pdt_rp_key_hash(KREC(j + PREFETCH_AHEAD)->s) & mask]);
         const uint32_t *s = KREC(j)->s;
-        size_t q = (size_t)key_hash(s) & mask;
+        size_t q = (size_t)pdt_rp_key_hash(s) & mask;
         while (slot[q].g != NONE32 &&
                (slot[q].s[0] != s[0] || slot[q].s[1] != s[1] || slot[q].s[2] != s[2]))
             q = (q + 1) & mask;
