@@ -135,7 +135,6 @@ static void cov_range(cov_job *J)
         uint32_t h = pdt_rstate_tri_entry(r, s, t);
         if (h == NONE32) continue;
         const pdt_rtri *tr = &r->tris[t];
-        uint8_t st = h + 1 == tr->h0 + tr->hn ? tr->last : r->hist[h].status;
         if (J->vis && !J->vis[tr->maker]) continue;
         double x[3], y[3];
         for (int k = 0; k < 3; k++) {
@@ -145,6 +144,7 @@ static void cov_range(cov_job *J)
         double xlo = min3(x[0], x[1], x[2]), xhi = max3(x[0], x[1], x[2]);
         double ylo = min3(y[0], y[1], y[2]), yhi = max3(y[0], y[1], y[2]);
         if (xhi < 0 || xlo >= cols || yhi < 0 || ylo >= rows) continue;  /* outside the box */
+        uint8_t st = h + 1 == tr->h0 + tr->hn ? tr->last : r->hist[h].status;
         if (st == PDT_TS_DISCARDED && J->fade && s->k - r->hist[h].ev >= J->fade) continue;
         binned++;
         int j0 = ylo < 0 ? 0 : (int)ylo, j1 = yhi >= rows ? rows - 1 : (int)yhi;
