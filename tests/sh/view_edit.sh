@@ -57,7 +57,7 @@ F=$TMP/mine.txt
 "$V" --edit "$F" --size ${W}x${H} --screenshot "$TMP/edit.png" >"$TMP/out.log" 2>"$TMP/err.log" &
 VPID=$!
 wid=
-for i in $(seq 100); do wid=$(pdtview_window 'pdtview'); [ -n "$wid" ] && break; sleep 0.1; done
+for i in $(seq 300); do wid=$(pdtview_window 'pdtview'); [ -n "$wid" ] && break; sleep 0.1; done
 if [ -n "$wid" ] && [ -f "$F" ] && [ ! -s "$F" ]; then ok edit_creates_missing_file
 else fail edit_creates_missing_file "window '$wid', file: $(ls -l "$F" 2>&1)"; fi
 sleep 1.5
