@@ -58,7 +58,28 @@ xvfb_start() {
     for _ in $(seq 50); do xdotool getdisplaygeometry >/dev/null 2>&1 && break; sleep 0.1; done
 }
 xvfb_cleanup() {
-    [ -n "${VPID:-}" ] && kill "$VPID" 2>/dev/null
+    [ -n "${VPID:-}" ] && stop_pid "$VPID"
     [ -n "${XPID:-}" ] && kill "$XPID" 2>/dev/null
     rm -rf "$TMP"
+}
+
+# stop_pid PID: SIGTERM, then SIGKILL if it is still there 3 s later (a
+# viewer stuck before its event loop never reads the quit SIGTERM posts).
+stop_pid() {
+    kill "$1" 2>/dev/null || return 0
+    for _ in $(seq 30); do kill -0 "$1" 2>/dev/null || return 0; sleep 0.1; done
+    kill -KILL "$1" 2>/dev/null
+}
+
+# stuck_report PID: where a process that should have shown a window is
+# (its threads' stacks when gdb is there, their kernel wait channels
+# otherwise) and which windows the X server has, for a failure's message.
+stuck_report() {
+    echo "process $1: $(ps -o stat=,etime=,time= -p "$1" 2>/dev/null || echo gone)"
+    if command -v gdb >/dev/null; then
+        timeout 20 gdb -batch -p "$1" -ex 'thread apply all bt 12' 2>/dev/null | grep -E '^(Thread|#)' | head -60
+    else
+        for t in /proc/"$1"/task/*; do echo "task ${t##*/}: $(cat "$t/wchan" 2>/dev/null) $(cut -d' ' -f3 "$t/stat" 2>/dev/null)"; done
+    fi
+    xwininfo -root -tree 2>&1 | head -20
 }

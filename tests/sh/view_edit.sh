@@ -59,7 +59,7 @@ VPID=$!
 wid=
 for i in $(seq 300); do wid=$(pdtview_window 'pdtview'); [ -n "$wid" ] && break; sleep 0.1; done
 if [ -n "$wid" ] && [ -f "$F" ] && [ ! -s "$F" ]; then ok edit_creates_missing_file
-else fail edit_creates_missing_file "window '$wid', file: $(ls -l "$F" 2>&1)"; fi
+else fail edit_creates_missing_file "window '$wid', file: $(ls -l "$F" 2>&1); $(stuck_report "$VPID"; cat "$TMP/err.log")"; fi
 sleep 1.5
 npts() { grep -cE '^-?[0-9]' "$F" 2>/dev/null || echo 0; }
 # wait until the file has $1 points
