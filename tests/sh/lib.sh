@@ -77,7 +77,8 @@ stop_pid() {
 stuck_report() {
     echo "process $1: $(ps -o stat=,etime=,time= -p "$1" 2>/dev/null || echo gone)"
     if command -v gdb >/dev/null; then
-        timeout 20 gdb -batch -p "$1" -ex 'thread apply all bt 12' 2>/dev/null | grep -E '^(Thread|#)' | head -60
+        timeout 20 gdb -batch -p "$1" -ex 'thread 1' -ex 'bt 30' -ex 'info threads' 2>/dev/null |
+            grep -E '^(\[Switching|#|[ *] +[0-9])' | head -60
     else
         for t in /proc/"$1"/task/*; do echo "task ${t##*/}: $(cat "$t/wchan" 2>/dev/null) $(cut -d' ' -f3 "$t/stat" 2>/dev/null)"; done
     fi

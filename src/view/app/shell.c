@@ -840,6 +840,7 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
         fprintf(stderr, "pdtview: renderer: %s\n", SDL_GetError());
         return shell_quit(&sh, 1);
     }
+    SDL_ShowWindow(sh.win); /* (after the renderer, which may make the window again) */
     pdt_window_settle(sh.win, o->fullscreen, &sh.saved);
     SDL_StartTextInput();
     sh.last = SDL_GetPerformanceCounter();

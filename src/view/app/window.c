@@ -57,7 +57,7 @@ SDL_Window *pdt_window_open(const char *title, int w, int h, pdt_window_saved *s
     if (h > U.h) h = U.h;
     memset(sv, 0, sizeof *sv);
     SDL_Window *win = SDL_CreateWindow(title, U.x + (U.w - w) / 2, U.y + (U.h - h) / 2, w, h,
-                                       SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI);
+                                       SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI | SDL_WINDOW_HIDDEN);
     return win;
 }
 

@@ -12,8 +12,10 @@ typedef struct pdt_window_saved {
 } pdt_window_saved;
 
 /* A resizable window of w x h logical pixels on the first display, never
- * larger than its usable area (the screen less the panels).  NULL on
- * failure (SDL_GetError says why). */
+ * larger than its usable area (the screen less the panels), hidden: shown
+ * (SDL_ShowWindow) once it has its renderer, so that it is not mapped, then
+ * made again with OpenGL, then mapped again.  NULL on failure (SDL_GetError
+ * says why). */
 SDL_Window *pdt_window_open(const char *title, int w, int h, pdt_window_saved *sv);
 
 /* Once the window has its renderer (which may make SDL recreate it): wait
