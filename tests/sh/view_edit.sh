@@ -49,15 +49,38 @@ same_events live_1_rank_records_what_pdt_triangulate_records "$TMP/one" "$TMP/li
 "$V" --edit "$TMP/c300.txt" --hull --ranks 4 --write-run "$TMP/live-hull" --quiet
 same_events live_hull_records_what_pdt_hull_records "$TMP/hull" "$TMP/live-hull" 1
 
+# no display: a message and exit 1, not a viewer running unseen (SDL's
+# offscreen driver)
+rc=0; env -u WAYLAND_DISPLAY DISPLAY=:1999 timeout 60 "$V" --edit "$TMP/nodisplay.txt" 2>"$TMP/nod.err" || rc=$?
+if [ "$rc" -eq 1 ] && grep -q 'cannot open a window.*DISPLAY=:1999' "$TMP/nod.err"; then ok no_display_is_an_error
+else fail no_display_is_an_error "exit $rc: $(cat "$TMP/nod.err")"; fi
+
 W=900; H=600
 xvfb_start ${W}x${H}
 trap xvfb_cleanup EXIT
 
 F=$TMP/mine.txt
-"$V" --edit "$F" --size ${W}x${H} --screenshot "$TMP/edit.png" >"$TMP/out.log" 2>"$TMP/err.log" &
-VPID=$!
-wid=
-for i in $(seq 300); do wid=$(pdtview_window 'pdtview'); [ -n "$wid" ] && break; sleep 0.1; done
+# start_editor: the editor on $F and its window's id in wid (empty if none
+# came).  A viewer that finds no display (it exits saying so) is started
+# once more: the X server's answer, not the editor, is what failed.
+start_editor() {
+    local try
+    for try in 1 2; do
+        "$V" --edit "$F" --size ${W}x${H} --screenshot "$TMP/edit.png" >"$TMP/out.log" 2>"$TMP/err.log" &
+        VPID=$!
+        wid=
+        for i in $(seq 300); do
+            wid=$(pdtview_window 'pdtview'); [ -n "$wid" ] && return 0
+            kill -0 "$VPID" 2>/dev/null || break
+            sleep 0.1
+        done
+        grep -q 'no display answers' "$TMP/err.log" || return 1
+        echo "# note: the editor found no display (try $try): $(cat "$TMP/err.log"; cat "$TMP/xvfb.log"; ls -la /tmp/.X11-unix)"
+        sleep 1
+    done
+    return 1
+}
+start_editor
 if [ -n "$wid" ] && [ -f "$F" ] && [ ! -s "$F" ]; then ok edit_creates_missing_file
 else fail edit_creates_missing_file "window '$wid', file: $(ls -l "$F" 2>&1); $(stuck_report "$VPID"; cat "$TMP/err.log")"; fi
 sleep 1.5

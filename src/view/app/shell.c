@@ -802,6 +802,28 @@ static int shell_quit(shell *sh, int rc)
     return rc;
 }
 
+/* SDL's video on a display a window can be seen on: 1, or 0 and a message.
+ * When no X or Wayland server answers, SDL falls back to drivers that draw
+ * nowhere (offscreen, dummy), and a viewer would run unseen; those only
+ * when $SDL_VIDEODRIVER names them. */
+static int video_init(void)
+{
+    SDL_SetHint(SDL_HINT_VIDEO_X11_NET_WM_BYPASS_COMPOSITOR, "0");
+    if (SDL_Init(SDL_INIT_VIDEO) != 0) {
+        fprintf(stderr, "pdtview: SDL_Init: %s\n", SDL_GetError());
+        return 0;
+    }
+    const char *drv = SDL_GetCurrentVideoDriver(), *want = getenv("SDL_VIDEODRIVER");
+    int unseen = drv && (!strcmp(drv, "offscreen") || !strcmp(drv, "dummy"));
+    if (unseen && !(want && strstr(want, drv))) {
+        const char *d = getenv("DISPLAY"), *w = getenv("WAYLAND_DISPLAY");
+        fprintf(stderr, "pdtview: cannot open a window: no display answers (DISPLAY=%s, WAYLAND_DISPLAY=%s);"
+                        " --headless draws to files without one\n", d ? d : "(unset)", w ? w : "(unset)");
+        return 0;
+    }
+    return 1;
+}
+
 int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_shell_opts *o)
 {
     shell sh;
@@ -821,11 +843,7 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
     v->hidden = sh.hidden;
     v->texts = o->layout_report ? pdt_text_log_new() : NULL;
     pdt_cluster_take(&sh.cl, r, v); /* made again when a hook's replay changes */
-    SDL_SetHint(SDL_HINT_VIDEO_X11_NET_WM_BYPASS_COMPOSITOR, "0");
-    if (SDL_Init(SDL_INIT_VIDEO) != 0) {
-        fprintf(stderr, "pdtview: SDL_Init: %s\n", SDL_GetError());
-        return shell_quit(&sh, 1);
-    }
+    if (!video_init()) return shell_quit(&sh, 1);
     char title[512];
     snprintf(title, sizeof title, "pdtview — %s", o->title ? o->title : "");
     sh.fullscreen = o->fullscreen;
