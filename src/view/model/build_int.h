@@ -4,6 +4,7 @@
 #ifndef PDT_VIEW_BUILD_INT_H
 #define PDT_VIEW_BUILD_INT_H
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -238,6 +239,8 @@ typedef struct builder {
     size_t npw;
     spill_log plog;
     uint8_t *lifted_any;  /* per rank: it lifted a point outside a merge */
+    pthread_t pt_th;      /* the points' pass, beside the join (pdt_rp_points_start) */
+    int pt_started, pt_ok;
     _Atomic uint64_t held, peak;  /* streamed: working memory (bytes) */
 } builder;
 
@@ -344,7 +347,8 @@ uint64_t pdt_rp_group_work(const pdt_replay *r, uint64_t budget);
 int pdt_rp_pt_note(builder *b, uint32_t p, uint32_t ev, uint32_t rank, uint32_t what);
 void pdt_rp_box_add(pdt_replay *r, uint32_t rank, pdt_point p);
 int pdt_rp_graham_tables(pdt_replay *r);
-int pdt_rp_points_pass(builder *b, const uint8_t *lifted_any);
+int pdt_rp_points_start(builder *b);
+int pdt_rp_points_finish(builder *b);
 
 /* handlers.c */
 int pdt_rp_index_event(builder *b, uint32_t i, const pdt_rec *rec);

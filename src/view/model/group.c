@@ -417,11 +417,13 @@ int pdt_rp_tri_histories(builder *b)
     if (!pl) return pdt_rp_tri_ids(b);
     pl->sdrop(pl->ctx, PDT_SCR_SPILL);
     if ((r->tris_at = pl->reserve(pl->ctx, (uint64_t)ntri * sizeof *r->tris)) == UINT64_MAX ||
-        !pdt_rp_tri_number(b) || !pdt_rp_tri_join(b))
+        !pdt_rp_tri_number(b) ||
+        !pdt_rp_points_start(b) || /* (beside the join and the tables: one core each) */
+        !pdt_rp_tri_join(b))
         return 0;
     pl->sdrop(pl->ctx, PDT_SCR_TRIS);
     pl->sdrop(pl->ctx, PDT_SCR_IDS);
     if (!pdt_rp_ev_tables(b)) return 0;
     pl->sdrop(pl->ctx, PDT_SCR_TRIEV);
-    return 1;
+    return pdt_rp_points_finish(b);
 }

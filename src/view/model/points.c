@@ -69,7 +69,9 @@ int pdt_rp_graham_tables(pdt_replay *r)
 /* After pass 1 (streamed): each window of points' records (pt_rec) gives
  * its first lifts (to lift_at of the place) and its share of the ranks'
  * boxes (lifted_any: the ranks that lifted a point outside a merge). */
-int pdt_rp_points_pass(builder *b, const uint8_t *lifted_any)
+#define PT_AHEAD 16 /* records ahead whose point is fetched (points_pass) */
+
+static int points_pass(builder *b, const uint8_t *lifted_any)
 {
     pdt_replay *r = b->r;
     const pdt_replay_place *pl = b->pl;
@@ -91,6 +93,9 @@ int pdt_rp_points_pass(builder *b, const uint8_t *lifted_any)
             ok = pl->sget(pl->ctx, PDT_SCR_POINTS, sorted[c].off, rec, sorted[c].n * sizeof *rec);
             for (size_t j = 0; ok && j < sorted[c].n; j++) {
                 const pt_rec *t = &rec[j];
+                if (j + PT_AHEAD < sorted[c].n && rec[j + PT_AHEAD].what != PT_LIFT) /* (random
+                                                  * places in a table of 10^8 bytes) */
+                    __builtin_prefetch(&r->pts[rec[j + PT_AHEAD].p]);
                 if (t->what != PT_PUSH && t->ev < lift[t->p - p0]) lift[t->p - p0] = t->ev;
                 if (t->what == PT_LIFT) continue;
                 size_t k = t->what == PT_PUSH ? t->rank : q1 + t->rank;
@@ -122,4 +127,40 @@ int pdt_rp_points_pass(builder *b, const uint8_t *lifted_any)
     free(hi);
     free(has);
     return ok;
+}
+
+static void *points_thread(void *arg)
+{
+    builder *b = arg;
+    b->pt_ok = points_pass(b, b->lifted_any);
+    return NULL;
+}
+
+/* After the numbering (streamed): the points' pass started on a thread of
+ * its own, beside the join and the per-event tables, which take one core (or
+ * here, when no thread can be made).  Its results
+ * (the lift table at lift_at, the ranks' boxes) are read by no one before
+ * pdt_rp_points_finish.  1, or 0 when it failed here. */
+int pdt_rp_points_start(builder *b)
+{
+    b->pt_ok = 0;
+    b->pt_started = pthread_create(&b->pt_th, NULL, points_thread, b) == 0;
+    if (!b->pt_started) points_thread(b);
+    return b->pt_started || b->pt_ok;
+}
+
+/* Wait for the points' pass (if it runs; also on a failed build's way out),
+ * then drop its scratch and buffers.  1 when it succeeded. */
+int pdt_rp_points_finish(builder *b)
+{
+    if (b->pt_started) pthread_join(b->pt_th, NULL);
+    b->pt_started = 0;
+    if (!b->pt_ok) return 0;
+    const pdt_replay_place *pl = b->pl;
+    pl->sdrop(pl->ctx, PDT_SCR_POINTS);
+    if (pl->points_read) pl->points_read(pl->ctx);
+    pdt_rp_bfree(b, b->pbuf, (b->npw ? b->npw : 1) * PBUF * sizeof *b->pbuf);
+    b->pbuf = NULL;
+    b->pt_ok = 0;
+    return 1;
 }

@@ -272,8 +272,9 @@ static int first_pass(builder *b, pdt_err *err)
 }
 
 /* After pass 1 (streamed): the stream's end (it finishes its part: pl->src
- * is ready), the last window of the per-event tables, and the points' first
- * lifts and the ranks' boxes (pdt_rp_points_pass). */
+ * is ready), the last window of the per-event tables, and the place of the
+ * points' first lifts (made with the ranks' boxes after the numbering,
+ * pdt_rp_points_start). */
 static int stream_end(builder *b, pdt_err *err)
 {
     pdt_replay *r = b->r;
@@ -292,14 +293,7 @@ static int stream_end(builder *b, pdt_err *err)
     pdt_rp_bfree(b, b->wkind, EVW);
     b->wobj = NULL;
     b->wkind = NULL;
-    if ((r->lift_at = pl->reserve(pl->ctx, (uint64_t)r->n * sizeof(uint32_t))) == UINT64_MAX ||
-        !pdt_rp_points_pass(b, b->lifted_any))
-        return 0;
-    pl->sdrop(pl->ctx, PDT_SCR_POINTS);
-    if (pl->points_read) pl->points_read(pl->ctx);
-    pdt_rp_bfree(b, b->pbuf, (b->npw ? b->npw : 1) * PBUF * sizeof *b->pbuf);
-    b->pbuf = NULL;
-    return 1;
+    return (r->lift_at = pl->reserve(pl->ctx, (uint64_t)r->n * sizeof(uint32_t))) != UINT64_MAX;
 }
 
 /* The phases that open a cluster of overlapping same phases (any rank). */
@@ -348,6 +342,7 @@ static int slot_index(pdt_replay *r)
 static pdt_status builder_close(builder *b, int ok, pdt_err *err)
 {
     pdt_replay *r = b->r;
+    pdt_rp_points_finish(b); /* (a failed build's: it may still run) */
     free(b->cur);
     free(b->lastst);
     free(b->lifted_any);
@@ -385,10 +380,10 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
 {
     builder b;
     int ok = builder_open(&b, r, pl) &&     /* the buckets planned, the tables sized */
-             first_pass(&b, err) &&          /* every event once */
-             (!pl || stream_end(&b, err)) && /* the points' first lifts, the ranks' boxes */
+             first_pass(&b, err) &&         /* every event once */
+             (!pl || stream_end(&b, err)) && /* the stream's end */
              phase_clusters(r) &&
-             pdt_rp_tri_histories(&b) &&            /* grouped by triangle, numbered */
+             pdt_rp_tri_histories(&b) &&          /* grouped by triangle, numbered */
              slot_index(r);
     return builder_close(&b, ok, err);
 }
