@@ -216,6 +216,9 @@ typedef struct builder {
     size_t *fine_off;     /* per fine bucket: its first history entry; nfine + 1 */
     const pdt_replay_place *pl;  /* streamed: the place, and per fine bucket a buffer */
     tri_xrec *fbuf;       /* nfine * fbuf_recs records */
+    tri_xrec **fcur;      /* streamed: per fine bucket, its buffer now (fbuf's, or a spare) */
+    struct spill_writer *sw;  /* streamed: pass 1's spill writer (spillw.c), or NULL */
+    int sw_live;          /* ... and its thread runs */
     tri_rec *spill;       /* not streamed: the triangle events by fine bucket */
     /* streamed: the spill is written a buffer (a chunk) at a time, where it
      * ends; chunk k of fine bucket f is chunk[ck_start[f] + k] after pass 1 */
@@ -342,6 +345,13 @@ int pdt_rp_tput(builder *b, void *arr, uint64_t base, size_t at, const void *p, 
 int pdt_rp_fine_flush(builder *b, size_t f);
 int pdt_rp_chunks_by_bucket(builder *b);
 uint64_t pdt_rp_group_work(const pdt_replay *r, uint64_t budget);
+
+/* spillw.c */
+typedef struct spill_writer spill_writer;
+int pdt_rp_sw_start(builder *b);
+void pdt_rp_sw_queue(builder *b, size_t f, size_t n);
+void pdt_rp_sw_stop(builder *b);
+void pdt_rp_sw_free(builder *b);
 
 /* points.c */
 int pdt_rp_pt_note(builder *b, uint32_t p, uint32_t ev, uint32_t rank, uint32_t what);

@@ -407,6 +407,7 @@ int pdt_rp_tri_histories(builder *b)
         r->nhist = b->fine_off[b->nfine];
         if ((r->hist_at = pl->reserve(pl->ctx, (uint64_t)r->nhist * sizeof *r->hist)) == UINT64_MAX)
             return 0;
+        pdt_rp_sw_free(b);
         pdt_rp_bfree(b, b->fbuf, b->nfine * b->fbuf_recs * sizeof *b->fbuf);
         b->fbuf = NULL;
     }

@@ -55,12 +55,16 @@ int pdt_rp_tput(builder *b, void *arr, uint64_t base, size_t at, const void *p, 
 }
 
 /* Flush the buffer of fine bucket f (streamed) to the end of the spill, a
- * chunk of it. */
+ * chunk of it (in pass 1, by the spill's writer). */
 int pdt_rp_fine_flush(builder *b, size_t f)
 {
     size_t k = b->fbn[f];
     b->fbn[f] = 0;
-    return pdt_rp_spill_put(b, PDT_SCR_SPILL, &b->tlog, b->fbuf + f * b->fbuf_recs, k, sizeof(tri_xrec), f);
+    if (b->sw_live) {
+        if (k) pdt_rp_sw_queue(b, f, k);
+        return !b->failed;
+    }
+    return pdt_rp_spill_put(b, PDT_SCR_SPILL, &b->tlog, b->fcur[f], k, sizeof(tri_xrec), f);
 }
 
 /* Streamed pass 1: have events i .. i + PREFETCH_AHEAD (or to the end) in
@@ -210,6 +214,7 @@ static int builder_open(builder *b, pdt_replay *r, const pdt_replay_place *pl)
         if (!b->fbuf || !b->fbn || !b->win || !b->wobj || !b->wkind || !b->tcount || !b->pbuf || !b->pbn)
             return 0;
         pdt_big_advise(b->fbuf, b->nfine * b->fbuf_recs * sizeof *b->fbuf);
+        if (!pdt_rp_sw_start(b)) return 0;
     } else {
         b->wobj = r->ev_obj;
         b->wkind = r->ev_kind;
@@ -279,6 +284,7 @@ static int stream_end(builder *b, pdt_err *err)
 {
     pdt_replay *r = b->r;
     const pdt_replay_place *pl = b->pl;
+    pdt_rp_sw_stop(b); /* (the spill complete) */
     pdt_rec extra;
     int more = pl->next(pl->ctx, &extra, 1, err);
     if (more != 0) {
@@ -343,6 +349,7 @@ static pdt_status builder_close(builder *b, int ok, pdt_err *err)
 {
     pdt_replay *r = b->r;
     pdt_rp_points_finish(b); /* (a failed build's: it may still run) */
+    pdt_rp_sw_free(b);
     free(b->cur);
     free(b->lastst);
     free(b->lifted_any);
