@@ -387,10 +387,10 @@ static pdt_status build(pdt_replay *r, const pdt_replay_place *pl, pdt_err *err)
 {
     builder b;
     int ok = builder_open(&b, r, pl) &&     /* the buckets planned, the tables sized */
-             first_pass(&b, err) &&         /* every event once */
-             (!pl || stream_end(&b, err)) && /* the stream's end */
+             first_pass(&b, err) &&          /* every event once */
+             (!pl || stream_end(&b, err)) && /* the stream's end, the spill complete */
              phase_clusters(r) &&
-             pdt_rp_tri_histories(&b) &&          /* grouped by triangle, numbered */
+             pdt_rp_tri_histories(&b) &&     /* grouped by triangle, numbered; the points' pass */
              slot_index(r);
     return builder_close(&b, ok, err);
 }
