@@ -47,6 +47,9 @@ int pdt_app_edit(const opts *o)
     pdt_live_opts lo = {o->hull, o->ranks ? o->ranks : 1, 1, 0};
     pdt_editor *ed;
     pdt_err err = {0};
+    struct stat sb;
+    if (!o->write_run && stat(o->edit, &sb) != 0 && !pdt_shell_video_init())
+        return 1; /* (a missing file is made only for a window that opens) */
     if (pdt_editor_open(o->edit, &lo, &ed, &err) != PDT_OK) {
         fprintf(stderr, "pdtview: %s\n", err.msg);
         return PDT_EXIT_USAGE;

@@ -802,12 +802,12 @@ static int shell_quit(shell *sh, int rc)
     return rc;
 }
 
-/* SDL's video on a display a window can be seen on: 1, or 0 and a message.
- * When no X or Wayland server answers, SDL falls back to drivers that draw
- * nowhere (offscreen, dummy), and a viewer would run unseen; those only
+/* When no X or Wayland server answers, SDL falls back to drivers that draw
+ * nowhere (offscreen, dummy), and a viewer would run unseen: those only
  * when $SDL_VIDEODRIVER names them. */
-static int video_init(void)
+int pdt_shell_video_init(void)
 {
+    if (SDL_WasInit(SDL_INIT_VIDEO)) return 1;
     SDL_SetHint(SDL_HINT_VIDEO_X11_NET_WM_BYPASS_COMPOSITOR, "0");
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
         fprintf(stderr, "pdtview: SDL_Init: %s\n", SDL_GetError());
@@ -843,7 +843,7 @@ int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_she
     v->hidden = sh.hidden;
     v->texts = o->layout_report ? pdt_text_log_new() : NULL;
     pdt_cluster_take(&sh.cl, r, v); /* made again when a hook's replay changes */
-    if (!video_init()) return shell_quit(&sh, 1);
+    if (!pdt_shell_video_init()) return shell_quit(&sh, 1);
     char title[512];
     snprintf(title, sizeof title, "pdtview — %s", o->title ? o->title : "");
     sh.fullscreen = o->fullscreen;

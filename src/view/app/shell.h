@@ -50,4 +50,9 @@ typedef struct pdt_shell_opts {
  * (message on stderr: the shell is part of the program, not the library). */
 int pdt_shell_run(const pdt_replay *r, pdt_rstate *s, pdt_view *v, const pdt_shell_opts *o);
 
+/* SDL's video on a display a window can be seen on (pdt_shell_run's first
+ * step; callers that must not touch a file before the window can open call
+ * it first): 1, or 0 with a message on stderr naming the display tried. */
+int pdt_shell_video_init(void);
+
 #endif
