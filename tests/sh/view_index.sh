@@ -246,6 +246,20 @@ same_pictures "$R2" 32K 4000 20000 end && ok level2_paged_tables_same_pictures |
 case "$("$V" "$R2" --check --mem 32K)" in *", 0 differ"*) ok level2_paged_tables_check ;;
     *) fail level2_paged_tables_check "$("$V" "$R2" --check --mem 32K)" ;; esac
 
+# the kept index is the same bytes at every build: no padding or other
+# unset bytes go into it (the 3-rank run's messages and hulls had some)
+same_index() { # RUN
+    rm -f "$1/.pdtview-index"
+    "$V" "$1" --counts --end --index on >/dev/null && cp "$1/.pdtview-index" "$TMP/ix.a" &&
+        rm -f "$1/.pdtview-index" && "$V" "$1" --counts --end --index on >/dev/null &&
+        cmp -s "$TMP/ix.a" "$1/.pdtview-index"
+}
+for run in "$R3" "$RH" "$R2"; do
+    [ -d "$run" ] || continue
+    if same_index "$run"; then ok "index_same_bytes_$(basename "$run")"
+    else fail "index_same_bytes_$(basename "$run")" "$(cmp "$TMP/ix.a" "$run/.pdtview-index" 2>&1)"; fi
+done
+
 # the build holds no table per event or per point (they go to the index
 # and to scratch files a window at a time): its working memory, as it
 # counts it, stays within --mem and does not grow with the run (a run four

@@ -118,6 +118,7 @@ typedef struct pdt_rmerge {
 /* A message: SEND on src and the matching RECV on dst. */
 typedef struct pdt_rmsg {
     uint32_t src, dst, tag;
+    uint32_t pad;               /* 0 (the table is kept in the index as it is) */
     uint64_t bytes;
     uint32_t send_ev, recv_ev;  /* UINT32_MAX when that side is missing */
     uint64_t send_t, recv_t;    /* their events' times (0 when that side is missing) */
@@ -130,6 +131,7 @@ typedef struct pdt_rhull {
     int32_t top2;       /* upper chain's top for a monotone chain, else -1 */
     uint32_t count;     /* hull vertices as reported */
     uint8_t degenerate;
+    uint8_t pad[3];     /* 0 (the table is kept in the index as it is) */
 } pdt_rhull;
 
 typedef struct pdt_replay pdt_replay;

@@ -133,7 +133,7 @@ static int ix_hull(IX_ARGS)
     const int32_t *cur = IX_CUR;
     if (!pdt_rp_tab_grow(r, (void **)&r->hulls, &r->cap_hull, r->nhull + 1, sizeof *r->hulls)) return 0;
     int st = b->lastst[rec->rank];
-    pdt_rhull h = {rec->rank, i, -1, -1, e->a, (uint8_t)(e->b != 0)};
+    pdt_rhull h = {rec->rank, i, -1, -1, e->a, (uint8_t)(e->b != 0), {0, 0, 0}};
     if (st == PDT_STACK_LOWER || st == PDT_STACK_UPPER) {
         h.top = cur[PDT_SLOT_STACK0 + PDT_STACK_LOWER];
         h.top2 = cur[PDT_SLOT_STACK0 + PDT_STACK_UPPER];
@@ -232,7 +232,7 @@ static int ix_msg(IX_ARGS)
     int32_t id;
     if (!pdt_rp_km_get(&b->msg_map, hi, lo, &id) || (send ? r->msgs[id].send_ev : r->msgs[id].recv_ev) != NONE32) {
         if (!pdt_rp_tab_grow(r, (void **)&r->msgs, &r->cap_msg, r->nmsg + 1, sizeof *r->msgs)) return 0;
-        r->msgs[r->nmsg] = (pdt_rmsg){src, dst, e->sub, pdt_event_bytes(e), NONE32, NONE32, 0, 0};
+        r->msgs[r->nmsg] = (pdt_rmsg){src, dst, e->sub, 0, pdt_event_bytes(e), NONE32, NONE32, 0, 0};
         id = (int32_t)r->nmsg++;
         if (!pdt_rp_km_put(&b->msg_map, hi, lo, id, r->tab_limit)) return 0;
     }
