@@ -433,8 +433,6 @@ static int open_spill(const char *path)
     return fd;
 }
 
-/* Write the tables of r after the records and the streamed ones (at pc->off),
- * then the header. */
 /* write_checkpoints in a thread of its own (stepping through the run takes
  * a core while the tables are written). */
 typedef struct ck_job {
@@ -487,36 +485,10 @@ static uint64_t place_tables(pdt_replay *r, ihdr *h, const placer *pc, size_t el
     return (off + 63) & ~(uint64_t)63;
 }
 
-/* Write the tables held in memory (ptr) while a second thread writes the
- * checkpoints at off (their checksums into *ck_crc).  The points are read
- * in place from the run: a chunk at a time, their pages given back behind,
- * while the checkpoints' state is held.  1, or 0 (errno). */
-static int write_sections(pdt_replay *r, int fd, const ihdr *h, const placer *pc, void **ptr[NSEC],
-                          uint64_t off, crcacc *ck_crc)
-{
-    ck_job ck = {r, fd, 0, off, {0}};
-    pthread_t th;
-    int threaded = pthread_create(&th, NULL, ck_worker, &ck) == 0;
-    int wrote = 1;
-    for (int i = 0; wrote && i < NSEC; i++) {
-        uint64_t at;
-        if (i == S_SEGS || i == S_CKPT || streamed_sec(r, i, &at)) continue;
-        for (uint64_t o = 0; wrote && o < h->sec[i].bytes; o += CHUNK_BYTES) {
-            uint64_t k = h->sec[i].bytes - o < CHUNK_BYTES ? h->sec[i].bytes - o : CHUNK_BYTES;
-            wrote = write_all(fd, (const char *)*ptr[i] + o, (size_t)k, h->sec[i].off + o);
-            if (i == S_POINTS) pdt_run_release_points(pc->run);
-            pdt_replay_tab_release(r, (const char *)*ptr[i] + o, (size_t)k);  /* (paged) */
-        }
-    }
-    if (threaded) pthread_join(th, NULL);
-    else ck_worker(&ck);
-    *ck_crc = ck.crc;
-    return wrote && ck.ok;
-}
-
 /* The chunk checksums (*tab, *n of them): of the tables in memory from
- * memory, of the records and checkpoints as they were written, of the
- * streamed triangles and histories read back (pread, by up to four
+ * memory, of the records and checkpoints as they were written (ck_crc;
+ * NULL: the checkpoints are not written yet, their section is empty), of
+ * the streamed triangles and histories read back (pread, by up to four
  * threads). */
 static pdt_status chunk_table(pdt_replay *r, int fd, const ihdr *h, const placer *pc,
                               void **ptr[NSEC], const evcopy *ec, const crcacc *ck_crc,
@@ -533,7 +505,7 @@ static pdt_status chunk_table(pdt_replay *r, int fd, const ihdr *h, const placer
         if (i == S_SEGS) {
             have = pdt_ix_crc_done(&ec->segs_crc, h->sec[i].bytes, tab + first[i]);
         } else if (i == S_CKPT) {
-            have = pdt_ix_crc_done(ck_crc, h->sec[i].bytes, tab + first[i]);
+            have = !ck_crc || pdt_ix_crc_done(ck_crc, h->sec[i].bytes, tab + first[i]);
         } else if (streamed_sec(r, i, &at)) {
             memset(todo + first[i], 1, nc);
         } else {
@@ -591,6 +563,45 @@ static pdt_status write_header(pdt_replay *r, int fd, ihdr *h, uint64_t ident, u
     return PDT_OK;
 }
 
+/* Write the tables held in memory (ptr) and make the chunk checksums of
+ * every section but the checkpoints' (*tab, *n), while a second thread
+ * writes the checkpoints at off (their checksums into *ck_crc: stepping
+ * through the run takes a core).  The points are read in place from the
+ * run: a chunk at a time, their pages given back behind, while the
+ * checkpoints' state is held. */
+static pdt_status write_sections(pdt_replay *r, int fd, const ihdr *h, const placer *pc,
+                                 void **ptr[NSEC], uint64_t off, const evcopy *ec,
+                                 crcacc *ck_crc, uint32_t **tab, uint64_t *n, pdt_err *err)
+{
+    ck_job ck = {r, fd, 0, off, {0}};
+    pthread_t th;
+    int threaded = pthread_create(&th, NULL, ck_worker, &ck) == 0;
+    int wrote = 1;
+    for (int i = 0; wrote && i < NSEC; i++) {
+        uint64_t at;
+        if (i == S_SEGS || i == S_CKPT || streamed_sec(r, i, &at)) continue;
+        for (uint64_t o = 0; wrote && o < h->sec[i].bytes; o += CHUNK_BYTES) {
+            uint64_t k = h->sec[i].bytes - o < CHUNK_BYTES ? h->sec[i].bytes - o : CHUNK_BYTES;
+            wrote = write_all(fd, (const char *)*ptr[i] + o, (size_t)k, h->sec[i].off + o);
+            if (i == S_POINTS) pdt_run_release_points(pc->run);
+            pdt_replay_tab_release(r, (const char *)*ptr[i] + o, (size_t)k);  /* (paged) */
+        }
+    }
+    int werr = wrote ? 0 : errno;
+    pdt_status st = wrote ? chunk_table(r, fd, h, pc, ptr, ec, NULL, tab, n, err) : PDT_OK;
+    if (threaded) pthread_join(th, NULL);
+    else ck_worker(&ck);
+    *ck_crc = ck.crc;
+    if (!wrote || !ck.ok) {
+        free(*tab);
+        *tab = NULL;
+        return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(werr ? werr : errno));
+    }
+    return st;
+}
+
+/* Write the tables of r after the records and the streamed ones (at pc->off),
+ * then the chunk table and the header. */
 static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, const placer *pc,
                                evcopy *ec, pdt_err *err)
 {
@@ -599,19 +610,26 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     uint64_t count[NSEC];
     pdt_ix_sections(r, ptr, elem, count);
     uint64_t off = place_tables(r, h, pc, elem, count);
-    crcacc ck_crc;
-    if (!write_sections(r, fd, h, pc, ptr, off, &ck_crc)) {
-        free(ck_crc.crc);
-        return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
-    }
+    crcacc ck_crc = {0};
+    uint32_t *tab = NULL;
+    uint64_t n = 0;
+    pdt_status st = write_sections(r, fd, h, pc, ptr, off, ec, &ck_crc, &tab, &n, err);
     h->count[S_CKPT] = r->nick ? r->ick_off[r->nick] : 0;
     h->sec[S_CKPT] = (isec){off, h->count[S_CKPT], 0, 0};
     off += h->count[S_CKPT];
-    uint32_t *tab = NULL;
-    uint64_t n = 0;
-    pdt_status st = chunk_table(r, fd, h, pc, ptr, ec, &ck_crc, &tab, &n, err);
+    if (st == PDT_OK) { /* (the checkpoints' chunks last: theirs is the last section) */
+        uint64_t n0 = n;
+        n += chunks_of(h->sec[S_CKPT].bytes);
+        uint32_t *grown = realloc(tab, n ? n * sizeof *tab : 1);
+        if (grown) tab = grown;
+        if (!grown || !pdt_ix_crc_done(&ck_crc, h->sec[S_CKPT].bytes, tab + n0))
+            st = pdt_err_set(err, PDT_ERR_NOMEM, "out of memory for the index's checksums");
+    }
     free(ck_crc.crc);
-    if (st != PDT_OK) return st;
+    if (st != PDT_OK) {
+        free(tab);
+        return st;
+    }
     off = (off + 63) & ~(uint64_t)63;
     h->ctab = (isec){off, n * sizeof *tab, pdt_crc32c(0, tab, (size_t)(n * sizeof *tab)), 0};
     int wrote = write_all(fd, tab, (size_t)(n * sizeof *tab), off);
@@ -620,7 +638,6 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     return write_header(r, fd, h, ident, off + h->ctab.bytes, err);
 }
 
-/* Build the index of run at `path` (temporary file + rename). */
 /* The events of the run's ranks. */
 static size_t run_events(pdt_run *run, int nranks)
 {

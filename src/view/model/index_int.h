@@ -68,6 +68,8 @@ enum {
     S_BOXHI, S_HASBOX, S_POINTS, S_WARN, S_EVKIND, S_BLKTAB, S_RANKBLK, S_CKPT, NSEC
 };
 
+_Static_assert(S_CKPT == NSEC - 1, "the checkpoints are the last section (write_tables)");
+
 typedef struct isec {
     uint64_t off, bytes;
     uint32_t crc, pad;
