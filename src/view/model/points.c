@@ -144,9 +144,13 @@ static void *points_thread(void *arg)
 int pdt_rp_points_start(builder *b)
 {
     b->pt_ok = 0;
-    b->pt_started = pthread_create(&b->pt_th, NULL, points_thread, b) == 0;
-    if (!b->pt_started) points_thread(b);
-    return b->pt_started || b->pt_ok;
+    if (pthread_create(&b->pt_th, NULL, points_thread, b) == 0) { /* (pt_ok is the thread's now) */
+        b->pt_started = 1;
+        return 1;
+    }
+    b->pt_started = 0;
+    points_thread(b);
+    return b->pt_ok;
 }
 
 /* Wait for the points' pass (if it runs; also on a failed build's way out),
