@@ -66,11 +66,11 @@ int pdt_rp_graham_tables(pdt_replay *r)
     return 1;
 }
 
+#define PT_AHEAD 16 /* records ahead whose point is fetched (points_pass) */
+
 /* After pass 1 (streamed): each window of points' records (pt_rec) gives
  * its first lifts (to lift_at of the place) and its share of the ranks'
  * boxes (lifted_any: the ranks that lifted a point outside a merge). */
-#define PT_AHEAD 16 /* records ahead whose point is fetched (points_pass) */
-
 static int points_pass(builder *b, const uint8_t *lifted_any)
 {
     pdt_replay *r = b->r;
@@ -138,9 +138,9 @@ static void *points_thread(void *arg)
 
 /* After the numbering (streamed): the points' pass started on a thread of
  * its own, beside the join and the per-event tables, which take one core (or
- * here, when no thread can be made).  Its results
- * (the lift table at lift_at, the ranks' boxes) are read by no one before
- * pdt_rp_points_finish.  1, or 0 when it failed here. */
+ * run here, when no thread can be made).  Its results (the lift table at
+ * lift_at, the ranks' boxes) are read by no one before pdt_rp_points_finish.
+ * 1, or 0 when it ran here and failed. */
 int pdt_rp_points_start(builder *b)
 {
     b->pt_ok = 0;
