@@ -64,7 +64,7 @@ xvfb_cleanup() {
 }
 
 # stop_pid PID: SIGTERM, then SIGKILL if it is still there 3 s later (a
-# viewer stuck before its event loop never reads the quit SIGTERM posts).
+# viewer stuck in a call never reads the quit event SDL makes of SIGTERM).
 stop_pid() {
     kill "$1" 2>/dev/null || return 0
     for _ in $(seq 30); do kill -0 "$1" 2>/dev/null || return 0; sleep 0.1; done

@@ -123,6 +123,7 @@ if [ -s "$TMP/edit.png" ] && [ -s "$TMP/x11.png" ]; then ok edit_screenshots; el
 # which); clicks on 4 ranks; the file's live run is mpirun's
 G=$TMP/four.txt
 cp "$TMP/c300.txt" "$G"
+[ -n "${VPID:-}" ] && stop_pid "$VPID"  # (an editor that did not quit: not left behind)
 "$V" --edit "$G" --ranks 4 --size ${W}x${H} --screenshot "$TMP/four.png" >"$TMP/out4.log" 2>"$TMP/err4.log" &
 VPID=$!
 wid=
