@@ -281,6 +281,29 @@ else fail build_memory_bounded "working memory ${small:-?} KiB (10000 points), $
 RB=$TMP/runb40000
 same_pictures "$RB" 16M 123457 end && ok build_bounded_same_pictures || fail build_bounded_same_pictures
 
+# the build's scratch tables (src/view/model/scratch_int.h) held in memory
+# (half of the default budget takes them all), in files (no memory), or
+# split between the two (a 2 MiB share: the spill's first part in memory,
+# the rest in its file, the next tables in files until it is dropped):
+# the same index, and the working memory counts what memory held.  Only a
+# test build (the sanitizer's) reads $PDT_TEST_SCRATCH_MEM.
+scratch_build() { # POOL (bytes, or default): RB's index to $TMP/ixs.POOL; prints the working memory
+    rm -f "$RB/.pdtview-index"
+    if [ "$1" = default ]; then "$V" "$RB" --bench --index on
+    else PDT_TEST_SCRATCH_MEM=$1 "$V" "$RB" --bench --index on; fi |
+        sed -n 's/^index build: working memory \([0-9.]*\) MiB.*/\1/p'
+    cp "$RB/.pdtview-index" "$TMP/ixs.$1"
+}
+if [ "$(basename "$BIN")" = san ]; then
+    w0=$(scratch_build 0); w2=$(scratch_build 2097152); wd=$(scratch_build default)
+    if cmp -s "$TMP/ixs.0" "$TMP/ixs.2097152" && cmp -s "$TMP/ixs.0" "$TMP/ixs.default"
+    then ok scratch_in_memory_same_index
+    else fail scratch_in_memory_same_index "$(cmp "$TMP/ixs.0" "$TMP/ixs.2097152"; cmp "$TMP/ixs.0" "$TMP/ixs.default")"; fi
+    if awk -v a="$w0" -v b="$w2" -v c="$wd" 'BEGIN { exit !(a > 0 && b >= a + 1.9 && b <= a + 2.1 && c > b + 2) }'
+    then ok scratch_memory_counted
+    else fail scratch_memory_counted "working memory ${w0:-?} MiB (none), ${w2:-?} MiB (2 MiB), ${wd:-?} MiB (default)"; fi
+fi
+
 # the triangle events grouped in more buckets (what a run of more than
 # 10^9 events gets at the default budget, forced here): the same replay
 RS=$TMP/runb10000

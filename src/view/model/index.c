@@ -6,6 +6,8 @@
 #include "pdt/view/replay.h"
 #include "replay_int.h"
 #include "index_int.h"
+#include "scratch_int.h"
+#include "pdt/testhook.h"
 #include "pdt/bigmem.h"
 
 #include <dirent.h>
@@ -30,19 +32,6 @@ uint32_t pdt_ix_ihdr_crc(const ihdr *h)
 }
 
 /* ---- building ------------------------------------------------------------------ */
-
-static int write_all(int fd, const void *p, size_t len, uint64_t off)
-{
-    const char *b = p;
-    while (len) {
-        ssize_t w = pwrite(fd, b, len > ((size_t)1 << 30) ? (size_t)1 << 30 : len, (off_t)off);
-        if (w <= 0) return 0;
-        b += w;
-        len -= (size_t)w;
-        off += (uint64_t)w;
-    }
-    return 1;
-}
 
 /* The events of a build: the merged order as segments (S_SEGS), and the
  * tables that find a block of a rank file (held here until write_tables
@@ -117,7 +106,7 @@ enum { SEG_BATCH = 8192 };
 static int seg_flush(evstream *es, pdt_err *err)
 {
     if (!es->nb) return 1;
-    if (!write_all(es->fd, es->buf, es->nb * sizeof *es->buf, es->off)) {
+    if (!pdt_pwrite_all(es->fd, es->buf, es->nb * sizeof *es->buf, es->off)) {
         pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
         return 0;
     }
@@ -289,11 +278,9 @@ static void pipe_stop(evpipe *p)
     p->started = 0;
 }
 
-static int read_all(int fd, uint64_t at, void *p, size_t bytes);
-
 static int fd_get(void *ctx, uint64_t at, void *p, size_t bytes)
 {
-    return read_all(*(const int *)ctx, at, p, bytes);
+    return pdt_pread_all(*(const int *)ctx, at, p, bytes);
 }
 
 /* The state at every r->ick_every-th cursor, stepped forwards from 0 (the
@@ -319,11 +306,11 @@ static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
             for (size_t o = 0; ok && o < len[j]; o += CHUNK_BYTES) { /* (a paged state's
                                                                        * pages go back) */
                 size_t k = len[j] - o < CHUNK_BYTES ? len[j] - o : CHUNK_BYTES;
-                ok = write_all(fd, (const char *)part[j] + o, k, at + o);
+                ok = pdt_pwrite_all(fd, (const char *)part[j] + o, k, at + o);
                 pdt_ix_crc_feed(crc, (const char *)part[j] + o, k);
                 pdt_replay_give_back(r, s);
             }
-            ok = ok && write_all(fd, zeros, pad[j], at + len[j]);
+            ok = ok && pdt_pwrite_all(fd, zeros, pad[j], at + len[j]);
             pdt_ix_crc_feed(crc, zeros, pad[j]);
             at += len[j] + pad[j];
         }
@@ -339,17 +326,16 @@ static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
  * file itself (pdt_replay_place): written once, in place, by pwrite (not
  * through a shared mapping: on this file system page faults on a file being
  * written back wait for the disk), and never held in memory.  The triangle
- * events the build groups go to a spill of their own, an unnamed file
- * beside the index (O_TMPFILE), dropped (closed) once they are grouped: its
- * pages leave the page cache with it, mostly before they were written back. */
+ * events the build groups go to a spill of their own, and its other scratch
+ * tables to theirs: in memory while their share of the budget has room,
+ * beyond it in unnamed files beside the index, dropped once read
+ * (scratch_int.h). */
 typedef struct placer {
     struct evpipe *pipe; /* (first: the stream's context is the placer's) */
     int fd;
     uint64_t off;  /* where the next table goes */
-    int sfd[PDT_SCR_COUNT];  /* the scratch files (-1: not made yet, or dropped) */
-    const char *near;        /* made in the folder of this path */
+    scr_set scr;   /* the scratch files */
     pdt_run *run;
-    pthread_mutex_t mu;      /* (the grouping's threads make them) */
 } placer;
 
 static uint64_t place_reserve(void *ctx, uint64_t bytes)
@@ -362,76 +348,27 @@ static uint64_t place_reserve(void *ctx, uint64_t bytes)
 
 static int place_put(void *ctx, uint64_t at, const void *p, size_t bytes)
 {
-    return write_all(((placer *)ctx)->fd, p, bytes, at);
-}
-
-static int read_all(int fd, uint64_t at, void *p, size_t bytes)
-{
-    char *b = p;
-    while (bytes) {
-        ssize_t got = pread(fd, b, bytes, (off_t)at);
-        if (got <= 0) return 0;
-        b += got;
-        bytes -= (size_t)got;
-        at += (uint64_t)got;
-    }
-    return 1;
+    return pdt_pwrite_all(((placer *)ctx)->fd, p, bytes, at);
 }
 
 static int place_get(void *ctx, uint64_t at, void *p, size_t bytes)
 {
-    return read_all(((placer *)ctx)->fd, at, p, bytes);
+    return pdt_pread_all(((placer *)ctx)->fd, at, p, bytes);
 }
-
-static int open_spill(const char *path);
 
 static int scratch_put(void *ctx, int file, uint64_t at, const void *p, size_t bytes)
 {
-    placer *pc = ctx;
-    if (file < 0 || file >= PDT_SCR_COUNT) return 0;
-    pthread_mutex_lock(&pc->mu);
-    if (pc->sfd[file] < 0) pc->sfd[file] = open_spill(pc->near);
-    int fd = pc->sfd[file];
-    pthread_mutex_unlock(&pc->mu);
-    return fd >= 0 && write_all(fd, p, bytes, at);
+    return pdt_scr_put(&((placer *)ctx)->scr, file, at, p, bytes);
 }
 
 static int scratch_get(void *ctx, int file, uint64_t at, void *p, size_t bytes)
 {
-    placer *pc = ctx;
-    if (file < 0 || file >= PDT_SCR_COUNT || pc->sfd[file] < 0) return 0;
-    return read_all(pc->sfd[file], at, p, bytes);
+    return pdt_scr_get(&((placer *)ctx)->scr, file, at, p, bytes);
 }
+
+static void scratch_drop(void *ctx, int file) { pdt_scr_drop(&((placer *)ctx)->scr, file); }
 
 static void points_read(void *ctx) { pdt_run_release_points(((placer *)ctx)->run); }
-
-/* A scratch file done with: closed (unnamed: its pages go with it, mostly
- * before they were written back). */
-static void scratch_drop(void *ctx, int file)
-{
-    placer *pc = ctx;
-    if (file < 0 || file >= PDT_SCR_COUNT || pc->sfd[file] < 0) return;
-    close(pc->sfd[file]);
-    pc->sfd[file] = -1;
-}
-
-/* An unnamed scratch file in the folder of `path` (O_TMPFILE; where the file
- * system has none, a named one removed at once), or -1. */
-static int open_spill(const char *path)
-{
-    char dir[PATH_MAX + 128];
-    snprintf(dir, sizeof dir, "%s", path);
-    char *slash = strrchr(dir, '/');
-    if (slash) *slash = 0;
-    else snprintf(dir, sizeof dir, ".");
-    int fd = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
-    if (fd >= 0) return fd;
-    char name[PATH_MAX + 160];
-    snprintf(name, sizeof name, "%s.spill", path);
-    fd = open(name, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-    if (fd >= 0) unlink(name);
-    return fd;
-}
 
 /* write_checkpoints in a thread of its own (stepping through the run takes
  * a core while the tables are written). */
@@ -558,7 +495,7 @@ static pdt_status write_header(pdt_replay *r, int fd, ihdr *h, uint64_t ident, u
     unsigned char page[HDR_BYTES];
     memset(page, 0, sizeof page);
     memcpy(page, h, sizeof *h);
-    if (ftruncate(fd, (off_t)file_bytes) != 0 || !write_all(fd, page, sizeof page, 0))
+    if (ftruncate(fd, (off_t)file_bytes) != 0 || !pdt_pwrite_all(fd, page, sizeof page, 0))
         return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
     return PDT_OK;
 }
@@ -582,7 +519,7 @@ static pdt_status write_sections(pdt_replay *r, int fd, const ihdr *h, const pla
         if (i == S_SEGS || i == S_CKPT || streamed_sec(r, i, &at)) continue;
         for (uint64_t o = 0; wrote && o < h->sec[i].bytes; o += CHUNK_BYTES) {
             uint64_t k = h->sec[i].bytes - o < CHUNK_BYTES ? h->sec[i].bytes - o : CHUNK_BYTES;
-            wrote = write_all(fd, (const char *)*ptr[i] + o, (size_t)k, h->sec[i].off + o);
+            wrote = pdt_pwrite_all(fd, (const char *)*ptr[i] + o, (size_t)k, h->sec[i].off + o);
             if (i == S_POINTS) pdt_run_release_points(pc->run);
             pdt_replay_tab_release(r, (const char *)*ptr[i] + o, (size_t)k);  /* (paged) */
         }
@@ -632,7 +569,7 @@ static pdt_status write_tables(pdt_replay *r, int fd, ihdr *h, uint64_t ident, c
     }
     off = (off + 63) & ~(uint64_t)63;
     h->ctab = (isec){off, n * sizeof *tab, pdt_crc32c(0, tab, (size_t)(n * sizeof *tab)), 0};
-    int wrote = write_all(fd, tab, (size_t)(n * sizeof *tab), off);
+    int wrote = pdt_pwrite_all(fd, tab, (size_t)(n * sizeof *tab), off);
     free(tab);
     if (!wrote) return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(errno));
     return write_header(r, fd, h, ident, off + h->ctab.bytes, err);
@@ -698,6 +635,23 @@ static pdt_status finish_build(pdt_replay *r, pdt_run *run, int fd, ihdr *h, uin
     return st;
 }
 
+/* The scratch files' share of a build's budget (scratch_int.h): half of a
+ * budget of SCRATCH_POOL_FROM or more, the build planning its own work
+ * within the other half (a build under a smaller one needs all of it);
+ * none without a limit.  A test build may set it ($PDT_TEST_SCRATCH_MEM,
+ * bytes). */
+#define SCRATCH_POOL_FROM ((uint64_t)512 << 20)
+
+static uint64_t scratch_pool(uint64_t budget)
+{
+    const char *t = pdt_test_hook("PDT_TEST_SCRATCH_MEM");
+    if (t) {
+        uint64_t want = strtoull(t, NULL, 10);
+        return want < budget / 2 ? want : budget / 2;
+    }
+    return budget >= SCRATCH_POOL_FROM ? budget / 2 : 0;
+}
+
 static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks, uint64_t ident,
                         const char *path, uint64_t budget, uint64_t *work, uint32_t *buckets,
                         pdt_err *err)
@@ -721,10 +675,11 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
     es.buf = malloc(SEG_BATCH * sizeof *es.buf);
     evpipe pipe;
     memset(&pipe, 0, sizeof pipe);
-    placer pc = {&pipe, fd, 0, {0}, tmp, run, PTHREAD_MUTEX_INITIALIZER};
-    for (int k = 0; k < PDT_SCR_COUNT; k++) pc.sfd[k] = -1;
-    pdt_replay_place pl = {place_reserve, place_put,   place_get, scratch_put, scratch_get,
-                           scratch_drop,  points_read, &pc,       budget,      stream_next,
+    placer pc = {.pipe = &pipe, .fd = fd, .run = run};
+    uint64_t pool = scratch_pool(budget);
+    pdt_scr_init(&pc.scr, tmp, pool);
+    pdt_replay_place pl = {place_reserve, place_put,   place_get, scratch_put,   scratch_get,
+                           scratch_drop,  points_read, &pc,       budget - pool, stream_next,
                            &ec.src,       0,           0};
     pdt_status st = h && es.buf ? block_table(run, &ec, err)
                                 : pdt_err_set(err, PDT_ERR_NOMEM, "out of memory");
@@ -740,14 +695,16 @@ static pdt_status build(pdt_run *run, const pdt_point *pts, size_t n, int nranks
         pl.evkind_at = place_reserve(&pc, m);
         es.at = es.off = (pc.off + 63) & ~(uint64_t)63;
         es.place_off = &pc.off;
-        if ((pc.sfd[PDT_SCR_SPILL] = open_spill(tmp)) < 0)
+        if (!pdt_scr_make_file(&pc.scr, PDT_SCR_SPILL))
             st = pdt_err_set(err, PDT_ERR_IO, "%s: a scratch file beside it: %s", tmp, strerror(errno));
     }
     if (st == PDT_OK && !pipe_start(&pipe, &es, err)) st = err->code;
     if (st == PDT_OK) st = pdt_replay_build(pts, n, NULL, m, nranks, &pl, &r, err);
     pipe_stop(&pipe);
-    for (int k = 0; k < PDT_SCR_COUNT; k++) scratch_drop(&pc, k);  /* the scratch: gone */
+    uint64_t scratch_peak = pc.scr.peak;
+    pdt_scr_free(&pc.scr);  /* the scratch: gone */
     if (st == PDT_OK) st = finish_build(r, run, fd, h, ident, &pc, &ec, budget, work, buckets, err);
+    if (st == PDT_OK) *work += scratch_peak;
     pdt_replay_free(r);
     pdt_evsrc_clear(&ec.src);
     evstream_free(&es);
