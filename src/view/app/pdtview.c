@@ -149,8 +149,8 @@ static pdt_status open_run(const opts *o, loaded *L, pdt_replay **r, pdt_replay_
     return PDT_OK;
 }
 
-/* What the opening did: for --bench, the index's figures; otherwise why an
- * index was rebuilt, and events the reader ignored. */
+/* What the opening did: for --bench, the index's figures; otherwise why no
+ * index could be kept or why one was rebuilt, and events the reader ignored. */
 static void say_opening(const opts *o, const pdt_replay *r, const pdt_replay_open_info *info)
 {
     if (o->bench) {
@@ -163,6 +163,9 @@ static void say_opening(const opts *o, const pdt_replay *r, const pdt_replay_ope
                    info->built ? "built at this opening" : "mapped", *info->why ? "; " : "", info->why);
         else
             printf("in memory (no kept index)%s%s\n", *info->write_error ? ": " : "", info->write_error);
+    } else if (!o->quiet && *info->write_error) {
+        fprintf(stderr, "pdtview: %s: no index kept (%s); the run is held in memory this time\n",
+                o->run, info->write_error);
     } else if (!o->quiet && info->built && *info->why && strcmp(info->why, "no index yet")) {
         fprintf(stderr, "pdtview: %s: rebuilt the index (%s)\n", o->run, info->why);
     }
