@@ -304,6 +304,28 @@ if [ "$(basename "$BIN")" = san ]; then
     else fail scratch_memory_counted "working memory ${w0:-?} MiB (none), ${w2:-?} MiB (2 MiB), ${wd:-?} MiB (default)"; fi
 fi
 
+# an index that cannot be written whole: the file size limit falls inside
+# the checkpoints (the last section, header bytes 1432..1447 its place and
+# length), so the thread writing them fails while another steps through the
+# run.  The opening still gives the replay (from memory), says in one line
+# that no index was kept, and leaves no index or temporary file behind.
+rm -f "$RB/.pdtview-index"
+want=$("$V" "$RB" --counts --end --index on)
+read -r ck_at ck_len < <(od -An -t u8 -j 1432 -N 16 "$RB/.pdtview-index")
+rm -f "$RB/.pdtview-index"
+if [ "${ck_len:-0}" -gt 4096 ]; then
+    got=$(trap '' XFSZ; ulimit -f $(((ck_at + ck_len / 2) / 1024))
+          timeout 120 "$V" "$RB" --counts --end --index on 2>"$TMP/efb")
+    rc=$?
+    left=$(ls -A "$RB" | grep -c pdtview-index)
+    if [ "$rc" = 0 ] && [ "$got" = "$want" ] && [ "$left" = 0 ] &&
+        grep -q "no index kept (writing the index: File too large)" "$TMP/efb"
+    then ok index_write_fails_in_checkpoints
+    else fail index_write_fails_in_checkpoints "exit $rc, $left index files left, $(head -2 "$TMP/efb")"; fi
+else
+    fail index_write_fails_in_checkpoints "no checkpoints found in the index (${ck_at:-?} ${ck_len:-?})"
+fi
+
 # the triangle events grouped in more buckets (what a run of more than
 # 10^9 events gets at the default budget, forced here): the same replay
 RS=$TMP/runb10000

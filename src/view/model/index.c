@@ -278,50 +278,6 @@ static void pipe_stop(evpipe *p)
     p->started = 0;
 }
 
-static int fd_get(void *ctx, uint64_t at, void *p, size_t bytes)
-{
-    return pdt_pread_all(*(const int *)ctx, at, p, bytes);
-}
-
-/* The state at every r->ick_every-th cursor, stepped forwards from 0 (the
- * streamed replay's tables read back from fd), written at off one after
- * the other (r->nick of them), each holding the triangles born before its
- * cursor; sets r->ick_off and r->ick_born.  Memory: one state. */
-static int write_checkpoints(pdt_replay *r, int fd, uint64_t off, crcacc *crc)
-{
-    static const uint8_t zeros[8];
-    r->ick_off[0] = 0;
-    if (!r->nick) return 1;
-    pdt_rstate *s = pdt_rstate_new(r);
-    pdt_fwd *fw = pdt_fwd_new(r, fd_get, &fd);
-    int ok = s && fw;
-    for (size_t c = 0; ok && c < r->nick; c++) {
-        ok = pdt_fwd_to(fw, s, c * r->ick_every);
-        size_t born = pdt_rstate_born(r, s), bytes = pdt_rstate_blob_bytes(r, born);
-        const void *part[5];
-        size_t len[5], pad[5];
-        uint64_t at = off + r->ick_off[c];
-        pdt_rstate_blob_parts(r, s, born, part, len, pad);
-        for (int j = 0; ok && j < 5; j++) {
-            for (size_t o = 0; ok && o < len[j]; o += CHUNK_BYTES) { /* (a paged state's
-                                                                       * pages go back) */
-                size_t k = len[j] - o < CHUNK_BYTES ? len[j] - o : CHUNK_BYTES;
-                ok = pdt_pwrite_all(fd, (const char *)part[j] + o, k, at + o);
-                pdt_ix_crc_feed(crc, (const char *)part[j] + o, k);
-                pdt_replay_give_back(r, s);
-            }
-            ok = ok && pdt_pwrite_all(fd, zeros, pad[j], at + len[j]);
-            pdt_ix_crc_feed(crc, zeros, pad[j]);
-            at += len[j] + pad[j];
-        }
-        r->ick_born[c] = born;
-        r->ick_off[c + 1] = r->ick_off[c] + bytes;
-    }
-    pdt_fwd_free(fw);
-    pdt_rstate_free(s);
-    return ok;
-}
-
 /* The triangles and histories of a replay being built, streamed to the index
  * file itself (pdt_replay_place): written once, in place, by pwrite (not
  * through a shared mapping: on this file system page faults on a file being
@@ -369,22 +325,6 @@ static int scratch_get(void *ctx, int file, uint64_t at, void *p, size_t bytes)
 static void scratch_drop(void *ctx, int file) { pdt_scr_drop(&((placer *)ctx)->scr, file); }
 
 static void points_read(void *ctx) { pdt_run_release_points(((placer *)ctx)->run); }
-
-/* write_checkpoints in a thread of its own (stepping through the run takes
- * a core while the tables are written). */
-typedef struct ck_job {
-    pdt_replay *r;
-    int fd, ok;
-    uint64_t off;
-    crcacc crc;
-} ck_job;
-
-static void *ck_worker(void *arg)
-{
-    ck_job *j = arg;
-    j->ok = write_checkpoints(j->r, j->fd, j->off, &j->crc);
-    return NULL;
-}
 
 /* 1 if section i of a streamed replay was written by the build (at *at). */
 static int streamed_sec(const pdt_replay *r, int i, uint64_t *at)
@@ -510,9 +450,7 @@ static pdt_status write_sections(pdt_replay *r, int fd, const ihdr *h, const pla
                                  void **ptr[NSEC], uint64_t off, const evcopy *ec,
                                  crcacc *ck_crc, uint32_t **tab, uint64_t *n, pdt_err *err)
 {
-    ck_job ck = {r, fd, 0, off, {0}};
-    pthread_t th;
-    int threaded = pthread_create(&th, NULL, ck_worker, &ck) == 0;
+    ck_job *ck = pdt_ix_ck_start(r, fd, off);  /* (the checkpoints, stepped beside) */
     int wrote = 1;
     for (int i = 0; wrote && i < NSEC; i++) {
         uint64_t at;
@@ -526,10 +464,8 @@ static pdt_status write_sections(pdt_replay *r, int fd, const ihdr *h, const pla
     }
     int werr = wrote ? 0 : errno;
     pdt_status st = wrote ? chunk_table(r, fd, h, pc, ptr, ec, NULL, tab, n, err) : PDT_OK;
-    if (threaded) pthread_join(th, NULL);
-    else ck_worker(&ck);
-    *ck_crc = ck.crc;
-    if (!wrote || !ck.ok) {
+    int ck_ok = pdt_ix_ck_finish(ck, ck_crc, &r->build_ck_bytes);
+    if (!wrote || !ck_ok) {
         free(*tab);
         *tab = NULL;
         return pdt_err_set(err, PDT_ERR_IO, "writing the index: %s", strerror(werr ? werr : errno));
@@ -628,8 +564,8 @@ static pdt_status finish_build(pdt_replay *r, pdt_run *run, int fd, ihdr *h, uin
     plan_checkpoints(r, budget);
     pdt_status st = write_tables(r, fd, h, ident, pc, ec, err);
     pdt_run_release_points(run);  /* (written from them) */
-    *work = r->build_peak + (r->state_paged ? 0 : pdt_replay_state_bytes(r)); /* (the
-                                                        * checkpoints' state, when held) */
+    *work = r->build_peak + (r->state_paged ? 0 : pdt_replay_state_bytes(r)) + /* (the
+             * checkpoints' state, when held, and its copies) */ r->build_ck_bytes;
     *buckets = r->build_buckets;
     r->nick = 0;  /* r's own tables are freed by the caller; it has no mapped checkpoints */
     return st;

@@ -188,4 +188,16 @@ lazy *pdt_ix_lazy_start(const ihdr *h, uint32_t *tab, int fd, const char *path, 
 void pdt_ix_lazy_stop(lazy *L);
 void pdt_ix_run_damaged(void *ctx, uint32_t rank);
 
+/* ---- the checkpoints (index_ck.c) ----------------------------------------------- */
+
+/* Start stepping through r's events (read back from the index fd) on a
+ * thread of its own, the checkpoints going to fd at off; NULL when out of
+ * memory.  pdt_ix_ck_finish (on the thread that started it, once its own
+ * tables are written) writes what the stepping thread handed over, waits
+ * for it and frees j: 1, or 0 with errno set; *crc takes the section's
+ * chunk checksums, *copy_bytes what the copies of states held. */
+typedef struct ck_job ck_job;
+ck_job *pdt_ix_ck_start(pdt_replay *r, int fd, uint64_t off);
+int pdt_ix_ck_finish(ck_job *j, crcacc *crc, uint64_t *copy_bytes);
+
 #endif

@@ -133,6 +133,7 @@ struct pdt_replay {
     int streamed;
     uint64_t tris_at, hist_at, evobj_at, evkind_at, lift_at;
     uint64_t build_peak;   /* the build's own working memory, at most (bytes) */
+    uint64_t build_ck_bytes; /* ... and what the copies of its checkpoints held (index_ck.c) */
     uint32_t build_buckets; /* the fine buckets its triangle events were grouped in */
     struct lazy *lazy;     /* the map is verified chunk by chunk as it is read (index.c) */
     const char *warnings;  /* the reader's warnings about the run (kept index), or NULL */
