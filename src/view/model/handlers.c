@@ -274,8 +274,13 @@ static int ix_tri(IX_ARGS)
     uint32_t step = (uint32_t)(cur[PDT_SLOT_MERGE] + 1); /* (0: none) */
     uint32_t x = border ? XREC_BORDER | (step <= XREC_STEP_MAX + 1 ? step : 0)
                         : (uint32_t)e->kind | (uint32_t)e->sub << 8;
-    b->fcur[f][b->fbn[f]++] =
-        (tri_xrec){{t.s[0], t.s[1], t.s[2]}, i, x | xrec_order(t.s, in)};
+    tri_xrec *to = &b->fcur[f][b->fbn[f]++];
+    /* the bucket's next lines, for writing: the buckets are written at
+     * random, each a few records a thousand events, and a line written
+     * first missed every cache (its buffer last held records the spill
+     * writer took long ago): the pass's handler stalled on those stores */
+    __builtin_prefetch(to + 6, 1);
+    *to = (tri_xrec){{t.s[0], t.s[1], t.s[2]}, i, x | xrec_order(t.s, in)};
     b->fine_fill[f]++;
     return b->fbn[f] < b->fbuf_recs || pdt_rp_fine_flush(b, f);
 }
