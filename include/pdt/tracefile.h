@@ -190,6 +190,10 @@ pdt_status pdt_merge_open(pdt_run *run, pdt_merge **m, pdt_err *err);
 /* The next record of the merged order into *rec: 1, 0 at the end, -1 on an
  * error (out of memory; err set). */
 int pdt_merge_next(pdt_merge *m, pdt_rec *rec, pdt_err *err);
+/* The next records of the merged order, up to max of them, into out: how
+ * many, 0 at the end, -1 on an error (err set).  What pdt_merge_next gives
+ * one at a time; a run of one rank is copied from its decoded blocks. */
+int pdt_merge_fill(pdt_merge *m, pdt_rec *out, size_t max, pdt_err *err);
 void pdt_merge_close(pdt_merge *m);
 
 /* Facts about one rank's file, known after pdt_run_open without decoding. */
@@ -219,6 +223,11 @@ pdt_status pdt_cursor_seek(pdt_cursor *c, uint64_t k, pdt_err *err);
 /* Next event (aligned time) into *ev and its index into *seq (may be NULL).
  * Returns 1, or 0 at the end. */
 int pdt_cursor_next(pdt_cursor *c, pdt_event *ev, uint64_t *seq);
+/* The next events, as pdt_cursor_next gives them, up to max of them and to
+ * the end of the block that holds the first: *evs points at them in the
+ * cursor's decoded block (valid until its next call), *seq at the first's
+ * index; the cursor moves past them.  Their count; 0 at the end. */
+size_t pdt_cursor_span(pdt_cursor *c, const pdt_event **evs, size_t max, uint64_t *seq);
 void pdt_cursor_close(pdt_cursor *c);
 
 /* One readable line for an event, without rank or time, e.g.

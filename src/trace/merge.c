@@ -262,6 +262,22 @@ static int place_message(pdt_merge *m, const pdt_event *e, uint32_t r, uint64_t 
     return 0;
 }
 
+/* Event e of rank r (its index seq) as the next record; -1 when its message
+ * could not be indexed (err set). */
+static int take(pdt_merge *m, const pdt_event *e, uint32_t r, uint64_t seq, pdt_rec *rec,
+                pdt_err *err)
+{
+    rec->ev = *e;
+    rec->rank = r;
+    rec->seq = (uint32_t)seq;
+    m->left--;
+    if ((e->kind == PDT_EV_SEND || e->kind == PDT_EV_RECV) && place_message(m, e, r, seq) != 0) {
+        pdt_err_set(err, PDT_ERR_NOMEM, "out of memory (message index)");
+        return -1;
+    }
+    return 0;
+}
+
 int pdt_merge_next(pdt_merge *m, pdt_rec *rec, pdt_err *err)
 {
     if (m->left == 0) return 0;
@@ -281,16 +297,8 @@ int pdt_merge_next(pdt_merge *m, pdt_rec *rec, pdt_err *err)
         m->blocked[r] = 0;
         m->nblocked--;
     }
-    rec->ev = m->head[r];
-    rec->rank = r;
-    rec->seq = (uint32_t)m->pos[r];
-    m->left--;
+    if (take(m, &m->head[r], r, m->pos[r], rec, err) != 0) return -1;
     advance(m, r);
-    if ((rec->ev.kind == PDT_EV_SEND || rec->ev.kind == PDT_EV_RECV) &&
-        place_message(m, &rec->ev, r, m->pos[r] - 1) != 0) {
-        pdt_err_set(err, PDT_ERR_NOMEM, "out of memory (message index)");
-        return -1;
-    }
     /* Fast path: if r's next event is no RECV and comes before every head in
      * the heap, pushing r and popping the heap would give r again (the order
      * (t, rank) is total), so skip both. */
@@ -300,6 +308,39 @@ int pdt_merge_next(pdt_merge *m, pdt_rec *rec, pdt_err *err)
     else
         schedule(m, r);
     return 1;
+}
+
+/* One rank: its file order (pdt_merge_open).  Its head, then the rest of
+ * that head's block straight from the cursor's decoded events, then the
+ * next head; rank 0 stays where pdt_merge_next finds it (the heap, or
+ * m->next), head[0] always the next event. */
+static int fill_one(pdt_merge *m, pdt_rec *out, size_t max, pdt_err *err)
+{
+    size_t k = 0;
+    while (k < max && m->left) {
+        if (!m->has[0]) {  /* a cursor stopped early: it could not get memory */
+            pdt_err_set(err, PDT_ERR_NOMEM, "out of memory decoding a trace block");
+            return -1;
+        }
+        if (take(m, &m->head[0], 0, m->pos[0], &out[k++], err) != 0) return -1;
+        const pdt_event *evs;
+        uint64_t seq, want = max - k < m->left ? max - k : m->left;
+        size_t n = pdt_cursor_span(m->cur[0], &evs, (size_t)want, &seq);
+        for (size_t i = 0; i < n; i++)
+            if (take(m, &evs[i], 0, seq + i, &out[k++], err) != 0) return -1;
+        advance(m, 0);
+    }
+    return (int)k;
+}
+
+int pdt_merge_fill(pdt_merge *m, pdt_rec *out, size_t max, pdt_err *err)
+{
+    if (max > INT32_MAX) max = INT32_MAX;
+    if (m->R == 1) return fill_one(m, out, max, err);
+    size_t k = 0;
+    int got = 1;
+    while (k < max && (got = pdt_merge_next(m, &out[k], err)) == 1) k++;
+    return got < 0 ? -1 : (int)k;
 }
 
 void pdt_merge_close(pdt_merge *m)
@@ -340,7 +381,7 @@ pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err
     }
     size_t k = 0;
     int got;
-    while (k < total && (got = pdt_merge_next(m, &out[k], err)) == 1) k++;
+    while (k < total && (got = pdt_merge_fill(m, &out[k], (size_t)(total - k), err)) > 0) k += (size_t)got;
     pdt_merge_close(m);
     if (k < total) {
         free(out);

@@ -792,31 +792,48 @@ static int cursor_load(pdt_cursor *c, size_t b)
     return 0;
 }
 
-int pdt_cursor_next(pdt_cursor *c, pdt_event *ev, uint64_t *seq)
+/* The block of c's position decoded (the next one, as a pass forwards
+ * goes, or found by a binary search): 1, or 0 at the end or when it could
+ * not be decoded. */
+static int cursor_at(pdt_cursor *c)
 {
     tf_rank *rk = c->rk;
     if (c->pos >= rk->nev) return 0;
     const tf_block *bk = c->blk != SIZE_MAX ? &rk->blk[c->blk] : NULL;
-    if (!bk || c->pos < bk->first || c->pos >= bk->first + bk->count) {
-        size_t b;
-        if (bk && c->blk + 1 < rk->nblk && rk->blk[c->blk + 1].first == c->pos) {
-            b = c->blk + 1;  /* the common case: the next block */
-        } else {             /* binary search: last block with first <= pos */
-            size_t lo = 0, hi = rk->nblk;
-            while (hi - lo > 1) {
-                size_t mid = lo + (hi - lo) / 2;
-                if (rk->blk[mid].first <= c->pos) lo = mid;
-                else hi = mid;
-            }
-            b = lo;
+    if (bk && c->pos >= bk->first && c->pos < bk->first + bk->count) return 1;
+    size_t b;
+    if (bk && c->blk + 1 < rk->nblk && rk->blk[c->blk + 1].first == c->pos) {
+        b = c->blk + 1;  /* the common case: the next block */
+    } else {             /* binary search: last block with first <= pos */
+        size_t lo = 0, hi = rk->nblk;
+        while (hi - lo > 1) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (rk->blk[mid].first <= c->pos) lo = mid;
+            else hi = mid;
         }
-        if (cursor_load(c, b) != 0) return 0;
-        bk = &rk->blk[b];
+        b = lo;
     }
-    *ev = c->buf[c->pos - bk->first];
+    return cursor_load(c, b) == 0;
+}
+
+int pdt_cursor_next(pdt_cursor *c, pdt_event *ev, uint64_t *seq)
+{
+    if (!cursor_at(c)) return 0;
+    *ev = c->buf[c->pos - c->rk->blk[c->blk].first];
     if (seq) *seq = c->pos;
     c->pos++;
     return 1;
+}
+
+size_t pdt_cursor_span(pdt_cursor *c, const pdt_event **evs, size_t max, uint64_t *seq)
+{
+    if (!max || !cursor_at(c)) return 0;
+    const tf_block *bk = &c->rk->blk[c->blk];
+    size_t at = (size_t)(c->pos - bk->first), n = bk->count - at < max ? bk->count - at : max;
+    *evs = c->buf + at;
+    *seq = c->pos;
+    c->pos += n;
+    return n;
 }
 
 void pdt_cursor_close(pdt_cursor *c)

@@ -662,6 +662,49 @@ TEST(merged_order_is_causal)
     pdt_run_close(run);
 }
 
+/* The merged order of `dir`'s run by pdt_merge_fill, `max` records a call,
+ * is pdt_merge_next's record for record (a run of one rank is copied from
+ * its decoded blocks: a call ends at a block's end).  The number of records
+ * compared, or -1 when they differ. */
+static long fill_same_as_next(const char *dir, size_t max)
+{
+    pdt_run *run;
+    pdt_err err = {0};
+    if (pdt_run_open(dir, &run, &err) != PDT_OK) return -1;
+    pdt_merge *a, *b;
+    long n = 0;
+    if (pdt_merge_open(run, &a, &err) == PDT_OK) {
+        if (pdt_merge_open(run, &b, &err) == PDT_OK) {
+            pdt_rec *buf = calloc(max, sizeof *buf), one;
+            int got;
+            while (buf && n >= 0 && (got = pdt_merge_fill(a, buf, max, &err)) > 0)
+                for (int i = 0; i < got && n >= 0; i++, n++)
+                    if (pdt_merge_next(b, &one, &err) != 1 || one.rank != buf[i].rank ||
+                        one.seq != buf[i].seq || !ev_eq(&one.ev, &buf[i].ev))
+                        n = -1;
+            if (n >= 0 && (!buf || pdt_merge_next(b, &one, &err) != 0)) n = -1;
+            free(buf);
+            pdt_merge_close(b);
+        }
+        pdt_merge_close(a);
+    }
+    pdt_run_close(run);
+    return n;
+}
+
+TEST(merge_fill_is_merge_next_order)
+{
+    char rt[400], merged[400];
+    snprintf(rt, sizeof rt, "%s/rt", tmpdir);          /* one rank, four blocks */
+    snprintf(merged, sizeof merged, "%s/merged", tmpdir); /* three ranks, messages */
+    size_t maxes[] = {1, 5, TF_BLOCK_EVENTS - 1, 100000};
+    for (size_t k = 0; k < sizeof maxes / sizeof *maxes; k++) {
+        long a = fill_same_as_next(rt, maxes[k]), b = fill_same_as_next(merged, maxes[k]);
+        CHECK_MSG(a == 3 * TF_BLOCK_EVENTS + 17, "one rank, %zu a call: %ld", maxes[k], a);
+        CHECK_MSG(b == 3 + 50 * 5, "three ranks, %zu a call: %ld", maxes[k], b);
+    }
+}
+
 TEST(event_text)
 {
     char buf[160];
@@ -706,6 +749,7 @@ int main(void)
     RUN(missing_rank_and_bad_version);
     RUN(format_1_runs_are_still_read);
     RUN(merged_order_is_causal);
+    RUN(merge_fill_is_merge_next_order);
     RUN(event_text);
     rm_rf(tmpdir);
     return test_summary();

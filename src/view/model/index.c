@@ -146,22 +146,24 @@ static int stream_fill(evstream *es, pdt_rec *out, size_t max, pdt_err *err)
 {
     size_t j = 0;
     while (!es->done && j < max) {
-        int got = pdt_merge_next(es->mg, &out[j], err);
+        int got = pdt_merge_fill(es->mg, out + j, max - j, err);
         if (got < 0) return -1;
         if (got == 0) {
             es->done = 1;
             if (!stream_finish(es, err)) return -1;
             break;
         }
-        const pdt_rec *rec = &out[j++];
-        if (rec->rank != es->cur.rank || rec->seq - es->cur.seq0 != es->count - es->cur.start) {
-            if (es->cur.rank != UINT32_MAX) {
-                es->buf[es->nb++] = es->cur;
-                if (es->nb == SEG_BATCH && !seg_flush(es, err)) return -1;
+        for (size_t end = j + (size_t)got; j < end; j++) {
+            const pdt_rec *rec = &out[j];
+            if (rec->rank != es->cur.rank || rec->seq - es->cur.seq0 != es->count - es->cur.start) {
+                if (es->cur.rank != UINT32_MAX) {
+                    es->buf[es->nb++] = es->cur;
+                    if (es->nb == SEG_BATCH && !seg_flush(es, err)) return -1;
+                }
+                es->cur = (pdt_evseg){(uint32_t)es->count, rec->rank, rec->seq};
             }
-            es->cur = (pdt_evseg){(uint32_t)es->count, rec->rank, rec->seq};
+            es->count++;
         }
-        es->count++;
     }
     return (int)j;
 }
