@@ -139,6 +139,7 @@ static void bcurs_free(builder *b, bcur *c, size_t rec)
  * their corners).  One thread finds them (num_window) a window ahead of
  * the one that numbers them (num_emit), so they are NUM_SLOTS. */
 #define NUM_SLOTS 2
+#define NUM_AHEAD 64 /* events ahead whose found counts num_emit fetches */
 typedef struct num_slot {
     uint32_t *wn, (*wv)[3];
     uint16_t *wf;
@@ -235,7 +236,11 @@ static void num_window(builder *b, numbering *N, num_slot *w, size_t lo, size_t 
 static int put_tri(builder *b, numbering *N, bcur *ic, const pdt_rtri *t, uint32_t id)
 {
     ((pdt_rtri *)(void *)N->tw.buf)[N->tw.n] = *t;
-    ((uint32_t *)(void *)ic->buf)[ic->n] = id;
+    uint32_t *ids = (uint32_t *)(void *)ic->buf;
+    ids[ic->n] = id;
+    /* the bucket's next line, for writing: the buckets are written at random,
+     * and each id stored to a line not in the cache stalled the numbering */
+    __builtin_prefetch(ids + ic->n + 16, 1);
     return (++N->tw.n < N->tw.cap || bput_flush(b, &N->tw)) && (++ic->n < ic->cap || bput_flush(b, ic));
 }
 
@@ -245,7 +250,10 @@ static int num_emit(builder *b, numbering *N, const num_slot *w)
 {
     pdt_replay *r = b->r;
     int ok = 1;
-    for (size_t k = 0; ok && k < w->hi - w->lo; k++) {
+    size_t nw = w->hi - w->lo;
+    for (size_t k = 0; ok && k < nw; k++) {
+        if (k + NUM_AHEAD < nw) __builtin_prefetch(&w->wn[k + NUM_AHEAD]); /* (the finder's,
+                                                    * from the other core's cache) */
         uint32_t nk = w->wn[k] & TF_N_MASK;
         if (!nk) continue;
         const uint32_t *v = w->wv[k];
