@@ -183,9 +183,11 @@ _Static_assert(NFINE == PDT_REPLAY_NFINE, "replay_int.h says how many fine bucke
 #define GROUP_BYTES_PER_EVENT PDT_REPLAY_GROUP_BYTES_PER_EVENT /* tri_groups' working memory
                                                               * per event, at most */
 /* Events per run, at most (unless one fine bucket holds more): a working set
- * of some 60 MiB, reused from run to run (fresh pages are dear on virtual
- * machines, and a smaller hash table misses the caches less). */
-#define GROUP_RUN_MAX ((size_t)1 << 19)
+ * of some 30 MiB, reused from run to run (fresh pages are dear on virtual
+ * machines, and a smaller hash table misses the caches less: at 2^19 the
+ * one-rank 10^7-point run's grouping took 1.7-1.9 s, at 2^18 1.4-1.6 s,
+ * one bucket a run instead of three). */
+#define GROUP_RUN_MAX ((size_t)1 << 18)
 
 /* A chunk of a spill: where, whose (fine bucket, or window of points), how
  * many records. */

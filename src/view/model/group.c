@@ -277,6 +277,14 @@ static int write_run(group_job *J, size_t k, group_scratch *S, const tri_xrec *b
         size_t j0 = b->fine_off[f] - base, j1 = b->fine_off[f + 1] - base;
         uint32_t g1 = g0;
         for (size_t j = j0; j < j1; j++) {
+            if (j + 2 * PREFETCH_AHEAD < j1) { /* the places of a group a few records on: its
+                                                * tables, then its next entry (for writing) */
+                uint32_t qa = S->gid[j + 2 * PREFETCH_AHEAD];
+                __builtin_prefetch(&S->gfill[qa]);
+                __builtin_prefetch(&S->gfirst[qa]);
+                __builtin_prefetch(&S->glast[qa], 1);
+                __builtin_prefetch(&out[S->gfill[S->gid[j + PREFETCH_AHEAD]] - base], 1);
+            }
             uint32_t q = S->gid[j], ev = buf[j].ev, at = S->gfill[q]++;
             if (q >= g1) g1 = q + 1;
             out[at - base] = hist_of_x(r, &buf[j]);
