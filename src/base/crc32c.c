@@ -18,6 +18,7 @@
  * over the whole file, whatever the number of ranks. */
 #include "pdt/checksum.h"
 
+#include <pthread.h>
 #include <string.h>
 
 static const uint32_t crc_table[256] = {
@@ -258,10 +259,43 @@ static const uint64_t crc64_table[256] = {
     0xe0ada17364673f59u,
 };
 
+/* Slicing by 8 (eight bytes a step through eight tables, each byte's
+ * contribution pushed on by one table per byte that follows it): the table
+ * above did a byte a step, 0.23 s for a run of 10^7 points. */
+static uint64_t crc64_slice[8][256];
+static pthread_once_t crc64_once = PTHREAD_ONCE_INIT;
+
+static void crc64_slice_init(void)
+{
+    for (int i = 0; i < 256; i++) crc64_slice[0][i] = crc64_table[i];
+    for (int k = 1; k < 8; k++)
+        for (int i = 0; i < 256; i++) {
+            uint64_t v = crc64_slice[k - 1][i];
+            crc64_slice[k][i] = crc64_table[v & 0xffu] ^ (v >> 8);
+        }
+}
+
 uint64_t pdt_crc64(uint64_t crc, const void *data, size_t n)
 {
     uint64_t c = ~crc;
     const uint8_t *p = data;
+    if (n >= 64) {
+        pthread_once(&crc64_once, crc64_slice_init);
+        for (; n >= 8; n -= 8, p += 8) {
+            uint64_t w;
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+            memcpy(&w, p, 8);
+#else
+            w = 0;
+            for (int b = 0; b < 8; b++) w |= (uint64_t)p[b] << (8 * b);
+#endif
+            w ^= c;
+            c = crc64_slice[7][w & 0xffu] ^ crc64_slice[6][(w >> 8) & 0xffu] ^
+                crc64_slice[5][(w >> 16) & 0xffu] ^ crc64_slice[4][(w >> 24) & 0xffu] ^
+                crc64_slice[3][(w >> 32) & 0xffu] ^ crc64_slice[2][(w >> 40) & 0xffu] ^
+                crc64_slice[1][(w >> 48) & 0xffu] ^ crc64_slice[0][w >> 56];
+        }
+    }
     while (n--) c = crc64_table[(c ^ *p++) & 0xffu] ^ (c >> 8);
     return ~c;
 }

@@ -104,6 +104,36 @@ TEST(crc64_check_value)
 /* The CRC of a concatenation from the CRCs of its parts, at every split of
  * random data into up to 9 parts (empty parts included): what lets every
  * rank checksum its block of points.bin. */
+/* CRC-64/XZ from its definition, a bit at a time (the reference for the
+ * table-driven pdt_crc64). */
+static uint64_t crc64_bitwise(const uint8_t *p, size_t n)
+{
+    uint64_t c = ~0ull;
+    while (n--) {
+        c ^= *p++;
+        for (int k = 0; k < 8; k++) c = c & 1 ? (c >> 1) ^ 0xC96C5795D7870F42ull : c >> 1;
+    }
+    return ~c;
+}
+
+TEST(crc64_every_length_and_offset)
+{
+    enum { N = 4099 };
+    uint8_t *buf = malloc(N + 8);
+    CHECK(buf != NULL);
+    if (!buf) return;
+    for (size_t i = 0; i < N + 8; i++) buf[i] = (uint8_t)next_rand();
+    size_t bad = 0;
+    for (size_t off = 0; off < 8; off++)
+        for (size_t len = 0; len <= 300; len++)
+            bad += pdt_crc64(0, buf + off, len) != crc64_bitwise(buf + off, len);
+    for (size_t off = 0; off < 8; off++) /* (a long one, and one continued after an odd start) */
+        bad += pdt_crc64(pdt_crc64(0, buf + off, 77), buf + off + 77, N - 77) !=
+               crc64_bitwise(buf + off, N);
+    CHECK_MSG(bad == 0, "%zu checksums differ from the bitwise definition", bad);
+    free(buf);
+}
+
 TEST(crc_combine_any_split)
 {
     enum { LEN = 3000 };
@@ -740,6 +770,7 @@ int main(void)
     RUN(crc32c_check_value);
     RUN(crc32c_long_buffers_three_lanes);
     RUN(crc64_check_value);
+    RUN(crc64_every_length_and_offset);
     RUN(crc_combine_any_split);
     RUN(points_checksum_is_crc64_of_the_bytes);
     RUN(codec_extremes);
