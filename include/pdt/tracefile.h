@@ -190,8 +190,8 @@ pdt_status pdt_merge_open(pdt_run *run, pdt_merge **m, pdt_err *err);
 /* The next record of the merged order into *rec: 1, 0 at the end, -1 on an
  * error (out of memory; err set). */
 int pdt_merge_next(pdt_merge *m, pdt_rec *rec, pdt_err *err);
-/* The next records of the merged order, up to max of them, into out: how
- * many, 0 at the end, -1 on an error (err set).  What pdt_merge_next gives
+/* The next records of the merged order, up to max (at least 1) of them,
+ * into out: how many, 0 at the end, -1 on an error (err set).  What pdt_merge_next gives
  * one at a time; a run of one rank is copied from its decoded blocks. */
 int pdt_merge_fill(pdt_merge *m, pdt_rec *out, size_t max, pdt_err *err);
 void pdt_merge_close(pdt_merge *m);

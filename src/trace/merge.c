@@ -381,7 +381,8 @@ pdt_status pdt_run_merged(pdt_run *run, const pdt_rec **recs, size_t *n, pdt_err
     }
     size_t k = 0;
     int got;
-    while (k < total && (got = pdt_merge_fill(m, &out[k], (size_t)(total - k), err)) > 0) k += (size_t)got;
+    while (k < total && (got = pdt_merge_fill(m, &out[k], (size_t)(total - k), err)) > 0)
+        k += (size_t)got;
     pdt_merge_close(m);
     if (k < total) {
         free(out);

@@ -118,9 +118,9 @@ static void *ck_step(void *arg)
 {
     ck_job *j = arg;
     pdt_replay *r = j->r;
-    pdt_rstate *s = pdt_rstate_new(r);
-    pdt_fwd *fw = pdt_fwd_new(r, fd_get, &j->fd);
-    int ok = s && fw;
+    pdt_rstate *s = r->nick ? pdt_rstate_new(r) : NULL;
+    pdt_fwd *fw = r->nick ? pdt_fwd_new(r, fd_get, &j->fd) : NULL;
+    int ok = !r->nick || (s && fw);
     if (!ok) errno = ENOMEM;
     r->ick_off[0] = 0;
     for (size_t c = 0; ok && c < r->nick; c++) {
@@ -155,7 +155,8 @@ ck_job *pdt_ix_ck_start(pdt_replay *r, int fd, uint64_t off)
     pthread_mutex_init(&j->mu, NULL);
     pthread_cond_init(&j->cv, NULL);
     size_t most = pdt_rstate_blob_bytes(r, r->ntri);  /* (a checkpoint's most) */
-    j->handoff = r->nick && !r->state_paged && (!r->mem_budget || 2 * (uint64_t)most <= r->mem_budget / 4);
+    j->handoff = r->nick && !r->state_paged &&
+                 (!r->mem_budget || 2 * (uint64_t)most <= r->mem_budget / 4);
     j->threaded = pthread_create(&j->th, NULL, ck_step, j) == 0;
     if (!j->threaded) j->handoff = 0;  /* (the calling thread steps: pdt_ix_ck_finish) */
     return j;
