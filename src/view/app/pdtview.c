@@ -163,8 +163,7 @@ static void say_opening(const opts *o, const pdt_replay *r, const pdt_replay_ope
                    info->built ? "built at this opening" : "mapped", *info->why ? "; " : "", info->why);
         else
             printf("in memory (no kept index)%s%s\n", *info->write_error ? ": " : "", info->write_error);
-    } else if (!o->quiet && !info->indexed && *info->write_error) { /* (neither beside the run
-                                                                    * nor in the cache) */
+    } else if (!o->quiet && *info->write_error) { /* (neither beside the run nor in the cache) */
         if (*info->why && strcmp(info->why, "no index yet"))
             fprintf(stderr, "pdtview: %s: the index could not be used (%s)\n", o->run, info->why);
         fprintf(stderr, "pdtview: %s: no index kept (%s); the run is held in memory this time\n",

@@ -746,6 +746,7 @@ static pdt_replay *build_kept(pdt_run *run, const char *dir, uint64_t ident, uin
         char why[160];
         r = pdt_ix_load(path, dir, ident, pts, n, 0, why, sizeof why);
     }
+    if (r) info->write_error[0] = 0; /* (the run's folder refused it, the cache took it) */
     info->built = r != NULL;
     info->build_s = pdt_seconds() - t0;
     return r;
