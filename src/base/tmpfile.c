@@ -42,3 +42,34 @@ FILE *pdt_tmp_file(const char *prefix, size_t buffer)
     if (buffer) setvbuf(f, NULL, _IOFBF, buffer);  /* (before any other operation on it) */
     return f;
 }
+
+/* One call a step of at most 1 GiB (what Linux moves in one call at most). */
+#define IO_STEP ((size_t)1 << 30)
+
+int pdt_pwrite_all(int fd, const void *p, size_t len, uint64_t off)
+{
+    const char *b = p;
+    while (len) {
+        ssize_t k = pwrite(fd, b, len < IO_STEP ? len : IO_STEP, (off_t)off);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return k == 0 ? (errno = EIO, 0) : 0;
+        b += k;
+        len -= (size_t)k;
+        off += (uint64_t)k;
+    }
+    return 1;
+}
+
+int pdt_pread_all(int fd, uint64_t off, void *p, size_t len)
+{
+    char *b = p;
+    while (len) {
+        ssize_t k = pread(fd, b, len < IO_STEP ? len : IO_STEP, (off_t)off);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return k == 0 ? (errno = EIO, 0) : 0;
+        b += k;
+        len -= (size_t)k;
+        off += (uint64_t)k;
+    }
+    return 1;
+}

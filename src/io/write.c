@@ -2,6 +2,7 @@
  * Numbers are formatted by hand into a large buffer: printf would cost more
  * than the triangulation itself on big outputs. */
 #include "pdt/io.h"
+#include "pdt/tmpfile.h"
 
 #include "pdt/bigmem.h"
 #include "pdt/testhook.h"
@@ -318,15 +319,7 @@ typedef struct section_worker {
 
 static int write_all_at(int fd, const char *b, size_t len, uint64_t off)
 {
-    while (len) {
-        ssize_t k = pwrite(fd, b, len, (off_t)off);
-        if (k < 0 && errno == EINTR) continue;
-        if (k <= 0) return k < 0 ? errno : EIO;
-        b += k;
-        len -= (size_t)k;
-        off += (uint64_t)k;
-    }
-    return 0;
+    return pdt_pwrite_all(fd, b, len, off) ? 0 : errno;
 }
 
 /* Chunk j's turn: wait for chunks before it, take their end as its offset.

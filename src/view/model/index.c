@@ -7,6 +7,7 @@
 #include "replay_int.h"
 #include "index_int.h"
 #include "scratch_int.h"
+#include "pdt/tmpfile.h"
 #include "pdt/testhook.h"
 #include "pdt/bigmem.h"
 

@@ -16,6 +16,7 @@
 #include "replay_int.h"
 #include "index_int.h"
 #include "scratch_int.h"
+#include "pdt/tmpfile.h"
 
 #include <errno.h>
 #include <pthread.h>

@@ -2,6 +2,7 @@
  * pool has room, a file part beyond (scratch_int.h). */
 #include "scratch_int.h"
 #include "pdt/bigmem.h"
+#include "pdt/tmpfile.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -12,38 +13,6 @@
 #include <unistd.h>
 
 #define SCR_PAGE ((uint64_t)2 << 20) /* the pool counts whole huge pages */
-
-int pdt_pwrite_all(int fd, const void *p, size_t len, uint64_t off)
-{
-    const char *b = p;
-    while (len) {
-        ssize_t w = pwrite(fd, b, len > ((size_t)1 << 30) ? (size_t)1 << 30 : len, (off_t)off);
-        if (w <= 0) {
-            if (w == 0) errno = EIO;
-            return 0;
-        }
-        b += w;
-        len -= (size_t)w;
-        off += (uint64_t)w;
-    }
-    return 1;
-}
-
-int pdt_pread_all(int fd, uint64_t at, void *p, size_t bytes)
-{
-    char *b = p;
-    while (bytes) {
-        ssize_t got = pread(fd, b, bytes, (off_t)at);
-        if (got <= 0) {
-            if (got == 0) errno = EIO;
-            return 0;
-        }
-        b += got;
-        bytes -= (size_t)got;
-        at += (uint64_t)got;
-    }
-    return 1;
-}
 
 void pdt_scr_init(scr_set *s, const char *near, uint64_t pool)
 {

@@ -38,11 +38,6 @@ typedef struct scr_set {
     scr_file f[PDT_SCR_COUNT];
 } scr_set;
 
-/* pwrite and pread of all `len` bytes at offset `off` (in steps, as the
- * system takes them): 1, or 0 with errno set. */
-int pdt_pwrite_all(int fd, const void *p, size_t len, uint64_t off);
-int pdt_pread_all(int fd, uint64_t off, void *p, size_t len);
-
 /* An empty set whose memory parts share `pool` bytes (0: every byte goes
  * to the files) and whose file parts are made beside path `near`. */
 void pdt_scr_init(scr_set *s, const char *near, uint64_t pool);
