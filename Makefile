@@ -120,7 +120,7 @@ DEB_BENCH := hyperfine libcgal-dev g++ nodejs npm valgrind time
 DEB_FUZZ  := clang libclang-rt-dev
 
 # the comm front and its local (threads) backend need no MPI: in libpdt.a
-COMM_SRC := src/par/comm.c src/par/comm_local.c
+COMM_SRC := src/par/comm.c src/par/comm_local.c src/par/comm_hops.c
 LIB_SRC  := $(wildcard src/base/*.c src/geom/*.c src/io/*.c src/trace/*.c) $(COMM_SRC)
 PAR_SRC  := $(filter-out $(COMM_SRC) src/par/comm_mpi.c,$(wildcard src/par/*.c))
 CLI_SRC  := $(wildcard src/cli/*.c)

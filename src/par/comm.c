@@ -4,6 +4,7 @@
  * local (src/par/comm_local.c: ranks as threads of one process; with one
  * rank it is the serial context of a plain run). */
 #include "comm_int.h"
+#include "pdt/testhook.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -98,9 +99,20 @@ pdt_status pdt_comm_alltoall(pdt_comm *c, const void *send, size_t bytes, void *
     return c->ops->alltoall(c, send, bytes, recv, err);
 }
 
+/* Two hops when the messages of a direct exchange would be many and small:
+ * MPI from PDT_COMM_HOPS_MIN ranks on (the same choice at every rank); a
+ * test build's PDT_TEST_COMM_HOPS=1 or 2 forces one or the other. */
+static int two_hops(const pdt_comm *c)
+{
+    const char *t = pdt_test_hook("PDT_TEST_COMM_HOPS");
+    if (t && (*t == '1' || *t == '2')) return *t == '2' && c->size > 1;
+    return c->ops->is_mpi && c->size >= PDT_COMM_HOPS_MIN;
+}
+
 pdt_status pdt_comm_alltoallv(pdt_comm *c, const void *send, const size_t *scount, void *recv,
                               const size_t *rcount, pdt_err *err)
 {
+    if (two_hops(c)) return pdt_comm_hops_alltoallv(c, send, scount, recv, rcount, err);
     return c->ops->alltoallv(c, send, scount, recv, rcount, err);
 }
 

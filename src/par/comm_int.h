@@ -64,6 +64,13 @@ size_t pdt_comm_chunk_from_env(void);
 /* A serial context (the local backend with one rank, no thread), *c owned by
  * the caller (pdt_comm_finalize). */
 pdt_status pdt_comm_serial_new(pdt_comm **c, pdt_err *err);
+/* An alltoallv through relays, about 6 sqrt(P) messages a rank instead of
+ * P - 1 (src/par/comm_hops.c); pdt_comm_alltoallv takes it from
+ * PDT_COMM_HOPS_MIN ranks on with MPI. */
+pdt_status pdt_comm_hops_alltoallv(pdt_comm *c, const void *send, const size_t *scount,
+                                   void *recv, const size_t *rcount, pdt_err *err);
+#define PDT_COMM_HOPS_MIN 64
+
 /* Every rank learns whether any rank failed: a rank that did not fail itself
  * gets PDT_ERR_IO "PATH: WHAT failed at rank R" (R the lowest failing rank). */
 pdt_status pdt_comm_agree(pdt_comm *c, pdt_status mine, const char *path, const char *what,

@@ -5,6 +5,7 @@
 #include "../harness.h"
 
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -320,6 +321,46 @@ static pdt_status rank_partition(pdt_comm *c, void *arg, pdt_err *err)
     return PDT_OK;
 }
 
+/* An alltoallv with pieces of 0 to 8 bytes, every pair its own size. */
+static pdt_status rank_alltoallv(pdt_comm *c, void *arg, pdt_err *err)
+{
+    (void)arg;
+    int r = pdt_comm_rank(c), P = pdt_comm_size(c);
+    size_t sc[64], rc[64], so = 0, ro = 0;
+    unsigned char sv[64 * 8], rv[64 * 8];
+    for (int j = 0; j < P; j++) {
+        sc[j] = (size_t)((r * 7 + j * 3 + r * j) % 9);
+        rc[j] = (size_t)((j * 7 + r * 3 + r * j) % 9);
+        for (size_t k = 0; k < sc[j]; k++) sv[so + k] = byte_of(r, j, k);
+        so += sc[j];
+    }
+    memset(rv, 0, sizeof rv);
+    pdt_status s = pdt_comm_alltoallv(c, sv, sc, rv, rc, err);
+    if (s != PDT_OK) return s;
+    for (int j = 0; j < P; j++) {
+        for (size_t k = 0; k < rc[j]; k++)
+            if (rv[ro + k] != byte_of(j, r, k))
+                WRONG("rank %d of %d: alltoallv from %d, byte %zu", r, P, j, k);
+        ro += rc[j];
+    }
+    return PDT_OK;
+}
+
+/* The exchange through relays (src/par/comm_hops.c), forced at every P:
+ * full grids (4, 9, 16, 64), short last rows (3, 5, 7, 10, 13, 21, 31) and a
+ * last row of one rank (17, 26, 37). */
+TEST(alltoallv_in_two_hops)
+{
+    static const int ps[] = {1, 2, 3, 4, 5, 7, 9, 10, 13, 16, 17, 21, 26, 31, 37, 64};
+    setenv("PDT_TEST_COMM_HOPS", "2", 1);
+    for (size_t k = 0; k < sizeof ps / sizeof *ps; k++) {
+        pdt_err err = {0};
+        pdt_status s = pdt_comm_local_run(ps[k], rank_alltoallv, NULL, &err);
+        CHECK_MSG(s == PDT_OK, "P=%d: %s", ps[k], err.msg);
+    }
+    unsetenv("PDT_TEST_COMM_HOPS");
+}
+
 /* (P = 33 and 64: many splitters share the selection's first rounds) */
 TEST(partition_exact_shares_p2_to_p7_33_64)
 {
@@ -347,5 +388,6 @@ int main(void)
     RUN(failing_rank_ends_the_run);
     RUN(commit_refused_when_any_rank_is_stopped);
     RUN(partition_exact_shares_p2_to_p7_33_64);
+    RUN(alltoallv_in_two_hops);
     return test_summary();
 }
