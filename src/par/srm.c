@@ -278,6 +278,7 @@ static srm_strip box_build(srm_rank *s, int lo, int hi, int at)
 pdt_status pdt_srm_use_tree(srm_rank *s, const srm_tree *t, pdt_err *err)
 {
     s->tree = t;
+    s->relay = 1;
     s->levels = pdt_srm_levels_of(t, s->p);
     free(s->nbox);
     s->nbox = malloc((size_t)t->p * sizeof *s->nbox);
@@ -294,6 +295,7 @@ void pdt_srm_free(srm_rank *s)
     free(s->more);
     free(s->pend);
     free(s->hull);
+    free(s->fwd);
     memset(s, 0, sizeof *s);
 }
 
@@ -479,11 +481,24 @@ static uint32_t find_gid(const srm_pt *p, size_t n, uint32_t gid)
     return (uint32_t)lo;
 }
 
-pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err)
+/* The merge rank a pending triangle of `level` is shipped to (traced). */
+static int64_t ship_to(const srm_rank *s, int level)
 {
-    *buf = NULL;
-    *len = 0;
-    int send_hull = s->holds_hull && pdt_srm_holder_of(s->tree, s->rank, s->p, level) == s->rank;
+    int gl, gr, ge;
+    if (s->tree && pdt_srm_pair_of(s->tree, s->rank, s->p, level, &gl, &gr, &ge)) return gr;
+    return (int64_t)((s->rank >> (level + 1) << (level + 1)) + (1 << level));
+}
+
+/* One blob: the pending triangles of `level` (left in s->pend) and, with
+ * send_hull, the hull, appended to b[*len ..] (room for blob_bound). */
+static size_t blob_bound(size_t nt, size_t nh)
+{
+    return sizeof(msg_head) + (3 * nt + nh) * 15 + (3 * nt + nh) * 5;
+}
+
+static pdt_status pack_blob(srm_rank *s, int level, int send_hull, unsigned char *b, size_t *len,
+                            pdt_err *err)
+{
     size_t nt = 0;
     for (size_t i = 0; i < s->npend; i++) nt += s->pend[i].level == level;
     size_t nh = send_hull ? s->nhull : 0;
@@ -503,14 +518,7 @@ pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err
     for (size_t i = 0; i < np; i++)
         if (u == 0 || tab[i].gid != tab[u - 1].gid) tab[u++] = tab[i];
     np = u;
-
-    size_t bytes = sizeof(msg_head) + np * 15 + (3 * nt + nh) * 5;
-    unsigned char *b = malloc(bytes);
-    if (!b) {
-        free(tab);
-        return nomem(err, s->who, "pack");
-    }
-    unsigned char *w = b + sizeof(msg_head);
+    unsigned char *b0 = b + *len, *w = b0 + sizeof(msg_head);
     uint32_t prev = 0;
     for (size_t i = 0; i < np; i++) {
         w += pdt_srm_put_varint(w, tab[i].gid - prev);
@@ -518,18 +526,13 @@ pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err
         w += pdt_srm_put_varint(w, pdt_srm_zigzag(tab[i].x));
         w += pdt_srm_put_varint(w, pdt_srm_zigzag(tab[i].y));
     }
-    size_t keep = 0;
     for (size_t i = 0; i < s->npend; i++) {
         srm_tri *t = &s->pend[i];
-        if (t->level != level) {
-            s->pend[keep++] = *t;
-            continue;
-        }
+        if (t->level != level) continue;
         for (int j = 0; j < 3; j++) w += pdt_srm_put_varint(w, find_gid(tab, np, t->p[j].gid));
         PDT_TRACE(s->tr, 1, PDT_EV_SHIP, 0, t->p[0].gid, t->p[1].gid, t->p[2].gid,
-                  (int64_t)((s->rank >> (level + 1) << (level + 1)) + (1 << level)));
+                  ship_to(s, level));
     }
-    s->npend = keep;
     s->cnt.shipped += nt;
     for (size_t i = 0; i < nh; i++) w += pdt_srm_put_varint(w, find_gid(tab, np, s->hull[i].gid));
     msg_head hd = {SRM_MSG_MAGIC,
@@ -540,17 +543,66 @@ pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err
                    (uint64_t)np,
                    (uint64_t)nt,
                    (uint64_t)nh,
-                   (uint64_t)(w - b - sizeof(msg_head)),
+                   (uint64_t)(w - b0 - sizeof(msg_head)),
                    s->cnt.critical_path,
                    s->cnt.critical_cpu};
-    memcpy(b, &hd, sizeof hd);
+    memcpy(b0, &hd, sizeof hd);
+    free(tab);
+    *len = (size_t)(w - b);
+    return PDT_OK;
+}
+
+/* The pending triangles of the levels in `sent` (a bit per level) leave. */
+static void drop_sent(srm_rank *s, uint64_t sent)
+{
+    size_t keep = 0;
+    for (size_t i = 0; i < s->npend; i++)
+        if (!(sent >> s->pend[i].level & 1)) s->pend[keep++] = s->pend[i];
+    s->npend = keep;
+}
+
+pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err)
+{
+    *buf = NULL;
+    *len = 0;
+    int holder = pdt_srm_holder_of(s->tree, s->rank, s->p, level) == s->rank;
+    if (s->relay && !holder) {
+        if (s->npend || s->nfwd)
+            return pdt_err_set(err, PDT_ERR_CHECK, "%s: holds pending triangles at level %d "
+                               "without holding its group", s->who, level);
+        return PDT_OK;
+    }
+    int send_hull = s->holds_hull && holder;
+    /* the levels whose triangles go: this one; with relay every later one */
+    uint64_t sent = (uint64_t)1 << level;
+    size_t bound = blob_bound(0, send_hull ? s->nhull : 0) + s->nfwd;
+    for (size_t i = 0; i < s->npend; i++) {
+        int lv = s->pend[i].level;
+        if (lv != level && !s->relay) continue;
+        if (!(sent >> lv & 1)) bound += sizeof(msg_head);
+        sent |= (uint64_t)1 << lv;
+        bound += blob_bound(1, 0) - sizeof(msg_head);
+    }
+    unsigned char *b = malloc(bound);
+    if (!b) return nomem(err, s->who, "pack");
+    size_t n = 0;
+    pdt_status st = PDT_OK;
+    for (int lv = level; lv < 64 && st == PDT_OK; lv++)
+        if (sent >> lv & 1) st = pack_blob(s, lv, send_hull && lv == level, b, &n, err);
+    if (st != PDT_OK) {
+        free(b);
+        return st;
+    }
+    if (s->nfwd) memcpy(b + n, s->fwd, s->nfwd);
+    n += s->nfwd;
+    s->nfwd = 0;
+    drop_sent(s, sent);
     if (send_hull) {
         s->holds_hull = 0;
         s->nhull = 0;
     }
-    free(tab);
     *buf = b;
-    *len = (size_t)(w - b);
+    *len = n;
     return PDT_OK;
 }
 
@@ -671,7 +723,9 @@ typedef struct merge_job {
     srm_rank *s;
     int level, gl, gr, ge, nm;
     pdt_err *err;
-    msg_view *mv;            /* the decoded messages, one per rank of the pair */
+    msg_view *mv;            /* the decoded blobs of this level, nmv of them */
+    int nmv;
+    int *mv_from;            /* the rank of the pair each came from */
     int hl, hr;              /* message holding the hull of G_L / G_R, or -1 */
     double cp_in, cpu_in;    /* longest critical path among the senders */
     gtri *shipped;           /* R_L ∪ R_R, canonical (sorted when traced) */
@@ -689,8 +743,9 @@ typedef struct merge_job {
 
 static void merge_job_free(merge_job *j)
 {
-    for (int i = 0; j->mv && i < j->nm; i++) msg_view_free(&j->mv[i]);
+    for (int i = 0; j->mv && i < j->nmv; i++) msg_view_free(&j->mv[i]);
     free(j->mv);
+    free(j->mv_from);
     free(j->shipped);
     pdt_srm_tset_free(&j->sset);
     pdt_srm_tset_free(&j->tset);
@@ -701,25 +756,91 @@ static void merge_job_free(merge_job *j)
     free(j->tris);
 }
 
+/* A blob's header at b[0 .. left): 1 if it is whole. */
+static int blob_at(const unsigned char *b, size_t left, msg_head *h)
+{
+    if (left < sizeof *h) return 0;
+    memcpy(h, b, sizeof *h);
+    return h->magic == SRM_MSG_MAGIC && h->payload <= left - sizeof *h;
+}
+
+/* Keep a blob for a later level: this rank carries it on (relay). */
+static pdt_status carry(srm_rank *s, const unsigned char *b, size_t n)
+{
+    if (s->nfwd + n > s->capfwd) {
+        size_t cap = s->capfwd ? s->capfwd : 4096;
+        while (cap < s->nfwd + n) cap *= 2;
+        unsigned char *f = realloc(s->fwd, cap);
+        if (!f) return PDT_ERR_NOMEM;
+        s->fwd = f;
+        s->capfwd = cap;
+    }
+    memcpy(s->fwd + s->nfwd, b, n);
+    s->nfwd += n;
+    return PDT_OK;
+}
+
+/* Split the messages into blobs: this level's are decoded into j->mv, a
+ * later level's carried on (relay only); a message without relay is one
+ * blob, of this level. */
+static pdt_status split_messages(merge_job *j, void *const *msg, const size_t *len)
+{
+    srm_rank *s = j->s;
+    int nblob = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (int i = 0; i < j->nm; i++) {
+            char from[40];
+            pdt_srm_name(s, j->gl + i, from, sizeof from);
+            if (!msg[i] && s->relay) continue;
+            const unsigned char *b = msg[i];
+            size_t left = msg[i] ? len[i] : 0;
+            int first = 1;
+            do {
+                msg_head h;
+                if (!blob_at(b, left, &h) || (!s->relay && (!first || h.level != (uint32_t)j->level)) ||
+                    h.level < (uint32_t)j->level || h.level >= (uint32_t)s->levels)
+                    return pdt_err_set(j->err, PDT_ERR_CORRUPT, "merge message from %s: bad "
+                                       "header", from);
+                size_t n = sizeof h + (size_t)h.payload;
+                if (h.level != (uint32_t)j->level) {
+                    if (pass == 1 && carry(s, b, n) != PDT_OK) return nomem(j->err, s->who, "merge");
+                } else if (pass == 0) {
+                    nblob++;
+                } else {
+                    j->mv_from[j->nmv] = j->gl + i;
+                    pdt_status st = decode(b, n, j->level, from, &j->mv[j->nmv], j->err);
+                    if (st != PDT_OK) return st;
+                    j->nmv++;
+                }
+                b += n;
+                left -= n;
+                first = 0;
+            } while (left > 0);
+        }
+        if (pass == 0) {
+            j->mv = calloc((size_t)nblob + 1, sizeof *j->mv);
+            j->mv_from = calloc((size_t)nblob + 1, sizeof *j->mv_from);
+            if (!j->mv || !j->mv_from) return nomem(j->err, s->who, "merge");
+        }
+    }
+    return PDT_OK;
+}
+
 /* Decode every message; find the two hulls and the longest critical path. */
 static pdt_status read_messages(merge_job *j, void *const *msg, const size_t *len)
 {
     srm_rank *s = j->s;
-    j->mv = calloc((size_t)j->nm, sizeof *j->mv);
-    if (!j->mv) return nomem(j->err, s->who, "merge");
     j->cp_in = s->cnt.critical_path;
     j->cpu_in = s->cnt.critical_cpu;
     j->hl = j->hr = -1;
-    for (int i = 0; i < j->nm; i++) {
-        char from[40];
-        pdt_srm_name(s, j->gl + i, from, sizeof from);
-        pdt_status st = decode(msg[i], len[i], j->level, from, &j->mv[i], j->err);
-        if (st != PDT_OK) return st;
+    pdt_status st = split_messages(j, msg, len);
+    if (st != PDT_OK) return st;
+    for (int i = 0; i < j->nmv; i++) {
         const msg_view *v = &j->mv[i];
         if (v->h.cp > j->cp_in) j->cp_in = v->h.cp;
         if (v->h.cp_cpu > j->cpu_in) j->cpu_in = v->h.cp_cpu;
         if (v->h.flags & MSG_HAS_HULL) {
-            int *side = j->gl + i < j->gr ? &j->hl : &j->hr;
+            int *side = j->mv_from[i] < j->gr ? &j->hl : &j->hr;
             if (*side >= 0)
                 return pdt_err_set(j->err, PDT_ERR_CORRUPT, "merge at level %d: two hulls",
                                    j->level);
@@ -736,7 +857,7 @@ static pdt_status border_set(merge_job *j)
 {
     srm_rank *s = j->s;
     size_t nship = 0, nbmax = 0;
-    for (int i = 0; i < j->nm; i++) {
+    for (int i = 0; i < j->nmv; i++) {
         nship += j->mv[i].h.ntri;
         nbmax += 3 * (size_t)j->mv[i].h.ntri + 2 * (size_t)j->mv[i].h.nhull;
     }
@@ -745,7 +866,7 @@ static pdt_status border_set(merge_job *j)
     if (!j->shipped || !j->B) return nomem(j->err, s->who, "merge");
     size_t ns = 0, nb = 0;
     srm_pt *B = j->B;
-    for (int i = 0; i < j->nm; i++) {
+    for (int i = 0; i < j->nmv; i++) {
         const msg_view *v = &j->mv[i];
         for (size_t t = 0; t < v->h.ntri; t++) {
             srm_pt a = v->pts[v->tri[3 * t]], b = v->pts[v->tri[3 * t + 1]],

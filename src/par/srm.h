@@ -272,6 +272,12 @@ typedef struct srm_rank {
     srm_pt *hull;
     size_t nhull;
     int hull_degenerate, holds_hull;
+    /* relay (bisection): a group's pending triangles travel up the merge tree
+     * with its hull, so that a merge gets two messages, from the holders of
+     * its halves; fwd holds the blobs this holder carries for later levels */
+    int relay;
+    unsigned char *fwd;
+    size_t nfwd, capfwd;
     srm_counts cnt;
     pdt_trace *tr;
     double (*clock)(void *);      /* seconds, for the counts */
@@ -322,11 +328,20 @@ int pdt_srm_holder(int r, int p, int level);
 /* Message from this rank to the merge rank of `level`: its pending
  * triangles waiting for that level (removed here), its hull if it holds the
  * hull of G_L or G_R, and its critical path so far.  *buf malloc'd (caller
- * frees).  Every rank of the pair sends one, possibly empty. */
+ * frees).  Every rank of the pair sends one, possibly empty.
+ *
+ * A message is a sequence of blobs, each a header and its payload: one
+ * without relay (the triangles of `level`).  With relay (s->relay, the
+ * bisection's merge tree) only the holders of the pair's two groups send
+ * (a rank that holds nothing gets *buf NULL): a blob for `level` (with the
+ * hull), one for each later level it has pending triangles for, and the
+ * blobs it carries for later levels (s->fwd), as they came. */
 pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err);
 
 /* At the merge rank: merge the messages of every rank of the pair
- * (msg[i] from rank gl + i, i = 0 .. ge-gl-1, including this rank's own).
+ * (msg[i] from rank gl + i, i = 0 .. ge-gl-1, including this rank's own;
+ * with relay NULL but for the two holders, whose blobs for later levels
+ * this rank then carries).
  * Shipped sets, border set, lift-up, kernel (run 1), selection, discards,
  * hull merge, reclassification.  The critical path continues from the
  * longest one among the senders (carried in the messages). */

@@ -111,6 +111,13 @@ const srm_tree *pdt_drv_sched(const drv *d)
     return d->tree.cut ? &d->tree : NULL;
 }
 
+/* Whether strip q sends a message at `level`: every strip of a pair, or
+ * with relay (the bisection's tree) the holders of its two groups only. */
+static int sends(const drv *d, int q, int level)
+{
+    return !d->tree.cut || pdt_srm_holder_of(pdt_drv_sched(d), q, d->p * d->k, level) == q;
+}
+
 /* At the merge strip g of a level (this rank's strip j): the messages of the
  * pair's strips [gl, ge): this rank's own (in own[], taken: freed here), the
  * others received from their ranks, in strip order (a rank sends its strips'
@@ -126,6 +133,7 @@ static pdt_status merge_at(drv *d, int level, int j, int gl, int ge, void **own,
     pdt_status st = msg && lens ? PDT_OK : pdt_drv_nomem(d, "merge");
     for (int q = gl; q < ge && st == PDT_OK; q++) {
         int from = q / k;
+        if (!sends(d, q, level)) continue;
         if (from == d->rank) {
             msg[q - gl] = own[q % k];
             lens[q - gl] = own_len[q % k];
@@ -155,6 +163,7 @@ static pdt_status merge_level(drv *d, int level, pdt_err *err)
     for (int j = 0; j < k && st == PDT_OK; j++) {
         int g = d->rank * k + j, gl, gr, ge;
         if (!pdt_srm_pair_of(pdt_drv_sched(d), g, np, level, &gl, &gr, &ge)) continue;
+        if (!sends(d, g, level)) continue;
         st = pdt_srm_pack(&d->s[j], level, &own[j], &own_len[j], err);
         if (st != PDT_OK || gr / k == d->rank) continue;
         st = pdt_comm_send(d->c, gr / k, TAG_MERGE + level, own[j], own_len[j], err);

@@ -376,6 +376,28 @@ TEST(merge_message_header)
                   err.msg);
         free(c);
     }
+    /* with relay a message is a sequence of blobs: a cut-off blob after the
+     * first, or a blob for a level past the last, is refused */
+    rk[1].relay = 1;
+    for (int k = 0; k < 2; k++) {
+        size_t extra = k == 0 ? 10 : len[0];
+        unsigned char *c = malloc(len[0] + extra);
+        memcpy(c, msg[0], len[0]);
+        memcpy(c + len[0], msg[0], extra);
+        if (k == 1) {
+            srm_msg_head later = h;
+            later.level = 5;
+            memcpy(c + len[0], &later, sizeof later);
+        }
+        void *mm[2] = {c, msg[1]};
+        size_t ll[2] = {len[0] + extra, len[1]};
+        pdt_err_clear(&err);
+        CHECK_MSG(pdt_srm_merge(&rk[1], 0, mm, ll, &err) == PDT_ERR_CORRUPT, "relay %d", k);
+        CHECK_MSG(strstr(err.msg, "bad header") != NULL, "relay %d: %s", k, err.msg);
+        CHECK(rk[1].nfwd == 0);
+        free(c);
+    }
+    rk[1].relay = 0;
     /* the undamaged messages merge: every triangle final, none pending */
     pdt_err_clear(&err);
     CHECK(pdt_srm_merge(&rk[1], 0, msg, len, &err) == PDT_OK);
