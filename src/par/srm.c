@@ -18,15 +18,6 @@
 #include "pdt/hull.h"
 #include "pdt/predicates.h"
 
-/* Message: a header (srm_msg_head, srm.h) and `payload` bytes of LEB128
- * varints: the point table in increasing gid order (gid delta, zigzag x,
- * zigzag y), then the triangles and the hull as positions in that table.
- * About 8 bytes per point and 5 per triangle for coordinates below 2^20,
- * instead of 12 and 12. */
-typedef srm_msg_head msg_head;
-
-enum { MSG_HAS_HULL = 1, MSG_HULL_DEGENERATE = 2 };
-
 /* ---- small helpers ------------------------------------------------------- */
 
 static int msb(unsigned v)
@@ -462,209 +453,12 @@ pdt_status pdt_srm_local(srm_rank *s, void *block, pdt_point *pts, const uint32_
     return st;
 }
 
-/* ---- messages ------------------------------------------------------------------ */
+/* ---- the merge's look-ups ---------------------------------------------------- */
 
 static int cmp_gid(const void *a, const void *b)
 {
     uint32_t x = ((const srm_pt *)a)->gid, y = ((const srm_pt *)b)->gid;
     return x < y ? -1 : x > y;
-}
-
-static uint32_t find_gid(const srm_pt *p, size_t n, uint32_t gid)
-{
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (p[mid].gid < gid) lo = mid + 1;
-        else hi = mid;
-    }
-    return (uint32_t)lo;
-}
-
-/* The merge rank a pending triangle of `level` is shipped to (traced). */
-static int64_t ship_to(const srm_rank *s, int level)
-{
-    int gl, gr, ge;
-    if (s->tree && pdt_srm_pair_of(s->tree, s->rank, s->p, level, &gl, &gr, &ge)) return gr;
-    return (int64_t)((s->rank >> (level + 1) << (level + 1)) + (1 << level));
-}
-
-/* One blob: the pending triangles of `level` (left in s->pend) and, with
- * send_hull, the hull, appended to b[*len ..] (room for blob_bound). */
-static size_t blob_bound(size_t nt, size_t nh)
-{
-    return sizeof(msg_head) + (3 * nt + nh) * 15 + (3 * nt + nh) * 5;
-}
-
-static pdt_status pack_blob(srm_rank *s, int level, int send_hull, unsigned char *b, size_t *len,
-                            pdt_err *err)
-{
-    size_t nt = 0;
-    for (size_t i = 0; i < s->npend; i++) nt += s->pend[i].level == level;
-    size_t nh = send_hull ? s->nhull : 0;
-    /* point table: distinct vertices of the shipped triangles and the hull */
-    srm_pt *tab = srm_big((3 * nt + nh + 1) * sizeof *tab);
-    if (!tab) return nomem(err, s->who, "pack");
-    size_t np = 0;
-    for (size_t i = 0; i < s->npend; i++)
-        if (s->pend[i].level == level)
-            for (int k = 0; k < 3; k++) tab[np++] = s->pend[i].p[k];
-    for (size_t i = 0; i < nh; i++) tab[np++] = s->hull[i];
-    if (pdt_srm_sort_pts(tab, np, 1) != PDT_OK) {
-        free(tab);
-        return nomem(err, s->who, "pack");
-    }
-    size_t u = 0;
-    for (size_t i = 0; i < np; i++)
-        if (u == 0 || tab[i].gid != tab[u - 1].gid) tab[u++] = tab[i];
-    np = u;
-    unsigned char *b0 = b + *len, *w = b0 + sizeof(msg_head);
-    uint32_t prev = 0;
-    for (size_t i = 0; i < np; i++) {
-        w += pdt_srm_put_varint(w, tab[i].gid - prev);
-        prev = tab[i].gid;
-        w += pdt_srm_put_varint(w, pdt_srm_zigzag(tab[i].x));
-        w += pdt_srm_put_varint(w, pdt_srm_zigzag(tab[i].y));
-    }
-    for (size_t i = 0; i < s->npend; i++) {
-        srm_tri *t = &s->pend[i];
-        if (t->level != level) continue;
-        for (int j = 0; j < 3; j++) w += pdt_srm_put_varint(w, find_gid(tab, np, t->p[j].gid));
-        PDT_TRACE(s->tr, 1, PDT_EV_SHIP, 0, t->p[0].gid, t->p[1].gid, t->p[2].gid,
-                  ship_to(s, level));
-    }
-    s->cnt.shipped += nt;
-    for (size_t i = 0; i < nh; i++) w += pdt_srm_put_varint(w, find_gid(tab, np, s->hull[i].gid));
-    msg_head hd = {SRM_MSG_MAGIC,
-                   (uint32_t)level,
-                   (send_hull ? MSG_HAS_HULL : 0u) |
-                       (send_hull && s->hull_degenerate ? MSG_HULL_DEGENERATE : 0u),
-                   0,
-                   (uint64_t)np,
-                   (uint64_t)nt,
-                   (uint64_t)nh,
-                   (uint64_t)(w - b0 - sizeof(msg_head)),
-                   s->cnt.critical_path,
-                   s->cnt.critical_cpu};
-    memcpy(b0, &hd, sizeof hd);
-    free(tab);
-    *len = (size_t)(w - b);
-    return PDT_OK;
-}
-
-/* The pending triangles of the levels in `sent` (a bit per level) leave. */
-static void drop_sent(srm_rank *s, uint64_t sent)
-{
-    size_t keep = 0;
-    for (size_t i = 0; i < s->npend; i++)
-        if (!(sent >> s->pend[i].level & 1)) s->pend[keep++] = s->pend[i];
-    s->npend = keep;
-}
-
-pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err)
-{
-    *buf = NULL;
-    *len = 0;
-    int holder = pdt_srm_holder_of(s->tree, s->rank, s->p, level) == s->rank;
-    if (s->relay && !holder) {
-        if (s->npend || s->nfwd)
-            return pdt_err_set(err, PDT_ERR_CHECK, "%s: holds pending triangles at level %d "
-                               "without holding its group", s->who, level);
-        return PDT_OK;
-    }
-    int send_hull = s->holds_hull && holder;
-    /* the levels whose triangles go: this one; with relay every later one */
-    uint64_t sent = (uint64_t)1 << level;
-    size_t bound = blob_bound(0, send_hull ? s->nhull : 0) + s->nfwd;
-    for (size_t i = 0; i < s->npend; i++) {
-        int lv = s->pend[i].level;
-        if (lv != level && !s->relay) continue;
-        if (!(sent >> lv & 1)) bound += sizeof(msg_head);
-        sent |= (uint64_t)1 << lv;
-        bound += blob_bound(1, 0) - sizeof(msg_head);
-    }
-    unsigned char *b = malloc(bound);
-    if (!b) return nomem(err, s->who, "pack");
-    size_t n = 0;
-    pdt_status st = PDT_OK;
-    for (int lv = level; lv < 64 && st == PDT_OK; lv++)
-        if (sent >> lv & 1) st = pack_blob(s, lv, send_hull && lv == level, b, &n, err);
-    if (st != PDT_OK) {
-        free(b);
-        return st;
-    }
-    if (s->nfwd) memcpy(b + n, s->fwd, s->nfwd);
-    n += s->nfwd;
-    s->nfwd = 0;
-    drop_sent(s, sent);
-    if (send_hull) {
-        s->holds_hull = 0;
-        s->nhull = 0;
-    }
-    *buf = b;
-    *len = n;
-    return PDT_OK;
-}
-
-/* A decoded message (arrays owned: msg_view_free). */
-typedef struct msg_view {
-    msg_head h;
-    srm_pt *pts;
-    uint32_t *tri;  /* 3 * ntri positions, then nhull positions */
-    uint32_t *hull;
-} msg_view;
-
-static void msg_view_free(msg_view *v)
-{
-    free(v->pts);
-    free(v->tri);
-    v->pts = NULL;
-    v->tri = v->hull = NULL;
-}
-
-static pdt_status decode(const void *buf, size_t len, int level, const char *from, msg_view *v,
-                         pdt_err *err)
-{
-    if (len < sizeof(msg_head))
-        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from %s: too short", from);
-    memcpy(&v->h, buf, sizeof v->h);
-    const msg_head *h = &v->h;
-    if (h->magic != SRM_MSG_MAGIC || h->level != (uint32_t)level ||
-        h->payload != (uint64_t)(len - sizeof(msg_head)))
-        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from %s: bad header", from);
-    /* every count is at most the payload (a varint takes a byte at least) */
-    if (h->npts > h->payload || h->ntri > h->payload / 3 ||
-        h->nhull > h->payload - 3 * h->ntri)
-        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from %s: bad counts", from);
-    size_t ni = 3 * (size_t)h->ntri + (size_t)h->nhull;
-    v->pts = malloc(((size_t)h->npts + 1) * sizeof *v->pts);
-    v->tri = malloc((ni + 1) * sizeof *v->tri);
-    if (!v->pts || !v->tri) {
-        msg_view_free(v);
-        return pdt_err_set(err, PDT_ERR_NOMEM, "merge message from %s: out of memory",
-                           from);
-    }
-    v->hull = v->tri + 3 * (size_t)h->ntri;
-    const unsigned char *p = (const unsigned char *)buf + sizeof(msg_head), *end = p + h->payload;
-    uint64_t gid = 0, a, x, y;
-    for (size_t i = 0; i < h->npts; i++) {
-        if (!pdt_srm_get_varint(&p, end, &a) || !pdt_srm_get_varint(&p, end, &x) || !pdt_srm_get_varint(&p, end, &y))
-            goto bad;
-        gid += a;
-        int64_t sx = (int64_t)(x >> 1) ^ -(int64_t)(x & 1), sy = (int64_t)(y >> 1) ^ -(int64_t)(y & 1);
-        if (gid > UINT32_MAX || sx < INT32_MIN || sx > INT32_MAX || sy < INT32_MIN || sy > INT32_MAX)
-            goto bad;
-        v->pts[i] = (srm_pt){(int32_t)sx, (int32_t)sy, (uint32_t)gid};
-    }
-    for (size_t i = 0; i < ni; i++) {
-        if (!pdt_srm_get_varint(&p, end, &a) || a >= h->npts) goto bad;
-        v->tri[i] = (uint32_t)a;
-    }
-    if (p != end) goto bad;
-    return PDT_OK;
-bad:
-    msg_view_free(v);
-    return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from %s: damaged payload", from);
 }
 
 /* ---- the merge step ------------------------------------------------------------ */
@@ -698,11 +492,11 @@ static int cmp_key(const void *a, const void *b)
 /* Collect the facing hull vertices of one side into B: endpoints of every
  * hull edge whose outer half-plane meets a box of the other side (all points
  * if the hull is degenerate). */
-static size_t facing(const srm_rank *s, const msg_view *hv, int q0, int q1, srm_pt *out)
+static size_t facing(const srm_rank *s, const srm_msg_view *hv, int q0, int q1, srm_pt *out)
 {
     size_t n = 0, k = hv->h.nhull;
     const uint32_t *h = hv->hull;
-    if (hv->h.flags & MSG_HULL_DEGENERATE) {
+    if (hv->h.flags & SRM_MSG_HULL_DEGENERATE) {
         for (size_t i = 0; i < k; i++) out[n++] = hv->pts[h[i]];
         return n;
     }
@@ -723,7 +517,7 @@ typedef struct merge_job {
     srm_rank *s;
     int level, gl, gr, ge, nm;
     pdt_err *err;
-    msg_view *mv;            /* the decoded blobs of this level, nmv of them */
+    srm_msg_view *mv;            /* the decoded blobs of this level, nmv of them */
     int nmv;
     int *mv_from;            /* the rank of the pair each came from */
     int hl, hr;              /* message holding the hull of G_L / G_R, or -1 */
@@ -743,7 +537,7 @@ typedef struct merge_job {
 
 static void merge_job_free(merge_job *j)
 {
-    for (int i = 0; j->mv && i < j->nmv; i++) msg_view_free(&j->mv[i]);
+    for (int i = 0; j->mv && i < j->nmv; i++) pdt_srm_msg_free(&j->mv[i]);
     free(j->mv);
     free(j->mv_from);
     free(j->shipped);
@@ -754,30 +548,6 @@ static void merge_job_free(merge_job *j)
     free(j->bp);
     free(j->bg);
     free(j->tris);
-}
-
-/* A blob's header at b[0 .. left): 1 if it is whole. */
-static int blob_at(const unsigned char *b, size_t left, msg_head *h)
-{
-    if (left < sizeof *h) return 0;
-    memcpy(h, b, sizeof *h);
-    return h->magic == SRM_MSG_MAGIC && h->payload <= left - sizeof *h;
-}
-
-/* Keep a blob for a later level: this rank carries it on (relay). */
-static pdt_status carry(srm_rank *s, const unsigned char *b, size_t n)
-{
-    if (s->nfwd + n > s->capfwd) {
-        size_t cap = s->capfwd ? s->capfwd : 4096;
-        while (cap < s->nfwd + n) cap *= 2;
-        unsigned char *f = realloc(s->fwd, cap);
-        if (!f) return PDT_ERR_NOMEM;
-        s->fwd = f;
-        s->capfwd = cap;
-    }
-    memcpy(s->fwd + s->nfwd, b, n);
-    s->nfwd += n;
-    return PDT_OK;
 }
 
 /* Split the messages into blobs: this level's are decoded into j->mv, a
@@ -796,19 +566,19 @@ static pdt_status split_messages(merge_job *j, void *const *msg, const size_t *l
             size_t left = msg[i] ? len[i] : 0;
             int first = 1;
             do {
-                msg_head h;
-                if (!blob_at(b, left, &h) || (!s->relay && (!first || h.level != (uint32_t)j->level)) ||
+                srm_msg_head h;
+                if (!pdt_srm_blob_at(b, left, &h) || (!s->relay && (!first || h.level != (uint32_t)j->level)) ||
                     h.level < (uint32_t)j->level || h.level >= (uint32_t)s->levels)
                     return pdt_err_set(j->err, PDT_ERR_CORRUPT, "merge message from %s: bad "
                                        "header", from);
                 size_t n = sizeof h + (size_t)h.payload;
                 if (h.level != (uint32_t)j->level) {
-                    if (pass == 1 && carry(s, b, n) != PDT_OK) return nomem(j->err, s->who, "merge");
+                    if (pass == 1 && pdt_srm_carry(s, b, n) != PDT_OK) return nomem(j->err, s->who, "merge");
                 } else if (pass == 0) {
                     nblob++;
                 } else {
                     j->mv_from[j->nmv] = j->gl + i;
-                    pdt_status st = decode(b, n, j->level, from, &j->mv[j->nmv], j->err);
+                    pdt_status st = pdt_srm_msg_decode(b, n, j->level, from, &j->mv[j->nmv], j->err);
                     if (st != PDT_OK) return st;
                     j->nmv++;
                 }
@@ -836,10 +606,10 @@ static pdt_status read_messages(merge_job *j, void *const *msg, const size_t *le
     pdt_status st = split_messages(j, msg, len);
     if (st != PDT_OK) return st;
     for (int i = 0; i < j->nmv; i++) {
-        const msg_view *v = &j->mv[i];
+        const srm_msg_view *v = &j->mv[i];
         if (v->h.cp > j->cp_in) j->cp_in = v->h.cp;
         if (v->h.cp_cpu > j->cpu_in) j->cpu_in = v->h.cp_cpu;
-        if (v->h.flags & MSG_HAS_HULL) {
+        if (v->h.flags & SRM_MSG_HAS_HULL) {
             int *side = j->mv_from[i] < j->gr ? &j->hl : &j->hr;
             if (*side >= 0)
                 return pdt_err_set(j->err, PDT_ERR_CORRUPT, "merge at level %d: two hulls",
@@ -867,7 +637,7 @@ static pdt_status border_set(merge_job *j)
     size_t ns = 0, nb = 0;
     srm_pt *B = j->B;
     for (int i = 0; i < j->nmv; i++) {
-        const msg_view *v = &j->mv[i];
+        const srm_msg_view *v = &j->mv[i];
         for (size_t t = 0; t < v->h.ntri; t++) {
             srm_pt a = v->pts[v->tri[3 * t]], b = v->pts[v->tri[3 * t + 1]],
                    c = v->pts[v->tri[3 * t + 2]];
@@ -988,7 +758,7 @@ static int64_t witness(const srm_pt *byg, size_t nb, gtri t)
 {
     pdt_point t3[3];
     for (int k = 0; k < 3; k++) {
-        srm_pt q = byg[find_gid(byg, nb, t.v[k])];
+        srm_pt q = byg[srm_find_gid(byg, nb, t.v[k])];
         t3[k] = (pdt_point){q.x, q.y};
     }
     for (size_t i = 0; i < nb; i++) {
@@ -1034,7 +804,7 @@ static pdt_status merge_hulls(merge_job *j)
 {
     srm_rank *s = j->s;
     pdt_trace *tr = s->tr;
-    const msg_view *ml = j->hl >= 0 ? &j->mv[j->hl] : NULL, *mr = j->hr >= 0 ? &j->mv[j->hr] : NULL;
+    const srm_msg_view *ml = j->hl >= 0 ? &j->mv[j->hl] : NULL, *mr = j->hr >= 0 ? &j->mv[j->hr] : NULL;
     size_t n1 = ml ? ml->h.nhull : 0, n2 = mr ? mr->h.nhull : 0, nh = n1 + n2;
     srm_pt *hp = malloc((nh + 1) * sizeof *hp), *nhull = malloc((nh + 1) * sizeof *nhull);
     uint32_t *hidx = malloc((nh + 2) * sizeof *hidx), *pg = malloc((nh + 1) * sizeof *pg);

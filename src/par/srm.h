@@ -26,6 +26,19 @@ typedef struct srm_pt {
     uint32_t gid;
 } srm_pt;
 
+/* The place of gid in p[0..n), sorted by gid (p[place].gid == gid when it is
+ * there). */
+static inline uint32_t srm_find_gid(const srm_pt *p, size_t n, uint32_t gid)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (p[mid].gid < gid) lo = mid + 1;
+        else hi = mid;
+    }
+    return (uint32_t)lo;
+}
+
 /* Strip descriptor of one rank (allgathered after the partition). */
 typedef struct srm_strip {
     uint64_t count;              /* distinct points (0 = empty strip: no box) */
@@ -241,6 +254,16 @@ typedef struct srm_msg_head {
     double cp, cp_cpu;          /* the sender's critical path (wall, CPU) */
 } srm_msg_head;
 
+enum { SRM_MSG_HAS_HULL = 1, SRM_MSG_HULL_DEGENERATE = 2 }; /* srm_msg_head.flags */
+
+/* A decoded blob (srm_codec.c; arrays owned: pdt_srm_msg_free). */
+typedef struct srm_msg_view {
+    srm_msg_head h;
+    srm_pt *pts;
+    uint32_t *tri;  /* 3 * ntri positions, then nhull positions */
+    uint32_t *hull;
+} srm_msg_view;
+
 typedef struct srm_counts {
     uint64_t local_tris, final_at_once, deferred, shipped, merges, border_max, kept, discarded,
         final_merge;
@@ -337,6 +360,17 @@ int pdt_srm_holder(int r, int p, int level);
  * hull), one for each later level it has pending triangles for, and the
  * blobs it carries for later levels (s->fwd), as they came. */
 pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err);
+
+/* Reading a message (srm_codec.c): the blob of `level` of len bytes at buf,
+ * decoded into v, or PDT_ERR_CORRUPT naming `from`; freed by
+ * pdt_srm_msg_free.  pdt_srm_blob_at: 1 if a whole blob begins at b (left
+ * bytes to the message's end), its header in *h.  pdt_srm_carry: keep n
+ * bytes of blobs for a later level in s->fwd (relay). */
+pdt_status pdt_srm_msg_decode(const void *buf, size_t len, int level, const char *from,
+                              srm_msg_view *v, pdt_err *err);
+void pdt_srm_msg_free(srm_msg_view *v);
+int pdt_srm_blob_at(const unsigned char *b, size_t left, srm_msg_head *h);
+pdt_status pdt_srm_carry(srm_rank *s, const unsigned char *b, size_t n);
 
 /* At the merge rank: merge the messages of every rank of the pair
  * (msg[i] from rank gl + i, i = 0 .. ge-gl-1, including this rank's own;

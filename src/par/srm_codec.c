@@ -1,6 +1,18 @@
-/* pdt — the varints of SRM's messages (LEB128, signed values zigzagged);
- * the message layout is described in srm.c. */
+/* pdt — SRM's merge messages: the varints (LEB128, signed values
+ * zigzagged), packing a rank's message (pdt_srm_pack) and reading one
+ * (pdt_srm_msg_decode, the blobs of a relay: pdt_srm_blob_at,
+ * pdt_srm_carry).
+ *
+ * A message is a sequence of blobs (one without relay).  A blob is a header
+ * (srm_msg_head, srm.h) and `payload` bytes of LEB128 varints: the point
+ * table in increasing gid order (gid delta, zigzag x, zigzag y), then the
+ * triangles and the hull as positions in that table.  About 8 bytes per
+ * point and 5 per triangle for coordinates below 2^20, instead of 12 and
+ * 12. */
 #include "srm.h"
+
+#include <stdlib.h>
+#include <string.h>
 
 size_t pdt_srm_put_varint(unsigned char *b, uint64_t v)
 {
@@ -31,4 +43,215 @@ int pdt_srm_get_varint(const unsigned char **p, const unsigned char *end, uint64
         }
     }
     return 0;
+}
+
+/* ---- packing ---------------------------------------------------------------- */
+
+static pdt_status nomem(pdt_err *err, const char *who, const char *what)
+{
+    return pdt_err_set(err, PDT_ERR_NOMEM, "%s: %s: out of memory", who, what);
+}
+
+/* The merge rank a pending triangle of `level` is shipped to (traced). */
+static int64_t ship_to(const srm_rank *s, int level)
+{
+    int gl, gr, ge;
+    if (s->tree && pdt_srm_pair_of(s->tree, s->rank, s->p, level, &gl, &gr, &ge)) return gr;
+    return (int64_t)((s->rank >> (level + 1) << (level + 1)) + (1 << level));
+}
+
+/* One blob: the pending triangles of `level` (left in s->pend) and, with
+ * send_hull, the hull, appended to b[*len ..] (room for blob_bound). */
+static size_t blob_bound(size_t nt, size_t nh)
+{
+    return sizeof(srm_msg_head) + (3 * nt + nh) * 15 + (3 * nt + nh) * 5;
+}
+
+static pdt_status pack_blob(srm_rank *s, int level, int send_hull, unsigned char *b, size_t *len,
+                            pdt_err *err)
+{
+    size_t nt = 0;
+    for (size_t i = 0; i < s->npend; i++) nt += s->pend[i].level == level;
+    size_t nh = send_hull ? s->nhull : 0;
+    /* point table: distinct vertices of the shipped triangles and the hull */
+    srm_pt *tab = srm_big((3 * nt + nh + 1) * sizeof *tab);
+    if (!tab) return nomem(err, s->who, "pack");
+    size_t np = 0;
+    for (size_t i = 0; i < s->npend; i++)
+        if (s->pend[i].level == level)
+            for (int k = 0; k < 3; k++) tab[np++] = s->pend[i].p[k];
+    for (size_t i = 0; i < nh; i++) tab[np++] = s->hull[i];
+    if (pdt_srm_sort_pts(tab, np, 1) != PDT_OK) {
+        free(tab);
+        return nomem(err, s->who, "pack");
+    }
+    size_t u = 0;
+    for (size_t i = 0; i < np; i++)
+        if (u == 0 || tab[i].gid != tab[u - 1].gid) tab[u++] = tab[i];
+    np = u;
+    unsigned char *b0 = b + *len, *w = b0 + sizeof(srm_msg_head);
+    uint32_t prev = 0;
+    for (size_t i = 0; i < np; i++) {
+        w += pdt_srm_put_varint(w, tab[i].gid - prev);
+        prev = tab[i].gid;
+        w += pdt_srm_put_varint(w, pdt_srm_zigzag(tab[i].x));
+        w += pdt_srm_put_varint(w, pdt_srm_zigzag(tab[i].y));
+    }
+    for (size_t i = 0; i < s->npend; i++) {
+        srm_tri *t = &s->pend[i];
+        if (t->level != level) continue;
+        for (int j = 0; j < 3; j++) w += pdt_srm_put_varint(w, srm_find_gid(tab, np, t->p[j].gid));
+        PDT_TRACE(s->tr, 1, PDT_EV_SHIP, 0, t->p[0].gid, t->p[1].gid, t->p[2].gid,
+                  ship_to(s, level));
+    }
+    s->cnt.shipped += nt;
+    for (size_t i = 0; i < nh; i++) w += pdt_srm_put_varint(w, srm_find_gid(tab, np, s->hull[i].gid));
+    srm_msg_head hd = {SRM_MSG_MAGIC,
+                   (uint32_t)level,
+                   (send_hull ? SRM_MSG_HAS_HULL : 0u) |
+                       (send_hull && s->hull_degenerate ? SRM_MSG_HULL_DEGENERATE : 0u),
+                   0,
+                   (uint64_t)np,
+                   (uint64_t)nt,
+                   (uint64_t)nh,
+                   (uint64_t)(w - b0 - sizeof(srm_msg_head)),
+                   s->cnt.critical_path,
+                   s->cnt.critical_cpu};
+    memcpy(b0, &hd, sizeof hd);
+    free(tab);
+    *len = (size_t)(w - b);
+    return PDT_OK;
+}
+
+/* The pending triangles of the levels in `sent` (a bit per level) leave. */
+static void drop_sent(srm_rank *s, uint64_t sent)
+{
+    size_t keep = 0;
+    for (size_t i = 0; i < s->npend; i++)
+        if (!(sent >> s->pend[i].level & 1)) s->pend[keep++] = s->pend[i];
+    s->npend = keep;
+}
+
+pdt_status pdt_srm_pack(srm_rank *s, int level, void **buf, size_t *len, pdt_err *err)
+{
+    *buf = NULL;
+    *len = 0;
+    int holder = pdt_srm_holder_of(s->tree, s->rank, s->p, level) == s->rank;
+    if (s->relay && !holder) {
+        if (s->npend || s->nfwd)
+            return pdt_err_set(err, PDT_ERR_CHECK, "%s: holds pending triangles at level %d "
+                               "without holding its group", s->who, level);
+        return PDT_OK;
+    }
+    int send_hull = s->holds_hull && holder;
+    /* the levels whose triangles go: this one; with relay every later one */
+    uint64_t sent = (uint64_t)1 << level;
+    size_t bound = blob_bound(0, send_hull ? s->nhull : 0) + s->nfwd;
+    for (size_t i = 0; i < s->npend; i++) {
+        int lv = s->pend[i].level;
+        if (lv != level && !s->relay) continue;
+        if (!(sent >> lv & 1)) bound += sizeof(srm_msg_head);
+        sent |= (uint64_t)1 << lv;
+        bound += blob_bound(1, 0) - sizeof(srm_msg_head);
+    }
+    unsigned char *b = malloc(bound);
+    if (!b) return nomem(err, s->who, "pack");
+    size_t n = 0;
+    pdt_status st = PDT_OK;
+    for (int lv = level; lv < 64 && st == PDT_OK; lv++)
+        if (sent >> lv & 1) st = pack_blob(s, lv, send_hull && lv == level, b, &n, err);
+    if (st != PDT_OK) {
+        free(b);
+        return st;
+    }
+    if (s->nfwd) memcpy(b + n, s->fwd, s->nfwd);
+    n += s->nfwd;
+    s->nfwd = 0;
+    drop_sent(s, sent);
+    if (send_hull) {
+        s->holds_hull = 0;
+        s->nhull = 0;
+    }
+    *buf = b;
+    *len = n;
+    return PDT_OK;
+}
+
+/* ---- reading ---------------------------------------------------------------- */
+
+/* A decoded message (arrays owned: srm_msg_view_free). */
+
+void pdt_srm_msg_free(srm_msg_view *v)
+{
+    free(v->pts);
+    free(v->tri);
+    v->pts = NULL;
+    v->tri = v->hull = NULL;
+}
+
+pdt_status pdt_srm_msg_decode(const void *buf, size_t len, int level, const char *from, srm_msg_view *v,
+                         pdt_err *err)
+{
+    if (len < sizeof(srm_msg_head))
+        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from %s: too short", from);
+    memcpy(&v->h, buf, sizeof v->h);
+    const srm_msg_head *h = &v->h;
+    if (h->magic != SRM_MSG_MAGIC || h->level != (uint32_t)level ||
+        h->payload != (uint64_t)(len - sizeof(srm_msg_head)))
+        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from %s: bad header", from);
+    /* every count is at most the payload (a varint takes a byte at least) */
+    if (h->npts > h->payload || h->ntri > h->payload / 3 ||
+        h->nhull > h->payload - 3 * h->ntri)
+        return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from %s: bad counts", from);
+    size_t ni = 3 * (size_t)h->ntri + (size_t)h->nhull;
+    v->pts = malloc(((size_t)h->npts + 1) * sizeof *v->pts);
+    v->tri = malloc((ni + 1) * sizeof *v->tri);
+    if (!v->pts || !v->tri) {
+        pdt_srm_msg_free(v);
+        return pdt_err_set(err, PDT_ERR_NOMEM, "merge message from %s: out of memory",
+                           from);
+    }
+    v->hull = v->tri + 3 * (size_t)h->ntri;
+    const unsigned char *p = (const unsigned char *)buf + sizeof(srm_msg_head), *end = p + h->payload;
+    uint64_t gid = 0, a, x, y;
+    for (size_t i = 0; i < h->npts; i++) {
+        if (!pdt_srm_get_varint(&p, end, &a) || !pdt_srm_get_varint(&p, end, &x) || !pdt_srm_get_varint(&p, end, &y))
+            goto bad;
+        gid += a;
+        int64_t sx = (int64_t)(x >> 1) ^ -(int64_t)(x & 1), sy = (int64_t)(y >> 1) ^ -(int64_t)(y & 1);
+        if (gid > UINT32_MAX || sx < INT32_MIN || sx > INT32_MAX || sy < INT32_MIN || sy > INT32_MAX)
+            goto bad;
+        v->pts[i] = (srm_pt){(int32_t)sx, (int32_t)sy, (uint32_t)gid};
+    }
+    for (size_t i = 0; i < ni; i++) {
+        if (!pdt_srm_get_varint(&p, end, &a) || a >= h->npts) goto bad;
+        v->tri[i] = (uint32_t)a;
+    }
+    if (p != end) goto bad;
+    return PDT_OK;
+bad:
+    pdt_srm_msg_free(v);
+    return pdt_err_set(err, PDT_ERR_CORRUPT, "merge message from %s: damaged payload", from);
+}
+
+int pdt_srm_blob_at(const unsigned char *b, size_t left, srm_msg_head *h)
+{
+    if (left < sizeof *h) return 0;
+    memcpy(h, b, sizeof *h);
+    return h->magic == SRM_MSG_MAGIC && h->payload <= left - sizeof *h;
+}
+
+pdt_status pdt_srm_carry(srm_rank *s, const unsigned char *b, size_t n)
+{
+    if (s->nfwd + n > s->capfwd) {
+        size_t cap = s->capfwd ? s->capfwd : 4096;
+        while (cap < s->nfwd + n) cap *= 2;
+        unsigned char *f = realloc(s->fwd, cap);
+        if (!f) return PDT_ERR_NOMEM;
+        s->fwd = f;
+        s->capfwd = cap;
+    }
+    memcpy(s->fwd + s->nfwd, b, n);
+    s->nfwd += n;
+    return PDT_OK;
 }
