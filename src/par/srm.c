@@ -559,9 +559,9 @@ static pdt_status split_messages(merge_job *j, void *const *msg, const size_t *l
     int nblob = 0;
     for (int pass = 0; pass < 2; pass++) {
         for (int i = 0; i < j->nm; i++) {
+            if (!msg[i] && s->relay) continue;
             char from[40];
             pdt_srm_name(s, j->gl + i, from, sizeof from);
-            if (!msg[i] && s->relay) continue;
             const unsigned char *b = msg[i];
             size_t left = msg[i] ? len[i] : 0;
             int first = 1;

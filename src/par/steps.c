@@ -119,21 +119,23 @@ static int sends(const drv *d, int q, int level)
 }
 
 /* At the merge strip g of a level (this rank's strip j): the messages of the
- * pair's strips [gl, ge): this rank's own (in own[], taken: freed here), the
- * others received from their ranks, in strip order (a rank sends its strips'
- * messages in that order, and messages from one rank with one tag arrive in
- * the order sent); merged. */
+ * pair's strips [gl, ge) that send (all, or with relay the two holders):
+ * this rank's own (in own[], taken: freed here), the others received from
+ * their ranks, in strip order (a rank sends its strips' messages in that
+ * order, and messages from one rank with one tag arrive in the order
+ * sent); merged. */
 static pdt_status merge_at(drv *d, int level, int j, int gl, int ge, void **own, size_t *own_len,
                            pdt_err *err)
 {
-    int k = d->k, nm = ge - gl;
+    int k = d->k, nm = ge - gl, relay = d->tree.cut != NULL, np = d->p * k;
+    int hold[2] = {relay ? pdt_srm_holder_of(pdt_drv_sched(d), gl, np, level) : 0,
+                   relay ? pdt_srm_holder_of(pdt_drv_sched(d), d->rank * k + j, np, level) : 0};
     pdt_par_test_sleep("PDT_TEST_SLEEP_BEFORE_MERGE", d->rank); /* kill before a merge */
     void **msg = calloc((size_t)nm, sizeof *msg);
     size_t *lens = calloc((size_t)nm, sizeof *lens);
     pdt_status st = msg && lens ? PDT_OK : pdt_drv_nomem(d, "merge");
-    for (int q = gl; q < ge && st == PDT_OK; q++) {
-        int from = q / k;
-        if (!sends(d, q, level)) continue;
+    for (int i = 0; i < (relay ? 2 : nm) && st == PDT_OK; i++) {
+        int q = relay ? hold[i] : gl + i, from = q / k;
         if (from == d->rank) {
             msg[q - gl] = own[q % k];
             lens[q - gl] = own_len[q % k];
