@@ -70,66 +70,71 @@ typedef struct bis_cell {
     int64_t x0, x1, y0, y1;
 } bis_cell;
 
-/* The t-th smallest of a[0..n) (t < n), a reordered so that the keys below
- * it come first and the others after; *below gets their number.
- * Quickselect with three-way partitions (many equal keys are common:
- * grids, copies). */
-static uint64_t bis_kth(uint64_t *a, size_t n, size_t t, size_t *below)
+/* The t-th smallest of a[0..n) (t < n), a left as it is: a radix
+ * selection, 11 bits at a time from the top, each pass counting the keys
+ * that are still candidates and keeping those of the digit holding the
+ * t-th in `keep` (n keys and 2048 counters of room).  No branch on a key
+ * (a quickselect's compares go either way half the time, each mispredicted
+ * one some 15 cycles); exact, so the cuts are those of any selection. */
+static uint64_t bis_radix_kth(const uint64_t *a, size_t n, size_t t, uint64_t *keep)
 {
-    size_t lo = 0, hi = n; /* a[0, lo) < a[lo, hi) < a[hi, n) */
-    for (;;) {
-        if (hi - lo <= 16) { /* insertion sort of the rest */
-            for (size_t i = lo + 1; i < hi; i++) {
-                uint64_t v = a[i];
-                size_t j = i;
-                for (; j > lo && a[j - 1] > v; j--) a[j] = a[j - 1];
-                a[j] = v;
-            }
-            size_t b = t;
-            while (b > lo && a[b - 1] == a[t]) b--;
-            *below = b;
-            return a[t];
+    static const int shift[6] = {53, 42, 31, 20, 9, 0}, width[6] = {11, 11, 11, 11, 11, 9};
+    const uint64_t *cur = a;
+    size_t *cnt = (size_t *)(void *)(keep + n); /* (2048 counters past keep) */
+    for (int d = 0;; d++) {
+        uint64_t mask = ((uint64_t)1 << width[d]) - 1;
+        memset(cnt, 0, ((size_t)mask + 1) * sizeof *cnt);
+        for (size_t i = 0; i < n; i++) cnt[(cur[i] >> shift[d]) & mask]++;
+        uint64_t b = 0;
+        while (t >= cnt[b]) t -= cnt[b++];
+        size_t k = 0; /* (in place from the second pass: k <= i) */
+        for (size_t i = 0; i < n; i++) {
+            keep[k] = cur[i];
+            k += ((cur[i] >> shift[d]) & mask) == b;
         }
-        uint64_t x = a[lo], y = a[lo + (hi - lo) / 2], z = a[hi - 1];
-        uint64_t piv = x < y ? (y < z ? y : x < z ? z : x) : (x < z ? x : y < z ? z : y);
-        size_t lt = lo, i = lo, gt = hi; /* [lo, lt) < piv, [lt, i) = piv, [gt, hi) > piv */
-        while (i < gt) {
-            uint64_t v = a[i];
-            if (v < piv) {
-                a[i++] = a[lt];
-                a[lt++] = v;
-            } else if (v > piv) {
-                a[i] = a[--gt];
-                a[gt] = v;
-            } else {
-                i++;
-            }
-        }
-        if (t < lt) hi = lt;
-        else if (t >= gt) lo = gt;
-        else {
-            *below = lt;
-            return piv;
-        }
+        cur = keep;
+        n = k;
+        if (d == 5 || n == 1) return cur[d == 5 ? 0 : t];
     }
+}
+
+/* The key of rank t of a[0..m) (keep: room for bis_radix_kth); a
+ * reordered, the *left keys below it first (one pass without branches). */
+static uint64_t bis_split(uint64_t *a, size_t m, size_t t, uint64_t *keep, size_t *left)
+{
+    uint64_t split = bis_radix_kth(a, m, t, keep);
+    size_t l = 0; /* a[0, l) < split <= a[l, i) */
+    for (size_t i = 0; i < m; i++) {
+        uint64_t v = a[i];
+        a[i] = a[l];
+        a[l] = v;
+        l += v < split;
+    }
+    *left = l;
+    return split;
 }
 
 /* The cut of a range of s = hi - lo ranks from its sample a[0..m), (x, y)
  * keys, in its cell c: across the longer side, at the key of the sample's
- * point of rank m ceil(s/2)/s along that axis (copies of it go right); a
- * reordered, the left side's *left keys first.  No sample: any cut. */
-static srm_cut bis_cut_of(int lo, int hi, uint64_t *a, size_t m, bis_cell c, size_t *left)
+ * point of rank m ceil(s/2)/s along that axis (bis_split; copies of it go
+ * right); a reordered, the left side's *left keys first.  No sample: any
+ * cut.  0 without memory. */
+static int bis_cut_of(int lo, int hi, uint64_t *a, size_t m, bis_cell c, srm_cut *cut,
+                      size_t *left)
 {
-    srm_cut cut = {0, c.x1 - c.x0 >= c.y1 - c.y0 ? 0 : 1};
+    *cut = (srm_cut){0, c.x1 - c.x0 >= c.y1 - c.y0 ? 0 : 1};
     *left = 0;
-    if (!m) return cut;
-    if (cut.axis)
+    if (!m) return 1;
+    uint64_t *keep = malloc(m * sizeof *keep + 2048 * sizeof(size_t));
+    if (!keep) return 0;
+    if (cut->axis)
         for (size_t i = 0; i < m; i++) a[i] = swap_key(a[i]);
     uint64_t t = (uint64_t)m * (uint64_t)(srm_bis_mid(lo, hi) - lo) / (uint64_t)(hi - lo);
-    cut.split = bis_kth(a, m, (size_t)t, left);
-    if (cut.axis)
+    cut->split = bis_split(a, m, (size_t)t, keep, left);
+    if (cut->axis)
         for (size_t i = 0; i < m; i++) a[i] = swap_key(a[i]);
-    return cut;
+    free(keep);
+    return 1;
 }
 
 /* A range's sample on its way to the range's first rank: its cell (4
@@ -186,7 +191,11 @@ static pdt_status bis_down(drv *d, uint64_t *buf, uint64_t *a, size_t m, bis_cel
         int mid = srm_bis_mid(lo, hi);
         if (lead) { /* r == lo */
             size_t left;
-            srm_cut cut = bis_cut_of(lo, hi, a, m, c, &left);
+            srm_cut cut;
+            if (!bis_cut_of(lo, hi, a, m, c, &cut, &left)) {
+                st = pdt_drv_nomem(d, "partition");
+                break;
+            }
             v[2 * at] = cut.split;
             v[2 * at + 1] = (uint64_t)cut.axis;
             bis_cell l = c, rc = c;
@@ -278,22 +287,29 @@ static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t firs
 }
 
 /* The rank whose region holds the point of key `key`: down the tree from
- * the root, left when the key on the cut's axis is below the cut. */
+ * the root, left when the key on the cut's axis is below the cut.  Without
+ * a branch on the comparison (half of them would be mispredicted, some 15
+ * cycles each at every depth): masks choose, and the descents of
+ * successive points overlap. */
 static inline uint32_t bis_dest(const srm_cut *cut, int p, uint64_t key)
 {
-    int lo = 0, hi = p, at = 0;
+    uint32_t lo = 0, hi = (uint32_t)p, at = 0;
+    uint64_t swapped = swap_key(key);
     while (hi - lo >= 2) {
-        int mid = srm_bis_mid(lo, hi);
+        uint32_t mid = (uint32_t)srm_bis_mid((int)lo, (int)hi);
         srm_cut c = cut[at];
-        uint64_t k = c.axis ? swap_key(key) : key;
-        int left = k < c.split;
-        at = left ? at + 1 : at + (mid - lo);
-        lo = left ? lo : mid;
-        hi = left ? mid : hi;
+        uint64_t am = (uint64_t)0 - (uint64_t)(c.axis != 0);
+        uint64_t k = (swapped & am) | (key & ~am);
+        uint32_t lm = (uint32_t)0 - (uint32_t)(k < c.split); /* all ones: left */
+        at += (1u & lm) | ((mid - lo) & ~lm);
+        lo = (lo & lm) | (mid & ~lm);
+        hi = (mid & lm) | (hi & ~lm);
     }
-    return (uint32_t)lo;
+    return lo;
 }
 
+/* Each point's region (in dst, counted in sc), then the records grouped by
+ * region into send. */
 pdt_status pdt_drv_bisect(drv *d, const pdt_point *pts, size_t n, uint64_t first, srm_rec *send,
                           srm_rec *tmp, uint64_t *sc, pdt_err *err)
 {
@@ -303,18 +319,18 @@ pdt_status pdt_drv_bisect(drv *d, const pdt_point *pts, size_t n, uint64_t first
     const srm_cut *cut = d->tree.cut;
     uint64_t *at = calloc((size_t)p, sizeof *at);
     if (!at) return pdt_drv_nomem(d, "partition");
-    for (size_t i = 0; i < n; i++) { /* (the region in the record's spare word) */
-        uint64_t key = pdt_key(pts[i]);
-        uint32_t q = bis_dest(cut, p, key);
-        tmp[i] = (srm_rec){key, (uint32_t)(first + i), q};
-        sc[q]++;
+    uint32_t *dst = (uint32_t *)(void *)tmp; /* (4 bytes a point of tmp's 16) */
+    for (size_t i = 0; i < n; i++) {
+        dst[i] = bis_dest(cut, p, pdt_key(pts[i]));
+        sc[dst[i]]++;
     }
     uint64_t sum = 0;
     for (int q = 0; q < p; q++) {
         at[q] = sum;
         sum += sc[q];
     }
-    for (size_t i = 0; i < n; i++) send[at[tmp[i].pad]++] = tmp[i];
+    for (size_t i = 0; i < n; i++) /* (the region in the record's spare word) */
+        send[at[dst[i]]++] = (srm_rec){pdt_key(pts[i]), (uint32_t)(first + i), dst[i]};
     free(at);
     return PDT_OK;
 }
