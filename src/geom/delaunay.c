@@ -36,7 +36,7 @@ pdt_status pdt_delaunay(const pdt_point *pts, size_t n, pdt_tri **tris, size_t *
     for (uint32_t i = 0; i < (uint32_t)n; i++) id[i] = i;
     memcpy(q, pts, n * sizeof *q);
     size_t nt = 0;
-    pdt_status s = pdt_dt_kernel(id, q, n, e, cap, &nt, run, tr, NULL, NULL, 0);
+    pdt_status s = pdt_dt_kernel(id, q, n, e, cap, &nt, run, tr, NULL, NULL, DT_SPREAD);
     free(id);
     pdt_big_free(q, n * sizeof *q);
     if (s != PDT_OK || nt == 0) {
@@ -124,7 +124,8 @@ pdt_status pdt_delaunay_strip(pdt_point *pts, size_t n, uint32_t *name, void *wo
     if (!on_args_ok(pts, n, work_bytes)) return PDT_ERR_ARG;
     size_t nt = 0;
     pdt_status s =
-        pdt_dt_kernel(name, pts, n, (edge *)work, dt_edge_cap(n), &nt, 0, NULL, hull, nhull, 1);
+        pdt_dt_kernel(name, pts, n, (edge *)work, dt_edge_cap(n), &nt, 0, NULL, hull, nhull,
+                      DT_BY_VERTEX);
     if (s == PDT_OK && *hull && nt > 0) {
         *ntri = nt;
         return PDT_OK;

@@ -82,6 +82,7 @@ typedef struct cutter {
     uint64_t *k, *ks;     /* scratch: frame-1 keys, twice */
     uint32_t *tp;         /* scratch: the upper part of a split (ids) */
     pdt_point *tq;        /* scratch: the upper part of a split (points) */
+    uint8_t *ax;          /* each node's frame (adaptive cuts), or NULL */
 } cutter;
 
 /* The frame-1 key of rank t among the keys of q[0, m) (the value with exactly
@@ -121,8 +122,9 @@ static uint64_t frame1_rank(const cutter *c, const pdt_point *q, size_t m, size_
 
 /* Split [lo, hi) (in frame-0 order) at the frame-1 median: the mid - lo
  * frame-1 smallest points first; both parts stay in frame-0 order (a stable
- * partition, branch-free), so frame-0 nodes never need a selection. */
-static void split_frame1(const cutter *c, uint32_t lo, uint32_t hi, uint32_t mid)
+ * partition, branch-free), so frame-0 nodes never need a selection.
+ * Returns the smallest frame-1 key of the upper part. */
+static uint64_t split_frame1(const cutter *c, uint32_t lo, uint32_t hi, uint32_t mid)
 {
     size_t m = hi - lo;
     uint32_t *id = c->id + lo;
@@ -142,6 +144,7 @@ static void split_frame1(const cutter *c, uint32_t lo, uint32_t hi, uint32_t mid
     }
     memcpy(id + a, c->tp, b * sizeof *c->tp);
     memcpy(q + a, c->tq, b * sizeof *c->tq);
+    return piv;
 }
 
 /* Sort [lo, hi) (at most 3 points) in frame `axis`. */
@@ -163,10 +166,35 @@ static void sort_small(const cutter *c, uint32_t lo, uint32_t hi, int axis)
     }
 }
 
+/* The frame of a node [lo, hi) of DT_SPREAD_MIN points or more (in frame-0
+ * order) with adaptive cuts: `alt`, the alternation's, unless one of its
+ * points' spreads is more than twice the other, then across that one.  A
+ * spread is the distance between the quartiles, in x exact (the order is by
+ * x), in y from 16 of its points evenly spaced in x; not the box: the
+ * border set of a merge is a thin band along a seam and a few hull vertices
+ * far from it, whose box is square.  Cut along its length, a band gives
+ * merges whose seams run its whole length (some twice the in-circle tests
+ * of cuts across it); on square inputs the alternation stands. */
+static int spread_frame(const pdt_point *q, uint32_t lo, uint32_t hi, int alt)
+{
+    uint32_t n = hi - lo;
+    int64_t x = (int64_t)q[lo + 3 * n / 4].x - q[lo + n / 4].x;
+    int32_t y[16];
+    for (uint32_t j = 0; j < 16; j++) {
+        int32_t v = q[lo + (2 * j + 1) * n / 32].y;
+        uint32_t i = j;
+        for (; i > 0 && y[i - 1] > v; i--) y[i] = y[i - 1];
+        y[i] = v;
+    }
+    int64_t yq = (int64_t)y[12] - y[4];
+    return yq > 2 * x ? 1 : x > 2 * yq ? 0 : alt;
+}
+
 /* The cuts of node [lo, hi) in frame `axis` and of all nodes below it. */
 static void cut_node(const cutter *c, uint32_t lo, uint32_t hi, int axis)
 {
     uint32_t n = hi - lo;
+    if (c->ax && n >= 2) c->ax[dt_node_at(lo, hi)] = (uint8_t)axis;
     if (n <= 3) {
         sort_small(c, lo, hi, axis);
         return;
@@ -174,13 +202,17 @@ static void cut_node(const cutter *c, uint32_t lo, uint32_t hi, int axis)
     uint32_t mid = lo + n / 2;
     /* invariant: id[lo, hi) is in frame-0 order */
     if (axis == 1) split_frame1(c, lo, hi, mid);
-    cut_node(c, lo, mid, 1 - axis);
-    cut_node(c, mid, hi, 1 - axis);
+    int la = 1 - axis, ra = 1 - axis;
+    if (c->ax && mid - lo >= DT_SPREAD_MIN) la = spread_frame(c->q, lo, mid, la);
+    if (c->ax && hi - mid >= DT_SPREAD_MIN) ra = spread_frame(c->q, mid, hi, ra);
+    cut_node(c, lo, mid, la);
+    cut_node(c, mid, hi, ra);
 }
 
-void pdt_dt_cut_order(pdt_point *q, uint32_t *id, size_t n, void *scratch, int axis)
+void pdt_dt_cut_order(pdt_point *q, uint32_t *id, size_t n, void *scratch, int axis,
+                      uint8_t *ax)
 {
-    cutter c = { q, id, scratch, NULL, NULL, NULL };
+    cutter c = { q, id, scratch, NULL, NULL, NULL, ax };
     c.ks = c.k + n;
     c.tp = (uint32_t *)(void *)(c.ks + n);
     c.tq = (pdt_point *)(void *)(c.tp + n);

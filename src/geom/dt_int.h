@@ -53,26 +53,44 @@ static inline uint64_t dt_frame_key(pdt_point p, int axis)
  * a point). */
 enum { PDT_DT_CUT_SCRATCH = 28 };
 
+/* A node [lo, hi) of the cut tree (hi - lo >= 2) is named by
+ * lo + (hi - lo) / 2: an internal node's median, a leaf's second point; no
+ * two nodes share it. */
+static inline uint32_t dt_node_at(uint32_t lo, uint32_t hi)
+{
+    return lo + (hi - lo) / 2;
+}
+
 /* Make every cut of the recursion on q[0, n) (distinct, sorted), the root
  * cutting in frame `axis`: afterwards q lists the points in the order of the
  * leaves (every node's points one contiguous range, each leaf of at most 3
  * points sorted in its frame), id moved along.  scratch: n *
- * PDT_DT_CUT_SCRATCH bytes, 8-byte aligned. */
-void pdt_dt_cut_order(pdt_point *q, uint32_t *id, size_t n, void *scratch, int axis);
+ * PDT_DT_CUT_SCRATCH bytes, 8-byte aligned.  With ax (n bytes) a node of
+ * DT_SPREAD_MIN points or more cuts across the wider spread of its points
+ * (dt_cut.c), and its frame is kept in ax[dt_node_at(lo, hi)]; without,
+ * the frames alternate from the root's. */
+enum { DT_SPREAD_MIN = 64 };
+void pdt_dt_cut_order(pdt_point *q, uint32_t *id, size_t n, void *scratch, int axis,
+                      uint8_t *ax);
 
 /* ---- dt_kernel.c ---- */
+
+/* pdt_dt_kernel's flags: the triangles named by vertex (not id[v]); the
+ * cuts across the points' spread (pdt_dt_cut_order with ax: for thin
+ * bands, the border sets of the merges; an untraced kernel only). */
+enum { DT_BY_VERTEX = 1, DT_SPREAD = 2 };
 
 /* The kernel on q[0, n) (n >= 2, distinct, sorted), moved to its leaf order
  * along with id, on cap edge records at e (cap >= dt_edge_cap(n)).  The
  * triangles are left over the edge records, ((pdt_tri *)e)[0, *ntri),
- * counter-clockwise, named id[v] (the vertex v itself when by_vertex); the
- * trace names vertex v tr->gid[id[v]] and marks new triangles with `run`.
- * hull (may be NULL): the convex hull, malloc'd, named as the triangles
- * (nothing when all points are on a line).  Returns PDT_OK or
+ * counter-clockwise, named id[v] (the vertex v itself with DT_BY_VERTEX);
+ * the trace names vertex v tr->gid[id[v]] and marks new triangles with
+ * `run`.  hull (may be NULL): the convex hull, malloc'd, named as the
+ * triangles (nothing when all points are on a line).  Returns PDT_OK or
  * PDT_ERR_NOMEM. */
 pdt_status pdt_dt_kernel(uint32_t *id, pdt_point *q, size_t n, dt_edge *e, size_t cap,
                          size_t *ntri, int run, pdt_trace *tr, uint32_t **hull, size_t *nhull,
-                         int by_vertex);
+                         int flags);
 
 /* ---- dt_sort.c ---- */
 

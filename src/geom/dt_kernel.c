@@ -46,6 +46,7 @@ typedef struct dt {
     size_t used;  /* directed edges ever handed out (even) */
     uint32_t freelist; /* a free even edge, chained through onext, or NIL */
     pdt_trace *tr;
+    const uint8_t *ax; /* each node's frame (pdt_dt_cut_order), or NULL: they alternate */
     int nomem;
     int small; /* every coordinate difference < 2^30: the int64 predicates */
 } dt;
@@ -287,7 +288,9 @@ static int build(dt *d, uint32_t lo, uint32_t hi, int axis, uint32_t *le, uint32
     }
     uint32_t mid = lo + n / 2;
     uint32_t ldo, ldi, rdi, rdo;
-    if (!build(d, lo, mid, 1 - axis, &ldo, &ldi) || !build(d, mid, hi, 1 - axis, &rdi, &rdo))
+    int la = d->ax ? d->ax[dt_node_at(lo, mid)] : 1 - axis;
+    int ra = d->ax ? d->ax[dt_node_at(mid, hi)] : 1 - axis;
+    if (!build(d, lo, mid, la, &ldo, &ldi) || !build(d, mid, hi, ra, &rdi, &rdo))
         return 0;
     /* the children answered in the other frame: find this frame's extremes */
     frame_extremes(d, ldo, axis, &ldo, &ldi);
@@ -375,9 +378,10 @@ static int outer_hull(const dt *d, uint32_t le, size_t n, const uint32_t *id, ui
 
 /* The box of q[0, n): d->small when every coordinate difference is below
  * 2^30 (the int64 predicates), and the axis of the first cut, across the
- * longer side (then the sides alternate): a strip taller than wide is cut
- * first by y, so that no merge seam runs its whole height; traced runs keep
- * the x cut first (their events are the lessons'). */
+ * longer side (then the sides alternate, or follow the points' spread: see
+ * pdt_dt_cut_order): a strip taller than wide is cut first by y, so that no
+ * merge seam runs its whole height; traced runs keep the x cut first (their
+ * events are the lessons'). */
 static int dt_box(dt *d, const pdt_point *q, size_t n, int traced)
 {
     int32_t minx = INT32_MAX, maxx = INT32_MIN, miny = INT32_MAX, maxy = INT32_MIN;
@@ -417,7 +421,7 @@ static int dt_trace_names(dt *d, pdt_trace *tr, pdt_trace *ktr, uint32_t *id, si
 
 pdt_status pdt_dt_kernel(uint32_t *id, pdt_point *q, size_t n, edge *e, size_t cap,
                          size_t *ntri, int run, pdt_trace *tr, uint32_t **hull, size_t *nhull,
-                         int by_vertex)
+                         int flags)
 {
     *ntri = 0;
     dt d;
@@ -427,17 +431,27 @@ pdt_status pdt_dt_kernel(uint32_t *id, pdt_point *q, size_t n, edge *e, size_t c
     d.cap = cap; /* at most 3n undirected edges alive */
     int axis = dt_box(&d, q, n, tr != NULL);
     /* the cuts, on the points moved along with their ids (scratch: 7 words
-     * per point, in the edge array before any edge exists) */
-    pdt_dt_cut_order(q, id, n, e, axis);
+     * per point, in the edge array before any edge exists); with DT_SPREAD
+     * untraced, across the points' spread (a frame a node: n bytes), else
+     * (traced: the lessons' events; without memory for the frames: the
+     * same triangles) alternating */
+    uint8_t *ax = !tr && (flags & DT_SPREAD) ? malloc(n + 1) : NULL;
+    pdt_dt_cut_order(q, id, n, e, axis, ax);
+    d.ax = ax;
     d.p = q;
     pdt_trace ktr;
     uint32_t *tid, *tmap;
-    if (!dt_trace_names(&d, tr, &ktr, id, n, &tid, &tmap)) return PDT_ERR_NOMEM;
+    if (!dt_trace_names(&d, tr, &ktr, id, n, &tid, &tmap)) {
+        free(ax);
+        return PDT_ERR_NOMEM;
+    }
     uint32_t le, re;
     int ok = build(&d, 0, (uint32_t)n, axis, &le, &re);
     if (ok && axis) frame_extremes(&d, le, 0, &le, &re); /* (the x frame's extremes) */
+    int by_vertex = flags & DT_BY_VERTEX;
     if (ok && hull && n >= 3) ok = outer_hull(&d, le, n, by_vertex ? NULL : id, hull, nhull);
     if (ok) *ntri = by_vertex ? collect(&d, NULL, tid, run) : collect(&d, id, tid, run);
+    free(ax);
     free(tmap);
     return ok ? PDT_OK : PDT_ERR_NOMEM;
 }
