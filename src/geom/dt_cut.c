@@ -8,6 +8,12 @@
  * vertical cuts only, on uniform points).  Cost: a selection per horizontal
  * cut, expected linear.
  *
+ * With adaptive cuts (pdt_dt_cut_order's ax: the merges' kernels) a node
+ * keeps the alternation unless its points spread more than twice as wide
+ * one way as the other, and then cuts across the wider spread
+ * (spread_frame): down to DT_SPREAD_MIN points, a thin band is cut across,
+ * not along its length.
+ *
  * A node splits its points at the median of its own frame (dt_frame_key):
  * frame 0 is the lexicographic (x, y) order, frame 1 the same order after
  * the rotation (x, y) -> (y, -x).  Rotations keep orient and in-circle signs
