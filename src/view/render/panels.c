@@ -276,6 +276,22 @@ static void stack_item(const ctx *c, int st, uint32_t p, int space, char *b, siz
     else snprintf(b, cap, space ? "%u " : "%u", p);
 }
 
+/* The first of the top elements of buf[0, k) that fit in `room` (k: none). */
+static size_t stack_fit(const ctx *c, int st, const uint32_t *buf, size_t k, double room)
+{
+    size_t first = k;
+    double wsum = 0;
+    char num[24];
+    while (first > 0) {
+        stack_item(c, st, buf[first - 1], 1, num, sizeof num);
+        double tw = text_w(c->cr, MONO, c->L.body, num);
+        if (wsum + tw > room) break;
+        wsum += tw;
+        first--;
+    }
+    return first;
+}
+
 void pdt_draw_stack_panel(ctx *c)
 {
     cairo_t *cr = c->cr;
@@ -299,18 +315,12 @@ void pdt_draw_stack_panel(ctx *c)
             set_rank(c, q, 1);
             text_at(cr, SANS, 1, fs, R.x + 0.5 * f, y, head);
             double x0 = R.x + 0.5 * f + text_wb(cr, SANS, 1, fs, head) + 0.4 * f;
-            /* as many elements from the top as fit */
+            /* as many elements from the top as fit, with the "… " ahead of
+             * them when some do not */
             double room = R.x + R.w - 0.5 * f - x0 - 1.5 * f;
-            size_t first = k;
-            double wsum = 0;
+            size_t first = stack_fit(c, st, buf, k, room);
+            if (first > 0) first = stack_fit(c, st, buf, k, room - text_w(cr, MONO, fs, "… "));
             char num[24];
-            while (first > 0) {
-                stack_item(c, st, buf[first - 1], 1, num, sizeof num);
-                double tw = text_w(cr, MONO, fs, num);
-                if (wsum + tw > room) break;
-                wsum += tw;
-                first--;
-            }
             double x = x0;
             rgb(cr, c->T->ink, 1);
             if (first > 0) {
