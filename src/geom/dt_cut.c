@@ -128,9 +128,8 @@ static uint64_t frame1_rank(const cutter *c, const pdt_point *q, size_t m, size_
 
 /* Split [lo, hi) (in frame-0 order) at the frame-1 median: the mid - lo
  * frame-1 smallest points first; both parts stay in frame-0 order (a stable
- * partition, branch-free), so frame-0 nodes never need a selection.
- * Returns the smallest frame-1 key of the upper part. */
-static uint64_t split_frame1(const cutter *c, uint32_t lo, uint32_t hi, uint32_t mid)
+ * partition, branch-free), so frame-0 nodes never need a selection. */
+static void split_frame1(const cutter *c, uint32_t lo, uint32_t hi, uint32_t mid)
 {
     size_t m = hi - lo;
     uint32_t *id = c->id + lo;
@@ -150,7 +149,6 @@ static uint64_t split_frame1(const cutter *c, uint32_t lo, uint32_t hi, uint32_t
     }
     memcpy(id + a, c->tp, b * sizeof *c->tp);
     memcpy(q + a, c->tq, b * sizeof *c->tq);
-    return piv;
 }
 
 /* Sort [lo, hi) (at most 3 points) in frame `axis`. */

@@ -292,7 +292,7 @@ static int build(dt *d, uint32_t lo, uint32_t hi, int axis, uint32_t *le, uint32
     int ra = d->ax ? d->ax[dt_node_at(mid, hi)] : 1 - axis;
     if (!build(d, lo, mid, la, &ldo, &ldi) || !build(d, mid, hi, ra, &rdi, &rdo))
         return 0;
-    /* the children answered in the other frame: find this frame's extremes */
+    /* the children answered in their own frames: find this frame's extremes */
     frame_extremes(d, ldo, axis, &ldo, &ldi);
     frame_extremes(d, rdi, axis, &rdi, &rdo);
     return merge(d, ldo, ldi, rdi, rdo, le, re);
