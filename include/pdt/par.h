@@ -255,6 +255,8 @@ typedef struct pdt_par_rank_stats {
                              * run (0: one kernel run on the rank's points) */
     /* seconds per phase of the pipeline */
     double t_read, t_partition, t_local, t_merge, t_order, t_write;
+    double t_total;         /* seconds from the start to the output in place (the
+                             * figures' own collection is not in it) */
     double critical_path;   /* seconds: longest chain of dependent compute ending here */
     double critical_cpu;    /* the same chain in CPU seconds */
     int64_t peak_rss_kib;   /* peak resident memory of this rank's process */

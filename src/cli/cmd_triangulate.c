@@ -378,6 +378,7 @@ static pdt_status write_output(run *R, pdt_err *err)
     st = agreed(R, st, err);
     if (st == PDT_OK && R->trace) st = put_in_place(R, &pw, err);
     pdt_pending_drop(&pw);
+    R->me.t_total = pdt_comm_wtime(R->c) - R->t_start;
     return st;
 }
 
@@ -447,8 +448,11 @@ static void json_parallel(const pdt_par_stats *s)
 
 /* --stats: one JSON object on one line.  "seconds" holds the largest time of each phase
  * over the ranks (a plain run also keeps its historical names: sort, kernel,
- * canonical); per_rank[] every rank's phases and peak memory. */
-static void json_stats(const run *R, const pdt_par_stats *s, double total)
+ * canonical) and the largest total: a rank's start to the output in place,
+ * without the gathering of these figures (at 1024 simulated ranks a linear
+ * gather of 1023 messages at rank 0, some 15 ms of a 0.1 s run); per_rank[]
+ * every rank's phases and peak memory. */
+static void json_stats(const run *R, const pdt_par_stats *s)
 {
     pdt_par_rank_stats mx;
     memset(&mx, 0, sizeof mx);
@@ -461,6 +465,7 @@ static void json_stats(const run *R, const pdt_par_stats *s, double total)
         PDT_MAX_(t_merge);
         PDT_MAX_(t_order);
         PDT_MAX_(t_write);
+        PDT_MAX_(t_total);
         PDT_MAX_(peak_rss_kib);
 #undef PDT_MAX_
     }
@@ -477,7 +482,7 @@ static void json_stats(const run *R, const pdt_par_stats *s, double total)
     if (s->nranks == 1)
         fprintf(stderr, "\"sort\": %.6f, \"kernel\": %.6f, \"canonical\": %.6f, ",
                 mx.t_partition, mx.t_local, mx.t_order);
-    fprintf(stderr, "\"total\": %.6f}, \"peak_rss_kib\": %lld, \"per_rank\": [", total,
+    fprintf(stderr, "\"total\": %.6f}, \"peak_rss_kib\": %lld, \"per_rank\": [", mx.t_total,
             (long long)mx.peak_rss_kib);
     for (int q = 0; q < s->nranks; q++) json_rank(q, &s->rank[q]);
     fprintf(stderr, "]");
@@ -509,7 +514,7 @@ static pdt_status report(run *R, pdt_err *err)
     else if (s.n_tri == 0)
         fprintf(stderr, "pdt: 0 triangles: all %llu distinct points are collinear\n",
                 (unsigned long long)s.n_unique);
-    if (R->o->stats) json_stats(R, &s, pdt_comm_wtime(R->c) - R->t_start);
+    if (R->o->stats) json_stats(R, &s);
     pdt_par_stats_free(&s);
     return PDT_OK;
 }

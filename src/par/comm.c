@@ -8,6 +8,7 @@
 
 #include <errno.h>
 #include <limits.h>
+#include <malloc.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -22,6 +23,22 @@ int pdt_comm_launched(void)
     for (size_t i = 0; i < sizeof vars / sizeof *vars; i++)
         if (getenv(vars[i])) return 1;
     return 0;
+}
+
+/* Under SMPI every rank is a thread of one process, whose heap SimGrid fills
+ * with millions of small blocks of its own (requests, actions) and frees
+ * again.  glibc keeps freed small blocks in "fast bins" and merges them all
+ * the next time anybody asks for or frees a large block, and it gives the
+ * heap's free top back to the system when a free leaves more than 128 KiB
+ * there: both run on the clock of whichever rank happened to call malloc or
+ * free, which then came out milliseconds late (up to 40 ms, measured, at
+ * random ranks at P = 1024, and every rank of an exchange waited for it).
+ * Neither is that rank's work on a real node.  No fast bins and no
+ * trimming: the same blocks, reused without either. */
+void pdt_comm_heap_shared(void)
+{
+    (void)mallopt(M_MXFAST, 0);
+    (void)mallopt(M_TRIM_THRESHOLD, -1);
 }
 
 size_t pdt_comm_chunk_from_env(void)

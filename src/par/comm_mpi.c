@@ -172,6 +172,7 @@ pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out,
         return pdt_err_set(err, PDT_ERR_MPI, "MPI_Init failed (code %d)", rc);
     }
     if (!PDT_SMPI) launcher_nodelay();
+    if (PDT_SMPI) pdt_comm_heap_shared(); /* (comm.c: smpicc wraps malloc.h's names) */
     /* From here on errors come back as codes instead of aborting. */
     pdt_status s = mpi_check(MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN),
                              "MPI_Comm_set_errhandler", c, err);

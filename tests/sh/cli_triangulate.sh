@@ -60,6 +60,9 @@ assert s["n"] == 7 and s["duplicates"] == 2 and s["unique"] == 5, s
 assert s["triangles"] == 4 and s["hull"] == 4, s
 for k in ("read", "sort", "kernel", "canonical", "write", "total"):
     assert s["seconds"][k] >= 0, k
+sec = s["seconds"]
+phases = sum(sec[k] for k in ("read", "sort", "kernel", "canonical", "write"))
+assert phases <= sec["total"] + 1e-6, sec
 assert s["peak_rss_kib"] > 0
 PY
 then ok stats_json; else fail stats_json "$(cat st.err)"; fi

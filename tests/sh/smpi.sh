@@ -43,6 +43,19 @@ if sim p256 256 u.txt -o sim.ele --stats; then
     else
         fail smpi_stats_have_parallel_figures "$(head -c 300 p256.err)"
     fi
+    # total: the slowest rank's start to the output in place, so at least
+    # every rank's phases one after the other (the figures' gathering after
+    # that is not in it)
+    if python3 - p256.err <<'PY'
+import json, sys
+t = open(sys.argv[1]).read()
+s = json.JSONDecoder().raw_decode(t[t.index('{"command"'):])[0]
+tot = s["seconds"]["total"]
+most = max(sum(r["seconds"].values()) for r in s["per_rank"])
+assert most > 0 and most <= tot + 1e-6, (most, tot)
+PY
+    then ok smpi_total_covers_every_rank_phases
+    else fail smpi_total_covers_every_rank_phases "$(head -c 300 p256.err)"; fi
 else
     fail smpi_256_ranks_same_bytes_as_plain "exit $?: $(head -3 p256.err)"
 fi
