@@ -34,7 +34,11 @@ int pdt_comm_launched(void)
  * free, which then came out milliseconds late (up to 40 ms, measured, at
  * random ranks at P = 1024, and every rank of an exchange waited for it).
  * Neither is that rank's work on a real node.  No fast bins and no
- * trimming: the same blocks, reused without either. */
+ * trimming: the same blocks, reused without either.  (Only with several
+ * ranks: setting the trim threshold also fixes glibc's mmap threshold,
+ * which `pdt triangulate` sets to 4 MiB for P > 1 anyway, while a plain run keeps the
+ * adaptive one; fixed at 128 KiB it made a one-rank run half as slow
+ * again.) */
 void pdt_comm_heap_shared(void)
 {
     (void)mallopt(M_MXFAST, 0);

@@ -172,11 +172,11 @@ pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out,
         return pdt_err_set(err, PDT_ERR_MPI, "MPI_Init failed (code %d)", rc);
     }
     if (!PDT_SMPI) launcher_nodelay();
-    if (PDT_SMPI) pdt_comm_heap_shared(); /* (comm.c: smpicc wraps malloc.h's names) */
     /* From here on errors come back as codes instead of aborting. */
     pdt_status s = mpi_check(MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN),
                              "MPI_Comm_set_errhandler", c, err);
     if (s == PDT_OK) s = private_comms(c, m, err);
+    if (PDT_SMPI && c->size > 1) pdt_comm_heap_shared(); /* (comm.c: smpicc wraps malloc.h) */
     /* Every rank must cut transfers the same way: rank 0's chunk size wins. */
     unsigned long long chunk = c->chunk;
     if (s == PDT_OK)
