@@ -22,8 +22,9 @@
  * O(P^2)-per-rank versions; an exchange posts its requests a window of
  * peers at a time, with synchronous sends (SimGrid walks lists of every
  * pending request); the output file is written with pwrite (SMPI's
- * MPI-IO opens files on simulated disks only); the launcher tweaks for Open
- * MPI are skipped (docs/simulation.md). */
+ * MPI-IO opens files on simulated disks only); the heap the ranks share
+ * with SimGrid has no fast bins and no trimming (pdt_comm_heap_shared); the
+ * launcher tweaks for Open MPI are skipped (docs/simulation.md). */
 #include "comm_int.h"
 
 #include <arpa/inet.h>
