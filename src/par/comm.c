@@ -36,9 +36,9 @@ int pdt_comm_launched(void)
  * Neither is that rank's work on a real node.  No fast bins and no
  * trimming: the same blocks, reused without either.  (Only with several
  * ranks: setting the trim threshold also fixes glibc's mmap threshold,
- * which `pdt triangulate` sets to 4 MiB for P > 1 anyway, while a plain run keeps the
- * adaptive one; fixed at 128 KiB it made a one-rank run half as slow
- * again.) */
+ * which `pdt triangulate` sets to 4 MiB for P > 1 anyway, while a plain run
+ * keeps the adaptive one; fixed at 128 KiB it made the simulated one-rank
+ * run of 10^6 points take 0.86 s against 0.61-0.71 s.) */
 void pdt_comm_heap_shared(void)
 {
     (void)mallopt(M_MXFAST, 0);
