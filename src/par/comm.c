@@ -31,8 +31,10 @@ int pdt_comm_launched(void)
  * the next time anybody asks for or frees a large block, and it gives the
  * heap's free top back to the system when a free leaves more than 128 KiB
  * there: both run on the clock of whichever rank happened to call malloc or
- * free, which then came out milliseconds late (up to 40 ms, measured, at
- * random ranks at P = 1024, and every rank of an exchange waited for it).
+ * free, which then came out milliseconds late (measured at P = 1024: 10 ms
+ * in three small allocations; 39 ms in an end of the order that frees large
+ * blocks, with the fast bins already off), and every rank of an exchange
+ * waited for it.
  * Neither is that rank's work on a real node.  No fast bins and no
  * trimming: the same blocks, reused without either.  (Only with several
  * ranks: setting the trim threshold also fixes glibc's mmap threshold,
