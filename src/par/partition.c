@@ -8,28 +8,19 @@
 #include <string.h>
 
 /* Stable LSD radix sort on the 64-bit key, 11 bits per pass over the bits
- * the records' coordinates actually span (see below). */
+ * the records' coordinates actually span (see below); a few records by
+ * insertion, a pass's counters costing more than their sort. */
 void pdt_srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n)
 {
+    enum { DBITS = 11, DB = 1 << DBITS, FEW = 48 };
     if (n < 2) return;
-    enum { DBITS = 11, DB = 1 << DBITS, MAXPASS = (64 + DBITS - 1) / DBITS };
-    size_t *hist = calloc((size_t)MAXPASS * DB, sizeof *hist);
-    if (!hist) { /* fall back to insertion-free merge sort: rare path */
-        /* Stable bottom-up merge sort using tmp. */
-        srm_rec *src = r, *dst = tmp;
-        for (size_t w = 1; w < n; w *= 2) {
-            for (size_t lo = 0; lo < n; lo += 2 * w) {
-                size_t mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
-                size_t i = lo, j = mid, k = lo;
-                while (i < mid && j < hi) dst[k++] = src[j].key < src[i].key ? src[j++] : src[i++];
-                while (i < mid) dst[k++] = src[i++];
-                while (j < hi) dst[k++] = src[j++];
-            }
-            srm_rec *t = src;
-            src = dst;
-            dst = t;
+    if (n <= FEW) {
+        for (size_t i = 1; i < n; i++) {
+            srm_rec v = r[i];
+            size_t j = i;
+            for (; j > 0 && r[j - 1].key > v.key; j--) r[j] = r[j - 1];
+            r[j] = v;
         }
-        if (src != r) memcpy(r, src, n * sizeof *r);
         return;
     }
     /* compact keys: (x - xmin) << ybits | (y - ymin) orders like the key
@@ -47,6 +38,25 @@ void pdt_srm_radix_sort(srm_rec *r, srm_rec *tmp, size_t n)
     while (ybits < 32 && ((uint64_t)(yhi - ylo) >> ybits)) ybits++;
     while (xbits < 32 && ((uint64_t)(xhi - xlo) >> xbits)) xbits++;
     int passes = (xbits + ybits + DBITS - 1) / DBITS;
+    if (passes == 0) return; /* one key */
+    size_t *hist = calloc((size_t)passes * DB, sizeof *hist);
+    if (!hist) { /* fall back to a stable bottom-up merge sort using tmp: rare path */
+        srm_rec *src = r, *dst = tmp;
+        for (size_t w = 1; w < n; w *= 2) {
+            for (size_t lo = 0; lo < n; lo += 2 * w) {
+                size_t mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
+                size_t i = lo, j = mid, k = lo;
+                while (i < mid && j < hi) dst[k++] = src[j].key < src[i].key ? src[j++] : src[i++];
+                while (i < mid) dst[k++] = src[i++];
+                while (j < hi) dst[k++] = src[j++];
+            }
+            srm_rec *t = src;
+            src = dst;
+            dst = t;
+        }
+        if (src != r) memcpy(r, src, n * sizeof *r);
+        return;
+    }
 #define CKEY(k) (((uint64_t)((uint32_t)((k) >> 32) - xlo) << ybits) | (uint64_t)((uint32_t)(k) - ylo))
     for (size_t i = 0; i < n; i++) {
         uint64_t ck = CKEY(r[i].key);

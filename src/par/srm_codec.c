@@ -11,6 +11,7 @@
  * 12. */
 #include "srm.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -67,28 +68,49 @@ static size_t blob_bound(size_t nt, size_t nh)
     return sizeof(srm_msg_head) + (3 * nt + nh) * 15 + (3 * nt + nh) * 5;
 }
 
+/* The point table of a blob: the distinct gids of the n slots' points (a
+ * shipped triangle's three corners, then the hull) in increasing order into
+ * tab, and each slot's place in it into pos.  One radix sort of (gid, slot)
+ * records gives both: equal gids are neighbours, and the table grows by one
+ * at each new gid.  Returns the table's size, or SIZE_MAX without memory. */
+static size_t point_table(const srm_pt *slot, size_t n, srm_pt *tab, uint32_t *pos)
+{
+    if (n == 0) return 0;
+    srm_rec *r = malloc(2 * n * sizeof *r);
+    if (!r) return SIZE_MAX;
+    for (size_t i = 0; i < n; i++) r[i] = (srm_rec){slot[i].gid, (uint32_t)i, 0};
+    pdt_srm_radix_sort(r, r + n, n);
+    size_t u = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (u == 0 || r[i].key != tab[u - 1].gid) tab[u++] = slot[r[i].idx];
+        pos[r[i].idx] = (uint32_t)(u - 1);
+    }
+    free(r);
+    return u;
+}
+
 static pdt_status pack_blob(srm_rank *s, int level, int send_hull, unsigned char *b, size_t *len,
                             pdt_err *err)
 {
     size_t nt = 0;
     for (size_t i = 0; i < s->npend; i++) nt += s->pend[i].level == level;
-    size_t nh = send_hull ? s->nhull : 0;
-    /* point table: distinct vertices of the shipped triangles and the hull */
-    srm_pt *tab = srm_big((3 * nt + nh + 1) * sizeof *tab);
-    if (!tab) return nomem(err, s->who, "pack");
+    size_t nh = send_hull ? s->nhull : 0, ns = 3 * nt + nh;
+    /* the slots: the shipped triangles' corners, then the hull */
+    srm_pt *slot = srm_big((2 * ns + 1) * sizeof *slot), *tab = slot + ns;
+    uint32_t *pos = malloc((ns + 1) * sizeof *pos);
     size_t np = 0;
-    for (size_t i = 0; i < s->npend; i++)
-        if (s->pend[i].level == level)
-            for (int k = 0; k < 3; k++) tab[np++] = s->pend[i].p[k];
-    for (size_t i = 0; i < nh; i++) tab[np++] = s->hull[i];
-    if (pdt_srm_sort_pts(tab, np, 1) != PDT_OK) {
-        free(tab);
+    if (slot && pos) {
+        for (size_t i = 0; i < s->npend; i++)
+            if (s->pend[i].level == level)
+                for (int k = 0; k < 3; k++) slot[np++] = s->pend[i].p[k];
+        for (size_t i = 0; i < nh; i++) slot[np++] = s->hull[i];
+        np = point_table(slot, ns, tab, pos);
+    }
+    if (!slot || !pos || np == SIZE_MAX) {
+        free(slot);
+        free(pos);
         return nomem(err, s->who, "pack");
     }
-    size_t u = 0;
-    for (size_t i = 0; i < np; i++)
-        if (u == 0 || tab[i].gid != tab[u - 1].gid) tab[u++] = tab[i];
-    np = u;
     unsigned char *b0 = b + *len, *w = b0 + sizeof(srm_msg_head);
     uint32_t prev = 0;
     for (size_t i = 0; i < np; i++) {
@@ -97,15 +119,16 @@ static pdt_status pack_blob(srm_rank *s, int level, int send_hull, unsigned char
         w += pdt_srm_put_varint(w, pdt_srm_zigzag(tab[i].x));
         w += pdt_srm_put_varint(w, pdt_srm_zigzag(tab[i].y));
     }
+    const uint32_t *at = pos;
     for (size_t i = 0; i < s->npend; i++) {
         srm_tri *t = &s->pend[i];
         if (t->level != level) continue;
-        for (int j = 0; j < 3; j++) w += pdt_srm_put_varint(w, srm_find_gid(tab, np, t->p[j].gid));
+        for (int j = 0; j < 3; j++) w += pdt_srm_put_varint(w, *at++);
         PDT_TRACE(s->tr, 1, PDT_EV_SHIP, 0, t->p[0].gid, t->p[1].gid, t->p[2].gid,
                   ship_to(s, level));
     }
     s->cnt.shipped += nt;
-    for (size_t i = 0; i < nh; i++) w += pdt_srm_put_varint(w, srm_find_gid(tab, np, s->hull[i].gid));
+    for (size_t i = 0; i < nh; i++) w += pdt_srm_put_varint(w, *at++);
     srm_msg_head hd = {SRM_MSG_MAGIC,
                    (uint32_t)level,
                    (send_hull ? SRM_MSG_HAS_HULL : 0u) |
@@ -118,7 +141,8 @@ static pdt_status pack_blob(srm_rank *s, int level, int send_hull, unsigned char
                    s->cnt.critical_path,
                    s->cnt.critical_cpu};
     memcpy(b0, &hd, sizeof hd);
-    free(tab);
+    free(slot);
+    free(pos);
     *len = (size_t)(w - b);
     return PDT_OK;
 }
