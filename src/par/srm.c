@@ -532,7 +532,7 @@ typedef struct merge_job {
     pdt_tri *tris;           /* T*(B), indices into B */
     size_t ntri;
     gtri *tb;                /* T*(B) as canonical global triangles */
-    size_t ntb, kept, ndisc;
+    size_t ntb, kept, kept_shipped, ndisc;
 } merge_job;
 
 static void merge_job_free(merge_job *j)
@@ -735,16 +735,21 @@ static pdt_status select_kept(merge_job *j)
     pdt_trace *tr = s->tr;
     const srm_pt *B = j->B;
     srm_cut cut = merge_cut(j);
-    j->tb = malloc((j->ntri + 1) * sizeof *j->tb);
-    if (!j->tb) return nomem(j->err, s->who, "merge");
+    if (PDT_TRACING(tr, 1)) { /* T*(B) kept whole: the discards' witnesses */
+        j->tb = malloc((j->ntri + 1) * sizeof *j->tb);
+        if (!j->tb) return nomem(j->err, s->who, "merge");
+    }
     for (size_t i = 0; i < j->ntri; i++) {
         const uint32_t *v = j->tris[i].v;
         gtri g = canon3(j->bg[v[0]], j->bg[v[1]], j->bg[v[2]]);
-        j->tb[j->ntb++] = g;
+        if (j->tb) j->tb[j->ntb++] = g;
         int nl = 0;
         for (int k = 0; k < 3; k++) nl += in_left(cut, B[v[k]]);
         int multi = nl > 0 && nl < 3;
-        if (!multi && !pdt_srm_tset_has(&j->sset, g)) continue;
+        if (!multi) {
+            if (!pdt_srm_tset_has(&j->sset, g)) continue;
+            j->kept_shipped++;
+        }
         j->kept++;
         int who;
         int lev = j->level + 1 < s->levels
@@ -783,25 +788,28 @@ static int64_t witness(const srm_pt *byg, size_t nb, gtri t)
 }
 
 /* Discards: the shipped triangles T*(B) does not contain (traced with a
- * witness when tracing). */
+ * witness when tracing).  A shipped triangle has its three corners in one
+ * group, so the selection met every one T*(B) contains among the triangles
+ * of one group: untraced, the discards are the rest. */
 static pdt_status note_discards(merge_job *j)
 {
     pdt_trace *tr = j->s->tr;
+    if (!PDT_TRACING(tr, 1)) {
+        j->ndisc = j->ns - j->kept_shipped;
+        j->s->cnt.discarded += j->ndisc;
+        return PDT_OK;
+    }
     if (pdt_srm_tset_init(&j->tset, j->tb, j->ntb) != PDT_OK)
         return nomem(j->err, j->s->who, "merge");
-    srm_pt *byg = NULL;
-    if (PDT_TRACING(tr, 1)) {
-        byg = malloc((j->nb + 1) * sizeof *byg);
-        if (byg) {
-            memcpy(byg, j->B, j->nb * sizeof *j->B);
-            qsort(byg, j->nb, sizeof *byg, cmp_gid);
-        }
+    srm_pt *byg = malloc((j->nb + 1) * sizeof *byg);
+    if (byg) {
+        memcpy(byg, j->B, j->nb * sizeof *j->B);
+        qsort(byg, j->nb, sizeof *byg, cmp_gid);
     }
     for (size_t i = 0; i < j->ns; i++) {
         gtri t = j->shipped[i];
         if (pdt_srm_tset_has(&j->tset, t)) continue;
         j->ndisc++;
-        if (!PDT_TRACING(tr, 1)) continue;
         int64_t wit = byg ? witness(byg, j->nb, t) : -1;
         PDT_TRACE(tr, 1, PDT_EV_DISCARD, 0, t.v[0], t.v[1], t.v[2], wit);
     }
