@@ -9,9 +9,9 @@
 #include <errno.h>
 #include <limits.h>
 #include <malloc.h>
-#include <sys/prctl.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 
 int pdt_comm_launched(void)
 {

@@ -24,7 +24,8 @@
  * pending request); the output file is written with pwrite (SMPI's
  * MPI-IO opens files on simulated disks only); the heap the ranks share
  * with SimGrid has no fast bins and no trimming (pdt_comm_heap_shared) and
- * no huge pages (pdt_comm_small_pages); the launcher tweaks for Open MPI are skipped (docs/simulation.md). */
+ * the process no huge pages (pdt_comm_small_pages); the launcher tweaks for
+ * Open MPI are skipped (docs/simulation.md). */
 #include "comm_int.h"
 
 #include <arpa/inet.h>

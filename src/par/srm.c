@@ -664,7 +664,7 @@ static pdt_status border_set(merge_job *j)
     if (j->hl >= 0) nb += facing(s, &j->mv[j->hl], j->gr, j->ge, B + nb);
     if (j->hr >= 0) nb += facing(s, &j->mv[j->hr], j->gl, j->gr, B + nb);
     if (pdt_srm_tset_init(&j->sset, j->shipped, ns) != PDT_OK ||
-        pdt_srm_sort_pts(B, nb, 0) != PDT_OK)
+        pdt_srm_sort_pts(B, nb) != PDT_OK)
         return nomem(j->err, s->who, "merge");
     size_t u = 0;
     for (size_t i = 0; i < nb; i++)

@@ -150,9 +150,8 @@ static inline uint64_t srm_key(srm_pt p)
 
 /* ---- srm_sets.c: the merge step's sorts and look-ups -------------------- */
 
-/* p[0..n) sorted by key (by_gid 0) or by global index (1); stable.
- * PDT_ERR_NOMEM (p unchanged) or PDT_OK. */
-pdt_status pdt_srm_sort_pts(srm_pt *p, size_t n, int by_gid);
+/* p[0..n) sorted by key; stable.  PDT_ERR_NOMEM (p unchanged) or PDT_OK. */
+pdt_status pdt_srm_sort_pts(srm_pt *p, size_t n);
 
 /* A triangle by its vertices' global indices, rotated to start at the
  * smallest (orientation kept). */

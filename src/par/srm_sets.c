@@ -1,13 +1,14 @@
 /* pdt — the merge step's sorts and look-ups (srm.h): point tables sorted by
- * key or by global index with the partition's radix sort, and sets of
- * canonical triangles hashed (a merge asks "was this triangle shipped?" and
- * "is this shipped triangle in T*(B)?" once per triangle; sorting both sets
- * with qsort and searching them took more of a merge than its kernel). */
+ * key with the partition's radix sort, and sets of canonical triangles
+ * hashed (a merge asks "was this triangle shipped?" of every one-group
+ * triangle of T*(B), and a traced one "is this shipped triangle in T*(B)?"
+ * of every shipped one; sorting both sets with qsort and searching them
+ * took more of a merge than its kernel). */
 #include <string.h>
 
 #include "srm.h"
 
-pdt_status pdt_srm_sort_pts(srm_pt *p, size_t n, int by_gid)
+pdt_status pdt_srm_sort_pts(srm_pt *p, size_t n)
 {
     if (n < 2) return PDT_OK;
     srm_rec *r = malloc(2 * n * sizeof *r);
@@ -18,7 +19,7 @@ pdt_status pdt_srm_sort_pts(srm_pt *p, size_t n, int by_gid)
         return PDT_ERR_NOMEM;
     }
     for (size_t i = 0; i < n; i++)
-        r[i] = (srm_rec){by_gid ? (uint64_t)p[i].gid : srm_key(p[i]), (uint32_t)i, 0};
+        r[i] = (srm_rec){srm_key(p[i]), (uint32_t)i, 0};
     pdt_srm_radix_sort(r, r + n, n);
     for (size_t i = 0; i < n; i++) out[i] = p[r[i].idx];
     memcpy(p, out, n * sizeof *p);
