@@ -36,6 +36,27 @@ nw=$("$PDT" trace dump run4 --kind discard | grep -c 'witness=[0-9]')
 if [ "$nd" -gt 0 ] && [ "$nx" -gt 0 ] && [ "$nw" -gt 0 ]; then ok deferrals_and_discards
 else fail deferrals_and_discards "ra-defer=$nd discard=$nx with witness=$nw"; fi
 
+# an untraced merge counts its discards without looking them up: every
+# rank's kept and discarded are the traced run's, on families that defer
+# little or nearly everything, strips (4 ranks) and bisection (16)
+counts() { sed -n 's/.*"per_rank": //p' "$1" | grep -o '"kept": [0-9]*, "discarded": [0-9]*'; }
+bad=
+for kind in uniform grid circle clusters; do
+    "$PDT" gen $kind 600 --seed 3 -o k.txt
+    for np in 4 16; do
+        mpirun -np $np "$PDT" triangulate k.txt -o k1.tri --stats 2> k1.err
+        mpirun -np $np "$PDT" triangulate k.txt -o k2.tri --stats --trace runk 2> k2.err
+        a=$(counts k1.err) b=$(counts k2.err)
+        nx=$("$PDT" trace dump runk --kind discard | wc -l)
+        sum=$(echo "$a" | awk '{s += $4} END {print s + 0}')
+        if [ -z "$a" ] || [ "$a" != "$b" ] || [ "$nx" != "$sum" ] || ! cmp -s k1.tri k2.tri; then
+            bad="$bad $kind/$np(discards traced $nx, counted $sum)"
+        fi
+        rm -rf runk
+    done
+done
+[ -z "$bad" ] && ok untraced_discards_counted || fail untraced_discards_counted "differ:$bad"
+
 # one merge step per pair per level: P = 4 -> (0|1) at 1, (2|3) at 3, (01|23) at 2
 "$PDT" trace dump run4 --kind merge-begin | sed 's/.*merge-begin //' | sort > merges.txt
 printf '%s\n' 'level=0 left=0 right=1 end=2 at=1' 'level=0 left=2 right=3 end=4 at=3' \

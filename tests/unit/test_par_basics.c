@@ -243,6 +243,25 @@ TEST(radix_sort_stable_dedupe)
     free(t);
 }
 
+TEST(radix_sort_every_small_size)
+{
+    /* sizes around the insertion sort's limit and one key repeated (no
+     * pass at all): sorted by key, equal keys in their input order */
+    for (size_t n = 0; n <= 130; n++)
+        for (int same = 0; same < 2; same++) {
+            srm_rec r[130], t[130];
+            for (size_t i = 0; i < n; i++) {
+                pdt_point p = same ? (pdt_point){7, -3} : (pdt_point){rndi(-5, 5), rndi(-1000, 1000)};
+                r[i] = (srm_rec){pdt_key(p), (uint32_t)i, 0};
+            }
+            pdt_srm_radix_sort(r, t, n);
+            int bad = 0;
+            for (size_t i = 1; i < n; i++)
+                bad += r[i - 1].key > r[i].key || (r[i - 1].key == r[i].key && r[i - 1].idx >= r[i].idx);
+            CHECK_MSG(bad == 0, "n = %zu%s: %d out of order", n, same ? ", one key" : "", bad);
+        }
+}
+
 TEST(merge_runs_stable)
 {
     /* three sorted runs with shared keys: the merge is sorted and keeps run
@@ -283,6 +302,7 @@ int main(void)
     RUN(slab_pretest_is_sound);
     RUN(slab_of_strips);
     RUN(radix_sort_stable_dedupe);
+    RUN(radix_sort_every_small_size);
     RUN(runs_to_strip_same_as_merge_dedupe);
     RUN(merge_runs_stable);
     RUN(schedule);
