@@ -52,9 +52,9 @@ void pdt_comm_heap_shared(void)
  * machine the figures of docs/simulation.md come from, a 2 MiB page the
  * process touches for the first time (or again after a few seconds free)
  * was cleared at 0.35-0.8 GB/s, against 6.6 GB/s touched again at once, and
- * 4 KiB pages at 2.2-2.7 GB/s whatever their past: the partition, where a rank first
- * touches its block, took two to three times as long with huge pages, and
- * from run to run twice as long or not.  No transparent huge pages for the
+ * 4 KiB pages at 2.2-2.7 GB/s whatever their past: the partition, where a
+ * rank first touches its block, took two to three times as long with huge
+ * pages, and from run to run twice as long or not.  No transparent huge pages for the
  * whole simulation, one rank or many (docs/simulation.md). */
 void pdt_comm_small_pages(void)
 {
