@@ -7,7 +7,7 @@
  * from each of s equal stretches of it, at a place a hash of the stretch's
  * global position chooses: a regular sample that no periodic input order
  * aliases; all the block's points when it has at most s), rank 0 gathers
- * the samples, and the cuts are made down the tree (bis_down): each rank
+ * the samples (bis_gather), and the cuts are made down the tree (bis_down): each rank
  * range across its cell's longer side, at the key that leaves ceil(s/2)/s
  * of the range's sample on the left.  Every rank then sends each of its
  * points to the region the cuts put it in, unsorted: the receiver sorts
@@ -23,9 +23,23 @@
 
 #include "driver.h"
 
+#include "pdt/testhook.h"
+
 /* Sample points over all ranks (a rank draws BIS_SAMPLE / p of its block,
  * at least BIS_MIN_SHARE). */
 enum { BIS_SAMPLE = 1 << 17, BIS_MIN_SHARE = 64 };
+
+/* The ranks from which the samples go to rank 0 up a tree (bis_gather):
+ * where the exchanges go in two hops too (comm_hops.c).  A test build's
+ * PDT_TEST_BIS_GATHER=1 or 2 forces the gather or the tree. */
+enum { BIS_TREE_FROM = 64 };
+
+static int bis_by_tree(int p)
+{
+    const char *t = pdt_test_hook("PDT_TEST_BIS_GATHER");
+    if (t && (*t == '1' || *t == '2')) return *t == '2';
+    return p >= BIS_TREE_FROM;
+}
 
 static size_t bis_share(int p)
 {
@@ -246,6 +260,61 @@ static size_t bis_pack(uint64_t *all, int p, size_t slot, bis_cell *c)
     return m;
 }
 
+/* Every rank's sample slot (`slot` words, mine) at rank 0 in rank order,
+ * *all (p * slot words; NULL at the other ranks).  Below BIS_TREE_FROM
+ * ranks one gather; from there up a binomial tree, the slots of ranks
+ * [r + s, r + 2s) going to rank r at step s = 1, 2, 4 ..., so that rank 0
+ * gets log2 p messages, not p - 1 (a gather's algorithm is linear: on 1024
+ * simulated ranks it took 2.8 ms of a partition of 10 ms). */
+static pdt_status bis_gather(drv *d, const uint64_t *mine, size_t slot, uint64_t **all,
+                             pdt_err *err)
+{
+    int p = d->p, r = d->rank;
+    size_t bytes = slot * sizeof *mine;
+    *all = NULL;
+    if (!bis_by_tree(p)) {
+        size_t *cnt = malloc((size_t)p * sizeof *cnt);
+        uint64_t *buf = r == 0 ? malloc((size_t)p * bytes) : NULL;
+        pdt_status st = cnt && (r || buf) ? PDT_OK : pdt_drv_nomem(d, "partition");
+        for (int q = 0; st == PDT_OK && q < p; q++) cnt[q] = bytes;
+        if (st == PDT_OK) st = pdt_comm_gatherv(d->c, mine, bytes, buf, cnt, 0, err);
+        if (st == PDT_OK) pdt_drv_note_all(d, TAG_SAMPLES, bytes); /* (uniform: the checker pairs them) */
+        free(cnt);
+        if (st == PDT_OK) *all = buf;
+        else free(buf);
+        return st;
+    }
+    size_t span = r ? (size_t)(r & -r) : (size_t)p, have = 1; /* [r, r + have) held */
+    if (span > (size_t)(p - r)) span = (size_t)(p - r);
+    uint64_t *buf = malloc(span * bytes);
+    if (!buf) return pdt_drv_nomem(d, "partition");
+    memcpy(buf, mine, bytes);
+    pdt_status st = PDT_OK;
+    for (int s = 1; s < p && st == PDT_OK; s <<= 1) {
+        if (r & s) {
+            st = pdt_comm_send(d->c, r - s, TAG_SAMPLES, buf, have * bytes, err);
+            if (st == PDT_OK) pdt_drv_note_send(d, TAG_SAMPLES, r - s, have * bytes);
+            break;
+        }
+        if (r + s >= p) continue;
+        void *got = NULL;
+        size_t len = 0;
+        st = pdt_comm_recv(d->c, r + s, TAG_SAMPLES, &got, &len, err);
+        if (st == PDT_OK) pdt_drv_note_recv(d, TAG_SAMPLES, r + s, len);
+        if (st == PDT_OK && (len % bytes || have + len / bytes > span))
+            st = pdt_err_set(err, PDT_ERR_CHECK, "rank %d: partition: %zu bytes of samples from "
+                             "rank %d", r, len, r + s);
+        if (st == PDT_OK) {
+            memcpy(buf + have * slot, got, len);
+            have += len / bytes;
+        }
+        free(got);
+    }
+    if (st == PDT_OK && r == 0) *all = buf;
+    else free(buf);
+    return st;
+}
+
 /* The cuts in d->tree, the same on every rank: the samples gathered at
  * rank 0, cut down the tree (bis_down), every cut summed into every rank
  * by one allreduce (each made by one rank, zero elsewhere). */
@@ -257,18 +326,13 @@ static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t firs
     d->tree.k = 1;
     d->tree.levels_p = pdt_srm_ceil_log2(p);
     d->tree.cut = calloc((size_t)p, sizeof *d->tree.cut);
-    uint64_t *mine = malloc(slot * sizeof *mine), *v = calloc(nv, sizeof *v);
-    uint64_t *all = d->rank == 0 ? malloc((size_t)p * slot * sizeof *all) : NULL;
-    size_t *cnt = malloc((size_t)p * sizeof *cnt);
-    pdt_status st = d->tree.cut && mine && v && cnt && (d->rank || all)
-                        ? PDT_OK : pdt_drv_nomem(d, "partition");
+    uint64_t *mine = malloc(slot * sizeof *mine), *v = calloc(nv, sizeof *v), *all = NULL;
+    pdt_status st = d->tree.cut && mine && v ? PDT_OK : pdt_drv_nomem(d, "partition");
     if (st == PDT_OK) {
         bis_sample(pts, n, first, share, mine);
-        for (int q = 0; q < p; q++) cnt[q] = slot * sizeof *mine;
-        st = pdt_comm_gatherv(d->c, mine, slot * sizeof *mine, all, cnt, 0, err);
+        st = bis_gather(d, mine, slot, &all, err);
     }
     if (st == PDT_OK) {
-        pdt_drv_note_all(d, TAG_SAMPLES, slot * sizeof *mine); /* (uniform: the checker pairs them) */
         bis_cell c = {0, 0, 0, 0};
         size_t m = d->rank == 0 ? bis_pack(all, p, slot, &c) : 0;
         st = bis_down(d, all, all, m, c, v, err); /* (all is bis_down's: freed there) */
@@ -282,7 +346,6 @@ static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t firs
     free(mine);
     free(v);
     free(all);
-    free(cnt);
     return st;
 }
 

@@ -73,6 +73,28 @@ if [ -n "$b0" ] && [ $((3 * b0)) -lt $((2 * s0)) ]; then ok stats_border_sets_by
 else fail stats_border_sets_by_level_shrink "level 0: strips $s0, bisect $b0"; fi
 cmp -s strips.tri bisect.tri && ok strips_and_bisect_same_bytes || fail strips_and_bisect_same_bytes "differ"
 
+# the samples reach rank 0 by one gather below 64 ranks and up a binomial
+# tree from there (PDT_TEST_BIS_GATHER=1 or 2 forces either in the test
+# build): both must give rank 0 every rank's sample once, so the same cuts
+# and every rank the same number of points (a sample lost or taken twice
+# moves the cuts; P = 5, 6 and 7: trees with short branches)
+for np in 5 6 7; do
+    for g in 1 2; do
+        mpirun -np $np -x PDT_TEST_BIS_GATHER=$g "$PDT_HOOKED" triangulate big.txt -o g$g.tri \
+            --partition bisect --stats 2> g$g.json > /dev/null
+    done
+    pts=$(python3 - <<'PY'
+import json
+a, b = (json.load(open(f"g{g}.json"))["per_rank"] for g in (1, 2))
+pa, pb = [r["points"] for r in a], [r["points"] for r in b]
+print("same" if pa == pb else f"gather {pa} tree {pb}")
+PY
+)
+    if [ "$pts" = same ] && cmp -s strips.tri g1.tri && cmp -s strips.tri g2.tri; then
+        ok "samples_by_tree_same_cuts_np$np"
+    else fail "samples_by_tree_same_cuts_np$np" "$pts"; fi
+done
+
 # a bad value
 "$PDT" triangulate u.txt -o x.tri --partition boxes 2> bad.err; rc=$?
 if [ $rc -eq 2 ] && grep -q "strips or bisect" bad.err; then ok partition_bad_value_usage
