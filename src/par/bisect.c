@@ -7,11 +7,11 @@
  * from each of s equal stretches of it, at a place a hash of the stretch's
  * global position chooses: a regular sample that no periodic input order
  * aliases; all the block's points when it has at most s), rank 0 gathers
- * the samples (bis_gather), and the cuts are made down the tree (bis_down): each rank
- * range across its cell's longer side, at the key that leaves ceil(s/2)/s
- * of the range's sample on the left.  Every rank then sends each of its
- * points to the region the cuts put it in, unsorted: the receiver sorts
- * its region once (spread.c).
+ * the samples (bis_gather), and the cuts are made down the tree (bis_down):
+ * each rank range across its cell's longer side, at the key that leaves
+ * ceil(s/2)/s of the range's sample on the left.  Every rank then sends
+ * each of its points to the region the cuts put it in, unsorted: the
+ * receiver sorts its region once (spread.c).
  *
  * Exact medians would need every rank's block sorted and rounds of counts
  * and allreduces at every depth of the tree.  A sample of 2^17 points in all puts a
@@ -278,7 +278,8 @@ static pdt_status bis_gather(drv *d, const uint64_t *mine, size_t slot, uint64_t
         pdt_status st = cnt && (r || buf) ? PDT_OK : pdt_drv_nomem(d, "partition");
         for (int q = 0; st == PDT_OK && q < p; q++) cnt[q] = bytes;
         if (st == PDT_OK) st = pdt_comm_gatherv(d->c, mine, bytes, buf, cnt, 0, err);
-        if (st == PDT_OK) pdt_drv_note_all(d, TAG_SAMPLES, bytes); /* (uniform: the checker pairs them) */
+        if (st == PDT_OK) /* (uniform: the checker pairs them) */
+            pdt_drv_note_all(d, TAG_SAMPLES, bytes);
         free(cnt);
         if (st == PDT_OK) *all = buf;
         else free(buf);
