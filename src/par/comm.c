@@ -54,8 +54,8 @@ void pdt_comm_heap_shared(void)
  * was cleared at 0.35-0.8 GB/s, against 6.6 GB/s touched again at once, and
  * 4 KiB pages at 2.2-2.7 GB/s whatever their past: the partition, where a
  * rank first touches its block, took two to three times as long with huge
- * pages, and from run to run twice as long or not.  No transparent huge pages for the
- * whole simulation, one rank or many (docs/simulation.md). */
+ * pages, and from run to run twice as long or not.  No transparent huge
+ * pages for the whole simulation, one rank or many (docs/simulation.md). */
 void pdt_comm_small_pages(void)
 {
 #ifdef PR_SET_THP_DISABLE
