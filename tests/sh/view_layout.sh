@@ -50,10 +50,12 @@ else fail checker_passes_clean "$(head -5 "$TMP/ok.out")"; fi
 
 # the lecture-room rules, on a projector (1024x768) and a large screen,
 # at font scales 1, 1.5 and 2: a Graham run and an SRM run of four ranks
-# with every panel, at their busy moments
+# with every panel, at their busy moments (at 780 both merge stacks of a
+# rank are open: at font scale 2 the elements go below their names)
 for sz in 1024x768 1920x1080; do
     for fs in 1 1.5 2; do
-        for spec in "synth:graham:40 --at 60" "synth:srm:8:8:4 --phase merge" "synth:srm:8:8:4 --at 465"; do
+        for spec in "synth:graham:40 --at 60" "synth:srm:8:8:4 --phase merge" "synth:srm:8:8:4 --at 465" \
+                    "synth:srm:8:8:4 --panels all --at 780"; do
             set -- $spec
             n=$(echo "$spec $sz $fs" | tr -c 'a-z0-9\n' _)
             "$V" --headless $spec -o "$TMP/$n.png" --size $sz --font-scale $fs --layout-report "$TMP/$n.json" --quiet

@@ -292,6 +292,34 @@ static size_t stack_fit(const ctx *c, int st, const uint32_t *buf, size_t k, dou
     return first;
 }
 
+/* The elements of one stack, buf[0, k), from x0 on the line at y up to the
+ * right edge xr: as many from the top as fit, with "… " ahead of them when
+ * some do not, and the "▸" at the top. 0 when not even the top one fits. */
+static int stack_elements(ctx *c, int st, const uint32_t *buf, size_t k, double x0, double y,
+                          double xr)
+{
+    cairo_t *cr = c->cr;
+    double f = c->L.font, fs = c->L.body;
+    double room = xr - x0 - 0.2 * f - text_wb(cr, SANS, 1, fs, "▸");
+    size_t first = stack_fit(c, st, buf, k, room);
+    if (first > 0) first = stack_fit(c, st, buf, k, room - text_w(cr, MONO, fs, "… "));
+    if (first >= k) return 0;
+    char num[24];
+    double x = x0;
+    rgb(cr, c->T->ink, 1);
+    if (first > 0) {
+        text_at(cr, MONO, 0, fs, x, y, "…");
+        x += text_w(cr, MONO, fs, "… ");
+    }
+    for (size_t i = first; i < k; i++) {
+        stack_item(c, st, buf[i], i + 1 < k, num, sizeof num);
+        text_at(cr, MONO, i + 1 == k, fs, x, y, num);
+        x += text_w(cr, MONO, fs, num);
+    }
+    text_at(cr, SANS, 1, fs, x + 0.2 * f, y, "▸");
+    return 1;
+}
+
 void pdt_draw_stack_panel(ctx *c)
 {
     cairo_t *cr = c->cr;
@@ -301,12 +329,13 @@ void pdt_draw_stack_panel(ctx *c)
     cairo_save(cr);
     clip_rect(cr, R);
     double fs = c->L.body, lh = 1.2 * fs, y = R.y + 1.6 * f + lh;
+    double xr = R.x + R.w - 0.5 * f, ybot = R.y + R.h - 0.3 * f;
     uint32_t *buf = malloc((c->n + 1) * sizeof *buf);
     int any = 0;
     for (int q = 0; q < c->nranks && buf; q++) {
         if (!shown(c, (uint32_t)q)) continue;
         for (int st = 0; st < 5; st++) {
-            if (y > R.y + R.h - 0.3 * f) break;
+            if (y > ybot) break;
             int32_t top = pdt_rstate_slot(c->r, c->s, q, PDT_SLOT_STACK0 + st);
             if (top < 0 || !pdt_replay_stack_open(c->r, c->s, top)) continue;
             size_t k = pdt_replay_stack_list(c->r, top, buf, c->n + 1);
@@ -315,24 +344,11 @@ void pdt_draw_stack_panel(ctx *c)
             set_rank(c, q, 1);
             text_at(cr, SANS, 1, fs, R.x + 0.5 * f, y, head);
             double x0 = R.x + 0.5 * f + text_wb(cr, SANS, 1, fs, head) + 0.4 * f;
-            /* as many elements from the top as fit, with the "… " ahead of
-             * them when some do not */
-            double room = R.x + R.w - 0.5 * f - x0 - 1.5 * f;
-            size_t first = stack_fit(c, st, buf, k, room);
-            if (first > 0) first = stack_fit(c, st, buf, k, room - text_w(cr, MONO, fs, "… "));
-            char num[24];
-            double x = x0;
-            rgb(cr, c->T->ink, 1);
-            if (first > 0) {
-                text_at(cr, MONO, 0, fs, x, y, "…");
-                x += text_w(cr, MONO, fs, "… ");
-            }
-            for (size_t i = first; i < k; i++) {
-                stack_item(c, st, buf[i], i + 1 < k, num, sizeof num);
-                text_at(cr, MONO, i + 1 == k, fs, x, y, num);
-                x += text_w(cr, MONO, fs, num);
-            }
-            if (k) text_at(cr, SANS, 1, fs, x + 0.2 * f, y, "▸");
+            /* no room after the name (large fonts): the elements on a line
+             * of their own, indented, when there is one */
+            if (k && !stack_elements(c, st, buf, k, x0, y, xr) && y + lh <= ybot &&
+                stack_elements(c, st, buf, k, R.x + 1.5 * f, y + lh, xr))
+                y += lh;
             y += lh;
             any = 1;
         }
