@@ -66,6 +66,45 @@ for sz in 1024x768 1920x1080; do
     done
 done
 
+# a recorded run of 8 ranks (lesson 09's), the same rules through it, at
+# 1024x768 and font scale 2 with every panel asked for: every 50th step and
+# the steps where the event line spills over a named point's label (2705,
+# 3395, 3440) or a merge stack's name fills its line (2065)
+R8=$ROOT/assets/runs/uniform-300-p8
+steps=$( (seq 0 50 5650; echo 2065 2705 3395 3440) | tr '\n' ' ')
+reports=()
+for k in $steps; do
+    "$V" --headless "$R8" --panels all --at "$k" -o "$TMP/r8.png" --size 1024x768 --font-scale 2 \
+        --layout-report "$TMP/r8-$k.json" --quiet && reports+=("$TMP/r8-$k.json")
+done
+if [ "${#reports[@]}" -eq "$(echo $steps | wc -w)" ] &&
+   $CHECK --min-px 16 --min-big 18 --panel event "${reports[@]}" >"$TMP/r8.out"; then
+    ok "readable_recorded_8_ranks: ${#reports[@]} steps"
+else fail readable_recorded_8_ranks "$(grep -v '^ok ' "$TMP/r8.out" | head -4)"; fi
+
+# the recorded run of 256 ranks (lesson 12's), the same rules at the steps
+# where a named point's label met a group's label, another named point's,
+# the event line's spill or the picture's edge, or a stack's name filled
+# its line: at 1024x768, font scales 1 and 2, and 1920x1080
+tar xJf "$ROOT/lessons/12-cluster/r256-uniform-3000.tar.xz" -C "$TMP"
+R256=$TMP/r256-uniform-3000
+reports=(); want=0
+for spec in "1024x768 1 10200 10950 16950 21600 43500 65400 120450" "1024x768 2 31800 117750" \
+            "1920x1080 1 10200 43500"; do
+    set -- $spec
+    sz=$1 fs=$2
+    shift 2
+    for k; do
+        want=$((want + 1))
+        "$V" --headless "$R256" --panels all --at "$k" -o "$TMP/r256.png" --size "$sz" --font-scale "$fs" \
+            --layout-report "$TMP/r256-$sz-$fs-$k.json" --quiet && reports+=("$TMP/r256-$sz-$fs-$k.json")
+    done
+done
+if [ "${#reports[@]}" -eq "$want" ] &&
+   $CHECK --min-px 16 --panel event "${reports[@]}" >"$TMP/r256.out"; then
+    ok "readable_recorded_256_ranks: $want steps"
+else fail readable_recorded_256_ranks "$(grep -v '^ok ' "$TMP/r256.out" | head -4)"; fi
+
 # the legend's groups and the timeline's rows of a 64-rank run, held to the
 # same rules: the legend flows its groups into rows and is given their height,
 # or, with no room for it, is named on the bottom line (Tab shows it)

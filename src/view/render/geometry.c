@@ -490,8 +490,10 @@ static size_t points_in_view(const ctx *c)
 /* Where point p's label (tw wide, at fs) goes beside it at (x, y): the
  * first free spot right-up, left-up (the others' labels); a named point's
  * (prio) also right-down, left-down, above, below, right, left, then as
- * much again one and two font sizes further out, else right-up.  A label
- * placed is added to B; P (may be NULL): the points, kept clear too. */
+ * much again one and two font sizes further out, over the points; none
+ * when every spot meets a label or a box the picture keeps (the event line
+ * names the point).  A label placed is added to B; P (may be NULL): the
+ * points, kept clear too. */
 static int label_spot(const ctx *c, lbox *B, size_t *nb, const lbox *P, size_t np, uint32_t p,
                       double x, double y, double tw, double fs, int prio, double *lx, double *ly)
 {
@@ -506,7 +508,7 @@ static int label_spot(const ctx *c, lbox *B, size_t *nb, const lbox *P, size_t n
                ay = y + oy[k % 8] + (k / 8) * dy[k % 8] * f;
         lbox b = {ax - 1, ay - th - 1, ax + tw + 1, ay + 0.2 * fs + 1};
         if (overlaps(B, *nb, b) || b.x1 > c->L.geo.x + c->L.geo.w || b.x0 < c->L.geo.x ||
-            b.y0 < c->L.geo.y)
+            b.y0 < c->L.geo.y || b.y1 > c->L.geo.y + c->L.geo.h)
             continue;
         int hit = 0; /* not over another point */
         for (size_t q = 0; P && q < np && !hit; q++) hit = q != p && overlaps(&P[q], 1, b);
@@ -516,9 +518,7 @@ static int label_spot(const ctx *c, lbox *B, size_t *nb, const lbox *P, size_t n
         *ly = ay;
         return 1;
     }
-    *lx = x + ox[0]; /* the named points always get theirs */
-    *ly = y + oy[0];
-    return prio;
+    return 0;
 }
 
 static void draw_labels(ctx *c)

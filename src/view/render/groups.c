@@ -135,6 +135,8 @@ int pdt_draw_group_labels(ctx *c)
                   c->taken[t].y0 < ly + 0.3 * fs;
         if (hit) continue;
         last[side] = (pdt_rect){lx, ly - fs, tw, fs};
+        if (c->ntaken < TAKEN_MAX) /* the point labels keep off it */
+            c->taken[c->ntaken++] = (lbox){lx - 0.1 * fs, ly - fs, lx + tw + 0.1 * fs, ly + 0.3 * fs};
         cairo_rectangle(cr, lx - 0.1 * fs, ly - 0.85 * fs, tw + 0.2 * fs, 1.1 * fs);
         rgb(cr, c->T->bg, 0.8);
         cairo_fill(cr);

@@ -292,6 +292,17 @@ static size_t stack_fit(const ctx *c, int st, const uint32_t *buf, size_t k, dou
     return first;
 }
 
+/* A stack's name on its line, "r3 merge-lower (11):", without the count or
+ * then the kind of stack when that is too wide for `room`. */
+static void stack_head(ctx *c, int q, int st, size_t k, double room, char *b, size_t cap)
+{
+    snprintf(b, cap, "r%d %s (%zu):", q, pdt_stack_name(st), k);
+    if (text_wb(c->cr, SANS, 1, c->L.body, b) <= room) return;
+    snprintf(b, cap, "r%d %s:", q, pdt_stack_name(st));
+    if (text_wb(c->cr, SANS, 1, c->L.body, b) <= room) return;
+    snprintf(b, cap, "r%d:", q);
+}
+
 /* The elements of one stack, buf[0, k), from x0 on the line at y up to the
  * right edge xr: as many from the top as fit, with "… " ahead of them when
  * some do not, and the "▸" at the top. 0 when not even the top one fits. */
@@ -340,7 +351,7 @@ void pdt_draw_stack_panel(ctx *c)
             if (top < 0 || !pdt_replay_stack_open(c->r, c->s, top)) continue;
             size_t k = pdt_replay_stack_list(c->r, top, buf, c->n + 1);
             char head[48];
-            snprintf(head, sizeof head, "r%d %s (%zu):", q, pdt_stack_name(st), k);
+            stack_head(c, q, st, k, xr - R.x - 0.5 * f, head, sizeof head);
             set_rank(c, q, 1);
             text_at(cr, SANS, 1, fs, R.x + 0.5 * f, y, head);
             double x0 = R.x + 0.5 * f + text_wb(cr, SANS, 1, fs, head) + 0.4 * f;
