@@ -521,6 +521,36 @@ static int label_spot(const ctx *c, lbox *B, size_t *nb, const lbox *P, size_t n
     return 0;
 }
 
+/* The labels of the points the event names and of the selected one, placed
+ * before the picture's other labels (strips', groups', merges', points'),
+ * which keep off them: only the event line's spill is there before. */
+static void place_named_labels(ctx *c)
+{
+    uint32_t named[5];
+    int nn = named_points(c, named);
+    if (c->v->sel_point >= 0 && (size_t)c->v->sel_point < c->n) named[nn++] = (uint32_t)c->v->sel_point;
+    double fs = 1.15 * c->L.label;
+    c->nnamed = 0;
+    for (int i = 0; i < nn && c->ntaken < TAKEN_MAX; i++) {
+        int dup = 0;
+        for (int j = 0; j < i; j++) dup |= named[j] == named[i];
+        double x, y, lx, ly;
+        wpt(c, named[i], &x, &y);
+        if (dup || x < c->L.geo.x || x > c->L.geo.x + c->L.geo.w || y < c->L.geo.y ||
+            y > c->L.geo.y + c->L.geo.h)
+            continue;
+        char lab[48];
+        pdt_point_label(c->r, c->s, named[i], lab, sizeof lab);
+        double tw = text_wb(c->cr, SANS, 1, fs, lab);
+        size_t nt = (size_t)c->ntaken;
+        if (!label_spot(c, c->taken, &nt, NULL, 0, named[i], x, y, tw, fs, 1, &lx, &ly)) continue;
+        c->ntaken = (int)nt;
+        c->named[c->nnamed].p = named[i];
+        c->named[c->nnamed].x = lx;
+        c->named[c->nnamed++].y = ly;
+    }
+}
+
 static void draw_labels(ctx *c)
 {
     size_t nvis = points_in_view(c);
@@ -564,12 +594,16 @@ static void draw_labels(ctx *c)
             continue;
         char lab[48];
         pdt_point_label(c->r, c->s, p, lab, sizeof lab);
-        int prio = i < first_other;
-        double fs = prio ? 1.15 * f : f;
-        double tw = text_wb(c->cr, SANS, prio, fs, lab);
+        if (i < first_other) { /* (placed before the picture's other labels) */
+            for (int k = 0; k < c->nnamed; k++)
+                if (c->named[k].p == p)
+                    halo_text(c, 1, 1.15 * f, c->named[k].x, c->named[k].y, lab, c->T->ink);
+            continue;
+        }
+        double tw = text_wb(c->cr, SANS, 0, f, lab);
         double lx, ly;
-        if (!label_spot(c, B, &nb, prio ? NULL : P, np, p, x, y, tw, fs, prio, &lx, &ly)) continue;
-        halo_text(c, prio, fs, lx, ly, lab, prio ? c->T->ink : c->T->label);
+        if (!label_spot(c, B, &nb, P, np, p, x, y, tw, f, 0, &lx, &ly)) continue;
+        halo_text(c, 0, f, lx, ly, lab, c->T->label);
     }
     free(P);
     free(B);
@@ -917,6 +951,7 @@ void pdt_draw_geometry(ctx *c)
         cur_tri = circum(c->P, v, &ox, &oy, &rr);
     }
     if (c->v->clean) cur_tri = 0;
+    place_named_labels(c);
     draw_boxes(c, cur_tri, 0);
     if (!c->v->clean) draw_kernel_edges(c);
     draw_triangles(c);

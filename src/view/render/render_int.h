@@ -93,6 +93,11 @@ typedef struct ctx {
     const pdt_theme *T;  /* colours */
     lbox taken[TAKEN_MAX]; /* the strip labels placed: point labels keep off them */
     int ntaken;
+    struct {
+        uint32_t p;
+        double x, y;
+    } named[5]; /* the named and selected points' labels, placed first (geometry.c) */
+    int nnamed;
     /* groups of ranks (groups.c) */
     const pdt_ranktree *tree;  /* v->tree, or own_tree */
     pdt_ranktree *own_tree;
