@@ -331,6 +331,24 @@ static int stack_elements(ctx *c, int st, const uint32_t *buf, size_t k, double 
     return 1;
 }
 
+/* Whose stacks the panel lists first: the rank of the current event (the
+ * stack it pushes on or pops from ahead of its others) when the open stacks
+ * might not all get a line each (two with their elements below the name),
+ * else -1 (rank order). */
+static int stack_first_rank(const ctx *c, int lines)
+{
+    if (!c->cur || c->cur->rank >= (uint32_t)c->nranks || !shown(c, c->cur->rank)) return -1;
+    int open = 0;
+    for (int q = 0; q < c->nranks && 2 * open <= lines; q++) {
+        if (!shown(c, (uint32_t)q)) continue;
+        for (int st = 0; st < 5; st++) {
+            int32_t top = pdt_rstate_slot(c->r, c->s, q, PDT_SLOT_STACK0 + st);
+            open += top >= 0 && pdt_replay_stack_open(c->r, c->s, top);
+        }
+    }
+    return 2 * open > lines ? (int)c->cur->rank : -1;
+}
+
 void pdt_draw_stack_panel(ctx *c)
 {
     cairo_t *cr = c->cr;
@@ -343,9 +361,14 @@ void pdt_draw_stack_panel(ctx *c)
     double xr = R.x + R.w - 0.5 * f, ybot = R.y + R.h - 0.3 * f;
     uint32_t *buf = malloc((c->n + 1) * sizeof *buf);
     int any = 0;
-    for (int q = 0; q < c->nranks && buf; q++) {
+    int first = stack_first_rank(c, (int)((ybot - y) / lh) + 1);
+    for (int i = 0; i < c->nranks && buf; i++) {
+        int q = first < 0 ? i : i == 0 ? first : i <= first ? i - 1 : i;
         if (!shown(c, (uint32_t)q)) continue;
-        for (int st = 0; st < 5; st++) {
+        int fst = q == first && (c->cur->ev.kind == PDT_EV_PUSH || c->cur->ev.kind == PDT_EV_POP) &&
+                          c->cur->ev.sub < 5 ? c->cur->ev.sub : -1; /* (the event's stack first) */
+        for (int j = 0; j < 5; j++) {
+            int st = fst < 0 ? j : j == 0 ? fst : j <= fst ? j - 1 : j;
             if (y > ybot) break;
             int32_t top = pdt_rstate_slot(c->r, c->s, q, PDT_SLOT_STACK0 + st);
             if (top < 0 || !pdt_replay_stack_open(c->r, c->s, top)) continue;
