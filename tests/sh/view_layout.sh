@@ -106,9 +106,10 @@ then ok "stack_panel_shows_the_events_stack: $(tail -1 "$TMP/r8s.out")"
 else fail stack_panel_shows_the_events_stack "$(head -3 "$TMP/r8s.out")"; fi
 
 # the recorded run of 256 ranks (lesson 12's), the same rules at the steps
-# where a named point's label met a group's label, another named point's,
-# the event line's spill or the picture's edge, or a stack's name filled
-# its line: at 1024x768, font scales 1 and 2, and 1920x1080
+# where a build of the viewer put a named point's label over a group's
+# label, another named point's, the event line's spill or the picture's
+# edge, or a stack's name past its panel: at 1024x768, font scales 1 and 2,
+# and 1920x1080
 tar xJf "$ROOT/lessons/12-cluster/r256-uniform-3000.tar.xz" -C "$TMP"
 R256=$TMP/r256-uniform-3000
 reports=(); want=0

@@ -331,6 +331,19 @@ static int stack_elements(ctx *c, int st, const uint32_t *buf, size_t k, double 
     return 1;
 }
 
+/* The i-th of 0, 1, 2 ... with `first` moved to the front (first < 0: i). */
+static int front(int i, int first)
+{
+    return first < 0 ? i : i == 0 ? first : i <= first ? i - 1 : i;
+}
+
+/* The stack a push or pop event works on, else -1. */
+static int event_stack(const ctx *c)
+{
+    const pdt_event *e = &c->cur->ev;
+    return (e->kind == PDT_EV_PUSH || e->kind == PDT_EV_POP) && e->sub < 5 ? e->sub : -1;
+}
+
 /* Whose stacks the panel lists first: the rank of the current event (the
  * stack it pushes on or pops from ahead of its others) when the open stacks
  * might not all get a line each (two with their elements below the name),
@@ -363,12 +376,11 @@ void pdt_draw_stack_panel(ctx *c)
     int any = 0;
     int first = stack_first_rank(c, (int)((ybot - y) / lh) + 1);
     for (int i = 0; i < c->nranks && buf; i++) {
-        int q = first < 0 ? i : i == 0 ? first : i <= first ? i - 1 : i;
+        int q = front(i, first);
         if (!shown(c, (uint32_t)q)) continue;
-        int fst = q == first && (c->cur->ev.kind == PDT_EV_PUSH || c->cur->ev.kind == PDT_EV_POP) &&
-                          c->cur->ev.sub < 5 ? c->cur->ev.sub : -1; /* (the event's stack first) */
+        int fst = q == first ? event_stack(c) : -1;
         for (int j = 0; j < 5; j++) {
-            int st = fst < 0 ? j : j == 0 ? fst : j <= fst ? j - 1 : j;
+            int st = front(j, fst);
             if (y > ybot) break;
             int32_t top = pdt_rstate_slot(c->r, c->s, q, PDT_SLOT_STACK0 + st);
             if (top < 0 || !pdt_replay_stack_open(c->r, c->s, top)) continue;
