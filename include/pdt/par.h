@@ -240,6 +240,8 @@ typedef struct pdt_par_rank_stats {
     uint64_t kept;          /* triangles kept by merges done here */
     uint64_t discarded;     /* shipped triangles discarded (non-Delaunay) here */
     uint64_t final_merge;   /* triangles made final by merges done here */
+    uint64_t shared;        /* merges done here planned as shared along their seams */
+    uint64_t share_fallbacks; /* of those, the ones this merge rank finished alone */
     uint64_t emitted;       /* final triangles this rank found */
     uint64_t written;       /* triangles of the output this rank wrote */
     uint64_t bytes_sent, bytes_recv;          /* all traffic of this rank */

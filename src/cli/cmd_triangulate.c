@@ -436,6 +436,13 @@ static void json_parallel(const pdt_par_stats *s)
             (unsigned long long)s->bytes_total, (unsigned long long)s->merge_bytes,
             s->n_in ? (double)s->merge_bytes / (8.0 * (double)s->n_in) : 0.0, s->critical_path,
             s->critical_cpu, s->t_compute);
+    uint64_t shared = 0, fallbacks = 0;
+    for (int q = 0; q < s->nranks; q++) {
+        shared += s->rank[q].shared;
+        fallbacks += s->rank[q].share_fallbacks;
+    }
+    fprintf(stderr, ", \"shared_merges\": %llu, \"shared_merges_done_alone\": %llu",
+            (unsigned long long)shared, (unsigned long long)fallbacks);
     fprintf(stderr, ", \"partition\": \"%s\", \"largest_border_set_by_level\": [",
             s->partition == PDT_PART_BISECT ? "bisect" : "strips");
     for (int l = 0; l < s->levels && l < PDT_PAR_MAX_LEVELS; l++)

@@ -130,6 +130,8 @@ static void figures(drv *d)
         me->kept += s->cnt.kept;
         me->discarded += s->cnt.discarded;
         me->final_merge += s->cnt.final_merge;
+        me->shared += s->cnt.shared;
+        me->share_fallbacks += s->cnt.share_fallbacks;
         if (s->cnt.critical_path > me->critical_path) me->critical_path = s->cnt.critical_path;
         if (s->cnt.critical_cpu > me->critical_cpu) me->critical_cpu = s->cnt.critical_cpu;
         int g = d->rank * d->k + j;

@@ -22,7 +22,10 @@ enum {
     TAG_STATS = 7,
     TAG_ORDER = 8,
     TAG_CUTS = 9,
-    TAG_MERGE = 100 /* + level */
+    TAG_MERGE = 100,       /* + level (the shared merge's too: merge bytes) */
+    TAG_SHARE = 100 + 32,  /* + level: a piece of a shared merge */
+    TAG_SHARE_BACK = 100 + 64, /* + level: its reply */
+    TAG_VERDICT = 100 + 96 /* + level: whether the pieces held the selection */
 };
 
 /* Per-rank state of the driver through the phases. */

@@ -8,7 +8,7 @@
  * half-plane outside the edge) meets a box of G_R (all of G_L if its hull is
  * degenerate), and symmetrically.  Then T*(G) = (unshipped triangles) ∪
  * {t in T*(B) : t has vertices in both groups, or t was shipped}. */
-#include "srm.h"
+#include "srm_int.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -69,7 +69,7 @@ static pdt_status grow(void **p, size_t *cap, size_t need, size_t size)
     return PDT_OK;
 }
 
-static pdt_status add_final(srm_rank *s, srm_pt a, srm_pt b, srm_pt c)
+pdt_status pdt_srm_add_final(srm_rank *s, srm_pt a, srm_pt b, srm_pt c)
 {
     if (grow((void **)&s->more, &s->capmore, s->nmore + 1, sizeof *s->more))
         return PDT_ERR_NOMEM;
@@ -78,7 +78,7 @@ static pdt_status add_final(srm_rank *s, srm_pt a, srm_pt b, srm_pt c)
     return PDT_OK;
 }
 
-static pdt_status add_pending(srm_rank *s, srm_pt a, srm_pt b, srm_pt c, int level)
+pdt_status pdt_srm_add_pending(srm_rank *s, srm_pt a, srm_pt b, srm_pt c, int level)
 {
     if (grow((void **)&s->pend, &s->cappend, s->npend + 1, sizeof *s->pend))
         return PDT_ERR_NOMEM;
@@ -96,7 +96,8 @@ static pdt_status add_pending(srm_rank *s, srm_pt a, srm_pt b, srm_pt c, int lev
  * touches (*who = that rank). */
 static int send_level_tree(const srm_rank *s, int h, int from, const srm_disk *d, int *who);
 
-static int send_level(const srm_rank *s, int h, int from, srm_pt a, srm_pt b, srm_pt c, int *who)
+int pdt_srm_send_level(const srm_rank *s, int h, int from, srm_pt a, srm_pt b, srm_pt c,
+                       int *who)
 {
     srm_disk d;
     pdt_srm_disk_of(&d, a, b, c);
@@ -416,12 +417,12 @@ static pdt_status classify(srm_rank *s, pdt_tri *tris, const strip_pts *sp, pdt_
         int who;
         int lev = alone || srm_disk_in_slab(&slab, v[0], v[1], v[2])
                       ? -1
-                      : send_level(s, s->rank, 0, v[0], v[1], v[2], &who);
+                      : pdt_srm_send_level(s, s->rank, 0, v[0], v[1], v[2], &who);
         if (lev < 0) {
             tris[k++] = (pdt_tri){{v[0].gid, v[1].gid, v[2].gid}};
             PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, v[0].gid, v[1].gid, v[2].gid, 0);
         } else {
-            if (add_pending(s, v[0], v[1], v[2], lev) != PDT_OK)
+            if (pdt_srm_add_pending(s, v[0], v[1], v[2], lev) != PDT_OK)
                 return nomem(err, s->who, "classify");
             s->cnt.deferred++;
             PDT_TRACE(tr, 1, PDT_EV_RA_DEFER, 0, v[0].gid, v[1].gid, v[2].gid, who);
@@ -463,18 +464,6 @@ static int cmp_gid(const void *a, const void *b)
 
 /* ---- the merge step ------------------------------------------------------------ */
 
-typedef srm_gtri gtri;
-
-/* rotate so that the smallest gid comes first (keeps the orientation) */
-static gtri canon3(uint32_t a, uint32_t b, uint32_t c)
-{
-    gtri t;
-    if (a < b && a < c) t = (gtri){{a, b, c}};
-    else if (b < c) t = (gtri){{b, c, a}};
-    else t = (gtri){{c, a, b}};
-    return t;
-}
-
 static int cmp_gtri(const void *x, const void *y)
 {
     const gtri *a = x, *b = y;
@@ -511,29 +500,6 @@ static size_t facing(const srm_rank *s, const srm_msg_view *hv, int q0, int q1, 
     }
     return n;
 }
-
-/* The state of one merge step at the merge rank, phase by phase. */
-typedef struct merge_job {
-    srm_rank *s;
-    int level, gl, gr, ge, nm;
-    pdt_err *err;
-    srm_msg_view *mv;            /* the decoded blobs of this level, nmv of them */
-    int nmv;
-    int *mv_from;            /* the rank of the pair each came from */
-    int hl, hr;              /* message holding the hull of G_L / G_R, or -1 */
-    double cp_in, cpu_in;    /* longest critical path among the senders */
-    gtri *shipped;           /* R_L ∪ R_R, canonical (sorted when traced) */
-    srm_tset sset, tset;     /* the shipped set and T*(B), for look-ups */
-    size_t ns;
-    srm_pt *B;               /* the border set, key-sorted, distinct */
-    size_t nb;
-    pdt_point *bp;           /* B as points, and their global indices */
-    uint32_t *bg;
-    pdt_tri *tris;           /* T*(B), indices into B */
-    size_t ntri;
-    gtri *tb;                /* T*(B) as canonical global triangles */
-    size_t ntb, kept, kept_shipped, ndisc;
-} merge_job;
 
 static void merge_job_free(merge_job *j)
 {
@@ -650,7 +616,7 @@ static pdt_status border_set(merge_job *j)
         memset(used, 0, (size_t)v->h.npts);
         for (size_t t = 0; t < v->h.ntri; t++) {
             const uint32_t *c = v->tri + 3 * t;
-            j->shipped[ns++] = canon3(v->pts[c[0]].gid, v->pts[c[1]].gid, v->pts[c[2]].gid);
+            j->shipped[ns++] = srm_canon3(v->pts[c[0]].gid, v->pts[c[1]].gid, v->pts[c[2]].gid);
             used[c[0]] = used[c[1]] = used[c[2]] = 1;
         }
         for (size_t k = 0; k < v->h.npts; k++) {
@@ -705,18 +671,11 @@ static pdt_status border_kernel(merge_job *j)
 }
 
 /* The cut between the groups of the merge: a point of the pair is in G_L
- * iff its axis key is below the split (in_left).  Strips (and a rank's two
- * strips): the first key of G_R's first non-empty strip, or with none,
+ * iff its axis key is below the split (srm_in_left).  Strips (and a rank's
+ * two strips): the first key of G_R's first non-empty strip, or with none,
  * CUT_ALL_LEFT (every point in G_L: no key is "below" UINT64_MAX, the key of
  * (2^31 - 1, 2^31 - 1)); a bisection range: its cut. */
-enum { CUT_ALL_LEFT = 2 };
-
-static int in_left(srm_cut c, srm_pt p)
-{
-    return c.axis == CUT_ALL_LEFT || srm_axis_key(c.axis, p.x, p.y) < c.split;
-}
-
-static srm_cut merge_cut(const merge_job *j)
+srm_cut pdt_srm_job_cut(const merge_job *j)
 {
     const srm_rank *s = j->s;
     const srm_tree *t = s->tree;
@@ -734,17 +693,17 @@ static pdt_status select_kept(merge_job *j)
     srm_rank *s = j->s;
     pdt_trace *tr = s->tr;
     const srm_pt *B = j->B;
-    srm_cut cut = merge_cut(j);
+    srm_cut cut = pdt_srm_job_cut(j);
     if (PDT_TRACING(tr, 1)) { /* T*(B) kept whole: the discards' witnesses */
         j->tb = malloc((j->ntri + 1) * sizeof *j->tb);
         if (!j->tb) return nomem(j->err, s->who, "merge");
     }
     for (size_t i = 0; i < j->ntri; i++) {
         const uint32_t *v = j->tris[i].v;
-        gtri g = canon3(j->bg[v[0]], j->bg[v[1]], j->bg[v[2]]);
+        gtri g = srm_canon3(j->bg[v[0]], j->bg[v[1]], j->bg[v[2]]);
         if (j->tb) j->tb[j->ntb++] = g;
         int nl = 0;
-        for (int k = 0; k < 3; k++) nl += in_left(cut, B[v[k]]);
+        for (int k = 0; k < 3; k++) nl += srm_in_left(cut, B[v[k]]);
         int multi = nl > 0 && nl < 3;
         if (!multi) {
             if (!pdt_srm_tset_has(&j->sset, g)) continue;
@@ -753,14 +712,14 @@ static pdt_status select_kept(merge_job *j)
         j->kept++;
         int who;
         int lev = j->level + 1 < s->levels
-                      ? send_level(s, s->rank, j->level + 1, B[v[0]], B[v[1]], B[v[2]], &who)
+                      ? pdt_srm_send_level(s, s->rank, j->level + 1, B[v[0]], B[v[1]], B[v[2]], &who)
                       : -1;
         pdt_status st;
         if (lev < 0) {
-            st = add_final(s, B[v[0]], B[v[1]], B[v[2]]);
+            st = pdt_srm_add_final(s, B[v[0]], B[v[1]], B[v[2]]);
             s->cnt.final_merge++;
         } else {
-            st = add_pending(s, B[v[0]], B[v[1]], B[v[2]], lev);
+            st = pdt_srm_add_pending(s, B[v[0]], B[v[1]], B[v[2]], lev);
             PDT_TRACE(tr, 1, PDT_EV_RA_DEFER, 0, B[v[0]].gid, B[v[1]].gid, B[v[2]].gid, who);
         }
         if (st != PDT_OK) return nomem(j->err, s->who, "merge");
@@ -870,31 +829,62 @@ done:
     return st;
 }
 
+pdt_status pdt_srm_job_open(merge_job *j, srm_rank *s, int level, void *const *msg,
+                            const size_t *len, pdt_err *err)
+{
+    memset(j, 0, sizeof *j);
+    j->s = s;
+    j->level = level;
+    j->err = err;
+    pdt_srm_pair_of(s->tree, s->rank, s->p, level, &j->gl, &j->gr, &j->ge);
+    j->nm = j->ge - j->gl;
+    j->t0 = now(s);
+    j->c0 = cpu_now();
+    PDT_TRACE(s->tr, 1, PDT_EV_MERGE_BEGIN, level, j->gl, j->gr, j->ge, s->rank);
+    pdt_status st = read_messages(j, msg, len);
+    return st == PDT_OK ? border_set(j) : st;
+}
+
+pdt_status pdt_srm_job_kernel(merge_job *j)
+{
+    return border_kernel(j);
+}
+
+pdt_status pdt_srm_job_select(merge_job *j)
+{
+    return select_kept(j);
+}
+
+pdt_status pdt_srm_job_discards(merge_job *j)
+{
+    return note_discards(j);
+}
+
+pdt_status pdt_srm_job_hulls(merge_job *j)
+{
+    return merge_hulls(j);
+}
+
+void pdt_srm_job_close(merge_job *j, pdt_status st)
+{
+    srm_rank *s = j->s;
+    if (st == PDT_OK) {
+        s->cnt.merges++;
+        PDT_TRACE(s->tr, 1, PDT_EV_MERGE_END, j->level, j->ns, j->nb, j->kept, (int64_t)j->ndisc);
+        s->cnt.critical_path = j->cp_in + (now(s) - j->t0);
+        s->cnt.critical_cpu = j->cpu_in + (cpu_now() - j->c0);
+    }
+    merge_job_free(j);
+}
+
 pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len, pdt_err *err)
 {
     merge_job j;
-    memset(&j, 0, sizeof j);
-    j.s = s;
-    j.level = level;
-    j.err = err;
-    pdt_srm_pair_of(s->tree, s->rank, s->p, level, &j.gl, &j.gr, &j.ge);
-    j.nm = j.ge - j.gl;
-    double t0 = now(s), c0 = cpu_now();
-    PDT_TRACE(s->tr, 1, PDT_EV_MERGE_BEGIN, level, j.gl, j.gr, j.ge, s->rank);
-
-    pdt_status st = read_messages(&j, msg, len);
-    if (st == PDT_OK) st = border_set(&j);
+    pdt_status st = pdt_srm_job_open(&j, s, level, msg, len, err);
     if (st == PDT_OK) st = border_kernel(&j);
     if (st == PDT_OK) st = select_kept(&j);
     if (st == PDT_OK) st = note_discards(&j);
     if (st == PDT_OK) st = merge_hulls(&j);
-
-    if (st == PDT_OK) {
-        s->cnt.merges++;
-        PDT_TRACE(s->tr, 1, PDT_EV_MERGE_END, level, j.ns, j.nb, j.kept, (int64_t)j.ndisc);
-        s->cnt.critical_path = j.cp_in + (now(s) - t0);
-        s->cnt.critical_cpu = j.cpu_in + (cpu_now() - c0);
-    }
-    merge_job_free(&j);
+    pdt_srm_job_close(&j, st);
     return st;
 }

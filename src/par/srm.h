@@ -267,6 +267,8 @@ typedef struct srm_counts {
     uint64_t local_tris, final_at_once, deferred, shipped, merges, border_max, kept, discarded,
         final_merge;
     uint64_t border_level[PDT_PAR_MAX_LEVELS]; /* largest |B| of a merge here, per level */
+    uint64_t shared, share_fallbacks; /* merges here shared along the seam; of those
+                                       * planned, the ones this rank did alone */
     double critical_path; /* compute seconds along the longest dependent chain */
     double critical_cpu;  /* the same chain in CPU seconds (insensitive to load) */
 } srm_counts;
@@ -400,6 +402,49 @@ srm_cut pdt_srm_cut_of(const srm_tree *t, int lo, int hi);
 /* After pdt_srm_init: s works on the bisection tree t (kept by pointer;
  * t->p * t->k == s->p) instead of strips' rank blocks. */
 pdt_status pdt_srm_use_tree(srm_rank *s, const srm_tree *t, pdt_err *err);
+
+/* ---- srm_share.c: one merge shared by several ranks along its seam ----- */
+
+/* The ranks that share a merge (algorithm.md §3.13): only in a bisection,
+ * untraced, when the merged group's points promise a border set of at least
+ * two pieces (PDT_SHARE_PIECE points each, 1000 unless set; 0: never).
+ * rank[0] is the merge rank; the others are ranks of the merged group,
+ * spread over it.  Every rank of the group computes the same plan. */
+#define PDT_SHARE_MAX 64
+typedef struct srm_share_plan {
+    int n;                     /* ranks sharing (0: the merge rank alone) */
+    int gl, gr, ge;            /* the pair of the level, as pdt_srm_pair_of */
+    int rank[PDT_SHARE_MAX];
+} srm_share_plan;
+
+/* The plan of the merge at `level` of s's group: 1 if shared, else 0. */
+int pdt_srm_share_plan(const srm_rank *s, int level, srm_share_plan *pl);
+
+typedef struct srm_job srm_job;
+
+/* The finals a sharing rank found, kept until the verdict. */
+typedef struct srm_held {
+    pdt_tri *t;
+    size_t n;
+} srm_held;
+
+/* At the merge rank: open the merge (messages as pdt_srm_merge; the border
+ * set and the merged hull are made), cut B into n pieces (piece[i] for
+ * plan.rank[i], malloc'd), read the n replies (*ok: 1 if they hold the
+ * whole selection), and close: with !ok the merge rank runs the rest of the
+ * step itself.  *job is freed by close, whatever st (the status so far). */
+pdt_status pdt_srm_share_open(srm_rank *s, int level, void *const *msg, const size_t *len,
+                              srm_job **job, pdt_err *err);
+pdt_status pdt_srm_share_pieces(srm_job *j, int n, void **piece, size_t *plen);
+pdt_status pdt_srm_share_join(srm_job *j, void *const *reply, const size_t *rlen, int n, int *ok);
+pdt_status pdt_srm_share_close(srm_job *j, int ok, pdt_status st);
+
+/* At each sharing rank (the merge rank too): the piece's triangles, the
+ * reply for the merge rank (malloc'd) and the finals held; then, told the
+ * verdict, the finals kept (ok) or dropped, and held emptied. */
+pdt_status pdt_srm_share_work(srm_rank *s, const void *piece, size_t len, void **reply,
+                              size_t *rlen, srm_held *held, pdt_err *err);
+pdt_status pdt_srm_share_commit(srm_rank *s, srm_held *held, int ok);
 
 /* ---- plain.c: the plain run on strips, one after the other ---------------- */
 

@@ -118,6 +118,94 @@ static int sends(const drv *d, int q, int level)
     return !d->tree.cut || pdt_srm_holder_of(pdt_drv_sched(d), q, d->p * d->k, level) == q;
 }
 
+/* ---- a merge shared along its seam (srm_share.c) --------------------------- */
+
+static pdt_status send_note(drv *d, int to, int tag, const void *buf, size_t len, pdt_err *err)
+{
+    pdt_status st = pdt_comm_send(d->c, to, tag, buf, len, err);
+    if (st == PDT_OK) pdt_drv_note_send(d, tag, to, len);
+    return st;
+}
+
+static pdt_status recv_note(drv *d, int from, int tag, void **buf, size_t *len, pdt_err *err)
+{
+    pdt_status st = pdt_comm_recv(d->c, from, tag, buf, len, err);
+    if (st == PDT_OK) pdt_drv_note_recv(d, tag, from, *len);
+    return st;
+}
+
+/* The verdict of a shared merge, from the merge rank to the others. */
+static pdt_status tell_verdict(drv *d, const srm_share_plan *pl, int level, unsigned char ok,
+                               pdt_err *err)
+{
+    pdt_status st = PDT_OK;
+    for (int i = 1; i < pl->n && st == PDT_OK; i++)
+        st = send_note(d, pl->rank[i], TAG_VERDICT + level, &ok, 1, err);
+    return st;
+}
+
+/* At the merge rank: the border set cut into pieces, one to each rank of
+ * the plan (its own the first), their replies, the verdict. */
+static pdt_status shared_merge(drv *d, int level, int j, const srm_share_plan *pl, void **msg,
+                               size_t *lens, pdt_err *err)
+{
+    int n = pl->n, ok = 0;
+    srm_job *job = NULL;
+    void *piece[PDT_SHARE_MAX] = {0}, *reply[PDT_SHARE_MAX] = {0};
+    size_t plen[PDT_SHARE_MAX] = {0}, rlen[PDT_SHARE_MAX] = {0};
+    srm_held held = {0};
+    pdt_status st = pdt_srm_share_open(&d->s[j], level, msg, lens, &job, err);
+    if (st == PDT_OK) st = pdt_srm_share_pieces(job, n, piece, plen);
+    for (int i = 1; i < n && st == PDT_OK; i++)
+        st = send_note(d, pl->rank[i], TAG_SHARE + level, piece[i], plen[i], err);
+    if (st == PDT_OK)
+        st = pdt_srm_share_work(&d->s[j], piece[0], plen[0], &reply[0], &rlen[0], &held, err);
+    for (int i = 1; i < n && st == PDT_OK; i++)
+        st = recv_note(d, pl->rank[i], TAG_SHARE_BACK + level, &reply[i], &rlen[i], err);
+    if (st == PDT_OK) st = pdt_srm_share_join(job, reply, rlen, n, &ok);
+    if (st == PDT_OK) st = tell_verdict(d, pl, level, (unsigned char)ok, err);
+    pdt_status cst = pdt_srm_share_commit(&d->s[j], &held, ok && st == PDT_OK);
+    if (st == PDT_OK) st = cst != PDT_OK ? pdt_drv_nomem(d, "merge") : PDT_OK;
+    st = job ? pdt_srm_share_close(job, ok, st) : st;
+    for (int i = 0; i < n; i++) {
+        free(piece[i]);
+        free(reply[i]);
+    }
+    return st;
+}
+
+/* At a rank of a shared merge's plan other than the merge rank: its piece,
+ * its reply, the verdict. */
+static pdt_status share_help(drv *d, int level, const srm_share_plan *pl, pdt_err *err)
+{
+    int m = pl->rank[0];
+    void *piece = NULL, *reply = NULL, *verdict = NULL;
+    size_t plen = 0, rlen = 0, vlen = 0;
+    srm_held held = {0};
+    pdt_status st = recv_note(d, m, TAG_SHARE + level, &piece, &plen, err);
+    if (st == PDT_OK) st = pdt_srm_share_work(&d->s[0], piece, plen, &reply, &rlen, &held, err);
+    if (st == PDT_OK) st = send_note(d, m, TAG_SHARE_BACK + level, reply, rlen, err);
+    if (st == PDT_OK) st = recv_note(d, m, TAG_VERDICT + level, &verdict, &vlen, err);
+    int ok = st == PDT_OK && vlen == 1 && *(unsigned char *)verdict;
+    pdt_status cst = pdt_srm_share_commit(&d->s[0], &held, ok);
+    if (st == PDT_OK && cst != PDT_OK) st = pdt_drv_nomem(d, "merge");
+    free(piece);
+    free(reply);
+    free(verdict);
+    return st;
+}
+
+/* Whether this rank shares the merge of its group at `level` without
+ * being its merge rank, and then its part. */
+static pdt_status maybe_help(drv *d, int level, pdt_err *err)
+{
+    srm_share_plan pl;
+    if (!pdt_srm_share_plan(&d->s[0], level, &pl)) return PDT_OK;
+    for (int i = 1; i < pl.n; i++)
+        if (pl.rank[i] == d->rank) return share_help(d, level, &pl, err);
+    return PDT_OK;
+}
+
 /* At the merge strip g of a level (this rank's strip j): the messages of the
  * pair's strips [gl, ge) that send (all, or with relay the two holders):
  * this rank's own (in own[], taken: freed here), the others received from
@@ -145,7 +233,11 @@ static pdt_status merge_at(drv *d, int level, int j, int gl, int ge, void **own,
         st = pdt_comm_recv(d->c, from, TAG_MERGE + level, &msg[q - gl], &lens[q - gl], err);
         if (st == PDT_OK) pdt_drv_note_recv(d, TAG_MERGE + level, from, lens[q - gl]);
     }
-    if (st == PDT_OK) st = pdt_srm_merge(&d->s[j], level, msg, lens, err);
+    srm_share_plan pl;
+    if (st == PDT_OK && pdt_srm_share_plan(&d->s[j], level, &pl))
+        st = shared_merge(d, level, j, &pl, msg, lens, err);
+    else if (st == PDT_OK)
+        st = pdt_srm_merge(&d->s[j], level, msg, lens, err);
     for (int i = 0; msg && i < nm; i++) free(msg[i]);
     free(msg);
     free(lens);
@@ -179,6 +271,7 @@ static pdt_status merge_level(drv *d, int level, pdt_err *err)
             st = merge_at(d, level, j, gl, ge, own, own_len, err);
     }
     for (int j = 0; j < k; j++) free(own[j]);
+    if (st == PDT_OK) st = maybe_help(d, level, err);
     return st;
 }
 

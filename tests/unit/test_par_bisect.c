@@ -30,6 +30,7 @@ typedef struct job {
     uint64_t ntri;        /* (rank 0) triangles in all */
     uint64_t border[PDT_PAR_MAX_LEVELS], border_max;
     int levels;
+    uint64_t shared, done_alone; /* shared merges, and those the merge rank finished alone */
     int bad_place;        /* a rank's block did not fit where it belongs */
 } job;
 
@@ -61,6 +62,10 @@ static pdt_status rank_run(pdt_comm *c, void *arg, pdt_err *err)
             j->border_max = all.border_max;
             j->levels = all.levels;
             memcpy(j->border, all.border_level, sizeof j->border);
+            for (int q = 0; q < P; q++) {
+                j->shared += all.rank[q].shared;
+                j->done_alone += all.rank[q].share_fallbacks;
+            }
         }
     }
     pdt_par_stats_free(&all);
@@ -214,11 +219,94 @@ TEST(bisection_schedule)
         }
 }
 
+
+/* A merge shared by several ranks along its seam (algorithm.md §3.13),
+ * forced on small inputs with pieces of a few points: every family, P not
+ * a power of two, one and two strips a rank, gives the sequential run's
+ * triangles, whether the pieces held the whole selection or the merge rank
+ * finished alone. */
+TEST(every_family_shared_merges_same_as_plain)
+{
+    static const int ps[] = {3, 5, 8, 13};
+    static const size_t ns[] = {40, 700, 3000};
+    static const char *const piece[] = {"2", "5", "30"};
+    int runs = 0, bad = 0;
+    uint64_t shared = 0, alone = 0;
+    for (int two = 0; two < 2; two++) {
+        if (two) setenv("PDT_RANK_STRIPS", "2", 1);
+        for (const char *const *k = pdt_gen_kinds(); *k; k++) {
+            uint64_t ks = 0, ka = 0;
+            for (size_t ni = 0; ni < 3; ni++) {
+                pdt_point *pts = NULL;
+                pdt_err err = {0};
+                size_t n = ns[ni];
+                if (pdt_gen(*k, n, 11 + ni, &pts, &err) != PDT_OK) {
+                    CHECK_MSG(0, "gen %s: %s", *k, err.msg);
+                    continue;
+                }
+                pdt_tri *ref = NULL;
+                size_t nref = 0;
+                CHECK(pdt_triangulate(pts, n, &ref, &nref, NULL, NULL) == PDT_OK);
+                for (size_t pi = 0; pi < 4; pi++) {
+                    if (n > 700 && ps[pi] > 8) continue;
+                    setenv("PDT_SHARE_PIECE", piece[(ni + pi) % 3], 1);
+                    job j;
+                    runs++;
+                    bad += !same_as(pts, n, ps[pi], PDT_PART_BISECT, two, ref, nref, &j, *k);
+                    ks += j.shared;
+                    ka += j.done_alone;
+                }
+                free(ref);
+                free(pts);
+            }
+            printf("# %s%s: %llu merges shared, %llu of them finished alone\n", *k,
+                   two ? " (two strips a rank)" : "", (unsigned long long)ks,
+                   (unsigned long long)ka);
+            shared += ks;
+            alone += ka;
+        }
+    }
+    unsetenv("PDT_RANK_STRIPS");
+    unsetenv("PDT_SHARE_PIECE");
+    CHECK_MSG(bad == 0, "%d of %d runs differ from the sequential run", bad, runs);
+    CHECK_MSG(shared > alone, "%llu shared merges, %llu finished alone",
+              (unsigned long long)shared, (unsigned long long)alone);
+    CHECK_MSG(alone > 0, "no shared merge fell back to the merge rank: that path is untested");
+}
+
+/* On uniform points the pieces hold the whole selection: every merge whose
+ * group is large enough is shared and none falls back (which would mean a
+ * wrong count of the selection, or pieces too narrow). */
+TEST(uniform_shared_merges_need_no_fallback)
+{
+    size_t n = 100000;
+    pdt_point *pts = NULL;
+    pdt_err err = {0};
+    CHECK(pdt_gen("uniform", n, 5, &pts, &err) == PDT_OK);
+    pdt_tri *ref = NULL;
+    size_t nref = 0;
+    CHECK(pdt_triangulate(pts, n, &ref, &nref, NULL, NULL) == PDT_OK);
+    setenv("PDT_SHARE_PIECE", "100", 1);
+    job j;
+    CHECK(same_as(pts, n, 16, PDT_PART_BISECT, 0, ref, nref, &j, "uniform"));
+    printf("# P = 16: %llu merges shared, %llu finished alone\n",
+           (unsigned long long)j.shared, (unsigned long long)j.done_alone);
+    CHECK(j.shared == 15 && j.done_alone == 0);
+    setenv("PDT_SHARE_PIECE", "0", 1);
+    CHECK(same_as(pts, n, 16, PDT_PART_BISECT, 0, ref, nref, &j, "uniform"));
+    CHECK(j.shared == 0 && j.done_alone == 0);
+    unsetenv("PDT_SHARE_PIECE");
+    free(ref);
+    free(pts);
+}
+
 int main(void)
 {
     RUN(bisection_schedule);
     RUN(every_family_both_partitions_same_as_plain);
     RUN(every_family_two_strips_a_rank_same_as_plain);
     RUN(bisection_seams_shrink_p16);
+    RUN(every_family_shared_merges_same_as_plain);
+    RUN(uniform_shared_merges_need_no_fallback);
     return test_summary();
 }
