@@ -514,6 +514,7 @@ static void merge_job_free(merge_job *j)
     free(j->bp);
     free(j->bg);
     free(j->tris);
+    free(j->ship_lo);
 }
 
 /* Split the messages into blobs: this level's are decoded into j->mv, a
@@ -605,7 +606,9 @@ static pdt_status border_set(merge_job *j)
     j->shipped = malloc((nship + 1) * sizeof *j->shipped);
     j->B = malloc((nbmax + 1) * sizeof *j->B);
     unsigned char *used = malloc(most + 1);
-    if (!j->shipped || !j->B || !used) {
+    int sax = srm_seam_axis(pdt_srm_job_cut(j));
+    if (j->share) j->ship_lo = malloc((nship + 1) * sizeof *j->ship_lo);
+    if (!j->shipped || !j->B || !used || (j->share && !j->ship_lo)) {
         free(used);
         return nomem(j->err, s->who, "merge");
     }
@@ -616,6 +619,13 @@ static pdt_status border_set(merge_job *j)
         memset(used, 0, (size_t)v->h.npts);
         for (size_t t = 0; t < v->h.ntri; t++) {
             const uint32_t *c = v->tri + 3 * t;
+            if (j->ship_lo) {
+                uint64_t k0 = srm_axis_key(sax, v->pts[c[0]].x, v->pts[c[0]].y);
+                uint64_t k1 = srm_axis_key(sax, v->pts[c[1]].x, v->pts[c[1]].y);
+                uint64_t k2 = srm_axis_key(sax, v->pts[c[2]].x, v->pts[c[2]].y);
+                k0 = k1 < k0 ? k1 : k0;
+                j->ship_lo[ns] = k2 < k0 ? k2 : k0;
+            }
             j->shipped[ns++] = srm_canon3(v->pts[c[0]].gid, v->pts[c[1]].gid, v->pts[c[2]].gid);
             used[c[0]] = used[c[1]] = used[c[2]] = 1;
         }
@@ -629,7 +639,7 @@ static pdt_status border_set(merge_job *j)
         qsort(j->shipped, ns, sizeof *j->shipped, cmp_gtri);
     if (j->hl >= 0) nb += facing(s, &j->mv[j->hl], j->gr, j->ge, B + nb);
     if (j->hr >= 0) nb += facing(s, &j->mv[j->hr], j->gl, j->gr, B + nb);
-    if (pdt_srm_tset_init(&j->sset, j->shipped, ns) != PDT_OK ||
+    if ((!j->share && pdt_srm_tset_init(&j->sset, j->shipped, ns) != PDT_OK) ||
         pdt_srm_sort_pts(B, nb) != PDT_OK)
         return nomem(j->err, s->who, "merge");
     size_t u = 0;
@@ -830,9 +840,10 @@ done:
 }
 
 pdt_status pdt_srm_job_open(merge_job *j, srm_rank *s, int level, void *const *msg,
-                            const size_t *len, pdt_err *err)
+                            const size_t *len, int share, pdt_err *err)
 {
     memset(j, 0, sizeof *j);
+    j->share = share;
     j->s = s;
     j->level = level;
     j->err = err;
@@ -880,7 +891,7 @@ void pdt_srm_job_close(merge_job *j, pdt_status st)
 pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len, pdt_err *err)
 {
     merge_job j;
-    pdt_status st = pdt_srm_job_open(&j, s, level, msg, len, err);
+    pdt_status st = pdt_srm_job_open(&j, s, level, msg, len, 0, err);
     if (st == PDT_OK) st = border_kernel(&j);
     if (st == PDT_OK) st = select_kept(&j);
     if (st == PDT_OK) st = note_discards(&j);

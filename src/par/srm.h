@@ -407,7 +407,7 @@ pdt_status pdt_srm_use_tree(srm_rank *s, const srm_tree *t, pdt_err *err);
 
 /* The ranks that share a merge (algorithm.md §3.13): only in a bisection,
  * untraced, when the merged group's points promise a border set of at least
- * two pieces (PDT_SHARE_PIECE points each, 1000 unless set; 0: never).
+ * two pieces (PDT_SHARE_PIECE points each, 500 unless set; 0: never).
  * rank[0] is the merge rank; the others are ranks of the merged group,
  * spread over it.  Every rank of the group computes the same plan. */
 #define PDT_SHARE_MAX 64

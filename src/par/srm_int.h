@@ -30,6 +30,8 @@ struct srm_job {
     size_t ntri;
     gtri *tb;                /* T*(B) as canonical global triangles */
     size_t ntb, kept, kept_shipped, ndisc;
+    int share;               /* a shared merge: ship_lo wanted */
+    uint64_t *ship_lo;       /* (share) each shipped triangle's lowest seam key */
 };
 typedef struct srm_job merge_job;
 
@@ -39,6 +41,13 @@ enum { CUT_ALL_LEFT = 2 };
 static inline int srm_in_left(srm_cut c, srm_pt p)
 {
     return c.axis == CUT_ALL_LEFT || srm_axis_key(c.axis, p.x, p.y) < c.split;
+}
+
+/* The order along a merge's seam: the key (y, x) for a cut across x (axis
+ * 1), else the key (x, y). */
+static inline int srm_seam_axis(srm_cut cut)
+{
+    return cut.axis == 0 ? 1 : 0;
 }
 
 /* Rotated so that the smallest gid comes first (orientation kept). */
@@ -53,7 +62,7 @@ static inline gtri srm_canon3(uint32_t a, uint32_t b, uint32_t c)
 
 /* srm.c's stages, in the order pdt_srm_merge runs them. */
 pdt_status pdt_srm_job_open(merge_job *j, srm_rank *s, int level, void *const *msg,
-                            const size_t *len, pdt_err *err); /* read, border set */
+                            const size_t *len, int share, pdt_err *err); /* read, border set */
 pdt_status pdt_srm_job_kernel(merge_job *j);                  /* T*(B) */
 pdt_status pdt_srm_job_select(merge_job *j);                  /* kept: final or pending */
 pdt_status pdt_srm_job_discards(merge_job *j);

@@ -38,7 +38,7 @@
 
 /* Points per piece when PDT_SHARE_PIECE does not say (0 there: no merge is
  * shared). */
-#define SHARE_PIECE_DEFAULT 1000
+#define SHARE_PIECE_DEFAULT 500
 
 typedef struct piece_head {
     uint32_t magic, level, sax, flags; /* sax: the seam's order (0: key (x, y), 1: (y, x)) */
@@ -108,7 +108,7 @@ pdt_status pdt_srm_share_open(srm_rank *s, int level, void *const *msg, const si
 {
     *job = calloc(1, sizeof **job);
     if (!*job) return pdt_err_set(err, PDT_ERR_NOMEM, "%s: merge: out of memory", s->who);
-    pdt_status st = pdt_srm_job_open(*job, s, level, msg, len, err);
+    pdt_status st = pdt_srm_job_open(*job, s, level, msg, len, 1, err);
     return st == PDT_OK ? pdt_srm_job_hulls(*job) : st;
 }
 
@@ -118,60 +118,48 @@ static size_t piece_start(size_t nb, int n, int i)
     return (size_t)((unsigned __int128)nb * (unsigned)i / (unsigned)n);
 }
 
-static int piece_of(size_t nb, int n, size_t x)
+/* B in the seam's order (B itself when that is the key's): *bs, and *own
+ * the piece of each shipped triangle (the piece of its lowest vertex along
+ * the seam), cnt[i] how many piece i owns. */
+static pdt_status seam_order(srm_job *j, int sax, int n, srm_pt **bs, int **own, size_t *cnt)
 {
-    int i = (int)((unsigned __int128)x * (unsigned)n / (nb ? nb : 1));
-    while (i + 1 < n && piece_start(nb, n, i + 1) <= x) i++;
-    while (i > 0 && piece_start(nb, n, i) > x) i--;
-    return i;
-}
-
-/* B in the seam's order: along y for a cut across x, else along x. */
-static int seam_axis(srm_cut cut)
-{
-    return cut.axis == 0 ? 1 : 0;
+    size_t nb = j->nb, ns = j->ns;
+    *own = malloc((ns + 1) * sizeof **own);
+    *bs = sax ? malloc((nb + 1) * sizeof **bs) : j->B;
+    srm_rec *r = sax ? malloc((2 * nb + 1) * sizeof *r) : NULL;
+    if (!*own || !*bs || (sax && !r)) {
+        free(r);
+        return PDT_ERR_NOMEM;
+    }
+    if (sax) {
+        for (size_t i = 0; i < nb; i++) r[i] = (srm_rec){seam_key(sax, j->B[i]), (uint32_t)i, 0};
+        pdt_srm_radix_sort(r, r + nb, nb);
+        for (size_t i = 0; i < nb; i++) (*bs)[i] = j->B[r[i].idx];
+        free(r);
+    }
+    uint64_t first[PDT_SHARE_MAX];
+    for (int i = 0; i < n; i++) {
+        size_t c0 = piece_start(nb, n, i);
+        first[i] = c0 < nb ? seam_key(sax, (*bs)[c0]) : UINT64_MAX;
+    }
+    for (size_t t = 0; t < ns; t++) {
+        int i = n - 1;
+        while (i > 0 && first[i] > j->ship_lo[t]) i--;
+        (*own)[t] = i;
+        cnt[i]++;
+    }
+    return PDT_OK;
 }
 
 pdt_status pdt_srm_share_pieces(srm_job *j, int n, void **piece, size_t *plen)
 {
     srm_cut cut = pdt_srm_job_cut(j);
-    int sax = seam_axis(cut);
-    size_t nb = j->nb, ns = j->ns;
-    srm_rec *r = malloc((2 * nb + 1) * sizeof *r);
-    srm_pt *bs = malloc((nb + 1) * sizeof *bs);
-    uint32_t *sidx = malloc((nb + 1) * sizeof *sidx); /* B's place in bs, by B's place */
-    size_t *cnt = calloc((size_t)n, sizeof *cnt);
-    int *own = malloc((ns + 1) * sizeof *own);
-    pdt_status st = r && bs && sidx && cnt && own ? PDT_OK : PDT_ERR_NOMEM;
+    int sax = srm_seam_axis(cut);
+    size_t nb = j->nb, ns = j->ns, cnt[PDT_SHARE_MAX] = {0};
+    srm_pt *bs = NULL;
+    int *own = NULL;
     for (int i = 0; i < n; i++) piece[i] = NULL;
-    if (st == PDT_OK) {
-        for (size_t i = 0; i < nb; i++) r[i] = (srm_rec){seam_key(sax, j->B[i]), (uint32_t)i, 0};
-        pdt_srm_radix_sort(r, r + nb, nb);
-        for (size_t i = 0; i < nb; i++) {
-            bs[i] = j->B[r[i].idx];
-            sidx[r[i].idx] = (uint32_t)i;
-        }
-        /* each shipped triangle to the piece of its lowest vertex in the seam's
-         * order (B is key-sorted: a vertex's place by binary search of its key
-         * is not possible with gids alone, so sort B's gids once) */
-        for (size_t i = 0; i < nb; i++) r[i] = (srm_rec){j->B[i].gid, (uint32_t)i, 0};
-        pdt_srm_radix_sort(r, r + nb, nb);
-        for (size_t t = 0; t < ns; t++) {
-            size_t lo = SIZE_MAX;
-            for (int k = 0; k < 3; k++) {
-                size_t a = 0, b = nb;
-                while (a < b) {
-                    size_t mid = (a + b) / 2;
-                    if (r[mid].key < j->shipped[t].v[k]) a = mid + 1;
-                    else b = mid;
-                }
-                size_t x = a < nb ? sidx[r[a].idx] : 0;
-                lo = x < lo ? x : lo;
-            }
-            own[t] = piece_of(nb, n, lo);
-            cnt[own[t]]++;
-        }
-    }
+    pdt_status st = seam_order(j, sax, n, &bs, &own, cnt);
     for (int i = 0; i < n && st == PDT_OK; i++) {
         size_t c0 = piece_start(nb, n, i), c1 = piece_start(nb, n, i + 1);
         size_t ov = (c1 - c0) / 3 > SHARE_OVERLAP_MIN ? (c1 - c0) / 3 : SHARE_OVERLAP_MIN;
@@ -188,16 +176,16 @@ pdt_status pdt_srm_share_pieces(srm_job *j, int n, void **piece, size_t *plen)
         }
         memcpy(b, &h, sizeof h);
         memcpy(b + sizeof h, bs + e0, h.n * sizeof(srm_pt));
-        gtri *gt = (gtri *)(b + sizeof h + h.n * sizeof(srm_pt));
-        for (size_t t = 0, m = 0; t < ns; t++)
-            if (own[t] == i) gt[m++] = j->shipped[t];
         piece[i] = b;
         plen[i] = bytes;
     }
-    free(r);
-    free(bs);
-    free(sidx);
-    free(cnt);
+    size_t at[PDT_SHARE_MAX] = {0};
+    for (size_t t = 0; t < ns && st == PDT_OK; t++) {
+        unsigned char *b = piece[own[t]];
+        const piece_head *h = (const piece_head *)b;
+        ((gtri *)(b + sizeof *h + h->n * sizeof(srm_pt)))[at[own[t]]++] = j->shipped[t];
+    }
+    if (bs != j->B) free(bs);
     free(own);
     if (st != PDT_OK) {
         for (int i = 0; i < n; i++) {
@@ -448,7 +436,9 @@ pdt_status pdt_srm_share_close(srm_job *j, int ok, pdt_status st)
 {
     if (st == PDT_OK && !ok) {
         j->s->cnt.share_fallbacks++;
-        st = pdt_srm_job_kernel(j);
+        st = pdt_srm_tset_init(&j->sset, j->shipped, j->ns);
+        if (st != PDT_OK) st = pdt_err_set(j->err, st, "%s: merge: out of memory", j->s->who);
+        if (st == PDT_OK) st = pdt_srm_job_kernel(j);
         if (st == PDT_OK) st = pdt_srm_job_select(j);
         if (st == PDT_OK) st = pdt_srm_job_discards(j);
     }

@@ -6,7 +6,8 @@
 # merges of the bisection tree (P = 5: [0,3)|[3,5) at the top, [0,2)|[2,3)
 # below it); a trace whose regions overlap is refused; the seams shrink
 # (--stats: border sets per level; at P = 8 the level-0 seams span half the
-# input's side, the strips' all of it); a bad value is a usage error.
+# input's side, the strips' all of it); merges shared along their seams
+# give the same bytes; a bad value is a usage error.
 source "$(dirname "$0")/lib.sh"
 cd "$TMP"
 export OMPI_MCA_rmaps_base_oversubscribe=1
@@ -94,6 +95,23 @@ PY
         ok "samples_by_tree_same_cuts_np$np"
     else fail "samples_by_tree_same_cuts_np$np" "$pts"; fi
 done
+
+# merges shared along their seams (algorithm.md §3.13), forced on a small
+# input with pieces of 20 points (PDT_SHARE_PIECE): the same bytes at
+# P = 8 and 13, --stats counts the shared merges, and on uniform points no
+# merge rank has to finish one alone; PDT_SHARE_PIECE=0 shares none
+for np in 8 13; do
+    mpirun -np $np -x PDT_SHARE_PIECE=20 "$PDT" triangulate big.txt -o sh$np.tri \
+        --partition bisect --stats 2> sh$np.json > /dev/null
+    got=$(python3 -c 'import json,sys; p=json.load(open(sys.argv[1]))["parallel"]
+print(p["shared_merges"], p["shared_merges_done_alone"])' sh$np.json 2> /dev/null)
+    if cmp -s strips.tri sh$np.tri && [ "${got% *}" -ge $((np - 1)) ] 2> /dev/null &&
+       [ "${got#* }" = 0 ]; then ok "shared_merges_same_bytes_np$np"
+    else fail "shared_merges_same_bytes_np$np" "shared, alone: $got"; fi
+done
+mpirun -np 8 -x PDT_SHARE_PIECE=0 "$PDT" triangulate big.txt -o sh0.tri --stats 2> sh0.json > /dev/null
+if cmp -s strips.tri sh0.tri && grep -q '"shared_merges": 0,' sh0.json; then ok share_piece_0_shares_none
+else fail share_piece_0_shares_none "$(grep -o '"shared_merges[^,]*' sh0.json)"; fi
 
 # a bad value
 "$PDT" triangulate u.txt -o x.tri --partition boxes 2> bad.err; rc=$?

@@ -5,8 +5,8 @@
 # one process's file), on every family of pdt gen and with either
 # partition, without PDT_MPI=1 (pdt sees smpirun by itself), with
 # --stats saying "simulated": true and 256 ranks; more ranks than points
-# work; --trace writes one file per rank (256 of them) that `pdt trace
-# check` accepts.
+# work; merges shared along their seams give the same bytes; --trace
+# writes one file per rank (256 of them) that `pdt trace check` accepts.
 # Builds bin/smpi/pdt if it is missing.
 source "$(dirname "$0")/lib.sh"
 SIM=$ROOT/scripts/simulate.sh
@@ -73,6 +73,23 @@ for fam in uniform grid circle circle-round parabola clusters collinear duplicat
         fail "smpi_256_ranks_${fam}_${part}_same_bytes" "$(head -3 "f-$fam.err")"
     fi
     if [ "$part" = strips ]; then part=bisect; else part=strips; fi
+done
+
+# merges shared along their seams on 256 simulated ranks (pieces of 10
+# points forced): the plain run's bytes, shared merges counted; and the
+# circle, where a shared merge's pieces never hold the whole selection and
+# the merge rank finishes it alone
+for fam in uniform circle; do
+    "$PDT" gen "$fam" 1200 --seed 4 -o "s-$fam.txt"
+    "$PDT" triangulate "s-$fam.txt" -o "s-$fam.ele"
+    if PDT_SHARE_PIECE=10 sim "s-$fam" 256 "s-$fam.txt" -o "s-$fam-sim.ele" --stats &&
+        cmp -s "s-$fam.ele" "s-$fam-sim.ele" &&
+        ! grep -q '"shared_merges": 0,' "s-$fam.err"; then
+        ok "smpi_256_ranks_shared_merges_${fam}_same_bytes"
+    else
+        fail "smpi_256_ranks_shared_merges_${fam}_same_bytes" \
+            "$(grep -o '"shared_merges[^,]*, "shared_merges_done_alone": [0-9]*' "s-$fam.err"; head -3 "s-$fam.err")"
+    fi
 done
 
 # more ranks than points: 64 ranks, 20 points (most ranks get none)
