@@ -148,6 +148,16 @@ TEST(every_family_two_strips_a_rank_same_as_plain)
     unsetenv("PDT_RANK_STRIPS");
 }
 
+/* n uniform points (pdt gen, seed) and the sequential run's triangles. */
+static pdt_point *uniform_and_plain(size_t n, unsigned seed, pdt_tri **ref, size_t *nref)
+{
+    pdt_point *pts = NULL;
+    pdt_err err = {0};
+    CHECK(pdt_gen("uniform", n, seed, &pts, &err) == PDT_OK);
+    CHECK(pdt_triangulate(pts, n, ref, nref, NULL, NULL) == PDT_OK);
+    return pts;
+}
+
 /* The seams shrink: on 10^5 uniform points at P = 16 every strip seam runs
  * the whole height, so the largest border set is about the same at every
  * level; the bisection's top seam spans the input too, but those below it
@@ -156,13 +166,9 @@ TEST(every_family_two_strips_a_rank_same_as_plain)
  * a third, and every level's but the top's is smaller. */
 TEST(bisection_seams_shrink_p16)
 {
-    size_t n = 100000;
-    pdt_point *pts = NULL;
-    pdt_err err = {0};
-    CHECK(pdt_gen("uniform", n, 3, &pts, &err) == PDT_OK);
+    size_t n = 100000, nref = 0;
     pdt_tri *ref = NULL;
-    size_t nref = 0;
-    CHECK(pdt_triangulate(pts, n, &ref, &nref, NULL, NULL) == PDT_OK);
+    pdt_point *pts = uniform_and_plain(n, 3, &ref, &nref);
     job js, jb;
     CHECK(same_as(pts, n, 16, PDT_PART_STRIPS, 0, ref, nref, &js, "uniform"));
     CHECK(same_as(pts, n, 16, PDT_PART_BISECT, 0, ref, nref, &jb, "uniform"));
@@ -279,13 +285,9 @@ TEST(every_family_shared_merges_same_as_plain)
  * wrong count of the selection, or pieces too narrow). */
 TEST(uniform_shared_merges_need_no_fallback)
 {
-    size_t n = 100000;
-    pdt_point *pts = NULL;
-    pdt_err err = {0};
-    CHECK(pdt_gen("uniform", n, 5, &pts, &err) == PDT_OK);
+    size_t n = 100000, nref = 0;
     pdt_tri *ref = NULL;
-    size_t nref = 0;
-    CHECK(pdt_triangulate(pts, n, &ref, &nref, NULL, NULL) == PDT_OK);
+    pdt_point *pts = uniform_and_plain(n, 5, &ref, &nref);
     setenv("PDT_SHARE_PIECE", "100", 1);
     job j;
     CHECK(same_as(pts, n, 16, PDT_PART_BISECT, 0, ref, nref, &j, "uniform"));
