@@ -118,8 +118,7 @@ static int sends(const drv *d, int q, int level)
     return !d->tree.cut || pdt_srm_holder_of(pdt_drv_sched(d), q, d->p * d->k, level) == q;
 }
 
-/* ---- a merge shared along its seam (srm_share.c) --------------------------- */
-
+/* A merge-tree message sent or received, and counted (and traced). */
 static pdt_status send_note(drv *d, int to, int tag, const void *buf, size_t len, pdt_err *err)
 {
     pdt_status st = pdt_comm_send(d->c, to, tag, buf, len, err);
@@ -133,6 +132,8 @@ static pdt_status recv_note(drv *d, int from, int tag, void **buf, size_t *len, 
     if (st == PDT_OK) pdt_drv_note_recv(d, tag, from, *len);
     return st;
 }
+
+/* ---- a merge shared along its seam (srm_share.c) --------------------------- */
 
 /* The verdict of a shared merge, from the merge rank to the others. */
 static pdt_status tell_verdict(drv *d, const srm_share_plan *pl, int level, unsigned char ok,
@@ -230,8 +231,7 @@ static pdt_status merge_at(drv *d, int level, int j, int gl, int ge, void **own,
             own[q % k] = NULL;
             continue;
         }
-        st = pdt_comm_recv(d->c, from, TAG_MERGE + level, &msg[q - gl], &lens[q - gl], err);
-        if (st == PDT_OK) pdt_drv_note_recv(d, TAG_MERGE + level, from, lens[q - gl]);
+        st = recv_note(d, from, TAG_MERGE + level, &msg[q - gl], &lens[q - gl], err);
     }
     srm_share_plan pl;
     if (st == PDT_OK && pdt_srm_share_plan(&d->s[j], level, &pl))
@@ -260,8 +260,7 @@ static pdt_status merge_level(drv *d, int level, pdt_err *err)
         if (!sends(d, g, level)) continue;
         st = pdt_srm_pack(&d->s[j], level, &own[j], &own_len[j], err);
         if (st != PDT_OK || gr / k == d->rank) continue;
-        st = pdt_comm_send(d->c, gr / k, TAG_MERGE + level, own[j], own_len[j], err);
-        if (st == PDT_OK) pdt_drv_note_send(d, TAG_MERGE + level, gr / k, own_len[j]);
+        st = send_note(d, gr / k, TAG_MERGE + level, own[j], own_len[j], err);
         free(own[j]);
         own[j] = NULL;
     }
