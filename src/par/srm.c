@@ -654,7 +654,7 @@ static pdt_status border_set(merge_job *j)
 }
 
 /* Lift-up of B (traced) and T*(B) by the kernel (run 1). */
-static pdt_status border_kernel(merge_job *j)
+pdt_status pdt_srm_job_kernel(merge_job *j)
 {
     srm_rank *s = j->s;
     pdt_trace *tr = s->tr;
@@ -698,7 +698,7 @@ srm_cut pdt_srm_job_cut(const merge_job *j)
 /* Selection: keep the triangles of T*(B) with vertices in both groups and
  * the shipped ones it contains; each kept one is final or waits for a later
  * level (reclassified against the boxes outside the merged group). */
-static pdt_status select_kept(merge_job *j)
+pdt_status pdt_srm_job_select(merge_job *j)
 {
     srm_rank *s = j->s;
     pdt_trace *tr = s->tr;
@@ -760,7 +760,7 @@ static int64_t witness(const srm_pt *byg, size_t nb, gtri t)
  * witness when tracing).  A shipped triangle has its three corners in one
  * group, so the selection met every one T*(B) contains among the triangles
  * of one group: untraced, the discards are the rest. */
-static pdt_status note_discards(merge_job *j)
+pdt_status pdt_srm_job_discards(merge_job *j)
 {
     pdt_trace *tr = j->s->tr;
     if (!PDT_TRACING(tr, 1)) {
@@ -789,7 +789,7 @@ static pdt_status note_discards(merge_job *j)
 
 /* The hull of the merged group: monotone chain over both hulls
  * (lex-sorted union); this rank now holds it. */
-static pdt_status merge_hulls(merge_job *j)
+pdt_status pdt_srm_job_hulls(merge_job *j)
 {
     srm_rank *s = j->s;
     pdt_trace *tr = s->tr;
@@ -856,26 +856,6 @@ pdt_status pdt_srm_job_open(merge_job *j, srm_rank *s, int level, void *const *m
     return st == PDT_OK ? border_set(j) : st;
 }
 
-pdt_status pdt_srm_job_kernel(merge_job *j)
-{
-    return border_kernel(j);
-}
-
-pdt_status pdt_srm_job_select(merge_job *j)
-{
-    return select_kept(j);
-}
-
-pdt_status pdt_srm_job_discards(merge_job *j)
-{
-    return note_discards(j);
-}
-
-pdt_status pdt_srm_job_hulls(merge_job *j)
-{
-    return merge_hulls(j);
-}
-
 void pdt_srm_job_close(merge_job *j, pdt_status st)
 {
     srm_rank *s = j->s;
@@ -892,10 +872,10 @@ pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t 
 {
     merge_job j;
     pdt_status st = pdt_srm_job_open(&j, s, level, msg, len, 0, err);
-    if (st == PDT_OK) st = border_kernel(&j);
-    if (st == PDT_OK) st = select_kept(&j);
-    if (st == PDT_OK) st = note_discards(&j);
-    if (st == PDT_OK) st = merge_hulls(&j);
+    if (st == PDT_OK) st = pdt_srm_job_kernel(&j);
+    if (st == PDT_OK) st = pdt_srm_job_select(&j);
+    if (st == PDT_OK) st = pdt_srm_job_discards(&j);
+    if (st == PDT_OK) st = pdt_srm_job_hulls(&j);
     pdt_srm_job_close(&j, st);
     return st;
 }
