@@ -78,6 +78,16 @@ pdt_status pdt_srm_add_final(srm_rank *s, srm_pt a, srm_pt b, srm_pt c)
     return PDT_OK;
 }
 
+pdt_status pdt_srm_add_finals(srm_rank *s, const pdt_tri *t, size_t n)
+{
+    if (grow((void **)&s->more, &s->capmore, s->nmore + n, sizeof *s->more))
+        return PDT_ERR_NOMEM;
+    if (n) memcpy(s->more + s->nmore, t, n * sizeof *t);
+    s->nmore += n;
+    s->cnt.final_merge += n;
+    return PDT_OK;
+}
+
 pdt_status pdt_srm_add_pending(srm_rank *s, srm_pt a, srm_pt b, srm_pt c, int level)
 {
     if (grow((void **)&s->pend, &s->cappend, s->npend + 1, sizeof *s->pend))
@@ -501,7 +511,7 @@ static size_t facing(const srm_rank *s, const srm_msg_view *hv, int q0, int q1, 
     return n;
 }
 
-static void merge_job_free(merge_job *j)
+static void job_free(srm_job *j)
 {
     for (int i = 0; j->mv && i < j->nmv; i++) pdt_srm_msg_free(&j->mv[i]);
     free(j->mv);
@@ -520,7 +530,7 @@ static void merge_job_free(merge_job *j)
 /* Split the messages into blobs: this level's are decoded into j->mv, a
  * later level's carried on (relay only); a message without relay is one
  * blob, of this level. */
-static pdt_status split_messages(merge_job *j, void *const *msg, const size_t *len)
+static pdt_status split_messages(srm_job *j, void *const *msg, const size_t *len)
 {
     srm_rank *s = j->s;
     int nblob = 0;
@@ -564,7 +574,7 @@ static pdt_status split_messages(merge_job *j, void *const *msg, const size_t *l
 }
 
 /* Decode every message; find the two hulls and the longest critical path. */
-static pdt_status read_messages(merge_job *j, void *const *msg, const size_t *len)
+static pdt_status read_messages(srm_job *j, void *const *msg, const size_t *len)
 {
     srm_rank *s = j->s;
     j->cp_in = s->cnt.critical_path;
@@ -593,7 +603,7 @@ static pdt_status read_messages(merge_job *j, void *const *msg, const size_t *le
  * holds its triangles' vertices and its hull's: the entries its triangles
  * use (marked) go into B once each, not once a corner, so the sort has a
  * third to a sixth of the entries. */
-static pdt_status border_set(merge_job *j)
+static pdt_status border_set(srm_job *j)
 {
     srm_rank *s = j->s;
     size_t nship = 0, nbmax = 0, most = 0;
@@ -606,7 +616,7 @@ static pdt_status border_set(merge_job *j)
     j->shipped = malloc((nship + 1) * sizeof *j->shipped);
     j->B = malloc((nbmax + 1) * sizeof *j->B);
     unsigned char *used = malloc(most + 1);
-    int sax = srm_seam_axis(pdt_srm_job_cut(j));
+    int sax = j->share ? srm_seam_axis(pdt_srm_job_cut(j)) : 0;
     if (j->share) j->ship_lo = malloc((nship + 1) * sizeof *j->ship_lo);
     if (!j->shipped || !j->B || !used || (j->share && !j->ship_lo)) {
         free(used);
@@ -654,7 +664,7 @@ static pdt_status border_set(merge_job *j)
 }
 
 /* Lift-up of B (traced) and T*(B) by the kernel (run 1). */
-pdt_status pdt_srm_job_kernel(merge_job *j)
+pdt_status pdt_srm_job_kernel(srm_job *j)
 {
     srm_rank *s = j->s;
     pdt_trace *tr = s->tr;
@@ -685,7 +695,7 @@ pdt_status pdt_srm_job_kernel(merge_job *j)
  * two strips): the first key of G_R's first non-empty strip, or with none,
  * CUT_ALL_LEFT (every point in G_L: no key is "below" UINT64_MAX, the key of
  * (2^31 - 1, 2^31 - 1)); a bisection range: its cut. */
-srm_cut pdt_srm_job_cut(const merge_job *j)
+srm_cut pdt_srm_job_cut(const srm_job *j)
 {
     const srm_rank *s = j->s;
     const srm_tree *t = s->tree;
@@ -698,7 +708,7 @@ srm_cut pdt_srm_job_cut(const merge_job *j)
 /* Selection: keep the triangles of T*(B) with vertices in both groups and
  * the shipped ones it contains; each kept one is final or waits for a later
  * level (reclassified against the boxes outside the merged group). */
-pdt_status pdt_srm_job_select(merge_job *j)
+pdt_status pdt_srm_job_select(srm_job *j)
 {
     srm_rank *s = j->s;
     pdt_trace *tr = s->tr;
@@ -760,7 +770,7 @@ static int64_t witness(const srm_pt *byg, size_t nb, gtri t)
  * witness when tracing).  A shipped triangle has its three corners in one
  * group, so the selection met every one T*(B) contains among the triangles
  * of one group: untraced, the discards are the rest. */
-pdt_status pdt_srm_job_discards(merge_job *j)
+pdt_status pdt_srm_job_discards(srm_job *j)
 {
     pdt_trace *tr = j->s->tr;
     if (!PDT_TRACING(tr, 1)) {
@@ -789,7 +799,7 @@ pdt_status pdt_srm_job_discards(merge_job *j)
 
 /* The hull of the merged group: monotone chain over both hulls
  * (lex-sorted union); this rank now holds it. */
-pdt_status pdt_srm_job_hulls(merge_job *j)
+pdt_status pdt_srm_job_hulls(srm_job *j)
 {
     srm_rank *s = j->s;
     pdt_trace *tr = s->tr;
@@ -839,7 +849,7 @@ done:
     return st;
 }
 
-pdt_status pdt_srm_job_open(merge_job *j, srm_rank *s, int level, void *const *msg,
+pdt_status pdt_srm_job_open(srm_job *j, srm_rank *s, int level, void *const *msg,
                             const size_t *len, int share, pdt_err *err)
 {
     memset(j, 0, sizeof *j);
@@ -856,7 +866,7 @@ pdt_status pdt_srm_job_open(merge_job *j, srm_rank *s, int level, void *const *m
     return st == PDT_OK ? border_set(j) : st;
 }
 
-void pdt_srm_job_close(merge_job *j, pdt_status st)
+void pdt_srm_job_close(srm_job *j, pdt_status st)
 {
     srm_rank *s = j->s;
     if (st == PDT_OK) {
@@ -865,12 +875,12 @@ void pdt_srm_job_close(merge_job *j, pdt_status st)
         s->cnt.critical_path = j->cp_in + (now(s) - j->t0);
         s->cnt.critical_cpu = j->cpu_in + (cpu_now() - j->c0);
     }
-    merge_job_free(j);
+    job_free(j);
 }
 
 pdt_status pdt_srm_merge(srm_rank *s, int level, void *const *msg, const size_t *len, pdt_err *err)
 {
-    merge_job j;
+    srm_job j;
     pdt_status st = pdt_srm_job_open(&j, s, level, msg, len, 0, err);
     if (st == PDT_OK) st = pdt_srm_job_kernel(&j);
     if (st == PDT_OK) st = pdt_srm_job_select(&j);

@@ -33,7 +33,6 @@ struct srm_job {
     int share;               /* a shared merge: ship_lo wanted */
     uint64_t *ship_lo;       /* (share) each shipped triangle's lowest seam key */
 };
-typedef struct srm_job merge_job;
 
 /* The cut between the groups of a merge (its in_left rule). */
 enum { CUT_ALL_LEFT = 2 };
@@ -61,17 +60,19 @@ static inline gtri srm_canon3(uint32_t a, uint32_t b, uint32_t c)
 }
 
 /* srm.c's stages, in the order pdt_srm_merge runs them. */
-pdt_status pdt_srm_job_open(merge_job *j, srm_rank *s, int level, void *const *msg,
+pdt_status pdt_srm_job_open(srm_job *j, srm_rank *s, int level, void *const *msg,
                             const size_t *len, int share, pdt_err *err); /* read, border set */
-pdt_status pdt_srm_job_kernel(merge_job *j);                  /* T*(B) */
-pdt_status pdt_srm_job_select(merge_job *j);                  /* kept: final or pending */
-pdt_status pdt_srm_job_discards(merge_job *j);
-pdt_status pdt_srm_job_hulls(merge_job *j);                   /* hull(G), held here */
-void pdt_srm_job_close(merge_job *j, pdt_status st);          /* counts, free */
-srm_cut pdt_srm_job_cut(const merge_job *j);
+pdt_status pdt_srm_job_kernel(srm_job *j);                  /* T*(B) */
+pdt_status pdt_srm_job_select(srm_job *j);                  /* kept: final or pending */
+pdt_status pdt_srm_job_discards(srm_job *j);
+pdt_status pdt_srm_job_hulls(srm_job *j);                   /* hull(G), held here */
+void pdt_srm_job_close(srm_job *j, pdt_status st);          /* counts, free */
+srm_cut pdt_srm_job_cut(const srm_job *j);
 
-/* A final triangle or a pending one (level) kept at s. */
+/* A final triangle or a pending one (level) kept at s; n finals a merge
+ * made, untraced (counted as final_merge). */
 pdt_status pdt_srm_add_final(srm_rank *s, srm_pt a, srm_pt b, srm_pt c);
+pdt_status pdt_srm_add_finals(srm_rank *s, const pdt_tri *t, size_t n);
 pdt_status pdt_srm_add_pending(srm_rank *s, srm_pt a, srm_pt b, srm_pt c, int level);
 /* The classification of a triangle held at strip h whose group has level
  * `from`: -1 final, else its send level (*who: a rank whose box it touches). */

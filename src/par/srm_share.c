@@ -356,13 +356,7 @@ pdt_status pdt_srm_share_work(srm_rank *s, const void *buf, size_t len, void **r
 
 pdt_status pdt_srm_share_commit(srm_rank *s, srm_held *held, int ok)
 {
-    pdt_status st = PDT_OK;
-    for (size_t i = 0; ok && i < held->n && st == PDT_OK; i++) {
-        const uint32_t *v = held->t[i].v;
-        st = pdt_srm_add_final(s, (srm_pt){0, 0, v[0]}, (srm_pt){0, 0, v[1]},
-                               (srm_pt){0, 0, v[2]});
-        s->cnt.final_merge++;
-    }
+    pdt_status st = ok ? pdt_srm_add_finals(s, held->t, held->n) : PDT_OK;
     free(held->t);
     held->t = NULL;
     held->n = 0;
