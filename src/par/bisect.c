@@ -9,15 +9,18 @@
  * aliases; all the block's points when it has at most s), rank 0 gathers
  * the samples (bis_gather), and the cuts are made down the tree (bis_down):
  * each rank range across its cell's longer side, at the key that leaves
- * ceil(s/2)/s of the range's sample on the left.  Every rank then sends
- * each of its points to the region the cuts put it in, unsorted: the
- * receiver sorts its region once (spread.c).
+ * ceil(s/2)/s of the range's sample on the left.  With many points a rank
+ * the cuts are then moved by counts of the points (bis_count).  Every rank
+ * then sends each of its points to the region the cuts put it in,
+ * unsorted: the receiver sorts its region once (spread.c).
  *
  * Exact medians would need every rank's block sorted and rounds of counts
  * and allreduces at every depth of the tree.  A sample of 2^17 points in all puts a
- * region within a few per cent of n / p: about 1/sqrt(s) of it, s = 2^17 / p
- * sample points a region (at p = 64 the largest of 10^7 uniform points'
- * regions held 4.3 % more than n / p). */
+ * region within about 1/sqrt(2s) of n / p, s = 2^17 / p sample points a
+ * region (at p = 64 the largest of 10^7 uniform points' regions held 4.3 %
+ * more than n / p; at p = 1024 the largest of 10^8, 31 %); the counts, a
+ * share of every rank's points at each cut's window, within a few bins of
+ * the windows (docs/parallel.md, "Cuts moved by counts"). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -128,15 +131,62 @@ static uint64_t bis_split(uint64_t *a, size_t m, size_t t, uint64_t *keep, size_
     return split;
 }
 
+/* Where a cut's true place lies, almost surely: keys [lo, hi) on the
+ * cut's axis, between the sample's points 2 sqrt(m) + 2 ranks either side
+ * of the one the cut is at (the sample's rank of the true place is off by
+ * about sqrt(m) / 2: four standard deviations).  Every rank counts its
+ * points there in BIS_BINS equal bins (bis_count), and the counts move the
+ * cut (bis_refined).  Empty (lo == hi): no sample, the cut stays. */
+typedef struct bis_window {
+    uint64_t lo, hi;
+    int shift; /* a key's bin: (key - lo) >> shift */
+} bis_window;
+
+/* The bins of a window; the points a rank counts in them; the first depth
+ * whose cuts are counted (above it a cut's sample has at least
+ * BIS_SAMPLE / 8 points, which put it within a fraction of a per cent). */
+enum { BIS_BINS = 16, BIS_COUNTED = 8192, BIS_COUNT_FROM = 3 };
+
+/* Whether the cuts are counted: from 2^15 points a rank, where the local
+ * phase is long enough for a region's excess to cost more than the rounds
+ * of counts (4-6 ms of the partition on 1024 simulated ranks).  A test
+ * build's PDT_TEST_BIS_COUNT=0 or 1 decides. */
+static int bis_counted(const drv *d)
+{
+    const char *t = pdt_test_hook("PDT_TEST_BIS_COUNT");
+    if (t && (*t == '0' || *t == '1')) return *t == '1';
+    return d->n_total / (uint64_t)d->p >= (uint64_t)1 << 15;
+}
+
+static size_t isqrt(size_t m)
+{
+    size_t r = 0;
+    while ((r + 1) * (r + 1) <= m) r++;
+    return r;
+}
+
+/* The window of a cut at rank t of a[0..m) (a reordered by bis_split: the
+ * *left keys below its split first), on the cut's axis. */
+static void bis_window_of(uint64_t *a, size_t m, size_t t, size_t left, uint64_t split,
+                          uint64_t *keep, bis_window *w)
+{
+    size_t span = 2 * isqrt(m) + 2, r0 = t > span ? t - span : 0;
+    size_t r1 = t + span < m ? t + span : m - 1; /* (t < m) */
+    w->lo = r0 < left ? bis_radix_kth(a, left, r0, keep) : split;
+    uint64_t top = r1 > left ? bis_radix_kth(a + left, m - left, r1 - left, keep) : split;
+    w->hi = top == UINT64_MAX ? top : top + 1;
+}
+
 /* The cut of a range of s = hi - lo ranks from its sample a[0..m), (x, y)
  * keys, in its cell c: across the longer side, at the key of the sample's
  * point of rank m ceil(s/2)/s along that axis (bis_split; copies of it go
- * right); a reordered, the left side's *left keys first.  No sample: any
- * cut.  0 without memory. */
+ * right), and its window (w not NULL); a reordered, the left side's *left
+ * keys first.  No sample: any cut, an empty window.  0 without memory. */
 static int bis_cut_of(int lo, int hi, uint64_t *a, size_t m, bis_cell c, srm_cut *cut,
-                      size_t *left)
+                      bis_window *w, size_t *left)
 {
     *cut = (srm_cut){0, c.x1 - c.x0 >= c.y1 - c.y0 ? 0 : 1};
+    if (w) *w = (bis_window){0, 0, 0};
     *left = 0;
     if (!m) return 1;
     uint64_t *keep = malloc(m * sizeof *keep + 2048 * sizeof(size_t));
@@ -145,6 +195,7 @@ static int bis_cut_of(int lo, int hi, uint64_t *a, size_t m, bis_cell c, srm_cut
         for (size_t i = 0; i < m; i++) a[i] = swap_key(a[i]);
     uint64_t t = (uint64_t)m * (uint64_t)(srm_bis_mid(lo, hi) - lo) / (uint64_t)(hi - lo);
     cut->split = bis_split(a, m, (size_t)t, keep, left);
+    if (w) bis_window_of(a, m, (size_t)t, *left, cut->split, keep, w);
     if (cut->axis)
         for (size_t i = 0; i < m; i++) a[i] = swap_key(a[i]);
     free(keep);
@@ -194,8 +245,8 @@ static pdt_status bis_recv(drv *d, int from, uint64_t **buf, size_t *m, bis_cell
  * rank of a range cuts its sample, keeps the left side's and sends the
  * right side's to the right half's first rank, which goes on there.  So
  * the work on the critical path is about twice the sample, not once per
- * depth, and the messages follow the tree.  v[2 at], v[2 at + 1]: the
- * split and axis of each cut this rank made (zero elsewhere). */
+ * depth, and the messages follow the tree.  v[4 at .. 4 at + 3]: the
+ * split, axis and window of each cut this rank made (zero elsewhere). */
 static pdt_status bis_down(drv *d, uint64_t *buf, uint64_t *a, size_t m, bis_cell c,
                            uint64_t *v, pdt_err *err)
 {
@@ -206,12 +257,15 @@ static pdt_status bis_down(drv *d, uint64_t *buf, uint64_t *a, size_t m, bis_cel
         if (lead) { /* r == lo */
             size_t left;
             srm_cut cut;
-            if (!bis_cut_of(lo, hi, a, m, c, &cut, &left)) {
+            bis_window w = {0, 0, 0};
+            if (!bis_cut_of(lo, hi, a, m, c, &cut, bis_counted(d) ? &w : NULL, &left)) {
                 st = pdt_drv_nomem(d, "partition");
                 break;
             }
-            v[2 * at] = cut.split;
-            v[2 * at + 1] = (uint64_t)cut.axis;
+            v[4 * at] = cut.split;
+            v[4 * at + 1] = (uint64_t)cut.axis;
+            v[4 * at + 2] = w.lo;
+            v[4 * at + 3] = w.hi;
             bis_cell l = c, rc = c;
             int64_t x = (int64_t)(cut.split >> 32); /* the cut's own coordinate (biased) */
             if (cut.axis) l.y1 = rc.y0 = x;
@@ -316,13 +370,15 @@ static pdt_status bis_gather(drv *d, const uint64_t *mine, size_t slot, uint64_t
     return st;
 }
 
-/* The cuts in d->tree, the same on every rank: the samples gathered at
- * rank 0, cut down the tree (bis_down), every cut summed into every rank
- * by one allreduce (each made by one rank, zero elsewhere). */
-static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t first, pdt_err *err)
+/* The cuts in d->tree and their windows in win[0 .. p - 1), the same on
+ * every rank: the samples gathered at rank 0, cut down the tree
+ * (bis_down), every cut summed into every rank by one allreduce (each made
+ * by one rank, zero elsewhere). */
+static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t first,
+                           bis_window *win, pdt_err *err)
 {
     int p = d->p;
-    size_t share = bis_share(p), slot = share + 1, nv = 2 * (size_t)p;
+    size_t share = bis_share(p), slot = share + 1, nv = 4 * (size_t)p;
     d->tree.p = p;
     d->tree.k = 1;
     d->tree.levels_p = pdt_srm_ceil_log2(p);
@@ -342,7 +398,12 @@ static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t firs
     if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, v, nv, PDT_COMM_SUM, err);
     if (st == PDT_OK) {
         pdt_drv_note_all(d, TAG_SAMPLES, nv * sizeof *v);
-        for (int i = 0; i + 1 < p; i++) d->tree.cut[i] = (srm_cut){v[2 * i], (int)v[2 * i + 1]};
+        for (int i = 0; i + 1 < p; i++) {
+            d->tree.cut[i] = (srm_cut){v[4 * i], (int)v[4 * i + 1]};
+            win[i] = (bis_window){v[4 * i + 2], v[4 * i + 3], 0};
+            while (win[i].hi > win[i].lo && (win[i].hi - win[i].lo - 1) >> win[i].shift >= BIS_BINS)
+                win[i].shift++;
+        }
     }
     free(mine);
     free(v);
@@ -372,14 +433,156 @@ static inline uint32_t bis_dest(const srm_cut *cut, int p, uint64_t key)
     return lo;
 }
 
+/* A cut of the tree: its ranks [lo, hi), its depth, its place among the
+ * cuts of that depth. */
+typedef struct bis_node {
+    int lo, hi, depth, slot;
+} bis_node;
+
+/* The cuts below `at` (ranks [lo, hi), depth `depth`) into node, each
+ * given the next slot of its depth (per: cuts so far at each depth). */
+static void bis_nodes(bis_node *node, int *per, int lo, int hi, int at, int depth)
+{
+    if (hi - lo < 2) return;
+    int mid = srm_bis_mid(lo, hi);
+    node[at] = (bis_node){lo, hi, depth, per[depth]++};
+    bis_nodes(node, per, lo, mid, at + 1, depth + 1);
+    bis_nodes(node, per, mid, hi, at + (mid - lo), depth + 1);
+}
+
+/* A counted point on its way down the tree: the cut it is at (hi - lo < 2:
+ * arrived). */
+typedef struct bis_walk {
+    uint32_t lo, hi, at;
+} bis_walk;
+
+/* A cut's counters: its window's bins, then the points above the window,
+ * below it, and left of the cut as it is. */
+enum { BIS_ABOVE = BIS_BINS, BIS_BELOW = BIS_BINS + 1, BIS_LEFT = BIS_BINS + 2,
+       BIS_ROWLEN = BIS_BINS + 3 };
+
+/* The point of key `key` counted in the row of the cut it is at. */
+static inline void bis_tally(srm_cut c, const bis_window *w, uint64_t key, uint64_t *row)
+{
+    uint64_t k = c.axis ? swap_key(key) : key;
+    size_t below = k < w->lo, in = !below & (k < w->hi);
+    row[in ? (size_t)((k - w->lo) >> w->shift) : BIS_ABOVE + below]++;
+    row[BIS_LEFT] += k < c.split;
+}
+
+/* One step down the tree past the cut it is at. */
+static inline void bis_step(const srm_cut *cut, uint64_t key, bis_walk *x)
+{
+    uint32_t mid = (uint32_t)srm_bis_mid((int)x->lo, (int)x->hi);
+    srm_cut c = cut[x->at];
+    uint64_t k = c.axis ? swap_key(key) : key;
+    if (k < c.split) {
+        x->hi = mid;
+        x->at += 1;
+    } else {
+        x->at += mid - x->lo;
+        x->lo = mid;
+    }
+}
+
+/* The split of a cut of ranks [lo, hi) that leaves the left side nearest
+ * its share of the cell's points, from the counts of every rank (row): the
+ * cut as it is, or a bin's edge of its window (ties: as it is, then the
+ * lower edge). */
+static uint64_t bis_refined(srm_cut c, bis_window w, const uint64_t *row, int lo, int hi)
+{
+    int mid = srm_bis_mid(lo, hi);
+    uint64_t cell = row[BIS_ABOVE] + row[BIS_BELOW], left = row[BIS_LEFT];
+    for (int b = 0; b < BIS_BINS; b++) cell += row[b];
+    uint64_t want = cell * (uint64_t)(mid - lo) / (uint64_t)(hi - lo);
+    if (w.hi <= w.lo) return c.split;
+    uint64_t best = c.split, gap = left > want ? left - want : want - left;
+    uint64_t below = row[BIS_BELOW], bins = ((w.hi - w.lo - 1) >> w.shift) + 1;
+    for (uint64_t b = 0; b <= bins; b++) { /* (b << shift: at most hi - lo - 1) */
+        uint64_t edge = b == bins ? w.hi : w.lo + (b << w.shift);
+        uint64_t g = below > want ? below - want : want - below;
+        if (g < gap) {
+            gap = g;
+            best = edge;
+        }
+        if (b < bins) below += row[b];
+    }
+    return best;
+}
+
+/* The counted points of walk[0..nc) (pts[j * stride]) that have reached a
+ * cut of depth `depth` counted at it, summed over the ranks (rows: a row
+ * a cut of the depth, ncut of them), and those cuts moved. */
+static pdt_status bis_count_depth(drv *d, const pdt_point *pts, size_t stride, const bis_walk *walk,
+                                  size_t nc, const bis_node *node, int depth, int ncut,
+                                  const bis_window *win, uint64_t *rows, pdt_err *err)
+{
+    srm_cut *cut = d->tree.cut;
+    size_t len = (size_t)ncut * BIS_ROWLEN;
+    memset(rows, 0, len * sizeof *rows);
+    for (size_t j = 0; j < nc; j++) {
+        const bis_walk *x = &walk[j];
+        if (x->hi - x->lo >= 2)
+            bis_tally(cut[x->at], &win[x->at], pdt_key(pts[j * stride]),
+                      rows + (size_t)node[x->at].slot * BIS_ROWLEN);
+    }
+    pdt_status st = pdt_comm_allreduce_u64(d->c, rows, len, PDT_COMM_SUM, err);
+    if (st != PDT_OK) return st;
+    pdt_drv_note_all(d, TAG_SAMPLES, len * sizeof *rows);
+    for (int at = 0; at + 1 < d->p; at++)
+        if (node[at].depth == depth)
+            cut[at].split = bis_refined(cut[at], win[at], rows + (size_t)node[at].slot * BIS_ROWLEN,
+                                        node[at].lo, node[at].hi);
+    return PDT_OK;
+}
+
+/* The sample's cuts moved by what the points say (algorithm.md §3.12),
+ * depth by depth from the root: every rank counts a share of its points
+ * (every n / BIS_COUNTED-th) at the cuts of the depth they have reached, in
+ * each cut's window, one allreduce sums the counts, every rank moves those
+ * cuts the same way, and the points step past them.  A cut is moved in its
+ * cell as its ancestors left it, so the cells below see its final place.
+ * The sample alone leaves a region within about 1/sqrt(2s) of n / p, s
+ * sample points a region (at p = 1024 on 10^8 points the largest held 31 %
+ * more than n / p). */
+static pdt_status bis_count(drv *d, const pdt_point *pts, size_t n, const bis_window *win,
+                            pdt_err *err)
+{
+    int p = d->p, depths = pdt_srm_ceil_log2(p);
+    size_t stride = n / BIS_COUNTED > 1 ? n / BIS_COUNTED : 1, nc = (n + stride - 1) / stride;
+    int *per = calloc((size_t)depths + 1, sizeof *per);
+    bis_node *node = malloc((size_t)p * sizeof *node);
+    bis_walk *walk = malloc((nc + 1) * sizeof *walk);
+    uint64_t *rows = malloc(((size_t)p * BIS_ROWLEN + 1) * sizeof *rows);
+    pdt_status st = per && node && walk && rows ? PDT_OK : pdt_drv_nomem(d, "partition");
+    if (st == PDT_OK) bis_nodes(node, per, 0, p, 0, 0);
+    for (size_t j = 0; j < nc; j++) walk[j] = (bis_walk){0, (uint32_t)p, 0};
+    for (int depth = 0; depth < depths && st == PDT_OK; depth++) {
+        if (depth >= BIS_COUNT_FROM)
+            st = bis_count_depth(d, pts, stride, walk, nc, node, depth, per[depth], win, rows, err);
+        for (size_t j = 0; st == PDT_OK && j < nc; j++)
+            if (walk[j].hi - walk[j].lo >= 2)
+                bis_step(d->tree.cut, pdt_key(pts[j * stride]), &walk[j]);
+    }
+    free(per);
+    free(node);
+    free(walk);
+    free(rows);
+    return st;
+}
+
 /* Each point's region (in dst, counted in sc), then the records grouped by
  * region into send. */
 pdt_status pdt_drv_bisect(drv *d, const pdt_point *pts, size_t n, uint64_t first, srm_rec *send,
                           srm_rec *tmp, uint64_t *sc, pdt_err *err)
 {
-    pdt_status st = bis_tree(d, pts, n, first, err);
-    if (st != PDT_OK) return st;
     int p = d->p;
+    bis_window *win = malloc((size_t)p * sizeof *win);
+    if (!win) return pdt_drv_nomem(d, "partition");
+    pdt_status st = bis_tree(d, pts, n, first, win, err);
+    if (st == PDT_OK && bis_counted(d)) st = bis_count(d, pts, n, win, err);
+    free(win);
+    if (st != PDT_OK) return st;
     const srm_cut *cut = d->tree.cut;
     uint64_t *at = calloc((size_t)p, sizeof *at);
     if (!at) return pdt_drv_nomem(d, "partition");

@@ -7,7 +7,8 @@
 # below it); a trace whose regions overlap is refused; the seams shrink
 # (--stats: border sets per level; at P = 8 the level-0 seams span half the
 # input's side, the strips' all of it); merges shared along their seams
-# give the same bytes; a bad value is a usage error.
+# give the same bytes, and so do cuts moved by counts; a bad value is a
+# usage error.
 source "$(dirname "$0")/lib.sh"
 cd "$TMP"
 export OMPI_MCA_rmaps_base_oversubscribe=1
@@ -112,6 +113,19 @@ done
 mpirun -np 8 -x PDT_SHARE_PIECE=0 "$PDT" triangulate big.txt -o sh0.tri --stats 2> sh0.json > /dev/null
 if cmp -s strips.tri sh0.tri && grep -q '"shared_merges": 0,' sh0.json; then ok share_piece_0_shares_none
 else fail share_piece_0_shares_none "$(grep -o '"shared_merges[^,]*' sh0.json)"; fi
+
+# from 2^15 points a rank the sample's cuts are moved by counts of the
+# points (docs/parallel.md, "Cuts moved by counts"): at P = 16 the same
+# bytes, and every region within 3 % of n / P
+"$PDT" gen uniform 540000 --seed 9 -o many.txt
+"$PDT" triangulate many.txt -o many.tri
+mpirun -np 16 "$PDT" triangulate many.txt -o many16.tri --partition bisect --stats \
+    2> many16.json > /dev/null
+spread=$(python3 -c 'import json,sys; d=json.load(open(sys.argv[1]))
+p=[r["points"] for r in d["parallel"]["per_rank"]]; s=d["n"]/len(p)
+print("ok" if max(p) < 1.03*s and min(p) > 0.97*s else f"{min(p)}..{max(p)}")' many16.json 2>&1)
+if cmp -s many.tri many16.tri && [ "$spread" = ok ]; then ok counted_cuts_same_bytes_np16
+else fail counted_cuts_same_bytes_np16 "regions: $spread"; fi
 
 # a bad value
 "$PDT" triangulate u.txt -o x.tri --partition boxes 2> bad.err; rc=$?

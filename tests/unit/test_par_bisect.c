@@ -31,6 +31,7 @@ typedef struct job {
     uint64_t border[PDT_PAR_MAX_LEVELS], border_max;
     int levels;
     uint64_t shared, done_alone; /* shared merges, and those the merge rank finished alone */
+    uint64_t fewest, most; /* the points of the smallest and the largest region */
     int bad_place;        /* a rank's block did not fit where it belongs */
 } job;
 
@@ -62,7 +63,12 @@ static pdt_status rank_run(pdt_comm *c, void *arg, pdt_err *err)
             j->border_max = all.border_max;
             j->levels = all.levels;
             memcpy(j->border, all.border_level, sizeof j->border);
+            j->fewest = UINT64_MAX;
+            j->most = 0;
             for (int q = 0; q < P; q++) {
+                uint64_t m = all.rank[q].points;
+                j->fewest = m < j->fewest ? m : j->fewest;
+                j->most = m > j->most ? m : j->most;
                 j->shared += all.rank[q].shared;
                 j->done_alone += all.rank[q].share_fallbacks;
             }
@@ -302,6 +308,35 @@ TEST(uniform_shared_merges_need_no_fallback)
     free(pts);
 }
 
+/* The counted cuts even the regions out: on 3 * 10^5 uniform points at
+ * P = 128 the sample alone (1,024 of its points a region) leaves the
+ * regions up to 7 % from n / P; the counts of every point in each cut's
+ * window, depth by depth, halve the spread and put every region within
+ * 3.5 % of n / P (a bin of a window is about 1 % of a region here). */
+TEST(counted_cuts_even_the_regions)
+{
+    size_t n = 300000, nref = 0;
+    int P = 128;
+    pdt_tri *ref = NULL;
+    pdt_point *pts = uniform_and_plain(n, 7, &ref, &nref);
+    job js, jc;
+    setenv("PDT_TEST_BIS_COUNT", "0", 1);
+    CHECK(same_as(pts, n, P, PDT_PART_BISECT, 0, ref, nref, &js, "uniform"));
+    setenv("PDT_TEST_BIS_COUNT", "1", 1);
+    CHECK(same_as(pts, n, P, PDT_PART_BISECT, 0, ref, nref, &jc, "uniform"));
+    unsetenv("PDT_TEST_BIS_COUNT");
+    double share = (double)n / P;
+    printf("# P = %d, n / P = %.0f: sample alone %llu .. %llu, counted %llu .. %llu\n", P, share,
+           (unsigned long long)js.fewest, (unsigned long long)js.most,
+           (unsigned long long)jc.fewest, (unsigned long long)jc.most);
+    CHECK(2 * (jc.most - jc.fewest) < js.most - js.fewest);
+    CHECK_MSG((double)jc.most < 1.035 * share && (double)jc.fewest > 0.965 * share,
+              "counted: %llu .. %llu", (unsigned long long)jc.fewest,
+              (unsigned long long)jc.most);
+    free(ref);
+    free(pts);
+}
+
 int main(void)
 {
     RUN(bisection_schedule);
@@ -310,5 +345,6 @@ int main(void)
     RUN(bisection_seams_shrink_p16);
     RUN(every_family_shared_merges_same_as_plain);
     RUN(uniform_shared_merges_need_no_fallback);
+    RUN(counted_cuts_even_the_regions);
     return test_summary();
 }
