@@ -556,7 +556,7 @@ static pdt_status bis_count(drv *d, const pdt_point *pts, size_t n, const bis_wi
     uint64_t *rows = malloc(((size_t)p * BIS_ROWLEN + 1) * sizeof *rows);
     pdt_status st = per && node && walk && rows ? PDT_OK : pdt_drv_nomem(d, "partition");
     if (st == PDT_OK) bis_nodes(node, per, 0, p, 0, 0);
-    for (size_t j = 0; j < nc; j++) walk[j] = (bis_walk){0, (uint32_t)p, 0};
+    for (size_t j = 0; st == PDT_OK && j < nc; j++) walk[j] = (bis_walk){0, (uint32_t)p, 0};
     for (int depth = 0; depth < depths && st == PDT_OK; depth++) {
         if (depth >= BIS_COUNT_FROM)
             st = bis_count_depth(d, pts, stride, walk, nc, node, depth, per[depth], win, rows, err);
