@@ -158,6 +158,13 @@ static int bis_counted(const drv *d)
     return d->n_total / (uint64_t)d->p >= (uint64_t)1 << 15;
 }
 
+/* Words of the cuts' allreduce a cut: split and axis, and its window when
+ * counted. */
+static size_t bis_words(const drv *d)
+{
+    return bis_counted(d) ? 4 : 2;
+}
+
 static size_t isqrt(size_t m)
 {
     size_t r = 0;
@@ -245,12 +252,14 @@ static pdt_status bis_recv(drv *d, int from, uint64_t **buf, size_t *m, bis_cell
  * rank of a range cuts its sample, keeps the left side's and sends the
  * right side's to the right half's first rank, which goes on there.  So
  * the work on the critical path is about twice the sample, not once per
- * depth, and the messages follow the tree.  v[4 at .. 4 at + 3]: the
- * split, axis and window of each cut this rank made (zero elsewhere). */
+ * depth, and the messages follow the tree.  v[w at .. w at + w) (w =
+ * bis_words): the split, axis and window of each cut this rank made (zero
+ * elsewhere). */
 static pdt_status bis_down(drv *d, uint64_t *buf, uint64_t *a, size_t m, bis_cell c,
                            uint64_t *v, pdt_err *err)
 {
     int lo = 0, hi = d->p, at = 0, r = d->rank, lead = r == 0;
+    size_t vw = bis_words(d);
     pdt_status st = PDT_OK;
     while (st == PDT_OK && hi - lo >= 2) {
         int mid = srm_bis_mid(lo, hi);
@@ -258,14 +267,17 @@ static pdt_status bis_down(drv *d, uint64_t *buf, uint64_t *a, size_t m, bis_cel
             size_t left;
             srm_cut cut;
             bis_window w = {0, 0, 0};
-            if (!bis_cut_of(lo, hi, a, m, c, &cut, bis_counted(d) ? &w : NULL, &left)) {
+            if (!bis_cut_of(lo, hi, a, m, c, &cut, vw == 4 ? &w : NULL, &left)) {
                 st = pdt_drv_nomem(d, "partition");
                 break;
             }
-            v[4 * at] = cut.split;
-            v[4 * at + 1] = (uint64_t)cut.axis;
-            v[4 * at + 2] = w.lo;
-            v[4 * at + 3] = w.hi;
+            uint64_t *mine = v + vw * (size_t)at;
+            mine[0] = cut.split;
+            mine[1] = (uint64_t)cut.axis;
+            if (vw == 4) {
+                mine[2] = w.lo;
+                mine[3] = w.hi;
+            }
             bis_cell l = c, rc = c;
             int64_t x = (int64_t)(cut.split >> 32); /* the cut's own coordinate (biased) */
             if (cut.axis) l.y1 = rc.y0 = x;
@@ -378,7 +390,7 @@ static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t firs
                            bis_window *win, pdt_err *err)
 {
     int p = d->p;
-    size_t share = bis_share(p), slot = share + 1, nv = 4 * (size_t)p;
+    size_t share = bis_share(p), slot = share + 1, vw = bis_words(d), nv = vw * (size_t)p;
     d->tree.p = p;
     d->tree.k = 1;
     d->tree.levels_p = pdt_srm_ceil_log2(p);
@@ -399,8 +411,9 @@ static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t firs
     if (st == PDT_OK) {
         pdt_drv_note_all(d, TAG_SAMPLES, nv * sizeof *v);
         for (int i = 0; i + 1 < p; i++) {
-            d->tree.cut[i] = (srm_cut){v[4 * i], (int)v[4 * i + 1]};
-            win[i] = (bis_window){v[4 * i + 2], v[4 * i + 3], 0};
+            const uint64_t *x = v + vw * (size_t)i;
+            d->tree.cut[i] = (srm_cut){x[0], (int)x[1]};
+            win[i] = vw == 4 ? (bis_window){x[2], x[3], 0} : (bis_window){0, 0, 0};
             while (win[i].hi > win[i].lo && (win[i].hi - win[i].lo - 1) >> win[i].shift >= BIS_BINS)
                 win[i].shift++;
         }
@@ -411,26 +424,38 @@ static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t firs
     return st;
 }
 
-/* The rank whose region holds the point of key `key`: down the tree from
- * the root, left when the key on the cut's axis is below the cut.  Without
+/* A point on its way down the tree: the cut it is at, of ranks [lo, hi)
+ * (hi - lo < 2: arrived, in region lo). */
+typedef struct bis_walk {
+    uint32_t lo, hi, at;
+} bis_walk;
+
+/* One step down the tree past the cut it is at, left when the key on the
+ * cut's axis is below the cut (swapped: the key's halves swapped).  Without
  * a branch on the comparison (half of them would be mispredicted, some 15
  * cycles each at every depth): masks choose, and the descents of
  * successive points overlap. */
+static inline void bis_step(const srm_cut *cut, uint64_t key, uint64_t swapped, bis_walk *x)
+{
+    uint32_t lo = x->lo, hi = x->hi, at = x->at;
+    uint32_t mid = (uint32_t)srm_bis_mid((int)lo, (int)hi);
+    srm_cut c = cut[at];
+    uint64_t am = (uint64_t)0 - (uint64_t)(c.axis != 0);
+    uint64_t k = (swapped & am) | (key & ~am);
+    uint32_t lm = (uint32_t)0 - (uint32_t)(k < c.split); /* all ones: left */
+    x->at = at + ((1u & lm) | ((mid - lo) & ~lm));
+    x->lo = (lo & lm) | (mid & ~lm);
+    x->hi = (mid & lm) | (hi & ~lm);
+}
+
+/* The rank whose region holds the point of key `key`: bis_step from the
+ * root to a region. */
 static inline uint32_t bis_dest(const srm_cut *cut, int p, uint64_t key)
 {
-    uint32_t lo = 0, hi = (uint32_t)p, at = 0;
+    bis_walk x = {0, (uint32_t)p, 0};
     uint64_t swapped = swap_key(key);
-    while (hi - lo >= 2) {
-        uint32_t mid = (uint32_t)srm_bis_mid((int)lo, (int)hi);
-        srm_cut c = cut[at];
-        uint64_t am = (uint64_t)0 - (uint64_t)(c.axis != 0);
-        uint64_t k = (swapped & am) | (key & ~am);
-        uint32_t lm = (uint32_t)0 - (uint32_t)(k < c.split); /* all ones: left */
-        at += (1u & lm) | ((mid - lo) & ~lm);
-        lo = (lo & lm) | (mid & ~lm);
-        hi = (mid & lm) | (hi & ~lm);
-    }
-    return lo;
+    while (x.hi - x.lo >= 2) bis_step(cut, key, swapped, &x);
+    return x.lo;
 }
 
 /* A cut of the tree: its ranks [lo, hi), its depth, its place among the
@@ -450,12 +475,6 @@ static void bis_nodes(bis_node *node, int *per, int lo, int hi, int at, int dept
     bis_nodes(node, per, mid, hi, at + (mid - lo), depth + 1);
 }
 
-/* A counted point on its way down the tree: the cut it is at (hi - lo < 2:
- * arrived). */
-typedef struct bis_walk {
-    uint32_t lo, hi, at;
-} bis_walk;
-
 /* A cut's counters: its window's bins, then the points above the window,
  * below it, and left of the cut as it is. */
 enum { BIS_ABOVE = BIS_BINS, BIS_BELOW = BIS_BINS + 1, BIS_LEFT = BIS_BINS + 2,
@@ -468,21 +487,6 @@ static inline void bis_tally(srm_cut c, const bis_window *w, uint64_t key, uint6
     size_t below = k < w->lo, in = !below & (k < w->hi);
     row[in ? (size_t)((k - w->lo) >> w->shift) : BIS_ABOVE + below]++;
     row[BIS_LEFT] += k < c.split;
-}
-
-/* One step down the tree past the cut it is at. */
-static inline void bis_step(const srm_cut *cut, uint64_t key, bis_walk *x)
-{
-    uint32_t mid = (uint32_t)srm_bis_mid((int)x->lo, (int)x->hi);
-    srm_cut c = cut[x->at];
-    uint64_t k = c.axis ? swap_key(key) : key;
-    if (k < c.split) {
-        x->hi = mid;
-        x->at += 1;
-    } else {
-        x->at += mid - x->lo;
-        x->lo = mid;
-    }
 }
 
 /* The split of a cut of ranks [lo, hi) that leaves the left side nearest
@@ -560,9 +564,10 @@ static pdt_status bis_count(drv *d, const pdt_point *pts, size_t n, const bis_wi
     for (int depth = 0; depth < depths && st == PDT_OK; depth++) {
         if (depth >= BIS_COUNT_FROM)
             st = bis_count_depth(d, pts, stride, walk, nc, node, depth, per[depth], win, rows, err);
-        for (size_t j = 0; st == PDT_OK && j < nc; j++)
-            if (walk[j].hi - walk[j].lo >= 2)
-                bis_step(d->tree.cut, pdt_key(pts[j * stride]), &walk[j]);
+        for (size_t j = 0; st == PDT_OK && j < nc; j++) {
+            uint64_t key = pdt_key(pts[j * stride]);
+            if (walk[j].hi - walk[j].lo >= 2) bis_step(d->tree.cut, key, swap_key(key), &walk[j]);
+        }
     }
     free(per);
     free(node);
