@@ -32,9 +32,8 @@
  * at least BIS_MIN_SHARE). */
 enum { BIS_SAMPLE = 1 << 17, BIS_MIN_SHARE = 64 };
 
-/* The ranks from which the samples go to rank 0 up a tree (bis_gather):
- * where the exchanges go in two hops too (comm_hops.c).  A test build's
- * PDT_TEST_BIS_GATHER=1 or 2 forces the gather or the tree. */
+/* The ranks from which the samples go to rank 0 up a tree (bis_gather).
+ * A test build's PDT_TEST_BIS_GATHER=1 or 2 forces the gather or the tree. */
 enum { BIS_TREE_FROM = 64 };
 
 static int bis_by_tree(int p)

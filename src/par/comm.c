@@ -138,39 +138,20 @@ pdt_status pdt_comm_alltoall(pdt_comm *c, const void *send, size_t bytes, void *
     return c->ops->alltoall(c, send, bytes, recv, err);
 }
 
-/* (comm_int.h) */
-int pdt_comm_hops_pay(int size, int is_mpi, uint64_t sent)
-{
-    if (!is_mpi || size < PDT_COMM_HOPS_MIN) return 0;
-    return sent < (uint64_t)PDT_COMM_HOPS_PIECE * (uint64_t)size * (uint64_t)size;
-}
-
-/* Whether this exchange goes in two hops (pdt_comm_hops_pay, on the bytes
- * every rank sends, summed by one allreduce: the same choice at every
- * rank).  A test build's PDT_TEST_COMM_HOPS=1 or 2 forces one or the other. */
-static pdt_status two_hops(pdt_comm *c, const size_t *scount, int *hops, pdt_err *err)
+/* Two hops when the messages of a direct exchange would be many and small:
+ * MPI from PDT_COMM_HOPS_MIN ranks on (the same choice at every rank); a
+ * test build's PDT_TEST_COMM_HOPS=1 or 2 forces one or the other. */
+static int two_hops(const pdt_comm *c)
 {
     const char *t = pdt_test_hook("PDT_TEST_COMM_HOPS");
-    *hops = 0;
-    if (t && (*t == '1' || *t == '2')) {
-        *hops = *t == '2' && c->size > 1;
-        return PDT_OK;
-    }
-    if (!pdt_comm_hops_pay(c->size, c->ops->is_mpi, 0)) return PDT_OK; /* (not even tiny) */
-    uint64_t sent = 0;
-    for (int q = 0; q < c->size; q++) sent += scount[q];
-    pdt_status st = pdt_comm_allreduce_u64(c, &sent, 1, PDT_COMM_SUM, err);
-    *hops = st == PDT_OK && pdt_comm_hops_pay(c->size, c->ops->is_mpi, sent);
-    return st;
+    if (t && (*t == '1' || *t == '2')) return *t == '2' && c->size > 1;
+    return c->ops->is_mpi && c->size >= PDT_COMM_HOPS_MIN;
 }
 
 pdt_status pdt_comm_alltoallv(pdt_comm *c, const void *send, const size_t *scount, void *recv,
                               const size_t *rcount, pdt_err *err)
 {
-    int hops = 0;
-    pdt_status st = two_hops(c, scount, &hops, err);
-    if (st != PDT_OK) return st;
-    if (hops) return pdt_comm_hops_alltoallv(c, send, scount, recv, rcount, err);
+    if (two_hops(c)) return pdt_comm_hops_alltoallv(c, send, scount, recv, rcount, err);
     return c->ops->alltoallv(c, send, scount, recv, rcount, err);
 }
 

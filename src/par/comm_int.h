@@ -71,20 +71,16 @@ void pdt_comm_small_pages(void);
  * the caller (pdt_comm_finalize). */
 pdt_status pdt_comm_serial_new(pdt_comm **c, pdt_err *err);
 /* An alltoallv through relays, about 6 sqrt(P) messages a rank instead of
- * P - 1 (src/par/comm_hops.c); pdt_comm_alltoallv takes it when
- * pdt_comm_hops_pay says so. */
+ * P - 1 (src/par/comm_hops.c); pdt_comm_alltoallv takes it from
+ * PDT_COMM_HOPS_MIN ranks on with MPI.  (Below, direct: on the simulated
+ * cluster, 64 ranks exchanging 10^7 points' records took 3.1 ms direct
+ * and 8.4-9.1 ms in two hops, the order's rounds 2.8-3.5 ms against 5.9;
+ * from 128 ranks direct exchanges gained the simulated runs nothing
+ * measurable and cost the simulator up to 17 times its wall time:
+ * docs/simulation.md, "Two hops and the relay".) */
 pdt_status pdt_comm_hops_alltoallv(pdt_comm *c, const void *send, const size_t *scount,
                                    void *recv, const size_t *rcount, pdt_err *err);
-/* 1 if an exchange among `size` ranks in which all of them send `sent`
- * bytes in all goes in two hops: with MPI, from PDT_COMM_HOPS_MIN ranks on,
- * when its pieces average under PDT_COMM_HOPS_PIECE bytes.  Larger pieces
- * go direct: on the simulated cluster, 64 ranks exchanging 10^7 points'
- * records (pieces of 39 KB) took 3.1 ms direct and 8.4-9.1 ms in two hops;
- * 128 ranks (9.8 KB) 2.9 and 5.1 ms; 256 ranks (2.4 KB) 3.0 ms either way
- * (docs/simulation.md, "Two hops and the relay"). */
-int pdt_comm_hops_pay(int size, int is_mpi, uint64_t sent);
-#define PDT_COMM_HOPS_MIN 64
-#define PDT_COMM_HOPS_PIECE 8192
+#define PDT_COMM_HOPS_MIN 128
 
 /* Every rank learns whether any rank failed: a rank that did not fail itself
  * gets PDT_ERR_IO "PATH: WHAT failed at rank R" (R the lowest failing rank). */

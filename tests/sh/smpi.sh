@@ -5,8 +5,8 @@
 # one process's file), on every family of pdt gen and with either
 # partition, without PDT_MPI=1 (pdt sees smpirun by itself), with
 # --stats saying "simulated": true and 256 ranks; more ranks than points
-# work; pieces large enough to go direct at 64 ranks and merges shared
-# along their seams give the same bytes; --trace
+# work; 64 ranks, whose exchanges go direct, and merges shared along
+# their seams give the same bytes; --trace
 # writes one file per rank (256 of them) that `pdt trace check` accepts.
 # Builds bin/smpi/pdt if it is missing.
 source "$(dirname "$0")/lib.sh"
@@ -93,17 +93,15 @@ for fam in uniform circle; do
     fi
 done
 
-# the partition's records in pieces large enough to go direct
-# (pdt_comm_hops_pay: 2.2*10^6 points on 64 ranks, some 8.6 KB from each
-# rank to each other): the plain run's bytes
-"$PDT" gen uniform 2200000 --seed 5 -o big.txt
-"$PDT" triangulate big.txt -o big.tri 2> /dev/null
-if sim big 64 big.txt -o big-sim.tri && cmp -s big.tri big-sim.tri; then
-    ok smpi_64_ranks_direct_exchange_same_bytes
+# 64 ranks, below PDT_COMM_HOPS_MIN: every exchange direct, in windows of
+# the pairwise schedule (src/par/comm_mpi.c): the plain run's bytes
+"$PDT" gen uniform 30000 --seed 5 -o mid.txt
+"$PDT" triangulate mid.txt -o mid.tri
+if sim mid 64 mid.txt -o mid-sim.tri && cmp -s mid.tri mid-sim.tri; then
+    ok smpi_64_ranks_direct_exchanges_same_bytes
 else
-    fail smpi_64_ranks_direct_exchange_same_bytes "$(head -3 big.err)"
+    fail smpi_64_ranks_direct_exchanges_same_bytes "$(head -3 mid.err)"
 fi
-rm -f big.txt big.tri big-sim.tri
 
 # more ranks than points: 64 ranks, 20 points (most ranks get none)
 "$PDT" gen uniform 20 --seed 7 -o few.txt

@@ -10,7 +10,6 @@
 #include <unistd.h>
 
 #include "pdt/par.h"
-#include "../../src/par/comm_int.h"
 
 #define WRONG(...) return pdt_err_set(err, PDT_ERR_CHECK, __VA_ARGS__)
 
@@ -362,24 +361,6 @@ TEST(alltoallv_in_two_hops)
     unsetenv("PDT_TEST_COMM_HOPS");
 }
 
-/* The choice of two hops: MPI only, from PDT_COMM_HOPS_MIN ranks on, when
- * the pieces average under PDT_COMM_HOPS_PIECE bytes (then direct: the
- * partition's records of 10^7 points on 64 ranks, 39 KB a piece; two hops
- * for 10^7 points on 1024 ranks, about 150 bytes). */
-TEST(two_hops_for_small_pieces_only)
-{
-    uint64_t piece = PDT_COMM_HOPS_PIECE, p64 = 64 * 64, p1024 = 1024 * 1024;
-    CHECK(!pdt_comm_hops_pay(64, 1, 160000000));      /* 10^7 records, P = 64 */
-    CHECK(pdt_comm_hops_pay(1024, 1, 160000000));     /* the same, P = 1024 */
-    CHECK(pdt_comm_hops_pay(64, 1, piece * p64 - 1)); /* just under the piece */
-    CHECK(!pdt_comm_hops_pay(64, 1, piece * p64));    /* the piece */
-    CHECK(pdt_comm_hops_pay(1024, 1, piece * p1024 - 1));
-    CHECK(!pdt_comm_hops_pay(1024, 1, piece * p1024));
-    CHECK(pdt_comm_hops_pay(64, 1, 0));
-    CHECK(!pdt_comm_hops_pay(63, 1, 0));              /* too few ranks */
-    CHECK(!pdt_comm_hops_pay(1024, 0, 0));            /* threads: never */
-}
-
 /* (P = 33 and 64: many splitters share the selection's first rounds) */
 TEST(partition_exact_shares_p2_to_p7_33_64)
 {
@@ -408,6 +389,5 @@ int main(void)
     RUN(commit_refused_when_any_rank_is_stopped);
     RUN(partition_exact_shares_p2_to_p7_33_64);
     RUN(alltoallv_in_two_hops);
-    RUN(two_hops_for_small_pieces_only);
     return test_summary();
 }
