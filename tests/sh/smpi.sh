@@ -93,24 +93,23 @@ for fam in uniform circle; do
     fi
 done
 
+# uniform NAME P N SEED EXT: N uniform points, the plain run and P simulated
+# ranks; true when they wrote the same bytes
+uniform() {
+    local name=$1 np=$2 n=$3 seed=$4 ext=$5
+    "$PDT" gen uniform "$n" --seed "$seed" -o "$name.txt"
+    "$PDT" triangulate "$name.txt" -o "$name.$ext"
+    sim "$name" "$np" "$name.txt" -o "$name-sim.$ext" && cmp -s "$name.$ext" "$name-sim.$ext"
+}
+
 # 64 ranks, below PDT_COMM_HOPS_MIN: every exchange direct, in windows of
-# the pairwise schedule (src/par/comm_mpi.c): the plain run's bytes
-"$PDT" gen uniform 30000 --seed 5 -o mid.txt
-"$PDT" triangulate mid.txt -o mid.tri
-if sim mid 64 mid.txt -o mid-sim.tri && cmp -s mid.tri mid-sim.tri; then
-    ok smpi_64_ranks_direct_exchanges_same_bytes
-else
-    fail smpi_64_ranks_direct_exchanges_same_bytes "$(head -3 mid.err)"
-fi
+# the pairwise schedule (src/par/comm_mpi.c)
+if uniform mid 64 30000 5 tri; then ok smpi_64_ranks_direct_exchanges_same_bytes
+else fail smpi_64_ranks_direct_exchanges_same_bytes "$(head -3 mid.err)"; fi
 
 # more ranks than points: 64 ranks, 20 points (most ranks get none)
-"$PDT" gen uniform 20 --seed 7 -o few.txt
-"$PDT" triangulate few.txt -o few.ele
-if sim few 64 few.txt -o few-sim.ele && cmp -s few.ele few-sim.ele; then
-    ok smpi_more_ranks_than_points
-else
-    fail smpi_more_ranks_than_points "$(head -3 few.err)"
-fi
+if uniform few 64 20 7 ele; then ok smpi_more_ranks_than_points
+else fail smpi_more_ranks_than_points "$(head -3 few.err)"; fi
 
 # a simulated trace: one file per rank, simulated clock, accepted by the checker
 "$PDT" gen clusters 600 -o c.txt
