@@ -74,7 +74,7 @@ pdt_status pdt_comm_serial_new(pdt_comm **c, pdt_err *err);
  * P - 1 (src/par/comm_hops.c); pdt_comm_alltoallv takes it from
  * PDT_COMM_HOPS_MIN ranks on with MPI.  (Below, direct: on the simulated
  * cluster, 64 ranks exchanging 10^7 points' records took 3.1 ms direct
- * and 8.4-9.1 ms in two hops, the order's rounds 2.8-3.5 ms against 5.9;
+ * and 8.4-9.1 ms in two hops, the order's rounds 2.5-3.5 ms against 5.4-6.3;
  * from 128 ranks direct exchanges gained the simulated runs nothing
  * measurable and cost the simulator up to 17 times its wall time:
  * docs/simulation.md, "Two hops and the relay".) */
