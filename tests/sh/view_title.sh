@@ -12,9 +12,11 @@ xpid=$!
 for _ in $(seq 100); do [ -s "$TMP/xvfb.num" ] && break; sleep 0.1; done
 dpy=:$(head -1 "$TMP/xvfb.num")
 want='pdtview — synth:graham:10'
+# (the viewer stays until it is killed once its title was read: a run of
+# a few frames could end between two looks under a loaded machine)
 for loc in C POSIX C.UTF-8; do
     env -u LC_ALL -u LC_CTYPE LANG=$loc DISPLAY=$dpy timeout 60 "$BIN/pdtview" synth:graham:10 \
-        --size 320x200 --script "wait:100 q" >/dev/null 2>&1 &
+        --size 320x200 --script "wait:1000000 q" >/dev/null 2>&1 &
     vpid=$!
     got=""
     for _ in $(seq 150); do
