@@ -564,8 +564,9 @@ static pdt_status bis_count(drv *d, const pdt_point *pts, size_t n, const bis_wi
         if (depth >= BIS_COUNT_FROM)
             st = bis_count_depth(d, pts, stride, walk, nc, node, depth, per[depth], win, rows, err);
         for (size_t j = 0; st == PDT_OK && j < nc; j++) {
+            if (walk[j].hi - walk[j].lo < 2) continue; /* (arrived) */
             uint64_t key = pdt_key(pts[j * stride]);
-            if (walk[j].hi - walk[j].lo >= 2) bis_step(d->tree.cut, key, swap_key(key), &walk[j]);
+            bis_step(d->tree.cut, key, swap_key(key), &walk[j]);
         }
     }
     free(per);
