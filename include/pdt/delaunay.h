@@ -85,6 +85,17 @@ pdt_status pdt_delaunay_strip(pdt_point *pts, size_t n, uint32_t *name, void *wo
  * of buckets; the receiver orders what it got (pdt_tri_bucket_order).  The
  * result is the canonical order of the union, whatever the grouping. */
 
+/* t rotated to start at its smallest index (the same triangle, the same
+ * orientation), branch-free: which corner is the smallest is random, and a
+ * branch on it mispredicts every other triangle. */
+static inline pdt_tri pdt_tri_smallest_first(pdt_tri t)
+{
+    uint32_t a = t.v[0], b = t.v[1], c = t.v[2];
+    uint32_t w[5] = {a, b, c, a, b};
+    unsigned r = (unsigned)((b < a) & (b < c)) + 2u * (unsigned)((c < a) & (c < b));
+    return (pdt_tri){{w[r], w[r + 1], w[r + 2]}};
+}
+
 /* Rotate each of t[0, n) to start at its smallest index v and add 1 to
  * hist[v >> shift] (hist: room for every bucket that occurs). */
 void pdt_tri_bucket_count(pdt_tri *t, size_t n, int shift, uint64_t *hist);
@@ -92,11 +103,13 @@ void pdt_tri_bucket_count(pdt_tri *t, size_t n, int shift, uint64_t *hist);
 /* Copy each of t[0, n) (rotated) to dst[at[b]++], b its bucket. */
 void pdt_tri_bucket_scatter(const pdt_tri *t, size_t n, int shift, uint64_t *at, pdt_tri *dst);
 /* The same for the triangles of the buckets b with in[b] = 1 only (an
- * exchange in rounds, each with a grouped array of its own share): those of
- * the others are written to dst[at[b]] without moving on, so at[b] must
- * name one spare place past the round's for them. */
-void pdt_tri_bucket_scatter_round(const pdt_tri *t, size_t n, int shift, const uint8_t *in,
-                                  uint64_t *at, pdt_tri *dst);
+ * exchange in rounds, each with a grouped array of its own share); the
+ * others are moved down to the front of t, in their order, and their number
+ * is returned, so that the next round reads only them.  Each of the others
+ * is also written to dst[at[b]] without moving on (no branch on the round):
+ * at[b] must name one spare place past the round's for them. */
+size_t pdt_tri_bucket_scatter_split(pdt_tri *t, size_t n, int shift, const uint8_t *in,
+                                     uint64_t *at, pdt_tri *dst);
 
 /* The ns runs src[k][0, len[k]) (rotated, each grouped by bucket in
  * increasing order, no triangle twice) into out in canonical order; out has

@@ -21,17 +21,9 @@ static int tri_qcmp(const void *a, const void *b)
     return tri_cmp(a, b);
 }
 
-/* Rotate t to start at its smallest index, branch-free (which corner is
- * the smallest is random: a branch on it mispredicted every other
- * triangle). */
 static void tri_rotate(pdt_tri *t)
 {
-    uint32_t a = t->v[0], b = t->v[1], c = t->v[2];
-    uint32_t w[5] = {a, b, c, a, b};
-    unsigned r = (unsigned)((b < a) & (b < c)) + 2u * (unsigned)((c < a) & (c < b));
-    t->v[0] = w[r];
-    t->v[1] = w[r + 1];
-    t->v[2] = w[r + 2];
+    *t = pdt_tri_smallest_first(*t);
 }
 
 /* a before b in the canonical order */
@@ -183,15 +175,20 @@ void pdt_tri_bucket_scatter(const pdt_tri *t, size_t n, int shift, uint64_t *at,
     for (size_t i = 0; i < n; i++) dst[at[t[i].v[0] >> shift]++] = t[i];
 }
 
-void pdt_tri_bucket_scatter_round(const pdt_tri *t, size_t n, int shift, const uint8_t *in,
-                                  uint64_t *at, pdt_tri *dst)
+size_t pdt_tri_bucket_scatter_split(pdt_tri *t, size_t n, int shift, const uint8_t *in,
+                                     uint64_t *at, pdt_tri *dst)
 {
+    size_t w = 0;
     for (size_t i = 0; i < n; i++) { /* (branch-free: which round is random) */
-        uint32_t b = t[i].v[0] >> shift;
+        pdt_tri x = t[i];
+        uint32_t b = x.v[0] >> shift;
         uint64_t a = at[b];
-        dst[a] = t[i];
+        dst[a] = x;
         at[b] = a + in[b];
+        t[w] = x; /* (w <= i: t[i] has been read) */
+        w += 1u - in[b];
     }
+    return w;
 }
 
 /* The runs cut into segments, one per run and bucket with triangles, the

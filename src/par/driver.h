@@ -11,6 +11,7 @@
 #ifndef PDT_DRIVER_H
 #define PDT_DRIVER_H
 
+#include "pdt/bigmem.h"
 #include "srm.h"
 
 enum {
@@ -36,6 +37,7 @@ typedef struct drv {
     uint32_t *seq_send, *seq_recv; /* per-peer message sequence numbers */
     uint64_t bytes_sent, bytes_recv, merge_sent, merge_recv;
     unsigned char *blk;            /* this rank's one block (see block_bytes) */
+    pdt_prefault *pf;              /* a thread faulting the block's pages in ahead */
     size_t blk_cap, blk_bytes;     /* room for blk_cap points; its size */
     size_t m;
     uint64_t nrecv;
@@ -49,9 +51,15 @@ typedef struct drv {
     int s_init[PDT_RANK_MAX_STRIPS];
     pdt_tri *more;                 /* the order phase's finals besides the block's */
     size_t nmore;
+    uint64_t *order_hist;          /* the local finals counted by bucket (order.c) */
+    size_t more_counted;           /* more[0, more_counted) are among them */
     pdt_par_rank_stats *me;
     pdt_err *err;
 } drv;
+
+/* order.c: the order phase's histogram, for the local phase to fill
+ * (srm_rank.order_hist of each strip). */
+pdt_status pdt_drv_order_hist(drv *d);
 
 /* Collectives are traced peer by peer up to this many ranks (the lessons'
  * runs: the viewer draws every message); beyond, a collective adds no event

@@ -43,6 +43,23 @@ static int order_shift(const drv *d)
     return sh;
 }
 
+static size_t order_buckets(const drv *d, int shift)
+{
+    return (size_t)((d->n_total ? d->n_total - 1 : 0) >> shift) + 1;
+}
+
+pdt_status pdt_drv_order_hist(drv *d)
+{
+    int shift = order_shift(d);
+    d->order_hist = calloc(order_buckets(d, shift), sizeof *d->order_hist);
+    if (!d->order_hist) return pdt_drv_nomem(d, "local");
+    for (int j = 0; j < d->k; j++) {
+        d->s[j].order_hist = d->order_hist;
+        d->s[j].order_shift = shift;
+    }
+    return PDT_OK;
+}
+
 /* The plan of the exchange, in `rounds` rounds (bucket b goes in round
  * b % rounds: a round's grouped array holds about 1/rounds of the finals):
  * hist[b], this rank's triangles in bucket b; the buckets' owners from the
@@ -69,8 +86,16 @@ static pdt_status order_plan_make(drv *d, finals *f, order_plan *o, pdt_err *err
     int p = d->p;
     int R = o->rounds = d->k > 1 ? 2 : 1; /* (two when the strips are, for memory) */
     o->shift = order_shift(d);
-    o->nb = (size_t)((d->n_total ? d->n_total - 1 : 0) >> o->shift) + 1;
-    o->hist = calloc(o->nb, sizeof *o->hist);
+    o->nb = order_buckets(d, o->shift);
+    size_t from[2] = {0, 0}; /* the finals the local phase counted (rotated) */
+    if (d->order_hist) {
+        o->hist = d->order_hist;
+        d->order_hist = NULL;
+        from[0] = f->n[0];
+        from[1] = d->more_counted;
+    } else {
+        o->hist = calloc(o->nb, sizeof *o->hist);
+    }
     o->at = calloc(o->nb, sizeof *o->at);
     o->sc = calloc((size_t)p * (size_t)R, sizeof *o->sc);
     o->rc = calloc((size_t)p * (size_t)R, sizeof *o->rc);
@@ -79,7 +104,8 @@ static pdt_status order_plan_make(drv *d, finals *f, order_plan *o, pdt_err *err
         free(sum);
         return pdt_drv_nomem(d, "order");
     }
-    for (int k = 0; k < 2; k++) pdt_tri_bucket_count(f->t[k], f->n[k], o->shift, o->hist);
+    for (int k = 0; k < 2; k++)
+        pdt_tri_bucket_count(f->t[k] + from[k], f->n[k] - from[k], o->shift, o->hist);
     memcpy(sum, o->hist, o->nb * sizeof *sum);
     pdt_status st = pdt_comm_allreduce_u64(d->c, sum, o->nb, PDT_COMM_SUM, err);
     if (st == PDT_OK) {
@@ -207,12 +233,14 @@ static pdt_status order_io_make(drv *d, const order_plan *o, order_io *x)
 
 /* Round r: the triangles of its buckets grouped, sent, received behind the
  * rounds before (*off of them); each source's run of a round is in bucket
- * order. */
-static pdt_status order_round(drv *d, const finals *f, const order_plan *o, order_room *room,
+ * order.  A round before the last moves the triangles it leaves to the
+ * front of their arrays (f shrinks to them): the rounds read the finals
+ * once and then only what is left. */
+static pdt_status order_round(drv *d, finals *f, const order_plan *o, order_room *room,
                               order_io *x, int r, size_t *off, pdt_err *err)
 {
     int p = d->p;
-    if (o->rounds == 1) {
+    if (r == o->rounds - 1) { /* (every triangle left is this round's) */
         for (int k = 0; k < 2; k++) pdt_tri_bucket_scatter(f->t[k], f->n[k], o->shift, o->at, room->grp);
     } else {
         for (size_t b = 0; b < o->nb; b++) { /* (the others: to the spare place) */
@@ -220,7 +248,7 @@ static pdt_status order_round(drv *d, const finals *f, const order_plan *o, orde
             x->at[b] = x->in[b] ? o->at[b] : o->most;
         }
         for (int k = 0; k < 2; k++)
-            pdt_tri_bucket_scatter_round(f->t[k], f->n[k], o->shift, x->in, x->at, room->grp);
+            f->n[k] = pdt_tri_bucket_scatter_split(f->t[k], f->n[k], o->shift, x->in, x->at, room->grp);
     }
     pdt_tri *into = room->got + *off;
     for (int q = 0; q < p; q++) {

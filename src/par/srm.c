@@ -397,7 +397,8 @@ static pdt_status strip_hull(srm_rank *s, const strip_pts *sp, const uint32_t *g
 /* Classification: final at once, or deferred until a merge level (with no
  * other strip at all, everything is final without a test).  The final
  * triangles stay in the kernel's array, renamed to global indices and moved
- * down over the deferred ones (k <= i): s->fin, no second array. */
+ * down over the deferred ones (k <= i): s->fin, no second array; with
+ * s->order_hist they are rotated and counted for the order phase. */
 static pdt_status classify(srm_rank *s, pdt_tri *tris, const strip_pts *sp, pdt_err *err)
 {
     pdt_trace *tr = s->tr;
@@ -410,6 +411,8 @@ static pdt_status classify(srm_rank *s, pdt_tri *tris, const strip_pts *sp, pdt_
     if (s->tree) pdt_srm_cell_of(&slab, s->tree, s->strip, s->rank);
     else pdt_srm_slab_of(&slab, s->strip, s->p, s->rank);
     size_t k = 0;
+    uint64_t *hist = s->order_hist;
+    int shift = s->order_shift;
     enum { AHEAD = 16 }; /* the triangles are in the kernel's (leaf) order:
                           * fetch ahead (traced: the points in their own) */
     for (size_t i = 0; i < ntri; i++) {
@@ -429,7 +432,12 @@ static pdt_status classify(srm_rank *s, pdt_tri *tris, const strip_pts *sp, pdt_
                       ? -1
                       : pdt_srm_send_level(s, s->rank, 0, v[0], v[1], v[2], &who);
         if (lev < 0) {
-            tris[k++] = (pdt_tri){{v[0].gid, v[1].gid, v[2].gid}};
+            pdt_tri t = {{v[0].gid, v[1].gid, v[2].gid}};
+            if (hist) {
+                t = pdt_tri_smallest_first(t);
+                hist[t.v[0] >> shift]++;
+            }
+            tris[k++] = t;
             PDT_TRACE(tr, 1, PDT_EV_TRI_FINAL, 0, v[0].gid, v[1].gid, v[2].gid, 0);
         } else {
             if (pdt_srm_add_pending(s, v[0], v[1], v[2], lev) != PDT_OK)

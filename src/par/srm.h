@@ -302,6 +302,12 @@ typedef struct srm_rank {
     int relay;
     unsigned char *fwd;
     size_t nfwd, capfwd;
+    /* the order phase's histogram (not owned; NULL: none): each final
+     * triangle of the local phase is rotated to start at its smallest index
+     * and counted in bucket v[0] >> order_shift as classify makes it
+     * (pdt_tri_bucket_count, while the triangle is in the cache) */
+    uint64_t *order_hist;
+    int order_shift;
     srm_counts cnt;
     pdt_trace *tr;
     double (*clock)(void *);      /* seconds, for the counts */

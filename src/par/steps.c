@@ -81,9 +81,12 @@ static pdt_status local_strip(drv *d, int j, unsigned char *blk, size_t *off, si
 pdt_status pdt_drv_local(drv *d, int prefault, pdt_err *err)
 {
     pdt_status st = local_init(d, err);
+    if (st == PDT_OK) st = pdt_drv_order_hist(d);
     if (st != PDT_OK) return st;
     unsigned char *blk = d->blk;
     size_t need = local_need(d);
+    pdt_prefault_stop(d->pf); /* (the partition's part: touched by now) */
+    d->pf = NULL;
     pdt_prefault *pf = NULL;
     if (prefault) { /* the kernel's edges grow past the partition's records, up to its
                      * bound for this strip's points (the block has room for more) */
@@ -99,6 +102,8 @@ pdt_status pdt_drv_local(drv *d, int prefault, pdt_err *err)
         d->s[0].nfin = nfin;
         d->s[0].capfin = nfin;
     }
+    d->more_counted = d->nmore; /* (the finals set aside) */
+    for (int j = 0; j < d->k; j++) d->s[j].order_hist = NULL;
     pdt_prefault_stop(pf); /* every page of the block has been touched */
     return st;
 }
