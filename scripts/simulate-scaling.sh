@@ -4,7 +4,8 @@
 #
 #   scripts/simulate-scaling.sh [--platform NAME|FILE] [--sizes "1e6 1e7 1e8"]
 #       [--ps "1 2 4 ... 1024"] [--weak-ps "1 2 4 ... 1024"] [--per-rank 1e5]
-#       [--partition strips|bisect] [--no-strong] [--no-weak] [--keep DIR]
+#       [--partition strips|bisect] [--base-runs 3] [--no-strong] [--no-weak]
+#       [--keep DIR]
 #
 # Strong scaling: for each n of --sizes uniform points (`pdt gen uniform`),
 # one simulated run per P of --ps; weak scaling: --per-rank points per rank
@@ -20,12 +21,16 @@
 #   largest border set (points in the largest merge), and the simulation's
 #   own wall seconds, CPU seconds (user + system: what the wall would be on
 #   an idle core) and peak memory (GNU time: the one process of all ranks).
-# --partition is passed to pdt as is.  Inputs and outputs live in a temporary
+# The first P of a table (normally 1) is the base of its speedups: it runs
+# --base-runs times and its row is the run with the median total (a one-rank
+# run of 10^7 points took from 5.0 to 6.7 simulated seconds from one
+# `make simulate` to the next on one host); the line under the table gives
+# all their totals.  --partition is passed to pdt as is.  Inputs and outputs live in a temporary
 # folder (--keep DIR keeps them there).  The platform and the load of the
 # machine (uptime) head the output.
 set -u
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-platform=cluster-10g sizes="1e6 1e7 1e8" per_rank=1e5 partition="" keep=""
+platform=cluster-10g sizes="1e6 1e7 1e8" per_rank=1e5 partition="" keep="" base_runs=3
 ps="1 2 4 8 16 32 64 128 256 512 1024" weak_ps=$ps strong=1 weak=1
 while [ $# -gt 0 ]; do
     case "$1" in
@@ -35,6 +40,7 @@ while [ $# -gt 0 ]; do
         --weak-ps) weak_ps=$2; shift 2 ;;
         --per-rank) per_rank=$2; shift 2 ;;
         --partition) partition=$2; shift 2 ;;
+        --base-runs) base_runs=$2; shift 2 ;;
         --no-strong) strong=0; shift ;;
         --no-weak) weak=0; shift ;;
         --keep) keep=$2; shift 2 ;;
@@ -72,6 +78,25 @@ run() {
     [ $rc = 0 ] && [ -s "$W/$name.json" ]
 }
 
+# run_base N P NAME: run N P NAME.1 ... NAME.$base_runs, NAME the one with the
+# median total; their totals to NAME.totals
+run_base() {
+    local n=$1 p=$2 name=$3 k ok=()
+    for k in $(seq "$base_runs"); do run "$n" "$p" "$name.$k" && ok+=("$name.$k"); done
+    [ ${#ok[@]} -gt 0 ] || return 1
+    python3 - "$W" "$name" "${ok[@]}" <<'EOF'
+import json, shutil, sys
+w, name, runs = sys.argv[1], sys.argv[2], sys.argv[3:]
+tot = {r: json.load(open(f"{w}/{r}.json"))["seconds"]["total"] for r in runs}
+order = sorted(runs, key=tot.get)
+mid = order[(len(order) - 1) // 2]
+for ext in ("json", "time", "err"):
+    shutil.copy(f"{w}/{mid}.{ext}", f"{w}/{name}.{ext}")
+with open(f"{w}/{name}.totals", "w") as f:
+    f.write(", ".join(f"{tot[r]:.4f}" for r in runs) + "\n")
+EOF
+}
+
 # table TITLE KIND NAMES...: the Markdown table of the named runs (KIND strong|weak)
 table() {
     python3 - "$W" "$@" <<'EOF'
@@ -105,14 +130,22 @@ for name in names:
           ("read", "partition", "local", "merge", "order", "write"))
           + f" | {tot:.4f} | {a} | {b} | {crit:.4f} | {par.get('merge_bytes', 0)} | "
           f"{par.get('largest_border_set', 0)} | {float(wall):.1f} | {cpu:.1f} | {int(rss) // 1024} |")
+try:
+    runs = open(f"{w}/{names[0]}.totals").read().strip()
+    print(f"\nThe first row is the run with the median total of {len(runs.split(','))} "
+          f"(totals {runs} s).")
+except OSError:
+    pass
 EOF
 }
 
 if [ "$strong" = 1 ]; then
     for n in $sizes; do
         N=$(int "$n"); names=()
+        first=1
         for p in $ps; do
-            run "$N" "$p" "strong-$N-$p" || echo "simulate-scaling.sh: n=$N P=$p failed (see $W/strong-$N-$p.err)" >&2
+            r=run; [ $first = 1 ] && r=run_base; first=0
+            $r "$N" "$p" "strong-$N-$p" || echo "simulate-scaling.sh: n=$N P=$p failed (see $W/strong-$N-$p.err)" >&2
             names+=("strong-$N-$p")
         done
         table "Strong scaling, n = $N uniform points (simulated seconds)" strong "${names[@]}"
@@ -120,10 +153,11 @@ if [ "$strong" = 1 ]; then
     done
 fi
 if [ "$weak" = 1 ]; then
-    names=()
+    names=() first=1
     for p in $weak_ps; do
         N=$(int "$per_rank" "$p")
-        run "$N" "$p" "weak-$p" || echo "simulate-scaling.sh: weak P=$p failed (see $W/weak-$p.err)" >&2
+        r=run; [ $first = 1 ] && r=run_base; first=0
+        $r "$N" "$p" "weak-$p" || echo "simulate-scaling.sh: weak P=$p failed (see $W/weak-$p.err)" >&2
         names+=("weak-$p")
         rm -f "$W/uniform-$N.txt"
     done

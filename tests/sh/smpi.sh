@@ -7,7 +7,8 @@
 # --stats saying "simulated": true and 256 ranks; more ranks than points
 # work; 64 ranks, whose exchanges go direct, and merges shared along
 # their seams give the same bytes; --trace
-# writes one file per rank (256 of them) that `pdt trace check` accepts.
+# writes one file per rank (256 of them) that `pdt trace check` accepts;
+# `make simulate`'s first row of a table is the median of three runs.
 # Builds bin/smpi/pdt if it is missing.
 source "$(dirname "$0")/lib.sh"
 SIM=$ROOT/scripts/simulate.sh
@@ -120,6 +121,25 @@ if sim tr 256 c.txt -o c-sim.ele --partition strips --trace run && cmp -s c.ele 
 else
     fail smpi_trace_256_ranks_checks "$(head -3 tr.err) $(tail -3 check.out 2>/dev/null)"
 fi
+
+# make simulate's tables (scripts/simulate-scaling.sh) on tiny sizes: the
+# first row of each is the run with the median total of its --base-runs
+# runs, and the line under the table lists them
+"$ROOT/scripts/simulate-scaling.sh" --sizes 2e3 --ps "1 4" --weak-ps "1 2" --per-rank 500 \
+    --base-runs 3 > scaling.out 2> scaling.err
+if python3 - scaling.out <<'EOF'
+import re, sys
+text = open(sys.argv[1]).read()
+tables = re.findall(r"\n\| 1 \| \d+ \|(?:[^|\n]*\|){6}([^|\n]*)\|.*?\n\n"
+                    r"The first row is the run with the median total of 3 \(totals ([^)]*) s\)",
+                    text, re.S)
+assert len(tables) == 2, text
+for row_total, totals in tables:
+    t = sorted(float(x) for x in totals.split(","))
+    assert len(t) == 3 and abs(float(row_total) - t[1]) < 1e-9, (row_total, totals)
+EOF
+then ok simulate_scaling_base_row_is_median_of_three
+else fail simulate_scaling_base_row_is_median_of_three "$(tail -5 scaling.err) $(tail -12 scaling.out)"; fi
 
 # a wrong platform is a usage error
 "$SIM" -np 2 --platform no-such-platform -- triangulate u.txt -o x.ele 2> bad.err
