@@ -313,7 +313,6 @@ static pdt_status par_phases(drv *d, pdt_par_input *in, pdt_par_output *out, pdt
 
 static void drv_free(drv *d)
 {
-    pdt_prefault_stop(d->pf);
     for (int j = 0; j < PDT_RANK_MAX_STRIPS; j++)
         if (d->s_init[j]) pdt_srm_free(&d->s[j]);
     free(d->more);

@@ -11,7 +11,6 @@
 #ifndef PDT_DRIVER_H
 #define PDT_DRIVER_H
 
-#include "pdt/bigmem.h"
 #include "srm.h"
 
 enum {
@@ -37,7 +36,6 @@ typedef struct drv {
     uint32_t *seq_send, *seq_recv; /* per-peer message sequence numbers */
     uint64_t bytes_sent, bytes_recv, merge_sent, merge_recv;
     unsigned char *blk;            /* this rank's one block (see block_bytes) */
-    pdt_prefault *pf;              /* a thread faulting the block's pages in ahead */
     size_t blk_cap, blk_bytes;     /* room for blk_cap points; its size */
     size_t m;
     uint64_t nrecv;

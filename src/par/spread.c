@@ -44,12 +44,8 @@ typedef struct part {
     size_t total;               /* records received */
 } part;
 
-static void part_free(drv *d, part *x)
+static void part_free(part *x)
 {
-    if (x->blk) { /* (still the partition's: a failed run) */
-        pdt_prefault_stop(d->pf);
-        d->pf = NULL;
-    }
     free(x->cnt);
     free(x->rcnt);
     free(x->start);
@@ -58,25 +54,6 @@ static void part_free(drv *d, part *x)
     free(x->rc);
     free(x->blk);
     free(x->more);
-}
-
-/* With `prefault`, a thread faults in the partition's part of the block
- * ahead of it, in the order the sort of the input block and the exchange
- * use it (as a plain run's arrays: pdt_srm_plain): the sort's bucket writes
- * rec[n, 2n), the points and indices at the block's end, rec[0, n), then the
- * rest of the records' room.  The local phase stops it and faults in the
- * kernel's part (pdt_drv_local): how far that reaches is known only then.
- * Blocks below PART_PREFAULT_MIN bytes are left to the rank. */
-enum { PART_PREFAULT_MIN = 8 << 20 };
-
-static void part_prefault(drv *d, const part *x, size_t n)
-{
-    unsigned char *b = x->blk;
-    size_t rec = sizeof(srm_rec), all = block_bytes(x->cap), tail = PDT_DELAUNAY_WORK(x->cap);
-    if (all < PART_PREFAULT_MIN) return;
-    pdt_range r[4] = {{b + n * rec, n * rec}, {b + tail, all - tail}, {b, n * rec},
-                      {b + 2 * n * rec, 2 * (x->cap - n) * rec}};
-    d->pf = pdt_prefault_start(r, 4);
 }
 
 /* The block: room for this rank's input block or its share of the whole
@@ -98,7 +75,6 @@ static pdt_status part_alloc(drv *d, const pdt_par_input *in, part *x)
     x->rc = calloc(p, sizeof *x->rc);
     if (!x->blk || !x->cnt || !x->rcnt || !x->start || !x->split || !x->sc || !x->rc)
         return pdt_drv_nomem(d, "partition");
-    if (in->prefault) part_prefault(d, x, n);
     return PDT_OK;
 }
 
@@ -218,8 +194,6 @@ static pdt_status part_move(drv *d, part *x, pdt_err *err)
     if (st != PDT_OK) return st;
     pdt_drv_note_v(d, TAG_RECORDS, x->cnt, x->rcnt);
     if (x->more) {
-        pdt_prefault_stop(d->pf); /* (before its pages go) */
-        d->pf = NULL;
         free(x->blk);
         x->blk = x->more;
         x->more = NULL;
@@ -250,7 +224,7 @@ pdt_status pdt_drv_partition(drv *d, pdt_par_input *in, pdt_err *err)
     }
     if (st == PDT_OK) st = part_room(d, &x, err);
     if (st == PDT_OK) st = part_move(d, &x, err);
-    part_free(d, &x);
+    part_free(&x);
     return st;
 }
 

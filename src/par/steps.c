@@ -85,8 +85,6 @@ pdt_status pdt_drv_local(drv *d, int prefault, pdt_err *err)
     if (st != PDT_OK) return st;
     unsigned char *blk = d->blk;
     size_t need = local_need(d);
-    pdt_prefault_stop(d->pf); /* (the partition's part: touched by now) */
-    d->pf = NULL;
     pdt_prefault *pf = NULL;
     if (prefault) { /* the kernel's edges grow past the partition's records, up to its
                      * bound for this strip's points (the block has room for more) */
