@@ -374,6 +374,69 @@ TEST(bucket_order_is_canonical)
             }
 }
 
+/* The order phase in two rounds (bucket b in round b % 2): the first round's
+ * split groups its buckets as one scatter of those triangles would, the
+ * others end at the front of the input in their order (their number
+ * returned), and the second round's scatter of those groups the rest; the
+ * spare place past the first round's group takes the others' writes. */
+TEST(bucket_scatter_split_rounds)
+{
+    size_t sizes[] = {0, 1, 7, 5000};
+    for (size_t k = 0; k < sizeof sizes / sizeof *sizes; k++) {
+        size_t n = sizes[k];
+        int shift = 4;
+        size_t nb = ((size_t)(4 * n + 8) >> shift) + 1;
+        pdt_tri *t = malloc((n + 1) * sizeof *t), *orig = malloc((n + 1) * sizeof *t);
+        pdt_tri *want = malloc((n + 1) * sizeof *t), *grp = malloc((n + 2) * sizeof *t);
+        uint64_t *hist = calloc(nb, sizeof *hist), *at = calloc(nb, sizeof *at);
+        uint64_t *at2 = calloc(nb, sizeof *at2);
+        uint8_t *in = calloc(nb, 1);
+        for (size_t i = 0; i < n; i++)
+            for (int e = 0; e < 3; e++) t[i].v[e] = (uint32_t)(rand() % (int)(4 * n + 8));
+        pdt_tri_bucket_count(t, n, shift, hist);
+        memcpy(orig, t, n * sizeof *t);
+        uint64_t pos[2] = {0, 0};
+        for (size_t b = 0; b < nb; b++) {
+            in[b] = b % 2 == 0;
+            at[b] = pos[b % 2];
+            pos[b % 2] += hist[b];
+        }
+        memcpy(at2, at, nb * sizeof *at);
+        for (size_t b = 0; b < nb; b++)
+            if (!in[b]) at[b] = pos[0]; /* the spare place */
+        /* what each round must give: a stable grouping of its own triangles */
+        size_t nw = 0, left = 0;
+        for (size_t r = 0; r < 2; r++) {
+            uint64_t *w = calloc(nb, sizeof *w);
+            for (size_t b = 0; b < nb; b++) w[b] = at2[b];
+            for (size_t i = 0; i < n; i++) {
+                size_t b = orig[i].v[0] >> shift;
+                if (b % 2 == r) want[nw + w[b]++] = orig[i];
+            }
+            nw += (size_t)pos[r];
+            free(w);
+        }
+        left = pdt_tri_bucket_scatter_split(t, n, shift, in, at, grp);
+        CHECK(left == (size_t)pos[1]);
+        CHECK(n == 0 || memcmp(grp, want, (size_t)pos[0] * sizeof *grp) == 0);
+        int kept = 1;
+        for (size_t i = 0, j = 0; i < n; i++)
+            if ((orig[i].v[0] >> shift) % 2 == 1)
+                kept &= j < left && memcmp(&t[j++], &orig[i], sizeof *t) == 0;
+        CHECK_MSG(kept, "n = %zu: the others are not at the front in their order", n);
+        pdt_tri_bucket_scatter(t, left, shift, at2, grp);
+        CHECK(left == 0 || memcmp(grp, want + pos[0], left * sizeof *grp) == 0);
+        free(t);
+        free(orig);
+        free(want);
+        free(grp);
+        free(hist);
+        free(at);
+        free(at2);
+        free(in);
+    }
+}
+
 TEST(trace_events)
 {
     pdt_point *p;
@@ -584,6 +647,7 @@ int main(void)
     RUN(kernel_rejects_unsorted_or_duplicate_points);
     RUN(canonical_order);
     RUN(bucket_order_is_canonical);
+    RUN(bucket_scatter_split_rounds);
     RUN(trace_events);
     RUN(symmetric_parabola_and_circle_large);
     RUN(high_degree_vertex);
