@@ -25,9 +25,9 @@
 # --base-runs times and its row is the run with the median total (a one-rank
 # run of 10^7 points took from 5.0 to 6.7 simulated seconds from one
 # `make simulate` to the next on one host); the line under the table gives
-# all their totals.  --partition is passed to pdt as is.  Inputs and outputs live in a temporary
-# folder (--keep DIR keeps them there).  The platform and the load of the
-# machine (uptime) head the output.
+# all their totals.  --partition is passed to pdt as is.  Inputs and outputs
+# live in a temporary folder (--keep DIR keeps them there).  The platform and
+# the load of the machine (uptime) head the output.
 set -u
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 platform=cluster-10g sizes="1e6 1e7 1e8" per_rank=1e5 partition="" keep="" base_runs=3

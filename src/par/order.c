@@ -87,15 +87,9 @@ static pdt_status order_plan_make(drv *d, finals *f, order_plan *o, pdt_err *err
     int R = o->rounds = d->k > 1 ? 2 : 1; /* (two when the strips are, for memory) */
     o->shift = order_shift(d);
     o->nb = order_buckets(d, o->shift);
-    size_t from[2] = {0, 0}; /* the finals the local phase counted (rotated) */
-    if (d->order_hist) {
-        o->hist = d->order_hist;
-        d->order_hist = NULL;
-        from[0] = f->n[0];
-        from[1] = d->more_counted;
-    } else {
-        o->hist = calloc(o->nb, sizeof *o->hist);
-    }
+    o->hist = d->order_hist; /* the local phase's finals, counted (and rotated) */
+    d->order_hist = NULL;
+    size_t from[2] = {f->n[0], d->more_counted};
     o->at = calloc(o->nb, sizeof *o->at);
     o->sc = calloc((size_t)p * (size_t)R, sizeof *o->sc);
     o->rc = calloc((size_t)p * (size_t)R, sizeof *o->rc);
