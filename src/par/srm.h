@@ -304,8 +304,9 @@ typedef struct srm_rank {
     size_t nfwd, capfwd;
     /* the order phase's histogram (not owned; NULL: none): each final
      * triangle of the local phase is rotated to start at its smallest index
-     * and counted in bucket v[0] >> order_shift as classify makes it
-     * (pdt_tri_bucket_count, while the triangle is in the cache) */
+     * and counted in bucket v[0] >> order_shift as classify makes it (what
+     * pdt_tri_bucket_count would do in a pass of its own, done while the
+     * triangle is in the registers) */
     uint64_t *order_hist;
     int order_shift;
     srm_counts cnt;
