@@ -15,12 +15,13 @@
  * unsorted: the receiver sorts its region once (spread.c).
  *
  * Exact medians would need every rank's block sorted and rounds of counts
- * and allreduces at every depth of the tree.  A sample of 2^17 points in all puts a
- * region within about 1/sqrt(2s) of n / p, s = 2^17 / p sample points a
- * region (at p = 64 the largest of 10^7 uniform points' regions held 4.3 %
- * more than n / p; at p = 1024 the largest of 10^8, 31 %); the counts, a
- * share of every rank's points at each cut's window, within a few bins of
- * the windows (docs/parallel.md, "Cuts moved by counts"). */
+ * and allreduces at every depth of the tree.  A sample of 2^17 points in
+ * all puts a region within about 1/sqrt(2s) of n / p, s = 2^17 / p sample
+ * points a region (at p = 64 the largest of 10^7 uniform points' regions
+ * held 4.3 % more than n / p; at p = 1024 the largest of 10^8, 31 %); the
+ * counts, a share of every rank's points at each cut's window, within a
+ * few bins of the windows (docs/parallel.md, "Cuts moved by counts").
+ * Uncounted cuts take half the sample (bis_share). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -29,7 +30,8 @@
 #include "pdt/testhook.h"
 
 /* Sample points over all ranks (a rank draws BIS_SAMPLE / p of its block,
- * at least BIS_MIN_SHARE). */
+ * at least BIS_MIN_SHARE), half as many when the cuts are not counted
+ * (bis_share). */
 enum { BIS_SAMPLE = 1 << 17, BIS_MIN_SHARE = 64 };
 
 /* The ranks from which the samples go to rank 0 up a tree (bis_gather).
@@ -41,12 +43,6 @@ static int bis_by_tree(int p)
     const char *t = pdt_test_hook("PDT_TEST_BIS_GATHER");
     if (t && (*t == '1' || *t == '2')) return *t == '2';
     return p >= BIS_TREE_FROM;
-}
-
-static size_t bis_share(int p)
-{
-    size_t s = (size_t)BIS_SAMPLE / (size_t)p;
-    return s < BIS_MIN_SHARE ? BIS_MIN_SHARE : s;
 }
 
 /* A record's key on the other axis: (x, y) <-> (y, x), the key's halves
@@ -114,22 +110,6 @@ static uint64_t bis_radix_kth(const uint64_t *a, size_t n, size_t t, uint64_t *k
     }
 }
 
-/* The key of rank t of a[0..m) (keep: room for bis_radix_kth); a
- * reordered, the *left keys below it first (one pass without branches). */
-static uint64_t bis_split(uint64_t *a, size_t m, size_t t, uint64_t *keep, size_t *left)
-{
-    uint64_t split = bis_radix_kth(a, m, t, keep);
-    size_t l = 0; /* a[0, l) < split <= a[l, i) */
-    for (size_t i = 0; i < m; i++) {
-        uint64_t v = a[i];
-        a[i] = a[l];
-        a[l] = v;
-        l += v < split;
-    }
-    *left = l;
-    return split;
-}
-
 /* Where a cut's true place lies, almost surely: keys [lo, hi) on the
  * cut's axis, between the sample's points 2 sqrt(m) + 2 ranks either side
  * of the one the cut is at (the sample's rank of the true place is off by
@@ -157,6 +137,19 @@ static int bis_counted(const drv *d)
     return d->n_total / (uint64_t)d->p >= (uint64_t)1 << 15;
 }
 
+/* A rank's share of the sample.  Uncounted cuts (below 2^15 points a
+ * rank) take half the sample: on 1024 simulated ranks its gather and cuts
+ * are most of the partition's fixed cost (10^7 uniform points: 9.1 ms with
+ * 2^17 points, 7.0-7.2 with 2^16), while the largest region grew from
+ * 12,587 to 13,812 points (n / p = 9,766), a local phase of a few
+ * milliseconds.  Counted cuts keep it all: their windows come from the
+ * sample, and the depths above the counted ones are its alone. */
+static size_t bis_share(const drv *d)
+{
+    size_t s = (size_t)BIS_SAMPLE / (bis_counted(d) ? 1 : 2) / (size_t)d->p;
+    return s < BIS_MIN_SHARE ? BIS_MIN_SHARE : s;
+}
+
 /* Words of the cuts' allreduce a cut: split and axis, and its window when
  * counted. */
 static size_t bis_words(const drv *d)
@@ -171,23 +164,57 @@ static size_t isqrt(size_t m)
     return r;
 }
 
-/* The window of a cut at rank t of a[0..m) (a reordered by bis_split: the
- * *left keys below its split first), on the cut's axis. */
-static void bis_window_of(uint64_t *a, size_t m, size_t t, size_t left, uint64_t split,
-                          uint64_t *keep, bis_window *w)
+/* A sample key on a cut's axis: as it is across x (axis 0), its halves
+ * swapped across y (am: all ones for axis 1), without a branch. */
+static inline uint64_t bis_axis_key(uint64_t k, uint64_t am)
 {
-    size_t span = 2 * isqrt(m) + 2, r0 = t > span ? t - span : 0;
-    size_t r1 = t + span < m ? t + span : m - 1; /* (t < m) */
-    w->lo = r0 < left ? bis_radix_kth(a, left, r0, keep) : split;
-    uint64_t top = r1 > left ? bis_radix_kth(a + left, m - left, r1 - left, keep) : split;
-    w->hi = top == UINT64_MAX ? top : top + 1;
+    return (swap_key(k) & am) | (k & ~am);
+}
+
+/* The keys of ranks r[0] <= r[1] <= r[2] among the axis keys of a[0..m)
+ * (r[2] < m) into at[0..3).  One pass finds the keys' span, one counts them
+ * in 2048 bins of its top 11 bits that differ, one keeps those of the bins
+ * from r[0]'s to r[2]'s, and the radix selection finds the three among
+ * them: four passes over the sample, where a selection for each rank would
+ * take two or more each.  Exact, so the keys are those of any selection.
+ * 0 without memory. */
+static int bis_ranks(const uint64_t *a, size_t m, uint64_t am, const size_t r[3], uint64_t at[3])
+{
+    uint64_t lo = UINT64_MAX, hi = 0;
+    for (size_t i = 0; i < m; i++) {
+        uint64_t k = bis_axis_key(a[i], am);
+        lo = k < lo ? k : lo;
+        hi = k > hi ? k : hi;
+    }
+    if (lo == hi) {
+        at[0] = at[1] = at[2] = lo;
+        return 1;
+    }
+    int top = 63 - __builtin_clzll(lo ^ hi), shift = top > 10 ? top - 10 : 0;
+    size_t cnt[2048] = {0}; /* ((k - lo) >> shift < 2^11: k - lo < 2^(top + 1)) */
+    for (size_t i = 0; i < m; i++) cnt[(bis_axis_key(a[i], am) - lo) >> shift]++;
+    size_t b0 = 0, base = 0;
+    while (base + cnt[b0] <= r[0]) base += cnt[b0++];
+    size_t b2 = b0, upto = base + cnt[b0];
+    while (upto <= r[2]) upto += cnt[++b2];
+    size_t n = upto - base, k = 0;
+    uint64_t *keep = malloc((2 * n + 1) * sizeof *keep + 2048 * sizeof(size_t));
+    if (!keep) return 0;
+    for (size_t i = 0; i < m; i++) { /* (keep[k] written before k moves: room n + 1) */
+        uint64_t v = bis_axis_key(a[i], am);
+        keep[k] = v;
+        k += ((v - lo) >> shift) - b0 <= b2 - b0;
+    }
+    for (int j = 0; j < 3; j++) at[j] = bis_radix_kth(keep, n, r[j] - base, keep + n + 1);
+    free(keep);
+    return 1;
 }
 
 /* The cut of a range of s = hi - lo ranks from its sample a[0..m), (x, y)
  * keys, in its cell c: across the longer side, at the key of the sample's
- * point of rank m ceil(s/2)/s along that axis (bis_split; copies of it go
- * right), and its window (w not NULL); a reordered, the left side's *left
- * keys first.  No sample: any cut, an empty window.  0 without memory. */
+ * point of rank m ceil(s/2)/s along that axis (copies of it go right), and
+ * its window (w not NULL); a reordered, the left side's *left keys first.
+ * No sample: any cut, an empty window.  0 without memory. */
 static int bis_cut_of(int lo, int hi, uint64_t *a, size_t m, bis_cell c, srm_cut *cut,
                       bis_window *w, size_t *left)
 {
@@ -195,16 +222,24 @@ static int bis_cut_of(int lo, int hi, uint64_t *a, size_t m, bis_cell c, srm_cut
     if (w) *w = (bis_window){0, 0, 0};
     *left = 0;
     if (!m) return 1;
-    uint64_t *keep = malloc(m * sizeof *keep + 2048 * sizeof(size_t));
-    if (!keep) return 0;
-    if (cut->axis)
-        for (size_t i = 0; i < m; i++) a[i] = swap_key(a[i]);
-    uint64_t t = (uint64_t)m * (uint64_t)(srm_bis_mid(lo, hi) - lo) / (uint64_t)(hi - lo);
-    cut->split = bis_split(a, m, (size_t)t, keep, left);
-    if (w) bis_window_of(a, m, (size_t)t, *left, cut->split, keep, w);
-    if (cut->axis)
-        for (size_t i = 0; i < m; i++) a[i] = swap_key(a[i]);
-    free(keep);
+    uint64_t am = (uint64_t)0 - (uint64_t)(cut->axis != 0), key[3];
+    size_t t = (size_t)((uint64_t)m * (uint64_t)(srm_bis_mid(lo, hi) - lo) / (uint64_t)(hi - lo));
+    size_t span = w ? 2 * isqrt(m) + 2 : 0, r[3] = {t > span ? t - span : 0, t,
+                                                   t + span < m ? t + span : m - 1};
+    if (!bis_ranks(a, m, am, r, key)) return 0;
+    cut->split = key[1];
+    if (w) {
+        w->lo = key[0];
+        w->hi = key[2] == UINT64_MAX ? key[2] : key[2] + 1;
+    }
+    size_t l = 0; /* a[0, l) below the split, a[l, i) not; without a branch */
+    for (size_t i = 0; i < m; i++) {
+        uint64_t v = a[i];
+        a[i] = a[l];
+        a[l] = v;
+        l += bis_axis_key(v, am) < cut->split;
+    }
+    *left = l;
     return 1;
 }
 
@@ -389,7 +424,7 @@ static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t firs
                            bis_window *win, pdt_err *err)
 {
     int p = d->p;
-    size_t share = bis_share(p), slot = share + 1, vw = bis_words(d), nv = vw * (size_t)p;
+    size_t share = bis_share(d), slot = share + 1, vw = bis_words(d), nv = vw * (size_t)p;
     d->tree.p = p;
     d->tree.k = 1;
     d->tree.levels_p = pdt_srm_ceil_log2(p);
@@ -447,14 +482,63 @@ static inline void bis_step(const srm_cut *cut, uint64_t key, uint64_t swapped, 
     x->hi = (mid & lm) | (hi & ~lm);
 }
 
-/* The rank whose region holds the point of key `key`: bis_step from the
- * root to a region. */
-static inline uint32_t bis_dest(const srm_cut *cut, int p, uint64_t key)
+/* The tree for the walk of every point (bis_dests): internal nodes 0 ..
+ * p - 2 are the cuts (in d->tree.cut's order), node p - 1 + q is region
+ * q, a leaf whose split (0) sends every key right, to itself.  am: all
+ * ones for a cut across y (its key's halves swapped). */
+typedef struct bis_node_walk {
+    uint64_t split, am;
+    uint32_t left, right;
+} bis_node_walk;
+
+/* The nodes below cut `at` of ranks [lo, hi) (hi - lo >= 2). */
+static void bis_walk_nodes(bis_node_walk *w, const srm_cut *cut, int p, int lo, int hi, int at)
 {
-    bis_walk x = {0, (uint32_t)p, 0};
-    uint64_t swapped = swap_key(key);
-    while (x.hi - x.lo >= 2) bis_step(cut, key, swapped, &x);
-    return x.lo;
+    int mid = srm_bis_mid(lo, hi);
+    uint32_t leaf = (uint32_t)(p - 1);
+    w[at] = (bis_node_walk){cut[at].split, (uint64_t)0 - (uint64_t)(cut[at].axis != 0),
+                            mid - lo >= 2 ? (uint32_t)(at + 1) : leaf + (uint32_t)lo,
+                            hi - mid >= 2 ? (uint32_t)(at + (mid - lo)) : leaf + (uint32_t)mid};
+    if (mid - lo >= 2) bis_walk_nodes(w, cut, p, lo, mid, at + 1);
+    if (hi - mid >= 2) bis_walk_nodes(w, cut, p, mid, hi, at + (mid - lo));
+}
+
+/* The region of each of pts[0..n) into dst (p >= 2; 0 without memory):
+ * every point steps down the tree as many times as it is deep (a region
+ * steps to itself), eight points at a time in lockstep, so that their
+ * chains of loads and compares overlap (one point's steps depend on each
+ * other; at 10^5 points a rank on 1024 simulated ranks the walk of one
+ * point at a time took some 7 ms). */
+static int bis_dests(const srm_cut *cut, int p, const pdt_point *pts, size_t n, uint32_t *dst)
+{
+    enum { W = 8 };
+    bis_node_walk *w = malloc((size_t)(2 * p - 1) * sizeof *w);
+    if (!w) return 0;
+    bis_walk_nodes(w, cut, p, 0, p, 0);
+    for (int q = 0; q < p; q++) {
+        uint32_t me = (uint32_t)(p - 1 + q);
+        w[me] = (bis_node_walk){0, 0, me, me};
+    }
+    int depth = pdt_srm_ceil_log2(p);
+    for (size_t i = 0; i < n; i += W) {
+        size_t m = n - i < W ? n - i : W;
+        uint64_t key[W], sw[W];
+        uint32_t at[W];
+        for (size_t k = 0; k < W; k++) {
+            key[k] = pdt_key(pts[i + (k < m ? k : 0)]);
+            sw[k] = swap_key(key[k]);
+            at[k] = 0;
+        }
+        for (int s = 0; s < depth; s++)
+            for (size_t k = 0; k < W; k++) {
+                const bis_node_walk *c = &w[at[k]];
+                uint64_t x = (sw[k] & c->am) | (key[k] & ~c->am);
+                at[k] = x < c->split ? c->left : c->right;
+            }
+        for (size_t k = 0; k < m; k++) dst[i + k] = at[k] - (uint32_t)(p - 1);
+    }
+    free(w);
+    return 1;
 }
 
 /* A cut of the tree: its ranks [lo, hi), its depth, its place among the
@@ -592,10 +676,11 @@ pdt_status pdt_drv_bisect(drv *d, const pdt_point *pts, size_t n, uint64_t first
     uint64_t *at = calloc((size_t)p, sizeof *at);
     if (!at) return pdt_drv_nomem(d, "partition");
     uint32_t *dst = (uint32_t *)(void *)tmp; /* (4 bytes a point of tmp's 16) */
-    for (size_t i = 0; i < n; i++) {
-        dst[i] = bis_dest(cut, p, pdt_key(pts[i]));
-        sc[dst[i]]++;
+    if (!bis_dests(cut, p, pts, n, dst)) {
+        free(at);
+        return pdt_drv_nomem(d, "partition");
     }
+    for (size_t i = 0; i < n; i++) sc[dst[i]]++;
     uint64_t sum = 0;
     for (int q = 0; q < p; q++) {
         at[q] = sum;
