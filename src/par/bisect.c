@@ -458,67 +458,60 @@ static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t firs
     return st;
 }
 
-/* A point on its way down the tree: the cut it is at, of ranks [lo, hi)
- * (hi - lo < 2: arrived, in region lo). */
+/* The tree as the points walk it: nodes 0 .. p - 2 are the cuts (in
+ * d->tree.cut's order), node p - 1 + q is region q, a leaf whose split (0)
+ * sends every key right, to itself.  am: all ones for a cut across y (its
+ * key's halves swapped). */
 typedef struct bis_walk {
-    uint32_t lo, hi, at;
-} bis_walk;
-
-/* One step down the tree past the cut it is at, left when the key on the
- * cut's axis is below the cut (swapped: the key's halves swapped).  Without
- * a branch on the comparison (half of them would be mispredicted, some 15
- * cycles each at every depth): masks choose, and the descents of
- * successive points overlap. */
-static inline void bis_step(const srm_cut *cut, uint64_t key, uint64_t swapped, bis_walk *x)
-{
-    uint32_t lo = x->lo, hi = x->hi, at = x->at;
-    uint32_t mid = (uint32_t)srm_bis_mid((int)lo, (int)hi);
-    srm_cut c = cut[at];
-    uint64_t am = (uint64_t)0 - (uint64_t)(c.axis != 0);
-    uint64_t k = (swapped & am) | (key & ~am);
-    uint32_t lm = (uint32_t)0 - (uint32_t)(k < c.split); /* all ones: left */
-    x->at = at + ((1u & lm) | ((mid - lo) & ~lm));
-    x->lo = (lo & lm) | (mid & ~lm);
-    x->hi = (mid & lm) | (hi & ~lm);
-}
-
-/* The tree for the walk of every point (bis_dests): internal nodes 0 ..
- * p - 2 are the cuts (in d->tree.cut's order), node p - 1 + q is region
- * q, a leaf whose split (0) sends every key right, to itself.  am: all
- * ones for a cut across y (its key's halves swapped). */
-typedef struct bis_node_walk {
     uint64_t split, am;
     uint32_t left, right;
-} bis_node_walk;
+} bis_walk;
 
-/* The nodes below cut `at` of ranks [lo, hi) (hi - lo >= 2). */
-static void bis_walk_nodes(bis_node_walk *w, const srm_cut *cut, int p, int lo, int hi, int at)
+/* The nodes of cut `at` of ranks [lo, hi) (hi - lo >= 2) and below. */
+static void bis_walk_cuts(bis_walk *w, const srm_cut *cut, int p, int lo, int hi, int at)
 {
     int mid = srm_bis_mid(lo, hi);
     uint32_t leaf = (uint32_t)(p - 1);
-    w[at] = (bis_node_walk){cut[at].split, (uint64_t)0 - (uint64_t)(cut[at].axis != 0),
-                            mid - lo >= 2 ? (uint32_t)(at + 1) : leaf + (uint32_t)lo,
-                            hi - mid >= 2 ? (uint32_t)(at + (mid - lo)) : leaf + (uint32_t)mid};
-    if (mid - lo >= 2) bis_walk_nodes(w, cut, p, lo, mid, at + 1);
-    if (hi - mid >= 2) bis_walk_nodes(w, cut, p, mid, hi, at + (mid - lo));
+    w[at] = (bis_walk){cut[at].split, (uint64_t)0 - (uint64_t)(cut[at].axis != 0),
+                       mid - lo >= 2 ? (uint32_t)(at + 1) : leaf + (uint32_t)lo,
+                       hi - mid >= 2 ? (uint32_t)(at + (mid - lo)) : leaf + (uint32_t)mid};
+    if (mid - lo >= 2) bis_walk_cuts(w, cut, p, lo, mid, at + 1);
+    if (hi - mid >= 2) bis_walk_cuts(w, cut, p, mid, hi, at + (mid - lo));
 }
 
-/* The region of each of pts[0..n) into dst (p >= 2; 0 without memory):
- * every point steps down the tree as many times as it is deep (a region
- * steps to itself), eight points at a time in lockstep, so that their
- * chains of loads and compares overlap (one point's steps depend on each
- * other; at 10^5 points a rank on 1024 simulated ranks the walk of one
- * point at a time took some 7 ms). */
-static int bis_dests(const srm_cut *cut, int p, const pdt_point *pts, size_t n, uint32_t *dst)
+/* The walk's 2p - 1 nodes for the cuts `cut`, or NULL (no memory). */
+static bis_walk *bis_walk_new(const srm_cut *cut, int p)
 {
-    enum { W = 8 };
-    bis_node_walk *w = malloc((size_t)(2 * p - 1) * sizeof *w);
-    if (!w) return 0;
-    bis_walk_nodes(w, cut, p, 0, p, 0);
+    bis_walk *w = malloc((size_t)(2 * p - 1) * sizeof *w);
+    if (!w) return NULL;
+    if (p >= 2) bis_walk_cuts(w, cut, p, 0, p, 0);
     for (int q = 0; q < p; q++) {
         uint32_t me = (uint32_t)(p - 1 + q);
-        w[me] = (bis_node_walk){0, 0, me, me};
+        w[me] = (bis_walk){0, 0, me, me};
     }
+    return w;
+}
+
+/* The node after `at` for the point of key `key` (swapped: its halves
+ * swapped): left when the key on the cut's axis is below the cut, by a
+ * conditional move, not a branch (half of them would be mispredicted, some
+ * 15 cycles each at every depth). */
+static inline uint32_t bis_step(const bis_walk *w, uint32_t at, uint64_t key, uint64_t swapped)
+{
+    const bis_walk *c = &w[at];
+    uint64_t k = (swapped & c->am) | (key & ~c->am);
+    return k < c->split ? c->left : c->right;
+}
+
+/* The region of each of pts[0..n) into dst: every point steps down the
+ * tree w of p regions as many times as it is deep (a region steps to
+ * itself), eight points at a time in lockstep, so that their chains of
+ * loads and compares overlap (one point's steps depend on each other; at
+ * 10^5 points a rank on 1024 simulated ranks the walk of one point at a
+ * time took some 7 ms). */
+static void bis_dests(const bis_walk *w, int p, const pdt_point *pts, size_t n, uint32_t *dst)
+{
+    enum { W = 8 };
     int depth = pdt_srm_ceil_log2(p);
     for (size_t i = 0; i < n; i += W) {
         size_t m = n - i < W ? n - i : W;
@@ -530,15 +523,9 @@ static int bis_dests(const srm_cut *cut, int p, const pdt_point *pts, size_t n, 
             at[k] = 0;
         }
         for (int s = 0; s < depth; s++)
-            for (size_t k = 0; k < W; k++) {
-                const bis_node_walk *c = &w[at[k]];
-                uint64_t x = (sw[k] & c->am) | (key[k] & ~c->am);
-                at[k] = x < c->split ? c->left : c->right;
-            }
+            for (size_t k = 0; k < W; k++) at[k] = bis_step(w, at[k], key[k], sw[k]);
         for (size_t k = 0; k < m; k++) dst[i + k] = at[k] - (uint32_t)(p - 1);
     }
-    free(w);
-    return 1;
 }
 
 /* A cut of the tree: its ranks [lo, hi), its depth, its place among the
@@ -597,29 +584,30 @@ static uint64_t bis_refined(srm_cut c, bis_window w, const uint64_t *row, int lo
     return best;
 }
 
-/* The counted points of walk[0..nc) (pts[j * stride]) that have reached a
- * cut of depth `depth` counted at it, summed over the ranks (rows: a row
- * a cut of the depth, ncut of them), and those cuts moved. */
-static pdt_status bis_count_depth(drv *d, const pdt_point *pts, size_t stride, const bis_walk *walk,
+/* The counted points (pts[j * stride]) whose walk has reached a cut of
+ * depth `depth` (at[j], nc of them) counted at it, summed over the ranks
+ * (rows: a row a cut of the depth, ncut of them), and those cuts moved, in
+ * d->tree.cut and in the walk w. */
+static pdt_status bis_count_depth(drv *d, const pdt_point *pts, size_t stride, const uint32_t *at,
                                   size_t nc, const bis_node *node, int depth, int ncut,
-                                  const bis_window *win, uint64_t *rows, pdt_err *err)
+                                  const bis_window *win, uint64_t *rows, bis_walk *w, pdt_err *err)
 {
     srm_cut *cut = d->tree.cut;
     size_t len = (size_t)ncut * BIS_ROWLEN;
+    uint32_t cuts = (uint32_t)(d->p - 1);
     memset(rows, 0, len * sizeof *rows);
-    for (size_t j = 0; j < nc; j++) {
-        const bis_walk *x = &walk[j];
-        if (x->hi - x->lo >= 2)
-            bis_tally(cut[x->at], &win[x->at], pdt_key(pts[j * stride]),
-                      rows + (size_t)node[x->at].slot * BIS_ROWLEN);
-    }
+    for (size_t j = 0; j < nc; j++)
+        if (at[j] < cuts)
+            bis_tally(cut[at[j]], &win[at[j]], pdt_key(pts[j * stride]),
+                      rows + (size_t)node[at[j]].slot * BIS_ROWLEN);
     pdt_status st = pdt_comm_allreduce_u64(d->c, rows, len, PDT_COMM_SUM, err);
     if (st != PDT_OK) return st;
     pdt_drv_note_all(d, TAG_SAMPLES, len * sizeof *rows);
-    for (int at = 0; at + 1 < d->p; at++)
-        if (node[at].depth == depth)
-            cut[at].split = bis_refined(cut[at], win[at], rows + (size_t)node[at].slot * BIS_ROWLEN,
-                                        node[at].lo, node[at].hi);
+    for (uint32_t c = 0; c < cuts; c++)
+        if (node[c].depth == depth)
+            w[c].split = cut[c].split =
+                bis_refined(cut[c], win[c], rows + (size_t)node[c].slot * BIS_ROWLEN, node[c].lo,
+                            node[c].hi);
     return PDT_OK;
 }
 
@@ -627,35 +615,34 @@ static pdt_status bis_count_depth(drv *d, const pdt_point *pts, size_t stride, c
  * depth by depth from the root: every rank counts a share of its points
  * (every n / BIS_COUNTED-th) at the cuts of the depth they have reached, in
  * each cut's window, one allreduce sums the counts, every rank moves those
- * cuts the same way, and the points step past them.  A cut is moved in its
- * cell as its ancestors left it, so the cells below see its final place.
- * The sample alone leaves a region within about 1/sqrt(2s) of n / p, s
- * sample points a region (at p = 1024 on 10^8 points the largest held 31 %
- * more than n / p). */
+ * cuts the same way (in d->tree.cut and the walk w), and the points step
+ * past them.  A cut is moved in its cell as its ancestors left it, so the
+ * cells below see its final place.  The sample alone leaves a region within
+ * about 1/sqrt(2s) of n / p, s sample points a region (at p = 1024 on 10^8
+ * points the largest held 31 % more than n / p). */
 static pdt_status bis_count(drv *d, const pdt_point *pts, size_t n, const bis_window *win,
-                            pdt_err *err)
+                            bis_walk *w, pdt_err *err)
 {
     int p = d->p, depths = pdt_srm_ceil_log2(p);
     size_t stride = n / BIS_COUNTED > 1 ? n / BIS_COUNTED : 1, nc = (n + stride - 1) / stride;
     int *per = calloc((size_t)depths + 1, sizeof *per);
     bis_node *node = malloc((size_t)p * sizeof *node);
-    bis_walk *walk = malloc((nc + 1) * sizeof *walk);
+    uint32_t *at = calloc(nc + 1, sizeof *at); /* (all at the root) */
     uint64_t *rows = malloc(((size_t)p * BIS_ROWLEN + 1) * sizeof *rows);
-    pdt_status st = per && node && walk && rows ? PDT_OK : pdt_drv_nomem(d, "partition");
+    pdt_status st = per && node && at && rows ? PDT_OK : pdt_drv_nomem(d, "partition");
     if (st == PDT_OK) bis_nodes(node, per, 0, p, 0, 0);
-    for (size_t j = 0; st == PDT_OK && j < nc; j++) walk[j] = (bis_walk){0, (uint32_t)p, 0};
     for (int depth = 0; depth < depths && st == PDT_OK; depth++) {
         if (depth >= BIS_COUNT_FROM)
-            st = bis_count_depth(d, pts, stride, walk, nc, node, depth, per[depth], win, rows, err);
+            st = bis_count_depth(d, pts, stride, at, nc, node, depth, per[depth], win, rows, w,
+                                 err);
         for (size_t j = 0; st == PDT_OK && j < nc; j++) {
-            if (walk[j].hi - walk[j].lo < 2) continue; /* (arrived) */
             uint64_t key = pdt_key(pts[j * stride]);
-            bis_step(d->tree.cut, key, swap_key(key), &walk[j]);
+            at[j] = bis_step(w, at[j], key, swap_key(key));
         }
     }
     free(per);
     free(node);
-    free(walk);
+    free(at);
     free(rows);
     return st;
 }
@@ -667,19 +654,20 @@ pdt_status pdt_drv_bisect(drv *d, const pdt_point *pts, size_t n, uint64_t first
 {
     int p = d->p;
     bis_window *win = malloc((size_t)p * sizeof *win);
-    if (!win) return pdt_drv_nomem(d, "partition");
-    pdt_status st = bis_tree(d, pts, n, first, win, err);
-    if (st == PDT_OK && bis_counted(d)) st = bis_count(d, pts, n, win, err);
-    free(win);
-    if (st != PDT_OK) return st;
-    const srm_cut *cut = d->tree.cut;
+    bis_walk *w = NULL;
     uint64_t *at = calloc((size_t)p, sizeof *at);
-    if (!at) return pdt_drv_nomem(d, "partition");
-    uint32_t *dst = (uint32_t *)(void *)tmp; /* (4 bytes a point of tmp's 16) */
-    if (!bis_dests(cut, p, pts, n, dst)) {
+    pdt_status st = win && at ? bis_tree(d, pts, n, first, win, err) : pdt_drv_nomem(d, "partition");
+    if (st == PDT_OK && !(w = bis_walk_new(d->tree.cut, p))) st = pdt_drv_nomem(d, "partition");
+    if (st == PDT_OK && bis_counted(d)) st = bis_count(d, pts, n, win, w, err);
+    free(win);
+    if (st != PDT_OK) {
+        free(w);
         free(at);
-        return pdt_drv_nomem(d, "partition");
+        return st;
     }
+    uint32_t *dst = (uint32_t *)(void *)tmp; /* (4 bytes a point of tmp's 16) */
+    bis_dests(w, p, pts, n, dst);
+    free(w);
     for (size_t i = 0; i < n; i++) sc[dst[i]]++;
     uint64_t sum = 0;
     for (int q = 0; q < p; q++) {
