@@ -172,12 +172,12 @@ static inline uint64_t bis_axis_key(uint64_t k, uint64_t am)
 }
 
 /* The keys of ranks r[0] <= r[1] <= r[2] among the axis keys of a[0..m)
- * (r[2] < m) into at[0..3).  One pass finds the keys' span, one counts them
- * in 2048 bins of its top 11 bits that differ, one keeps those of the bins
- * from r[0]'s to r[2]'s, and the radix selection finds the three among
- * them: four passes over the sample, where a selection for each rank would
- * take two or more each.  Exact, so the keys are those of any selection.
- * 0 without memory. */
+ * (r[2] < m) into at[0..3).  One pass finds the keys' span, one counts
+ * them in 2048 bins of the top 11 bits in which they differ, one keeps
+ * those of the bins from r[0]'s to r[2]'s, and the radix selection finds
+ * the three among them: four passes over the sample, where a selection for
+ * each rank would take two or more each.  Exact, so the keys are those of
+ * any selection.  0 without memory. */
 static int bis_ranks(const uint64_t *a, size_t m, uint64_t am, const size_t r[3], uint64_t at[3])
 {
     uint64_t lo = UINT64_MAX, hi = 0;
@@ -508,7 +508,7 @@ static inline uint32_t bis_step(const bis_walk *w, uint32_t at, uint64_t key, ui
  * itself), eight points at a time in lockstep, so that their chains of
  * loads and compares overlap (one point's steps depend on each other; at
  * 10^5 points a rank on 1024 simulated ranks the walk of one point at a
- * time took some 7 ms). */
+ * time took 7-12 ms on the median rank, eight at a time 1.3-2.2 ms). */
 static void bis_dests(const bis_walk *w, int p, const pdt_point *pts, size_t n, uint32_t *dst)
 {
     enum { W = 8 };
