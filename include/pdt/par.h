@@ -128,11 +128,23 @@ pdt_status pdt_comm_file_open(pdt_comm *c, const char *path, uint64_t size, pdt_
  * fails the same way, and pdt_comm_file_close reports it to every rank. */
 pdt_status pdt_comm_file_write_at(pdt_comm_file *f, uint64_t offset, const void *buf,
                                   size_t bytes, pdt_err *err);
+/* Not collective: this rank's share of the file failed for a reason of its
+ * own (e, as its writes would have): later writes fail the same way, and
+ * the close reports it to every rank. */
+void pdt_comm_file_failed(pdt_comm_file *f, const pdt_err *e);
 /* Collective: close and free f (f may be NULL on every rank).  Same status
  * at every rank: PDT_ERR_IO if a write or the close failed at any rank (the
  * failing rank keeps its own message; the others get "PATH: write failed
  * at rank R").  Does not remove the file, even after a failed write. */
 pdt_status pdt_comm_file_close(pdt_comm_file *f, pdt_err *err);
+/* Collective: pdt_comm_file_close and, unless path is NULL, the commit
+ * point of `path` (pdt_comm_commit_ok) in one agreement: each rank asks its
+ * stop query as it closes, rank 0 again once all have answered.  A rank
+ * that did not fail gets the failing rank's status with no message (the
+ * failing rank's own is the one to print, as pdt_par_agree).  f may be
+ * NULL on every rank (the commit point alone). */
+pdt_status pdt_comm_file_close_commit(pdt_comm *c, pdt_comm_file *f, const char *path,
+                                      pdt_err *err);
 
 /* Point to point, blocking.  recv: waits (sleeping between polls) for the
  * message, *buf is malloc'd (caller frees; may be non-NULL even for 0

@@ -204,18 +204,18 @@ pdt_status pdt_comm_agree(pdt_comm *c, pdt_status mine, const char *path, const 
                           pdt_err *err)
 {
     if (c->size == 1) return mine;
-    uint64_t bad = mine != PDT_OK, who = mine != PDT_OK ? (uint64_t)c->rank : UINT64_MAX;
+    /* one allreduce: the largest size - rank is the lowest failing rank */
+    uint64_t v = mine != PDT_OK ? (uint64_t)(c->size - c->rank) : 0;
     pdt_err e2 = {0};
-    pdt_status s = pdt_comm_allreduce_u64(c, &bad, 1, PDT_COMM_MAX, &e2);
-    if (s == PDT_OK) s = pdt_comm_allreduce_u64(c, &who, 1, PDT_COMM_MIN, &e2);
+    pdt_status s = pdt_comm_allreduce_u64(c, &v, 1, PDT_COMM_MAX, &e2);
     if (mine != PDT_OK) return mine;
     if (s != PDT_OK) {
         *err = e2;
         return s;
     }
-    if (bad)
+    if (v)
         return pdt_err_set(err, PDT_ERR_IO, "%s: %s failed at rank %llu", path, what,
-                           (unsigned long long)who);
+                           (unsigned long long)((uint64_t)c->size - v));
     return PDT_OK;
 }
 
@@ -254,17 +254,47 @@ pdt_status pdt_comm_file_write_at(pdt_comm_file *f, uint64_t offset, const void 
     return s;
 }
 
-pdt_status pdt_comm_file_close(pdt_comm_file *f, pdt_err *err)
+void pdt_comm_file_failed(pdt_comm_file *f, const pdt_err *e)
 {
-    if (!f) return PDT_OK;
+    if (f && f->first.code == PDT_OK) f->first = *e;
+}
+
+/* The close, and with `close_commit` and `commit` (the user's file) the
+ * commit point's stop question in the same agreement (pdt_comm_commit_ok). */
+static pdt_status file_close(pdt_comm_file *f, int close_commit, const char *commit,
+                             pdt_err *err)
+{
     pdt_comm *c = f->c;
     pdt_err cerr;
     pdt_err_clear(&cerr);
     pdt_status s = c->ops->file_close(f, &cerr);
     pdt_status mine = f->first.code != PDT_OK ? f->first.code : s;
-    if (mine != PDT_OK) pdt_err_set(err, mine, "%s", f->first.code ? f->first.msg : cerr.msg);
-    mine = pdt_comm_agree(c, mine, f->path, f->first.code ? "write" : "close", err);
+    const char *what = f->first.code ? "write" : "close";
+    if (mine != PDT_OK) {
+        pdt_err_set(err, mine, "%s", f->first.code ? f->first.msg : cerr.msg);
+    } else if (commit && stopping(c)) {
+        mine = pdt_err_set(err, PDT_ERR_IO, "%s: not written: the job was stopped (rank %d)",
+                           commit, c->rank);
+        what = "the commit (the job was stopped)";
+    }
+    pdt_status own = mine;
+    mine = pdt_comm_agree(c, mine, f->path, what, err);
+    if (close_commit && own == PDT_OK && mine != PDT_OK) err->msg[0] = '\0';
+    if (mine == PDT_OK && commit && c->rank == 0 && stopping(c))
+        mine = pdt_err_set(err, PDT_ERR_IO, "%s: not written: the job was stopped (rank 0)", commit);
     free(f->path);
     free(f);
     return mine;
+}
+
+pdt_status pdt_comm_file_close(pdt_comm_file *f, pdt_err *err)
+{
+    return f ? file_close(f, 0, NULL, err) : PDT_OK;
+}
+
+pdt_status pdt_comm_file_close_commit(pdt_comm *c, pdt_comm_file *f, const char *path,
+                                      pdt_err *err)
+{
+    if (f) return file_close(f, 1, path, err);
+    return path ? pdt_comm_commit_ok(c, path, err) : PDT_OK;
 }

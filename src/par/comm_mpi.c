@@ -668,10 +668,12 @@ static pdt_status mpi_file_close(pdt_comm_file *f, pdt_err *err)
 
 /* ---- one file written by all ranks (SMPI: pwrite) ---------------------------
  * SMPI's MPI-IO writes to the simulated hosts' disks only.  Under it every
- * rank is a thread of this one process: rank 0 creates the file at its final
- * size, then every rank opens it and writes its range with pwrite at the same
- * offsets MPI-IO would use.  The write's simulated time is the formatting
- * and the system calls, with no disk or file-system model. */
+ * rank is a thread of this one process: every rank opens the file (creating
+ * it if it is not there yet) and writes its range with pwrite at the same
+ * offsets MPI-IO would use; rank 0 also gives it its final size, which no
+ * write reaches past, so its ftruncate may come before or after any of them.
+ * One agreement, on the opens.  The write's simulated time is the
+ * formatting and the system calls, with no disk or file-system model. */
 #if PDT_SMPI
 static pdt_status smpi_file_open(pdt_comm *c, pdt_comm_file *f, pdt_err *err)
 {
@@ -679,16 +681,12 @@ static pdt_status smpi_file_open(pdt_comm *c, pdt_comm_file *f, pdt_err *err)
     pdt_status s = fd ? PDT_OK
                       : pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: %s: out of memory", c->rank,
                                     f->path);
-    if (s == PDT_OK && c->rank == 0) {
-        int h = open(f->path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-        if (h < 0 || ftruncate(h, (off_t)f->size) != 0)
-            s = pdt_err_set(err, PDT_ERR_IO, "%s: cannot create: %s", f->path, strerror(errno));
-        if (h >= 0) close(h);
+    if (s == PDT_OK) {
+        *fd = open(f->path, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0666);
+        if (*fd < 0 || (c->rank == 0 && ftruncate(*fd, (off_t)f->size) != 0))
+            s = pdt_err_set(err, PDT_ERR_IO, "%s: cannot %s at rank %d: %s", f->path,
+                            *fd < 0 ? "open" : "truncate", c->rank, strerror(errno));
     }
-    s = pdt_comm_agree(c, s, f->path, "create", err);
-    if (s == PDT_OK && (*fd = open(f->path, O_WRONLY | O_CLOEXEC)) < 0)
-        s = pdt_err_set(err, PDT_ERR_IO, "%s: cannot open at rank %d: %s", f->path, c->rank,
-                        strerror(errno));
     s = pdt_comm_agree(c, s, f->path, "open", err);
     if (s != PDT_OK) {
         if (fd && *fd >= 0) close(*fd);

@@ -71,6 +71,7 @@ typedef struct order_plan {
     int shift, rounds;
     size_t nb, most;
     uint64_t *hist, *at, *sc, *rc;
+    uint64_t first, all; /* the triangles of the ranks before this one; of all ranks */
 } order_plan;
 
 static void order_plan_free(order_plan *o)
@@ -108,12 +109,15 @@ static pdt_status order_plan_make(drv *d, finals *f, order_plan *o, pdt_err *err
         for (size_t b = 0; b < o->nb; b++) total += sum[b];
         for (size_t b = 0; b < o->nb; b++) {
             uint64_t q = total ? (before + sum[b] / 2) * (uint64_t)p / total : 0;
+            q = q < (uint64_t)p ? q : (uint64_t)p - 1;
             int r = (int)(b % (size_t)R);
+            if (q < (uint64_t)d->rank) o->first += sum[b];
             before += sum[b];
-            o->sc[(q < (uint64_t)p ? q : (uint64_t)p - 1) * (uint64_t)R + (uint64_t)r] += o->hist[b];
+            o->sc[q * (uint64_t)R + (uint64_t)r] += o->hist[b];
             o->at[b] = pos[r];
             pos[r] += o->hist[b];
         }
+        o->all = total;
         o->most = (size_t)(pos[0] > pos[1] ? pos[0] : pos[1]);
         st = pdt_comm_alltoall(d->c, o->sc, (size_t)R * sizeof *o->sc, o->rc, err);
         if (st == PDT_OK) pdt_drv_note_all(d, TAG_COUNTS, (size_t)R * sizeof *o->sc);
@@ -259,9 +263,11 @@ static pdt_status order_round(drv *d, finals *f, const order_plan *o, order_room
 }
 
 /* The ordered triangles handed to out (the block shrunk to them when they
- * are in it), with their place in the whole output. */
-static pdt_status order_done(drv *d, order_room *room, size_t total, pdt_par_output *out,
-                             pdt_err *err)
+ * are in it), with their place in the whole output: the plan's, from the
+ * histogram summed over the ranks (no prefix sum: every rank knows which
+ * buckets the ranks before it hold). */
+static void order_done(drv *d, const order_plan *o, order_room *room, size_t total,
+                       pdt_par_output *out)
 {
     free(d->more); /* every triangle went somewhere (itself included) */
     d->more = NULL;
@@ -276,16 +282,11 @@ static pdt_status order_done(drv *d, order_room *room, size_t total, pdt_par_out
     }
     room->blk = NULL;
     room->out_own = 0;
-    uint64_t first = 0, all = total;
-    pdt_status st = pdt_comm_exscan_u64(d->c, total, &first, err); /* place in the whole output */
-    if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, &all, 1, PDT_COMM_SUM, err);
     out->tris = room->out;
     out->ntri = total;
-    out->first = first;
-    out->n_total = all;
+    out->first = o->first;
+    out->n_total = o->all;
     room->out = NULL;
-    if (st == PDT_OK) pdt_drv_note_all(d, TAG_ORDER, sizeof all);
-    return st;
 }
 
 /* Phase 4: the final triangles go to the rank of their smallest index's
@@ -309,7 +310,7 @@ pdt_status pdt_drv_order(drv *d, pdt_par_output *out, pdt_err *err)
     if (st == PDT_OK &&
         pdt_tri_bucket_order(x.src, x.len, (size_t)d->p * (size_t)o.rounds, o.shift, room.out) != PDT_OK)
         st = pdt_drv_nomem(d, "order");
-    if (st == PDT_OK) st = order_done(d, &room, total, out, err);
+    if (st == PDT_OK) order_done(d, &o, &room, total, out);
     order_room_free(&room);
     order_plan_free(&o);
     order_io_free(&x);

@@ -234,10 +234,23 @@ pdt_status pdt_par_read(pdt_comm *c, const char *path, double scale, int prefaul
     pdt_points_head h;
     memset(&h, 0, sizeof h);
     pdt_status st = PDT_OK;
-    if (pdt_comm_size(c) > 1) {
-        if (pdt_comm_rank(c) == 0) st = pdt_points_head_read(path, scale, &h, err);
-        st = pdt_par_agree(c, st, NULL, err);
-        if (st == PDT_OK) st = pdt_comm_bcast(c, &h, sizeof h, 0, err);
+    if (pdt_comm_size(c) > 1) { /* rank 0 reads the head; one broadcast says how it went */
+        struct {
+            pdt_points_head h;
+            int32_t status;
+        } m;
+        memset(&m, 0, sizeof m);
+        if (pdt_comm_rank(c) == 0) m.status = pdt_points_head_read(path, scale, &m.h, err);
+        pdt_err berr;
+        pdt_err_clear(&berr);
+        st = pdt_comm_bcast(c, &m, sizeof m, 0, &berr);
+        if (st != PDT_OK) {
+            if (m.status == PDT_OK || pdt_comm_rank(c) != 0) *err = berr;
+        } else if ((st = (pdt_status)m.status) != PDT_OK && pdt_comm_rank(c) != 0) {
+            err->code = st; /* (rank 0 has the message) */
+            err->msg[0] = '\0';
+        }
+        h = m.h;
     }
     if (st == PDT_OK)
         st = h.parts ? read_parts(c, path, scale, flags, &h, in, err)

@@ -11,6 +11,7 @@
  * and its .node together), removed otherwise.  Standard output, a device or a pipe cannot be
  * written at offsets: the blocks are gathered at rank 0 and written there. */
 #include <errno.h>
+#include <stddef.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
@@ -173,9 +174,11 @@ static pdt_status write_section(pdt_comm_file *f, const section *s, uint64_t at,
     return st;
 }
 
-/* Collective: write o's temporary.  Every rank gets the same status; the
+/* Collective: write o's temporary; with `commit` (the last file of a run
+ * that puts its files in place now), the commit point's stop question is
+ * asked in the close's agreement.  Every rank gets the same status; the
  * temporary may be left behind on failure (the caller removes it). */
-static pdt_status write_file(pdt_comm *c, outfile *o, pdt_err *err)
+static pdt_status write_file(pdt_comm *c, outfile *o, const char *commit, pdt_err *err)
 {
     int r = pdt_comm_rank(c);
     uint64_t len[2] = {0, 0}, off[2] = {0, 0}, tot[2] = {0, 0};
@@ -186,7 +189,7 @@ static pdt_status write_file(pdt_comm *c, outfile *o, pdt_err *err)
     pdt_status st = PDT_OK;
     for (int k = 0; k < o->nsec && st == PDT_OK; k++)
         st = pdt_comm_exscan_u64(c, len[k], &off[k], err);
-    if (st == PDT_OK) st = pdt_comm_allreduce_u64(c, tot, 2, PDT_COMM_SUM, err);
+    if (st == PDT_OK) st = pdt_comm_allreduce_u64(c, tot, (size_t)o->nsec, PDT_COMM_SUM, err);
     if (st != PDT_OK) return st;
     pdt_comm_file *f = NULL;
     st = pdt_comm_file_open(c, o->tmp, o->hlen + tot[0] + tot[1], &f, err);
@@ -209,60 +212,88 @@ static pdt_status write_file(pdt_comm *c, outfile *o, pdt_err *err)
         at += tot[k];
     }
     free(buf);
+    if (wst != PDT_OK) pdt_comm_file_failed(f, &werr); /* (for the close to tell the others) */
     pdt_err cerr;
     pdt_err_clear(&cerr);
-    pdt_status cst = pdt_comm_file_close(f, &cerr); /* collective: agrees on the writes */
+    /* collective: agrees on the writes (and the stop question) */
+    pdt_status cst = pdt_comm_file_close_commit(c, f, commit, &cerr);
     if (wst != PDT_OK) {
         *err = werr;
         cst = wst;
     } else if (cst != PDT_OK) {
         *err = cerr;
     }
-    return pdt_par_agree(c, cst, NULL, err);
+    return cst;
 }
 
-/* Rank 0: the temporaries of the n files, by the rule of pdt/safefile.h
- * (created O_EXCL|O_NOFOLLOW beside each target, its mode and owner; a
- * read-only target refused); their names broadcast into o[k].tmp. */
-static pdt_status make_temps(pdt_comm *c, outfile *o, int n, pdt_safe_file *sf, pdt_err *err)
+/* What rank 0 decides for every rank before a write: whether the files go
+ * in place at offsets, its status, the temporaries' names. */
+typedef struct temps_msg {
+    int32_t direct, status;
+    char tmp[2][4096];
+} temps_msg;
+
+/* Rank 0 decides whether the files are written at offsets (a regular file
+ * or no file yet, under a name of reasonable length; else they are gathered
+ * and written at rank 0) and if so creates their temporaries by the rule of
+ * pdt/safefile.h (O_EXCL|O_NOFOLLOW beside each target, its mode and owner;
+ * a read-only target refused).  One broadcast takes its answer, its status
+ * and the names (into o[k].tmp) to every rank: one collective, where each
+ * question and answer used to be one (at 1024 simulated ranks each took
+ * 0.1-0.2 ms).  Every rank returns rank 0's status (the others with no
+ * message). */
+static pdt_status make_temps(pdt_comm *c, outfile *o, int n, pdt_safe_file *sf, int *direct,
+                             pdt_err *err)
 {
     int r = pdt_comm_rank(c);
-    pdt_status st = PDT_OK;
-    for (int k = 0; k < n && r == 0; k++) {
-        sf[k].fd = -1;
-        sf[k].tmp = NULL;
-        if (st == PDT_OK) st = pdt_safe_open(&sf[k], o[k].path, 0, err);
-        if (st == PDT_OK && strlen(sf[k].tmp) >= sizeof o[k].tmp)
-            st = pdt_err_set(err, PDT_ERR_IO, "%s: name too long", o[k].path);
-        if (st == PDT_OK) snprintf(o[k].tmp, sizeof o[k].tmp, "%s", sf[k].tmp);
+    temps_msg m;
+    memset(&m, 0, sizeof m);
+    if (r == 0) {
+        pdt_status st = PDT_OK;
+        m.direct = renamable(o[0].path) && strlen(o[0].path) < 3000;
+        for (int k = 0; k < n && m.direct; k++) {
+            sf[k].fd = -1;
+            sf[k].tmp = NULL;
+            if (st == PDT_OK) st = pdt_safe_open(&sf[k], o[k].path, 0, err);
+            if (st == PDT_OK && strlen(sf[k].tmp) >= sizeof m.tmp[k])
+                st = pdt_err_set(err, PDT_ERR_IO, "%s: name too long", o[k].path);
+            if (st == PDT_OK) snprintf(m.tmp[k], sizeof m.tmp[k], "%s", sf[k].tmp);
+        }
+        m.status = st;
     }
-    st = pdt_par_agree(c, st, NULL, err);
-    for (int k = 0; k < n && st == PDT_OK; k++)
-        st = pdt_comm_bcast(c, o[k].tmp, sizeof o[k].tmp, 0, err);
+    pdt_err berr;
+    pdt_err_clear(&berr);
+    pdt_status st = pdt_comm_bcast(c, &m, offsetof(temps_msg, tmp) + (size_t)n * sizeof m.tmp[0],
+                                   0, &berr);
+    if (st == PDT_OK) st = (pdt_status)m.status;
+    else if (r != 0 || m.status == PDT_OK) *err = berr;
+    if (st != PDT_OK && r != 0 && m.status != PDT_OK) { /* rank 0's failure */
+        err->code = st;
+        err->msg[0] = '\0';
+    }
     if (st != PDT_OK && r == 0)
-        for (int k = 0; k < n; k++)
+        for (int k = 0; k < n && m.direct; k++)
             if (sf[k].name) pdt_safe_abort(&sf[k]);
+    *direct = m.direct;
+    for (int k = 0; k < n && st == PDT_OK; k++) memcpy(o[k].tmp, m.tmp[k], sizeof o[k].tmp);
     return st;
 }
 
-/* Collective: the files (one, or an .ele and its .node) written in parallel
- * into their temporaries, then put in place by rank 0 together (both or
- * neither: pdt_safe_commit_group). */
-static pdt_status write_files(pdt_comm *c, outfile *o, int nfile, pdt_pending_write *defer,
-                              pdt_err *err)
+/* Collective: the files (one, or an .ele and its .node), whose temporaries
+ * make_temps created, written in parallel and put in place by rank 0
+ * together (both or neither: pdt_safe_commit_group). */
+static pdt_status write_files(pdt_comm *c, outfile *o, int nfile, pdt_safe_file *sf,
+                              pdt_pending_write *defer, pdt_err *err)
 {
     int r = pdt_comm_rank(c);
-    pdt_safe_file sf[2];
-    memset(sf, 0, sizeof sf);
-    pdt_status st = make_temps(c, o, nfile, sf, err);
-    if (st != PDT_OK) return st;
+    pdt_status st = PDT_OK;
     for (int k = 0; k < nfile; k++)
         if (pdt_comm_is_mpi(c)) { /* (one process per rank: the list is this rank's) */
             memcpy(pending[k], o[k].tmp, sizeof pending[k]);
             npending = k + 1;
         }
-    for (int k = 0; k < nfile && st == PDT_OK; k++) st = write_file(c, &o[k], err);
-    if (st == PDT_OK && !defer) st = pdt_comm_commit_ok(c, o[0].path, err); /* (not if stopped) */
+    for (int k = 0; k < nfile && st == PDT_OK; k++) /* (not if stopped: the last close asks) */
+        st = write_file(c, &o[k], k == nfile - 1 && !defer ? o[0].path : NULL, err);
     if (r == 0) {
         if (st == PDT_OK && defer) {
             for (int k = 0; k < nfile; k++) defer->f[k] = sf[k];
@@ -302,11 +333,6 @@ pdt_status pdt_par_write_deferred(pdt_comm *c, const char *path, pdt_tri_format 
                : out->release_tris
                    ? pdt_write_tris_releasing(path, fmt, in->pts, in->n, out->tris, out->ntri, err)
                    : pdt_write_tris(path, fmt, in->pts, in->n, out->tris, out->ntri, err);
-    int direct = renamable(path) && strlen(path) < 3000;
-    if (pdt_par_agree(c, direct ? PDT_OK : PDT_ERR_ARG, NULL, err) != PDT_OK) {
-        pdt_err_clear(err);
-        return write_gathered(c, path, fmt, in, out, defer, err);
-    }
     outfile o[2];
     memset(o, 0, sizeof o);
     char npath[4096];
@@ -315,17 +341,26 @@ pdt_status pdt_par_write_deferred(pdt_comm *c, const char *path, pdt_tri_format 
                                                : PDT_LINES_TRI,
                           out->tris, sizeof(pdt_tri), out->ntri, out->first,
                           out->release_tris};
+    int nfile = 1;
     o[0].path = path;
     o[0].hlen = pdt_format_tri_header(o[0].head, fmt, in->n_total, out->n_total);
     if (fmt == PDT_FMT_OFF)
         o[0].sec[o[0].nsec++] = (section){PDT_LINES_OFF_POINT, in->pts, sizeof(pdt_point), in->n,
                                           in->first, 0};
     o[0].sec[o[0].nsec++] = tris;
-    if (fmt != PDT_FMT_ELE) return write_files(c, o, 1, defer, err);
-    node_path(npath, sizeof npath, path);
-    o[1].path = npath;
-    o[1].hlen = pdt_format_node_header(o[1].head, in->n_total);
-    o[1].sec[o[1].nsec++] = (section){PDT_LINES_NODE, in->pts, sizeof(pdt_point), in->n,
-                                      in->first, 0};
-    return write_files(c, o, 2, defer, err);
+    if (fmt == PDT_FMT_ELE) {
+        node_path(npath, sizeof npath, path);
+        o[1].path = npath;
+        o[1].hlen = pdt_format_node_header(o[1].head, in->n_total);
+        o[1].sec[o[1].nsec++] = (section){PDT_LINES_NODE, in->pts, sizeof(pdt_point), in->n,
+                                          in->first, 0};
+        nfile = 2;
+    }
+    pdt_safe_file sf[2];
+    memset(sf, 0, sizeof sf);
+    int direct = 0;
+    pdt_status st = make_temps(c, o, nfile, sf, &direct, err);
+    if (st != PDT_OK) return st;
+    if (!direct) return write_gathered(c, path, fmt, in, out, defer, err);
+    return write_files(c, o, nfile, sf, defer, err);
 }
