@@ -607,10 +607,10 @@ static pdt_status read_messages(srm_job *j, void *const *msg, const size_t *len)
 
 /* The shipped set and the border set B: the vertices of the shipped
  * triangles and the facing hull vertices (the hull-vertex rule of the Merge
- * Lemma), key-sorted and distinct.  A blob's point table is distinct and
- * holds its triangles' vertices and its hull's: the entries its triangles
- * use (marked) go into B once each, not once a corner, so the sort has a
- * third to a sixth of the entries. */
+ * Lemma), key-sorted and distinct.  A blob's point table is distinct, in key
+ * order, and holds its triangles' vertices and its hull's: the entries its
+ * triangles use (marked) go into B once each, in that order, so B is a run
+ * per blob and a short run of facing vertices, merged (no sort). */
 static pdt_status border_set(srm_job *j)
 {
     srm_rank *s = j->s;
@@ -630,8 +630,12 @@ static pdt_status border_set(srm_job *j)
         free(used);
         return nomem(j->err, s->who, "merge");
     }
-    size_t ns = 0, nb = 0;
+    size_t ns = 0, nb = 0, *end = malloc(((size_t)j->nmv + 1) * sizeof *end);
     srm_pt *B = j->B;
+    if (!end) {
+        free(used);
+        return nomem(j->err, s->who, "merge");
+    }
     for (int i = 0; i < j->nmv; i++) {
         const srm_msg_view *v = &j->mv[i];
         memset(used, 0, (size_t)v->h.npts);
@@ -651,15 +655,20 @@ static pdt_status border_set(srm_job *j)
             B[nb] = v->pts[k];
             nb += used[k];
         }
+        end[i] = nb;
     }
     free(used);
     if (PDT_TRACING(s->tr, 1)) /* (the discards are traced in this order) */
         qsort(j->shipped, ns, sizeof *j->shipped, cmp_gtri);
+    size_t nf = nb;
     if (j->hl >= 0) nb += facing(s, &j->mv[j->hl], j->gr, j->ge, B + nb);
     if (j->hr >= 0) nb += facing(s, &j->mv[j->hr], j->gl, j->gr, B + nb);
-    if ((!j->share && pdt_srm_tset_init(&j->sset, j->shipped, ns) != PDT_OK) ||
-        pdt_srm_sort_pts(B, nb) != PDT_OK)
-        return nomem(j->err, s->who, "merge");
+    end[j->nmv] = nb;
+    pdt_status st = !j->share ? pdt_srm_tset_init(&j->sset, j->shipped, ns) : PDT_OK;
+    if (st == PDT_OK) st = pdt_srm_sort_pts(B + nf, nb - nf);
+    if (st == PDT_OK) st = pdt_srm_merge_pt_runs(B, end, j->nmv + 1);
+    free(end);
+    if (st != PDT_OK) return nomem(j->err, s->who, "merge");
     size_t u = 0;
     for (size_t i = 0; i < nb; i++)
         if (u == 0 || B[i].gid != B[u - 1].gid) B[u++] = B[i];

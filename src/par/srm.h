@@ -152,6 +152,9 @@ static inline uint64_t srm_key(srm_pt p)
 
 /* p[0..n) sorted by key; stable.  PDT_ERR_NOMEM (p unchanged) or PDT_OK. */
 pdt_status pdt_srm_sort_pts(srm_pt *p, size_t n);
+/* p[end[r-1], end[r]) (end[-1] = 0) are nrun runs, each in key order: p
+ * in key order (end is overwritten).  PDT_ERR_NOMEM leaves p as it was. */
+pdt_status pdt_srm_merge_pt_runs(srm_pt *p, size_t *end, int nrun);
 
 /* A triangle by its vertices' global indices, rotated to start at the
  * smallest (orientation kept). */

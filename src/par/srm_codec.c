@@ -5,10 +5,11 @@
  *
  * A message is a sequence of blobs (one without relay).  A blob is a header
  * (srm_msg_head, srm.h) and `payload` bytes of LEB128 varints: the point
- * table in increasing gid order (gid delta, zigzag x, zigzag y), then the
- * triangles and the hull as positions in that table.  About 8 bytes per
- * point and 5 per triangle for coordinates below 2^20, instead of 12 and
- * 12. */
+ * table in increasing key order (x, then y: the order of the merge's border
+ * set, which then merges the tables' runs instead of sorting them; each
+ * point as x's step from the one before, zigzag y, gid), then the triangles
+ * and the hull as positions in that table.  About 8 bytes per point and 5
+ * per triangle for coordinates below 2^20, instead of 12 and 12. */
 #include "srm.h"
 
 #include <stdint.h>
@@ -68,25 +69,33 @@ static size_t blob_bound(size_t nt, size_t nh)
     return sizeof(srm_msg_head) + (3 * nt + nh) * 15 + (3 * nt + nh) * 5;
 }
 
-/* The point table of a blob: the distinct gids of the n slots' points (a
- * shipped triangle's three corners, then the hull) in increasing order into
- * tab, and each slot's place in it into pos.  One radix sort of (gid, slot)
- * records gives both: equal gids are neighbours, and the table grows by one
- * at each new gid.  Returns the table's size, or SIZE_MAX without memory. */
+/* The point table of a blob: the distinct points of the n slots (a shipped
+ * triangle's three corners, then the hull) in increasing key order into tab,
+ * and each slot's place in it into pos.  One radix sort of (key, slot)
+ * records gives both: equal points are neighbours, and the table grows by
+ * one at each new key.  Returns the table's size, or SIZE_MAX without
+ * memory. */
 static size_t point_table(const srm_pt *slot, size_t n, srm_pt *tab, uint32_t *pos)
 {
     if (n == 0) return 0;
     srm_rec *r = malloc(2 * n * sizeof *r);
     if (!r) return SIZE_MAX;
-    for (size_t i = 0; i < n; i++) r[i] = (srm_rec){slot[i].gid, (uint32_t)i, 0};
+    for (size_t i = 0; i < n; i++) r[i] = (srm_rec){srm_key(slot[i]), (uint32_t)i, 0};
     pdt_srm_radix_sort(r, r + n, n);
     size_t u = 0;
     for (size_t i = 0; i < n; i++) {
-        if (u == 0 || r[i].key != tab[u - 1].gid) tab[u++] = slot[r[i].idx];
+        if (u == 0 || r[i].key != r[i - 1].key) tab[u++] = slot[r[i].idx];
         pos[r[i].idx] = (uint32_t)(u - 1);
     }
     free(r);
     return u;
+}
+
+/* x as an unsigned number in the keys' order (x's step from the point
+ * before is then never negative). */
+static uint32_t key_x(int32_t x)
+{
+    return (uint32_t)x ^ 0x80000000u;
 }
 
 static pdt_status pack_blob(srm_rank *s, int level, int send_hull, unsigned char *b, size_t *len,
@@ -114,10 +123,10 @@ static pdt_status pack_blob(srm_rank *s, int level, int send_hull, unsigned char
     unsigned char *b0 = b + *len, *w = b0 + sizeof(srm_msg_head);
     uint32_t prev = 0;
     for (size_t i = 0; i < np; i++) {
-        w += pdt_srm_put_varint(w, tab[i].gid - prev);
-        prev = tab[i].gid;
-        w += pdt_srm_put_varint(w, pdt_srm_zigzag(tab[i].x));
+        w += pdt_srm_put_varint(w, key_x(tab[i].x) - prev);
+        prev = key_x(tab[i].x);
         w += pdt_srm_put_varint(w, pdt_srm_zigzag(tab[i].y));
+        w += pdt_srm_put_varint(w, tab[i].gid);
     }
     const uint32_t *at = pos;
     for (size_t i = 0; i < s->npend; i++) {
@@ -237,15 +246,17 @@ pdt_status pdt_srm_msg_decode(const void *buf, size_t len, int level, const char
     }
     v->hull = v->tri + 3 * (size_t)h->ntri;
     const unsigned char *p = (const unsigned char *)buf + sizeof(srm_msg_head), *end = p + h->payload;
-    uint64_t gid = 0, a, x, y;
+    uint64_t ux = 0, a, y, gid, prev = 0;
     for (size_t i = 0; i < h->npts; i++) {
-        if (!pdt_srm_get_varint(&p, end, &a) || !pdt_srm_get_varint(&p, end, &x) || !pdt_srm_get_varint(&p, end, &y))
+        if (!pdt_srm_get_varint(&p, end, &a) || !pdt_srm_get_varint(&p, end, &y) || !pdt_srm_get_varint(&p, end, &gid))
             goto bad;
-        gid += a;
-        int64_t sx = (int64_t)(x >> 1) ^ -(int64_t)(x & 1), sy = (int64_t)(y >> 1) ^ -(int64_t)(y & 1);
-        if (gid > UINT32_MAX || sx < INT32_MIN || sx > INT32_MAX || sy < INT32_MIN || sy > INT32_MAX)
-            goto bad;
-        v->pts[i] = (srm_pt){(int32_t)sx, (int32_t)sy, (uint32_t)gid};
+        ux += a;
+        int64_t sy = (int64_t)(y >> 1) ^ -(int64_t)(y & 1);
+        if (ux > UINT32_MAX || gid > UINT32_MAX || sy < INT32_MIN || sy > INT32_MAX) goto bad;
+        srm_pt q = {(int32_t)((uint32_t)ux ^ 0x80000000u), (int32_t)sy, (uint32_t)gid};
+        if (i > 0 && srm_key(q) <= prev) goto bad; /* (the merge relies on the order) */
+        prev = srm_key(q);
+        v->pts[i] = q;
     }
     for (size_t i = 0; i < ni; i++) {
         if (!pdt_srm_get_varint(&p, end, &a) || a >= h->npts) goto bad;

@@ -28,6 +28,38 @@ pdt_status pdt_srm_sort_pts(srm_pt *p, size_t n)
     return PDT_OK;
 }
 
+/* Two key-sorted runs a[0, na) and b[0, nb) into out. */
+static void merge_two(const srm_pt *a, size_t na, const srm_pt *b, size_t nb, srm_pt *out)
+{
+    size_t i = 0, j = 0, k = 0;
+    while (i < na && j < nb) out[k++] = srm_key(b[j]) < srm_key(a[i]) ? b[j++] : a[i++];
+    while (i < na) out[k++] = a[i++];
+    while (j < nb) out[k++] = b[j++];
+}
+
+pdt_status pdt_srm_merge_pt_runs(srm_pt *p, size_t *end, int nrun)
+{
+    size_t n = nrun > 0 ? end[nrun - 1] : 0;
+    if (nrun < 2 || n < 2) return PDT_OK;
+    srm_pt *tmp = malloc(n * sizeof *tmp), *src = p, *dst = tmp;
+    if (!tmp) return PDT_ERR_NOMEM;
+    while (nrun > 1) { /* adjacent pairs, until one run is left */
+        int k = 0;
+        for (int r = 0; r < nrun; r += 2) {
+            size_t lo = r ? end[r - 1] : 0, mid = end[r], hi = r + 1 < nrun ? end[r + 1] : mid;
+            merge_two(src + lo, mid - lo, src + mid, hi - mid, dst + lo);
+            end[k++] = hi;
+        }
+        nrun = k;
+        srm_pt *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != p) memcpy(p, src, n * sizeof *p);
+    free(tmp);
+    return PDT_OK;
+}
+
 /* Empty slots: all ones (a triangle's three indices are distinct). */
 static int tset_empty(const srm_gtri *t)
 {

@@ -360,6 +360,41 @@ TEST(merge_message_header)
                   err.msg);
         free(c);
     }
+    /* a point table out of key order (the merge merges the tables as runs),
+     * or with a point twice, is refused */
+    for (int k = 0; k < 2; k++) {
+        unsigned char c[sizeof h + 64], *w = c + sizeof h;
+        w += pdt_srm_put_varint(w, 0x80000000u + 10); /* (10, 0), gid 1 */
+        w += pdt_srm_put_varint(w, pdt_srm_zigzag(0));
+        w += pdt_srm_put_varint(w, 1);
+        w += pdt_srm_put_varint(w, 0); /* (10, -5) or (10, 0) again, gid 2 */
+        w += pdt_srm_put_varint(w, pdt_srm_zigzag(k == 0 ? -5 : 0));
+        w += pdt_srm_put_varint(w, 2);
+        srm_msg_head two = {SRM_MSG_MAGIC, 0, 0, 0, 2, 0, 0, (uint64_t)(w - c - sizeof h), 0, 0};
+        memcpy(c, &two, sizeof two);
+        srm_msg_view v;
+        pdt_err_clear(&err);
+        CHECK_MSG(pdt_srm_msg_decode(c, (size_t)(w - c), 0, "rank 0", &v, &err) == PDT_ERR_CORRUPT,
+                  "order %d", k);
+        CHECK_MSG(strstr(err.msg, "from rank 0: damaged payload") != NULL, "order %d: %s", k,
+                  err.msg);
+        /* in order, the same two points are read back */
+        if (k == 0) {
+            unsigned char *y = c + sizeof h;
+            y += pdt_srm_put_varint(y, 0x80000000u + 10);
+            y += pdt_srm_put_varint(y, pdt_srm_zigzag(-5));
+            y += pdt_srm_put_varint(y, 2);
+            y += pdt_srm_put_varint(y, 0);
+            y += pdt_srm_put_varint(y, pdt_srm_zigzag(0));
+            y += pdt_srm_put_varint(y, 1);
+            two.payload = (uint64_t)(y - c - sizeof h);
+            memcpy(c, &two, sizeof two);
+            CHECK(pdt_srm_msg_decode(c, (size_t)(y - c), 0, "rank 0", &v, &err) == PDT_OK);
+            CHECK(v.pts[0].x == 10 && v.pts[0].y == -5 && v.pts[0].gid == 2);
+            CHECK(v.pts[1].x == 10 && v.pts[1].y == 0 && v.pts[1].gid == 1);
+            pdt_srm_msg_free(&v);
+        }
+    }
     /* the same among the strips of a plain run: the sender named as a strip */
     pdt_srm_as_strips(&rk[1]);
     CHECK_MSG(strcmp(rk[1].who, "strip 2 of 2") == 0, "%s", rk[1].who);
