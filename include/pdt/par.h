@@ -303,6 +303,15 @@ void pdt_par_stats_free(pdt_par_stats *s);
  * whose own st was PDT_OK, err gets the status and an empty message).  Never blocks on a rank that already failed: call it from every
  * rank after the step. */
 pdt_status pdt_par_agree(pdt_comm *c, pdt_status st, int *who, pdt_err *err);
+/* Collective: a step only rank 0 takes (its status st, what it made in buf,
+ * `bytes` long at every rank, at most PDT_PAR_OUTCOME_MAX) told to every rank
+ * in one broadcast, where an agreement and a broadcast would be two.
+ * Returns rank 0's status at every rank (err at rank 0 holds the message;
+ * the others get the status and an empty message), and buf holds rank 0's
+ * bytes. */
+enum { PDT_PAR_OUTCOME_MAX = 16384 };
+pdt_status pdt_par_bcast_outcome(pdt_comm *c, pdt_status st, void *buf, size_t bytes,
+                                 pdt_err *err);
 
 /* Collective: read the points of `path` ("-" = standard input; ".node" =
  * Triangle's format; else text), scaled by `scale` as pdt_read_points does.

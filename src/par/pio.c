@@ -2,6 +2,7 @@
  * is src/par/pwrite.c), and the agreement step that every collective phase
  * of the pipeline ends with. */
 #include <errno.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -32,6 +33,38 @@ pdt_status pdt_par_agree(pdt_comm *c, pdt_status st, int *who, pdt_err *err)
         err->msg[0] = '\0';
     }
     return (pdt_status)(v % 256);
+}
+
+/* pdt_par_bcast_outcome's message: rank 0's status, then its bytes. */
+typedef struct outcome_msg {
+    int32_t status;
+    unsigned char b[PDT_PAR_OUTCOME_MAX];
+} outcome_msg;
+
+pdt_status pdt_par_bcast_outcome(pdt_comm *c, pdt_status st, void *buf, size_t bytes,
+                                 pdt_err *err)
+{
+    if (pdt_comm_size(c) == 1) return st;
+    int r = pdt_comm_rank(c);
+    outcome_msg m;
+    if (bytes > sizeof m.b) /* (the same at every rank) */
+        return pdt_err_set(err, PDT_ERR_ARG, "rank %d: broadcast of %zu bytes", r, bytes);
+    m.status = (int32_t)st;
+    memcpy(m.b, buf, bytes);
+    pdt_err berr;
+    pdt_err_clear(&berr);
+    pdt_status bst = pdt_comm_bcast(c, &m, offsetof(outcome_msg, b) + bytes, 0, &berr);
+    if (bst != PDT_OK) {
+        if (r != 0 || st == PDT_OK) *err = berr;
+        return bst;
+    }
+    memcpy(buf, m.b, bytes);
+    st = (pdt_status)m.status;
+    if (st != PDT_OK && r != 0) { /* (rank 0 has the message) */
+        err->code = st;
+        err->msg[0] = '\0';
+    }
+    return st;
 }
 
 void pdt_par_input_free(pdt_par_input *in)
@@ -234,23 +267,9 @@ pdt_status pdt_par_read(pdt_comm *c, const char *path, double scale, int prefaul
     pdt_points_head h;
     memset(&h, 0, sizeof h);
     pdt_status st = PDT_OK;
-    if (pdt_comm_size(c) > 1) { /* rank 0 reads the head; one broadcast says how it went */
-        struct {
-            pdt_points_head h;
-            int32_t status;
-        } m;
-        memset(&m, 0, sizeof m);
-        if (pdt_comm_rank(c) == 0) m.status = pdt_points_head_read(path, scale, &m.h, err);
-        pdt_err berr;
-        pdt_err_clear(&berr);
-        st = pdt_comm_bcast(c, &m, sizeof m, 0, &berr);
-        if (st != PDT_OK) {
-            if (m.status == PDT_OK || pdt_comm_rank(c) != 0) *err = berr;
-        } else if ((st = (pdt_status)m.status) != PDT_OK && pdt_comm_rank(c) != 0) {
-            err->code = st; /* (rank 0 has the message) */
-            err->msg[0] = '\0';
-        }
-        h = m.h;
+    if (pdt_comm_size(c) > 1) { /* rank 0 reads the head */
+        if (pdt_comm_rank(c) == 0) st = pdt_points_head_read(path, scale, &h, err);
+        st = pdt_par_bcast_outcome(c, st, &h, sizeof h, err);
     }
     if (st == PDT_OK)
         st = h.parts ? read_parts(c, path, scale, flags, &h, in, err)

@@ -227,9 +227,9 @@ static pdt_status write_file(pdt_comm *c, outfile *o, const char *commit, pdt_er
 }
 
 /* What rank 0 decides for every rank before a write: whether the files go
- * in place at offsets, its status, the temporaries' names. */
+ * in place at offsets, the temporaries' names. */
 typedef struct temps_msg {
-    int32_t direct, status;
+    int32_t direct;
     char tmp[2][4096];
 } temps_msg;
 
@@ -238,18 +238,15 @@ typedef struct temps_msg {
  * and written at rank 0) and if so creates their temporaries by the rule of
  * pdt/safefile.h (O_EXCL|O_NOFOLLOW beside each target, its mode and owner;
  * a read-only target refused).  One broadcast takes its answer, its status
- * and the names (into o[k].tmp) to every rank: one collective, where each
- * question and answer used to be one (at 1024 simulated ranks each took
- * 0.1-0.2 ms).  Every rank returns rank 0's status (the others with no
- * message). */
+ * and the names (into o[k].tmp) to every rank (pdt_par_bcast_outcome). */
 static pdt_status make_temps(pdt_comm *c, outfile *o, int n, pdt_safe_file *sf, int *direct,
                              pdt_err *err)
 {
     int r = pdt_comm_rank(c);
     temps_msg m;
     memset(&m, 0, sizeof m);
+    pdt_status st = PDT_OK;
     if (r == 0) {
-        pdt_status st = PDT_OK;
         m.direct = renamable(o[0].path) && strlen(o[0].path) < 3000;
         for (int k = 0; k < n && m.direct; k++) {
             sf[k].fd = -1;
@@ -259,20 +256,11 @@ static pdt_status make_temps(pdt_comm *c, outfile *o, int n, pdt_safe_file *sf, 
                 st = pdt_err_set(err, PDT_ERR_IO, "%s: name too long", o[k].path);
             if (st == PDT_OK) snprintf(m.tmp[k], sizeof m.tmp[k], "%s", sf[k].tmp);
         }
-        m.status = st;
     }
-    pdt_err berr;
-    pdt_err_clear(&berr);
-    pdt_status st = pdt_comm_bcast(c, &m, offsetof(temps_msg, tmp) + (size_t)n * sizeof m.tmp[0],
-                                   0, &berr);
-    if (st == PDT_OK) st = (pdt_status)m.status;
-    else if (r != 0 || m.status == PDT_OK) *err = berr;
-    if (st != PDT_OK && r != 0 && m.status != PDT_OK) { /* rank 0's failure */
-        err->code = st;
-        err->msg[0] = '\0';
-    }
+    st = pdt_par_bcast_outcome(c, st, &m, offsetof(temps_msg, tmp) + (size_t)n * sizeof m.tmp[0],
+                               err);
     if (st != PDT_OK && r == 0)
-        for (int k = 0; k < n && m.direct; k++)
+        for (int k = 0; k < n && m.direct; k++) /* (the temporaries made) */
             if (sf[k].name) pdt_safe_abort(&sf[k]);
     *direct = m.direct;
     for (int k = 0; k < n && st == PDT_OK; k++) memcpy(o[k].tmp, m.tmp[k], sizeof o[k].tmp);
