@@ -11,9 +11,9 @@
  * and its .node together), removed otherwise.  Standard output, a device or a pipe cannot be
  * written at offsets: the blocks are gathered at rank 0 and written there. */
 #include <errno.h>
-#include <stddef.h>
 #include <fcntl.h>
 #include <signal.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

@@ -250,9 +250,10 @@ pdt_status pdt_srm_msg_decode(const void *buf, size_t len, int level, const char
     for (size_t i = 0; i < h->npts; i++) {
         if (!pdt_srm_get_varint(&p, end, &a) || !pdt_srm_get_varint(&p, end, &y) || !pdt_srm_get_varint(&p, end, &gid))
             goto bad;
+        if (a > UINT32_MAX - ux) goto bad; /* (checked before the sum, which could wrap) */
         ux += a;
         int64_t sy = (int64_t)(y >> 1) ^ -(int64_t)(y & 1);
-        if (ux > UINT32_MAX || gid > UINT32_MAX || sy < INT32_MIN || sy > INT32_MAX) goto bad;
+        if (gid > UINT32_MAX || sy < INT32_MIN || sy > INT32_MAX) goto bad;
         srm_pt q = {(int32_t)((uint32_t)ux ^ 0x80000000u), (int32_t)sy, (uint32_t)gid};
         if (i > 0 && srm_key(q) <= prev) goto bad; /* (the merge relies on the order) */
         prev = srm_key(q);
