@@ -87,9 +87,10 @@ typedef struct pdt_range {
 pdt_prefault *pdt_prefault_start(const pdt_range *r, int nr);
 void pdt_prefault_stop(pdt_prefault *pf);
 
-/* For a helper thread just started: when the process is bound to one CPU
- * (mpirun binds a job's only rank to a core), move the thread to the other
- * CPUs online, so that it does not take turns with the caller. */
-void pdt_helper_off_my_cpu(pthread_t th);
+/* pthread_create for a helper thread: when the caller is bound to one CPU
+ * (mpirun binds each rank to a core), the thread is created on the other
+ * CPUs online, so that it does not take turns with the caller.  Returns
+ * pthread_create's code. */
+int pdt_helper_start(pthread_t *th, void *(*fn)(void *), void *arg);
 
 #endif

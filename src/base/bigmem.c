@@ -99,16 +99,26 @@ static void *prefault_run(void *arg)
 }
 
 /* (bigmem.h) A process bound to one CPU would run the helper on that CPU,
- * taking turns with the main thread. */
-void pdt_helper_off_my_cpu(pthread_t th)
+ * taking turns with the main thread.  The helper's CPUs are an attribute of
+ * its creation, not set afterwards: a thread that has already ended has no
+ * kernel id left in its handle, and setting the CPUs of such a handle sets
+ * the caller's own (a quick helper then moved the main thread onto the other
+ * rank's CPU). */
+int pdt_helper_start(pthread_t *th, void *(*fn)(void *), void *arg)
 {
     cpu_set_t mine, other;
-    if (sched_getaffinity(0, sizeof mine, &mine) != 0 || CPU_COUNT(&mine) != 1) return;
-    long online = sysconf(_SC_NPROCESSORS_ONLN);
-    CPU_ZERO(&other);
-    for (long c = 0; c < online && c < CPU_SETSIZE; c++)
-        if (!CPU_ISSET((size_t)c, &mine)) CPU_SET((size_t)c, &other);
-    if (CPU_COUNT(&other) > 0) (void)pthread_setaffinity_np(th, sizeof other, &other);
+    pthread_attr_t at;
+    if (pthread_attr_init(&at) != 0) return -1;
+    if (sched_getaffinity(0, sizeof mine, &mine) == 0 && CPU_COUNT(&mine) == 1) {
+        long online = sysconf(_SC_NPROCESSORS_ONLN);
+        CPU_ZERO(&other);
+        for (long c = 0; c < online && c < CPU_SETSIZE; c++)
+            if (!CPU_ISSET((size_t)c, &mine)) CPU_SET((size_t)c, &other);
+        if (CPU_COUNT(&other) > 0) (void)pthread_attr_setaffinity_np(&at, sizeof other, &other);
+    }
+    int rc = pthread_create(th, &at, fn, arg);
+    pthread_attr_destroy(&at);
+    return rc;
 }
 
 pdt_prefault *pdt_prefault_start(const pdt_range *r, int nr)
@@ -119,11 +129,10 @@ pdt_prefault *pdt_prefault_start(const pdt_range *r, int nr)
     atomic_init(&pf->stop, 0);
     pf->nr = nr;
     memcpy(pf->r, r, (size_t)nr * sizeof *r);
-    if (pthread_create(&pf->th, NULL, prefault_run, pf) != 0) {
+    if (pdt_helper_start(&pf->th, prefault_run, pf) != 0) {
         free(pf);
         return NULL;
     }
-    pdt_helper_off_my_cpu(pf->th);
     return pf;
 }
 

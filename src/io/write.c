@@ -383,7 +383,7 @@ static void *section_work(void *arg)
 
 /* PDT_WRITE_THREADS=N if set (1 = the one-thread loop), else the CPUs
  * online, at most SEC_MAX_THREADS.  (A process that mpirun bound to one core
- * has its helpers moved to the others: pdt_helper_off_my_cpu.) */
+ * has its helpers started on the others: pdt_helper_start.) */
 static int section_threads(void)
 {
     const char *e = getenv("PDT_WRITE_THREADS");
@@ -425,9 +425,8 @@ static int section_run(section_job *jb)
     int most = cap && *cap ? atoi(cap) : SEC_MAX_THREADS;
     for (; started < jb->nthreads; started++) {
         if (started > most ||
-            pthread_create(&th[started], NULL, section_work, &wk[started]) != 0)
+            pdt_helper_start(&th[started], section_work, &wk[started]) != 0)
             break;
-        pdt_helper_off_my_cpu(th[started]);
     }
     int all = started == jb->nthreads;
     if (all) section_work(&wk[0]);

@@ -8,6 +8,8 @@
 #include "pdt/predicates.h"
 #include "pdt/bigmem.h"
 
+#include <pthread.h>
+#include <sched.h>
 #include <string.h>
 #include <sys/mman.h>
 #include <unistd.h>
@@ -630,6 +632,43 @@ TEST(prefault_makes_pages_resident)
     munmap(m, bytes);
 }
 
+/* A helper thread of a caller bound to one CPU runs on the other CPUs, and
+ * the caller stays bound to its own, even when the helper ends before
+ * pthread_create has returned (a helper's CPUs set on its handle after the
+ * thread has ended would set the caller's: a rank's main thread then moved
+ * onto the other rank's CPU). */
+static void *note_cpus(void *arg)
+{
+    cpu_set_t *got = arg;
+    if (sched_getaffinity(0, sizeof *got, got) != 0) CPU_ZERO(got);
+    return NULL;
+}
+
+TEST(helper_keeps_caller_cpu)
+{
+    cpu_set_t saved, one, now, helper;
+    if (sysconf(_SC_NPROCESSORS_ONLN) < 2 || sched_getaffinity(0, sizeof saved, &saved) != 0 ||
+        !CPU_ISSET(0, &saved) || CPU_COUNT(&saved) < 2)
+        return; /* (one CPU: nothing to keep apart) */
+    CPU_ZERO(&one);
+    CPU_SET(0, &one);
+    CHECK(sched_setaffinity(0, sizeof one, &one) == 0);
+    for (int i = 0; i < 200; i++) {
+        pthread_t th;
+        CPU_ZERO(&helper);
+        CHECK(pdt_helper_start(&th, note_cpus, &helper) == 0);
+        struct timespec ts = { 0, 20 * 1000 }; /* the helper has ended by now, mostly */
+        nanosleep(&ts, NULL);
+        CHECK(pthread_join(th, NULL) == 0);
+        CHECK(sched_getaffinity(0, sizeof now, &now) == 0);
+        CHECK_MSG(CPU_EQUAL(&now, &one), "round %d: the caller was moved off CPU 0", i);
+        CHECK_MSG(CPU_COUNT(&helper) > 0 && !CPU_ISSET(0, &helper),
+                  "round %d: the helper ran on the caller's CPU", i);
+        if (!CPU_EQUAL(&now, &one)) break;
+    }
+    CHECK(sched_setaffinity(0, sizeof saved, &saved) == 0);
+}
+
 int main(void)
 {
     RUN(oracle_every_gen_family);
@@ -654,5 +693,6 @@ int main(void)
     RUN(inplace_restores_points);
     RUN(prefault_same_triangles);
     RUN(prefault_makes_pages_resident);
+    RUN(helper_keeps_caller_cpu);
     return test_summary();
 }
