@@ -379,7 +379,7 @@ static pdt_status bis_gather(drv *d, const uint64_t *mine, size_t slot, uint64_t
         for (int q = 0; st == PDT_OK && q < p; q++) cnt[q] = bytes;
         if (st == PDT_OK) st = pdt_comm_gatherv(d->c, mine, bytes, buf, cnt, 0, err);
         if (st == PDT_OK) /* (uniform: the checker pairs them) */
-            pdt_drv_note_all(d, TAG_SAMPLES, bytes);
+            pdt_drv_note_gather(d, TAG_SAMPLES, bytes, 0);
         free(cnt);
         if (st == PDT_OK) *all = buf;
         else free(buf);
@@ -443,7 +443,7 @@ static pdt_status bis_tree(drv *d, const pdt_point *pts, size_t n, uint64_t firs
     }
     if (st == PDT_OK) st = pdt_comm_allreduce_u64(d->c, v, nv, PDT_COMM_SUM, err);
     if (st == PDT_OK) {
-        pdt_drv_note_all(d, TAG_SAMPLES, nv * sizeof *v);
+        pdt_drv_note_reduce(d, TAG_SAMPLES, nv * sizeof *v);
         for (int i = 0; i + 1 < p; i++) {
             const uint64_t *x = v + vw * (size_t)i;
             d->tree.cut[i] = (srm_cut){x[0], (int)x[1]};
@@ -602,7 +602,7 @@ static pdt_status bis_count_depth(drv *d, const pdt_point *pts, size_t stride, c
                       rows + (size_t)node[at[j]].slot * BIS_ROWLEN);
     pdt_status st = pdt_comm_allreduce_u64(d->c, rows, len, PDT_COMM_SUM, err);
     if (st != PDT_OK) return st;
-    pdt_drv_note_all(d, TAG_SAMPLES, len * sizeof *rows);
+    pdt_drv_note_reduce(d, TAG_SAMPLES, len * sizeof *rows);
     for (uint32_t c = 0; c < cuts; c++)
         if (node[c].depth == depth)
             w[c].split = cut[c].split =

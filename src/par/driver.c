@@ -30,39 +30,68 @@
 #include "driver.h"
 
 /* Trace one message (or one pair's share of a collective) and count it. */
+static void trace_send(drv *d, int tag, int peer, size_t bytes)
+{
+    PDT_TRACE(d->tr, 1, PDT_EV_SEND, tag, peer, (uint32_t)bytes, (uint32_t)((uint64_t)bytes >> 32),
+              d->seq_send[peer]);
+    d->seq_send[peer]++;
+}
+
+static void trace_recv(drv *d, int tag, int peer, size_t bytes)
+{
+    PDT_TRACE(d->tr, 1, PDT_EV_RECV, tag, peer, (uint32_t)bytes, (uint32_t)((uint64_t)bytes >> 32),
+              d->seq_recv[peer]);
+    d->seq_recv[peer]++;
+}
+
 void pdt_drv_note_send(drv *d, int tag, int peer, size_t bytes)
 {
     d->bytes_sent += bytes;
     if (tag >= TAG_MERGE) d->merge_sent += bytes;
-    PDT_TRACE(d->tr, 1, PDT_EV_SEND, tag, peer, (uint32_t)bytes, (uint32_t)((uint64_t)bytes >> 32),
-              d->seq_send[peer]);
-    d->seq_send[peer]++;
+    trace_send(d, tag, peer, bytes);
 }
 
 void pdt_drv_note_recv(drv *d, int tag, int peer, size_t bytes)
 {
     d->bytes_recv += bytes;
     if (tag >= TAG_MERGE) d->merge_recv += bytes;
-    PDT_TRACE(d->tr, 1, PDT_EV_RECV, tag, peer, (uint32_t)bytes, (uint32_t)((uint64_t)bytes >> 32),
-              d->seq_recv[peer]);
-    d->seq_recv[peer]++;
+    trace_recv(d, tag, peer, bytes);
 }
 
-/* Collective with uniform block size: every pair exchanges `bytes` (traced
- * peer by peer up to PDT_DRV_TRACE_PEERS ranks, counted beyond). */
+/* A collective as the viewer draws it: every pair exchanges `bytes` (traced
+ * peer by peer up to PDT_DRV_TRACE_PEERS ranks, nothing beyond). */
+static void trace_pairs(drv *d, int tag, size_t bytes)
+{
+    if (!d->tr || d->p > PDT_DRV_TRACE_PEERS) return;
+    for (int q = 0; q < d->p; q++)
+        if (q != d->rank) {
+            trace_send(d, tag, q, bytes);
+            trace_recv(d, tag, q, bytes);
+        }
+}
+
 void pdt_drv_note_all(drv *d, int tag, size_t bytes)
 {
     if (!bytes) return;
-    if (d->tr && d->p <= PDT_DRV_TRACE_PEERS) {
-        for (int q = 0; q < d->p; q++)
-            if (q != d->rank) {
-                pdt_drv_note_send(d, tag, q, bytes);
-                pdt_drv_note_recv(d, tag, q, bytes);
-            }
-        return;
-    }
+    trace_pairs(d, tag, bytes);
     d->bytes_sent += (uint64_t)bytes * (uint64_t)(d->p - 1);
     d->bytes_recv += (uint64_t)bytes * (uint64_t)(d->p - 1);
+}
+
+void pdt_drv_note_reduce(drv *d, int tag, size_t bytes)
+{
+    if (!bytes || d->p < 2) return;
+    trace_pairs(d, tag, bytes);
+    d->bytes_sent += bytes;
+    d->bytes_recv += bytes;
+}
+
+void pdt_drv_note_gather(drv *d, int tag, size_t bytes, int root)
+{
+    if (!bytes || d->p < 2) return;
+    trace_pairs(d, tag, bytes);
+    if (d->rank == root) d->bytes_recv += (uint64_t)bytes * (uint64_t)(d->p - 1);
+    else d->bytes_sent += bytes;
 }
 
 /* An alltoallv: count what went to and came from each peer (traced as

@@ -68,8 +68,16 @@ pdt_status pdt_drv_order_hist(drv *d);
 /* Trace one message and count it (driver.c). */
 void pdt_drv_note_send(drv *d, int tag, int peer, size_t bytes);
 void pdt_drv_note_recv(drv *d, int tag, int peer, size_t bytes);
-/* A collective with uniform block size: every pair exchanges `bytes`. */
+/* The collectives (traced as every pair exchanging `bytes`, the viewer's
+ * picture of one; counted as below).  An alltoall or allgather of `bytes`
+ * blocks: `bytes` to and from every other rank. */
 void pdt_drv_note_all(drv *d, int tag, size_t bytes);
+/* An allreduce of a `bytes` vector: the vector out and the result back,
+ * once each (however the library routes it: counting it to every rank made
+ * a 1024-rank run's counts a thousand times its traffic). */
+void pdt_drv_note_reduce(drv *d, int tag, size_t bytes);
+/* A gather of `bytes` from every rank at root. */
+void pdt_drv_note_gather(drv *d, int tag, size_t bytes, int root);
 /* An alltoallv: what went to and came from each peer. */
 void pdt_drv_note_v(drv *d, int tag, const size_t *sent, const size_t *recvd);
 /* PDT_ERR_NOMEM with the rank and phase in the message. */

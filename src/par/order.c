@@ -104,7 +104,7 @@ static pdt_status order_plan_make(drv *d, finals *f, order_plan *o, pdt_err *err
     memcpy(sum, o->hist, o->nb * sizeof *sum);
     pdt_status st = pdt_comm_allreduce_u64(d->c, sum, o->nb, PDT_COMM_SUM, err);
     if (st == PDT_OK) {
-        pdt_drv_note_all(d, TAG_ORDER, o->nb * sizeof *sum);
+        pdt_drv_note_reduce(d, TAG_ORDER, o->nb * sizeof *sum);
         uint64_t total = 0, before = 0, pos[2] = {0, 0};
         for (size_t b = 0; b < o->nb; b++) total += sum[b];
         for (size_t b = 0; b < o->nb; b++) {

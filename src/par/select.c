@@ -109,7 +109,7 @@ static pdt_status sel_tighten(drv *d, sel *s, int *open, pdt_err *err)
     }
     pdt_status st = pdt_comm_allreduce_u64(d->c, s->v, 2 * z, PDT_COMM_MIN, err);
     if (st != PDT_OK) return st;
-    pdt_drv_note_all(d, TAG_SAMPLES, 2 * z * sizeof *s->v);
+    pdt_drv_note_reduce(d, TAG_SAMPLES, 2 * z * sizeof *s->v);
     *open = 0;
     for (size_t q = 0; q < z; q++) {
         if (!sel_open(s, (int)q)) continue;
@@ -159,7 +159,7 @@ static pdt_status sel_count(drv *d, sel *s, pdt_err *err)
     }
     pdt_status st = pdt_comm_allreduce_u64(d->c, cnt, nc, PDT_COMM_SUM, err);
     if (st != PDT_OK) return st;
-    pdt_drv_note_all(d, TAG_SAMPLES, nc * sizeof *cnt);
+    pdt_drv_note_reduce(d, TAG_SAMPLES, nc * sizeof *cnt);
     for (int q = 0; q < s->ns; q++) {
         if (!sel_open(s, q)) continue;
         size_t g = s->g[q], nw = s->w[g] - 1, j = 0;
@@ -205,7 +205,7 @@ pdt_status pdt_drv_splitters(drv *d, const srm_rec *rec, size_t n, uint64_t *spl
     uint64_t ext[2] = {n ? rec[0].key : UINT64_MAX, n ? ~rec[n - 1].key : UINT64_MAX};
     pdt_status st = pdt_comm_allreduce_u64(d->c, ext, 2, PDT_COMM_MIN, err);
     if (st != PDT_OK) return st;
-    pdt_drv_note_all(d, TAG_SAMPLES, sizeof ext);
+    pdt_drv_note_reduce(d, TAG_SAMPLES, sizeof ext);
     uint64_t N = d->n_total;
     uint64_t *hi = malloc(((size_t)q1 + 1) * sizeof *hi), *t = malloc(((size_t)q1 + 1) * sizeof *t);
     size_t *len = malloc(((size_t)q1 + 1) * sizeof *len);

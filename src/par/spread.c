@@ -273,7 +273,7 @@ pdt_status pdt_drv_rank_strips(drv *d, const pdt_par_input *in, pdt_err *err)
         uint64_t votes = (uint64_t)pdt_srm_plain_pays(block_pts(d), d->m);
         pdt_status st = pdt_comm_allreduce_u64(d->c, &votes, 1, PDT_COMM_SUM, err);
         if (st != PDT_OK) return st;
-        pdt_drv_note_all(d, TAG_STRIPS, sizeof votes);
+        pdt_drv_note_reduce(d, TAG_STRIPS, sizeof votes);
         if (votes < (uint64_t)d->p) k = 1;
     }
     d->k = k;
