@@ -191,6 +191,27 @@ size_t pdt_tri_bucket_scatter_split(pdt_tri *t, size_t n, int shift, const uint8
     return w;
 }
 
+/* Past the segment of bucket b = t[i].v[0] >> shift in t[i, n) (grouped by
+ * bucket in increasing order): galloping, then halving -- O(log length)
+ * where a scan read every triangle's first index (three passes of the order
+ * phase's 10^7 triangles at 10^7 points on two ranks). */
+static size_t seg_end(const pdt_tri *t, size_t i, size_t n, int shift)
+{
+    uint32_t b = t[i].v[0] >> shift;
+    size_t lo = i, step = 1; /* t[lo] is in b; t[hi] (if hi < n) is not */
+    while (step < n - lo && t[lo + step].v[0] >> shift == b) {
+        lo += step;
+        step *= 2;
+    }
+    size_t hi = step < n - lo ? lo + step : n;
+    while (hi - lo > 1) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (t[mid].v[0] >> shift == b) lo = mid;
+        else hi = mid;
+    }
+    return hi;
+}
+
 /* The runs cut into segments, one per run and bucket with triangles, the
  * segments grouped by bucket (a counting sort over the buckets present, in
  * run order within one), then each bucket counted by first index and placed
@@ -205,7 +226,7 @@ pdt_status pdt_tri_bucket_order(const pdt_tri *const *src, const size_t *len, si
     for (size_t k = 0; k < ns; k++)
         for (size_t i = 0; i < len[k]; nseg++) {
             uint64_t b = src[k][i].v[0] >> shift;
-            while (i < len[k] && src[k][i].v[0] >> shift == b) i++;
+            i = seg_end(src[k], i, len[k], shift);
             bmin = b < bmin ? b : bmin;
             bmax = b > bmax ? b : bmax;
         }
@@ -218,9 +239,8 @@ pdt_status pdt_tri_bucket_order(const pdt_tri *const *src, const size_t *len, si
     for (int pass = 0; pass < 2 && st == PDT_OK; pass++) {
         for (size_t k = 0; k < ns; k++)
             for (size_t i = 0; i < len[k];) {
-                size_t e = i;
+                size_t e = seg_end(src[k], i, len[k], shift);
                 uint64_t b = src[k][i].v[0] >> shift;
-                while (e < len[k] && src[k][e].v[0] >> shift == b) e++;
                 if (pass == 0) {
                     first[b - bmin + 1]++;
                 } else {
