@@ -193,8 +193,7 @@ size_t pdt_tri_bucket_scatter_split(pdt_tri *t, size_t n, int shift, const uint8
 
 /* Past the segment of bucket b = t[i].v[0] >> shift in t[i, n) (grouped by
  * bucket in increasing order): galloping, then halving -- O(log length)
- * where a scan read every triangle's first index (three passes of the order
- * phase's 10^7 triangles at 10^7 points on two ranks). */
+ * reads, where a scan would read every triangle's first index. */
 static size_t seg_end(const pdt_tri *t, size_t i, size_t n, int shift)
 {
     uint32_t b = t[i].v[0] >> shift;

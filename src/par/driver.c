@@ -29,7 +29,8 @@
 #include "pdt/testhook.h"
 #include "driver.h"
 
-/* Trace one message (or one pair's share of a collective) and count it. */
+/* One message (or one pair's share of a collective) as a trace event;
+ * pdt_drv_note_send and _recv also count it. */
 static void trace_send(drv *d, int tag, int peer, size_t bytes)
 {
     PDT_TRACE(d->tr, 1, PDT_EV_SEND, tag, peer, (uint32_t)bytes, (uint32_t)((uint64_t)bytes >> 32),
