@@ -61,25 +61,32 @@ xvfb_start ${W}x${H}
 trap xvfb_cleanup EXIT
 
 F=$TMP/mine.txt
-# start_editor: the editor on $F and its window's id in wid (empty if none
+# start_viewer TITLE OUT ERR ARGS...: pdtview ARGS in the background (VPID)
+# and the id of its window whose title matches TITLE in wid (empty if none
 # came).  A viewer that finds no display (it exits saying so) is started
-# once more: the X server's answer, not the editor, is what failed.
-start_editor() {
-    local try
+# once more: the X server's answer, not the editor, is what failed (seen
+# under load).
+start_viewer() {
+    local title=$1 out=$2 err=$3 try
+    shift 3
     for try in 1 2; do
-        "$V" --edit "$F" --size ${W}x${H} --screenshot "$TMP/edit.png" >"$TMP/out.log" 2>"$TMP/err.log" &
+        "$V" "$@" >"$out" 2>"$err" &
         VPID=$!
         wid=
         for i in $(seq 300); do
-            wid=$(pdtview_window 'pdtview'); [ -n "$wid" ] && return 0
+            wid=$(pdtview_window "$title"); [ -n "$wid" ] && return 0
             kill -0 "$VPID" 2>/dev/null || break
             sleep 0.1
         done
-        grep -q 'no display answers' "$TMP/err.log" || return 1
-        echo "# note: the editor found no display (try $try): $(cat "$TMP/err.log"; cat "$TMP/xvfb.log"; ls -la /tmp/.X11-unix)"
+        grep -q 'no display answers' "$err" || return 1
+        echo "# note: the viewer found no display (try $try): $(cat "$err"; cat "$TMP/xvfb.log"; ls -la /tmp/.X11-unix)"
         sleep 1
     done
     return 1
+}
+# start_editor: the editor on $F (its window's id in wid)
+start_editor() {
+    start_viewer 'pdtview' "$TMP/out.log" "$TMP/err.log" --edit "$F" --size ${W}x${H} --screenshot "$TMP/edit.png"
 }
 start_editor
 if [ -n "$wid" ] && [ -f "$F" ] && [ ! -s "$F" ]; then ok edit_creates_missing_file
@@ -124,10 +131,8 @@ if [ -s "$TMP/edit.png" ] && [ -s "$TMP/x11.png" ]; then ok edit_screenshots; el
 G=$TMP/four.txt
 cp "$TMP/c300.txt" "$G"
 [ -n "${VPID:-}" ] && stop_pid "$VPID"  # (an editor that did not quit: not left behind)
-"$V" --edit "$G" --ranks 4 --size ${W}x${H} --screenshot "$TMP/four.png" >"$TMP/out4.log" 2>"$TMP/err4.log" &
-VPID=$!
-wid=
-for i in $(seq 100); do wid=$(pdtview_window 'editing.*four'); [ -n "$wid" ] && break; sleep 0.1; done
+start_viewer 'editing.*four' "$TMP/out4.log" "$TMP/err4.log" --edit "$G" --ranks 4 --size ${W}x${H} \
+    --screenshot "$TMP/four.png"
 # wait until the window title matches $1
 wait_title() { for i in $(seq 100); do xdotool getwindowname "$wid" 2>/dev/null | grep -q "$1" && return 0; sleep 0.1; done; return 1; }
 if [ -n "$wid" ] && wait_title 'triangulate, 4 ranks'; then ok edit_ranks_4_window
