@@ -89,8 +89,8 @@ void pdt_prefault_stop(pdt_prefault *pf);
 
 /* pthread_create for a helper thread: when the caller is bound to one CPU
  * (mpirun binds each rank to a core), the thread is created on the other
- * CPUs online, so that it does not take turns with the caller.  Returns
- * pthread_create's code. */
+ * CPUs online, so that it does not take turns with the caller.  Returns 0,
+ * or pthread_attr_init's or pthread_create's error code. */
 int pdt_helper_start(pthread_t *th, void *(*fn)(void *), void *arg);
 
 #endif

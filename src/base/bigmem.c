@@ -108,7 +108,8 @@ int pdt_helper_start(pthread_t *th, void *(*fn)(void *), void *arg)
 {
     cpu_set_t mine, other;
     pthread_attr_t at;
-    if (pthread_attr_init(&at) != 0) return -1;
+    int rc = pthread_attr_init(&at);
+    if (rc != 0) return rc;
     if (sched_getaffinity(0, sizeof mine, &mine) == 0 && CPU_COUNT(&mine) == 1) {
         long online = sysconf(_SC_NPROCESSORS_ONLN);
         CPU_ZERO(&other);
@@ -116,7 +117,7 @@ int pdt_helper_start(pthread_t *th, void *(*fn)(void *), void *arg)
             if (!CPU_ISSET((size_t)c, &mine)) CPU_SET((size_t)c, &other);
         if (CPU_COUNT(&other) > 0) (void)pthread_attr_setaffinity_np(&at, sizeof other, &other);
     }
-    int rc = pthread_create(th, &at, fn, arg);
+    rc = pthread_create(th, &at, fn, arg);
     pthread_attr_destroy(&at);
     return rc;
 }

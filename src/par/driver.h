@@ -73,8 +73,8 @@ void pdt_drv_note_recv(drv *d, int tag, int peer, size_t bytes);
  * blocks: `bytes` to and from every other rank. */
 void pdt_drv_note_all(drv *d, int tag, size_t bytes);
 /* An allreduce of a `bytes` vector: the vector out and the result back,
- * once each (however the library routes it: counting it to every rank made
- * a 1024-rank run's counts a thousand times its traffic). */
+ * once each, however the library routes it (counted to every rank, a
+ * 1024-rank run's counts would be a thousand times its traffic). */
 void pdt_drv_note_reduce(drv *d, int tag, size_t bytes);
 /* A gather of `bytes` from every rank at root. */
 void pdt_drv_note_gather(drv *d, int tag, size_t bytes, int root);
