@@ -211,6 +211,66 @@ static size_t seg_end(const pdt_tri *t, size_t i, size_t n, int shift)
     return hi;
 }
 
+/* A range of first indices far wider than its triangles is ordered flat:
+ * the runs' triangles sorted by first index over the range's span, a stable
+ * radix sort of at most 12 bits a pass, least significant digit first, then
+ * the runs of one first index by the other two.  Indices are in input order,
+ * so a triangle's smallest one is rarely near the end: at 1024 ranks on 10^8
+ * uniform points the last rank's range held some 1,200 buckets of 8,192
+ * indices and a triangle or two per bucket and run, so the bucket by bucket
+ * way took 20 ms on it (a segment for nearly every triangle, a bucket's
+ * counters cleared and summed for a hundred of them), four times the other
+ * ranks' whole ordering. */
+enum { FLAT_SPAN = 8, FLAT_BITS = 12 };
+
+static pdt_status order_flat(const pdt_tri *const *src, const size_t *len, size_t ns,
+                             size_t total, pdt_tri *out)
+{
+    uint32_t lo = UINT32_MAX, hi = 0;
+    for (size_t k = 0; k < ns; k++)
+        for (size_t i = 0; i < len[k]; i++) {
+            uint32_t v = src[k][i].v[0];
+            lo = v < lo ? v : lo;
+            hi = v > hi ? v : hi;
+        }
+    int bits = 32 - __builtin_clz((hi - lo) | 1u);
+    int passes = (bits + FLAT_BITS - 1) / FLAT_BITS, dbits = (bits + passes - 1) / passes;
+    size_t nd = (size_t)1 << dbits;
+    pdt_tri *tmp = malloc(total * sizeof *tmp);
+    size_t *cnt = malloc(nd * sizeof *cnt);
+    if (!tmp || !cnt) {
+        free(tmp);
+        free(cnt);
+        return PDT_ERR_NOMEM;
+    }
+    const pdt_tri *from = NULL; /* (the first pass reads the runs) */
+    for (int pass = 0; pass < passes; pass++) {
+        int sh = pass * dbits;
+        pdt_tri *to = (passes - 1 - pass) % 2 ? tmp : out; /* (the last pass writes out) */
+        memset(cnt, 0, nd * sizeof *cnt);
+        for (size_t k = 0; k < (from ? 1 : ns); k++) {
+            const pdt_tri *t = from ? from : src[k];
+            for (size_t i = 0, m = from ? total : len[k]; i < m; i++)
+                cnt[((t[i].v[0] - lo) >> sh) & (nd - 1)]++;
+        }
+        for (size_t d = 0, sum = 0; d < nd; d++) {
+            size_t c = cnt[d];
+            cnt[d] = sum;
+            sum += c;
+        }
+        for (size_t k = 0; k < (from ? 1 : ns); k++) {
+            const pdt_tri *t = from ? from : src[k];
+            for (size_t i = 0, m = from ? total : len[k]; i < m; i++)
+                to[cnt[((t[i].v[0] - lo) >> sh) & (nd - 1)]++] = t[i];
+        }
+        from = to;
+    }
+    order_first_runs(out, 0, total);
+    free(tmp);
+    free(cnt);
+    return PDT_OK;
+}
+
 /* The runs cut into segments, one per run and bucket with triangles, the
  * segments grouped by bucket (a counting sort over the buckets present, in
  * run order within one), then each bucket counted by first index and placed
@@ -220,8 +280,19 @@ static size_t seg_end(const pdt_tri *t, size_t i, size_t n, int shift)
 pdt_status pdt_tri_bucket_order(const pdt_tri *const *src, const size_t *len, size_t ns, int shift,
                                 pdt_tri *out)
 {
-    size_t nseg = 0;
+    size_t nseg = 0, total = 0;
     uint64_t bmin = UINT64_MAX, bmax = 0;
+    for (size_t k = 0; k < ns; k++)
+        if (len[k]) { /* (a run's buckets increase) */
+            total += len[k];
+            uint64_t b0 = src[k][0].v[0] >> shift, b1 = src[k][len[k] - 1].v[0] >> shift;
+            bmin = b0 < bmin ? b0 : bmin;
+            bmax = b1 > bmax ? b1 : bmax;
+        }
+    if (total && total * FLAT_SPAN < (bmax - bmin + 1) << shift)
+        return order_flat(src, len, ns, total, out);
+    bmin = UINT64_MAX;
+    bmax = 0;
     for (size_t k = 0; k < ns; k++)
         for (size_t i = 0; i < len[k]; nseg++) {
             uint64_t b = src[k][i].v[0] >> shift;

@@ -376,6 +376,48 @@ TEST(bucket_order_is_canonical)
             }
 }
 
+/* A range of first indices far wider than its triangles (the last rank's,
+ * where first indices are rare) is ordered flat, by a radix sort over its
+ * span: one, two and three passes (spans of 2^10, 2^20 and 2^31 indices),
+ * runs of equal first indices and of equal triangles, from three runs
+ * grouped by bucket as the exchange leaves them; the same order as
+ * pdt_tri_canonical's. */
+TEST(bucket_order_flat_is_canonical)
+{
+    uint32_t spans[] = {1u << 12, 1u << 20, 1u << 31};
+    size_t counts[] = {300, 6000, 6000};
+    for (size_t si = 0; si < sizeof spans / sizeof *spans; si++) {
+        enum { NS = 3, SHIFT = 8 };
+        size_t N = counts[si];
+        uint32_t lo = 1000;
+        pdt_tri *ref = malloc(N * sizeof *ref), *run = malloc(N * sizeof *run);
+        pdt_tri *out = malloc(N * sizeof *out);
+        for (size_t i = 0; i < N; i++) {
+            uint32_t a = lo + (uint32_t)(((uint64_t)rand() << 16 ^ (uint64_t)rand()) % spans[si]);
+            if (i % 5 == 2) a = ref[i - 1].v[0]; /* runs of one first index */
+            ref[i] = (pdt_tri){{a, a + 1 + (uint32_t)(rand() % 50), a + 1 + (uint32_t)(rand() % 50)}};
+            if (i % 11 == 7) ref[i] = ref[i - 1]; /* and of equal triangles */
+        }
+        /* three runs (every third triangle), each grouped by bucket */
+        const pdt_tri *src[NS];
+        size_t len[NS];
+        for (size_t r = 0, at = 0; r < NS; r++) {
+            src[r] = run + at;
+            len[r] = 0;
+            for (size_t i = r; i < N; i += NS) run[at + len[r]++] = ref[i];
+            pdt_tri_canonical(run + at, len[r]); /* (sorted: grouped by bucket too) */
+            at += len[r];
+        }
+        pdt_tri_canonical(ref, N);
+        CHECK(pdt_tri_bucket_order(src, len, NS, SHIFT, out) == PDT_OK);
+        CHECK_MSG(memcmp(out, ref, N * sizeof *ref) == 0, "span 2^%d: order differs",
+                  __builtin_ctz(spans[si]));
+        free(ref);
+        free(run);
+        free(out);
+    }
+}
+
 /* The order phase in two rounds (bucket b in round b % 2): the first round's
  * split groups its buckets as one scatter of those triangles would, the
  * others end at the front of the input in their order (their number
@@ -686,6 +728,7 @@ int main(void)
     RUN(kernel_rejects_unsorted_or_duplicate_points);
     RUN(canonical_order);
     RUN(bucket_order_is_canonical);
+    RUN(bucket_order_flat_is_canonical);
     RUN(bucket_scatter_split_rounds);
     RUN(trace_events);
     RUN(symmetric_parabola_and_circle_large);
