@@ -496,9 +496,29 @@ static int cmp_key(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+/* The box around the boxes of strips [q0, q1) (count 0: all empty). */
+static srm_strip boxes_around(const srm_rank *s, int q0, int q1)
+{
+    srm_strip all = {0, 0, 0, INT32_MAX, INT32_MIN, INT32_MAX, INT32_MIN};
+    for (int q = q0; q < q1; q++) {
+        const srm_strip *b = &s->strip[q];
+        if (!b->count) continue;
+        all.count += b->count;
+        all.xmin = b->xmin < all.xmin ? b->xmin : all.xmin;
+        all.xmax = b->xmax > all.xmax ? b->xmax : all.xmax;
+        all.ymin = b->ymin < all.ymin ? b->ymin : all.ymin;
+        all.ymax = b->ymax > all.ymax ? b->ymax : all.ymax;
+    }
+    return all;
+}
+
 /* Collect the facing hull vertices of one side into B: endpoints of every
  * hull edge whose outer half-plane meets a box of the other side (all points
- * if the hull is degenerate). */
+ * if the hull is degenerate).  An edge whose half-plane misses the box
+ * around them all misses each of them (a closed half-plane meets a box when
+ * it holds a corner): at the top of 1024 ranks most of a side's hull edges
+ * face away from the other's 1024 boxes, whose exact tests one by one took
+ * 2 ms of the merge step. */
 static size_t facing(const srm_rank *s, const srm_msg_view *hv, int q0, int q1, srm_pt *out)
 {
     size_t n = 0, k = hv->h.nhull;
@@ -507,8 +527,10 @@ static size_t facing(const srm_rank *s, const srm_msg_view *hv, int q0, int q1, 
         for (size_t i = 0; i < k; i++) out[n++] = hv->pts[h[i]];
         return n;
     }
+    srm_strip around = boxes_around(s, q0, q1);
     for (size_t i = 0; i < k; i++) {
         srm_pt u = hv->pts[h[i]], w = hv->pts[h[(i + 1) % k]];
+        if (!pdt_srm_edge_touch(u, w, &around)) continue;
         for (int q = q0; q < q1; q++)
             if (s->strip[q].count && pdt_srm_edge_touch(u, w, &s->strip[q])) {
                 out[n++] = u;
