@@ -518,7 +518,7 @@ static srm_strip boxes_around(const srm_rank *s, int q0, int q1)
  * around them all misses each of them (a closed half-plane meets a box when
  * it holds a corner): at the top of 1024 ranks most of a side's hull edges
  * face away from the other's 1024 boxes, whose exact tests one by one took
- * 2 ms of the merge step. */
+ * 1.4 ms of the top merge step (0.4 ms now). */
 static size_t facing(const srm_rank *s, const srm_msg_view *hv, int q0, int q1, srm_pt *out)
 {
     size_t n = 0, k = hv->h.nhull;
