@@ -250,6 +250,17 @@ pdt_status pdt_srm_init(srm_rank *s, int rank, int p, const srm_strip *strip, pd
     return PDT_OK;
 }
 
+/* b grown to hold box x too (an empty x adds nothing; an empty b takes x). */
+static void box_add(srm_strip *b, const srm_strip *x)
+{
+    if (!x->count) return;
+    if (!b->count || x->xmin < b->xmin) b->xmin = x->xmin;
+    if (!b->count || x->xmax > b->xmax) b->xmax = x->xmax;
+    if (!b->count || x->ymin < b->ymin) b->ymin = x->ymin;
+    if (!b->count || x->ymax > b->ymax) b->ymax = x->ymax;
+    b->count += x->count;
+}
+
 /* The box of every rank range of the tree with two ranks or more (its
  * preorder cut `at`), from the strips' boxes; returns the range's. */
 static srm_strip box_build(srm_rank *s, int lo, int hi, int at)
@@ -264,15 +275,7 @@ static srm_strip box_build(srm_rank *s, int lo, int hi, int at)
         part[nparts++] = box_build(s, lo, mid, at + 1);
         part[nparts++] = box_build(s, mid, hi, at + mid - lo);
     }
-    for (int i = 0; i < nparts; i++) {
-        const srm_strip *x = &part[i];
-        if (!x->count) continue;
-        if (!b.count || x->xmin < b.xmin) b.xmin = x->xmin;
-        if (!b.count || x->xmax > b.xmax) b.xmax = x->xmax;
-        if (!b.count || x->ymin < b.ymin) b.ymin = x->ymin;
-        if (!b.count || x->ymax > b.ymax) b.ymax = x->ymax;
-        b.count += x->count;
-    }
+    for (int i = 0; i < nparts; i++) box_add(&b, &part[i]);
     if (hi - lo >= 2) s->nbox[at] = b;
     return b;
 }
@@ -499,16 +502,8 @@ static int cmp_key(const void *a, const void *b)
 /* The box around the boxes of strips [q0, q1) (count 0: all empty). */
 static srm_strip boxes_around(const srm_rank *s, int q0, int q1)
 {
-    srm_strip all = {0, 0, 0, INT32_MAX, INT32_MIN, INT32_MAX, INT32_MIN};
-    for (int q = q0; q < q1; q++) {
-        const srm_strip *b = &s->strip[q];
-        if (!b->count) continue;
-        all.count += b->count;
-        all.xmin = b->xmin < all.xmin ? b->xmin : all.xmin;
-        all.xmax = b->xmax > all.xmax ? b->xmax : all.xmax;
-        all.ymin = b->ymin < all.ymin ? b->ymin : all.ymin;
-        all.ymax = b->ymax > all.ymax ? b->ymax : all.ymax;
-    }
+    srm_strip all = {0, 0, 0, 0, 0, 0, 0};
+    for (int q = q0; q < q1; q++) box_add(&all, &s->strip[q]);
     return all;
 }
 
