@@ -218,9 +218,9 @@ static size_t seg_end(const pdt_tri *t, size_t i, size_t n, int shift)
  * so a triangle's smallest one is rarely near the end: at 1024 ranks on 10^8
  * uniform points the last rank's range held some 1,200 buckets of 8,192
  * indices and a triangle or two per bucket and run, so the bucket by bucket
- * way took 15-25 ms on it (a segment for nearly every triangle, a bucket's
- * counters cleared and summed for a hundred of them), three to five times
- * the other ranks' whole ordering. */
+ * way took 14.8 ms on it (a segment for nearly every triangle, a bucket's
+ * counters cleared and summed for a hundred of them), three times the
+ * median rank's whole ordering. */
 enum { FLAT_SPAN = 8, FLAT_BITS = 12 };
 
 static pdt_status order_flat(const pdt_tri *const *src, const size_t *len, size_t ns,

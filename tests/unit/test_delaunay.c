@@ -378,7 +378,7 @@ TEST(bucket_order_is_canonical)
 
 /* A range of first indices far wider than its triangles (the last rank's,
  * where first indices are rare) is ordered flat, by a radix sort over its
- * span: one, two and three passes (spans of 2^10, 2^20 and 2^31 indices),
+ * span: one, two and three passes (spans of 2^12, 2^20 and 2^31 indices),
  * runs of equal first indices and of equal triangles, from three runs
  * grouped by bucket as the exchange leaves them; the same order as
  * pdt_tri_canonical's. */
