@@ -11,6 +11,7 @@
 
 #include "pdt/io.h"
 #include "pdt/par.h"
+#include "pdt/testhook.h"
 
 pdt_status pdt_par_agree(pdt_comm *c, pdt_status st, int *who, pdt_err *err)
 {
@@ -206,12 +207,20 @@ static pdt_status collisions_across(pdt_comm *c, const pdt_points_part *pt, uint
 /* A regular file: every rank loads and parses its own part (pdt/io.h),
  * the line numbers from a prefix sum of the '\n' counts, the point indices
  * from a prefix sum of the point counts. */
+/* PDT_TEST_READ_NOMEM=R: rank R finds no room for the table of the ranks'
+ * parts (tests: every rank fails the read, and none writes past its table). */
+static int test_read_nomem(int r)
+{
+    const char *e = pdt_test_hook("PDT_TEST_READ_NOMEM");
+    return e && *e && atoi(e) == r;
+}
+
 static pdt_status read_parts(pdt_comm *c, const char *path, double scale, int flags,
                              const pdt_points_head *h, pdt_par_input *in, pdt_err *err)
 {
     int p = pdt_comm_size(c), r = pdt_comm_rank(c);
     pdt_points_part pt;
-    part_info *all = malloc((size_t)p * sizeof *all);
+    part_info *all = test_read_nomem(r) ? NULL : malloc((size_t)p * sizeof *all);
     pdt_status st = pdt_points_part_load(path, h, r, p, &pt, err), cst;
     if (!all && st == PDT_OK) {
         st = pdt_err_set(err, PDT_ERR_NOMEM, "rank %d: read: out of memory", r);
@@ -224,21 +233,21 @@ static pdt_status read_parts(pdt_comm *c, const char *path, double scale, int fl
         st = pdt_points_part_parse(&pt, path, h, scale,
                                    1 + nl_before + (r == 0 ? h->body_nl : 0), flags, err);
     part_info me = {pt.n, nl_mine, (uint64_t)pt.has_idx0, pt.idx0};
-    part_info dummy[1];
-    cst = pdt_comm_allgather(c, &me, sizeof me, all ? all : dummy, err);
+    /* the allgather writes p entries at every rank: a rank without the room
+     * for them stops every rank before it (its message, the others' status) */
+    cst = pdt_par_agree(c, all ? PDT_OK : st, NULL, err); /* (st fails without all) */
+    if (cst == PDT_OK) cst = pdt_comm_allgather(c, &me, sizeof me, all, err);
     if (cst != PDT_OK) goto done;
     uint64_t first = 0, total = 0, nl = 0;
     int64_t base = 0;
     int based = 0;
-    if (all) {
-        for (int q = 0; q < p; q++) {
-            if (q < r) first += all[q].n;
-            total += all[q].n;
-            nl += all[q].nl;
-            if (!based && all[q].has_idx0) {
-                base = all[q].idx0;
-                based = 1;
-            }
+    for (int q = 0; q < p; q++) {
+        if (q < r) first += all[q].n;
+        total += all[q].n;
+        nl += all[q].nl;
+        if (!based && all[q].has_idx0) {
+            base = all[q].idx0;
+            based = 1;
         }
     }
     if (pt.err_key != 0)

@@ -90,6 +90,18 @@ if [ $rc -eq 2 ] && grep -q 'rank 1, write: wdir/fw.tri' fw.err && [ -z "$(ls -A
     ok write_fails_on_one_rank
 else fail write_fails_on_one_rank "rc=$rc files=$(ls -A wdir) $(grep pdt fw.err | head -3)"; fi
 
+# --- a rank without room for the table of every rank's part of the input
+# (test-only variable): every rank stops before the allgather that fills the
+# table, whichever rank it is; the message names that rank, nothing is written
+mkdir -p rdir
+for r in 0 2; do
+    PDT_TEST_READ_NOMEM=$r mpirun -np 3 -x PDT_TEST_READ_NOMEM "$PDT" triangulate u.txt \
+        -o rdir/nm.tri > /dev/null 2> nm$r.err; rc=$?
+    if [ $rc -eq 2 ] && grep -q "rank $r: read: out of memory" nm$r.err && [ -z "$(ls -A rdir)" ]; then
+        ok read_table_nomem_rank$r
+    else fail read_table_nomem_rank$r "rc=$rc files=$(ls -A rdir) $(grep pdt nm$r.err | head -3)"; fi
+done
+
 # --- the parallel write gives the plain run's bytes
 "$PDT" triangulate u.txt -o u.plain.tri
 mpirun -np 3 "$PDT" triangulate u.txt -o u.par.tri > /dev/null 2> pw.err; rc=$?
