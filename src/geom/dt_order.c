@@ -291,16 +291,9 @@ pdt_status pdt_tri_bucket_order(const pdt_tri *const *src, const size_t *len, si
         }
     if (total && total * FLAT_SPAN < (bmax - bmin + 1) << shift)
         return order_flat(src, len, ns, total, out);
-    bmin = UINT64_MAX;
-    bmax = 0;
-    for (size_t k = 0; k < ns; k++)
-        for (size_t i = 0; i < len[k]; nseg++) {
-            uint64_t b = src[k][i].v[0] >> shift;
-            i = seg_end(src[k], i, len[k], shift);
-            bmin = b < bmin ? b : bmin;
-            bmax = b > bmax ? b : bmax;
-        }
-    if (nseg == 0) return PDT_OK;
+    if (total == 0) return PDT_OK;
+    for (size_t k = 0; k < ns; k++) /* (the buckets' span is the runs' ends', above) */
+        for (size_t i = 0; i < len[k]; nseg++) i = seg_end(src[k], i, len[k], shift);
     size_t nlo = (size_t)1 << shift, nb = (size_t)(bmax - bmin) + 1;
     size_t *lc = malloc((nlo + 1) * sizeof *lc), *first = calloc(nb + 1, sizeof *first),
            *sl = malloc(nseg * sizeof *sl);
