@@ -204,9 +204,6 @@ static pdt_status collisions_across(pdt_comm *c, const pdt_points_part *pt, uint
     return st;
 }
 
-/* A regular file: every rank loads and parses its own part (pdt/io.h),
- * the line numbers from a prefix sum of the '\n' counts, the point indices
- * from a prefix sum of the point counts. */
 /* PDT_TEST_READ_NOMEM=R: rank R finds no room for the table of the ranks'
  * parts (tests: every rank fails the read, and none writes past its table). */
 static int test_read_nomem(int r)
@@ -215,6 +212,9 @@ static int test_read_nomem(int r)
     return e && *e && atoi(e) == r;
 }
 
+/* A regular file: every rank loads and parses its own part (pdt/io.h),
+ * the line numbers from a prefix sum of the '\n' counts, the point indices
+ * from a prefix sum of the point counts. */
 static pdt_status read_parts(pdt_comm *c, const char *path, double scale, int flags,
                              const pdt_points_head *h, pdt_par_input *in, pdt_err *err)
 {
