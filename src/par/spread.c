@@ -159,8 +159,11 @@ static pdt_status part_room(drv *d, part *x, pdt_err *err)
  * (from the ranks in rank order, each in input order) -- sorted by the plain
  * run's sort, the first of equal keys kept (the smallest index), into the
  * strip's points and global indices.  The block (cap M) holds the records
- * at 0 or 16 M (bytes); their points and indices go in the other of [0,
- * 16 M) and [16 M, 32 M), the sort's scratch from 32 M. */
+ * at 0 or 16 M (bytes); their points and indices (12 M) go in the other of
+ * [0, 16 M) and [16 M, 32 M).  The sort's scratch follows them when the
+ * records were at 16 M (the usual case: the records are spent by then, and
+ * the scratch reuses their pages, which the exchange touched), else it
+ * starts at 32 M. */
 static pdt_status part_sort_region(drv *d, part *x)
 {
     size_t T = x->total, M = d->blk_cap, nu = 0;
@@ -172,7 +175,8 @@ static pdt_status part_sort_region(drv *d, part *x)
         pt[i] = srm_key_point(x->got[i].key);
         idx[i] = x->got[i].idx;
     }
-    size_t need = PDT_SORT_WORK(T), at = 2 * half;
+    size_t past = (M * (sizeof *pt + sizeof *idx) + 7) & ~(size_t)7;
+    size_t need = PDT_SORT_WORK(T), at = goff ? past : 2 * half;
     void *work = at + need <= PDT_DELAUNAY_WORK(M) ? (void *)(b + at) : malloc(need);
     uint32_t *g = block_gid(d);
     pdt_status st = work ? pdt_sort_unique_on(pt, T, work, g, block_pts(d), &nu) : PDT_ERR_NOMEM;
