@@ -22,10 +22,11 @@
  * O(P^2)-per-rank versions; an exchange posts its requests a window of
  * peers at a time, with synchronous sends (SimGrid walks lists of every
  * pending request); the output file is written with pwrite, through to
- * the disk (SMPI's MPI-IO opens files on simulated disks only); the heap the ranks share
- * with SimGrid has no fast bins and no trimming (pdt_comm_heap_shared) and
- * the process no huge pages (pdt_comm_small_pages); the launcher tweaks for
- * Open MPI are skipped (docs/simulation.md). */
+ * the disk (SMPI's MPI-IO opens files on simulated disks only); the heap
+ * the ranks share with SimGrid has no fast bins and no trimming
+ * (pdt_comm_heap_shared) and the process no huge pages
+ * (pdt_comm_small_pages); the launcher tweaks for Open MPI are skipped
+ * (docs/simulation.md). */
 #include "comm_int.h"
 
 #include <arpa/inet.h>
@@ -719,7 +720,8 @@ static pdt_status smpi_file_write_at(pdt_comm_file *f, uint64_t offset, const vo
      * reuse these pages */
     unsigned how = SYNC_FILE_RANGE_WAIT_BEFORE | SYNC_FILE_RANGE_WRITE |
                    SYNC_FILE_RANGE_WAIT_AFTER;
-    if (sync_file_range(fd, (off_t)offset, (off_t)bytes, how) != 0 && errno == EIO)
+    if (sync_file_range(fd, (off_t)offset, (off_t)bytes, how) != 0 &&
+        (errno == EIO || errno == ENOSPC)) /* (not EINVAL: a file system without it) */
         return pdt_err_set(err, PDT_ERR_IO, "%s: write failed at rank %d: %s", f->path,
                            f->c->rank, strerror(errno));
     (void)posix_fadvise(fd, (off_t)offset, (off_t)bytes, POSIX_FADV_DONTNEED);
