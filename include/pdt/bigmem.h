@@ -3,9 +3,7 @@
  * Arrays of 1 MiB or more are mapped directly (mmap) and unmapped when freed,
  * so the memory goes back to the system at once (glibc keeps freed heap
  * memory resident when its adaptive mmap threshold has grown, which made the
- * sort's scratch count twice in the peak), and they ask for transparent huge
- * pages: the kernel's random accesses then miss the TLB far less.  Smaller
- * ones use malloc. */
+ * sort's scratch count twice in the peak).  Smaller ones use malloc. */
 #ifndef PDT_GEOM_BIGMEM_H
 #define PDT_GEOM_BIGMEM_H
 
@@ -17,8 +15,13 @@
 void *pdt_big_alloc(size_t bytes);
 void pdt_big_free(void *p, size_t bytes);
 
-/* Ask for transparent huge pages on the whole pages inside [p, p + bytes)
- * (of any allocation, e.g. a large malloc'd block).  Only a hint. */
+/* With PDT_HUGEPAGES=1 in the environment, ask for transparent huge pages on
+ * the whole 2 MiB pages inside [p, p + bytes) of any allocation of 1 MiB or
+ * more (a large malloc'd block too); otherwise nothing.  Only a hint.  Off by
+ * default: measured on the development machines (docs/geometry.md, "Fresh
+ * memory"), huge pages saved no user time and their first touch cost system
+ * time several times over, the free 2 MiB blocks being the ones the virtual
+ * machine hands back to its host. */
 void pdt_big_advise(void *p, size_t bytes);
 
 /* `bytes` of zeros in a shared mapping of an anonymous temporary file in

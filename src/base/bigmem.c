@@ -1,4 +1,4 @@
-/* pdt — large scratch arrays: mmap'd, huge pages asked for (see bigmem.h). */
+/* pdt — large scratch arrays: mmap'd, huge pages on request (see bigmem.h). */
 #include "pdt/bigmem.h"
 #include "pdt/tmpfile.h"
 
@@ -7,6 +7,7 @@
 #include <pthread.h>
 #include <sched.h>
 #include <stdatomic.h>
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,12 +17,25 @@
 
 enum { BIG = 1 << 20, HUGE_PAGE = 1 << 21 };
 
+/* PDT_HUGEPAGES=1, read once (bigmem.h). */
+static bool huge_wanted(void)
+{
+    static atomic_int wanted = -1;
+    int w = atomic_load_explicit(&wanted, memory_order_relaxed);
+    if (w < 0) {
+        const char *e = getenv("PDT_HUGEPAGES");
+        w = e && strcmp(e, "1") == 0;
+        atomic_store_explicit(&wanted, w, memory_order_relaxed);
+    }
+    return w;
+}
+
 void pdt_big_advise(void *p, size_t bytes)
 {
 #ifdef MADV_HUGEPAGE
     uintptr_t a = ((uintptr_t)p + HUGE_PAGE - 1) & ~(uintptr_t)(HUGE_PAGE - 1);
     uintptr_t b = ((uintptr_t)p + bytes) & ~(uintptr_t)(HUGE_PAGE - 1);
-    if (bytes >= BIG && b > a) madvise((void *)a, b - a, MADV_HUGEPAGE);
+    if (bytes >= BIG && b > a && huge_wanted()) madvise((void *)a, b - a, MADV_HUGEPAGE);
 #else
     (void)p;
     (void)bytes;

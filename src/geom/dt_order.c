@@ -101,7 +101,7 @@ static void bucket_place(const pdt_tri *const *seg, const size_t *len, size_t ns
 
 /* The triangles are put in order by their first (smallest) index with two
  * counting passes: first by its high bits into at most 2048 buckets (2048
- * output streams: cache lines and huge pages enough for all), then each
+ * output streams: cache lines enough for all), then each
  * bucket, now small enough for the cache, by its low bits; equal first
  * indices (two triangles per vertex on average) are then sorted by the other
  * two.  A random scatter of all triangles in one pass, as before, missed the

@@ -37,7 +37,7 @@ static pdt_status grow(reader *r)
     pdt_point *p = realloc(r->pts, cap * sizeof *p);
     if (!p) return pdt_err_set(r->err, PDT_ERR_NOMEM, "%s: out of memory", r->cur.name);
     r->pts = p;
-    pdt_big_advise(p, cap * sizeof *p); /* huge pages: a fresh 4 KiB page costs a fault */
+    pdt_big_advise(p, cap * sizeof *p);
     if (r->scale > 0) {
         pdt_io_dec *o = realloc(r->orig, 2 * cap * sizeof *o);
         if (!o) return pdt_err_set(r->err, PDT_ERR_NOMEM, "%s: out of memory", r->cur.name);
@@ -483,8 +483,8 @@ pdt_status pdt_read_points_ex(const char *path, double scale, int flags, pdt_poi
     if (st != PDT_OK) return st;
     reader r = { .scale = scale, .err = err };
     const char *name = strcmp(path, "-") == 0 ? "standard input" : path;
-    /* at most one point per line (lines end at '\n'): one allocation, on huge
-     * pages (growing it by doubling copied it, and faulted every 4 KiB page) */
+    /* at most one point per line (lines end at '\n'): one allocation (growing
+     * it by doubling copied it) */
     r.cap = (size_t)count_nl(t.buf, t.len) + 1;
     r.pts = malloc(r.cap * sizeof *r.pts);
     if (scale > 0) r.orig = malloc(2 * r.cap * sizeof *r.orig);

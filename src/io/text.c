@@ -34,7 +34,7 @@ static pdt_status read_stream(int fd, const char *name, size_t cap, pdt_io_text 
 {
     char *buf = malloc(cap);
     if (!buf) return pdt_err_set(err, PDT_ERR_NOMEM, "%s: out of memory (%zu bytes)", name, cap);
-    pdt_big_advise(buf, cap); /* huge pages: a fresh 4 KiB page costs a fault */
+    pdt_big_advise(buf, cap);
     size_t len = 0, ls = 0; /* ls: where the last line seen starts */
     pdt_status st = PDT_OK;
     for (;;) {

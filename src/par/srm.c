@@ -44,9 +44,9 @@ static pdt_status nomem(pdt_err *err, const char *who, const char *what)
     return pdt_err_set(err, PDT_ERR_NOMEM, "%s: %s: out of memory", who, what);
 }
 
-/* realloc for arrays that may be large: a large new block asks for huge
- * pages BEFORE the old contents are copied into it (realloc would copy
- * first, faulting in every 4 KiB page, and advise after). */
+/* realloc for arrays that may be large: a large new block is advised
+ * (srm_big) BEFORE the old contents are copied into it (realloc would copy
+ * first and advise after). */
 static void *big_realloc(void *p, size_t old_bytes, size_t bytes)
 {
     if (bytes < ((size_t)2 << 20)) return realloc(p, bytes);

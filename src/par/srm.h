@@ -91,10 +91,8 @@ typedef struct srm_tri {
 /* ---- partition.c ------------------------------------------------------- */
 
 /* A record of the partition: key and input index. */
-/* An array proportional to the input (records, points, triangles): malloc
- * with transparent huge pages asked for.  On this kind of machine a fresh
- * 4 KiB page costs a fault each; with 2 MiB pages the partition of 2*10^6
- * records per rank went from 1.17 s to 0.21 s.  Free with free(). */
+/* An array proportional to the input (records, points, triangles): malloc,
+ * with huge pages if asked for (pdt_big_advise).  Free with free(). */
 static inline void *srm_big(size_t bytes)
 {
     void *p = malloc(bytes);

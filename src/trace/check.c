@@ -559,7 +559,7 @@ static pdt_status ck_tri_final(CK_ARGS)
     }
     if (c->nfin == c->capfin) {
         if (chk_grow((void **)&c->fin, &c->capfin, c->nfin, sizeof *c->fin)) return chk_nomem(c);
-        /* up to half the budget, filled once: huge pages spare most page faults */
+        /* up to half the budget, filled once */
         pdt_big_advise(c->fin, c->capfin * sizeof *c->fin);
     }
     c->totfin++;

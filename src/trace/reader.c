@@ -2,6 +2,7 @@
  * order of the ranks' events: merge.c). */
 #include "tf_internal.h"
 #include "run_int.h"
+#include "pdt/bigmem.h"
 #include "pdt/io.h"
 
 #include <errno.h>
@@ -688,8 +689,8 @@ int pdt_block_decode(const uint8_t *payload, uint32_t len, uint32_t count, uint6
 }
 
 /* malloc() for the big arrays of decoded and merged events (hundreds of MB
- * for 10^7 events): they ask for transparent huge pages, which cuts the page
- * faults of filling them.  NULL when out of memory; free with free(). */
+ * for 10^7 events), 2 MiB-aligned for huge pages if asked for
+ * (pdt_big_advise).  NULL when out of memory; free with free(). */
 void *pdt_tf_big_alloc(size_t bytes)
 {
     const size_t huge = (size_t)2 << 20;
@@ -697,7 +698,7 @@ void *pdt_tf_big_alloc(size_t bytes)
     if (bytes > SIZE_MAX - huge) return NULL;
     size_t round = (bytes + huge - 1) / huge * huge;
     void *p = aligned_alloc(huge, round);
-    if (p) madvise(p, round, MADV_HUGEPAGE);
+    if (p) pdt_big_advise(p, round);
     return p;
 }
 

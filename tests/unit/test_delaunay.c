@@ -11,7 +11,11 @@
 #include <pthread.h>
 #include <sched.h>
 #include <string.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <sys/mman.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <time.h>
 
@@ -711,8 +715,61 @@ TEST(helper_keeps_caller_cpu)
     CHECK(sched_setaffinity(0, sizeof saved, &saved) == 0);
 }
 
-int main(void)
+/* Whether the mapping that holds p asks for transparent huge pages (the
+ * "hg" flag in /proc/self/smaps): 1 or 0, -1 if it cannot be read. */
+static int asks_huge(const void *p)
 {
+    FILE *f = fopen("/proc/self/smaps", "r");
+    if (!f) return -1;
+    char line[512];
+    int inside = 0, got = -1;
+    while (got < 0 && fgets(line, sizeof line, f)) {
+        unsigned long lo, hi;
+        if (sscanf(line, "%lx-%lx ", &lo, &hi) == 2 && strchr(line, '-') < strchr(line, ' '))
+            inside = (uintptr_t)p >= lo && (uintptr_t)p < hi;
+        else if (inside && strncmp(line, "VmFlags:", 8) == 0)
+            got = strstr(line, " hg") != NULL;
+    }
+    fclose(f);
+    return got;
+}
+
+/* Re-run of this program with PDT_HUGEPAGES=1 (pdt_big_advise reads the
+ * variable once per process): exit 0 if a big array asks for huge pages. */
+static int huge_child(void)
+{
+    size_t bytes = (size_t)8 << 20;
+    void *p = pdt_big_alloc(bytes);
+    int got = p ? asks_huge((char *)p + bytes / 2) : -1;
+    pdt_big_free(p, bytes);
+    return got == 1 ? 0 : 1;
+}
+
+/* Big arrays ask for no huge pages unless PDT_HUGEPAGES=1 says so. */
+TEST(huge_pages_only_when_asked)
+{
+    if (getenv("PDT_HUGEPAGES")) return; /* the default cannot be seen here */
+    size_t bytes = (size_t)8 << 20;
+    void *p = pdt_big_alloc(bytes);
+    CHECK(p != NULL);
+    CHECK_MSG(asks_huge((char *)p + bytes / 2) == 0, "a big array asked for huge pages by default");
+    pdt_big_free(p, bytes);
+    if (access("/sys/kernel/mm/transparent_hugepage", F_OK) != 0) return; /* no THP here */
+    pid_t pid = fork();
+    CHECK(pid >= 0);
+    if (pid == 0) {
+        setenv("PDT_HUGEPAGES", "1", 1);
+        execl("/proc/self/exe", "test_delaunay", "--huge-child", (char *)NULL);
+        _exit(2);
+    }
+    int st = 0;
+    CHECK(waitpid(pid, &st, 0) == pid);
+    CHECK_MSG(WIFEXITED(st) && WEXITSTATUS(st) == 0, "with PDT_HUGEPAGES=1 a big array asked for none");
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1 && strcmp(argv[1], "--huge-child") == 0) return huge_child();
     RUN(oracle_every_gen_family);
     RUN(oracle_random_small_ranges);
     RUN(tiny_inputs);
@@ -737,5 +794,6 @@ int main(void)
     RUN(prefault_same_triangles);
     RUN(prefault_makes_pages_resident);
     RUN(helper_keeps_caller_cpu);
+    RUN(huge_pages_only_when_asked);
     return test_summary();
 }

@@ -35,9 +35,8 @@ int pdt_rp_grow(void **p, size_t *cap, size_t need, size_t elem)
 }
 
 /* Room for at least `n` keys at load <= 3/4: in a temporary file's mapping
- * beyond `limit` bytes (0: no limit), else in memory.  Big tables in memory
- * ask for huge pages: lookups are random, and TLB misses otherwise
- * dominate. */
+ * beyond `limit` bytes (0: no limit), else in memory (big tables 2 MiB-
+ * aligned, for huge pages if asked for: pdt_big_advise). */
 int pdt_rp_km_alloc(keymap *km, size_t n, uint64_t limit)
 {
     size_t cap = 1024;
@@ -48,7 +47,7 @@ int pdt_rp_km_alloc(keymap *km, size_t n, uint64_t limit)
         km->e = pdt_temp_zeros(bytes);
     } else if (bytes >= ((size_t)4 << 20)) {
         km->e = aligned_alloc((size_t)2 << 20, bytes);
-        if (km->e) madvise(km->e, bytes, MADV_HUGEPAGE);
+        if (km->e) pdt_big_advise(km->e, bytes);
         if (km->e) memset(km->e, 0, bytes);
     } else {
         km->e = calloc(cap, sizeof *km->e);
@@ -130,8 +129,8 @@ void pdt_rp_tab_free(pdt_replay *r, void *p)
     r->ptab[i] = r->ptab[--r->nptab];
 }
 
-/* A new table of `bytes` (zero-filled when paged; else malloc's, asking
- * for huge pages), or NULL. */
+/* A new table of `bytes` (zero-filled when paged; else malloc's, huge
+ * pages if asked for), or NULL. */
 void *pdt_rp_tab_new(pdt_replay *r, size_t bytes)
 {
     if (!r->tab_limit || bytes <= r->tab_limit || r->nptab == PDT_PTAB_MAX) {
