@@ -11,6 +11,7 @@
 #include <malloc.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 
 int pdt_comm_launched(void)
 {
@@ -45,6 +46,22 @@ void pdt_comm_heap_shared(void)
 {
     (void)mallopt(M_MXFAST, 0);
     (void)mallopt(M_TRIM_THRESHOLD, -1);
+}
+
+/* Under SMPI a rank's code is timed on this machine, and on the virtual
+ * machine the figures of docs/simulation.md come from, a 2 MiB page the
+ * process touches for the first time (or again after a few seconds free)
+ * was cleared at 0.35-0.8 GB/s, against 6.6 GB/s touched again at once, and
+ * 4 KiB pages at 2.2-2.7 GB/s whatever their past: the partition, where a
+ * rank first touches its block, took two to three times as long with huge
+ * pages, and from run to run twice as long or not.  No transparent huge
+ * pages for the whole simulation, one rank or many, whatever PDT_HUGEPAGES
+ * or the system's setting ("always") says (docs/simulation.md). */
+void pdt_comm_small_pages(void)
+{
+#ifdef PR_SET_THP_DISABLE
+    (void)prctl(PR_SET_THP_DISABLE, 1, 0, 0, 0);
+#endif
 }
 
 size_t pdt_comm_chunk_from_env(void)

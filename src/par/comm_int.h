@@ -64,6 +64,9 @@ size_t pdt_comm_chunk_from_env(void);
 /* For a backend whose ranks share one heap with a simulator (SMPI): glibc
  * tuned so that no rank's malloc or free pays for the others' blocks. */
 void pdt_comm_heap_shared(void);
+/* For a backend timed on a virtual machine's first touches (SMPI): no
+ * transparent huge pages in this process. */
+void pdt_comm_small_pages(void);
 /* A serial context (the local backend with one rank, no thread), *c owned by
  * the caller (pdt_comm_finalize). */
 pdt_status pdt_comm_serial_new(pdt_comm **c, pdt_err *err);

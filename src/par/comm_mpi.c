@@ -24,7 +24,8 @@
  * pending request); the output file is written with pwrite, through to
  * the disk (SMPI's MPI-IO opens files on simulated disks only); the heap
  * the ranks share with SimGrid has no fast bins and no trimming
- * (pdt_comm_heap_shared); the launcher tweaks for Open MPI are skipped
+ * (pdt_comm_heap_shared) and the process no huge pages
+ * (pdt_comm_small_pages); the launcher tweaks for Open MPI are skipped
  * (docs/simulation.md). */
 #include "comm_int.h"
 
@@ -179,6 +180,7 @@ pdt_status pdt_comm_init(int *argc, char ***argv, int force_mpi, pdt_comm **out,
                              "MPI_Comm_set_errhandler", c, err);
     if (s == PDT_OK) s = private_comms(c, m, err);
     if (PDT_SMPI && c->size > 1) pdt_comm_heap_shared(); /* (comm.c: smpicc wraps malloc.h) */
+    if (PDT_SMPI) pdt_comm_small_pages();
     /* Every rank must cut transfers the same way: rank 0's chunk size wins. */
     unsigned long long chunk = c->chunk;
     if (s == PDT_OK)
